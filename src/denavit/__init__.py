@@ -1,0 +1,42 @@
+"""denavit: serial robot arms from their Denavit–Hartenberg table.
+
+The core import is light (numpy only): the symbolic engine lives in :mod:`denavit.symbolic` (sympy),
+pictures in :mod:`denavit.viz` (matplotlib).
+"""
+
+from .errors import (
+    DenavitError,
+    MissingDependencyError,
+    ModelError,
+    ParseError,
+    ShapeError,
+    UnsupportedRobotError,
+)
+from .io import catalogue_names, dump_robot, load_robot, robot_from_dict, save_robot, with_parameters
+from .model import Convention, DHLink, DHRobot, JointType, LinkInertia
+from .numeric import forward_kinematics, link_transforms
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "DenavitError",
+    "MissingDependencyError",
+    "ModelError",
+    "ParseError",
+    "ShapeError",
+    "UnsupportedRobotError",
+    "catalogue_names",
+    "dump_robot",
+    "load_robot",
+    "robot_from_dict",
+    "save_robot",
+    "with_parameters",
+    "Convention",
+    "DHLink",
+    "DHRobot",
+    "JointType",
+    "LinkInertia",
+    "forward_kinematics",
+    "link_transforms",
+    "__version__",
+]

@@ -1,0 +1,342 @@
+"""A small, restricted expression language for robot files, command-line values and claims.
+
+Robot files and pasted values are untrusted input: they are read here by a hand-written tokenizer and
+recursive-descent parser into a tiny syntax tree, then evaluated to a float or built into a sympy
+expression node by node.  Nothing ever reaches ``eval``, ``exec``, ``sympify`` or ``parse_expr``.
+
+Grammar (``^`` and ``**`` are both power, right associative)::
+
+    expr   := term (('+' | '-') term)*
+    term   := unary (('*' | '/') unary)*
+    unary  := ('+' | '-') unary | power
+    power  := atom (('^' | '**') unary)?
+    atom   := NUMBER ['deg'] | NAME ['deg'] | NAME '(' expr (',' expr)* ')' | '(' expr ')' ['deg']
+
+Length, nesting depth and exponents are capped, so ``9**9**9`` or a deeply nested input is refused
+quickly with a :class:`~denavit.errors.ParseError` instead of eating memory.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+from .errors import ParseError
+
+__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "MAX_LENGTH", "MAX_DEPTH"]
+
+MAX_LENGTH = 500
+MAX_DEPTH = 30
+MAX_EXPONENT = 64.0
+
+# A node is a plain tuple so that it is hashable and cheap:
+#   ("num", "0.5")  ("name", "L1")  ("neg", node)  ("bin", op, left, right)  ("call", fname, (args...))
+Node = tuple
+
+FUNCTIONS: dict[str, int] = {  # name -> number of arguments
+    "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1, "atan2": 2,
+    "sqrt": 1, "exp": 1, "log": 1, "abs": 1, "deg": 1, "rad": 1,
+}
+CONSTANTS = ("pi",)
+
+_TOKEN = re.compile(
+    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z_0-9]*)"
+    r"|(?P<op>\*\*|[-+*/^(),]))"
+)
+
+
+@dataclass(frozen=True)
+class _Tok:
+    kind: str
+    text: str
+    pos: int
+
+
+def _tokenize(text: str) -> list[_Tok]:
+    toks: list[_Tok] = []
+    pos = 0
+    text = text.replace("\u2212", "-").replace("\u00d7", "*").replace("\u03c0", "pi").replace("°", "deg")
+    while pos < len(text):
+        if text[pos:].strip() == "":
+            break
+        m = _TOKEN.match(text, pos)
+        if not m or m.end() == pos:
+            bad = text[pos:].lstrip()[:1]
+            raise ParseError(f"unexpected character {bad!r} at position {pos + 1} in {text!r}")
+        kind = m.lastgroup or "op"
+        toks.append(_Tok(kind, m.group(kind), m.start(kind)))
+        pos = m.end()
+    return toks
+
+
+class _Parser:
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.toks = _tokenize(text)
+        self.i = 0
+        self.depth = 0
+
+    def peek(self) -> _Tok | None:
+        return self.toks[self.i] if self.i < len(self.toks) else None
+
+    def take(self, text: str | None = None) -> _Tok:
+        tok = self.peek()
+        if tok is None:
+            raise ParseError(f"unexpected end of expression {self.text!r}")
+        if text is not None and tok.text != text:
+            raise ParseError(f"expected {text!r} but found {tok.text!r} in {self.text!r}")
+        self.i += 1
+        return tok
+
+    def enter(self) -> None:
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise ParseError(f"expression nested too deeply (more than {MAX_DEPTH} levels)")
+
+    def expr(self) -> Node:
+        self.enter()
+        node = self.term()
+        while (tok := self.peek()) is not None and tok.text in "+-" and tok.kind == "op":
+            self.take()
+            node = ("bin", tok.text, node, self.term())
+        self.depth -= 1
+        return node
+
+    def term(self) -> Node:
+        node = self.unary()
+        while (tok := self.peek()) is not None and tok.text in ("*", "/"):
+            self.take()
+            node = ("bin", tok.text, node, self.unary())
+        return node
+
+    def unary(self) -> Node:
+        tok = self.peek()
+        if tok is not None and tok.text in ("+", "-"):
+            self.take()
+            self.enter()
+            inner = self.unary()
+            self.depth -= 1
+            return ("neg", inner) if tok.text == "-" else inner
+        return self.power()
+
+    def power(self) -> Node:
+        base = self.atom()
+        tok = self.peek()
+        if tok is not None and tok.text in ("^", "**"):
+            self.take()
+            self.enter()
+            exponent = self.unary()
+            self.depth -= 1
+            return ("bin", "^", base, exponent)
+        return base
+
+    def _deg_suffix(self, node: Node) -> Node:
+        tok = self.peek()
+        if tok is not None and tok.kind == "name" and tok.text == "deg":
+            self.take()
+            return ("call", "deg", (node,))
+        return node
+
+    def atom(self) -> Node:
+        tok = self.take()
+        if tok.kind == "num":
+            return self._deg_suffix(("num", tok.text))
+        if tok.text == "(":
+            inner = self.expr()
+            self.take(")")
+            return self._deg_suffix(inner)
+        if tok.kind == "name":
+            nxt = self.peek()
+            if nxt is not None and nxt.text == "(":
+                if tok.text not in FUNCTIONS:
+                    raise ParseError(
+                        f"unknown function {tok.text!r}; allowed: {', '.join(sorted(FUNCTIONS))}"
+                    )
+                self.take("(")
+                args = [self.expr()]
+                while (t := self.peek()) is not None and t.text == ",":
+                    self.take()
+                    args.append(self.expr())
+                self.take(")")
+                if len(args) != FUNCTIONS[tok.text]:
+                    raise ParseError(f"{tok.text}() takes {FUNCTIONS[tok.text]} argument(s), got {len(args)}")
+                return ("call", tok.text, tuple(args))
+            if tok.text in FUNCTIONS:
+                raise ParseError(f"function {tok.text!r} needs parentheses, e.g. {tok.text}(x)")
+            return self._deg_suffix(("name", tok.text))
+        raise ParseError(f"unexpected {tok.text!r} at position {tok.pos + 1} in {self.text!r}")
+
+
+def parse(text: Any) -> Node:
+    """Parse ``text`` (a string or a plain number) into a syntax tree; raise ParseError if malformed."""
+    if isinstance(text, bool):
+        raise ParseError(f"expected a number or expression, got {text!r}")
+    if isinstance(text, (int, float)):
+        if not math.isfinite(text):
+            raise ParseError(f"value must be finite, got {text!r}")
+        return ("num", repr(float(text)) if isinstance(text, float) else str(text))
+    if not isinstance(text, str):
+        raise ParseError(f"expected a number or expression, got {type(text).__name__}")
+    if len(text) > MAX_LENGTH:
+        raise ParseError(f"expression longer than {MAX_LENGTH} characters")
+    if not text.strip():
+        raise ParseError("empty expression")
+    p = _Parser(text)
+    node = p.expr()
+    if p.peek() is not None:
+        tok = p.toks[p.i]
+        raise ParseError(f"unexpected {tok.text!r} at position {tok.pos + 1} in {text!r}")
+    return node
+
+
+def names_in(node: Node) -> set[str]:
+    """The free names used by a tree (constants such as ``pi`` excluded)."""
+    kind = node[0]
+    if kind == "name":
+        return set() if node[1] in CONSTANTS else {node[1]}
+    if kind == "neg":
+        return names_in(node[1])
+    if kind == "bin":
+        return names_in(node[2]) | names_in(node[3])
+    if kind == "call":
+        out: set[str] = set()
+        for a in node[2]:
+            out |= names_in(a)
+        return out
+    return set()
+
+
+_FLOAT_FUNCS: dict[str, Callable[..., float]] = {
+    "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
+    "atan": math.atan, "atan2": math.atan2, "sqrt": math.sqrt, "exp": math.exp, "log": math.log,
+    "abs": abs, "deg": math.radians, "rad": lambda x: x,
+}
+
+
+def evaluate(node: Node, env: Mapping[str, float] | None = None) -> float:
+    """Evaluate a tree to a finite float; names are looked up in ``env`` (plus ``pi``)."""
+    env = env or {}
+    try:
+        value = _eval(node, env)
+    except (OverflowError, ZeroDivisionError, ValueError) as exc:
+        if isinstance(exc, ParseError):
+            raise
+        raise ParseError(f"cannot evaluate {to_text(node)!r}: {exc}") from None
+    if not math.isfinite(value):
+        raise ParseError(f"value of {to_text(node)!r} is not finite")
+    return value
+
+
+def _eval(node: Node, env: Mapping[str, float]) -> float:
+    kind = node[0]
+    if kind == "num":
+        return float(node[1])
+    if kind == "name":
+        if node[1] == "pi":
+            return math.pi
+        if node[1] not in env:
+            known = ", ".join(sorted(env)) or "none"
+            raise ParseError(f"unknown symbol {node[1]!r} (known: pi, {known})")
+        return float(env[node[1]])
+    if kind == "neg":
+        return -_eval(node[1], env)
+    if kind == "bin":
+        a, b = _eval(node[2], env), _eval(node[3], env)
+        op = node[1]
+        if op == "+":
+            return a + b
+        if op == "-":
+            return a - b
+        if op == "*":
+            return a * b
+        if op == "/":
+            return a / b
+        if abs(b) > MAX_EXPONENT:
+            raise ParseError(f"exponent {b:g} too large (at most {MAX_EXPONENT:g})")
+        result = a ** b
+        if isinstance(result, complex):
+            raise ValueError("negative number to a fractional power")
+        return float(result)
+    if kind == "call":
+        args = [_eval(a, env) for a in node[2]]
+        return float(_FLOAT_FUNCS[node[1]](*args))
+    raise ParseError(f"malformed expression node {kind!r}")
+
+
+def to_sympy(node: Node, symbols: Mapping[str, Any]) -> Any:
+    """Build a sympy expression from a tree, node by node (no string parsing by sympy).
+
+    ``symbols`` maps names to sympy objects.  Decimal numbers become exact rationals
+    (``0.4`` -> ``2/5``) so that exact evaluation stays exact.
+    """
+    import sympy as sp
+
+    kind = node[0]
+    if kind == "num":
+        return sp.Rational(node[1]) if ("e" not in node[1].lower()) else sp.Float(node[1])
+    if kind == "name":
+        if node[1] == "pi":
+            return sp.pi
+        if node[1] not in symbols:
+            known = ", ".join(sorted(symbols)) or "none"
+            raise ParseError(f"unknown symbol {node[1]!r} (known: pi, {known})")
+        return symbols[node[1]]
+    if kind == "neg":
+        return -to_sympy(node[1], symbols)
+    if kind == "bin":
+        a, b = to_sympy(node[2], symbols), to_sympy(node[3], symbols)
+        op = node[1]
+        if op == "+":
+            return a + b
+        if op == "-":
+            return a - b
+        if op == "*":
+            return a * b
+        if op == "/":
+            if b == 0:
+                raise ParseError(f"division by zero in {to_text(node)!r}")
+            return a / b
+        if not b.is_number or abs(float(b)) > MAX_EXPONENT:
+            raise ParseError(f"exponent in {to_text(node)!r} must be a number of size at most {MAX_EXPONENT:g}")
+        return a ** b
+    if kind == "call":
+        args = [to_sympy(a, symbols) for a in node[2]]
+        fname = node[1]
+        table: dict[str, Callable[..., Any]] = {
+            "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "asin": sp.asin, "acos": sp.acos,
+            "atan": sp.atan, "atan2": sp.atan2, "sqrt": sp.sqrt, "exp": sp.exp, "log": sp.log,
+            "abs": sp.Abs, "deg": lambda x: x * sp.pi / 180, "rad": lambda x: x,
+        }
+        return table[fname](*args)
+    raise ParseError(f"malformed expression node {kind!r}")
+
+
+_PREC = {"+": 1, "-": 1, "*": 2, "/": 2, "^": 4}
+
+
+def to_text(node: Node, parent: int = 0) -> str:
+    """Print a tree back as canonical text that :func:`parse` reads to the same tree."""
+    kind = node[0]
+    if kind == "num":
+        return node[1]
+    if kind == "name":
+        return node[1]
+    if kind == "neg":
+        s = "-" + to_text(node[1], 3)
+        return f"({s})" if parent >= 3 else s
+    if kind == "bin":
+        op = node[1]
+        prec = _PREC[op]
+        if op == "^":
+            s = f"{to_text(node[2], 5)}^{to_text(node[3], 4)}"
+        else:
+            right_prec = prec + 1 if op in "-/" else prec
+            s = f"{to_text(node[2], prec)} {op} {to_text(node[3], right_prec)}"
+            if op in "*/":
+                s = f"{to_text(node[2], prec)}{op}{to_text(node[3], right_prec)}"
+        return f"({s})" if prec < parent else s
+    if kind == "call":
+        return f"{node[1]}({', '.join(to_text(a) for a in node[2])})"
+    raise ParseError(f"malformed expression node {kind!r}")

@@ -1,0 +1,77 @@
+"""The ``denavit`` command line: parse → load the robot → one library call → format.
+
+Each group of subcommands lives in its own module with a ``register(subparsers)`` function; the
+handler it sets returns ``(json_data, text)``.  Every command takes ``--json``.  Errors print one
+line on stderr: exit code 2 for bad input, 1 for failures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+from typing import Sequence
+
+from ..errors import DenavitError, MissingDependencyError, ModelError, ParseError, ShapeError
+from ._common import OneLineParser, emit
+
+__all__ = ["main", "build_parser"]
+
+# Modules that add subcommands, in the order they appear in --help.
+COMMAND_MODULES = ("_model",)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = OneLineParser(
+        prog="denavit",
+        description="Serial robot arms from their DH table: kinematics, Jacobians, IK, dynamics, pictures, reports.",
+        epilog="ROBOT is a built-in name (see 'denavit robots') or a robot file (.yaml/.toml/.json).",
+    )
+    parser.add_argument("--version", action="version", version=f"denavit {_version()}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def _version() -> str:
+    from .. import __version__
+
+    return __version__
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a usage error (2), already printed
+        return int(exc.code or 0)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return 0
+    try:
+        data, text = args.handler(args)
+        emit(args, data, text)
+        return 0
+    except (ParseError, ShapeError, ModelError) as exc:
+        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except MissingDependencyError as exc:
+        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except DenavitError as exc:
+        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("denavit: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    except Exception as exc:  # a bug of ours: one line, the traceback only on request
+        if os.environ.get("DENAVIT_DEBUG"):
+            raise
+        print(f"denavit {args.command}: internal error: {type(exc).__name__}: {exc} "
+              "(set DENAVIT_DEBUG=1 for the traceback, and please report it)", file=sys.stderr)
+        return 1

@@ -1,0 +1,120 @@
+"""Shared pieces of the command line: the one-line-error parser, common arguments, output."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParseError
+
+__all__ = ["OneLineParser", "add_common", "add_q", "emit", "load", "joint_values", "to_json", "matrix_text"]
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line on stderr and exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        print(f"{self.prog}: error: {message} (see '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def add_common(p: argparse.ArgumentParser, robot: bool = True) -> None:
+    """ROBOT, --json and --deg."""
+    if robot:
+        p.add_argument("robot", metavar="ROBOT", help="built-in name or robot file")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.add_argument("--deg", action="store_true", help="angles in and out in degrees (radians otherwise)")
+    p.add_argument(
+        "--param", action="append", default=[], metavar="NAME=VALUE", help="override a robot parameter (repeatable)"
+    )
+
+
+def add_q(p: argparse.ArgumentParser, required: bool = True) -> None:
+    """-q/--q: a joint vector."""
+    p.add_argument(
+        "-q", "--q", dest="q", required=required, metavar="Q",
+        help='joint values: comma-separated numbers or expressions, e.g. "0, pi/4, 90deg"',
+    )
+    p.add_argument("--ignore-limits", action="store_true", help="compute even if q is outside the joint limits")
+
+
+def load(args: argparse.Namespace):
+    """The robot named on the command line, with --param overrides."""
+    from .. import _expr
+    from ..io import load_robot
+
+    overrides: dict[str, float] = {}
+    for item in args.param:
+        if "=" not in item:
+            raise ParseError(f"--param {item!r}: expected NAME=VALUE")
+        k, v = item.split("=", 1)
+        try:
+            overrides[k.strip()] = _expr.evaluate(_expr.parse(v))
+        except ParseError as exc:
+            raise ParseError(f"--param {k.strip()}: {exc}") from None
+    return load_robot(args.robot, **overrides)
+
+
+def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = "q", check_limits: bool = True,
+                 rates: bool = False) -> np.ndarray:
+    """Parse a joint vector from the command line (degrees with --deg for revolute joints)."""
+    from ..io import parse_values
+    from ..model import JointType
+
+    if text is None:
+        raise ParseError(f"{what}: missing (give {robot.dof} values)")
+    vals = parse_values(text, robot.dof, what=what)
+    if args.deg:
+        revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+        vals = np.where(revolute, np.radians(vals), vals)
+    if check_limits and not rates and not getattr(args, "ignore_limits", False):
+        lim = robot.q_limits
+        for k in range(robot.dof):
+            if not (lim[k, 0] - 1e-12 <= vals[k] <= lim[k, 1] + 1e-12):
+                lo, hi = lim[k]
+                unit = "m"
+                if robot.joint_types[k] is JointType.REVOLUTE:
+                    unit = "rad"
+                raise ParseError(
+                    f"{what}: joint {k + 1} = {vals[k]:.6g} {unit} is outside its limits [{lo:.6g}, {hi:.6g}] "
+                    f"(use --ignore-limits to compute anyway)"
+                )
+    return vals
+
+
+def to_json(x: Any) -> Any:
+    """Arrays → nested lists, sympy → strings, recursively."""
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, dict):
+        return {str(k): to_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [to_json(v) for v in x]
+    if hasattr(x, "free_symbols"):  # sympy object
+        if hasattr(x, "tolist"):
+            return [[str(e) for e in row] for row in x.tolist()]
+        return str(x)
+    return x
+
+
+def matrix_text(M: np.ndarray, digits: int = 6, indent: str = "  ") -> str:
+    """A numeric matrix as aligned text."""
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    M = np.where(np.abs(M) < 0.5 * 10.0 ** (-digits), 0.0, M)
+    cells = [[f"{v:.{digits}f}".rstrip("0").rstrip(".") if v != 0 else "0" for v in row] for row in M]
+    width = max(len(c) for row in cells for c in row)
+    return "\n".join(indent + "[ " + "  ".join(c.rjust(width) for c in row) + " ]" for row in cells)
+
+
+def emit(args: argparse.Namespace, data: Any, text: str) -> None:
+    if getattr(args, "json", False):
+        json.dump(to_json(data), sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    elif text:
+        sys.stdout.write(text if text.endswith("\n") else text + "\n")

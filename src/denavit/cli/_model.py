@@ -1,0 +1,198 @@
+"""Subcommands on the model and forward kinematics: robots, show, fk, convert."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParseError
+from ._common import add_common, add_q, joint_values, load, matrix_text
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("robots", help="list the built-in robots")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.set_defaults(handler=cmd_robots)
+
+    p = sub.add_parser("show", help="DH table, parameters and limits of a robot")
+    add_common(p)
+    p.set_defaults(handler=cmd_show)
+
+    p = sub.add_parser("fk", help="forward kinematics: pose of the end effector (and every frame)")
+    add_common(p)
+    add_q(p, required=False)
+    p.add_argument("--frames", action="store_true", help="also every DH frame T_0_i")
+    p.add_argument("--symbolic", action="store_true", help="the symbolic link transforms A_i and T_0_n")
+    p.add_argument("--latex", action="store_true", help="symbolic output as LaTeX")
+    p.add_argument("--shorthand", action="store_true", help="write cos(q1+q2) as C12, sin(q3) as S3")
+    p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
+    p.set_defaults(handler=cmd_fk)
+
+    p = sub.add_parser("convert", help="write the same arm in the other DH convention")
+    add_common(p)
+    p.add_argument("--to", required=True, choices=["standard", "modified"], help="target convention")
+    p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
+    p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+    p.set_defaults(handler=cmd_convert)
+
+
+def cmd_robots(args: argparse.Namespace):
+    from ..io import catalogue_names, load_robot
+
+    rows = []
+    for name in catalogue_names():
+        r = load_robot(name)
+        types = "".join("R" if t.value == "revolute" else "P" for t in r.joint_types)
+        rows.append({"name": name, "dof": r.dof, "joints": types, "convention": r.convention.value,
+                     "dynamics": r.has_dynamics, "description": r.description})
+    width = max(len(r["name"]) for r in rows)
+    lines = [f"{'name'.ljust(width)}  dof  joints   convention  dyn  description"]
+    for r in rows:
+        lines.append(
+            f"{r['name'].ljust(width)}  {r['dof']:>3}  {r['joints']:<7}  {r['convention']:<10}  "
+            f"{'yes' if r['dynamics'] else ' - '}  {r['description']}"
+        )
+    return {"robots": rows}, "\n".join(lines)
+
+
+def _angle(x: float, deg: bool) -> str:
+    return f"{math.degrees(x):.6g}°" if deg else _pretty_rad(x)
+
+
+def _pretty_rad(x: float) -> str:
+    for k in (1, 2, 3, 4, 6, 12):
+        for num in range(-12, 13):
+            if num and abs(x - num * math.pi / k) < 1e-12:
+                n = "" if abs(num) == 1 else str(abs(num))
+                s = "-" if num < 0 else ""
+                return f"{s}{n}pi" + (f"/{k}" if k != 1 else "")
+    return f"{x:.6g}"
+
+
+def cmd_show(args: argparse.Namespace):
+    robot = load(args)
+    from ..model import JointType
+
+    head = ["i", "a_{i-1}" if robot.convention.value == "modified" else "a_i",
+            "alpha_{i-1}" if robot.convention.value == "modified" else "alpha_i", "d_i", "theta_i", "joint", "limits"]
+    table = []
+    k = 0
+    data_rows = []
+    for i, link in enumerate(robot.links, start=1):
+        sym = dict(link.symbols)
+        a = sym.get("a", f"{link.a:.6g}")
+        alpha = sym.get("alpha", _angle(link.alpha, args.deg))
+        d = sym.get("d", f"{link.d:.6g}")
+        theta = sym.get("theta", _angle(link.theta, args.deg))
+        lim = ""
+        if link.is_joint:
+            k += 1
+            if link.joint is JointType.REVOLUTE:
+                theta = f"q{k}" if theta in ("0", "0°") else f"q{k} + {theta}"
+            else:
+                d = f"q{k}" if d in ("0", "0.0") else f"q{k} + {d}"
+            if link.q_limits:
+                lo, hi = link.q_limits
+                conv = (lambda v: _angle(v, args.deg)) if link.joint is JointType.REVOLUTE else (lambda v: f"{v:.6g} m")
+                lim = f"[{conv(lo)}, {conv(hi)}]"
+        table.append([str(i), a, alpha, d, theta, link.joint.value, lim])
+        data_rows.append({"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta,
+                          "joint": link.joint.value, "limits": list(link.q_limits) if link.q_limits else None,
+                          "expressions": dict(link.symbols)})
+    widths = [max(len(r[c]) for r in [head] + table) for c in range(len(head))]
+    lines = [f"{robot.name}: {robot.description}".rstrip(": "),
+             f"convention: {robot.convention.value} "
+             + ("(A_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i))" if robot.convention.value == "standard"
+                else "(A_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i))"),
+             f"joints: {robot.dof} ({', '.join(t.value for t in robot.joint_types)})", ""]
+    lines.append("  ".join(h.ljust(w) for h, w in zip(head, widths)))
+    lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)) for r in table]
+    if robot.parameters:
+        lines += ["", "parameters: " + ", ".join(f"{k} = {v:g}" for k, v in robot.parameters)]
+    if not np.allclose(robot.base_matrix, np.eye(4)):
+        lines += ["", "base:", matrix_text(robot.base_matrix)]
+    if not np.allclose(robot.tool_matrix, np.eye(4)):
+        lines += ["", "tool:", matrix_text(robot.tool_matrix)]
+    lines += ["", f"gravity: {list(robot.gravity)} m/s^2", f"inertial data: {'yes' if robot.has_dynamics else 'no'}"]
+    data = {"robot": robot.name, "convention": robot.convention.value, "dof": robot.dof, "rows": data_rows,
+            "parameters": dict(robot.parameters), "base": robot.base_matrix, "tool": robot.tool_matrix,
+            "gravity": list(robot.gravity), "dynamics": robot.has_dynamics}
+    return data, "\n".join(lines)
+
+
+def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:
+    from .. import symbolic as S
+    import sympy as sp
+
+    q = S.joint_symbols(robot.dof).q
+    fmt = (lambda M: sp.latex(M)) if args.latex else (lambda M: sp.pretty(M, use_unicode=True, wrap_line=False))
+    show = (lambda M: S.shorthand_matrix(M, q)) if args.shorthand else (lambda M: M)
+    lines = []
+    As = S.link_matrices_sym(robot)
+    data: dict = {"A": [], "T_symbolic": None}
+    for i, A in enumerate(As, start=1):
+        A = S.simplify_matrix(A, args.simplify)
+        lines += [f"A_{i} = T_{i - 1}_{i} =", fmt(show(A)), ""]
+        data["A"].append(A)
+    T = S.forward_kinematics_sym(robot, args.simplify)
+    lines += [f"T_0_{len(As)}" + (" (with base and tool)" if not (np.allclose(robot.base_matrix, np.eye(4))
+                                                                 and np.allclose(robot.tool_matrix, np.eye(4))) else "")
+              + " =", fmt(show(T))]
+    data["T_symbolic"] = T
+    data["T_latex"] = sp.latex(T)
+    return data, lines
+
+
+def cmd_fk(args: argparse.Namespace):
+    from ..numeric import forward_kinematics, link_transforms, rpy_from_rotation, zyz_from_rotation
+
+    robot = load(args)
+    data: dict = {"robot": robot.name, "convention": robot.convention.value}
+    lines: list[str] = []
+    if args.symbolic:
+        sdata, slines = _symbolic_fk(robot, args)
+        data.update(sdata)
+        lines += slines
+    elif args.q is None:
+        raise ParseError("give joint values with -q (or --symbolic for the formulas)")
+    if args.q is not None:
+        q = joint_values(args, robot, args.q)
+        T = forward_kinematics(robot, q)
+        rpy = rpy_from_rotation(T[:3, :3])
+        zyz = zyz_from_rotation(T[:3, :3])
+        unit = "deg" if args.deg else "rad"
+        conv = np.degrees if args.deg else (lambda x: x)
+        data.update({"q": conv(q) if args.deg else q, "angle_unit": unit, "T": T, "position": T[:3, 3],
+                     "rpy": conv(rpy), "zyz": conv(zyz)})
+        if lines:
+            lines.append("")
+        lines += [f"{robot.name}: end-effector pose at q = [{', '.join(f'{v:.6g}' for v in (conv(q) if args.deg else q))}]"
+                  f" ({unit})", "T_0_e =", matrix_text(T),
+                  f"position [m]: {', '.join(f'{v:.6g}' for v in T[:3, 3])}",
+                  f"RPY (roll, pitch, yaw) [{unit}]: {', '.join(f'{v:.6g}' for v in conv(rpy))}",
+                  f"ZYZ (phi, theta, psi) [{unit}]: {', '.join(f'{v:.6g}' for v in conv(zyz))}"]
+        if args.frames:
+            frames = link_transforms(robot, q)
+            data["frames"] = frames
+            for i, F in enumerate(frames):
+                lines += ["", f"T_0_{i} =", matrix_text(F)]
+    return data, "\n".join(lines)
+
+
+def cmd_convert(args: argparse.Namespace):
+    from .._convert import convert_convention
+    from ..io import dump_robot, robot_to_dict, save_robot
+
+    robot = load(args)
+    out = convert_convention(robot, args.to)
+    if args.output:
+        path = Path(args.output)
+        save_robot(out, path, overwrite=args.force)
+        text = f"wrote {path} ({out.convention.value} DH, {out.n_rows} rows)"
+    else:
+        text = dump_robot(out)
+    return {"robot": robot.name, "from": robot.convention.value, "to": out.convention.value,
+            "output": args.output, "robot_file": robot_to_dict(out)}, text

@@ -1,0 +1,47 @@
+"""Exception hierarchy of denavit.
+
+Every error a user can cause derives from :class:`DenavitError`; the command line catches it at the
+top and prints one line.  The ``ValueError`` subclasses keep ``except ValueError`` working.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "DenavitError",
+    "ModelError",
+    "ShapeError",
+    "ParseError",
+    "UnsupportedRobotError",
+    "MissingDependencyError",
+]
+
+
+class DenavitError(Exception):
+    """Base class of every denavit error."""
+
+
+class ModelError(DenavitError, ValueError):
+    """The robot model is invalid (bad DH table, limits, inertial data...)."""
+
+
+class ShapeError(DenavitError, ValueError):
+    """An array has the wrong shape; the message says what was expected and what was received."""
+
+
+class ParseError(DenavitError, ValueError):
+    """A robot file, expression, table or claim could not be read.
+
+    The message names the place: file, row and field where known.
+    """
+
+    def __init__(self, message: str, *, where: str | None = None) -> None:
+        self.where = where
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class UnsupportedRobotError(DenavitError):
+    """The requested method does not apply to this robot (e.g. analytic IK of a non-Pieper arm)."""
+
+
+class MissingDependencyError(DenavitError, ImportError):
+    """An optional dependency is missing; the message names the extra to install."""

@@ -1,0 +1,308 @@
+"""The robot model: a frozen, hashable description of a serial arm by its Denavit–Hartenberg table.
+
+The model holds data only (no joint state, no algorithms).  Numbers are floats in SI units and
+radians; where a value came from an expression of named parameters (``d: H1``), the expression text
+is kept in ``DHLink.symbols`` so the symbolic engine can keep ``H1`` as a symbol.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from enum import Enum
+from typing import Any, Iterable
+
+import numpy as np
+
+from .errors import ModelError
+
+__all__ = [
+    "Convention",
+    "JointType",
+    "LinkInertia",
+    "DHLink",
+    "DHRobot",
+    "IDENTITY",
+    "DH_FIELDS",
+    "INERTIA_ORDER",
+]
+
+IDENTITY: tuple[tuple[float, ...], ...] = (
+    (1.0, 0.0, 0.0, 0.0),
+    (0.0, 1.0, 0.0, 0.0),
+    (0.0, 0.0, 1.0, 0.0),
+    (0.0, 0.0, 0.0, 1.0),
+)
+DH_FIELDS = ("a", "alpha", "d", "theta")
+INERTIA_ORDER = ("Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz")
+
+
+class Convention(str, Enum):
+    """Which DH convention a table uses.
+
+    ``STANDARD`` (distal; Spong, Siciliano):  A_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i).
+    ``MODIFIED`` (proximal; Craig):            A_i = Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ_i) Tz(d_i);
+    in a modified row the ``a`` and ``alpha`` fields hold a_{i-1} and α_{i-1}.
+    """
+
+    STANDARD = "standard"
+    MODIFIED = "modified"
+
+
+class JointType(str, Enum):
+    """Revolute (variable in θ), prismatic (variable in d) or fixed (no variable)."""
+
+    REVOLUTE = "revolute"
+    PRISMATIC = "prismatic"
+    FIXED = "fixed"
+
+
+def _finite(value: float, what: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ModelError(f"{what} must be finite, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True, slots=True)
+class LinkInertia:
+    """Inertial data of one link, expressed in that link's DH frame {i}.
+
+    Attributes
+    ----------
+    mass : float
+        Mass [kg].
+    com : tuple of 3 floats
+        Centre of mass in frame {i} [m].
+    inertia : tuple of 6 floats
+        Inertia tensor about the centre of mass, axes of frame {i}, in the order
+        (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) [kg m²]; products are the tensor entries (I[0,1] = Ixy).
+    motor_inertia : float
+        Rotor inertia reflected to the joint side (G² Jm) [kg m²], added to M's diagonal.
+    viscous, coulomb : float
+        Joint friction: τ_f = viscous·q̇ + coulomb·sign(q̇).
+    symbols : tuple of (field, expression) pairs
+        Expression text of fields written with named parameters (``mass`` → ``"m1"``,
+        ``com1`` → ``"Lc1"``, ``inertia2`` → ``"I1"``), for the symbolic engine.
+    """
+
+    mass: float = 0.0
+    com: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inertia: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    motor_inertia: float = 0.0
+    viscous: float = 0.0
+    coulomb: float = 0.0
+    symbols: tuple[tuple[str, str], ...] = ()
+
+    def __post_init__(self) -> None:
+        if _finite(self.mass, "mass") < 0:
+            raise ModelError(f"mass must be non-negative, got {self.mass!r}")
+        if len(self.com) != 3:
+            raise ModelError(f"com must have 3 values, got {len(self.com)}")
+        if len(self.inertia) != 6:
+            raise ModelError(f"inertia must have 6 values {INERTIA_ORDER}, got {len(self.inertia)}")
+        object.__setattr__(self, "com", tuple(_finite(c, "com") for c in self.com))
+        object.__setattr__(self, "inertia", tuple(_finite(c, "inertia") for c in self.inertia))
+        for name in ("motor_inertia", "viscous", "coulomb"):
+            if _finite(getattr(self, name), name) < 0:
+                raise ModelError(f"{name} must be non-negative, got {getattr(self, name)!r}")
+
+    @property
+    def inertia_matrix(self) -> np.ndarray:
+        """The 3×3 inertia tensor about the centre of mass, frame {i} axes (a fresh array)."""
+        ixx, iyy, izz, ixy, ixz, iyz = self.inertia
+        return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float)
+
+
+@dataclass(frozen=True, slots=True)
+class DHLink:
+    """One row of a DH table.
+
+    ``a``, ``alpha``, ``d``, ``theta`` are the constant parts [m, rad]; the joint variable q is
+    added to ``theta`` (revolute) or ``d`` (prismatic), so a revolute row's ``theta`` is its offset.
+    In a ``MODIFIED`` robot, ``a`` and ``alpha`` of row i are a_{i-1} and α_{i-1}.
+    ``symbols`` keeps the expression text of fields written with parameters (``("d", "H1")``).
+    """
+
+    a: float = 0.0
+    alpha: float = 0.0
+    d: float = 0.0
+    theta: float = 0.0
+    joint: JointType = JointType.REVOLUTE
+    q_limits: tuple[float, float] | None = None
+    inertia: LinkInertia | None = None
+    symbols: tuple[tuple[str, str], ...] = ()
+
+    def __post_init__(self) -> None:
+        for name in DH_FIELDS:
+            object.__setattr__(self, name, _finite(getattr(self, name), name))
+        if not isinstance(self.joint, JointType):
+            try:
+                object.__setattr__(self, "joint", JointType(self.joint))
+            except ValueError:
+                choices = ", ".join(j.value for j in JointType)
+                raise ModelError(f"unknown joint type {self.joint!r}; choose one of {choices}") from None
+        if self.q_limits is not None:
+            if self.joint is JointType.FIXED:
+                raise ModelError("a fixed row has no joint variable, so it cannot have limits")
+            if len(self.q_limits) != 2:
+                raise ModelError(f"limits must be [low, high], got {self.q_limits!r}")
+            lo, hi = (_finite(v, "limit") for v in self.q_limits)
+            if lo > hi:
+                raise ModelError(f"limits low > high: [{lo}, {hi}]")
+            object.__setattr__(self, "q_limits", (lo, hi))
+        for key, _ in self.symbols:
+            if key not in DH_FIELDS:
+                raise ModelError(f"unknown DH field {key!r} in symbols")
+
+    @property
+    def is_joint(self) -> bool:
+        """True for revolute and prismatic rows."""
+        return self.joint is not JointType.FIXED
+
+    def expression(self, field_name: str) -> str:
+        """The expression text of a DH field (its number printed if none was given)."""
+        return dict(self.symbols).get(field_name, repr(getattr(self, field_name)))
+
+
+def _as_transform(value: Any, what: str) -> tuple[tuple[float, ...], ...]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (4, 4):
+        raise ModelError(f"{what} must be a 4×4 homogeneous transform, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{what} has non-finite entries")
+    R = arr[:3, :3]
+    if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+        raise ModelError(f"{what} rotation part is not a rotation matrix")
+    if not np.allclose(arr[3], [0, 0, 0, 1]):
+        raise ModelError(f"{what} last row must be [0, 0, 0, 1]")
+    return tuple(tuple(float(x) for x in row) for row in arr)
+
+
+@dataclass(frozen=True)
+class DHRobot:
+    """A serial arm: DH rows from base to tip plus base/tool transforms and gravity.
+
+    Frames: {0} is the base DH frame, {i} the frame attached by row i (fixed rows included).
+    World pose of the end effector: ``T_w_e = base @ A_1 ⋯ A_N @ tool``.
+
+    Attributes
+    ----------
+    name : str
+    links : tuple of DHLink
+        Rows base to tip; fixed rows (no variable) may stand anywhere.
+    convention : Convention
+    base, tool : 4×4 nested tuples
+        Pose of {0} in the world frame; pose of the end effector in {N}.
+    gravity : 3-tuple
+        Gravity acceleration in the world frame [m/s²].
+    parameters : tuple of (name, value)
+        Named constants used by the ``symbols`` of links and inertias, with their values.
+    """
+
+    name: str
+    links: tuple[DHLink, ...]
+    convention: Convention = Convention.STANDARD
+    base: tuple[tuple[float, ...], ...] = IDENTITY
+    tool: tuple[tuple[float, ...], ...] = IDENTITY
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    parameters: tuple[tuple[str, float], ...] = ()
+    description: str = ""
+    source: str = ""
+    _joint_rows: tuple[int, ...] = field(init=False, repr=False, compare=False, hash=False, default=())
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.convention, Convention):
+            try:
+                object.__setattr__(self, "convention", Convention(self.convention))
+            except ValueError:
+                raise ModelError(
+                    f"unknown convention {self.convention!r}; choose one of standard, modified"
+                ) from None
+        links = tuple(self.links)
+        if not links:
+            raise ModelError("a robot needs at least one DH row")
+        if not all(isinstance(link, DHLink) for link in links):
+            raise ModelError("links must be DHLink values")
+        object.__setattr__(self, "links", links)
+        rows = tuple(i for i, link in enumerate(links) if link.is_joint)
+        if not rows:
+            raise ModelError("a robot needs at least one joint (a row with q)")
+        object.__setattr__(self, "_joint_rows", rows)
+        object.__setattr__(self, "base", _as_transform(self.base, "base"))
+        object.__setattr__(self, "tool", _as_transform(self.tool, "tool"))
+        g = tuple(_finite(x, "gravity") for x in self.gravity)
+        if len(g) != 3:
+            raise ModelError(f"gravity must have 3 components, got {len(g)}")
+        object.__setattr__(self, "gravity", g)
+        object.__setattr__(self, "parameters", tuple((str(k), _finite(v, f"parameter {k}")) for k, v in self.parameters))
+
+    # --- trivial derived properties -------------------------------------------------------------
+    @property
+    def dof(self) -> int:
+        """Number of joint variables."""
+        return len(self._joint_rows)
+
+    @property
+    def n_rows(self) -> int:
+        """Number of DH rows, fixed rows included."""
+        return len(self.links)
+
+    @property
+    def joint_rows(self) -> tuple[int, ...]:
+        """Row index (0-based) of each joint variable."""
+        return self._joint_rows
+
+    @property
+    def joints(self) -> tuple[DHLink, ...]:
+        """The rows that carry a joint variable, in order."""
+        return tuple(self.links[i] for i in self._joint_rows)
+
+    @property
+    def joint_types(self) -> tuple[JointType, ...]:
+        return tuple(link.joint for link in self.joints)
+
+    @property
+    def q_limits(self) -> np.ndarray:
+        """Joint limits, shape (dof, 2); ±inf where a joint has none (a fresh array)."""
+        out = np.empty((self.dof, 2))
+        for k, link in enumerate(self.joints):
+            out[k] = link.q_limits if link.q_limits is not None else (-np.inf, np.inf)
+        return out
+
+    @property
+    def base_matrix(self) -> np.ndarray:
+        return np.array(self.base, dtype=float)
+
+    @property
+    def tool_matrix(self) -> np.ndarray:
+        return np.array(self.tool, dtype=float)
+
+    @property
+    def parameter_values(self) -> dict[str, float]:
+        return dict(self.parameters)
+
+    @property
+    def has_dynamics(self) -> bool:
+        """True when every joint row carries inertial data."""
+        return all(link.inertia is not None for link in self.joints)
+
+    def replace(self, **changes: Any) -> "DHRobot":
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+
+def joint_names(robot: DHRobot) -> list[str]:
+    """``q1 … qn``."""
+    return [f"q{k + 1}" for k in range(robot.dof)]
+
+
+def rows_of(links: Iterable[DHLink]) -> list[dict[str, Any]]:
+    """Plain dictionaries of DH rows, for presenters."""
+    return [
+        {"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta, "joint": link.joint.value}
+        for link in links
+    ]

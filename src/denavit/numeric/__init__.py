@@ -1,0 +1,34 @@
+"""The numeric engine (numpy): every function is batched over leading axes ``(..., n)``."""
+
+from ._kinematics import forward_kinematics, link_transforms
+from ._transforms import (
+    adjoint,
+    dh_transform,
+    inverse_transform,
+    rotation_from_rpy,
+    rotation_from_zyz,
+    rotx,
+    roty,
+    rotz,
+    rpy_from_rotation,
+    skew,
+    transform_from_xyz_rpy,
+    zyz_from_rotation,
+)
+
+__all__ = [
+    "forward_kinematics",
+    "link_transforms",
+    "adjoint",
+    "dh_transform",
+    "inverse_transform",
+    "rotation_from_rpy",
+    "rotation_from_zyz",
+    "rotx",
+    "roty",
+    "rotz",
+    "rpy_from_rotation",
+    "skew",
+    "transform_from_xyz_rpy",
+    "zyz_from_rotation",
+]

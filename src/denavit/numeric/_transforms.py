@@ -1,0 +1,155 @@
+"""Homogeneous transforms and small rotation helpers, batched over leading axes (..., 4, 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Convention
+
+__all__ = [
+    "dh_transform",
+    "inverse_transform",
+    "skew",
+    "adjoint",
+    "rotx",
+    "roty",
+    "rotz",
+    "transform_from_xyz_rpy",
+    "rpy_from_rotation",
+    "zyz_from_rotation",
+    "rotation_from_rpy",
+    "rotation_from_zyz",
+]
+
+
+def dh_transform(convention: Convention, theta, d, a, alpha) -> np.ndarray:
+    """One DH link transform A_i, shape (..., 4, 4) broadcast over the inputs.
+
+    Notes
+    -----
+    standard: :math:`A_i = R_z(\\theta_i) T_z(d_i) T_x(a_i) R_x(\\alpha_i)` (Spong 2nd ed. eq. 3.10);
+    modified: :math:`A_i = R_x(\\alpha_{i-1}) T_x(a_{i-1}) R_z(\\theta_i) T_z(d_i)` (Craig 3rd ed. eq. 3.6).
+    """
+    theta, d, a, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (theta, d, a, alpha)))
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    A = np.zeros(theta.shape + (4, 4))
+    A[..., 3, 3] = 1.0
+    if Convention(convention) is Convention.STANDARD:
+        A[..., 0, :] = np.stack([ct, -st * ca, st * sa, a * ct], axis=-1)
+        A[..., 1, :] = np.stack([st, ct * ca, -ct * sa, a * st], axis=-1)
+        A[..., 2, 1], A[..., 2, 2], A[..., 2, 3] = sa, ca, d
+    else:
+        A[..., 0, :] = np.stack([ct, -st, np.zeros_like(ct), a], axis=-1)
+        A[..., 1, :] = np.stack([st * ca, ct * ca, -sa, -sa * d], axis=-1)
+        A[..., 2, :] = np.stack([st * sa, ct * sa, ca, ca * d], axis=-1)
+    return A
+
+
+def inverse_transform(T: np.ndarray) -> np.ndarray:
+    """Inverse of rigid transforms (..., 4, 4): [Rᵀ, −Rᵀp; 0, 1]."""
+    T = np.asarray(T, dtype=float)
+    out = np.zeros_like(T)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    out[..., :3, :3] = Rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    """Skew-symmetric matrices (..., 3, 3) with skew(v) @ w = v × w."""
+    v = np.asarray(v, dtype=float)
+    z = np.zeros(v.shape[:-1])
+    x, y, w = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack(
+        [np.stack([z, -w, y], -1), np.stack([w, z, -x], -1), np.stack([-y, x, z], -1)], axis=-2
+    )
+
+
+def adjoint(T: np.ndarray) -> np.ndarray:
+    """Adjoint (..., 6, 6) mapping twists (v, ω) in frame {b} to frame {a} for T = T_a_b."""
+    T = np.asarray(T, dtype=float)
+    R, p = T[..., :3, :3], T[..., :3, 3]
+    out = np.zeros(T.shape[:-2] + (6, 6))
+    out[..., :3, :3] = R
+    out[..., 3:, 3:] = R
+    out[..., :3, 3:] = skew(p) @ R
+    return out
+
+
+def _rot(axis: int, angle) -> np.ndarray:
+    angle = np.asarray(angle, dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    R = np.zeros(angle.shape + (3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    R[..., axis, axis] = 1.0
+    R[..., i, i], R[..., j, j] = c, c
+    R[..., i, j], R[..., j, i] = -s, s
+    return R
+
+
+def rotx(angle) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) about x."""
+    return _rot(0, angle)
+
+
+def roty(angle) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) about y."""
+    return _rot(1, angle)
+
+
+def rotz(angle) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) about z."""
+    return _rot(2, angle)
+
+
+def rotation_from_rpy(rpy) -> np.ndarray:
+    """R = Rz(yaw) Ry(pitch) Rx(roll) from rpy = (roll, pitch, yaw), shape (..., 3) → (..., 3, 3)."""
+    rpy = np.asarray(rpy, dtype=float)
+    return rotz(rpy[..., 2]) @ roty(rpy[..., 1]) @ rotx(rpy[..., 0])
+
+
+def rotation_from_zyz(zyz) -> np.ndarray:
+    """R = Rz(φ) Ry(θ) Rz(ψ) from (φ, θ, ψ), shape (..., 3) → (..., 3, 3)."""
+    zyz = np.asarray(zyz, dtype=float)
+    return rotz(zyz[..., 0]) @ roty(zyz[..., 1]) @ rotz(zyz[..., 2])
+
+
+def transform_from_xyz_rpy(xyz, rpy) -> np.ndarray:
+    """Homogeneous transform (..., 4, 4) from a translation and roll-pitch-yaw angles."""
+    xyz = np.asarray(xyz, dtype=float)
+    R = rotation_from_rpy(rpy)
+    shape = np.broadcast_shapes(xyz.shape[:-1], R.shape[:-2])
+    T = np.zeros(shape + (4, 4))
+    T[..., :3, :3] = R
+    T[..., :3, 3] = xyz
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def rpy_from_rotation(R: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (..., 3) with R = Rz(yaw) Ry(pitch) Rx(roll); pitch in [−π/2, π/2].
+
+    At pitch = ±π/2 (gimbal lock) roll is set to 0 and yaw carries the whole rotation.
+    """
+    R = np.asarray(R, dtype=float)
+    pitch = np.arctan2(-R[..., 2, 0], np.hypot(R[..., 0, 0], R[..., 1, 0]))
+    lock = np.hypot(R[..., 0, 0], R[..., 1, 0]) < 1e-10
+    roll = np.where(lock, 0.0, np.arctan2(R[..., 2, 1], R[..., 2, 2]))
+    yaw = np.where(lock, np.arctan2(-R[..., 0, 1], R[..., 1, 1]), np.arctan2(R[..., 1, 0], R[..., 0, 0]))
+    return np.stack([roll, pitch, yaw], axis=-1)
+
+
+def zyz_from_rotation(R: np.ndarray) -> np.ndarray:
+    """Euler angles (φ, θ, ψ) (..., 3) with R = Rz(φ) Ry(θ) Rz(ψ), θ in [0, π].
+
+    At θ = 0 or π only φ ± ψ is defined; φ is set to 0.
+    """
+    R = np.asarray(R, dtype=float)
+    s = np.hypot(R[..., 0, 2], R[..., 1, 2])
+    theta = np.arctan2(s, R[..., 2, 2])
+    lock = s < 1e-10
+    phi = np.where(lock, 0.0, np.arctan2(R[..., 1, 2], R[..., 0, 2]))
+    psi_free = np.arctan2(R[..., 1, 0], np.where(R[..., 2, 2] > 0, R[..., 0, 0], -R[..., 0, 0]))
+    psi = np.where(lock, psi_free, np.arctan2(R[..., 2, 1], -R[..., 2, 0]))
+    return np.stack([phi, theta, psi], axis=-1)

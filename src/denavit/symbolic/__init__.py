@@ -1,0 +1,25 @@
+"""The symbolic engine (sympy).  Importing this module is what imports sympy.
+
+Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the robot's named parameters.
+"""
+
+from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
+from ._simplify import POLICIES, shorthand, shorthand_matrix, simplify_expr, simplify_matrix
+from ._symbols import JointSymbols, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
+
+__all__ = [
+    "dh_matrix_sym",
+    "forward_kinematics_sym",
+    "link_matrices_sym",
+    "link_transforms_sym",
+    "POLICIES",
+    "shorthand",
+    "shorthand_matrix",
+    "simplify_expr",
+    "simplify_matrix",
+    "JointSymbols",
+    "joint_symbols",
+    "matrix_from_floats",
+    "parameter_symbols",
+    "row_expressions",
+]

@@ -1,0 +1,77 @@
+"""Simplification policies and the compact C/S shorthand display.
+
+Policies are named and explicit: ``"none"`` (as multiplied), ``"trig"`` (expand, then collapse products
+of sines and cosines into sines and cosines of angle sums, Fu et al.'s TR10i, which is what a person
+writes by hand: cos(q2 + q3), not cos q2 cos q3 − sin q2 sin q3), and ``"full"`` (sympy's ``simplify``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import sympy as sp
+from sympy.simplify.fu import TR10, TR10i
+
+__all__ = ["simplify_expr", "simplify_matrix", "shorthand", "POLICIES"]
+
+POLICIES = ("none", "trig", "full")
+
+
+def _trig(e: sp.Expr) -> sp.Expr:
+    if e.is_number or not e.has(sp.sin, sp.cos):
+        return sp.factor_terms(sp.expand(e))
+    e = sp.expand(e)
+    e = TR10i(e)  # c1 c2 − s1 s2 → cos(q1 + q2), repeatedly
+    e = TR10i(sp.expand(TR10(e)) if e.count_ops() > 400 else e)
+    e = sp.factor_terms(e)
+    return e
+
+
+def simplify_expr(e: sp.Expr, policy: str = "trig") -> sp.Expr:
+    """Simplify one expression by a named policy (see module docstring)."""
+    if policy == "none":
+        return e
+    if policy == "trig":
+        return _trig(e)
+    if policy == "full":
+        return sp.simplify(e)
+    raise ValueError(f"unknown simplification policy {policy!r}; choose one of {', '.join(POLICIES)}")
+
+
+def simplify_matrix(M: sp.MatrixBase, policy: str = "trig") -> sp.ImmutableMatrix:
+    """Apply :func:`simplify_expr` to every entry."""
+    return sp.ImmutableMatrix(M.shape[0], M.shape[1], [simplify_expr(e, policy) for e in M])
+
+
+def _digits(arg: sp.Expr, qs: dict[sp.Symbol, int]) -> str | None:
+    terms = sp.Add.make_args(arg)
+    idx = []
+    for t in terms:
+        if t in qs:
+            idx.append(qs[t])
+        else:
+            return None
+    idx.sort()
+    return "".join(str(i) for i in idx) if max(idx) < 10 else "_".join(str(i) for i in idx)
+
+
+def shorthand(e: sp.Expr, q: tuple[sp.Symbol, ...], style: str = "C") -> sp.Expr:
+    """Replace cos(q1 + q2) by the symbol C12, sin(q3) by S3 (``style="c"`` gives c12, s3).
+
+    For display only: the result uses plain symbols and is not meant to be computed with.
+    """
+    qs = {s: i + 1 for i, s in enumerate(q)}
+    cname, sname = ("C", "S") if style == "C" else ("c", "s")
+    repl: dict[sp.Expr, sp.Expr] = {}
+    for f in e.atoms(sp.cos, sp.sin):
+        digits = _digits(f.args[0], qs)
+        if digits is not None:
+            repl[f] = sp.Symbol(f"{cname if isinstance(f, sp.cos) else sname}{digits}", real=True)
+    return e.xreplace(repl)
+
+
+def shorthand_matrix(M: sp.MatrixBase, q, style: str = "C") -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(M.shape[0], M.shape[1], [shorthand(e, q, style) for e in M])
+
+
+Simplifier = Callable[[sp.Expr], sp.Expr]

@@ -1,0 +1,73 @@
+"""Symbols of a robot: joint variables q1…qn (and rates), named parameters, DH rows as sympy."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import sympy as sp
+
+from .. import _expr
+from ..model import DHLink, DHRobot, JointType
+
+__all__ = ["JointSymbols", "joint_symbols", "parameter_symbols", "row_expressions", "matrix_from_floats"]
+
+
+class JointSymbols:
+    """q, qd, qdd as tuples of real symbols ``q1…qn``, ``qd1…``, ``qdd1…``."""
+
+    def __init__(self, n: int) -> None:
+        self.q = tuple(sp.symbols(f"q1:{n + 1}", real=True))
+        self.qd = tuple(sp.symbols(f"qd1:{n + 1}", real=True))
+        self.qdd = tuple(sp.symbols(f"qdd1:{n + 1}", real=True))
+
+    def __iter__(self):
+        return iter((self.q, self.qd, self.qdd))
+
+
+@lru_cache(maxsize=64)
+def joint_symbols(n: int) -> JointSymbols:
+    return JointSymbols(n)
+
+
+def parameter_symbols(robot: DHRobot) -> dict[str, sp.Symbol]:
+    """One real symbol per named parameter of the robot."""
+    return {name: sp.Symbol(name, real=True) for name, _ in robot.parameters}
+
+
+def _field(link: DHLink, field: str, syms: dict[str, sp.Symbol]) -> sp.Expr:
+    text = dict(link.symbols).get(field)
+    if text is None:
+        return sp.nsimplify(getattr(link, field), [sp.pi], tolerance=1e-13, rational=True)
+    return _expr.to_sympy(_expr.parse(text), syms)
+
+
+def row_expressions(robot: DHRobot, numeric: bool = False) -> list[dict[str, sp.Expr]]:
+    """Each row's (a, alpha, d, theta) as sympy, the joint variable included (qk added to θ or d).
+
+    With ``numeric=True`` parameters are replaced by their values (exact rationals).
+    """
+    syms = parameter_symbols(robot)
+    q = joint_symbols(robot.dof).q
+    values = {s: sp.Rational(repr(v)) for s, v in zip(syms.values(), robot.parameter_values.values())}
+    rows = []
+    k = 0
+    for link in robot.links:
+        row = {f: _field(link, f, syms) for f in ("a", "alpha", "d", "theta")}
+        if link.joint is JointType.REVOLUTE:
+            row["theta"] = q[k] + row["theta"]
+            k += 1
+        elif link.joint is JointType.PRISMATIC:
+            row["d"] = q[k] + row["d"]
+            k += 1
+        if numeric:
+            row = {f: e.subs(values) for f, e in row.items()}
+        rows.append(row)
+    return rows
+
+
+def matrix_from_floats(M) -> sp.ImmutableMatrix:
+    """A 4×4 of floats as exact numbers where they are close to simple ones (0.5 → 1/2, 0.7071… → √2/2)."""
+    out = []
+    for row in M:
+        out.append([sp.nsimplify(float(x), [sp.sqrt(2), sp.sqrt(3)], tolerance=1e-12) for x in row])
+    return sp.ImmutableMatrix(out)
