@@ -13,8 +13,9 @@ from .errors import (
     UnsupportedRobotError,
 )
 from .io import catalogue_names, dump_robot, load_robot, robot_from_dict, save_robot, with_parameters
-from .model import Convention, DHLink, DHRobot, JointType, LinkInertia
-from .numeric import forward_kinematics, link_transforms
+from .model import Convention, DHLink, DHRobot, Frame, JointType, LinkInertia
+from ._convert import convert_convention
+from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 
 __version__ = "0.1.0"
 
@@ -31,12 +32,15 @@ __all__ = [
     "robot_from_dict",
     "save_robot",
     "with_parameters",
+    "convert_convention",
     "Convention",
+    "Frame",
     "DHLink",
     "DHRobot",
     "JointType",
     "LinkInertia",
     "forward_kinematics",
     "link_transforms",
+    "geometric_jacobian",
     "__version__",
 ]

@@ -19,6 +19,7 @@ from .errors import ModelError
 __all__ = [
     "Convention",
     "JointType",
+    "Frame",
     "LinkInertia",
     "DHLink",
     "DHRobot",
@@ -47,6 +48,17 @@ class Convention(str, Enum):
 
     STANDARD = "standard"
     MODIFIED = "modified"
+
+
+class Frame(str, Enum):
+    """Which axes a Jacobian, twist or wrench is expressed in.
+
+    ``BASE``: the world/base axes (J0); ``TOOL``: the end-effector axes (Je).  Both use the
+    end-effector origin as reference point and rows (v, ω).
+    """
+
+    BASE = "base"
+    TOOL = "tool"
 
 
 class JointType(str, Enum):

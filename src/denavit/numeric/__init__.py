@@ -1,5 +1,6 @@
 """The numeric engine (numpy): every function is batched over leading axes ``(..., n)``."""
 
+from ._jacobians import geometric_jacobian, joint_axes
 from ._kinematics import forward_kinematics, link_transforms
 from ._transforms import (
     adjoint,
@@ -17,6 +18,8 @@ from ._transforms import (
 )
 
 __all__ = [
+    "geometric_jacobian",
+    "joint_axes",
     "forward_kinematics",
     "link_transforms",
     "adjoint",
