@@ -48,6 +48,9 @@ __all__ = [
 ]
 
 
+SINGULAR_TOL = 1e-12  # relative size of the smallest Cholesky pivot² below which M counts as singular
+
+
 @dataclass(frozen=True)
 class _Piece:
     row: int  # DH row whose frame holds the data
@@ -340,7 +343,23 @@ def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool
     )
     bias = rnea(robot, q, qd, np.zeros(n), gravity=gravity, friction=friction)
     M = mass_matrix(robot, q)
+    _check_regular(robot, M)
     return np.linalg.solve(M, (tau - bias)[..., None])[..., 0]
+
+
+def _check_regular(robot: DHRobot, M: np.ndarray) -> None:
+    """Raise ModelError when M is singular (a joint whose subtree has no inertia about its axis)."""
+    try:
+        L = np.linalg.cholesky(M)
+        d = np.diagonal(L, axis1=-2, axis2=-1) ** 2
+        bad = (d.min(axis=-1) <= SINGULAR_TOL * d.max(axis=-1)).any()
+    except np.linalg.LinAlgError:
+        bad = True
+    if bad:
+        raise ModelError(
+            f"robot {robot.name!r}: the mass matrix is singular here, so q̈ is undefined (a joint moves no "
+            "mass or inertia, e.g. point masses on its axis); give the links inertia tensors or motor inertia"
+        )
 
 
 def kinetic_energy(robot: DHRobot, q, qd) -> np.ndarray:
