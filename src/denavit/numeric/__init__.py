@@ -1,6 +1,41 @@
 """The numeric engine (numpy): every function is batched over leading axes ``(..., n)``."""
 
-from ._jacobians import geometric_jacobian, joint_axes
+from ._jacobians import (
+    analytic_jacobian,
+    differentiation_jacobian,
+    end_effector_twist,
+    geometric_jacobian,
+    jacobian_base_from_tool,
+    jacobian_tool_from_base,
+    joint_axes,
+    rpy_rate_matrix,
+    zyz_rate_matrix,
+)
+from ._propagation import (
+    ForcePropagation,
+    VelocityPropagation,
+    force_propagation,
+    propagation_jacobian,
+    velocity_propagation,
+)
+from ._singularities import (
+    Ellipsoid,
+    condition_number,
+    force_ellipsoid,
+    is_singular,
+    jacobian_rank,
+    manipulability,
+    singular_values,
+    smallest_singular_value,
+    velocity_ellipsoid,
+)
+from ._statics import (
+    as_wrench,
+    joint_torques,
+    joint_torques_from_jacobian,
+    wrench_base_from_tool,
+    wrench_tool_from_base,
+)
 from ._dynamics import (
     coriolis_matrix,
     coriolis_vector,
@@ -32,6 +67,32 @@ from ._transforms import (
 __all__ = [
     "geometric_jacobian",
     "joint_axes",
+    "analytic_jacobian",
+    "differentiation_jacobian",
+    "end_effector_twist",
+    "jacobian_base_from_tool",
+    "jacobian_tool_from_base",
+    "rpy_rate_matrix",
+    "zyz_rate_matrix",
+    "ForcePropagation",
+    "VelocityPropagation",
+    "force_propagation",
+    "propagation_jacobian",
+    "velocity_propagation",
+    "Ellipsoid",
+    "condition_number",
+    "force_ellipsoid",
+    "is_singular",
+    "jacobian_rank",
+    "manipulability",
+    "singular_values",
+    "smallest_singular_value",
+    "velocity_ellipsoid",
+    "as_wrench",
+    "joint_torques",
+    "joint_torques_from_jacobian",
+    "wrench_base_from_tool",
+    "wrench_tool_from_base",
     "rnea",
     "mass_matrix",
     "mass_matrix_derivatives",

@@ -1,13 +1,46 @@
-"""Geometric Jacobians from the frames, batched: shape (..., 6, n), rows (v, ω)."""
+"""Jacobians of the end effector, batched: shape (..., 6, n), rows (v, ω).
+
+Three numeric routes that share nothing but the model:
+
+* :func:`geometric_jacobian` — from the joint axes of the world frames (Siciliano eq. 3.30);
+* :func:`differentiation_jacobian` — by differentiating the product of DH matrices entry by entry,
+  linear rows ∂p/∂q, angular rows from the skew matrix Ṙ Rᵀ (Spong eq. 4.30);
+* :func:`denavit.numeric.propagation_jacobian` — Craig's outward velocity propagation (Craig eq. 5.45–5.47).
+
+All use the end-effector origin (after ``tool``) as reference point. ``frame="base"`` gives J0 (world axes,
+``base`` included), ``frame="tool"`` gives Je (end-effector axes); :func:`jacobian_tool_from_base` and
+:func:`jacobian_base_from_tool` convert between them. :func:`analytic_jacobian` maps joint rates to
+(ṗ, φ̇) with φ roll–pitch–yaw or ZYZ Euler angles.
+"""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+from .._validate import as_joint_array
+from ..errors import ShapeError
 from ..model import Convention, DHRobot, Frame, JointType
-from ._kinematics import link_transforms
+from ._kinematics import joint_values_per_row, link_transforms
+from ._transforms import dh_transform, rpy_from_rotation, zyz_from_rotation
 
-__all__ = ["geometric_jacobian", "joint_axes"]
+__all__ = [
+    "geometric_jacobian",
+    "joint_axes",
+    "differentiation_jacobian",
+    "jacobian_tool_from_base",
+    "jacobian_base_from_tool",
+    "analytic_jacobian",
+    "rpy_rate_matrix",
+    "zyz_rate_matrix",
+    "end_effector_twist",
+    "REPRESENTATIONS",
+]
+
+REPRESENTATIONS = ("rpy", "zyz")
+#: Below this |cos pitch| (RPY) or |sin θ| (ZYZ) the angle-rate map is treated as singular.
+REPRESENTATION_SINGULAR_TOL = 1e-9
 
 
 def joint_axes(robot: DHRobot, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -47,3 +80,161 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np
         Rt = np.swapaxes(T_e[..., :3, :3], -1, -2)
         J = np.concatenate([Rt @ J[..., :3, :], Rt @ J[..., 3:, :]], axis=-2)
     return J
+
+
+def _dh_derivative(convention: Convention, joint: JointType, theta, d, a: float, alpha: float) -> np.ndarray:
+    """∂A/∂q of one DH matrix, entry by entry (the matrix of :func:`dh_transform` differentiated)."""
+    theta, d = np.broadcast_arrays(np.asarray(theta, float), np.asarray(d, float))
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    dA = np.zeros(theta.shape + (4, 4))
+    zero = np.zeros_like(ct)
+    if joint is JointType.PRISMATIC:  # only the translation along z_{i-1} / z_i depends on d
+        if convention is Convention.STANDARD:
+            dA[..., 2, 3] = 1.0
+        else:
+            dA[..., 1, 3], dA[..., 2, 3] = -sa, ca
+        return dA
+    if convention is Convention.STANDARD:  # ∂/∂θ of Spong eq. 3.10
+        dA[..., 0, :3] = np.stack([-st, -ct * ca, ct * sa], -1)
+        dA[..., 0, 3] = -a * st
+        dA[..., 1, :3] = np.stack([ct, -st * ca, st * sa], -1)
+        dA[..., 1, 3] = a * ct
+    else:  # ∂/∂θ of Craig eq. 3.6
+        dA[..., 0, :3] = np.stack([-st, -ct, zero], -1)
+        dA[..., 1, :3] = np.stack([ct * ca, -st * ca, zero], -1)
+        dA[..., 2, :3] = np.stack([ct * sa, -st * sa, zero], -1)
+    return dA
+
+
+def differentiation_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np.ndarray:
+    """Jacobian by differentiating the forward-kinematics product, shape (..., 6, n), rows (v, ω).
+
+    For the joint of row k, ∂T/∂q_k = base A_1 ⋯ A_{k-1} (∂A_k/∂q_k) A_{k+1} ⋯ A_N tool; the linear rows
+    are the translation column of that derivative and the angular rows the vector of the skew matrix
+    (∂R/∂q_k) Rᵀ (Spong, Hutchinson & Vidyasagar 2006, sec. 4.2–4.6). Reference point: end-effector origin.
+
+    Parameters
+    ----------
+    robot : DHRobot
+    q : array_like, shape (..., n)
+        Joint values [rad or m].
+    frame : Frame or {"base", "tool"}
+        Axes of the result: world/base (J0) or end effector (Je).
+    """
+    frame = Frame(frame)
+    q = as_joint_array(q, robot.dof)
+    batch = q.shape[:-1]
+    rows = joint_values_per_row(robot, q)
+    A = [np.broadcast_to(dh_transform(robot.convention, th, d, link.a, link.alpha), batch + (4, 4))
+         for link, (th, d) in zip(robot.links, rows)]  # N × (..., 4, 4)
+    prefix = [np.broadcast_to(robot.base_matrix, batch + (4, 4))]
+    for Ak in A:
+        prefix.append(prefix[-1] @ Ak)
+    suffix = [np.broadcast_to(robot.tool_matrix, batch + (4, 4))]
+    for Ak in reversed(A):
+        suffix.append(Ak @ suffix[-1])
+    suffix.reverse()  # suffix[k] = A_{k+1} ⋯ A_N tool (0-based rows)
+    T = prefix[-1] @ robot.tool_matrix  # (..., 4, 4)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    cols = []
+    for r in robot.joint_rows:
+        link = robot.links[r]
+        th, d = rows[r]
+        dT = prefix[r] @ _dh_derivative(robot.convention, link.joint, th, d, link.a, link.alpha) @ suffix[r + 1]
+        W = dT[..., :3, :3] @ Rt  # (..., 3, 3) skew(ω)
+        w = 0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1)
+        cols.append(np.concatenate([dT[..., :3, 3], w], axis=-1))  # (..., 6)
+    J = np.stack(cols, axis=-1)  # (..., 6, n)
+    return jacobian_tool_from_base(J, T) if frame is Frame.TOOL else J
+
+
+def _rotation(R_or_T) -> np.ndarray:
+    M = np.asarray(R_or_T, dtype=float)
+    if M.ndim < 2 or M.shape[-2:] not in ((3, 3), (4, 4)):
+        raise ShapeError(f"expected a rotation (..., 3, 3) or transform (..., 4, 4), got shape {M.shape}")
+    return M[..., :3, :3]
+
+
+def _rotate_rows(J: np.ndarray, R: np.ndarray) -> np.ndarray:
+    J = np.asarray(J, dtype=float)
+    if J.ndim < 2 or J.shape[-2] != 6:
+        raise ShapeError(f"J: expected shape (..., 6, n), got {J.shape}")
+    return np.concatenate([R @ J[..., :3, :], R @ J[..., 3:, :]], axis=-2)
+
+
+def jacobian_tool_from_base(J0, T_w_e) -> np.ndarray:
+    """Je = diag(Rᵀ, Rᵀ) J0 with R the end-effector orientation in world axes (Siciliano eq. 3.112).
+
+    ``T_w_e`` is the end-effector pose (..., 4, 4) or its rotation (..., 3, 3). Same reference point.
+    """
+    return _rotate_rows(J0, np.swapaxes(_rotation(T_w_e), -1, -2))
+
+
+def jacobian_base_from_tool(Je, T_w_e) -> np.ndarray:
+    """J0 = diag(R, R) Je, the inverse of :func:`jacobian_tool_from_base`."""
+    return _rotate_rows(Je, _rotation(T_w_e))
+
+
+def rpy_rate_matrix(rpy) -> np.ndarray:
+    """E (..., 3, 3) with ω = E φ̇ for φ = (roll, pitch, yaw), R = Rz(yaw) Ry(pitch) Rx(roll), ω in world axes.
+
+    ω = ẏ z + ṗ Rz(y) y + ṙ Rz(y) Ry(p) x (Siciliano eq. 3.64 for the RPY/ZYX case).
+    """
+    rpy = np.asarray(rpy, dtype=float)
+    p, y = rpy[..., 1], rpy[..., 2]
+    cp, sp, cy, sy = np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    z = np.zeros_like(p)
+    return np.stack([np.stack([cy * cp, -sy, z], -1),
+                     np.stack([sy * cp, cy, z], -1),
+                     np.stack([-sp, z, z + 1.0], -1)], axis=-2)
+
+
+def zyz_rate_matrix(zyz) -> np.ndarray:
+    """E (..., 3, 3) with ω = E φ̇ for ZYZ angles (φ, θ, ψ), R = Rz(φ) Ry(θ) Rz(ψ) (Siciliano eq. 3.64)."""
+    zyz = np.asarray(zyz, dtype=float)
+    ph, th = zyz[..., 0], zyz[..., 1]
+    cf, sf, ct, st = np.cos(ph), np.sin(ph), np.cos(th), np.sin(th)
+    z = np.zeros_like(ph)
+    return np.stack([np.stack([z, -sf, cf * st], -1),
+                     np.stack([z, cf, sf * st], -1),
+                     np.stack([z + 1.0, z, ct], -1)], axis=-2)
+
+
+def analytic_jacobian(robot: DHRobot, q, representation: str = "rpy") -> tuple[np.ndarray, np.ndarray]:
+    """Analytic Jacobian Ja (..., 6, n) mapping q̇ to (ṗ, φ̇), and the angles φ (..., 3).
+
+    Ja = diag(I, E(φ)⁻¹) J0 (Siciliano eq. 3.66), φ the roll–pitch–yaw angles (``"rpy"``, R = Rz Ry Rx)
+    or ZYZ Euler angles (``"zyz"``) of the end effector in world axes, extracted as in
+    :func:`denavit.numeric.rpy_from_rotation` / :func:`zyz_from_rotation`. At a representation singularity
+    (cos pitch = 0, or sin θ = 0) the angle rows are not defined: a warning is issued and they are NaN.
+    """
+    if representation not in REPRESENTATIONS:
+        raise ValueError(f"unknown representation {representation!r}; choose one of {', '.join(REPRESENTATIONS)}")
+    frames = link_transforms(robot, q)
+    T = frames[..., -1, :, :] @ robot.tool_matrix
+    J0 = geometric_jacobian(robot, q, Frame.BASE)
+    if representation == "rpy":
+        phi = rpy_from_rotation(T[..., :3, :3])
+        E = rpy_rate_matrix(phi)
+        bad = np.abs(np.cos(phi[..., 1])) < REPRESENTATION_SINGULAR_TOL
+    else:
+        phi = zyz_from_rotation(T[..., :3, :3])
+        E = zyz_rate_matrix(phi)
+        bad = np.abs(np.sin(phi[..., 1])) < REPRESENTATION_SINGULAR_TOL
+    if np.any(bad):
+        warnings.warn(f"{representation} representation singularity: angle-rate rows set to NaN", stacklevel=2)
+    E = np.where(bad[..., None, None], np.eye(3), E)
+    rates = np.linalg.solve(E, J0[..., 3:, :])  # (..., 3, n)
+    rates = np.where(bad[..., None, None], np.nan, rates)
+    return np.concatenate([J0[..., :3, :], rates], axis=-2), phi
+
+
+def end_effector_twist(robot: DHRobot, q, qd, frame: Frame | str = Frame.BASE) -> np.ndarray:
+    """End-effector twist (v, ω) = J q̇, shape (..., 6), in base (J0) or tool (Je) axes.
+
+    v is the velocity of the end-effector origin [m/s], ω the angular velocity [rad/s].
+    """
+    q = as_joint_array(q, robot.dof)
+    qd = as_joint_array(qd, robot.dof, "qd")
+    J = geometric_jacobian(robot, q, frame)
+    return np.einsum("...ij,...j->...i", J, qd)
