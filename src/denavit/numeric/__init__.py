@@ -49,6 +49,13 @@ from ._dynamics import (
     rnea,
 )
 from ._kinematics import forward_kinematics, link_transforms
+from ._trajectory import (
+    CartesianPath,
+    JointTrajectory,
+    cartesian_path,
+    quintic_trajectory,
+    trapezoidal_trajectory,
+)
 from ._transforms import (
     adjoint,
     dh_transform,
@@ -105,6 +112,11 @@ __all__ = [
     "potential_energy",
     "forward_kinematics",
     "link_transforms",
+    "JointTrajectory",
+    "CartesianPath",
+    "quintic_trajectory",
+    "trapezoidal_trajectory",
+    "cartesian_path",
     "adjoint",
     "dh_transform",
     "inverse_transform",
