@@ -55,13 +55,16 @@ def _view_box(robot: DHRobot, lim: np.ndarray) -> tuple[list[float], float]:
 def _sliders(robot: DHRobot, lim: np.ndarray, q0: np.ndarray) -> str:
     out = []
     for k, kind in enumerate(robot.joint_types):
-        lo, hi = lim[k]
+        lo, hi = float(lim[k, 0]), float(lim[k, 1])
         step = (hi - lo) / SLIDER_STEPS if hi > lo else 1e-3
+        m = round((float(q0[k]) - lo) / step)
+        if m >= 1:  # put q0 on the slider's grid (the grid starts at min)
+            step = (float(q0[k]) - lo) / m
         unit = "revolute" if kind is JointType.REVOLUTE else "prismatic"
         out.append(
             f'<div class="joint"><label for="q{k + 1}"><span>q{k + 1} ({unit})</span>'
             f'<span id="qv{k + 1}"></span></label>'
-            f'<input type="range" id="q{k + 1}" min="{lo!r}" max="{hi!r}" step="{step!r}" value="{q0[k]!r}"></div>')
+            f'<input type="range" id="q{k + 1}" min="{lo!r}" max="{hi!r}" step="{step!r}" value="{float(q0[k])!r}"></div>')
     return "\n  ".join(out)
 
 

@@ -122,7 +122,7 @@
       seg(list, P([o0[0] + i * step, o0[1] - G, o0[2]]), P([o0[0] + i * step, o0[1] + G, o0[2]]), "#e6e6e6", 1);
       seg(list, P([o0[0] - G, o0[1] + i * step, o0[2]]), P([o0[0] + G, o0[1] + i * step, o0[2]]), "#e6e6e6", 1);
     }
-    box(list, P, mul(DATA.base, tz(-0.6 * r)), 1.6 * r, 1.6 * r, 0.4 * r, "#9e9e9e", "#616161");
+    box(list, P, mul(DATA.base, tz(-1.6 * r)), 1.6 * r, 1.6 * r, 0.3 * r, "#9e9e9e", "#616161");
     // links: o_0, k_1, o_1, ..., o_N, o_e
     var pts = [col(g.frames[0], 3)];
     for (i = 0; i < g.knees.length; i++) { pts.push(g.knees[i]); pts.push(col(g.frames[i + 1], 3)); }
@@ -192,13 +192,18 @@
   function onSlider(k) {
     return function (ev) { q[k] = parseFloat(ev.target.value); update(true); };
   }
+  // the sliders are the state: start from their values (the browser may snap q0 to the slider grid)
   for (var k = 0; k < q.length; k++) {
     var s = document.getElementById("q" + (k + 1));
+    q[k] = parseFloat(s.value);
     s.addEventListener("input", onSlider(k));
   }
   document.getElementById("reset").addEventListener("click", function () {
-    q = DATA.q0.slice();
-    for (var k = 0; k < q.length; k++) document.getElementById("q" + (k + 1)).value = q[k];
+    for (var k = 0; k < q.length; k++) {
+      var el = document.getElementById("q" + (k + 1));
+      el.value = DATA.q0[k];
+      q[k] = parseFloat(el.value);
+    }
     trace = []; update(true);
   });
   document.getElementById("clear-trace").addEventListener("click", function () { trace = []; update(true); });
