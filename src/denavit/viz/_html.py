@@ -100,7 +100,8 @@ def viewer_html(robot: DHRobot, q=None, title: str | None = None) -> str:
         "center": centre,
         "radius": radius,
     }
-    blob = json.dumps(data).replace("</", "<\\/")
+    # \u escapes keep any text of the robot file from closing the <script> block
+    blob = json.dumps(data).replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
     name = html.escape(title or robot.name)
     subtitle = html.escape(f"{robot.convention.value} DH, {robot.dof} joints "
                            f"({''.join('R' if t is JointType.REVOLUTE else 'P' for t in robot.joint_types)})"
