@@ -1,0 +1,131 @@
+"""Subcommands on written work: report (a whole derivation), check (a person's claims), import-table."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParseError
+from ._common import add_common, add_q, joint_values, load
+
+_SPLIT = re.compile(r"[,;\s]+(?![^()]*\))")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="the whole derivation as a document (.md, .tex, .html or .pdf)")
+    add_common(p)
+    add_q(p, required=False)
+    p.add_argument("--qd", metavar="QD", help="joint rates for the velocity section")
+    p.add_argument("--wrench", metavar="W", help="end-effector wrench fx,fy,fz,nx,ny,nz (base axes) for statics")
+    p.add_argument("-o", "--output", metavar="FILE", help="report file: .md, .tex, .html or .pdf (Markdown on stdout if absent)")
+    p.add_argument("--topics", metavar="LIST", help="comma-separated sections to include (default: all)")
+    p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
+    p.set_defaults(handler=cmd_report)
+
+    p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
+    add_common(p)
+    p.add_argument("claims", metavar="CLAIMS_FILE", help="YAML claims file (see docs/claims.md)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random test points (default 0)")
+    p.set_defaults(handler=cmd_check)
+
+    p = sub.add_parser("import-table", help="read a DH table pasted from a document and write a robot file")
+    p.add_argument("file", metavar="FILE", help="text file holding the table (tab, Markdown or LaTeX cells)")
+    p.add_argument("-o", "--output", metavar="ROBOT_FILE", help="robot file to write (.yaml or .json); stdout if absent")
+    p.add_argument("--convention", choices=["standard", "modified"], help="override the convention read from the header")
+    p.add_argument("--name", help="robot name (default: the file's stem)")
+    p.add_argument("--force", action="store_true", help="overwrite ROBOT_FILE if it exists")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.add_argument("--deg", action="store_true", help="the table's angles are in degrees")
+    p.set_defaults(handler=cmd_import_table)
+
+
+def _parts(text: str | None) -> list[str] | None:
+    if text is None:
+        return None
+    return [p for p in _SPLIT.split(text.strip().strip("[]()")) if p]
+
+
+def cmd_report(args: argparse.Namespace):
+    from ..report import derive, format_from_path, render_markdown, write_report
+
+    robot = load(args)
+    fmt = format_from_path(args.output) if args.output else "md"
+    q = qd = wrench = None
+    if args.q is not None:
+        joint_values(args, robot, args.q)  # validates count, syntax and limits
+        q = _parts(args.q)
+    if args.qd is not None:
+        joint_values(args, robot, args.qd, what="qd", rates=True)
+        qd = _parts(args.qd)
+    if args.wrench is not None:
+        from ..io import parse_values
+
+        parse_values(args.wrench, 6, what="wrench")
+        wrench = _parts(args.wrench)
+    topics = [t.strip() for t in args.topics.split(",") if t.strip()] if args.topics else None
+    d = derive(robot, q, qd, wrench, topics=topics, simplify=args.simplify, deg=args.deg)
+    data = derivation_json(d)
+    if args.output:
+        written = write_report(d, args.output, fmt)
+        data["output"] = [str(p) for p in written]
+        done = sum(s.status == "done" for s in d.sections)
+        text = (f"wrote {written[0]} ({fmt}, {done} of {len(d.sections)} sections complete"
+                + "".join(f"; {s.key}: {s.status} ({s.reason})" for s in d.sections if s.status != "done") + ")")
+        if len(written) > 1:
+            text += "\nand " + ", ".join(str(p) for p in written[1:])
+        return data, text
+    return data, render_markdown(d)[0]
+
+
+def derivation_json(d) -> dict[str, Any]:
+    """The derivation as plain data: sections of steps with their LaTeX and values."""
+    from ..report import Equation, Figure, Numbers, Table, Text, math_of
+
+    sections = []
+    for s in d.sections:
+        steps: list[dict[str, Any]] = []
+        for st in s.steps:
+            if isinstance(st, Text):
+                steps.append({"type": "text", "text": st.text})
+            elif isinstance(st, Equation):
+                steps.append({"type": "equation", "lhs": st.lhs, "latex": math_of(st), "note": st.note})
+            elif isinstance(st, Numbers):
+                steps.append({"type": "numbers", "lhs": st.lhs, "values": st.values, "note": st.note})
+            elif isinstance(st, Table):
+                steps.append({"type": "table", "header": list(st.header), "rows": [list(r) for r in st.rows]})
+            elif isinstance(st, Figure):
+                steps.append({"type": "figure", "caption": st.caption, "name": st.name})
+        sections.append({"key": s.key, "title": s.title, "status": s.status, "reason": s.reason, "steps": steps})
+    return {**d.inputs, "title": d.title, "sections": sections}
+
+
+def cmd_check(args: argparse.Namespace):
+    from ..check import check_file, verdicts_text
+
+    robot = load(args)
+    result = check_file(robot, Path(args.claims), seed=args.seed)
+    return result.to_json(), verdicts_text(result)
+
+
+def cmd_import_table(args: argparse.Namespace):
+    from ..io import dump_robot, robot_to_dict, save_robot
+    from ..tables import import_table
+
+    path = Path(args.file)
+    if not path.is_file():
+        raise ParseError(f"no such file: {str(path)!r}")
+    text = path.read_text(encoding="utf-8", errors="replace")
+    result = import_table(text, name=args.name or path.stem, convention=args.convention,
+                          degrees=True if args.deg else None, where=str(path))
+    robot = result.robot
+    if args.output:
+        save_robot(robot, args.output, overwrite=args.force)
+        msg = f"wrote {args.output} ({robot.convention.value} DH, {robot.n_rows} rows, {robot.dof} joints)"
+    else:
+        msg = dump_robot(robot)
+    if result.notes:
+        msg += "\n" + "\n".join(f"note: {n}" for n in result.notes)
+    return {"file": str(path), "output": args.output, "convention": robot.convention.value,
+            "notes": list(result.notes), "robot_file": robot_to_dict(robot)}, msg

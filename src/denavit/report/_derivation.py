@@ -1,0 +1,187 @@
+"""A derivation as data: sections of steps (text, equations, numbers, tables, figures).
+
+:func:`derive` builds the whole worked derivation of a robot, in the order a textbook or a course report
+writes it (Craig 2005, ch. 3-6; Spong et al. 2006, ch. 3-7): the DH table and convention, each link
+transform A_i (general form, then substituted), T_0_n, the end-effector position, the Jacobian with its
+route, velocities, statics, singularities, inverse kinematics, dynamics and figures.  Nothing here is
+text layout: :mod:`denavit.report._render` turns a :class:`Derivation` into Markdown, LaTeX or HTML.
+
+Sections whose library functions are not available in this installation are kept, with
+``status="unavailable"`` and the reason, so a report never pretends to contain what it does not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ..model import DHRobot
+
+__all__ = [
+    "Text",
+    "Equation",
+    "Numbers",
+    "Table",
+    "Figure",
+    "Section",
+    "Derivation",
+    "Step",
+    "derive",
+    "TOPICS",
+]
+
+
+@dataclass(frozen=True)
+class Text:
+    """A paragraph; ``$...$`` spans are inline mathematics (LaTeX)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class Equation:
+    """``lhs = rhs``: ``lhs`` is LaTeX, ``expr`` a sympy expression or matrix (exact or symbolic).
+
+    ``shorthand`` marks that C_12/S_3 style symbols stand for cos(q1 + q2)/sin(q3) (display only).
+    """
+
+    lhs: str
+    expr: Any
+    relation: str = "="
+    note: str = ""
+    shorthand: bool = False
+
+
+@dataclass(frozen=True)
+class Numbers:
+    """``lhs ≈ values``: decimals computed by the numeric engine (``values`` an ndarray, any shape ≤ 2-D)."""
+
+    lhs: str
+    values: np.ndarray = field(compare=False)
+    digits: int = 4
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table whose cells are LaTeX snippets (rendered as inline mathematics) or plain text."""
+
+    header: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    math: bool = True
+    caption: str = ""
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A PNG picture (bytes) with a caption."""
+
+    png: bytes = field(repr=False)
+    caption: str
+    name: str
+
+
+Step = Text | Equation | Numbers | Table | Figure
+
+
+@dataclass(frozen=True)
+class Section:
+    """One part of the derivation.  ``status`` is ``"done"``, ``"skipped"`` (an input was not given)
+    or ``"unavailable"`` (the library function is not there); ``reason`` says why for the last two."""
+
+    key: str
+    title: str
+    steps: tuple[Step, ...] = ()
+    status: str = "done"
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """The whole report as data."""
+
+    robot: DHRobot
+    title: str
+    inputs: dict[str, Any]
+    sections: tuple[Section, ...]
+
+    def section(self, key: str) -> Section:
+        """The section with this key (KeyError naming the keys if absent)."""
+        for s in self.sections:
+            if s.key == key:
+                return s
+        raise KeyError(f"no section {key!r}; sections: {', '.join(s.key for s in self.sections)}")
+
+
+TOPICS = (
+    "model", "links", "fk", "case", "jacobian", "velocity", "statics", "singularities", "ik", "dynamics", "figures",
+)
+
+
+def _builders() -> dict[str, Callable[..., Section]]:
+    from . import _capabilities, _motion, _sections
+
+    return {
+        "model": _sections.section_model,
+        "links": _sections.section_links,
+        "fk": _sections.section_fk,
+        "case": _sections.section_case,
+        "jacobian": _motion.section_jacobian,
+        "velocity": _motion.section_velocity,
+        "statics": _motion.section_statics,
+        "singularities": _capabilities.section_singularities,
+        "ik": _capabilities.section_ik,
+        "dynamics": _capabilities.section_dynamics,
+        "figures": _capabilities.section_figures,
+    }
+
+
+def derive(
+    robot: DHRobot,
+    q: Sequence[Any] | None = None,
+    qd: Sequence[Any] | None = None,
+    wrench: Sequence[Any] | None = None,
+    *,
+    topics: Sequence[str] | None = None,
+    simplify: str = "trig",
+    deg: bool = False,
+) -> Derivation:
+    """Build the derivation of ``robot`` (data only; render it with :func:`render`).
+
+    Parameters
+    ----------
+    robot : DHRobot
+    q : sequence of float or str, shape (n,), optional
+        Joint values of the numeric case.  Strings (``"pi/4"``) are read exactly by the restricted
+        expression parser, so cos(π/4) appears as √2/2; floats are used as given.  ``None`` picks a
+        default configuration (π/6 for revolute joints, the middle of the stroke for prismatic ones).
+    qd : sequence, shape (n,), optional
+        Joint rates for the velocity section [rad/s or m/s].
+    wrench : sequence, shape (6,), optional
+        End-effector wrench (f, n) in base axes [N, N·m] for the statics section.
+    topics : sequence of str, optional
+        Sections to build, from :data:`TOPICS` (all by default).
+    simplify : {"none", "trig", "full"}
+        Simplification policy of the symbolic results.
+    deg : bool
+        Read revolute joint values in ``q`` (and rates in ``qd``) as degrees.
+
+    Returns
+    -------
+    Derivation
+    """
+    from ._context import Context
+
+    topics = tuple(TOPICS if topics is None else topics)
+    bad = [t for t in topics if t not in TOPICS]
+    if bad:
+        from ..errors import ParseError
+
+        raise ParseError(f"unknown report topic {bad[0]!r}; choose from {', '.join(TOPICS)}")
+    ctx = Context.build(robot, q, qd, wrench, simplify=simplify, deg=deg)
+    builders = _builders()
+    sections = tuple(builders[t](ctx) for t in TOPICS if t in topics)
+    title = f"Kinematics and dynamics of {robot.name}"
+    return Derivation(robot=robot, title=title, inputs=ctx.inputs(), sections=sections)

@@ -1,0 +1,182 @@
+"""Derivation reports: built as data, rendered in every format, numbers equal to the library's."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+from html import unescape
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import denavit as dn
+from denavit.report import Equation, Numbers, derive, render, write_report
+from denavit.report import _capabilities
+
+CI = os.environ.get("CI") == "true"
+ALL = dn.catalogue_names()
+FEW = ["report000-6r", "puma560", "report004-4-rrp", "planar2r"]
+
+
+def _case_inputs(robot, rng):
+    lo, hi = robot.q_limits.T
+    lo, hi = np.maximum(lo, -np.pi), np.minimum(hi, np.pi)
+    q = rng.uniform(lo, hi)
+    return q, rng.normal(size=robot.dof), rng.normal(size=6)
+
+
+def _numbers(sec, lhs):
+    return [s for s in sec.steps if isinstance(s, Numbers) and s.lhs == lhs]
+
+
+def _equations(sec, lhs):
+    return [s for s in sec.steps if isinstance(s, Equation) and s.lhs == lhs]
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_report_every_arm_renders_markdown(name):
+    robot = dn.load_robot(name)
+    d = derive(robot, qd=[0.5] * robot.dof, wrench=[1, 2, 3, 0.1, 0.2, 0.3])
+    text, _ = render(d, "md")
+    assert text.startswith(f"# Kinematics and dynamics of {name}")
+    for sec in d.sections:
+        assert sec.title in text
+        assert sec.status in ("done", "skipped", "unavailable")
+        if sec.status != "done":
+            assert sec.reason and sec.reason in text
+    assert "DISAGREE" not in text
+
+
+@pytest.mark.parametrize("name", FEW[:2] if CI else FEW)
+@pytest.mark.parametrize("fmt", ["html", "tex"])
+def test_report_renders_html_and_latex(name, fmt, tmp_path):
+    robot = dn.load_robot(name)
+    d = derive(robot, qd=[1] * robot.dof, wrench=[0, 0, -10, 0, 0, 0])
+    out = tmp_path / f"r.{fmt}"
+    written = write_report(d, out)
+    text = out.read_text()
+    assert written[0] == out
+    if fmt == "html":
+        assert text.startswith("<!DOCTYPE html>") and "katex.render" in text and "data:font/woff2;base64" in text
+        assert "http://" not in text.split("<script>")[0]  # no remote resources before the scripts
+    else:
+        assert text.startswith(r"\documentclass") and text.rstrip().endswith(r"\end{document}")
+        assert text.count(r"\begin{center}") == text.count(r"\end{center}")
+
+
+def test_report_numbers_equal_the_library():
+    rng = np.random.default_rng(7)
+    for name in ["report000-6r", "report001-6r", "stanford", "report004-8-prrr"]:
+        robot = dn.load_robot(name)
+        q, qd, w = _case_inputs(robot, rng)
+        d = derive(robot, q, qd, w)
+        label = "T_{we}" if not (np.allclose(robot.base_matrix, np.eye(4)) and np.allclose(robot.tool_matrix, np.eye(4))) \
+            else f"{{}}^{{0}}T_{{{robot.n_rows}}}"
+        case = d.section("case")
+        T = dn.forward_kinematics(robot, q)
+        np.testing.assert_allclose(_numbers(case, label)[0].values, T, atol=1e-12)
+        J = dn.geometric_jacobian(robot, q)
+        np.testing.assert_allclose(_numbers(d.section("jacobian"), "J_0(q)")[0].values, J, atol=1e-12)
+        np.testing.assert_allclose(_numbers(d.section("velocity"), "\\nu")[0].values, J @ qd, atol=1e-10)
+        np.testing.assert_allclose(_numbers(d.section("statics"), "\\tau")[0].values, J.T @ w, atol=1e-10)
+        # the decimals printed in the Markdown are the library's numbers, rounded
+        text, _ = render(d, "md")
+        for v in T[:3, 3]:
+            assert dn_number(v) in text
+
+
+def dn_number(v):
+    from denavit.report import number_text
+
+    return number_text(float(v))
+
+
+def test_report_exact_case_is_exact_and_agrees_with_numeric():
+    """q given as text is substituted exactly: cos(π/3) appears as 1/2, √3/2, and the exact T equals the
+    numeric engine's (an independent route: sympy arithmetic vs the numpy chain)."""
+    robot = dn.load_robot("report000-6r")
+    q = ["0", "pi/4", "pi/3", "-pi/2", "-pi/3", "pi/6"]
+    d = derive(robot, q, topics=["case"])
+    case = d.section("case")
+    A3 = _equations(case, "A_{3}")[0].expr
+    assert A3[0, 0] == sp.Rational(1, 2) and A3[2, 0] == sp.sqrt(3) / 2
+    T_exact = _equations(case, "{}^{0}T_{7}")[0].expr
+    assert all(e.is_number and not e.has(sp.Float) for e in T_exact)
+    qf = np.array([0, np.pi / 4, np.pi / 3, -np.pi / 2, -np.pi / 3, np.pi / 6])
+    np.testing.assert_allclose(np.array(T_exact.evalf(30), dtype=float), dn.forward_kinematics(robot, qf), atol=1e-14)
+
+
+def test_report_symbolic_jacobian_matches_numeric_at_random_points():
+    """The report's symbolic J0 (z_i × (p_e − p_i) from symbolic frames), evaluated at random q, equals
+    central finite differences of the numeric FK position (an independent route)."""
+    from denavit.report._context import Context
+    from denavit.report._motion import jacobian_sym
+    from denavit.symbolic import joint_symbols, parameter_symbols
+
+    rng = np.random.default_rng(3)
+    for name in ["report001-6r", "report004-4-rrp", "scara"]:
+        robot = dn.load_robot(name)
+        ctx = Context.build(robot, None, None, None)
+        J = jacobian_sym(ctx)
+        qs = joint_symbols(robot.dof).q
+        params = {parameter_symbols(robot)[k]: v for k, v in robot.parameters}
+        for _ in range(3):
+            q = rng.uniform(-np.pi, np.pi, robot.dof) * 0.5
+            Jq = np.array(J.xreplace(params).xreplace(dict(zip(qs, q))).evalf(), dtype=float)
+            h = 1e-6
+            fd = np.stack([(dn.forward_kinematics(robot, q + h * e)[:3, 3] - dn.forward_kinematics(robot, q - h * e)[:3, 3])
+                           / (2 * h) for e in np.eye(robot.dof)], axis=1)
+            np.testing.assert_allclose(Jq[:3], fd, atol=1e-7)
+
+
+def test_report_sections_say_honestly_when_a_capability_is_missing(monkeypatch):
+    monkeypatch.setattr(_capabilities, "capability", lambda module, *names: None)
+    robot = dn.load_robot("puma560")
+    d = derive(robot, topics=["singularities", "ik", "dynamics", "figures"])
+    for key in ("ik", "dynamics", "figures"):
+        assert d.section(key).status == "unavailable"
+        assert "not available" in d.section(key).reason
+    text, _ = render(d, "md")
+    assert text.count("> Not available:") == 4
+
+
+def test_report_skips_sections_without_their_inputs():
+    d = derive(dn.load_robot("planar3r"), topics=["velocity", "statics"])
+    assert [s.status for s in d.sections] == ["skipped", "skipped"]
+    assert "--qd" in d.section("velocity").reason and "--wrench" in d.section("statics").reason
+
+
+def test_report_bad_inputs_raise_parse_errors():
+    robot = dn.load_robot("planar2r")
+    with pytest.raises(dn.ParseError, match="q: expected 2 values, got 3"):
+        derive(robot, ["0", "1", "2"])
+    with pytest.raises(dn.ParseError, match="q: value 2"):
+        derive(robot, ["0", "import os"])
+    with pytest.raises(dn.ParseError, match="unknown report topic"):
+        derive(robot, topics=["nonsense"])
+
+
+@pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+def test_report_every_formula_is_valid_katex(tmp_path):
+    """Every formula of the HTML report is parsed by the bundled KaTeX with throwOnError."""
+    js = Path(dn.__file__).parent / "report" / "assets" / "katex" / "katex.min.js"
+    script = tmp_path / "check.js"
+    script.write_text(
+        "const k=require(process.argv[2]);const items=JSON.parse(require('fs').readFileSync(0,'utf8'));"
+        "const bad=[];for(const [s,d] of items){try{k.renderToString(s,{displayMode:d,throwOnError:true,"
+        "strict:false,maxSize:20});}catch(e){bad.push([s.slice(0,120),String(e).slice(0,160)]);}}"
+        "console.log(JSON.stringify(bad));")
+    for name in ["report000-6r", "report004-4-rrp", "puma560"]:
+        robot = dn.load_robot(name)
+        text, _ = render(derive(robot, qd=[1] * robot.dof, wrench=[1, 0, 0, 0, 0, 1]), "html")
+        items = [(unescape(m.group(2)), m.group(1) == "display")
+                 for m in re.finditer(r'<(?:div|span) class="math-(display|inline)">(.*?)</(?:div|span)>', text, re.S)]
+        assert len(items) > 20
+        out = subprocess.run(["node", str(script), str(js)], input=json.dumps(items), capture_output=True,
+                             text=True, timeout=120, check=True)
+        assert json.loads(out.stdout) == [], name
