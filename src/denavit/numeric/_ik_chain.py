@@ -1,0 +1,155 @@
+"""The joint-screw form of a DH chain and the small subproblems the analytic IK is built from.
+
+Every DH row, in either convention, factors into constant transforms and one elementary joint motion about
+or along a local z axis:
+
+    standard, revolute   Rz(q+θ) Tz(d) Tx(a) Rx(α)       = Rz(q) · [Rz(θ) Tz(d) Tx(a) Rx(α)]
+    standard, prismatic  Rz(θ) Tz(q+d) Tx(a) Rx(α)       = Tz(q) · [Rz(θ) Tz(d) Tx(a) Rx(α)]
+    modified, revolute   Rx(α) Tx(a) Rz(q+θ) Tz(d)       = [Rx(α) Tx(a)] · Rz(q) · [Rz(θ) Tz(d)]
+    modified, prismatic  Rx(α) Tx(a) Rz(θ) Tz(q+d)       = [Rx(α) Tx(a)] · Tz(q) · [Rz(θ) Tz(d)]
+
+so the whole arm, base, fixed rows and tool included, is ``T_w_e = C0 J1(q1) C1 J2(q2) ⋯ Jn(qn) Cn`` with
+constant ``C_k`` (the product-of-exponentials form in local coordinates, Lynch & Park 2017, Sec. 4.1).
+The IK solvers work on this form only, so they treat both conventions, offsets and fixed rows alike
+(no per-convention derivation to get wrong).  The subproblems are those of Paden (1986) and Kahan,
+as collected in Murray, Li & Sastry (1994), Sec. 3.3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import Convention, DHRobot, JointType
+from ._transforms import inverse_transform
+
+__all__ = ["Chain", "chain_of", "chain_fk", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
+           "wrap_angle", "axis_lines"]
+
+
+def _rz(t: float) -> np.ndarray:
+    c, s = np.cos(t), np.sin(t)
+    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+
+
+def _rx(t: float) -> np.ndarray:
+    c, s = np.cos(t), np.sin(t)
+    return np.array([[1.0, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
+
+
+def _tz(d: float) -> np.ndarray:
+    T = np.eye(4)
+    T[2, 3] = d
+    return T
+
+
+def _tx(a: float) -> np.ndarray:
+    T = np.eye(4)
+    T[0, 3] = a
+    return T
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """``T = C0 J1(q1) C1 ⋯ Jn(qn) Cn``: consts (n+1, 4, 4), prismatic (n,) bool."""
+
+    consts: np.ndarray
+    prismatic: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.prismatic)
+
+
+def chain_of(robot: DHRobot) -> Chain:
+    """The joint-screw form of a robot (base, fixed rows and tool folded into the constants)."""
+    consts = []
+    cur = robot.base_matrix
+    std = robot.convention is Convention.STANDARD
+    for link in robot.links:
+        after = _rz(link.theta) @ _tz(link.d)
+        if std:
+            after = after @ _tx(link.a) @ _rx(link.alpha)
+        else:
+            cur = cur @ _rx(link.alpha) @ _tx(link.a)
+        if link.joint is JointType.FIXED:
+            cur = cur @ after
+        else:
+            consts.append(cur)
+            cur = after
+    consts.append(cur @ robot.tool_matrix)
+    prismatic = np.array([t is JointType.PRISMATIC for t in robot.joint_types])
+    return Chain(np.array(consts), prismatic)
+
+
+def joint_motion(prismatic: bool, q: np.ndarray) -> np.ndarray:
+    """Rz(q) or Tz(q), shape q.shape + (4, 4)."""
+    q = np.asarray(q, dtype=float)
+    J = np.zeros(q.shape + (4, 4))
+    J[..., 3, 3] = 1.0
+    J[..., 2, 2] = 1.0
+    if prismatic:
+        J[..., 0, 0] = J[..., 1, 1] = 1.0
+        J[..., 2, 3] = q
+    else:
+        c, s = np.cos(q), np.sin(q)
+        J[..., 0, 0], J[..., 0, 1], J[..., 1, 0], J[..., 1, 1] = c, -s, s, c
+    return J
+
+
+def chain_fk(chain: Chain, q: np.ndarray, upto: int | None = None, start: int = 0) -> np.ndarray:
+    """``C_start J_{start+1} C_{start+1} ⋯ J_upto C_upto`` (joint indices 1-based), batched over q (..., m).
+
+    ``q[..., k]`` is the value of joint ``start + k + 1``.  With ``upto=None`` the whole chain is used.
+    """
+    upto = chain.n if upto is None else upto
+    q = np.asarray(q, dtype=float)
+    T = np.broadcast_to(chain.consts[start], q.shape[:-1] + (4, 4))
+    for k in range(start, upto):
+        T = T @ joint_motion(bool(chain.prismatic[k]), q[..., k - start]) @ chain.consts[k + 1]
+    return T
+
+
+def reverse_chain(chain: Chain) -> Chain:
+    """The chain of ``T⁻¹``: ``Cn⁻¹ Jn(−qn) ⋯ C0⁻¹``; its joint k is joint n+1−k with the sign flipped."""
+    return Chain(inverse_transform(chain.consts[::-1]), chain.prismatic[::-1].copy())
+
+
+def axis_lines(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Point on and direction of every joint axis in world coordinates at q, each (..., n, 3)."""
+    q = np.asarray(q, dtype=float)
+    T = np.broadcast_to(chain.consts[0], q.shape[:-1] + (4, 4))
+    pts, dirs = [], []
+    for k in range(chain.n):
+        pts.append(T[..., :3, 3])
+        dirs.append(T[..., :3, 2])
+        T = T @ joint_motion(bool(chain.prismatic[k]), q[..., k]) @ chain.consts[k + 1]
+    return np.stack(pts, axis=-2), np.stack(dirs, axis=-2)
+
+
+def wrap_angle(x: np.ndarray) -> np.ndarray:
+    """Angles wrapped into (−π, π]."""
+    return np.pi - np.mod(np.pi - np.asarray(x, dtype=float), 2 * np.pi)
+
+
+def solve_trig(a, b, c, tol: float = 1e-9) -> np.ndarray:
+    """All θ with ``a cos θ + b sin θ = c`` (Paden–Kahan subproblem 1 in scalar form), shape (..., 2).
+
+    θ = atan2(b, a) ± arccos(c / √(a² + b²)); NaN where there is no solution (|c| > ρ) or the equation does
+    not depend on θ (ρ ≈ 0).  A ratio within ``tol`` beyond ±1 is taken as the tangent (double) root.
+    """
+    a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (a, b, c)))
+    rho = np.hypot(a, b)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = c / rho
+    ok = (rho > 1e-12) & (np.abs(ratio) <= 1 + tol)
+    base = np.arctan2(b, a)
+    delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
+    out = np.stack([base + delta, base - delta], axis=-1)
+    return np.where(ok[..., None], out, np.nan)
+
+
+def angle_about_z(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """θ with Rz(θ) u ≈ v in the xy-plane (Paden–Kahan subproblem 2 about z), shape (...)."""
+    return np.arctan2(v[..., 1], v[..., 0]) - np.arctan2(u[..., 1], u[..., 0])

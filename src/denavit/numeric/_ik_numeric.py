@@ -1,0 +1,343 @@
+"""Numerical inverse kinematics: Levenberg–Marquardt (damped least squares), batched over targets.
+
+Every target of a batch runs its own LM iteration (own damping, own acceptance test), but the arithmetic
+of one iteration is done for the whole batch at once with numpy: one forward-kinematics pass, one
+Jacobian, one batched n×n solve.  Targets that converge drop out; targets that stall are restarted from
+random joint values within the limits.  Success is always decided by re-running the forward kinematics on
+the returned joint values, never taken from the iteration's own bookkeeping.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+
+from .._validate import as_joint_array, as_transform
+from ..errors import ShapeError
+from ..model import DHRobot, JointType
+from ._jacobians import geometric_jacobian
+from ._kinematics import forward_kinematics
+
+__all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
+
+TOL = 1e-9  # default position [m] and orientation [rad] tolerance
+MAX_ITERATIONS = 100
+RESTARTS = 32
+PARALLEL_SEEDS = 4
+LAMBDA0 = 1e-3  # initial damping, relative to the squared characteristic length
+LAMBDA_MAX = 1e3  # damping (relative to L²) beyond which an attempt counts as stuck
+_REASONS = ("", "iterations", "limits", "unreachable")
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Result of :func:`solve_ik` (arrays with the batch shape of the targets; scalars for one target).
+
+    Attributes
+    ----------
+    q : ndarray, shape (..., n)
+        Joint values [rad, m]: the solution, or the best point found when ``success`` is False.
+    success : bool or ndarray of bool, shape (...)
+        True when ``forward_kinematics(robot, q)`` matches the target within ``tol`` on the selected rows
+        and q is within the joint limits (decided by re-running FK, not by the iteration).
+    position_error, orientation_error : float or ndarray, shape (...)
+        Norm of the selected rows of the residual: position [m] and rotation vector log(R_t Rᵀ) [rad],
+        both in world axes.
+    iterations : int or ndarray, shape (...)
+        LM iterations spent, all restarts included.
+    restarts : int or ndarray, shape (...)
+        Random restarts used.
+    reason : str or ndarray of str, shape (...)
+        ``""`` on success; otherwise ``"unreachable"`` (no solution found even ignoring limits: the target
+        is probably outside the workspace), ``"limits"`` (a solution exists only outside the joint limits)
+        or ``"iterations"`` (the iteration budget ran out while still improving).
+    """
+
+    q: np.ndarray
+    success: Any
+    position_error: Any
+    orientation_error: Any
+    iterations: Any
+    restarts: Any
+    reason: Any
+
+
+def row_mask(mask: str | Sequence[bool] | None, dof: int | None = None) -> np.ndarray:
+    """Which pose rows (x, y, z, ωx, ωy, ωz) to match: ``"pose"``, ``"position"``, or 6 booleans."""
+    if mask is None or (isinstance(mask, str) and mask == "pose"):
+        return np.ones(6, dtype=bool)
+    if isinstance(mask, str):
+        if mask == "position":
+            return np.array([True] * 3 + [False] * 3)
+        raise ValueError(f"unknown mask {mask!r}; choose 'pose', 'position' or 6 booleans (x, y, z, wx, wy, wz)")
+    m = np.asarray(mask, dtype=bool).reshape(-1)
+    if m.shape != (6,) or not m.any():
+        raise ShapeError(f"mask: expected 6 booleans (x, y, z, wx, wy, wz) with at least one True, got {mask!r}")
+    return m
+
+
+def rotation_log(R: np.ndarray) -> np.ndarray:
+    """Rotation vector θ·u of rotation matrices (..., 3, 3) → (..., 3), θ in [0, π].
+
+    Rodrigues inverted: sin θ [u]× = (R − Rᵀ)/2, cos θ = (tr R − 1)/2; near θ = π the axis is taken from the
+    symmetric part, u uᵀ = (R + Rᵀ)/2 − cos θ I) / (1 − cos θ) (Murray, Li & Sastry 1994, Sec. 2.2).
+    """
+    R = np.asarray(R, dtype=float)
+    tr = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
+    cos = np.clip((tr - 1.0) / 2.0, -1.0, 1.0)
+    theta = np.arccos(cos)
+    v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
+    sin = np.sin(theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        factor = np.where(theta < 1e-6, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(sin == 0, 1, sin)))
+    out = v * factor[..., None]
+    near_pi = cos < -0.9
+    if np.any(near_pi):
+        Rn, cn, vn, tn = R[near_pi], cos[near_pi], v[near_pi], theta[near_pi]
+        S = 0.5 * (Rn + np.swapaxes(Rn, -1, -2)) - cn[:, None, None] * np.eye(3)
+        S = S / (1.0 - cn)[:, None, None]  # u uᵀ
+        k = np.argmax(np.diagonal(S, axis1=-2, axis2=-1), axis=-1)
+        u = S[np.arange(len(k)), :, k]
+        u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+        sign = np.where(np.einsum("...i,...i->...", u, vn) < 0, -1.0, 1.0)
+        out[near_pi] = u * (sign * tn)[:, None]
+    return out
+
+
+def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Residual (..., 6) = (p_t − p, log(R_t Rᵀ)) in world axes."""
+    dp = T_target[..., :3, 3] - T[..., :3, 3]
+    dw = rotation_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
+    return np.concatenate([dp, dw], axis=-1)
+
+
+def _char_length(robot: DHRobot) -> float:
+    """A length scale of the arm [m]: sum of |a| and |d| over the rows and the tool offset (≥ 1 mm)."""
+    s = sum(abs(l.a) + abs(l.d) for l in robot.links) + float(np.linalg.norm(robot.tool_matrix[:3, 3]))
+    return max(s, 1e-3)
+
+
+class _Limits:
+    """Joint limits as arrays, with the rule that brings q back inside (clip; wrap a full-turn revolute)."""
+
+    def __init__(self, robot: DHRobot, ignore: bool = False) -> None:
+        lim = robot.q_limits
+        self.revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+        if ignore:
+            lim = np.tile([-np.inf, np.inf], (robot.dof, 1))
+        self.lo, self.hi = lim[:, 0], lim[:, 1]
+        self.full_turn = self.revolute & (self.hi - self.lo >= 2 * np.pi)
+
+    def project(self, q: np.ndarray) -> np.ndarray:
+        q = np.where(self.revolute, np.pi - np.mod(np.pi - q, 2 * np.pi), q)  # wrap into (−π, π]
+        shift = np.where(q < self.lo, 2 * np.pi, np.where(q > self.hi, -2 * np.pi, 0.0))
+        q = np.where(self.revolute & (shift != 0) & (q + shift >= self.lo) & (q + shift <= self.hi), q + shift, q)
+        return np.clip(q, self.lo, self.hi)
+
+    def inside(self, q: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+        return np.all((q >= self.lo - tol) & (q <= self.hi + tol), axis=-1)
+
+    def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
+        lo = np.where(np.isfinite(self.lo), self.lo, np.where(self.revolute, -np.pi, -scale))
+        hi = np.where(np.isfinite(self.hi), self.hi, np.where(self.revolute, np.pi, scale))
+        return rng.uniform(lo, hi, size=shape + (len(lo),))
+
+
+def _lm(robot, q, T_t, w, limits, max_iter, tol_p, tol_r, L):
+    """Run LM on a flat batch q (B, n) towards T_t (B, 4, 4); returns q, converged, iterations, stalled.
+
+    The Jacobian is recomputed only where a step was accepted (a rejected step leaves q unchanged).
+    """
+    B, n = q.shape
+    e = pose_error(T_t, forward_kinematics(robot, q)) * w  # (B, 6)
+    cost = np.einsum("bi,bi->b", e, e)
+    lam = np.full(B, LAMBDA0 * L * L)
+    iters = np.zeros(B, dtype=int)
+    stalled = np.zeros(B, dtype=bool)
+    done = _converged(e, w, tol_p, tol_r, L)
+    J = np.zeros((B, 6, n))
+    fresh = ~done  # where J must be (re)computed
+    eye = np.eye(n)
+    for _ in range(max_iter):
+        act = np.flatnonzero(~done & ~stalled)
+        if act.size == 0:
+            break
+        upd = np.flatnonzero(fresh)
+        if upd.size:
+            J[upd] = geometric_jacobian(robot, q[upd]) * w[:, None]  # (b, 6, n), rows weighted
+            fresh[:] = False
+        Ja = J[act]
+        Jt = np.swapaxes(Ja, -1, -2)
+        A = Jt @ Ja + lam[act, None, None] * eye  # (b, n, n)
+        g = np.einsum("bij,bj->bi", Jt, e[act])
+        dq = np.linalg.solve(A, g[..., None])[..., 0]
+        q_new = limits.project(q[act] + dq)
+        e_new = pose_error(T_t[act], forward_kinematics(robot, q_new)) * w
+        c_new = np.einsum("bi,bi->b", e_new, e_new)
+        better = c_new < cost[act]
+        iters[act] += 1
+        acc, rej = act[better], act[~better]
+        q[acc], e[acc], cost[acc] = q_new[better], e_new[better], c_new[better]
+        lam[acc] = np.maximum(lam[acc] * 0.2, 1e-12 * L * L)
+        lam[rej] *= 8.0
+        fresh[acc] = True
+        stalled[rej[lam[rej] > LAMBDA_MAX * L * L]] = True
+        done[act] = _converged(e[act], w, tol_p, tol_r, L)
+    return q, done, iters, stalled
+
+
+def _converged(e, w, tol_p, tol_r, L):
+    wp = np.where(w[:3] > 0, 1.0, 0.0)
+    wr = np.where(w[3:] > 0, 1.0 / L, 0.0)
+    pe = np.sqrt(np.einsum("bi,bi->b", e[:, :3] * wp, e[:, :3] * wp))
+    re = np.sqrt(np.einsum("bi,bi->b", e[:, 3:] * wr, e[:, 3:] * wr))
+    # a margin below tol so that the FK re-check (a second computation) passes too
+    return (pe <= 0.5 * tol_p) & (re <= 0.5 * tol_r)
+
+
+def _residuals(robot, q, T_t, mask):
+    e = pose_error(T_t, forward_kinematics(robot, q))
+    pe = np.linalg.norm(e[..., :3] * mask[:3], axis=-1)
+    re = np.linalg.norm(e[..., 3:] * mask[3:], axis=-1)
+    return pe, re
+
+
+def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = "pose", tol: float = TOL,
+             max_iterations: int = MAX_ITERATIONS, restarts: int = RESTARTS, respect_limits: bool = True,
+             rng: np.random.Generator | None = None) -> IKResult:
+    """Numerical inverse kinematics by Levenberg–Marquardt, batched over targets.
+
+    Minimises ½‖W e(q)‖² with e = (p_t − p(q), log(R_t R(q)ᵀ)) (world axes, rows selected by ``mask``,
+    rotation rows scaled by the arm's characteristic length L so both parts are lengths).  Each step solves
+
+    .. math:: (J_W^T J_W + \\lambda I)\\, \\Delta q = J_W^T W e, \\qquad J_W = W J_0
+
+    and is accepted only if it lowers the cost; λ shrinks on success and grows on rejection
+    (Levenberg 1944; Marquardt 1963; Nakamura & Hanafusa 1986 for the damped least-squares form;
+    Sugihara 2011 for LM in IK).  After each step q is brought back inside the joint limits (clipped;
+    revolute joints wrapped into (−π, π] first).  Targets that stall restart from random q within limits.
+
+    Parameters
+    ----------
+    robot : DHRobot
+    T : array_like, shape (..., 4, 4)
+        Target end-effector poses in the world frame (``T_w_e``).
+    q0 : array_like, shape (n,) or (..., n), optional
+        Seed configuration(s); default: the middle of the limits (0 for unlimited revolute joints).
+    mask : "pose", "position" or 6 booleans
+        Rows of (x, y, z, ωx, ωy, ωz) to match; use "position" or a mask for arms with fewer than 6 joints
+        when the target's orientation is not reachable.
+    tol : float
+        Success tolerance on the position [m] and orientation [rad] residual norms.
+    max_iterations : int
+        LM iterations per attempt.
+    restarts : int
+        Random restarts for targets not solved from the seed.
+    respect_limits : bool
+        Keep q within the joint limits (default) or ignore them.
+    rng : numpy.random.Generator, optional
+        Source of the random restarts.
+
+    Returns
+    -------
+    IKResult
+        Unreachable targets are results with ``success=False`` and a ``reason``, not exceptions.
+
+    Examples
+    --------
+    >>> import numpy as np, denavit
+    >>> robot = denavit.load_robot("puma560")
+    >>> T = denavit.forward_kinematics(robot, [0.1, 0.2, -0.3, 0.4, 0.5, 0.6])
+    >>> res = denavit.solve_ik(robot, T, rng=np.random.default_rng(0))
+    >>> bool(res.success), bool(np.allclose(denavit.forward_kinematics(robot, res.q), T, atol=1e-8))
+    (True, True)
+    """
+    T = as_transform(T, "T")
+    batch = T.shape[:-2]
+    w_mask = row_mask(mask)
+    rng = np.random.default_rng() if rng is None else rng
+    n, L = robot.dof, _char_length(robot)
+    w = np.where(w_mask, 1.0, 0.0) * np.array([1, 1, 1, L, L, L])
+    limits = _Limits(robot, ignore=not respect_limits)
+    Tf = T.reshape(-1, 4, 4)
+    B = Tf.shape[0]
+    if q0 is None:
+        mid = np.where(np.isfinite(limits.lo) & np.isfinite(limits.hi), 0.5 * (limits.lo + limits.hi), 0.0)
+        q = np.tile(mid, (B, 1))
+    else:
+        q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
+    q = limits.project(q)
+    free = _Limits(robot, ignore=True)
+    # first attempt without limits, folded back by whole turns: the clipped iteration is slow and cannot
+    # pass a limit, while the free one converges in a few steps (the fold is checked below like any q)
+    q, done, iters, stalled = _lm(robot, q, Tf, w, free, max_iterations, tol, tol, L)
+    q = limits.project(q)
+    pe, re = _residuals(robot, q, Tf, w_mask)
+    done = (pe <= tol) & (re <= tol) & limits.inside(q)
+    n_restarts = np.zeros(B, dtype=int)
+    best_q = q.copy()
+    left = restarts
+    while left > 0:
+        todo = np.flatnonzero(~done)
+        if todo.size == 0:
+            break
+        k = min(PARALLEL_SEEDS, left)  # seeds tried side by side for every unsolved target
+        left -= k
+        idx = np.repeat(todo, k)
+        qs = limits.sample(rng, (idx.size,), L)
+        # most seeds run without limits and are folded back by whole turns afterwards: the clipped
+        # iteration cannot pass a limit, so a solution lying beyond it is often reached only this way
+        unlimited = np.tile(np.arange(k) >= k // 4, todo.size)
+        qr = np.empty_like(qs)
+        ir = np.zeros(idx.size, dtype=int)
+        sr = np.zeros(idx.size, dtype=bool)
+        for flag, lim in ((False, limits), (True, free)):
+            sel = np.flatnonzero(unlimited == flag)
+            if sel.size:
+                qr[sel], _, ir[sel], sr[sel] = _lm(robot, qs[sel], Tf[idx[sel]], w, lim, max(max_iterations // 2, 1),
+                                                   tol, tol, L)
+        qr = limits.project(qr)
+        pe_new, re_new = _residuals(robot, qr, Tf[idx], w_mask)
+        ok = (pe_new <= tol) & (re_new <= tol) & limits.inside(qr)
+        n_restarts[todo] += k
+        iters[todo] += ir.reshape(-1, k).sum(axis=1)
+        stalled[todo] = sr.reshape(-1, k).all(axis=1)
+        score = np.where(ok, -1.0, pe_new + L * re_new).reshape(-1, k)
+        pick = np.argmin(score, axis=1)
+        cand = qr.reshape(-1, k, n)[np.arange(todo.size), pick]
+        pe_old, re_old = _residuals(robot, best_q[todo], Tf[todo], w_mask)
+        improve = score[np.arange(todo.size), pick] < pe_old + L * re_old
+        best_q[todo[improve]] = cand[improve]
+        done[todo] = ok.reshape(-1, k).any(axis=1)
+    q = best_q
+    pe, re = _residuals(robot, q, Tf, w_mask)
+    success = (pe <= tol) & (re <= tol) & limits.inside(q)
+    reason = _reasons(robot, q, Tf, mask, success, stalled, tol, rng, respect_limits, max_iterations)
+    return _pack(batch, n, q, success, pe, re, iters, n_restarts, reason)
+
+
+def _reasons(robot, q, Tf, mask, success, stalled, tol, rng, respect_limits, max_iterations) -> np.ndarray:
+    """Why each failed target failed (see :class:`IKResult`)."""
+    reason = np.full(len(q), "", dtype=object)
+    failed = np.flatnonzero(~success)
+    if failed.size == 0:
+        return reason
+    reason[failed] = "unreachable"
+    if respect_limits:  # does a solution exist when the limits are ignored?
+        free = solve_ik(robot, Tf[failed], q[failed], mask=mask, tol=tol, max_iterations=max_iterations,
+                        restarts=3, respect_limits=False, rng=rng)
+        ok = np.atleast_1d(free.success)
+        reason[failed[ok]] = "limits"
+    still = failed[(reason[failed] == "unreachable") & ~stalled[failed]]
+    reason[still] = "iterations"
+    return reason
+
+
+def _pack(batch, n, q, success, pe, re, iters, n_restarts, reason) -> IKResult:
+    if batch == ():
+        return IKResult(q[0], bool(success[0]), float(pe[0]), float(re[0]), int(iters[0]), int(n_restarts[0]),
+                        str(reason[0]))
+    return IKResult(q.reshape(batch + (n,)), success.reshape(batch), pe.reshape(batch), re.reshape(batch),
+                    iters.reshape(batch), n_restarts.reshape(batch), reason.reshape(batch))

@@ -1,0 +1,426 @@
+"""Recognising an arm's structure from its DH table and solving it in closed form: the IK "plans".
+
+A plan is chosen from the geometry of the joint axes (computed from the table, never from the robot's name):
+
+``pieper``    6 joints, the last three revolute axes through one point (spherical wrist); also the mirror
+              case (first three axes through one point) by inverting the chain.  Joints 1–3 may be revolute
+              or prismatic and may carry any offsets (shoulder offset, a3, d3 …).
+``parallel``  6 revolute joints with axes 2, 3, 4 parallel and axes 5, 6 intersecting (UR family), or
+              5 joints with axes 2, 3, 4 parallel (e.g. after merging two coaxial joints); also mirrored.
+``planar``    2–4 joints whose axes are all parallel (planar 2R/3R, SCARA, PRRR …): at most one prismatic.
+``wrist``     3 revolute axes through one point (orientation only).
+``position``  any other 3-joint arm: the end-effector origin is placed (position only).
+
+Coaxial consecutive revolute joints are merged first (their sum is all the pose sees); the result then
+names the free combination.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import UnsupportedRobotError
+from ..model import DHRobot
+from ._ik_chain import Chain, angle_about_z, axis_lines, chain_fk, chain_of, reverse_chain, solve_trig
+from ._ik_subproblems import Position3, rotation3, rz_bilinear, trig_coefficients
+from ._transforms import inverse_transform
+
+__all__ = ["Plan", "make_plan"]
+
+GEOM_TOL = 1e-9  # relative tolerance of the structural tests (axes parallel / through one point)
+
+
+@dataclass
+class Plan:
+    """How an arm is solved: kind, the rows verified, and the batched candidate generator."""
+
+    kind: str
+    projector: np.ndarray  # (6, 6) rows of the pose residual the arm controls (world axes)
+    solve: Callable  # (B, 4, 4) -> candidates (B, K, n), free (B, K) object array of str
+    point_e: np.ndarray | None = None  # wrist / reference point in the end-effector frame, for labels
+    notes: list[str] = field(default_factory=list)
+
+
+# ---------------------------------------------------------------------------------------------------
+# structural tests
+
+
+def _scale(chain: Chain) -> float:
+    return max(float(np.sum(np.abs(chain.consts[:, :3, 3]))), 1e-3)
+
+
+def _configs(chain: Chain, rng) -> list[np.ndarray]:
+    return [np.zeros(chain.n), rng.uniform(-np.pi, np.pi, chain.n), rng.uniform(-np.pi, np.pi, chain.n)]
+
+
+def _common_point(pts: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares point nearest to lines (pts, dirs (k, 3)) and its largest distance to them."""
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    for p, d in zip(pts, dirs):
+        M = np.eye(3) - np.outer(d, d)
+        A += M
+        b += M @ p
+    x = np.linalg.lstsq(A, b, rcond=None)[0]
+    dist = max(np.linalg.norm((np.eye(3) - np.outer(d, d)) @ (x - p)) for p, d in zip(pts, dirs))
+    return x, dist
+
+
+def _intersect(chain: Chain, idx, rng) -> bool:
+    """Do the axes ``idx`` pass through one point (and no two of them coincide) in every test pose?"""
+    L = _scale(chain)
+    for q in _configs(chain, rng):
+        pts, dirs = axis_lines(chain, q)
+        for a, b in zip(idx[:-1], idx[1:]):
+            if np.linalg.norm(np.cross(dirs[a], dirs[b])) < 1e-6:
+                return False
+        if _common_point(pts[list(idx)], dirs[list(idx)])[1] > GEOM_TOL * L:
+            return False
+    return True
+
+
+def _parallel(chain: Chain, idx, rng) -> bool:
+    for q in _configs(chain, rng):
+        _, dirs = axis_lines(chain, q)
+        if any(np.linalg.norm(np.cross(dirs[idx[0]], dirs[k])) > GEOM_TOL for k in idx[1:]):
+            return False
+    return True
+
+
+# ---------------------------------------------------------------------------------------------------
+# coaxial joints and mirrored chains
+
+
+def _merge_coaxial(chain: Chain):
+    """Merge consecutive coaxial revolute joints; returns (chain, expand(q_reduced) -> q, notes, free)."""
+    consts, pris = list(chain.consts), list(chain.prismatic)
+    groups: list[list[tuple[int, float]]] = [[(0, 1.0)]]
+    k = 0
+    while k < len(pris) - 1:
+        C = consts[k + 1]
+        if (not pris[k] and not pris[k + 1] and abs(abs(C[2, 2]) - 1) < 1e-12
+                and np.hypot(C[0, 3], C[1, 3]) < 1e-12):
+            sign = float(np.sign(C[2, 2]))  # J(q_k) C J(q_k+1) = J(q_k ± q_k+1) C
+            orig = groups[-1][-1][0] + 1
+            groups[-1].append((orig, sign))
+            consts[k + 1] = C @ consts[k + 2]
+            del consts[k + 2], pris[k + 1]
+            continue
+        groups.append([(groups[-1][-1][0] + 1, 1.0)])
+        k += 1
+    n = chain.n
+    free = []
+    for g in groups:
+        if len(g) > 1:
+            terms = f"q{g[0][0] + 1}" + "".join(f" {'+' if s > 0 else '-'} q{i + 1}" for i, s in g[1:])
+            free.append(f"{terms} fixed (coaxial joints)")
+
+    def expand(qr: np.ndarray) -> np.ndarray:
+        out = np.zeros(qr.shape[:-1] + (n,))
+        for j, g in enumerate(groups):
+            out[..., g[0][0]] = qr[..., j]  # representative: the first joint takes the whole sum
+        return out
+
+    reps = [g[0][0] for g in groups]
+    return Chain(np.array(consts), np.array(pris)), expand, "; ".join(free), reps
+
+
+# ---------------------------------------------------------------------------------------------------
+# solvers
+
+
+def _free_text(mask: np.ndarray, text: str, out: np.ndarray) -> np.ndarray:
+    if not text:
+        return out
+    add = np.where(out == "", text, out + "; " + text)
+    return np.where(mask, add, out)
+
+
+def _pieper(chain: Chain, rng, names, limits3) -> tuple[Callable, np.ndarray]:
+    L = _scale(chain)
+    pts, dirs = axis_lines(chain, np.zeros(6))
+    X = _common_point(pts[3:], dirs[3:])[0]
+    F3 = chain_fk(chain, np.zeros(3), upto=3)
+    P = (chain.consts[3] @ inverse_transform(F3) @ np.append(X, 1))[:3]
+    X_e = (inverse_transform(chain_fk(chain, np.zeros(6))) @ np.append(X, 1))[:3]
+    pos = Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng)
+    C0i, R4, R5, R6 = inverse_transform(chain.consts[0]), chain.consts[4][:3, :3], chain.consts[5][:3, :3], \
+        chain.consts[6][:3, :3]
+
+    def solve(T: np.ndarray):
+        Xw = T[:, :3, :3] @ X_e + T[:, :3, 3]
+        W = Xw @ C0i[:3, :3].T + C0i[:3, 3]
+        q123, f123 = pos.solve(W)  # (B, M, 3)
+        F = chain_fk(chain, np.nan_to_num(q123), upto=3)  # (B, M, 4, 4)
+        M = np.swapaxes(F[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ R6.T
+        q456, sing, sign = rotation3(M, R4, R5)  # (B, M, 2, 3)
+        q = np.concatenate([np.broadcast_to(q123[:, :, None, :], q456.shape), q456], axis=-1)
+        free = np.full(q.shape[:-1], "", dtype=object)
+        free = _free_text(np.broadcast_to((f123 & 1)[..., None] > 0, free.shape), f"{names[0]} free (wrist centre on axis 1)", free)
+        free = _free_text(np.broadcast_to((f123 & 2)[..., None] > 0, free.shape), f"{names[1]} free", free)
+        free = _free_text(sing & (sign > 0), f"{names[3]} + {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
+        free = _free_text(sing & (sign < 0), f"{names[3]} - {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
+        B = len(T)
+        return q.reshape(B, -1, 6), free.reshape(B, -1)
+
+    return solve, X_e
+
+
+def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
+    """q_a, q_b (..., 2) with Rz(q_a)(p2 + R2 Rz(q_b) p3) = P, R2 keeping the z axis (parallel joints).
+
+    Law of cosines: |v|² = |p2|² + |p3|² + 2 p2ᵀ R2 Rz(q_b) p3 with v_z constant, so |P_xy|² = |v_xy|²
+    is a cos q_b + b sin q_b = c; then q_a turns v onto P (Spong eq. 3.40–3.43 for the planar elbow).
+    """
+    a, b, g = rz_bilinear(R2.T @ p2, p3)
+    vz = p2[2] + R2[2, 2] * p3[2]
+    rhs = np.sum(P[..., :2] ** 2, -1) - p2 @ p2 - p3 @ p3 + vz**2 - 2 * g
+    qb = solve_trig(2 * a, 2 * b, rhs, tol=1e-7)
+    cb, sb = np.cos(qb), np.sin(qb)
+    v = np.stack([cb * p3[0] - sb * p3[1], sb * p3[0] + cb * p3[1], np.full(qb.shape, p3[2])], -1)
+    v = p2 + v @ R2.T
+    qa = angle_about_z(v, np.broadcast_to(P[..., None, :], v.shape))
+    return qa, qb
+
+
+def _rot_z_angle(R: np.ndarray) -> np.ndarray:
+    return np.arctan2(R[..., 1, 0], R[..., 0, 0])
+
+
+def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
+    """Axes 2, 3, 4 parallel; 6 joints with axes 5, 6 meeting at Q, or 5 joints (Q on axis 5).
+
+    In the frame F1 = C0 J1 C1 the parallel joints turn about z, so the z coordinate of any point and of
+    any direction fixed to link 4 is constant: that fixes q1 (from Q), then q5 (from the direction of the
+    last axis), q6 (from the rest of the orientation), and leaves a planar 3R problem for q2, q3, q4
+    (Hawkins 2013 for the UR arms; Lynch & Park 2017, Sec. 6.1.2).
+    """
+    n = chain.n
+    C = chain.consts
+    pts, dirs = axis_lines(chain, np.zeros(n))
+    if n == 6:
+        Q = _common_point(pts[4:], dirs[4:])[0]
+    else:
+        Q = pts[4]
+    T0 = chain_fk(chain, np.zeros(n))
+    Q_e = (inverse_transform(T0) @ np.append(Q, 1))[:3]
+    F1_0 = chain_fk(chain, np.zeros(1), upto=1)
+    h = (inverse_transform(F1_0) @ np.append(Q, 1))[2]  # z of Q in F1: the same for every q2, q3, q4
+    Rc1, pc1 = C[1][:3, :3], C[1][:3, 3]
+    a = Rc1[:, 2]  # axis 2 in the frame after joint 1
+    sigma = np.sign((C[2] @ C[3])[2, 2])  # the parallel joints map z to σ z
+    C0i = inverse_transform(C[0])
+
+    def solve(T: np.ndarray):
+        B = len(T)
+        V = (T[:, :3, :3] @ Q_e + T[:, :3, 3]) @ C0i[:3, :3].T + C0i[:3, 3]
+        q1 = solve_trig(a[0] * V[:, 0] + a[1] * V[:, 1], a[0] * V[:, 1] - a[1] * V[:, 0],
+                        h + a @ pc1 - a[2] * V[:, 2], tol=1e-7)  # (B, 2)
+        F1 = chain_fk(chain, np.nan_to_num(q1)[..., None], upto=1)  # (B, 2, 4, 4)
+        RL = np.swapaxes(F1[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ C[n][:3, :3].T  # (B, 2, 3, 3)
+        ell = RL[..., 2, :]  # e_zᵀ R_L
+        free = np.full((B, 2, 2), "", dtype=object)
+        if n == 6:
+            r, u = C[4][2, :3], C[5][:3, 2]
+            al, be, ga = rz_bilinear(r, u)
+            d_last = RL[..., :, 2]  # axis 6 in F1 axes... z component is (RL e_z)_z
+            q5 = solve_trig(al, be, sigma * d_last[..., 2] - ga, tol=1e-7)  # (B, 2, 2)
+            y = sigma * np.einsum("j,...jk,kl->...l", C[4][2, :3], _rz(q5), C[5][:3, :3])
+            ell2 = np.broadcast_to(ell[..., None, :], y.shape)
+            sing = np.hypot(y[..., 0], y[..., 1]) < 1e-9
+            q6 = np.where(sing, 0.0, -angle_about_z(y, ell2))
+            free = _free_text(sing, f"{names[5]} and {names[1]} + {names[2]} + {names[3]} coupled "
+                              "(axis 6 parallel to axes 2-4)", free)
+            tail = C[4] @ _jz(q5) @ C[5] @ _jz(q6) @ C[6]
+        else:
+            y = sigma * C[4][2, :3]
+            q5 = -angle_about_z(np.broadcast_to(y, ell.shape), ell)[..., None] * np.ones(2)
+            q5[..., 1] = np.nan
+            q6 = None
+            tail = C[4] @ _jz(q5) @ C[5]
+        X = inverse_transform(F1)[..., None, :, :] @ T[:, None, None] @ inverse_transform(tail)  # (B,2,2,4,4)
+        P = X[..., :3, 3]
+        q2, q3 = _planar_pair(P, C[2][:3, 3], C[2][:3, :3], C[3][:3, 3])  # (B, 2, 2, 2)
+        R23 = _rz(q2) @ C[2][:3, :3] @ _rz(q3) @ C[3][:3, :3]
+        q4 = _rot_z_angle(np.swapaxes(R23, -1, -2) @ X[..., None, :3, :3])
+        shape = q2.shape
+        cols = [np.broadcast_to(q1[:, :, None, None], shape), q2, q3, q4,
+                np.broadcast_to(q5[..., None], shape)]
+        if n == 6:
+            cols.append(np.broadcast_to(q6[..., None], shape))
+        q = np.stack(cols, axis=-1).reshape(B, -1, n)
+        free = np.broadcast_to(free[..., None], shape).reshape(B, -1)
+        return q, free
+
+    return solve, Q_e
+
+
+def _rz(t):
+    t = np.asarray(t, dtype=float)
+    c, s = np.cos(t), np.sin(t)
+    R = np.zeros(t.shape + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
+
+
+def _jz(t):
+    J = np.zeros(np.shape(t) + (4, 4))
+    J[..., :3, :3] = _rz(t)
+    J[..., 3, 3] = 1.0
+    return J
+
+
+def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]:
+    """All axes parallel (to z of C0): two revolute joints place a point in the plane (law of cosines),
+    a prismatic joint sets the height, a third revolute joint the heading."""
+    n = chain.n
+    rev = [k for k in range(n) if not chain.prismatic[k]]
+    pri = [k for k in range(n) if chain.prismatic[k]]
+    r1, r2 = rev[0], rev[1]
+    pts, dirs = axis_lines(chain, np.zeros(n))
+    C0i = inverse_transform(chain.consts[0])
+    T0 = chain_fk(chain, np.zeros(n))
+    Q = pts[rev[2]] if len(rev) == 3 else T0[:3, 3]
+    Q_e = (inverse_transform(T0) @ np.append(Q, 1))[:3]
+    c1 = (C0i @ np.append(pts[r1], 1))[:2]
+    s1 = np.sign((C0i[:3, :3] @ dirs[r1])[2])
+
+    def point(qfull):  # xy of the reference point in C0, (..., 2)
+        Tq = C0i @ chain_fk(chain, qfull)
+        return (Tq[..., :3, :3] @ Q_e + Tq[..., :3, 3])[..., :2] - c1
+
+    def solve(T: np.ndarray):
+        B = len(T)
+        Tl = C0i @ T
+        Qt = (Tl[:, :3, :3] @ Q_e + Tl[:, :3, 3])[:, :2] - c1  # (B, 2)
+        probe = np.zeros((3, n))
+        probe[:, r2] = (0.0, np.pi / 2, np.pi)
+        A, Bc, Cc = trig_coefficients(*(np.sum(point(p) ** 2) for p in probe))
+        q2 = solve_trig(A, Bc, np.sum(Qt**2, -1) - Cc, tol=1e-7)  # (B, 2)
+        q = np.zeros((B, 2, n))
+        q[..., r2] = q2
+        q[..., r1] = s1 * angle_about_z(np.concatenate([point(np.nan_to_num(q)), np.zeros((B, 2, 1))], -1),
+                                         np.concatenate([np.broadcast_to(Qt[:, None], (B, 2, 2)),
+                                                         np.zeros((B, 2, 1))], -1))
+        if pri:
+            p = pri[0]
+            Tq = C0i @ chain_fk(chain, np.nan_to_num(q))
+            sp = np.sign((C0i[:3, :3] @ dirs[p])[2])
+            q[..., p] = sp * (Tl[:, None, 2, 3] - Tq[..., 2, 3])
+        if len(rev) == 3:
+            r3 = rev[2]
+            qq = np.nan_to_num(q)
+            pre = chain_fk(chain, qq[..., :r3], upto=r3)
+            post = chain_fk(chain, qq[..., r3 + 1:], start=r3 + 1)
+            Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
+            q[..., r3] = _rot_z_angle(Rz)
+        q[~np.isfinite(q2)] = np.nan
+        return q, np.full((B, 2), "", dtype=object)
+
+    n_world = chain.consts[0][:3, 2]
+    return solve, Q_e, n_world
+
+
+def _wrist_plan(chain: Chain, names) -> Callable:
+    C = chain.consts
+
+    def solve(T: np.ndarray):
+        M = C[0][:3, :3].T @ T[:, :3, :3] @ C[3][:3, :3].T
+        q, sing, sign = rotation3(M, C[1][:3, :3], C[2][:3, :3])
+        free = np.full(q.shape[:-1], "", dtype=object)
+        free = _free_text(sing & (sign > 0), f"{names[0]} + {names[2]} fixed (axes 1 and 3 aligned)", free)
+        free = _free_text(sing & (sign < 0), f"{names[0]} - {names[2]} fixed (axes 1 and 3 aligned)", free)
+        return q, free
+
+    return solve
+
+
+def _position_plan(chain: Chain, rng, names, limits3) -> Callable:
+    C = chain.consts
+    pos = Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng)
+    C0i = inverse_transform(C[0])
+
+    def solve(T: np.ndarray):
+        W = T[:, :3, 3] @ C0i[:3, :3].T + C0i[:3, 3]
+        q, f = pos.solve(W)
+        free = np.full(q.shape[:-1], "", dtype=object)
+        free = _free_text((f & 1) > 0, f"{names[0]} free (point on axis 1)", free)
+        free = _free_text((f & 2) > 0, f"{names[1]} free", free)
+        return q, free
+
+    return solve
+
+
+def _mirrored(solve: Callable) -> Callable:
+    """Solve the reversed chain for T⁻¹ and map back: q_k = −q'_{n+1−k}."""
+    def run(T: np.ndarray):
+        q, free = solve(inverse_transform(T))
+        return -q[..., ::-1], free
+    return run
+
+
+def make_plan(robot: DHRobot) -> Plan:
+    """Recognise the structure of an arm and build its closed-form solver (see module notes).
+
+    Raises
+    ------
+    UnsupportedRobotError
+        No closed form is known for this structure (use the numerical solver).
+    """
+    rng = np.random.default_rng(20240601)  # fixed: the structural tests must not depend on call order
+    full = chain_of(robot)
+    chain, expand, coaxial, reps = _merge_coaxial(full)
+    m = chain.n
+    names = [f"q{r + 1}" for r in reps]
+    rnames = names[::-1]
+    rev = reverse_chain(chain)
+    lim = robot.q_limits
+    eye = np.eye(6)
+    all_rev = not chain.prismatic.any()
+    solve, point, kind, P = None, None, "", eye
+    if m == 6:
+        if not chain.prismatic[3:].any() and _intersect(chain, (3, 4, 5), rng):
+            solve, point = _pieper(chain, rng, names, tuple(lim[reps[2]]))
+            kind = "pieper"
+        elif not chain.prismatic[:3].any() and _intersect(chain, (0, 1, 2), rng):
+            s, _ = _pieper(rev, rng, rnames, tuple(-lim[reps[3]][::-1]))
+            solve, kind = _mirrored(s), "pieper (mirrored: spherical joint at the base)"
+    if solve is None and m in (5, 6) and all_rev:
+        if _parallel(chain, (1, 2, 3), rng) and (m == 5 or _intersect(chain, (4, 5), rng)):
+            solve, point = _parallel_plan(chain, names)
+            kind = "parallel"
+        elif _parallel(rev, (1, 2, 3), rng) and (m == 5 or _intersect(rev, (4, 5), rng)):
+            s, _ = _parallel_plan(rev, rnames)
+            solve, kind = _mirrored(s), "parallel (mirrored)"
+    if solve is None and 2 <= m <= 4 and _parallel(chain, tuple(range(m)), rng) \
+            and chain.prismatic.sum() <= 1 and 2 <= (~chain.prismatic).sum() <= 3:
+        solve, point, n_w = _planar_plan(chain, names)
+        kind = "planar"
+        P = np.zeros((6, 6))
+        P[:3, :3] = np.eye(3)
+        if (~chain.prismatic).sum() == 3:
+            P[3:, 3:] = np.outer(n_w, n_w)
+    if solve is None and m == 3:
+        if all_rev and _intersect(chain, (0, 1, 2), rng):
+            solve, kind = _wrist_plan(chain, names), "wrist"
+            P = np.zeros((6, 6))
+            P[3:, 3:] = np.eye(3)
+        else:
+            solve, kind = _position_plan(chain, rng, names, tuple(lim[reps[2]])), "position"
+            P = np.zeros((6, 6))
+            P[:3, :3] = np.eye(3)
+    if solve is None:
+        types = "".join("P" if p else "R" for p in full.prismatic)
+        raise UnsupportedRobotError(
+            f"{robot.name}: no closed-form inverse kinematics for this {full.n}-joint {types} structure "
+            "(known: 6 joints with a spherical wrist, UR-type 6R with three parallel axes, planar/SCARA arms, "
+            "3-joint arms); use the numerical solver (solve_ik / --method numeric)")
+
+    def run(T: np.ndarray):
+        q, free = solve(T)
+        return expand(q), (free if not coaxial else _free_text(np.ones(free.shape, bool), coaxial, free))
+
+    return Plan(kind, P, run, point, [coaxial] if coaxial else [])

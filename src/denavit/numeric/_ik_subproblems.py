@@ -1,0 +1,258 @@
+"""Subproblems of the analytic IK, batched: three-joint positioning, three-axis orientation, planar pairs.
+
+All work on the joint-screw form ``C0 J1 C1 ⋯`` of :mod:`._ik_chain` and return NaN for "no solution"
+so that every pose of a batch carries the same number of candidate slots.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._ik_chain import angle_about_z, joint_motion, solve_trig
+
+__all__ = ["Position3", "rotation3", "trig_coefficients", "rz_bilinear"]
+
+_KMAX = 6  # harmonics sampled for a revolute sweep joint (the resultant has degree ≤ 4)
+_PMAX = 8  # polynomial degree sampled for a prismatic sweep joint (the resultant has degree ≤ 6)
+FREE_EPS = 1e-9  # relative size under which an equation is taken not to depend on a joint
+
+
+def rz_bilinear(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(α, β, γ) with mᵀ Rz(θ) p = α cos θ + β sin θ + γ, for vectors (..., 3)."""
+    a = m[..., 0] * p[..., 0] + m[..., 1] * p[..., 1]
+    b = m[..., 1] * p[..., 0] - m[..., 0] * p[..., 1]
+    return a, b, m[..., 2] * p[..., 2]
+
+
+def trig_coefficients(G0, G90, G180):
+    """(A, B, C) of G(θ) = A cos θ + B sin θ + C from its values at θ = 0, π/2, π."""
+    C = 0.5 * (G0 + G180)
+    return 0.5 * (G0 - G180), G90 - C, C
+
+
+def rotation3(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
+    """All (qa, qb, qc) with Rz(qa) Ra Rz(qb) Rb Rz(qc) = M: three revolute axes through one point.
+
+    The z-row of the equation does not involve qa or qc: (Raᵀ e_z)ᵀ Rz(qb) (Rb e_z) = M_zz, an equation
+    a cos qb + b sin qb = c with two roots (the wrist flip); then qa aligns Ra Rz(qb) Rb e_z with M e_z and
+    qc is read from (Rz(qa) Ra Rz(qb) Rb)ᵀ M (Paden–Kahan subproblems 2 and 1; Murray, Li & Sastry 1994,
+    Sec. 3.3; for the orthogonal ZYZ wrist this is Craig 3rd ed. eq. 2.71 / Spong eq. 2.28).
+
+    Parameters
+    ----------
+    M : (..., 3, 3)
+    Ra, Rb : (3, 3) constant rotations between the joints.
+
+    Returns
+    -------
+    q : (..., 2, 3) with NaN rows where there is no solution
+    singular : (..., 2) bool — axes a and c aligned: only qa ± qc is determined (qa is set to 0)
+    sign : (..., 2) — +1 where qa + qc is the determined combination at the singularity, −1 for qa − qc
+    """
+    r, u = Ra[2, :], Rb[:, 2]  # Raᵀ e_z and Rb e_z
+    a, b, g = rz_bilinear(r, u)
+    qb = solve_trig(a, b, M[..., 2, 2] - g)  # (..., 2)
+    Rzb = _rz3(qb)  # (..., 2, 3, 3)
+    v = np.einsum("ij,...jk,k->...i", Ra, Rzb, u)  # Ra Rz(qb) u, (..., 2, 3)
+    m = np.broadcast_to(M[..., None, :, 2], v.shape)
+    singular = np.hypot(v[..., 0], v[..., 1]) < 1e-9
+    qa = np.where(singular, 0.0, angle_about_z(v, m))
+    W = _rz3(qa) @ Ra @ Rzb @ Rb  # (..., 2, 3, 3)
+    N = np.swapaxes(W, -1, -2) @ M[..., None, :, :]
+    qc = np.arctan2(N[..., 1, 0], N[..., 0, 0])
+    sign = np.where(v[..., 2] >= 0, 1.0, -1.0)
+    return np.stack([qa, qb, qc], axis=-1), singular & np.isfinite(qb), sign
+
+
+def _rz3(t: np.ndarray) -> np.ndarray:
+    t = np.asarray(t, dtype=float)
+    c, s = np.cos(t), np.sin(t)
+    R = np.zeros(t.shape + (3, 3))
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1], R[..., 2, 2] = c, -s, s, c, 1.0
+    return R
+
+
+class Position3:
+    """Three joints (revolute or prismatic, any geometry) placing a point: all solutions, batched.
+
+    ``W = J1(q1) C1 J2(q2) C2 J3(q3) P`` (coordinates of the frame before joint 1).  With g = C1 J2 C2 J3 P,
+    joint 1 leaves two quantities unchanged: for a revolute joint the height g_z and the squared distance
+    |g − c|² to a point c of its axis; for a prismatic joint g_x and g_y.  Both are of the form
+    A(q3) cos q2 + B(q3) sin q2 + C(q3) (or a quadratic in a prismatic q2).  Eliminating q2 (the resultant
+    of the two, Sylvester) leaves one equation in q3, a trigonometric polynomial of degree ≤ 4 (a polynomial
+    of degree ≤ 6 for a prismatic q3) whose roots are all found at once as eigenvalues of a companion
+    matrix.  This is Pieper's reduction (Pieper 1968; Craig 3rd ed. Sec. 4.6, eqs. 4.68–4.80, where the
+    resultant is the quartic in tan(θ3/2)), obtained here numerically: the coefficient functions are
+    sampled from the chain itself, which is exact because their degree is known.
+    """
+
+    def __init__(self, C1: np.ndarray, C2: np.ndarray, P: np.ndarray, prismatic: np.ndarray, scale: float,
+                 limits3: tuple[float, float], rng: np.random.Generator) -> None:
+        self.C1, self.C2, self.P = C1, C2, np.append(P, 1.0)
+        self.pr1, self.pr2, self.pr3 = (bool(x) for x in prismatic)
+        self.L = scale
+        self.c = self._axis_foot() if not self.pr1 else np.zeros(3)
+        if self.pr3:
+            lo, hi = limits3
+            lo, hi = (lo if np.isfinite(lo) else -2 * scale), (hi if np.isfinite(hi) else 2 * scale)
+            self.mid, self.half = 0.5 * (lo + hi), max(0.5 * (hi - lo), 1e-3 * scale)
+            nodes = np.cos(np.pi * (np.arange(_PMAX + 1) + 0.5) / (_PMAX + 1))  # Chebyshev nodes
+            self.nodes = self.mid + self.half * nodes
+            self.fit = np.linalg.inv(np.vander(nodes, _PMAX + 1))  # samples → monomials (highest first)
+        else:
+            self.nodes = 2 * np.pi * np.arange(2 * _KMAX + 1) / (2 * _KMAX + 1)
+        self.coef = self._coefficients(self.nodes)  # (2, 3, N): rows k, (A, B, C)
+        self.degree = self._effective_degree(rng)
+
+    # -- robot-only parts ------------------------------------------------------------------------
+    def _axis_foot(self) -> np.ndarray:
+        """Foot on axis 1 (the z axis) of the common normal with axis 2; origin if they are parallel."""
+        o, d = self.C1[:3, 3], self.C1[:3, 2]
+        s = 1.0 - d[2] ** 2
+        if s < 1e-12:
+            return np.zeros(3)
+        t = (o[2] - d[2] * np.dot(d, o)) / s  # closest point z·t on the z axis
+        return np.array([0.0, 0.0, t])
+
+    def g(self, q2, q3) -> np.ndarray:
+        """C1 J2(q2) C2 J3(q3) P, shape broadcast(q2, q3) + (3,)."""
+        q2, q3 = np.broadcast_arrays(np.asarray(q2, float), np.asarray(q3, float))
+        T = self.C1 @ joint_motion(self.pr2, q2) @ self.C2 @ joint_motion(self.pr3, q3)
+        return (T @ self.P)[..., :3]
+
+    def invariants(self, g: np.ndarray) -> np.ndarray:
+        """The two quantities joint 1 cannot change, (..., 2)."""
+        if self.pr1:
+            return g[..., :2]
+        return np.stack([g[..., 2], np.sum((g - self.c) ** 2, axis=-1)], axis=-1)
+
+    def _coefficients(self, q3) -> np.ndarray:
+        """(A, B, C) of both invariants in q2 at the given q3, shape (2, 3) + q3.shape."""
+        if self.pr2:
+            s = self.L
+            G = [self.invariants(self.g(v, q3)) for v in (-s, 0.0, s)]
+            C = G[1]
+            A = (G[0] + G[2] - 2 * C) / (2 * s * s)
+            B = (G[2] - G[0]) / (2 * s)
+        else:
+            A, B, C = trig_coefficients(*(self.invariants(self.g(v, q3)) for v in (0.0, np.pi / 2, np.pi)))
+        return np.moveaxis(np.stack([A, B, C], axis=0), -1, 0)  # (2, 3, ...)
+
+    def _effective_degree(self, rng) -> int:
+        """Degree of the resultant for this arm (found on random reachable points; −1: identically zero)."""
+        q3 = rng.uniform(self.nodes.min(), self.nodes.max(), 16) if self.pr3 else rng.uniform(-3, 3, 16)
+        c = np.abs(self._poly(self.invariants(self.g(rng.uniform(-3, 3, 16), q3))))  # (16, m+1)
+        rel = c.max(axis=0) / max(c.max(), 1e-300)
+        nz = np.flatnonzero(rel > 1e-9)
+        if nz.size == 0 or c.max() < 1e-12 * self.L ** 8:
+            return -1
+        if self.pr3:
+            return c.shape[1] - 1 - int(nz[0])
+        return int(np.max(np.abs(_KMAX - nz)))
+
+    # -- per target -------------------------------------------------------------------------------
+    def _resultant_samples(self, w: np.ndarray) -> np.ndarray:
+        A, B, C = self.coef[:, 0], self.coef[:, 1], self.coef[:, 2] - w[..., :, None]  # (..., 2, N)
+        A1, B1, C1, A2, B2, C2 = A[0], B[0], C[..., 0, :], A[1], B[1], C[..., 1, :]
+        if not self.pr2:
+            D = A1 * B2 - A2 * B1
+            return (B1 * C2 - B2 * C1) ** 2 + (A2 * C1 - A1 * C2) ** 2 - D**2
+        if np.max(np.abs(A1)) + np.max(np.abs(A2)) < FREE_EPS:
+            return B1 * C2 - B2 * C1
+        return (A1 * C2 - A2 * C1) ** 2 - (A1 * B2 - A2 * B1) * (B1 * C2 - B2 * C1)
+
+    def _poly(self, w: np.ndarray) -> np.ndarray:
+        """Coefficients (highest first) of the resultant in z = e^{iq3} (revolute) or in x (prismatic)."""
+        R = self._resultant_samples(w)  # (..., N)
+        if self.pr3:
+            return R @ self.fit.T
+        N = R.shape[-1]
+        k = np.arange(_KMAX, -_KMAX - 1, -1)
+        return (R @ np.exp(-1j * np.outer(self.nodes, k))) / N  # c_K … c_{-K}
+
+    def _q3_candidates(self, w: np.ndarray) -> np.ndarray:
+        p = self._poly(w)  # (B, 2K+1) or (B, P+1)
+        if self.pr3:
+            top = p.shape[-1] - 1 - self.degree
+            p = p[:, top:]
+        else:
+            p = p[:, _KMAX - self.degree: _KMAX + self.degree + 1]
+        roots = _batched_roots(p)
+        if self.pr3:
+            ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
+            return np.where(ok, self.mid + self.half * roots.real, np.nan)
+        ok = np.abs(np.abs(roots) - 1.0) < 1e-3
+        return np.where(ok, np.angle(roots), np.nan)
+
+    def solve(self, W: np.ndarray):
+        """All (q1, q2, q3) placing the point at W (B, 3).
+
+        Returns q (B, M, 3) with NaN rows for unused slots and free (B, M) int flags:
+        bit 1 = q1 undetermined (point on axis 1), bit 2 = q2 undetermined.
+        """
+        w = self.invariants(W)
+        if self.degree < 0:
+            raise ValueError("joints 1-3 do not determine the point (continuum)")
+        q3 = self._q3_candidates(w) if self.degree > 0 else np.full((len(W), 1), np.nan)
+        q2, free2 = self._q2_candidates(q3, w)  # (B, M, 2)
+        q3 = np.broadcast_to(q3[..., None], q2.shape)
+        g = self.g(np.nan_to_num(q2), np.nan_to_num(q3))  # (B, M, 2, 3)
+        Wb = W[:, None, None, :]
+        if self.pr1:
+            q1 = Wb[..., 2] - g[..., 2]
+            free1 = np.zeros(q1.shape, dtype=bool)
+        else:
+            free1 = (np.hypot(g[..., 0], g[..., 1]) < 1e-9 * self.L) & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-7 * self.L)
+            q1 = np.where(free1, 0.0, angle_about_z(g, np.broadcast_to(Wb, g.shape)))
+        q = np.stack([q1, q2, q3], axis=-1).reshape(len(W), -1, 3)
+        bad = ~np.all(np.isfinite(q), axis=-1)
+        q[bad] = np.nan
+        free = (free1 * 1 + free2 * 2).reshape(len(W), -1)
+        return q, free
+
+    def _q2_candidates(self, q3: np.ndarray, w: np.ndarray):
+        co = self._coefficients(np.nan_to_num(q3))  # (2, 3, B, M)
+        A, B, C = co[:, 0], co[:, 1], co[:, 2] - np.moveaxis(w, -1, 0)[:, :, None]  # (2, B, M)
+        size = np.abs(A) + np.abs(B)
+        k = np.argmax(size, axis=0)  # the row that depends most on q2
+        pick = lambda X, i: np.take_along_axis(X, i[None], 0)[0]  # noqa: E731
+        Ak, Bk, Ck = pick(A, k), pick(B, k), pick(C, k)
+        Ao, Bo, Co = pick(A, 1 - k), pick(B, 1 - k), pick(C, 1 - k)
+        scale = self.L ** np.array([1.0, 2.0])[1 - k] if not self.pr1 else self.L
+        free = pick(size, k) < FREE_EPS * np.maximum(scale, 1e-12)
+        if self.pr2:
+            lin = np.abs(Ak) < FREE_EPS * np.abs(Bk)
+            disc = Bk**2 - 4 * Ak * Ck
+            sq = np.sqrt(np.where(disc >= -1e-12 * Bk**2, np.maximum(disc, 0.0), np.nan))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                quad = np.stack([(-Bk + sq) / (2 * Ak), (-Bk - sq) / (2 * Ak)], axis=-1)
+                line = np.stack([-Ck / Bk, np.full(Ck.shape, np.nan)], axis=-1)
+            q2 = np.where(lin[..., None], line, quad)
+        else:
+            q2 = solve_trig(Ak, Bk, -Ck, tol=1e-7)
+        q2 = np.where(free[..., None], np.stack([np.zeros(Ck.shape), np.full(Ck.shape, np.nan)], -1), q2)
+        # the other invariant must hold too (loose test: the candidates are polished and re-checked later)
+        with np.errstate(invalid="ignore"):
+            if self.pr2:
+                other = Ao[..., None] * q2**2 + Bo[..., None] * q2 + Co[..., None]
+            else:
+                other = Ao[..., None] * np.cos(q2) + Bo[..., None] * np.sin(q2) + Co[..., None]
+            ok = np.abs(other) <= 1e-2 * (np.abs(Ao) + np.abs(Bo) + np.abs(Co) + scale)[..., None]
+        q2 = np.where(ok | free[..., None], q2, np.nan)
+        return q2, np.broadcast_to(free[..., None], q2.shape)
+
+
+def _batched_roots(p: np.ndarray) -> np.ndarray:
+    """Roots of polynomials (B, m+1), highest coefficient first, via batched companion matrices → (B, m)."""
+    B, m1 = p.shape
+    m = m1 - 1
+    if m <= 0:
+        return np.full((B, 0), np.nan + 0j)
+    lead = p[:, :1]
+    tiny = np.abs(lead) < 1e-13 * np.max(np.abs(p), axis=1, keepdims=True)
+    lead = np.where(tiny, 1e-13 * np.max(np.abs(p), axis=1, keepdims=True) + 1e-300, lead)
+    comp = np.zeros((B, m, m), dtype=np.result_type(p, float))
+    comp[:, 0, :] = -p[:, 1:] / lead
+    if m > 1:
+        comp[:, np.arange(1, m), np.arange(m - 1)] = 1.0
+    return np.linalg.eigvals(comp)
