@@ -1,5 +1,7 @@
 """The numeric engine (numpy): every function is batched over leading axes ``(..., n)``."""
 
+from ._ik_analytic import AnalyticIKResult, analytic_ik, ik_structure
+from ._ik_numeric import IKResult, solve_ik
 from ._jacobians import (
     analytic_jacobian,
     differentiation_jacobian,
@@ -72,6 +74,11 @@ from ._transforms import (
 )
 
 __all__ = [
+    "AnalyticIKResult",
+    "analytic_ik",
+    "ik_structure",
+    "IKResult",
+    "solve_ik",
     "geometric_jacobian",
     "joint_axes",
     "analytic_jacobian",
