@@ -122,7 +122,7 @@ def _fold(robot: DHRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         moved = q + shift
         q = np.where(rev & out & (moved >= lim[:, 0]) & (moved <= lim[:, 1]), moved, q)
     inside = np.all((q >= lim[:, 0] - 1e-12) & (q <= lim[:, 1] + 1e-12), axis=-1)
-    return np.clip(q, lim[:, 0], lim[:, 1]), inside
+    return q, inside
 
 
 def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray) -> np.ndarray:

@@ -24,8 +24,8 @@ __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
 
 TOL = 1e-9  # default position [m] and orientation [rad] tolerance
 MAX_ITERATIONS = 100
-RESTARTS = 32
-PARALLEL_SEEDS = 4
+RESTARTS = 64
+PARALLEL_SEEDS = 8
 LAMBDA0 = 1e-3  # initial damping, relative to the squared characteristic length
 LAMBDA_MAX = 1e3  # damping (relative to L²) beyond which an attempt counts as stuck
 _REASONS = ("", "iterations", "limits", "unreachable")
@@ -177,8 +177,11 @@ def _lm(robot, q, T_t, w, limits, max_iter, tol_p, tol_r, L):
         e_new = pose_error(T_t[act], forward_kinematics(robot, q_new)) * w
         c_new = np.einsum("bi,bi->b", e_new, e_new)
         better = c_new < cost[act]
+        # an accepted step that barely lowers the cost: a local minimum with a residual (or unreachable)
+        flat = better & (cost[act] - c_new < 1e-9 * cost[act])
         iters[act] += 1
         acc, rej = act[better], act[~better]
+        stalled[act[flat]] = True
         q[acc], e[acc], cost[acc] = q_new[better], e_new[better], c_new[better]
         lam[acc] = np.maximum(lam[acc] * 0.2, 1e-12 * L * L)
         lam[rej] *= 8.0
@@ -264,7 +267,8 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     Tf = T.reshape(-1, 4, 4)
     B = Tf.shape[0]
     if q0 is None:
-        mid = np.where(np.isfinite(limits.lo) & np.isfinite(limits.hi), 0.5 * (limits.lo + limits.hi), 0.0)
+        finite = np.isfinite(limits.lo) & np.isfinite(limits.hi)
+        mid = np.where(finite, 0.5 * (np.where(finite, limits.lo, 0) + np.where(finite, limits.hi, 0)), 0.0)
         q = np.tile(mid, (B, 1))
     else:
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
