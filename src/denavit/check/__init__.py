@@ -1,0 +1,105 @@
+"""Checking a person's derivation: a claims file in, a verdict per claim out.
+
+A claim names a quantity (a link transform, T_0_n, the end-effector position, a Jacobian or one of its
+columns, a twist, joint torques, M or g), where it holds (``q``, ``qd``, ``wrench``, or everywhere when it is
+a formula in the joint variables) and its value in LaTeX or plain mathematics.  See ``docs/claims.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParseError
+from ..model import DHRobot
+from ._engine import Verdict, check_claim
+from ._latex import parse_math, parse_matrix, split_matrix
+from ._quantities import QUANTITIES
+from ._resolve import robot_resolver
+
+__all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_text", "parse_math", "parse_matrix",
+           "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_FILE_BYTES"]
+
+MAX_CLAIMS = 500
+MAX_FILE_BYTES = 1_000_000
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """Verdicts on every claim of a file."""
+
+    robot: str
+    source: str
+    verdicts: tuple[Verdict, ...]
+    notes: tuple[str, ...] = ()
+
+    def count(self, verdict: str) -> int:
+        return sum(v.verdict == verdict for v in self.verdicts)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"robot": self.robot, "claims_file": self.source, "notes": list(self.notes),
+                "summary": {k: self.count(k) for k in ("correct", "incorrect", "unreadable")},
+                "claims": [v.to_json() for v in self.verdicts]}
+
+
+def check_claims(robot: DHRobot, claims: list[Any], *, seed: int = 0, deg: bool = False,
+                 source: str = "<claims>") -> CheckResult:
+    """Judge a list of claims (mappings as in a claims file) for ``robot``."""
+    if not isinstance(claims, list):
+        raise ParseError("'claims' must be a list of claims", where=source)
+    if len(claims) > MAX_CLAIMS:
+        raise ParseError(f"too many claims ({len(claims)}; at most {MAX_CLAIMS})", where=source)
+    rng = np.random.default_rng(seed)
+    verdicts = tuple(check_claim(robot, c, f"claim {k}", rng, deg) for k, c in enumerate(claims, start=1))
+    return CheckResult(robot.name, source, verdicts)
+
+
+def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResult:
+    """Read a YAML claims file (see ``docs/claims.md``) and judge its claims."""
+    import yaml
+
+    path = Path(path)
+    where = str(path)
+    if not path.is_file():
+        raise ParseError(f"no such claims file: {where!r}")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ParseError(f"claims file too large (at most {MAX_FILE_BYTES} bytes)", where=where)
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8", errors="replace"))
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        raise ParseError(f"malformed YAML{at}: {getattr(exc, 'problem', None) or 'syntax error'}", where=where) from None
+    if isinstance(data, list):
+        data = {"claims": data}
+    if not isinstance(data, dict) or "claims" not in data:
+        raise ParseError("a claims file is a mapping with a 'claims' list (see docs/claims.md)", where=where)
+    unit = str(data.get("angle_unit", "rad")).lower()
+    if unit not in ("rad", "deg"):
+        raise ParseError(f"'angle_unit' must be rad or deg, got {unit!r}", where=where)
+    result = check_claims(robot, data["claims"], seed=seed, deg=unit == "deg", source=where)
+    notes = []
+    named = data.get("robot")
+    if named is not None and str(named) != robot.name:
+        notes.append(f"the claims file names robot {named!r}; checked against {robot.name!r}")
+    return CheckResult(result.robot, result.source, result.verdicts, tuple(notes))
+
+
+def verdicts_text(result: CheckResult) -> str:
+    """A readable summary, one block per claim."""
+    lines = [f"{result.robot}: {result.count('correct')} correct, {result.count('incorrect')} incorrect, "
+             f"{result.count('unreadable')} unreadable ({result.source})"]
+    lines += [f"note: {n}" for n in result.notes]
+    for v in result.verdicts:
+        lines.append(f"\n[{v.verdict.upper()}] {v.id} ({v.quantity}): {v.message}")
+        for e in v.entries[:12]:
+            lines.append(f"  entry {tuple(e['entry'])}: claimed {e['claimed']:.6g}, expected {e['expected']:.6g}")
+        if v.counterexample:
+            cx = v.counterexample
+            lines.append("  counterexample: q = [" + ", ".join(f"{x:.6g}" for x in cx["q"]) + "]"
+                         + (f", parameters {cx['parameters']}" if "parameters" in cx else ""))
+        lines += [f"  hint: {h}" for h in v.hints]
+    return "\n".join(lines)

@@ -1,0 +1,258 @@
+"""The verdict on one claim: read it, evaluate it and the truth at random points, compare, explain.
+
+Equivalence is decided by evaluation, never by comparing text: the claimed formula and the library's
+value are computed at several random configurations (and, when the claim keeps parameters as symbols,
+at random parameter values too).  Different but equal forms (cos(q1 + q2) and c1 c2 − s1 s2, √3/2 and
+0.866…) therefore agree.  A trigonometric polynomial that vanishes at six random points drawn from a
+continuous distribution is zero with probability one; the tolerance is 1e-9 relative for exact claims and
+one unit of the last decimal written for claims written with rounded decimals.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .. import _expr
+from ..errors import ParseError
+from ..io import with_parameters
+from ..model import DHRobot, JointType
+from ._hints import hints_for
+from ._latex import parse_math, parse_matrix
+from ._quantities import Point, quantity
+from ._resolve import robot_resolver
+
+__all__ = ["Verdict", "check_claim", "N_POINTS", "EXACT_RTOL"]
+
+N_POINTS = 6
+N_PARAM_SETS = 2
+EXACT_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict on one claim: ``verdict`` is ``correct``, ``incorrect`` or ``unreadable``."""
+
+    id: str
+    quantity: str
+    verdict: str
+    message: str
+    entries: tuple[dict[str, Any], ...] = ()
+    counterexample: dict[str, Any] | None = None
+    hints: tuple[str, ...] = ()
+    expected: Any = None
+    method: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        out = {"id": self.id, "quantity": self.quantity, "verdict": self.verdict, "message": self.message,
+               "entries": list(self.entries), "counterexample": self.counterexample, "hints": list(self.hints),
+               "expected": self.expected, "method": self.method}
+        out.update(self.extra)
+        return out
+
+
+def _values(raw: Any, resolve) -> list[list[tuple]]:
+    """A claim's value: a LaTeX/plain string (matrix or scalar) or a YAML list (of lists)."""
+    if isinstance(raw, (int, float)) and not isinstance(raw, bool):
+        return [[_expr.parse(raw)]]
+    if isinstance(raw, str):
+        return parse_matrix(raw, resolve)
+    if isinstance(raw, list) and raw:
+        if all(isinstance(r, list) for r in raw):
+            rows = raw
+        else:
+            rows = [[v] for v in raw]
+        out = []
+        for i, row in enumerate(rows, start=1):
+            cells = []
+            for j, v in enumerate(row, start=1):
+                try:
+                    cells.append(_expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), resolve, rhs=False))
+                except ParseError as exc:
+                    raise ParseError(f"entry ({i}, {j}) {str(v)[:40]!r}: {exc}") from None
+            out.append(cells)
+        if len({len(r) for r in out}) != 1:
+            raise ParseError("rows of different lengths in the value")
+        return out
+    raise ParseError("'value' must be a formula (string) or a list of entries / rows")
+
+
+def _decimals(node: tuple) -> int:
+    """The most decimals of any number written in a tree (0 if none)."""
+    kind = node[0]
+    if kind == "num":
+        s = node[1]
+        return len(s.split(".")[1]) if "." in s and "e" not in s.lower() else 0
+    if kind == "neg":
+        return _decimals(node[1])
+    if kind == "bin":
+        return max(_decimals(node[2]), _decimals(node[3]))
+    if kind == "call":
+        return max((_decimals(a) for a in node[2]), default=0)
+    return 0
+
+
+def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
+    r, c = len(claimed), len(claimed[0])
+    if len(shape) == 1:
+        if (r, c) == (shape[0], 1):
+            return claimed
+        if (r, c) == (1, shape[0]):
+            return [[x] for x in claimed[0]]
+        raise ParseError(f"expected a vector of {shape[0]} entries, got a {r}×{c} value")
+    if (r, c) != shape:
+        raise ParseError(f"expected a {shape[0]}×{shape[1]} matrix, got {r}×{c}")
+    return claimed
+
+
+def _no_names(ident) -> tuple:
+    raise ParseError(f"unknown symbol {ident.plain!r} (joint values are numbers; pi is allowed)")
+
+
+def numbers(raw: Any, n: int, what: str) -> np.ndarray:
+    """``"-pi/3, 0, \\frac{\\pi}{2}"`` or a YAML list → floats, read by the restricted LaTeX/plain reader."""
+    if isinstance(raw, str):
+        parts, level, cur = [], 0, ""
+        for ch in raw.strip().strip("[]").strip():
+            level += ch in "({[" and 1 or 0
+            level -= ch in ")}]" and 1 or 0
+            if ch in ",;" and level == 0:
+                parts.append(cur)
+                cur = ""
+            else:
+                cur += ch
+        parts.append(cur)
+        items: list[Any] = [p for p in parts if p.strip()]
+    elif isinstance(raw, list):
+        items = raw
+    else:
+        items = [raw]
+    if len(items) != n:
+        raise ParseError(f"{what}: expected {n} values, got {len(items)}")
+    out = []
+    for i, v in enumerate(items, start=1):
+        try:
+            node = _expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), _no_names, rhs=False)
+            out.append(_expr.evaluate(node))
+        except ParseError as exc:
+            raise ParseError(f"{what}: value {i} ({str(v)[:40]!r}): {exc}") from None
+    return np.array(out, dtype=float)
+
+
+def _joint_values(raw: Any, robot: DHRobot, what: str, deg: bool) -> np.ndarray:
+    vals = numbers(raw, robot.dof, what)
+    if deg:
+        rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+        vals = np.where(rev, np.radians(vals), vals)
+    return vals
+
+
+def _sample_q(robot: DHRobot, rng: np.random.Generator) -> np.ndarray:
+    lo, hi = robot.q_limits.T
+    lo = np.where(np.isfinite(lo), lo, -np.pi)
+    hi = np.where(np.isfinite(hi), hi, np.pi)
+    return rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi))
+
+
+def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, deg: bool) -> list[Point]:
+    """Evaluation points: the claim's q (or random ones), its q̇/wrench (or random), robot parameter sets."""
+    params = [k for k, _ in robot.parameters]
+    robots = [robot]
+    if names & set(params):
+        for _ in range(N_PARAM_SETS):
+            robots.append(with_parameters(robot, **{k: v * rng.uniform(0.6, 1.4) if v else rng.uniform(0.1, 1.0)
+                                                   for k, v in robot.parameters if k in names}))
+    fixed_q = _joint_values(spec["q"], robot, "q", deg) if "q" in spec else None
+    fixed_qd = _joint_values(spec["qd"], robot, "qd", deg) if "qd" in spec else None
+    wrench = numbers(spec["wrench"], 6, "wrench") if "wrench" in spec else None
+    if "wrench" in needs and wrench is None:
+        raise ParseError("a torques claim needs 'wrench' (6 numbers f, n)")
+    uses_q = any(n.startswith("q") for n in names)
+    n_q = 1 if fixed_q is not None or not uses_q else N_POINTS
+    pts = []
+    for r in robots:
+        for _ in range(n_q):
+            q = fixed_q if fixed_q is not None else _sample_q(robot, rng)
+            qd = fixed_qd if fixed_qd is not None else rng.normal(size=robot.dof)
+            pts.append(Point(r, q, qd, wrench))
+    return pts
+
+
+def _env(p: Point) -> dict[str, float]:
+    env = dict(p.robot.parameters)
+    for k in range(p.robot.dof):
+        env[f"q{k + 1}"] = float(p.q[k])
+        if p.qd is not None:
+            env[f"qd{k + 1}"] = float(p.qd[k])
+    return env
+
+
+def _evaluate(cells: list[list[tuple]], p: Point) -> np.ndarray:
+    env = _env(p)
+    return np.array([[_expr.evaluate(c, env) for c in row] for row in cells], dtype=float)
+
+
+def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.Generator,
+                deg: bool = False) -> Verdict:
+    """Read, evaluate and judge one claim (a mapping from the claims file)."""
+    cid = str(raw.get("id", label)) if isinstance(raw, dict) else label
+    qname = str(raw.get("quantity", "?")) if isinstance(raw, dict) else "?"
+    try:
+        if not isinstance(raw, dict):
+            raise ParseError("a claim must be a mapping with at least 'quantity' and 'value'")
+        if "value" not in raw:
+            raise ParseError("the claim has no 'value'")
+        qty, extra = quantity(raw.get("quantity"))
+        spec = {**extra, **{k: v for k, v in raw.items() if k not in ("id", "quantity", "value")}}
+        deg = bool(spec.get("deg", deg))
+        cells = _values(raw["value"], robot_resolver(robot))
+        names: set[str] = set()
+        for row in cells:
+            for c in row:
+                names |= _expr.names_in(c)
+        points = _points(robot, spec, names, qty.needs, rng, deg)
+        truth = np.array([np.asarray(qty.truth(p, spec), dtype=float) for p in points])  # (P, *shape)
+        cells = _shape_to(cells, truth.shape[1:])
+        claimed = np.array([_evaluate(cells, p).reshape(truth.shape[1:]) for p in points])
+    except ParseError as exc:
+        return Verdict(cid, qname, "unreadable", str(exc))
+    dec = np.array([[_decimals(c) for c in row] for row in cells]).reshape(truth.shape[1:])
+    tol = np.where(dec >= 2, 10.0 ** (-dec.astype(float)), 0.0)  # one unit of the last decimal written
+    scale = np.maximum(1.0, np.abs(truth))
+    ok_tight = np.abs(claimed - truth) <= EXACT_RTOL * scale
+    ok = np.abs(claimed - truth) <= EXACT_RTOL * scale + tol
+    method = (f"evaluated at {len(points)} point(s)" + (" (random q)" if len(points) > 1 else "")
+              + ", compared with the numeric engine")
+    expected = truth[0].tolist()
+    if ok.all():
+        how = "exactly" if ok_tight.all() else "to the decimals written"
+        return Verdict(cid, qty.name, "correct", f"correct ({how})", expected=expected, method=method)
+    return _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng)
+
+
+def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng) -> Verdict:
+    bad = ~ok.all(axis=0)  # entries wrong at some point
+    idx = [tuple(int(i) + 1 for i in np.atleast_1d(ix)) for ix in zip(*np.nonzero(np.atleast_1d(bad)))]
+    err = np.abs(claimed - truth) / (EXACT_RTOL * np.maximum(1, np.abs(truth)) + tol)
+    err = err.reshape(len(points), -1).max(axis=1)
+    own = np.array([p.robot is robot for p in points])
+    k = int(np.argmax(np.where(own, err, -1.0))) if (own & (err > 1)).any() else int(np.argmax(err))
+    p = points[k]
+    entries = tuple({"entry": list(e), "claimed": float(claimed[k][tuple(i - 1 for i in e)]),
+                     "expected": float(truth[k][tuple(i - 1 for i in e)])} for e in idx)
+    cex: dict[str, Any] = {"q": p.q.tolist()}
+    if p.qd is not None and "qd" in qty.needs:
+        cex["qd"] = p.qd.tolist()
+    if p.robot is not robot:
+        cex["parameters"] = dict(p.robot.parameters)
+    hints = hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng)
+    only_params = all(ok[j].all() for j in range(len(points)) if points[j].robot is robot)
+    if only_params:
+        hints = ("it agrees at this robot's parameter values but not as a formula in the parameters "
+                 "(check which parameter goes where)",) + hints
+    where = ", ".join(str(tuple(e)) if len(e) > 1 else str(e[0]) for e in idx[:12])
+    msg = f"incorrect: {len(idx)} entr{'y differs' if len(idx) == 1 else 'ies differ'} ({where})"
+    return Verdict(cid, qty.name, "incorrect", msg, entries, cex, hints, truth[k].tolist(), method)

@@ -1,0 +1,158 @@
+"""Hints for an incorrect claim: which typical slip would make it right.
+
+Each hint is tested, not guessed: the claimed values are compared with the truth changed by one slip
+(a sign, a transposition, two entries swapped, the other DH convention, another frame, another
+parameter value, a joint angle's sign), at the same evaluation points.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..model import Convention, Frame
+from ._quantities import Point
+
+__all__ = ["hints_for"]
+
+RTOL = 1e-9
+MAX_HINTS = 6
+
+
+def _close(a: np.ndarray, b: np.ndarray, tol: Any = 0.0) -> bool:
+    return a.shape == b.shape and bool(np.all(np.abs(a - b) <= RTOL * np.maximum(1.0, np.abs(b)) + tol))
+
+
+def _alt(qty, spec, points, robot_map=None, spec_change=None) -> np.ndarray | None:
+    """The truth with one change (a different robot per point, or a changed spec), or None if undefined."""
+    try:
+        s = {**spec, **(spec_change or {})}
+        return np.array([np.asarray(qty.truth(Point(robot_map(p.robot) if robot_map else p.robot, p.q, p.qd,
+                                                    p.wrench), s), dtype=float) for p in points])
+    except Exception:  # e.g. an index out of range for the changed spec: no hint
+        return None
+
+
+def _entry_name(ix: tuple[int, ...]) -> str:
+    return str(tuple(int(i) + 1 for i in ix)) if len(ix) > 1 else str(int(ix[0]) + 1)
+
+
+def _entrywise(claimed, truth, bad, tol) -> list[str]:
+    hints = []
+    shape = truth.shape[1:]
+    bad_ix = [tuple(ix) for ix in zip(*np.nonzero(bad))] if bad.ndim else []
+    signs = [ix for ix in bad_ix if _close(claimed[(slice(None),) + ix], -truth[(slice(None),) + ix], tol[ix])]
+    if signs:
+        hints.append("sign slip: entr" + ("y " if len(signs) == 1 else "ies ") + ", ".join(map(_entry_name, signs))
+                     + " ha" + ("s" if len(signs) == 1 else "ve") + " the opposite sign")
+    for n, a in enumerate(bad_ix):
+        for b in bad_ix[n + 1:]:
+            sa, sb = (slice(None),) + a, (slice(None),) + b
+            if _close(claimed[sa], truth[sb], tol[a]) and _close(claimed[sb], truth[sa], tol[b]):
+                hints.append(f"entries {_entry_name(a)} and {_entry_name(b)} are swapped")
+    if len(shape) == 2 and shape[0] == shape[1] and _close(claimed, np.swapaxes(truth, -1, -2), tol.T):
+        hints.append("the matrix is transposed")
+    elif len(shape) == 2 and shape == (4, 4):
+        Rt = truth.copy()
+        Rt[:, :3, :3] = np.swapaxes(truth[:, :3, :3], -1, -2)
+        if _close(claimed, Rt, tol):
+            hints.append("the rotation part is transposed (that is the inverse rotation)")
+        elif _close(claimed, np.linalg.inv(truth), tol):
+            hints.append("this is the inverse transform (the pose of the first frame in the second)")
+    return hints
+
+
+def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
+    hints = []
+    points = spec["_points"]
+    if qty.fk_like:
+        other = Convention.MODIFIED if robot.convention is Convention.STANDARD else Convention.STANDARD
+        alt = _alt(qty, spec, points, robot_map=lambda r: r.replace(convention=other))
+        if alt is not None and _close(claimed, alt, tol):
+            hints.append(f"it matches the {other.value} DH link formula, but this table is {robot.convention.value} "
+                         "(a swapped convention)")
+    if qty.name in ("transform", "end_effector"):
+        n = robot.n_rows
+        for j in range(1, n + 1):
+            if qty.name == "transform" and j == spec.get("to", n):
+                continue
+            alt = _alt(qty, spec, points, spec_change={"from": 0, "to": j}) if qty.name == "transform" else None
+            if qty.name == "end_effector":
+                from ._quantities import QUANTITIES
+                alt = _alt(QUANTITIES["transform"], {}, points, spec_change={"from": 0, "to": j})
+            if alt is not None and _close(claimed, alt, tol):
+                hints.append(f"this is the pose of frame {{{j}}} in {{0}} (T_0_{j})"
+                             + (" - a fixed row or the tool is missing" if j < n else ""))
+                break
+    if qty.name in ("jacobian", "twist", "torques"):
+        other = "tool" if Frame(spec.get("frame", "base")) is Frame.BASE else "base"
+        alt = _alt(qty, spec, points, spec_change={"frame": other})
+        if alt is not None and _close(claimed, alt, tol):
+            hints.append(f"it is expressed in {other} axes (J{'e' if other == 'tool' else '0'}), not "
+                         f"{spec.get('frame', 'base')} axes")
+        if truth.shape[1] == 6:
+            perm = [3, 4, 5, 0, 1, 2]
+            if _close(claimed, truth[:, perm], tol[perm]):
+                hints.append("the rows are in (ω, v) order; denavit's twists and Jacobians are (v, ω)")
+    return hints
+
+
+def _parameter(robot, qty, spec, claimed, truth, tol) -> list[str]:
+    """A named parameter (or a length) with another value that makes the claim right."""
+    from ..io import with_parameters
+
+    points = [p for p in spec["_points"] if p.robot is robot]
+    sel = [k for k, p in enumerate(spec["_points"]) if p.robot is robot]
+    if not points or not robot.parameters:
+        return []
+    hints = []
+    for name, value in robot.parameters:
+        span = max(1.0, 3 * abs(value))
+        grid = np.unique(np.concatenate([np.linspace(-span, span, 121), [v for _, v in robot.parameters]]))
+        best, best_err = None, np.inf
+        for x in grid:
+            alt = _alt(qty, spec, points, robot_map=lambda r, x=x: with_parameters(r, **{name: float(x)}))
+            if alt is None:
+                return []
+            e = float(np.max(np.abs(claimed[sel] - alt)))
+            if e < best_err:
+                best, best_err = x, e
+        if best is None or abs(best - value) < 1e-9:
+            continue
+        from scipy.optimize import minimize_scalar
+
+        step = 2 * span / 120
+        res = minimize_scalar(lambda x: float(np.max(np.abs(claimed[sel] - _alt(
+            qty, spec, points, robot_map=lambda r: with_parameters(r, **{name: float(x)}))))),
+            bounds=(best - step, best + step), method="bounded", options={"xatol": 1e-12})
+        x = float(res.x)
+        alt = _alt(qty, spec, points, robot_map=lambda r: with_parameters(r, **{name: x}))
+        if alt is not None and _close(claimed[sel], alt, tol) and abs(x - value) > 1e-6:
+            hints.append(f"it would be right with {name} = {x:.6g} (this robot has {name} = {value:g})")
+    return hints
+
+
+def _joint_sign(robot, qty, spec, claimed, truth, tol) -> list[str]:
+    if "q" not in spec:
+        return []
+    points = spec["_points"]
+    for k in range(robot.dof):
+        flipped = [Point(p.robot, p.q * np.where(np.arange(robot.dof) == k, -1, 1), p.qd, p.wrench) for p in points]
+        alt = _alt(qty, spec, flipped)
+        if alt is not None and _close(claimed, alt, tol):
+            return [f"it is right for the opposite sign of joint {k + 1} (q{k + 1} = {-points[0].q[k]:.6g})"]
+    return []
+
+
+def hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng) -> tuple[str, ...]:
+    """Tested explanations of an incorrect claim (at most a few, the most specific first)."""
+    bad = ~ok.all(axis=0)
+    spec = {**spec, "_points": points}
+    hints = _structural(robot, qty, spec, claimed, truth, tol)
+    hints += _entrywise(claimed, truth, bad, tol)
+    if not hints:
+        hints += _parameter(robot, qty, spec, claimed, truth, tol)
+    if not hints:
+        hints += _joint_sign(robot, qty, spec, claimed, truth, tol)
+    return tuple(hints[:MAX_HINTS])

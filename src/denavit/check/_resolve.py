@@ -1,0 +1,69 @@
+"""What the names in a person's formulas mean for a given robot.
+
+``\\theta_i``, ``\\vartheta_i``, ``q_i``, ``Q_i`` are joint variable i (``q{i}``); with a dot, its rate
+(``qd{i}``), two dots its acceleration (``qdd{i}``).  ``C_{12}``, ``c_1``, ``S_{123}``, ``s12`` are the
+cosine/sine of the sum of those joint variables; ``C_{\\theta_1}`` the cosine of the subscript.
+``L_1`` is the parameter ``L1``; ``d_3`` is the parameter ``d3`` when the robot has one, else joint 3 when
+that joint is prismatic.  A name the robot does not know is an error that lists the known ones.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Iterable
+
+from ..errors import ParseError
+from ..model import DHRobot, JointType
+from ._latex import Ident
+
+__all__ = ["robot_resolver", "JOINT_BASES"]
+
+JOINT_BASES = ("theta", "vartheta", "q", "Q")
+_SHORT = {"C": "cos", "c": "cos", "S": "sin", "s": "sin"}
+
+
+def _joint_sum(digits: str, n: int) -> tuple | None:
+    """``"123"`` → q1 + q2 + q3 (single digits when n < 10; ``"1,2"`` style separators allowed)."""
+    parts = [p for p in re.split(r"[,\s]+", digits) if p] if "," in digits else list(digits)
+    if not parts or not all(p.isdigit() and 1 <= int(p) <= n for p in parts):
+        return None
+    node: tuple = ("name", f"q{parts[0]}")
+    for p in parts[1:]:
+        node = ("bin", "+", node, ("name", f"q{p}"))
+    return node
+
+
+def robot_resolver(robot: DHRobot, extra: Iterable[str] = ()):
+    """A resolver (see :mod:`denavit.check._latex`) for the names of ``robot``'s formulas."""
+    params = {k for k, _ in robot.parameters}
+    n = robot.dof
+    extra = set(extra)
+    prismatic = {k + 1 for k, t in enumerate(robot.joint_types) if t is JointType.PRISMATIC}
+
+    def known() -> str:
+        return ", ".join(sorted(params | extra) + [f"q1..q{n}", "C_12/S_3 shorthand"])
+
+    def resolve(ident: Ident) -> tuple:
+        plain = ident.plain
+        if ident.dots == 0 and (plain in params or plain in extra):
+            return ("name", plain)
+        base, sub = ident.base, ident.sub
+        if base == "heta":  # "\t" of "\theta" eaten by a text conversion
+            base = "theta"
+        prefix = {0: "q", 1: "qd", 2: "qdd"}[ident.dots]
+        if base in JOINT_BASES and sub.isdigit() and 1 <= int(sub) <= n:
+            return ("name", f"{prefix}{int(sub)}")
+        if base in ("qd", "qdd", "dq", "ddq") and sub.isdigit() and 1 <= int(sub) <= n and ident.dots == 0:
+            return ("name", f"{'qd' if base in ('qd', 'dq') else 'qdd'}{int(sub)}")
+        if base == "d" and sub.isdigit() and int(sub) in prismatic:
+            return ("name", f"{prefix}{int(sub)}")
+        if base in _SHORT and ident.dots == 0:
+            if ident.sub_tree is not None and sub and not sub.isdigit():
+                return ("call", _SHORT[base], (ident.sub_tree,))
+            node = _joint_sum(sub, n)
+            if node is not None:
+                return ("call", _SHORT[base], (node,))
+        written = base + (f"_{{{sub}}}" if sub else "") if not ident.dots else f"\\dot{{{base}}}_{sub}"
+        raise ParseError(f"unknown symbol {written!r}; known: {known()}")
+
+    return resolve
