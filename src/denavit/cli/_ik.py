@@ -1,0 +1,155 @@
+"""Subcommand ik: inverse kinematics, all closed-form solutions or a numerical solve."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..errors import DenavitError, ParseError, UnsupportedRobotError
+from ._common import add_common, emit, joint_values, load, matrix_text
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("ik", help="inverse kinematics: every closed-form solution, or a numerical solve")
+    add_common(p)
+    target = p.add_mutually_exclusive_group(required=True)
+    target.add_argument("--pose", metavar="X,Y,Z,ROLL,PITCH,YAW",
+                        help="target position [m] and roll-pitch-yaw R = Rz(yaw) Ry(pitch) Rx(roll) [rad or --deg]")
+    target.add_argument("--T", dest="T", metavar="T11,...,T44", help="target pose as 16 numbers, row by row")
+    target.add_argument("--from-q", dest="from_q", metavar="Q", help="target = the pose of the arm at these joint values")
+    p.add_argument("--method", choices=["auto", "analytic", "numeric"], default="auto",
+                   help="closed form (all solutions), numerical LM, or auto: closed form when the arm has one")
+    p.add_argument("--all", action="store_true",
+                   help="numeric: search many seeds and list every distinct solution found (analytic always lists all)")
+    p.add_argument("--seed", metavar="Q", help="numeric: starting configuration")
+    p.add_argument("--mask", choices=["pose", "position"], default="pose", help="numeric: rows to match")
+    p.add_argument("--tol", type=float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
+    p.add_argument("--restarts", type=int, default=64, help="numeric: random restarts (default 64)")
+    p.add_argument("--ignore-limits", action="store_true", help="accept --from-q outside the joint limits")
+    p.set_defaults(handler=cmd_ik)
+
+
+def _target(args, robot) -> np.ndarray:
+    from .._validate import as_transform
+    from ..io import parse_values
+    from ..numeric import forward_kinematics, transform_from_xyz_rpy
+
+    if args.pose is not None:
+        v = parse_values(args.pose, 6, what="--pose")
+        rpy = np.radians(v[3:]) if args.deg else v[3:]
+        return transform_from_xyz_rpy(v[:3], rpy)
+    if args.T is not None:
+        v = parse_values(args.T, 16, what="--T").reshape(4, 4)
+        if not np.allclose(v[3], [0, 0, 0, 1]):
+            raise ParseError("--T: the last row must be 0, 0, 0, 1")
+        return as_transform(v, "--T")
+    return forward_kinematics(robot, joint_values(args, robot, args.from_q, what="--from-q"))
+
+
+def _fmt_q(robot, q, deg: bool) -> list[str]:
+    from ..model import JointType
+
+    out = []
+    for v, t in zip(q, robot.joint_types):
+        out.append(f"{np.degrees(v):.6g}" if deg and t is JointType.REVOLUTE else f"{v:.6g}")
+    return out
+
+
+def _to_unit(robot, q, deg: bool) -> np.ndarray:
+    from ..model import JointType
+
+    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    return np.where(rev, np.degrees(q), q) if deg else np.asarray(q)
+
+
+def _analytic(args, robot, T):
+    from ..numeric import analytic_ik
+
+    res = analytic_ik(robot, T)
+    sols = res.solutions
+    data = {"method": "analytic", "structure": res.method, "controlled": res.controlled,
+            "solutions": _to_unit(robot, sols, args.deg), "success": res.count > 0,
+            "branches": list(res.branches), "free": list(res.free),
+            "residuals": [{"position": float(p), "orientation": float(o)}
+                          for p, o in zip(res.position_error, res.orientation_error)],
+            "outside_limits": _to_unit(robot, res.outside_limits, args.deg)}
+    lines = [f"closed form ({res.method}; the arm controls: {res.controlled}): {res.count} solution(s)"]
+    for k, (q, b, f) in enumerate(zip(sols, res.branches, res.free), start=1):
+        lines.append(f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]" + (f"   {b}" if b else ""))
+        if f:
+            lines.append(f"     continuum: {f}")
+    if len(res.outside_limits):
+        lines.append(f"  ({len(res.outside_limits)} more outside the joint limits)")
+    return data, lines
+
+
+def _numeric(args, robot, T):
+    from ..io import parse_values
+    from ..numeric import solve_ik
+
+    rng = np.random.default_rng()
+    seed = None
+    if args.seed is not None:
+        seed = parse_values(args.seed, robot.dof, what="--seed", deg=args.deg)
+    if args.all:
+        n = 256
+        lim = robot.q_limits
+        lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
+        seeds = rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
+        res = solve_ik(robot, np.broadcast_to(T, (n, 4, 4)), seeds, mask=args.mask, tol=args.tol, restarts=0, rng=rng)
+        sols = _distinct(robot, res.q[res.success])
+        data = {"method": "numeric", "solutions": _to_unit(robot, np.array(sols).reshape(-1, robot.dof), args.deg),
+                "success": bool(sols), "seeds": n, "residuals": None}
+        lines = [f"numeric search from {n} random seeds: {len(sols)} distinct solution(s)"]
+        lines += [f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]" for k, q in enumerate(sols, start=1)]
+        return data, lines
+    res = solve_ik(robot, T, seed, mask=args.mask, tol=args.tol, restarts=args.restarts, rng=rng)
+    data = {"method": "numeric", "solutions": _to_unit(robot, res.q[None], args.deg) if res.success else [],
+            "q": _to_unit(robot, res.q, args.deg), "success": res.success,
+            "residuals": [{"position": res.position_error, "orientation": res.orientation_error}],
+            "iterations": res.iterations, "restarts": res.restarts, "reason": res.reason}
+    head = "converged" if res.success else f"failed ({res.reason})"
+    lines = [f"numeric (Levenberg-Marquardt): {head} after {res.iterations} iterations, {res.restarts} restarts",
+             f"  q = [{', '.join(_fmt_q(robot, res.q, args.deg))}]",
+             f"  residual: position {res.position_error:.3g} m, orientation {res.orientation_error:.3g} rad"]
+    return data, lines
+
+
+def _distinct(robot, qs, tol: float = 1e-6) -> list[np.ndarray]:
+    from ..model import JointType
+
+    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    out: list[np.ndarray] = []
+    for q in qs:
+        if all(np.max(np.where(rev, np.abs((q - p + np.pi) % (2 * np.pi) - np.pi), np.abs(q - p))) > tol for p in out):
+            out.append(q)
+    return out
+
+
+def cmd_ik(args: argparse.Namespace):
+    robot = load(args)
+    T = _target(args, robot)
+    method = args.method
+    if method == "auto":
+        from ..numeric import ik_structure
+
+        try:
+            ik_structure(robot)
+            method = "analytic"
+        except UnsupportedRobotError:
+            method = "numeric"
+    data, lines = (_analytic if method == "analytic" else _numeric)(args, robot, T)
+    data = {"robot": robot.name, "angle_unit": "deg" if args.deg else "rad", "T": T, **data}
+    text = "\n".join([f"{robot.name}: inverse kinematics of", "T =", matrix_text(T), ""] + lines)
+    if not data["success"]:
+        emit(args, data, text)  # the result is printed, then the exit code says "no solution"
+        raise _NoSolution("no solution" + (f" ({data.get('reason')})" if data.get("reason") else ""))
+    return data, text
+
+
+class _NoSolution(DenavitError):
+    """No inverse-kinematics solution: exit code 1 after the (empty) result is printed."""
+
+
+__all__ = ["register", "cmd_ik"]
