@@ -110,22 +110,30 @@ def cmd_check(args: argparse.Namespace):
 
 
 def cmd_import_table(args: argparse.Namespace):
-    from ..io import dump_robot, robot_to_dict, save_robot
-    from ..tables import import_table
+    from ..io import robot_to_dict
+    from ..tables import import_table, table_file_text
 
     path = Path(args.file)
     if not path.is_file():
         raise ParseError(f"no such file: {str(path)!r}")
+    if path.stat().st_size > 1_000_000:
+        raise ParseError(f"{str(path)!r} is too large for a DH table (at most 1 MB)")
     text = path.read_text(encoding="utf-8", errors="replace")
     result = import_table(text, name=args.name or path.stem, convention=args.convention,
                           degrees=True if args.deg else None, where=str(path))
     robot = result.robot
-    if args.output:
-        save_robot(robot, args.output, overwrite=args.force)
-        msg = f"wrote {args.output} ({robot.convention.value} DH, {robot.n_rows} rows, {robot.dof} joints)"
+    out = Path(args.output) if args.output else None
+    fmt = "json" if out is not None and out.suffix.lower() == ".json" else "yaml"
+    file_text = table_file_text(result, fmt, source=path.name)
+    if out is not None:
+        if out.suffix.lower() not in (".yaml", ".yml", ".json"):
+            raise ParseError(f"-o {str(out)!r}: a robot file ends in .yaml, .yml or .json")
+        if out.exists() and not args.force:
+            raise ParseError(f"{str(out)!r} exists; not overwriting it (choose another name or pass --force)")
+        out.write_text(file_text, encoding="utf-8")
+        msg = f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} rows, {robot.dof} joints)"
+        msg += "".join(f"\nnote: {n}" for n in result.notes)
     else:
-        msg = dump_robot(robot)
-    if result.notes:
-        msg += "\n" + "\n".join(f"note: {n}" for n in result.notes)
+        msg = file_text
     return {"file": str(path), "output": args.output, "convention": robot.convention.value,
-            "notes": list(result.notes), "robot_file": robot_to_dict(robot)}, msg
+            "notes": list(result.notes), "robot_file": result.data, "robot": robot_to_dict(robot)}, msg
