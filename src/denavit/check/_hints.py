@@ -123,13 +123,14 @@ def _parameter(robot, qty, spec, claimed, truth, tol) -> list[str]:
         from scipy.optimize import minimize_scalar
 
         step = 2 * span / 120
-        res = minimize_scalar(lambda x: float(np.max(np.abs(claimed[sel] - _alt(
-            qty, spec, points, robot_map=lambda r: with_parameters(r, **{name: float(x)}))))),
-            bounds=(best - step, best + step), method="bounded", options={"xatol": 1e-12})
-        x = float(res.x)
-        alt = _alt(qty, spec, points, robot_map=lambda r: with_parameters(r, **{name: x}))
-        if alt is not None and _close(claimed[sel], alt, tol) and abs(x - value) > 1e-6:
-            hints.append(f"it would be right with {name} = {x:.6g} (this robot has {name} = {value:g})")
+        res = minimize_scalar(lambda x: float(np.sum((claimed[sel] - _alt(  # smooth: converges tightly
+            qty, spec, points, robot_map=lambda r: with_parameters(r, **{name: float(x)}))) ** 2)),
+            bounds=(best - step, best + step), method="bounded", options={"xatol": 1e-13})
+        for x in [round(float(res.x), d) for d in (2, 3, 4, 6, 8)] + [float(res.x)]:
+            alt = _alt(qty, spec, points, robot_map=lambda r, x=x: with_parameters(r, **{name: x}))
+            if alt is not None and _close(claimed[sel], alt, tol) and abs(x - value) > 1e-6:
+                hints.append(f"it would be right with {name} = {x:.6g} (this robot has {name} = {value:g})")
+                break
     return hints
 
 

@@ -69,6 +69,7 @@ Resolver = Callable[[Ident], tuple]
 
 
 def _normalize(text: str) -> str:
+    text = re.sub(r"([θαβφψωτϑ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
     for k, v in _UNICODE.items():
         text = text.replace(k, v)
     return text

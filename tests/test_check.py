@@ -1,0 +1,259 @@
+"""The claims checker: the restricted reader, verdicts on correct and broken claims, the CLI.
+
+Correct claims are produced independently of the checker (sympy's LaTeX printer applied to the symbolic
+engine's matrices, rewritten in several equivalent forms); broken ones are made from them by one slip.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+import sympy as sp
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import denavit as dn
+from denavit import _expr
+from denavit import symbolic as S
+from denavit.check import check_claims, parse_math, robot_resolver
+from denavit.cli import main
+
+CI = os.environ.get("CI") == "true"
+ARMS = ["report000-6r", "report001-6r", "report004-4-rrp", "scara", "planar3r"]
+
+
+def _val(text, robot, env=None):
+    node = parse_math(text, robot_resolver(robot))
+    return _expr.evaluate(node, {**robot.parameter_values, **(env or {})})
+
+
+# --- the reader ------------------------------------------------------------------------------------
+
+
+def test_reader_equivalent_forms_evaluate_alike():
+    robot = dn.load_robot("report000-6r")
+    env = {"q1": 0.3, "q2": -1.1, "q3": 0.7}
+    want = math.cos(0.3 - 1.1)
+    for text in [r"C_{12}", r"c_{12}", "C12", r"\cos(\theta_1 + \theta_2)", r"\cos\left(q_{1}+q_{2}\right)",
+                 r"c_1 c_2 - s_1 s_2", "c1*c2 - s1*s2", r"\cos\theta_1\cos\theta_2-\sin\theta_1\sin\theta_2",
+                 r"C_{\theta_1 + \theta_2}", r"\cos{\left(q_{1} + q_{2} \right)}", "cos(θ1 + θ2)"]:
+        assert _val(text, robot, env) == pytest.approx(want, abs=1e-14), text
+    assert _val(r"\frac{\sqrt{3}}{2}", robot) == pytest.approx(math.sqrt(3) / 2)
+    assert _val(r"2 L_1 \cdot 3", robot) == pytest.approx(3.0)
+    assert _val(r"\sin^2\theta_3 + \cos^{2}(\theta_3)", robot, env) == pytest.approx(1.0)
+    assert _val(r"-\frac{\sqrt{3}\cdot(0.5 - 0.1\sqrt{3})}{2}", robot) == pytest.approx(-math.sqrt(3) * (0.5 - 0.1 * math.sqrt(3)) / 2)
+    assert _val("H_1 + L_{2}", robot) == pytest.approx(0.9)
+    assert _val(r"{}^{0}T_{1} = 0.5", robot) == 0.5
+
+
+@pytest.mark.parametrize("text,match", [
+    ("__import__('os').system('x')", "unknown symbol|unexpected"),
+    (r"\input{/etc/passwd}", "unsupported LaTeX command"),
+    ("Z_9", "unknown symbol"),
+    ("(" * 100 + "1" + ")" * 100, "nested too deeply"),
+    ("1+" * 12000 + "1", "longer than"),
+    ("x^{1000}", "unknown symbol|exponent"),
+    (r"\frac{1}{", "end of expression"),
+])
+def test_reader_refuses_bad_text(text, match):
+    with pytest.raises(dn.ParseError, match=match):
+        _val(text, dn.load_robot("planar2r"))
+
+
+def test_reader_caps_exponents():
+    with pytest.raises(dn.ParseError, match="exponent"):
+        _val("2^{1000}", dn.load_robot("planar2r"))
+
+
+# --- claims from the symbolic engine ---------------------------------------------------------------
+
+
+def _tex(M, robot, style: str) -> str:
+    q = S.joint_symbols(robot.dof).q
+    if style == "shorthand":
+        M = S.shorthand_matrix(M, q)
+    elif style == "expanded":
+        M = M.applyfunc(lambda e: sp.expand(sp.expand_trig(e)))
+    elif style == "theta":
+        M = M.xreplace({s: sp.Symbol(f"theta_{k + 1}") for k, s in enumerate(q)})
+    elif style == "decimal":  # numbers only (at a fixed q): 8 decimals
+        M = M.applyfunc(lambda e: sp.Float(float(e), 12) if e.is_number else e)
+        return sp.latex(M.applyfunc(lambda e: sp.Symbol(f"{float(e):.8f}") if e.is_number else e),
+                        mat_str="bmatrix", mat_delim="")
+    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+
+
+def _check(robot, claims, seed=0):
+    return check_claims(robot, claims, seed=seed).verdicts
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_check_correct_symbolic_claims_in_varied_forms_are_accepted(name):
+    robot = dn.load_robot(name)
+    A = S.link_matrices_sym(robot)
+    T = S.link_transforms_sym(robot)
+    claims = []
+    for k, style in enumerate(["plain", "shorthand", "expanded", "theta"]):
+        i = k % robot.n_rows + 1
+        claims.append({"id": f"A{i}-{style}", "quantity": "link_transform", "index": i, "value": _tex(A[i - 1], robot, style)})
+        claims.append({"id": f"T-{style}", "quantity": "transform", "value": _tex(T[-1], robot, style)})
+    claims.append({"quantity": "position", "value": _tex(S.forward_kinematics_sym(robot)[:3, 3], robot, "shorthand")})
+    for v in _check(robot, claims):
+        assert v.verdict == "correct", (v.id, v.message)
+
+
+@pytest.mark.parametrize("name", ["report000-6r", "report004-4-rrp", "report001-6r"])
+def test_check_jacobian_claims_from_an_independent_symbolic_route(name):
+    """J0 columns by differentiating the symbolic position (linear rows) are accepted by the checker."""
+    robot = dn.load_robot(name)
+    q = S.joint_symbols(robot.dof).q
+    p = S.forward_kinematics_sym(robot)[:3, 3]
+    Jv = p.jacobian(sp.Matrix(q))
+    claims = [{"quantity": "jacobian", "rows": "linear", "value": _tex(sp.ImmutableMatrix(Jv), robot, "shorthand")},
+              {"quantity": "jacobian", "rows": "linear", "column": 2, "value": _tex(sp.ImmutableMatrix(Jv[:, 1]), robot, "plain")}]
+    for v in _check(robot, claims):
+        assert v.verdict == "correct", v.message
+
+
+def _case(robot, rng):
+    lo, hi = np.maximum(robot.q_limits[:, 0], -np.pi), np.minimum(robot.q_limits[:, 1], np.pi)
+    return rng.uniform(lo, hi)
+
+
+@settings(max_examples=12 if CI else 30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(name=st.sampled_from(ARMS), style=st.sampled_from(["plain", "shorthand", "expanded", "theta", "decimal"]),
+       seed=st.integers(0, 2**31 - 1), which=st.sampled_from(["A", "T", "position"]))
+def test_check_never_calls_a_correct_claim_incorrect(name, style, seed, which):
+    """Property: a claim equal to the truth (any rewriting, at random q, or as a formula) is never rejected."""
+    robot = dn.load_robot(name)
+    rng = np.random.default_rng(seed)
+    q = _case(robot, rng)
+    subs = dict(zip(S.joint_symbols(robot.dof).q, [sp.Float(v, 30) for v in q]))
+    i = int(rng.integers(1, robot.n_rows + 1))
+    M = {"A": lambda: S.link_matrices_sym(robot)[i - 1], "T": lambda: S.link_transforms_sym(robot)[-1],
+         "position": lambda: S.forward_kinematics_sym(robot)[:3, 3]}[which]()
+    claim = {"quantity": {"A": "link_transform", "T": "transform", "position": "position"}[which]}
+    if which == "A":
+        claim["index"] = i
+    if style == "decimal":
+        params = {sp.Symbol(k, real=True): sp.Float(v, 30) for k, v in robot.parameters}
+        M = sp.ImmutableMatrix(M.xreplace(params).xreplace(subs).evalf(30))
+        claim["q"] = ", ".join(repr(float(v)) for v in q)
+    claim["value"] = _tex(sp.ImmutableMatrix(M), robot, style)
+    (v,) = _check(robot, [claim], seed=seed)
+    assert v.verdict == "correct", (claim, v.message)
+
+
+# --- broken claims ---------------------------------------------------------------------------------
+
+
+def _numeric_claim(robot, q, M, quantity, **spec):
+    return {"quantity": quantity, "q": ", ".join(repr(float(x)) for x in q),
+            "value": [[f"{x:.10f}" for x in row] for row in np.atleast_2d(M)] if np.ndim(M) == 2
+            else [f"{x:.10f}" for x in M], **spec}
+
+
+@pytest.mark.parametrize("name", ["report000-6r", "report001-6r", "puma560"])
+def test_check_broken_claims_are_rejected_with_the_right_entries(name):
+    robot = dn.load_robot(name)
+    rng = np.random.default_rng(11)
+    q = _case(robot, rng)
+    T = dn.forward_kinematics(robot, q)
+    F = dn.link_transforms(robot, q)
+    # sign flip of one entry
+    bad = T.copy()
+    bad[0, 3] = -bad[0, 3]
+    (v,) = _check(robot, [_numeric_claim(robot, q, bad, "end_effector")])
+    assert v.verdict == "incorrect" and [e["entry"] for e in v.entries] == [[1, 4]]
+    assert any("sign" in h for h in v.hints)
+    # two entries swapped
+    bad = T.copy()
+    bad[[0, 1], 3] = bad[[1, 0], 3]
+    (v,) = _check(robot, [_numeric_claim(robot, q, bad, "end_effector")])
+    assert {tuple(e["entry"]) for e in v.entries} == {(1, 4), (2, 4)} and any("swapped" in h for h in v.hints)
+    # transposed rotation
+    bad = T.copy()
+    bad[:3, :3] = T[:3, :3].T
+    (v,) = _check(robot, [_numeric_claim(robot, q, bad, "end_effector")])
+    assert v.verdict == "incorrect" and any("transposed" in h for h in v.hints)
+    # a link transform computed with the other convention's formula
+    other = robot.replace(convention="modified" if robot.convention.value == "standard" else "standard")
+    i = 3
+    Fo = dn.link_transforms(other, q)
+    A_other = np.linalg.solve(Fo[i - 1], Fo[i])
+    A_true = np.linalg.solve(F[i - 1], F[i])
+    assert not np.allclose(A_other, A_true)
+    (v,) = _check(robot, [_numeric_claim(robot, q, A_other, "link_transform", index=i)])
+    assert v.verdict == "incorrect" and any("convention" in h for h in v.hints)
+
+
+def test_check_wrong_parameter_value_is_found():
+    robot = dn.load_robot("report000-6r")
+    q = np.array([0.3, -0.2, 0.9, -1.0, 0.4, 0.1])
+    wrong = dn.with_parameters(robot, L2=0.55)
+    (v,) = _check(robot, [_numeric_claim(robot, q, dn.forward_kinematics(wrong, q)[:3, 3], "position")])
+    assert v.verdict == "incorrect"
+    assert any("L2 = 0.55" in h for h in v.hints), v.hints
+
+
+def test_check_symbolic_sign_slip_gives_a_counterexample():
+    robot = dn.load_robot("planar2r")
+    claims = [{"id": "x", "quantity": "position", "value": [r"L_1 c_1 + L_2 c_{12}", r"L_1 s_1 - L_2 s_{12}", "0"]}]
+    (v,) = _check(robot, claims)
+    assert v.verdict == "incorrect" and [e["entry"] for e in v.entries] == [[2]]
+    q = np.array(v.counterexample["q"])
+    truth = dn.forward_kinematics(robot, q)[1, 3]
+    claimed = math.sin(q[0]) - math.sin(q[0] + q[1])
+    assert abs(claimed - truth) > 1e-6
+
+
+def test_check_jacobian_frame_and_twist_and_torques():
+    robot = dn.load_robot("report004-4-rrp")
+    q = np.array([0.4, -0.7, 0.2])
+    Je = dn.geometric_jacobian(robot, q, frame="tool")
+    J0 = dn.geometric_jacobian(robot, q)
+    qd = np.array([1.0, -2.0, 0.5])
+    w = np.array([1, 2, 3, 0.1, 0.2, 0.3])
+    claims = [_numeric_claim(robot, q, Je, "jacobian"),
+              _numeric_claim(robot, q, Je, "jacobian", frame="tool"),
+              {**_numeric_claim(robot, q, J0 @ qd, "twist"), "qd": "1, -2, 0.5"},
+              {**_numeric_claim(robot, q, J0.T @ w, "torques"), "wrench": "1, 2, 3, 0.1, 0.2, 0.3"}]
+    v = _check(robot, claims)
+    assert v[0].verdict == "incorrect" and any("tool axes" in h for h in v[0].hints)
+    assert [x.verdict for x in v[1:]] == ["correct"] * 3
+
+
+def test_check_unreadable_claims_say_why():
+    robot = dn.load_robot("planar2r")
+    v = _check(robot, [{"quantity": "position", "value": r"\begin{bmatrix} x \\ 1 \end{bmatrix}"},
+                       {"quantity": "nonsense", "value": "1"},
+                       {"quantity": "position"},
+                       {"quantity": "link_transform", "index": 9, "value": "1"}])
+    assert [x.verdict for x in v] == ["unreadable"] * 4
+    assert "unknown symbol" in v[0].message and "choose one of" in v[1].message
+    assert "no 'value'" in v[2].message and "index" in v[3].message
+
+
+# --- command line ----------------------------------------------------------------------------------
+
+
+def test_cli_check_json_and_errors(tmp_path, capsys):
+    f = tmp_path / "claims.yaml"
+    f.write_text("robot: planar2r\nclaims:\n"
+                 "  - {id: p, quantity: position, value: ['L_1 \\cos\\theta_1 + L_2 C_{12}', 'L_1 S_1 + L_2 S_{12}', 0]}\n"
+                 "  - {id: bad, quantity: position, value: ['L_1 C_1', 'L_1 S_1', 0]}\n")
+    assert main(["check", "planar2r", str(f), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["summary"] == {"correct": 1, "incorrect": 1, "unreadable": 0}
+    assert data["claims"][1]["entries"][0]["entry"] == [1]
+    assert main(["check", "planar2r", str(f)]) == 0
+    assert "[INCORRECT] bad" in capsys.readouterr().out
+    f.write_text("claims: [ {quantity: position\n")
+    assert main(["check", "planar2r", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "malformed YAML" in err
+    assert main(["check", "planar2r", str(tmp_path / "none.yaml")]) == 2
