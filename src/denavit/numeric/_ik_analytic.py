@@ -27,7 +27,8 @@ __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure"]
 
 VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
 POLISH_STEPS = 30
-DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
+DUPLICATE_TOL = 1e-6
+PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished  # joint-space distance under which two solutions are the same [rad, m]
 
 
 @dataclass(frozen=True)
@@ -180,6 +181,12 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     ok = np.all(np.isfinite(cand), axis=-1)
     Tk = np.broadcast_to(Tf[:, None], (B, K, 4, 4))
     q = np.full(cand.shape, np.nan)
+    if ok.any():  # false roots are far off: drop them before the (costly) polish
+        e0 = pose_error(Tk[ok], forward_kinematics(robot, cand[ok])) @ plan.projector.T
+        near = np.zeros_like(ok)
+        near[ok] = np.linalg.norm(e0[:, :3], axis=-1) + _reach(robot) * np.linalg.norm(e0[:, 3:], axis=-1) \
+            < PREFILTER * max(_reach(robot), 1e-3)
+        ok &= near
     if ok.any():
         q[ok] = _polish(robot, cand[ok], Tk[ok], plan.projector)
     ok &= np.all(np.isfinite(q), axis=-1)
@@ -189,6 +196,10 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
         e = pose_error(Tk[ok], forward_kinematics(robot, q[ok])) @ plan.projector.T
         pe[ok], re[ok] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
     ok &= (pe <= VERIFY_TOL * max(1.0, _reach(robot))) & (re <= VERIFY_TOL)
+    # keep only the slots some pose uses: the verified candidates first, the rest dropped
+    order = np.argsort(~ok, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
+    take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
+    q, ok, free, pe, re = take(q), take(ok), take(free), take(pe), take(re)
     q, inside = _fold(robot, np.where(ok[..., None], q, 0.0))
     ok = _dedupe(robot, np.where(ok[..., None], q, np.nan), ok)
     outside = ok & ~inside
