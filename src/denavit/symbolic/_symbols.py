@@ -9,7 +9,7 @@ import sympy as sp
 from .. import _expr
 from ..model import DHLink, DHRobot, JointType
 
-__all__ = ["JointSymbols", "joint_symbols", "parameter_symbols", "row_expressions", "matrix_from_floats"]
+__all__ = ["JointSymbols", "joint_symbols", "parameter_symbols", "row_expressions", "matrix_from_floats", "exact_or_float"]
 
 
 class JointSymbols:
@@ -34,10 +34,28 @@ def parameter_symbols(robot: DHRobot) -> dict[str, sp.Symbol]:
     return {name: sp.Symbol(name, real=True) for name, _ in robot.parameters}
 
 
+_EXACT_TOL = 1e-12
+
+
+def exact_or_float(x: float) -> sp.Expr:
+    """x as a simple exact number when it is one (3/4, pi/6, √2/2, √3/2 …), else as a sympy Float.
+
+    Only small denominators are tried, so a random float never turns into a huge rational.
+    """
+    x = float(x)
+    for base in (sp.Integer(1), sp.pi, sp.sqrt(2), sp.sqrt(3)):
+        b = float(base)
+        for den in (1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 25, 100, 1000):
+            num = round(x * den / b)
+            if abs(num) <= 100_000 and abs(x - num * b / den) < _EXACT_TOL * max(1.0, abs(x)):
+                return sp.Rational(num, den) * base
+    return sp.Float(x)
+
+
 def _field(link: DHLink, field: str, syms: dict[str, sp.Symbol]) -> sp.Expr:
     text = dict(link.symbols).get(field)
     if text is None:
-        return sp.nsimplify(getattr(link, field), [sp.pi], tolerance=1e-13, rational=True)
+        return exact_or_float(getattr(link, field))
     return _expr.to_sympy(_expr.parse(text), syms)
 
 
@@ -67,7 +85,4 @@ def row_expressions(robot: DHRobot, numeric: bool = False) -> list[dict[str, sp.
 
 def matrix_from_floats(M) -> sp.ImmutableMatrix:
     """A 4×4 of floats as exact numbers where they are close to simple ones (0.5 → 1/2, 0.7071… → √2/2)."""
-    out = []
-    for row in M:
-        out.append([sp.nsimplify(float(x), [sp.sqrt(2), sp.sqrt(3)], tolerance=1e-12) for x in row])
-    return sp.ImmutableMatrix(out)
+    return sp.ImmutableMatrix([[exact_or_float(x) for x in row] for row in M])
