@@ -75,12 +75,14 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
         lim = robot.q_limits
         for k in range(robot.dof):
             if not (lim[k, 0] - 1e-12 <= vals[k] <= lim[k, 1] + 1e-12):
-                lo, hi = lim[k]
+                lo, hi, v = lim[k, 0], lim[k, 1], vals[k]
                 unit = "m"
                 if robot.joint_types[k] is JointType.REVOLUTE:
                     unit = "rad"
+                    if args.deg:
+                        lo, hi, v, unit = np.degrees(lo), np.degrees(hi), np.degrees(v), "deg"
                 raise ParseError(
-                    f"{what}: joint {k + 1} = {vals[k]:.6g} {unit} is outside its limits [{lo:.6g}, {hi:.6g}] "
+                    f"{what}: joint {k + 1} = {v:.6g} {unit} is outside its limits [{lo:.6g}, {hi:.6g}] "
                     f"(use --ignore-limits to compute anyway)"
                 )
     return vals

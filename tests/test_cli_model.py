@@ -1,0 +1,130 @@
+"""The command line for robots/show/fk/convert: in-process and as a real process."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_help_and_version(capsys):
+    code, out, _ = run(capsys, "--help")
+    assert code == 0 and "fk" in out and "robots" in out
+    code, out, _ = run(capsys, "--version")
+    assert code == 0 and denavit.__version__ in out
+
+
+def test_robots_lists_the_catalogue(capsys):
+    code, out, _ = run(capsys, "robots", "--json")
+    assert code == 0
+    names = [r["name"] for r in json.loads(out)["robots"]]
+    assert names == denavit.catalogue_names()
+    code, out, _ = run(capsys, "robots")
+    assert "puma560" in out and "report000-6r" in out
+
+
+def test_show_prints_table_and_json(capsys):
+    code, out, _ = run(capsys, "show", "report000-6r")
+    assert code == 0 and "modified" in out and "H1" in out and "fixed" in out
+    code, out, _ = run(capsys, "show", "puma560", "--json")
+    data = json.loads(out)
+    assert data["dof"] == 6 and len(data["rows"]) == 6
+
+
+def test_fk_json_equals_library(capsys):
+    code, out, _ = run(capsys, "fk", "report000-6r", "-q", "0, pi/4, pi/3, -pi/2, -pi/3, pi/6", "--json", "--frames")
+    assert code == 0
+    data = json.loads(out)
+    robot = denavit.load_robot("report000-6r")
+    q = [0, np.pi / 4, np.pi / 3, -np.pi / 2, -np.pi / 3, np.pi / 6]
+    np.testing.assert_allclose(data["T"], denavit.forward_kinematics(robot, q), atol=1e-12)
+    np.testing.assert_allclose(data["frames"], denavit.link_transforms(robot, q), atol=1e-12)
+    assert data["robot"] == "report000-6r" and len(data["q"]) == 6 and len(data["rpy"]) == 3
+
+
+def test_fk_degrees(capsys):
+    code, out, _ = run(capsys, "fk", "puma560", "-q", "0 45 -60 -90 -60 30", "--deg", "--json")
+    assert code == 0
+    data = json.loads(out)
+    T = denavit.forward_kinematics(denavit.load_robot("puma560"), np.radians([0, 45, -60, -90, -60, 30]))
+    np.testing.assert_allclose(data["T"], T, atol=1e-12)
+    assert data["q"][1] == pytest.approx(45)
+    code, _, err = run(capsys, "fk", "puma560", "-q", "0 45 60 -90 -60 30", "--deg")
+    assert code == 2 and "joint 3 = 60 deg is outside its limits [-225, 45]" in err
+
+
+def test_fk_symbolic_text_latex_json(capsys):
+    code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--shorthand")
+    assert code == 0 and "C₁₂" in out or "C12" in out
+    code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--latex")
+    assert code == 0 and "\\cos" in out
+    code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--json")
+    data = json.loads(out)
+    assert "cos(q1 + q2)" in "".join(sum(data["T_symbolic"], []))
+
+
+def test_convert_writes_a_file_with_identical_fk(capsys, tmp_path):
+    out_file = tmp_path / "puma_mdh.yaml"
+    code, out, err = run(capsys, "convert", "puma560", "--to", "modified", "-o", str(out_file))
+    assert code == 0, err
+    a, b = denavit.load_robot("puma560"), denavit.load_robot(out_file)
+    assert b.convention.value == "modified"
+    q = np.random.default_rng(1).uniform(-2, 2, (10, 6))
+    np.testing.assert_allclose(denavit.forward_kinematics(b, q), denavit.forward_kinematics(a, q), atol=1e-12)
+    # refuses to overwrite, leaves the file as it was
+    before = out_file.read_text()
+    code, _, err = run(capsys, "convert", "puma560", "--to", "modified", "-o", str(out_file))
+    assert code == 2 and "not overwriting" in err and out_file.read_text() == before
+
+
+BAD_INPUT = [
+    (["fk", "puma560", "-q", "1, 2"], "expected 6 values, got 2"),
+    (["fk", "puma560", "-q", "1, 2, 3, 4, 5, nan"], "unknown symbol 'nan'"),
+    (["fk", "puma560", "-q", "1, 2, 3, 4, 5, __import__('os')"], "value 6"),
+    (["fk", "puma560", "-q", "0, 0, 0, 0, 0, 9**9**9"], "exponent"),
+    (["fk", "puma560", "-q", "0, 0, 0, 0, 0, 100"], "outside its limits"),
+    (["fk", "no-such-robot", "-q", "0"], "unknown robot"),
+    (["fk", "puma560"], "give joint values"),
+    (["fk", "puma560", "-q", "0,0,0,0,0,0", "--param", "L9=1"], "no parameter"),
+    (["show", "missing.yaml"], "no such robot file"),
+    (["convert", "puma560", "--to", "sideways"], "invalid choice"),
+    (["nosuchcommand"], "invalid choice"),
+]
+
+
+@pytest.mark.parametrize("argv, message", BAD_INPUT)
+def test_bad_input_one_line_exit_2(capsys, argv, message):
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    assert message in err
+    assert len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err
+
+
+def test_bad_robot_file_names_file_row_field(capsys, tmp_path):
+    p = tmp_path / "bad.yaml"
+    p.write_text("convention: standard\njoints:\n  - {a: 1, theta: q}\n  - {a: \"L2 +\", theta: q}\n")
+    code, _, err = run(capsys, "show", str(p))
+    assert code == 2 and str(p) in err and "row 2" in err and "'a'" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_console_script_runs_as_a_process():
+    proc = subprocess.run([sys.executable, "-m", "denavit", "fk", "planar2r", "-q", "0, 0", "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["T"][0][3] == pytest.approx(
+        denavit.forward_kinematics(denavit.load_robot("planar2r"), [0, 0])[0, 3])
+    proc = subprocess.run([sys.executable, "-m", "denavit", "fk", "planar2r", "-q", "0"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
