@@ -32,58 +32,76 @@ def joint_values_per_row(robot: DHRobot, q: np.ndarray) -> list[tuple[object, ob
     return out
 
 
-def _cs(x: object) -> tuple[object, object]:
-    if isinstance(x, np.ndarray):
-        return np.cos(x)[..., None], np.sin(x)[..., None]
-    return float(np.cos(x)), float(np.sin(x))
-
-
-def _scalar(x: object) -> object:
-    return x[..., None] if isinstance(x, np.ndarray) else x
+def _row_values(robot: DHRobot, cols) -> list[tuple[object, object]]:
+    """(θ, d) per row from per-joint values ``cols[k]`` (floats, or contiguous (B,) arrays)."""
+    out: list[tuple[object, object]] = []
+    k = 0
+    for link in robot.links:
+        if link.joint is JointType.REVOLUTE:
+            out.append((cols[k] + link.theta, link.d))
+            k += 1
+        elif link.joint is JointType.PRISMATIC:
+            out.append((link.theta, cols[k] + link.d))
+            k += 1
+        else:
+            out.append((link.theta, link.d))
+    return out
 
 
 class _Pose:
-    """A pose as rotation columns x, y, z and origin p, each (..., 3); composed on the right."""
+    """A batch of poses as rotation columns x, y, z and origin p, each (3, B) with B contiguous.
+
+    Composition is on the right (T ← T · motion); c, s, d, a are floats or (B,) arrays.
+    """
 
     __slots__ = ("x", "y", "z", "p")
 
-    def __init__(self, T: np.ndarray, batch: tuple[int, ...]) -> None:
-        T = np.broadcast_to(T, batch + (4, 4))
-        self.x, self.y, self.z, self.p = (np.array(T[..., :3, j]) for j in range(4))
+    def __init__(self, T: np.ndarray, size: int) -> None:
+        self.x, self.y, self.z, self.p = (np.repeat(T[:3, j : j + 1], size, axis=1) for j in range(4))
 
+    # In-place updates where possible: at large batches the cost is memory traffic, not arithmetic.
     def rot_z(self, c, s) -> None:
-        self.x, self.y = c * self.x + s * self.y, c * self.y - s * self.x
+        x, y = self.x, self.y
+        nx = c * x
+        nx += s * y
+        ny = c * y
+        ny -= s * x
+        self.x, self.y = nx, ny
 
     def rot_x(self, c, s) -> None:
-        self.y, self.z = c * self.y + s * self.z, c * self.z - s * self.y
+        y, z = self.y, self.z
+        ny = c * y
+        ny += s * z
+        nz = c * z
+        nz -= s * y
+        self.y, self.z = ny, nz
 
     def move_z(self, d) -> None:
-        if not (isinstance(d, float) and d == 0.0):
-            self.p = self.p + _scalar(d) * self.z
+        if isinstance(d, np.ndarray) or d != 0.0:
+            self.p += d * self.z
 
     def move_x(self, a) -> None:
-        if not (isinstance(a, float) and a == 0.0):
-            self.p = self.p + _scalar(a) * self.x
+        if a != 0.0:
+            self.p += a * self.x
 
-    def matrix(self) -> np.ndarray:
-        batch = self.p.shape[:-1]
-        T = np.zeros(batch + (4, 4))
-        T[..., :3, 0], T[..., :3, 1], T[..., :3, 2], T[..., :3, 3] = self.x, self.y, self.z, self.p
-        T[..., 3, 3] = 1.0
-        return T
+    def matrix(self, batch: tuple[int, ...]) -> np.ndarray:
+        T = np.zeros((4, 4) + self.p.shape[1:])
+        T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = self.x, self.y, self.z, self.p
+        T[3, 3] = 1.0
+        return np.moveaxis(T, (0, 1), (-2, -1)).reshape(batch + (4, 4))
 
 
 def _apply_row(pose: _Pose, convention: Convention, theta, d, a: float, alpha: float) -> None:
-    ct, st = _cs(theta)
+    ct, st = np.cos(theta), np.sin(theta)
     if convention is Convention.STANDARD:  # Rz(θ) Tz(d) Tx(a) Rx(α)
         pose.rot_z(ct, st)
         pose.move_z(d)
         pose.move_x(a)
         if alpha != 0.0:
-            pose.rot_x(*_cs(alpha))
+            pose.rot_x(np.cos(alpha), np.sin(alpha))
     else:  # Rx(α) Tx(a) Rz(θ) Tz(d)
         if alpha != 0.0:
-            pose.rot_x(*_cs(alpha))
+            pose.rot_x(np.cos(alpha), np.sin(alpha))
         pose.move_x(a)
         pose.rot_z(ct, st)
         pose.move_z(d)
@@ -92,13 +110,41 @@ def _apply_row(pose: _Pose, convention: Convention, theta, d, a: float, alpha: f
 def _run_chain(robot: DHRobot, q, keep_frames: bool):
     q = as_joint_array(q, robot.dof)
     batch = q.shape[:-1]
-    pose = _Pose(robot.base_matrix, batch)
-    frames = [pose.matrix()] if keep_frames else []
-    for link, (theta, d) in zip(robot.links, joint_values_per_row(robot, q)):
+    size = int(np.prod(batch, dtype=int))
+    qT = np.ascontiguousarray(q.reshape(size, robot.dof).T)  # (n, B): each joint's values contiguous
+    pose = _Pose(robot.base_matrix, size)
+    frames = [pose.matrix(batch)] if keep_frames else []
+    for link, (theta, d) in zip(robot.links, _row_values(robot, qT)):
         _apply_row(pose, robot.convention, theta, d, link.a, link.alpha)
         if keep_frames:
-            frames.append(pose.matrix())
-    return pose, frames
+            frames.append(pose.matrix(batch))
+    return pose, frames, batch
+
+
+def _single_pose(robot: DHRobot, q: np.ndarray) -> np.ndarray:
+    """Unbatched fast path in plain floats (numpy's per-call overhead dominates for one pose)."""
+    from math import cos, sin
+
+    B = robot.base
+    x, y, z, p = ([B[0][j], B[1][j], B[2][j]] for j in range(4))
+    std = robot.convention is Convention.STANDARD
+    for link, (theta, d) in zip(robot.links, _row_values(robot, q)):
+        c, s = cos(theta), sin(theta)
+        if not std and link.alpha != 0.0:
+            ca, sa = cos(link.alpha), sin(link.alpha)
+            y, z = [ca * y[i] + sa * z[i] for i in range(3)], [ca * z[i] - sa * y[i] for i in range(3)]
+        if not std and link.a != 0.0:
+            p = [p[i] + link.a * x[i] for i in range(3)]
+        x, y = [c * x[i] + s * y[i] for i in range(3)], [c * y[i] - s * x[i] for i in range(3)]
+        if d != 0.0:
+            p = [p[i] + d * z[i] for i in range(3)]
+        if std:
+            if link.a != 0.0:
+                p = [p[i] + link.a * x[i] for i in range(3)]
+            if link.alpha != 0.0:
+                ca, sa = cos(link.alpha), sin(link.alpha)
+                y, z = [ca * y[i] + sa * z[i] for i in range(3)], [ca * z[i] - sa * y[i] for i in range(3)]
+    return np.array([[x[0], y[0], z[0], p[0]], [x[1], y[1], z[1], p[1]], [x[2], y[2], z[2], p[2]], [0.0, 0.0, 0.0, 1.0]])
 
 
 def link_transforms(robot: DHRobot, q) -> np.ndarray:
@@ -113,7 +159,7 @@ def link_transforms(robot: DHRobot, q) -> np.ndarray:
     q : array_like, shape (..., n)
         Joint values [rad for revolute, m for prismatic].
     """
-    _, frames = _run_chain(robot, q, keep_frames=True)
+    _, frames, _ = _run_chain(robot, q, keep_frames=True)
     return np.stack(frames, axis=-3)
 
 
@@ -134,8 +180,12 @@ def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
     >>> T.shape
     (4, 4)
     """
-    pose, _ = _run_chain(robot, q, keep_frames=False)
-    T = pose.matrix()
+    qa = as_joint_array(q, robot.dof)
+    if qa.ndim == 1:
+        T = _single_pose(robot, qa.tolist())
+    else:
+        pose, _, batch = _run_chain(robot, qa, keep_frames=False)
+        T = pose.matrix(batch)
     tool = robot.tool_matrix
     if not np.array_equal(tool, np.eye(4)):
         T = T @ tool
