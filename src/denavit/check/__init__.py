@@ -102,4 +102,6 @@ def verdicts_text(result: CheckResult) -> str:
             lines.append("  counterexample: q = [" + ", ".join(f"{x:.6g}" for x in cx["q"]) + "]"
                          + (f", parameters {cx['parameters']}" if "parameters" in cx else ""))
         lines += [f"  hint: {h}" for h in v.hints]
+        if v.extra.get("expected_latex"):
+            lines.append(f"  correct formula (LaTeX): {v.extra['expected_latex']}")
     return "\n".join(lines)

@@ -249,10 +249,48 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
     if p.robot is not robot:
         cex["parameters"] = dict(p.robot.parameters)
     hints = hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng)
+    extra = {}
+    if len(points) > 1 and "q" not in spec:  # a formula: give the correct formula too
+        formula = expected_formula(robot, qty.name, spec)
+        if formula is not None:
+            extra["expected_latex"] = formula
     only_params = all(ok[j].all() for j in range(len(points)) if points[j].robot is robot)
     if only_params:
         hints = ("it agrees at this robot's parameter values but not as a formula in the parameters "
                  "(check which parameter goes where)",) + hints
     where = ", ".join(str(tuple(e)) if len(e) > 1 else str(e[0]) for e in idx[:12])
     msg = f"incorrect: {len(idx)} entr{'y differs' if len(idx) == 1 else 'ies differ'} ({where})"
-    return Verdict(cid, qty.name, "incorrect", msg, entries, cex, hints, truth[k].tolist(), method)
+    return Verdict(cid, qty.name, "incorrect", msg, entries, cex, hints, truth[k].tolist(), method, extra)
+
+
+def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | None:
+    """The correct formula in LaTeX (C_12/S_3 shorthand) from the symbolic engine, when it is cheap."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    try:
+        if name == "link_transform":
+            M = S.simplify_matrix(S.link_matrices_sym(robot)[int(spec["index"]) - 1])
+        elif name == "transform":
+            F = S.link_transforms_sym(robot)
+            i, j = int(spec.get("from", 0)), int(spec.get("to", robot.n_rows))
+            M = S.simplify_matrix(_inverse(F[i]) * F[j])
+        elif name in ("end_effector", "position", "rotation"):
+            T = S.forward_kinematics_sym(robot)
+            M = T if name == "end_effector" else T[:3, 3] if name == "position" else T[:3, :3]
+        else:
+            return None
+    except (KeyError, ValueError, IndexError, TypeError):
+        return None
+    if len(str(M)) > 20_000:
+        return None
+    M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
+    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+
+
+def _inverse(T):
+    import sympy as sp
+
+    R, p = T[:3, :3], T[:3, 3]
+    return sp.ImmutableMatrix(sp.BlockMatrix([[R.T, -R.T * p], [sp.zeros(1, 3), sp.ones(1, 1)]]).as_explicit())

@@ -47,8 +47,12 @@ def section_singularities(ctx: Context) -> Section:
     robot = ctx.robot
     steps: list = [Text("A configuration is singular when $J_0$ loses rank: the arm cannot move (or resist) "
                         "in some direction.")]
-    sym = capability("denavit.symbolic", "singularities_sym", "singular_conditions", "singularities")
-    if sym is not None:
+    sym = capability("denavit.symbolic", "singularity_analysis", "singularities_sym", "singular_conditions")
+    heavy = robot.dof > 6 or not ctx.symbolic_jacobian_ok
+    if sym is not None and heavy:
+        steps.append(Text("The symbolic analysis is left out for this arm (more than six joints or a long pose "
+                          "formula: it would take minutes); numeric measures at the numeric case follow."))
+    elif sym is not None:
         try:
             result = sym[1](robot)
         except Exception as exc:  # another area's function: report, do not crash the report
@@ -70,19 +74,31 @@ def section_singularities(ctx: Context) -> Section:
 
 
 def _singular_result_steps(result: Any) -> list:
-    """Present whatever the singularity analysis returned: a list of conditions with kinds, or text."""
-    items = getattr(result, "conditions", result)
+    """Present a singularity analysis: the measure, its factors, each condition solved and classified."""
+    steps: list = []
+    measure = getattr(result, "measure", "")
+    det = getattr(result, "determinant", None)
+    if det is not None and hasattr(det, "free_symbols") and len(str(det)) < 4000:
+        steps.append(Text(f"Measure: {measure}." if measure else "Determinant:"))
+        steps.append(Equation("\\det", det))
+    if getattr(result, "reason", ""):
+        steps.append(Text(f"Note: {result.reason}."))
     rows = []
-    try:
-        for item in items:
-            cond = getattr(item, "condition", getattr(item, "expr", item))
-            kind = getattr(item, "kind", getattr(item, "classification", ""))
-            rows.append((latex(cond) if hasattr(cond, "free_symbols") else str(cond), f"\\text{{{kind}}}"))
-    except TypeError:
-        return [Text(str(result))]
-    if not rows:
-        return [Text("No singular configurations were found.")]
-    return [Table(("\\text{condition}", "\\text{kind}"), tuple(rows), caption="singular configurations")]
+    for c in getattr(result, "conditions", ()):
+        sols = "; ".join(f"{s.variable} = " + ", ".join(f"{v:.4g}" for v in s.values)
+                         for s in getattr(c, "solutions", ()))
+        factor = getattr(c, "factor", getattr(c, "condition", ""))
+        rows.append((latex(factor) + " = 0" if hasattr(factor, "free_symbols") else str(factor),
+                     f"\\text{{{getattr(c, 'kind', '')}}}", f"\\text{{{sols or '-'}}}"))
+        if getattr(c, "explanation", ""):
+            steps.append(Text(f"${latex(factor)} = 0$ ({getattr(c, 'kind', '')}): {c.explanation}"))
+    if rows:
+        steps.insert(len(steps) - sum(isinstance(s, Text) and s.text.startswith("$") for s in steps),
+                     Table(("\\text{condition}", "\\text{kind}", "\\text{solutions [rad or m]}"), tuple(rows),
+                           caption="singular configurations"))
+    elif not getattr(result, "reason", ""):
+        steps.append(Text("No singular configurations were found."))
+    return steps
 
 
 def section_ik(ctx: Context) -> Section:
@@ -97,16 +113,27 @@ def section_ik(ctx: Context) -> Section:
         return _unavailable("ik", "Inverse kinematics", "inverse kinematics", tuple(steps))
     solutions: list[np.ndarray] = []
     used = ""
+    structure = capability("denavit.numeric", "ik_structure")
+    if structure is not None:
+        try:
+            kind = structure[1](robot)
+        except Exception:  # a structure the recogniser does not name
+            kind = None
+        if kind:
+            steps.append(Text(f"Structure recognised from the DH table: {kind} "
+                              + ("(closed form by kinematic decoupling at the wrist centre, Pieper 1968; "
+                                 "Craig 2005, sec. 4.6-4.7; see docs/ik.md)." if kind == "pieper"
+                                 else "(closed form; see docs/ik.md for the derivation).")))
     if analytic is not None:
         try:
             res = analytic[1](robot, target)
             sols = np.atleast_2d(np.asarray(getattr(res, "solutions", res), dtype=float))
-            solutions = [s for s in sols if s.size == robot.dof]
+            solutions = [s for s in sols if s.size == robot.dof and np.all(np.isfinite(s))]
             used = f"analytic ({analytic[0]})"
         except Exception as exc:  # e.g. UnsupportedRobotError for a non-Pieper arm
             steps.append(Text(f"No analytic solution: {exc}."))
     if not solutions and numeric is not None:
-        res = numeric[1](robot, target)
+        res = numeric[1](robot, target, rng=np.random.default_rng(0)) if numeric[0] == "solve_ik" else numeric[1](robot, target)
         q_sol = np.asarray(getattr(res, "q", res), dtype=float)
         solutions = [q_sol.reshape(-1)]
         used = f"numeric ({numeric[0]})"
@@ -146,6 +173,9 @@ def section_dynamics(ctx: Context) -> Section:
         except Exception as exc:
             steps.append(Text(f"The symbolic derivation ({sym[0]}) failed: {type(exc).__name__}: {exc}."))
     steps.append(Numbers("M(q)", mass[1](robot, ctx.q), note="at the numeric case"))
+    cor = capability("denavit.numeric", "coriolis_vector")
+    if cor is not None and ctx.qd is not None:
+        steps.append(Numbers("c(q, \\dot q)", cor[1](robot, ctx.q, ctx.qd), note="at the numeric case"))
     if grav is not None:
         steps.append(Numbers("g(q)", grav[1](robot, ctx.q), note="at the numeric case"))
     return Section("dynamics", "Dynamics", tuple(steps))
