@@ -68,6 +68,8 @@ def test_fk_symbolic_text_latex_json(capsys):
     assert code == 0 and "C₁₂" in out or "C12" in out
     code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--latex")
     assert code == 0 and "\\cos" in out
+    code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--markdown")
+    assert code == 0 and out.count("$$") >= 6 and "\\cos" in out
     code, out, _ = run(capsys, "fk", "planar2r", "--symbolic", "--json")
     data = json.loads(out)
     assert "cos(q1 + q2)" in "".join(sum(data["T_symbolic"], []))

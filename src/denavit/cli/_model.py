@@ -27,6 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--frames", action="store_true", help="also every DH frame T_0_i")
     p.add_argument("--symbolic", action="store_true", help="the symbolic link transforms A_i and T_0_n")
     p.add_argument("--latex", action="store_true", help="symbolic output as LaTeX")
+    p.add_argument("--markdown", action="store_true", help="symbolic output as Markdown with $$ math $$ blocks")
     p.add_argument("--shorthand", action="store_true", help="write cos(q1+q2) as C12, sin(q3) as S3")
     p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
     p.set_defaults(handler=cmd_fk)
@@ -128,7 +129,12 @@ def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:
     import sympy as sp
 
     q = S.joint_symbols(robot.dof).q
-    fmt = (lambda M: sp.latex(M)) if args.latex else (lambda M: sp.pretty(M, use_unicode=True, wrap_line=False))
+    if args.markdown:
+        fmt = lambda M: "$$\n" + sp.latex(M) + "\n$$"  # noqa: E731
+    elif args.latex:
+        fmt = sp.latex
+    else:
+        fmt = lambda M: sp.pretty(M, use_unicode=True, wrap_line=False)  # noqa: E731
     show = (lambda M: S.shorthand_matrix(M, q)) if args.shorthand else (lambda M: M)
     lines = []
     As = S.link_matrices_sym(robot)
