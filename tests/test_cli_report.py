@@ -1,0 +1,89 @@
+"""The report / check command lines: files written, JSON, exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import denavit as dn
+from denavit.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "claims"
+
+
+def _one_line_error(capsys, *words):
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for w in words:
+        assert w in err, err
+
+
+@pytest.mark.parametrize("suffix", ["md", "html", "tex"])
+def test_cli_report_writes_each_format(tmp_path, capsys, suffix):
+    out = tmp_path / f"r.{suffix}"
+    code = main(["report", "planar3r", "-q", "0, pi/4, -pi/2", "--qd", "1, 0, 0", "--wrench", "1,0,0,0,0,0",
+                 "-o", str(out)])
+    assert code == 0, capsys.readouterr().err
+    assert out.exists() and out.stat().st_size > 1000
+    assert f"wrote {out}" in capsys.readouterr().out
+
+
+def test_cli_report_json_numbers_equal_fk(capsys):
+    assert main(["report", "report000-6r", "-q", "0, 45, 60, -90, -60, 30", "--deg", "--topics", "case", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    q = np.radians([0, 45, 60, -90, -60, 30])
+    np.testing.assert_allclose(data["q"], q, atol=1e-15)
+    (case,) = data["sections"]
+    T = [s for s in case["steps"] if s["type"] == "numbers" and s["lhs"] == "{}^{0}T_{7}"][0]["values"]
+    np.testing.assert_allclose(T, dn.forward_kinematics(dn.load_robot("report000-6r"), q), atol=1e-12)
+    assert any("\\sqrt{3}" in s.get("latex", "") for s in case["steps"])
+
+
+def test_cli_report_default_robot_to_stdout(capsys):
+    assert main(["report", "planar2r", "--topics", "model,fk"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("# Kinematics and dynamics of planar2r") and "p_x" in out
+
+
+def test_cli_report_bad_inputs(tmp_path, capsys):
+    assert main(["report", "planar2r", "-q", "1, 2, 3", "-o", str(tmp_path / "r.md")]) == 2
+    _one_line_error(capsys, "q: expected 2 values")
+    assert main(["report", "planar2r", "-q", "0, 9", "-o", str(tmp_path / "r.md")]) == 2
+    _one_line_error(capsys, "outside its limits")
+    assert main(["report", "planar2r", "-o", str(tmp_path / "r.docx")]) == 2
+    _one_line_error(capsys, ".md, .tex, .html or .pdf")
+    assert main(["report", "planar2r", "--wrench", "1,2", "-o", str(tmp_path / "r.md")]) == 2
+    _one_line_error(capsys, "wrench")
+    assert main(["report", "planar2r", "--topics", "fk,bogus"]) == 2
+    _one_line_error(capsys, "unknown report topic 'bogus'")
+    assert main(["report", "no-such-robot"]) == 2
+    _one_line_error(capsys, "unknown robot")
+
+
+def test_cli_report_pdf_needs_an_engine(tmp_path, capsys, monkeypatch):
+    out = tmp_path / "r.pdf"
+    if shutil.which("pdflatex") or shutil.which("tectonic") or shutil.which("xelatex") or shutil.which("lualatex"):
+        assert main(["report", "planar2r", "--topics", "model,links,fk", "-o", str(out)]) == 0
+        assert out.read_bytes().startswith(b"%PDF")
+    monkeypatch.setenv("PATH", str(tmp_path))  # no engine on PATH
+    assert main(["report", "planar2r", "--topics", "model", "-o", str(out)]) == 1
+    _one_line_error(capsys, "LaTeX engine")
+
+
+@pytest.mark.parametrize("example", sorted(p.name for p in EXAMPLES.glob("*.yaml")))
+def test_cli_check_examples_run_and_judge_every_claim(example, capsys):
+    import yaml
+
+    path = EXAMPLES / example
+    robot = yaml.safe_load(path.read_text())["robot"]
+    assert main(["check", robot, str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["summary"]["unreadable"] == 0
+    assert sum(data["summary"].values()) == len(data["claims"]) > 0
+    for c in data["claims"]:
+        if c["verdict"] == "incorrect":
+            assert c["entries"] and c["counterexample"]["q"]
