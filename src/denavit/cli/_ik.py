@@ -13,7 +13,7 @@ from ._common import add_common, emit, joint_values, load, matrix_text
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("ik", help="inverse kinematics: every closed-form solution, or a numerical solve")
     add_common(p)
-    target = p.add_mutually_exclusive_group(required=True)
+    target = p.add_mutually_exclusive_group()
     target.add_argument("--pose", metavar="X,Y,Z,ROLL,PITCH,YAW",
                         help="target position [m] and roll-pitch-yaw R = Rz(yaw) Ry(pitch) Rx(roll) [rad or --deg]")
     target.add_argument("--T", dest="T", metavar="T11,...,T44", help="target pose as 16 numbers, row by row")
@@ -27,6 +27,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tol", type=float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
     p.add_argument("--restarts", type=int, default=64, help="numeric: random restarts (default 64)")
     p.add_argument("--ignore-limits", action="store_true", help="accept --from-q outside the joint limits")
+    p.add_argument("--derive", action="store_true",
+                   help="print the symbolic derivation of the closed form (spherical-wrist 6-joint and planar 2R/3R "
+                        "arms) instead of solving a target")
+    p.add_argument("--latex", action="store_true", help="with --derive: LaTeX instead of plain text")
     p.set_defaults(handler=cmd_ik)
 
 
@@ -127,8 +131,33 @@ def _distinct(robot, qs, tol: float = 1e-6) -> list[np.ndarray]:
     return out
 
 
+def _derive(args, robot):
+    from ..symbolic import ik_derivation
+
+    d = ik_derivation(robot)
+    steps = [{"title": s.title, "text": s.text, "lhs": str(s.lhs) if s.lhs is not None else None,
+              "rhs": str(s.rhs) if s.rhs is not None else None, "assign": s.assign,
+              "latex": f"{_latex(s.lhs)} {s.relation} {_latex(s.rhs)}" if s.lhs is not None else None}
+             for s in d.steps]
+    data = {"robot": robot.name, "kind": d.kind, "branches": [str(b) for b in d.branches], "steps": steps,
+            "text": d.to_text(), "latex": d.to_latex(), "markdown": d.to_markdown()}
+    return data, (d.to_latex() if args.latex else d.to_text())
+
+
+def _latex(e) -> str:
+    import sympy as sp
+
+    return sp.latex(e)
+
+
 def cmd_ik(args: argparse.Namespace):
     robot = load(args)
+    if args.derive:
+        return _derive(args, robot)
+    if args.pose is None and args.T is None and args.from_q is None:
+        raise ParseError("give a target: --pose, --T or --from-q (or --derive for the symbolic derivation)")
+    if args.latex:
+        raise ParseError("--latex goes with --derive")
     T = _target(args, robot)
     method = args.method
     if method == "auto":

@@ -3,11 +3,15 @@
 Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the robot's named parameters.
 """
 
+from ._ik import IKDerivation, IKStep, ik_derivation
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
 from ._simplify import POLICIES, shorthand, shorthand_matrix, simplify_expr, simplify_matrix
 from ._symbols import JointSymbols, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
 
 __all__ = [
+    "IKDerivation",
+    "IKStep",
+    "ik_derivation",
     "dh_matrix_sym",
     "forward_kinematics_sym",
     "link_matrices_sym",
