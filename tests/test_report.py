@@ -180,3 +180,42 @@ def test_report_every_formula_is_valid_katex(tmp_path):
         out = subprocess.run(["node", str(script), str(js)], input=json.dumps(items), capture_output=True,
                              text=True, timeout=120, check=True)
         assert json.loads(out.stdout) == [], name
+
+
+CHROMIUM = os.environ.get("DENAVIT_CHROMIUM", "/usr/bin/chromium")
+
+
+@pytest.mark.browser
+def test_report_html_typesets_offline_in_a_browser(tmp_path):
+    """The HTML report opened in headless Chromium: every formula typeset by the bundled KaTeX, no KaTeX
+    error, no request leaves the file (fonts and scripts are embedded)."""
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        pytest.skip("playwright is not installed")
+    if not Path(CHROMIUM).exists():
+        if CI:
+            pytest.fail(f"no chromium at {CHROMIUM} under CI")
+        pytest.skip(f"no chromium at {CHROMIUM}")
+    robot = dn.load_robot("report000-6r")
+    out = tmp_path / "r.html"
+    write_report(derive(robot, ["0", "pi/4", "pi/3", "-pi/2", "-pi/3", "pi/6"], [1] * 6, [1, 0, 0, 0, 0, 1]), out)
+    n_math = out.read_text().count('class="math-')
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, headless=True,
+                               args=["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"])
+        page = b.new_page()
+        requests: list[str] = []
+        errors: list[str] = []
+        page.on("request", lambda r: requests.append(r.url))
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(out.as_uri())
+        page.wait_for_function("document.querySelectorAll('.katex').length > 0")
+        typeset = page.evaluate("document.querySelectorAll('.katex').length")
+        bad = page.evaluate("document.querySelectorAll('.katex-error').length")
+        fonts_ok = page.evaluate("document.fonts.check('16px KaTeX_Main')")
+        b.close()
+    assert errors == [] and bad == 0
+    assert typeset == n_math
+    assert fonts_ok
+    assert all(u.startswith(("file:", "data:")) for u in requests), requests

@@ -137,6 +137,7 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
         r"\usepackage[margin=2cm]{geometry}",
         r"\usepackage{amsmath,amssymb,graphicx,adjustbox}",
         r"\setcounter{MaxMatrixCols}{20}",
+        r"\renewcommand{\arraystretch}{1.4}",
         rf"\title{{{_tex_text(d.title)}}}",
         r"\author{denavit}",
         rf"\date{{{date.today().isoformat()}}}",
@@ -188,6 +189,8 @@ table.dh { border-collapse: collapse; margin: .8rem 0; } table.dh td, table.dh t
 figure img { max-width: 100%; } .meta { color: #555; }
 """
 
+_STRETCH = "\\def\\arraystretch{1.45}"  # room for fractions inside matrices
+
 _SCRIPT = """
 document.querySelectorAll('.math-display, .math-inline').forEach(function (el) {
   try { katex.render(el.textContent, el, {displayMode: el.classList.contains('math-display'),
@@ -226,7 +229,7 @@ def _html_step(step: Any) -> str:
     if isinstance(step, Text):
         return f"<p>{_html_text(step.text)}</p>"
     if isinstance(step, (Equation, Numbers)):
-        return f'<div class="math-display">{html.escape(math_of(step))}</div>'
+        return f'<div class="math-display">{html.escape(_STRETCH + math_of(step))}</div>'
     if isinstance(step, Table):
         cell = ((lambda c: f'<span class="math-inline">{html.escape(c)}</span>') if step.math
                 else (lambda c: html.escape(c)))
