@@ -41,6 +41,18 @@ def make_robot(rng, convention=None, n_rows=None):
     return DHRobot(name="random", links=tuple(links), convention=conv, base=base, tool=tool)
 
 
+def make_nice_robot(rng):
+    """A random arm with the values people write in DH tables (α in multiples of π/2, lengths in tenths),
+    so that the symbolic engine stays fast; both conventions, prismatic and fixed rows, base/tool in quarter turns."""
+    rough = make_robot(rng, n_rows=int(rng.integers(1, 5)))
+    links = tuple(DHLink(a=float(rng.integers(0, 6)) / 10, alpha=float(rng.choice([0, 1, -1, 2])) * np.pi / 2,
+                         d=float(rng.integers(0, 6)) / 10, theta=float(rng.choice([0, 1])) * np.pi / 2, joint=link.joint)
+                  for link in rough.links)
+    base = N.transform_from_xyz_rpy(rng.integers(-3, 4, 3) / 10, rng.integers(-2, 3, 3) * np.pi / 2)
+    tool = N.transform_from_xyz_rpy(rng.integers(-3, 4, 3) / 10, rng.integers(-2, 3, 3) * np.pi / 2)
+    return rough.replace(links=links, base=np.round(base, 15), tool=np.round(tool, 15))
+
+
 def vee(W):
     return 0.5 * np.stack([W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]], -1)
 
@@ -278,3 +290,93 @@ def test_random_robots_match_pinocchio_frame_jacobians():
         np.testing.assert_allclose(data.oMf[fid].homogeneous, forward_kinematics(robot, q), atol=1e-9)
         np.testing.assert_allclose(N.geometric_jacobian(robot, q, "base"), J_lwa, atol=1e-9)
         np.testing.assert_allclose(N.geometric_jacobian(robot, q, "tool"), J_local, atol=1e-9)
+
+
+# --- symbolic engine ---------------------------------------------------------------------------------
+
+SYMBOLIC_ROBOTS = ["report004-1-planar2r", "report004-4-rrp", "report004-5-rpp-cylindrical", "report004-7-scara-rrrp",
+                   "report000-6r", "stanford", "puma560"]
+
+
+def _lambdify(robot, expr, extra=()):
+    sp = pytest.importorskip("sympy")
+    from denavit.symbolic import joint_symbols, parameter_symbols
+
+    syms = list(joint_symbols(robot.dof).q) + list(parameter_symbols(robot).values()) + list(extra)
+    f = sp.lambdify(syms, expr, "numpy")
+    values = list(robot.parameter_values.values())
+    return lambda q, *more: np.array(f(*q, *values, *more), dtype=float)
+
+
+@pytest.mark.parametrize("name", SYMBOLIC_ROBOTS)
+def test_symbolic_routes_match_numeric_on_catalogue(name):
+    from denavit.symbolic import jacobian_sym
+
+    robot = load_robot(name)
+    rng = np.random.default_rng(30)
+    qs = rng.uniform(-np.pi, np.pi, (3, robot.dof))
+    for method in ("geometric", "differentiation", "propagation"):
+        for frame in ("base", "tool"):
+            f = _lambdify(robot, jacobian_sym(robot, method, frame))
+            for q in qs:
+                np.testing.assert_allclose(f(q), N.geometric_jacobian(robot, q, frame), atol=1e-12)
+
+
+def test_symbolic_routes_match_numeric_on_random_robots():
+    from denavit.symbolic import jacobian_sym
+
+    rng = np.random.default_rng(31)
+    for _ in range(6 if CI else 15):
+        robot = make_nice_robot(rng)
+        q = rng.uniform(-np.pi, np.pi, robot.dof)
+        for method in ("geometric", "differentiation", "propagation"):
+            for frame in ("base", "tool"):
+                J = _lambdify(robot, jacobian_sym(robot, method, frame))(q)
+                np.testing.assert_allclose(J, fd_jacobian(robot, q, frame), atol=ATOL_FD)
+
+
+def test_planar_2r_symbolic_jacobian_equals_hand_derivation():
+    """Planar 2R (Craig Example 5.3 / seed 004 arm 1), rows vx, vy, wz in base axes, derived by hand:
+    x = L1 c1 + L2 c12, y = L1 s1 + L2 s12, φ = q1 + q2."""
+    sp = pytest.importorskip("sympy")
+    from denavit.symbolic import jacobian_sym
+
+    q1, q2, L1, L2 = sp.symbols("q1 q2 L1 L2", real=True)
+    hand = sp.Matrix([[-L1 * sp.sin(q1) - L2 * sp.sin(q1 + q2), -L2 * sp.sin(q1 + q2)],
+                      [L1 * sp.cos(q1) + L2 * sp.cos(q1 + q2), L2 * sp.cos(q1 + q2)], [0, 0], [0, 0], [0, 0], [1, 1]])
+    robot = load_robot("report004-1-planar2r")
+    for method in ("geometric", "differentiation", "propagation"):
+        assert sp.simplify(jacobian_sym(robot, method, "base") - hand) == sp.zeros(6, 2)
+
+
+@pytest.mark.parametrize("name", ["report004-3-articulated-rrr", "report004-4-rrp", "puma560", "report000-6r"])
+def test_symbolic_propagation_steps_match_numeric_steps(name):
+    from denavit.symbolic import force_propagation_sym, joint_symbols, velocity_propagation_sym, wrench_symbols
+
+    robot = load_robot(name)
+    rng = np.random.default_rng(32)
+    q, qd, F = rng.uniform(-np.pi, np.pi, robot.dof), rng.normal(size=robot.dof), rng.normal(size=6)
+    vel = velocity_propagation_sym(robot)
+    num = N.velocity_propagation(robot, q, qd)
+    qds = joint_symbols(robot.dof).qd
+    for step in vel.steps:
+        k = num.labels.index(step.label)
+        np.testing.assert_allclose(_lambdify(robot, step.omega, qds)(q, *qd).ravel(), num.omega[k], atol=1e-12)
+        np.testing.assert_allclose(_lambdify(robot, step.v, qds)(q, *qd).ravel(), num.v[k], atol=1e-12)
+    frc = force_propagation_sym(robot)
+    nf = N.force_propagation(robot, q, F, "tool")
+    for step in frc.steps:
+        k = nf.labels.index(step.label)
+        np.testing.assert_allclose(_lambdify(robot, step.f, wrench_symbols())(q, *F).ravel(), nf.f[k], atol=1e-12)
+        np.testing.assert_allclose(_lambdify(robot, step.n, wrench_symbols())(q, *F).ravel(), nf.n[k], atol=1e-12)
+    np.testing.assert_allclose(_lambdify(robot, frc.tau, wrench_symbols())(q, *F).ravel(),
+                               N.geometric_jacobian(robot, q, "tool").T @ F, atol=1e-12)
+
+
+def test_import_denavit_stays_light():
+    import subprocess
+    import sys
+
+    code = "import sys, denavit, denavit.numeric; print('sympy' in sys.modules, 'matplotlib' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
