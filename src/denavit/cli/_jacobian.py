@@ -1,0 +1,359 @@
+"""Subcommands on Jacobians: jacobian, velocity, statics, singularities.
+
+Each handler parses, calls the library, and formats; results carry their frame, reference point and row order.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from ..errors import ParseError
+from ._common import add_common, add_q, joint_values, load, matrix_text
+
+ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
+REFERENCE = "end-effector origin (after the tool transform)"
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("jacobian", help="Jacobian J0 (base axes) or Je (tool axes), numeric or symbolic")
+    add_common(p)
+    add_q(p, required=False)
+    _frame(p)
+    p.add_argument("--method", choices=["geometric", "differentiation", "propagation"], default="geometric",
+                   help="route: joint axes of the frames, differentiation of FK, or Craig's velocity propagation")
+    p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
+    p.add_argument("--analytic", choices=["rpy", "zyz"], help="numeric analytic Jacobian: rows (xdot, ydot, zdot, angle rates)")
+    p.add_argument("--steps", action="store_true", help="with --method propagation: every omega_i and v_i (symbolic)")
+    _sym_format(p)
+    p.set_defaults(handler=cmd_jacobian)
+
+    p = sub.add_parser("velocity", help="end-effector twist (v, w) from joint rates")
+    add_common(p)
+    add_q(p)
+    p.add_argument("--qd", required=True, metavar="QD", help="joint rates [rad/s or m/s; deg/s with --deg]")
+    _frame(p)
+    p.add_argument("--steps", action="store_true", help="omega_i and v_i of every frame (outward propagation)")
+    p.set_defaults(handler=cmd_velocity)
+
+    p = sub.add_parser("statics", help="joint torques balancing an end-effector wrench (f, n)")
+    add_common(p)
+    add_q(p)
+    p.add_argument("--wrench", required=True, metavar="W",
+                   help="fx, fy, fz[, nx, ny, nz] [N, N m] exerted by the end effector, at its origin")
+    _frame(p, what="axes of the wrench")
+    p.add_argument("--method", choices=["jacobian", "propagation"], default="jacobian",
+                   help="tau = J^T F, or Craig's inward force propagation")
+    p.add_argument("--steps", action="store_true", help="f_i and n_i of every frame (inward propagation)")
+    p.set_defaults(handler=cmd_statics)
+
+    p = sub.add_parser("singularities", help="singular configurations: factored determinant, conditions, kinds")
+    add_common(p)
+    add_q(p, required=False)
+    p.add_argument("--rows", metavar="ROWS", help="task rows of the Jacobian, e.g. vx,vy,wz (default: all six)")
+    _frame(p, what="axes of the Jacobian whose rows are taken")
+    _sym_format(p, simplify=False)
+    p.set_defaults(handler=cmd_singularities)
+
+
+def _frame(p, what: str = "axes of the result") -> None:
+    p.add_argument("--frame", choices=["base", "tool"], default="base", help=f"{what}: base/world (J0) or tool (Je)")
+
+
+def _sym_format(p, simplify: bool = True) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--latex", action="store_true", help="symbolic output as LaTeX")
+    g.add_argument("--markdown", action="store_true", help="symbolic output as Markdown with $$ math $$ blocks")
+    p.add_argument("--shorthand", action="store_true", help="write cos(q1+q2) as C12, sin(q3) as S3")
+    if simplify:
+        p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
+
+
+def _formatter(args, q):
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    show = (lambda M: S.shorthand(M, q) if not hasattr(M, "shape") else S.shorthand_matrix(M, q)) \
+        if args.shorthand else (lambda M: M)
+    if getattr(args, "markdown", False):
+        return lambda M: "$$\n" + sp.latex(show(M)) + "\n$$"
+    if getattr(args, "latex", False):
+        return lambda M: sp.latex(show(M))
+    return lambda M: sp.pretty(show(M), use_unicode=True, wrap_line=False)
+
+
+def _header(frame: str, what: str = "J") -> str:
+    axes = "base/world axes (J0)" if frame == "base" else "tool axes (Je)"
+    return f"{what} in {axes}; reference point: {REFERENCE}; rows (vx, vy, vz, wx, wy, wz)"
+
+
+def _labelled(M: np.ndarray, labels=ROWS) -> str:
+    body = matrix_text(M).split("\n")
+    return "\n".join(f"{lab:>2} {row}" for lab, row in zip(labels, body))
+
+
+def _q_out(args, robot, q):
+    from ..model import JointType
+
+    if not args.deg:
+        return q
+    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    return np.where(rev, np.degrees(q), q)
+
+
+def _q_text(args, robot, q) -> str:
+    unit = "deg for revolute joints" if args.deg else "rad"
+    return f"q = [{', '.join(f'{v:.6g}' for v in _q_out(args, robot, q))}] ({unit})"
+
+
+# --- jacobian ------------------------------------------------------------------------------------------
+
+
+def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    q = S.joint_symbols(robot.dof).q
+    fmt = _formatter(args, q)
+    J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
+    name = "J0" if args.frame == "base" else "Je"
+    lines = [f"{robot.name}: symbolic Jacobian by {args.method}", _header(args.frame), f"{name} =", fmt(J)]
+    data = {"J_symbolic": J, "J_latex": sp.latex(J)}
+    if args.steps:
+        if args.method != "propagation":
+            raise ParseError("--steps goes with --method propagation")
+        prop = S.velocity_propagation_sym(robot, args.simplify)
+        lines += ["", "outward velocity propagation (each vector in its own frame's axes):"]
+        steps = []
+        for st in prop.steps[1:]:
+            lines += [f"omega_{st.label} =", fmt(st.omega), f"v_{st.label} =", fmt(st.v)]
+            steps.append({"frame": st.label, "joint": st.joint, "omega": [str(e) for e in st.omega],
+                          "v": [str(e) for e in st.v]})
+        data["steps"] = steps
+    return data, lines
+
+
+def cmd_jacobian(args: argparse.Namespace):
+    from .. import numeric as N
+
+    robot = load(args)
+    data: dict = {"robot": robot.name, "frame": args.frame, "method": args.method, "reference_point": REFERENCE,
+                  "rows": list(ROWS)}
+    lines: list[str] = []
+    if args.symbolic or args.q is None:
+        if args.analytic:
+            raise ParseError("--analytic needs joint values -q")
+        sdata, lines = _symbolic_jacobian(robot, args)
+        data.update(sdata)
+    if args.q is not None:
+        q = joint_values(args, robot, args.q)
+        data["q"] = _q_out(args, robot, q)
+        if args.analytic:
+            Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
+            names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
+            conv = np.degrees(phi) if args.deg else phi
+            data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
+            lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {_q_text(args, robot, q)}",
+                      f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
+                      f"angles: {', '.join(f'{n} = {v:.6g}' for n, v in zip(names[3:], conv))} "
+                      f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
+        else:
+            J = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
+                 "propagation": N.propagation_jacobian}[args.method](robot, q, args.frame)
+            data["J"] = J
+            if lines:
+                lines.append("")
+            lines += [f"{robot.name}: Jacobian by {args.method} at {_q_text(args, robot, q)}", _header(args.frame),
+                      "(columns: per rad for revolute joints, per m for prismatic ones)", _labelled(J)]
+    return data, "\n".join(line for line in lines if line is not None)
+
+
+# --- velocity ------------------------------------------------------------------------------------------
+
+
+def cmd_velocity(args: argparse.Namespace):
+    from .. import numeric as N
+
+    robot = load(args)
+    q = joint_values(args, robot, args.q)
+    qd = joint_values(args, robot, args.qd, what="qd", rates=True)
+    twist = N.end_effector_twist(robot, q, qd, args.frame)
+    ang = np.degrees if args.deg else (lambda x: x)
+    aunit = "deg/s" if args.deg else "rad/s"
+    data = {"robot": robot.name, "q": _q_out(args, robot, q), "qd": _q_out(args, robot, qd), "frame": args.frame,
+            "reference_point": REFERENCE, "twist": np.concatenate([twist[:3], ang(twist[3:])]),
+            "v": twist[:3], "omega": ang(twist[3:]), "angle_unit": "deg" if args.deg else "rad"}
+    lines = [f"{robot.name}: end-effector twist at {_q_text(args, robot, q)}", _header(args.frame, "twist (v, w)"),
+             f"v = [{', '.join(f'{x:.6g}' for x in twist[:3])}] m/s",
+             f"w = [{', '.join(f'{x:.6g}' for x in ang(twist[3:]))}] {aunit}"]
+    if args.steps:
+        prop = N.velocity_propagation(robot, q, qd)
+        lines += ["", "outward propagation (omega_i, v_i of frame {i} in its own axes):"]
+        for lab, w, v in zip(prop.labels, prop.omega, prop.v):
+            lines.append(f"  {{{lab}}}: omega = [{', '.join(f'{x:.6g}' for x in ang(w))}] {aunit}, "
+                         f"v = [{', '.join(f'{x:.6g}' for x in v)}] m/s")
+        data["steps"] = [{"frame": lab, "omega": ang(w), "v": v} for lab, w, v in zip(prop.labels, prop.omega, prop.v)]
+    return data, "\n".join(lines)
+
+
+# --- statics -------------------------------------------------------------------------------------------
+
+
+def _wrench(text: str) -> np.ndarray:
+    from ..io import parse_values
+
+    W = parse_values(text, what="--wrench")
+    if W.size not in (3, 6):
+        raise ParseError(f"--wrench: expected 3 values (fx, fy, fz) or 6 (fx, fy, fz, nx, ny, nz), got {W.size}")
+    return W
+
+
+def cmd_statics(args: argparse.Namespace):
+    from .. import numeric as N
+    from ..model import JointType
+
+    robot = load(args)
+    q = joint_values(args, robot, args.q)
+    W = _wrench(args.wrench)
+    prop = N.force_propagation(robot, q, W, args.frame)
+    tau = N.joint_torques(robot, q, W, args.frame) if args.method == "jacobian" else prop.tau
+    units = ["N m" if t is JointType.REVOLUTE else "N" for t in robot.joint_types]
+    F6 = N.as_wrench(W)
+    data = {"robot": robot.name, "q": _q_out(args, robot, q), "wrench": F6, "frame": args.frame,
+            "method": args.method, "reference_point": REFERENCE, "tau": tau, "units": units}
+    axes = "base/world" if args.frame == "base" else "tool"
+    lines = [f"{robot.name}: joint torques at {_q_text(args, robot, q)}",
+             f"wrench (f, n) = [{', '.join(f'{x:.6g}' for x in F6)}] N, N m exerted by the end effector, "
+             f"in {axes} axes, at the {REFERENCE}",
+             f"method: {'tau = J^T F' if args.method == 'jacobian' else 'inward force propagation (Craig 5.80-5.81)'}"]
+    lines += [f"  tau{k + 1} = {t:.6g} {u}" for k, (t, u) in enumerate(zip(tau, units))]
+    if args.steps:
+        lines += ["", "inward propagation (f_i, n_i at the origin of {i}, in its axes):"]
+        for lab, f, n in zip(prop.labels, prop.f, prop.n):
+            lines.append(f"  {{{lab}}}: f = [{', '.join(f'{x:.6g}' for x in f)}] N, "
+                         f"n = [{', '.join(f'{x:.6g}' for x in n)}] N m")
+        data["steps"] = [{"frame": lab, "f": f, "n": n} for lab, f, n in zip(prop.labels, prop.f, prop.n)]
+    return data, "\n".join(lines)
+
+
+# --- singularities -------------------------------------------------------------------------------------
+
+
+def _value_text(v: float, revolute: bool, deg: bool) -> str:
+    if not revolute:
+        return f"{v:.6g} m"
+    if deg:
+        return f"{math.degrees(v):.6g}°"
+    return f"{v:.6g} rad"
+
+
+def _condition_lines(cond, robot, args, fmt) -> list[str]:
+    import sympy as sp
+
+    from ..model import JointType
+
+    eq = fmt(sp.Eq(cond.factor, 0, evaluate=False)) if (args.latex or args.markdown) else f"{cond.factor} = 0"
+    if args.shorthand and not (args.latex or args.markdown):
+        eq = f"{fmt(cond.factor)} = 0" if "\n" not in fmt(cond.factor) else eq
+    lines = [f"- {eq}"]
+    if cond.solutions:
+        parts: dict[str, list[str]] = {}
+        for s in cond.solutions:
+            k = int(s.variable[1:]) - 1
+            rev = robot.joint_types[k] is JointType.REVOLUTE
+            vals = ", ".join(_value_text(v, rev, args.deg) + ("" if ok else " (outside limits)")
+                             for v, ok in zip(s.values, s.in_limits))
+            expr = f"{s.expression} = " if s.expression is not None and not s.expression.is_number else ""
+            parts.setdefault(s.variable, []).append(expr + vals)
+        lines.append("    → " + "; ".join(f"{var} = {', '.join(vals)}" for var, vals in parts.items()))
+    else:
+        lines.append("    (kept as an equation: no closed form in one variable)")
+    lines.append(f"    kind: {cond.kind} — {cond.explanation}")
+    return lines
+
+
+def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
+    from .. import numeric as N
+
+    q = joint_values(args, robot, args.q)
+    J = N.geometric_jacobian(robot, q, args.frame)[rows_idx, :]
+    s = N.singular_values(J)
+    lin = [i for i, r in enumerate(rows_idx) if r < 3] or list(range(len(rows_idx)))
+    vel, frc = N.velocity_ellipsoid(J[lin]), N.force_ellipsoid(J[lin])
+    which = ", ".join(ROWS[rows_idx[i]] for i in lin)
+    data = {"q": _q_out(args, robot, q), "J": J, "singular_values": s, "manipulability": float(N.manipulability(J)),
+            "condition_number": float(N.condition_number(J)), "smallest_singular_value": float(s[-1]),
+            "rank": int(N.jacobian_rank(J)), "singular": bool(N.is_singular(J)),
+            "ellipsoid_rows": [ROWS[rows_idx[i]] for i in lin],
+            "velocity_ellipsoid": {"axes": vel.axes, "radii": vel.radii},
+            "force_ellipsoid": {"axes": frc.axes, "radii": frc.radii}}
+    lines = ["", f"numeric measures at {_q_text(args, robot, q)} (rows {', '.join(ROWS[i] for i in rows_idx)}):",
+             f"  singular values: {', '.join(f'{x:.6g}' for x in s)}",
+             f"  rank {data['rank']} of {min(J.shape)} (threshold 1e-9 · largest singular value)"
+             + ("  → SINGULAR" if data["singular"] else ""),
+             f"  manipulability (Yoshikawa) sqrt(det J J^T) = {data['manipulability']:.6g}",
+             f"  condition number = {data['condition_number']:.6g}, smallest singular value = {s[-1]:.6g}",
+             f"  velocity ellipsoid (rows {which}, |qd| <= 1): radii {', '.join(f'{x:.6g}' for x in vel.radii)}",
+             f"  force ellipsoid (rows {which}, |tau| <= 1): radii {', '.join(f'{x:.6g}' for x in frc.radii)}",
+             "  axes (columns, same for both):", matrix_text(vel.axes, indent="    ")]
+    return data, lines
+
+
+def cmd_singularities(args: argparse.Namespace):
+    import sympy as sp
+
+    from .. import symbolic as S
+    from ..numeric._singularities import select_rows
+
+    robot = load(args)
+    try:
+        rows_idx = select_rows(args.rows)
+    except ValueError as exc:
+        raise ParseError(f"--rows: {exc}") from None
+    rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
+    res = S.singularity_analysis(robot, rows, args.frame)
+    fmt = _formatter(args, S.joint_symbols(robot.dof).q)
+    det_text = fmt(res.determinant)
+    lines = [f"{robot.name}: singularities", f"matrix: {res.matrix_note}", f"measure: {res.measure}"]
+    if args.markdown:
+        lines = [f"## {robot.name}: singularities", "", f"matrix: {res.matrix_note}", "", f"measure: {res.measure}", ""]
+    lines += ["matrix =", fmt(res.matrix), f"{res.measure} =", det_text]
+    if res.constant_factors:
+        lines.append("constant factors (assumed non-zero): " + ", ".join(str(c) for c in res.constant_factors))
+    if res.everywhere:
+        lines += ["", f"SINGULAR EVERYWHERE: rank {res.generic_rank} of {res.full_rank} for every q ({res.reason})"]
+    elif res.conditions:
+        lines += ["", "singular when:"]
+        for cond in res.conditions:
+            lines += _condition_lines(cond, robot, args, fmt)
+    else:
+        lines += ["", "no singular configuration: the common factor never vanishes"
+                  + ("" if args.rows else " (with fewer joints than rows, try --rows, e.g. vx,vy,vz)")]
+    data = {"robot": robot.name, "rows": list(res.rows), "frame": args.frame, "matrix_note": res.matrix_note,
+            "measure": res.measure, "matrix": res.matrix, "determinant": str(res.determinant),
+            "determinant_latex": sp.latex(res.determinant), "constant_factors": [str(c) for c in res.constant_factors],
+            "everywhere": res.everywhere, "generic_rank": res.generic_rank, "full_rank": res.full_rank,
+            "reason": res.reason, "angle_unit": "deg" if args.deg else "rad",
+            "conditions": [{"equation": f"{c.factor} = 0", "latex": sp.latex(c.factor) + " = 0",
+                            "variables": list(c.variables), "kind": c.kind, "explanation": c.explanation,
+                            "solutions": [{"variable": s.variable,
+                                           "expression": None if s.expression is None else str(s.expression),
+                                           "values": [math.degrees(v) if args.deg and _is_rev(robot, s.variable) else v
+                                                      for v in s.values],
+                                           "in_limits": list(s.in_limits)} for s in c.solutions]}
+                           for c in res.conditions]}
+    if args.q is not None:
+        mdata, mlines = _measures(robot, args, rows_idx)
+        data["measures"] = mdata
+        lines += mlines
+    return data, "\n".join(lines)
+
+
+def _is_rev(robot, var: str) -> bool:
+    from ..model import JointType
+
+    return robot.joint_types[int(var[1:]) - 1] is JointType.REVOLUTE

@@ -1,0 +1,131 @@
+"""Command line: jacobian, velocity, statics, singularities — run in-process through main([...])."""
+
+import json
+
+import numpy as np
+import pytest
+
+from denavit import forward_kinematics, load_robot
+from denavit import numeric as N
+from denavit.cli import main
+
+Q_PUMA = "0, pi/4, -pi/2, 0.3, pi/3, -0.2"
+Q_PUMA_VALUES = np.array([0, np.pi / 4, -np.pi / 2, 0.3, np.pi / 3, -0.2])
+
+
+def run_json(capsys, *argv):
+    code = main([*argv, "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return json.loads(out)
+
+
+def run_error(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    assert code == 2, (out, err)
+    assert err.count("\n") == 1 and "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize("method", ["geometric", "differentiation", "propagation"])
+@pytest.mark.parametrize("frame", ["base", "tool"])
+def test_jacobian_numeric_json_matches_finite_differences(capsys, method, frame):
+    data = run_json(capsys, "jacobian", "puma560", "-q", Q_PUMA, "--frame", frame, "--method", method)
+    assert data["frame"] == frame and data["rows"] == ["vx", "vy", "vz", "wx", "wy", "wz"]
+    assert "end-effector origin" in data["reference_point"]
+    robot, h = load_robot("puma560"), 1e-6
+    T0 = forward_kinematics(robot, Q_PUMA_VALUES)
+    R = T0[:3, :3]
+    for k in range(6):
+        e = np.eye(6)[k] * h
+        dT = (forward_kinematics(robot, Q_PUMA_VALUES + e) - forward_kinematics(robot, Q_PUMA_VALUES - e)) / (2 * h)
+        W = dT[:3, :3] @ R.T
+        col = np.concatenate([dT[:3, 3], [W[2, 1], W[0, 2], W[1, 0]]])
+        if frame == "tool":
+            col = np.concatenate([R.T @ col[:3], R.T @ col[3:]])
+        np.testing.assert_allclose(np.array(data["J"])[:, k], col, atol=1e-6)
+
+
+def test_jacobian_symbolic_without_q(capsys):
+    data = run_json(capsys, "jacobian", "report004-1-planar2r")
+    assert data["J_symbolic"][5] == ["1", "1"]
+    assert "L2*sin(q1 + q2)" in data["J_symbolic"][0][1]
+    assert main(["jacobian", "report004-1-planar2r", "--shorthand"]) == 0
+    out = capsys.readouterr().out
+    assert "S₁₂" in out and "reference point" in out
+    assert main(["jacobian", "report004-1-planar2r", "--method", "propagation", "--steps", "--latex"]) == 0
+    out = capsys.readouterr().out
+    assert "omega_2" in out and "\\sin" in out
+
+
+def test_jacobian_degrees_input(capsys):
+    a = run_json(capsys, "jacobian", "puma560", "-q", "0, 45, -90, 0, 60, 0", "--deg")
+    b = run_json(capsys, "jacobian", "puma560", "-q", "0, pi/4, -pi/2, 0, pi/3, 0")
+    np.testing.assert_allclose(a["J"], b["J"], atol=1e-12)
+    np.testing.assert_allclose(a["q"], [0, 45, -90, 0, 60, 0])
+
+
+def test_analytic_jacobian_option(capsys):
+    data = run_json(capsys, "jacobian", "puma560", "-q", Q_PUMA, "--analytic", "zyz")
+    Ja, _ = N.analytic_jacobian(load_robot("puma560"), Q_PUMA_VALUES, "zyz")
+    np.testing.assert_allclose(data["Ja"], Ja)
+    assert data["representation"] == "zyz"
+
+
+def test_velocity_twist_and_degrees(capsys):
+    data = run_json(capsys, "velocity", "report004-1-planar2r", "-q", "30, 60", "--qd", "10, 20", "--deg", "--steps")
+    # by hand: L1 = 0.5, L2 = 0.4; v = J q̇ with q̇ in rad/s, ω_z = q̇1 + q̇2 = 30 deg/s
+    q, qd = np.radians([30, 60]), np.radians([10, 20])
+    vx = -(0.5 * np.sin(q[0]) + 0.4 * np.sin(q.sum())) * qd[0] - 0.4 * np.sin(q.sum()) * qd[1]
+    vy = (0.5 * np.cos(q[0]) + 0.4 * np.cos(q.sum())) * qd[0] + 0.4 * np.cos(q.sum()) * qd[1]
+    np.testing.assert_allclose(data["twist"], [vx, vy, 0, 0, 0, 30], atol=1e-12)
+    assert data["steps"][-1]["frame"] == "e"
+    tool = run_json(capsys, "velocity", "report004-1-planar2r", "-q", "30, 60", "--qd", "10, 20", "--deg",
+                    "--frame", "tool")
+    assert np.isclose(np.linalg.norm(tool["v"]), np.hypot(vx, vy))
+
+
+@pytest.mark.parametrize("method", ["jacobian", "propagation"])
+def test_statics_tau(capsys, method):
+    data = run_json(capsys, "statics", "puma560", "-q", Q_PUMA, "--wrench", "1, -2, 3, 0.1, 0.2, -0.3",
+                    "--method", method, "--frame", "tool")
+    J = N.geometric_jacobian(load_robot("puma560"), Q_PUMA_VALUES, "tool")
+    np.testing.assert_allclose(data["tau"], J.T @ [1, -2, 3, 0.1, 0.2, -0.3], atol=1e-10)
+    force_only = run_json(capsys, "statics", "report004-1-planar2r", "-q", "0, pi/2", "--wrench", "1, 0, 0")
+    np.testing.assert_allclose(force_only["tau"], [-0.4, -0.4], atol=1e-12)  # moment of f about each axis, by hand
+    assert force_only["units"] == ["N m", "N m"]
+
+
+def test_singularities_json(capsys):
+    data = run_json(capsys, "singularities", "report004-1-planar2r", "--rows", "vx,vy", "--deg")
+    (cond,) = data["conditions"]
+    assert cond["equation"] == "sin(q2) = 0" and cond["kind"] == "elbow"
+    np.testing.assert_allclose(sorted(v for s in cond["solutions"] for v in s["values"]), [0, 180], atol=1e-9)
+    data = run_json(capsys, "singularities", "report000-6r")
+    assert data["everywhere"] and data["generic_rank"] == 5
+    data = run_json(capsys, "singularities", "puma560", "-q", "0, 0.5, -1, 0, 0, 0")
+    assert data["measures"]["singular"] is True and data["measures"]["rank"] == 5  # q5 = 0: wrist singular
+    assert {c["kind"] for c in data["conditions"]} == {"wrist", "elbow", "shoulder"}
+
+
+def test_singularities_markdown(capsys):
+    assert main(["singularities", "report004-3-articulated-rrr", "--rows", "vx,vy,vz", "--markdown"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("## ") and "$$" in out
+
+
+@pytest.mark.parametrize("argv, what", [
+    (["singularities", "puma560", "--rows", "vx,vq"], "--rows"),
+    (["statics", "puma560", "-q", Q_PUMA, "--wrench", "1,2,3,4"], "--wrench"),
+    (["statics", "puma560", "-q", Q_PUMA, "--wrench", "1,2,foo"], "--wrench"),
+    (["velocity", "puma560", "-q", Q_PUMA, "--qd", "1,2"], "qd"),
+    (["jacobian", "puma560", "-q", "0,0,0"], "q"),
+    (["jacobian", "puma560", "-q", "0,0,0,0,0,0", "--frame", "side"], "--frame"),
+    (["jacobian", "puma560", "--analytic", "rpy"], "-q"),
+    (["jacobian", "puma560", "--steps"], "--steps"),
+    (["jacobian", "no-such-robot"], "no-such-robot"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, argv, what):
+    err = run_error(capsys, *argv)
+    assert what in err
