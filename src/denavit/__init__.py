@@ -16,6 +16,7 @@ from .io import catalogue_names, dump_robot, load_robot, robot_from_dict, save_r
 from .model import Convention, DHLink, DHRobot, Frame, JointType, LinkInertia
 from ._convert import convert_convention
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
+from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 
 __version__ = "0.1.0"
@@ -43,6 +44,11 @@ __all__ = [
     "forward_kinematics",
     "link_transforms",
     "geometric_jacobian",
+    "end_effector_twist",
+    "force_propagation",
+    "joint_torques",
+    "manipulability",
+    "velocity_propagation",
     "AnalyticIKResult",
     "IKResult",
     "analytic_ik",
