@@ -17,7 +17,7 @@ import numpy as np
 from .._validate import as_joint_array, as_transform
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
-from ._jacobians import geometric_jacobian
+from ._ik_kernel import kernel_of, targets_soa
 from ._kinematics import forward_kinematics
 
 __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
@@ -25,7 +25,10 @@ __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
 TOL = 1e-9  # default position [m] and orientation [rad] tolerance
 MAX_ITERATIONS = 100
 RESTARTS = 64
-PARALLEL_SEEDS = 8
+PARALLEL_SEEDS = 32  # at most this many seeds side by side per target once few targets are left
+SMALL_BATCH = 512  # "few": at most this many attempts in flight
+RESTART_ITERATIONS = 0.3  # iteration budget of a restart, relative to max_iterations
+CLIPPED_SEEDS = 0.1  # share of restarts iterated inside the limits (the rest run free and are folded)
 LAMBDA0 = 1e-3  # initial damping, relative to the squared characteristic length
 LAMBDA_MAX = 1e3  # damping (relative to L²) beyond which an attempt counts as stuck
 _REASONS = ("", "iterations", "limits", "unreachable")
@@ -145,50 +148,123 @@ class _Limits:
         return rng.uniform(lo, hi, size=shape + (len(lo),))
 
 
-def _lm(robot, q, T_t, w, limits, max_iter, tol_p, tol_r, L):
-    """Run LM on a flat batch q (B, n) towards T_t (B, 4, 4); returns q, converged, iterations, stalled.
+class _Slots:
+    """The LM attempts in flight: one row per attempt, ``tgt`` the target each one works on."""
 
-    The Jacobian is recomputed only where a step was accepted (a rejected step leaves q unchanged).
+    def __init__(self, kin, L):
+        self.kin, self.L = kin, L
+        n = kin.n
+        self.tgt = np.zeros(0, dtype=int)
+        self.q = np.zeros((0, n))
+        self.e = np.zeros((0, 6))
+        self.J = np.zeros((0, 6, n))
+        self.cost = np.zeros(0)
+        self.lam = np.zeros(0)
+        self.it = np.zeros(0, dtype=int)
+        self.cap = np.zeros(0, dtype=int)
+        self.clip = np.zeros(0, dtype=bool)
+
+    def add(self, tgt, q, clip, cap):
+        """New attempts; their residual and Jacobian come with the next iteration's evaluation (e = 0 and J = 0
+        make that iteration's step zero, and an infinite cost makes it accepted)."""
+        m, n, cat = len(tgt), self.kin.n, np.concatenate
+        self.tgt, self.q = cat([self.tgt, tgt]), cat([self.q, q])
+        self.e, self.J = cat([self.e, np.zeros((m, 6))]), cat([self.J, np.zeros((m, 6, n))])
+        self.cost = cat([self.cost, np.full(m, np.inf)])
+        self.lam = cat([self.lam, np.full(m, 5.0 * LAMBDA0 * self.L**2)])  # ×0.2 at the first (zero) step
+        self.it = cat([self.it, np.zeros(m, dtype=int)])
+        self.cap = cat([self.cap, np.full(m, cap + 1)])
+        self.clip = cat([self.clip, clip])
+
+    def keep(self, mask):
+        for name in ("tgt", "q", "e", "J", "cost", "lam", "it", "cap", "clip"):
+            setattr(self, name, getattr(self, name)[mask])
+
+
+def _search(robot, q0, Tf, w, limits, max_iter, restarts, tol, L, rng):
+    """Levenberg–Marquardt from q0 (B, n), restarting each target from random seeds until it is solved within
+    the limits or its restarts are used up.  Every attempt is a row of one batch: an attempt that ends
+    (converged outside the limits, stalled, out of iterations) is replaced at once by the target's next seed,
+    so the batch stays full; when few targets are left, each gets several seeds side by side.
+
+    Returns q (B, n) (the solution, or the best point found), iterations, restarts, stalled (B,).
     """
-    B, n = q.shape
-    e = pose_error(T_t, forward_kinematics(robot, q)) * w  # (B, 6)
-    cost = np.einsum("bi,bi->b", e, e)
-    lam = np.full(B, LAMBDA0 * L * L)
+    B, n = q0.shape
+    Rt, pt = targets_soa(Tf)
+    S = _Slots(kernel_of(robot), L)
+    lo, hi, rev = limits.lo, limits.hi, limits.revolute
+    out = q0.copy()
+    best = np.full(B, np.inf)
     iters = np.zeros(B, dtype=int)
+    n_restarts = np.zeros(B, dtype=int)
     stalled = np.zeros(B, dtype=bool)
-    done = _converged(e, w, tol_p, tol_r, L)
-    J = np.zeros((B, 6, n))
-    fresh = ~done  # where J must be (re)computed
+    done = np.zeros(B, dtype=bool)
+    # first attempt without limits, folded back by whole turns afterwards: the clipped iteration is slow and
+    # cannot pass a limit, while the free one converges in a few steps
+    S.add(np.arange(B), q0.copy(), np.zeros(B, dtype=bool), max_iter)
     eye = np.eye(n)
-    for _ in range(max_iter):
-        act = np.flatnonzero(~done & ~stalled)
-        if act.size == 0:
-            break
-        upd = np.flatnonzero(fresh)
-        if upd.size:
-            J[upd] = geometric_jacobian(robot, q[upd]) * w[:, None]  # (b, 6, n), rows weighted
-            fresh[:] = False
-        Ja = J[act]
-        Jt = np.swapaxes(Ja, -1, -2)
-        A = Jt @ Ja + lam[act, None, None] * eye  # (b, n, n)
-        g = np.einsum("bij,bj->bi", Jt, e[act])
-        dq = np.linalg.solve(A, g[..., None])[..., 0]
-        q_new = limits.project(q[act] + dq)
-        e_new = pose_error(T_t[act], forward_kinematics(robot, q_new)) * w
+    while S.tgt.size:
+        Jt = np.swapaxes(S.J, -1, -2)
+        dq = np.linalg.solve(Jt @ S.J + S.lam[:, None, None] * eye, np.einsum("bij,bj->bi", Jt, S.e)[..., None])[..., 0]
+        q_new = _wrap(S.q + dq, rev)
+        q_new = np.where(S.clip[:, None], np.clip(q_new, lo, hi), q_new)
+        e_new, J_new = S.kin.residual(q_new, Rt[..., S.tgt], pt[:, S.tgt], w)
         c_new = np.einsum("bi,bi->b", e_new, e_new)
-        better = c_new < cost[act]
+        better = c_new < S.cost
         # an accepted step that barely lowers the cost: a local minimum with a residual (or unreachable)
-        flat = better & (cost[act] - c_new < 1e-9 * cost[act])
-        iters[act] += 1
-        acc, rej = act[better], act[~better]
-        stalled[act[flat]] = True
-        q[acc], e[acc], cost[acc] = q_new[better], e_new[better], c_new[better]
-        lam[acc] = np.maximum(lam[acc] * 0.2, 1e-12 * L * L)
-        lam[rej] *= 8.0
-        fresh[acc] = True
-        stalled[rej[lam[rej] > LAMBDA_MAX * L * L]] = True
-        done[act] = _converged(e[act], w, tol_p, tol_r, L)
-    return q, done, iters, stalled
+        with np.errstate(invalid="ignore"):
+            flat = better & (S.cost - c_new < 1e-9 * S.cost)
+        np.add.at(iters, S.tgt, 1)
+        S.q[better], S.e[better], S.J[better], S.cost[better] = q_new[better], e_new[better], J_new[better], c_new[better]
+        S.lam = np.where(better, np.maximum(S.lam * 0.2, 1e-12 * L * L), S.lam * 8.0)
+        S.it += 1
+        stop = flat | (~better & (S.lam > LAMBDA_MAX * L * L)) | (S.it >= S.cap)
+        conv = _converged(S.e, w, tol, tol, L)
+        qf = _fold(S.q, lo, hi, rev)
+        ok = conv & np.all((qf >= lo - 1e-12) & (qf <= hi + 1e-12), axis=-1)
+        ended = ok | conv | stop
+        cand = np.zeros(0, dtype=int)
+        if ended.any():
+            # record the best end point of every finished attempt (for failures), then the solved targets
+            fin = np.flatnonzero(ended)
+            score = np.where(ok[fin], -1.0, S.cost[fin])
+            fin = fin[np.argsort(-score)]  # worst first: for a target ending twice, the best is written last
+            t, sc = S.tgt[fin], np.sort(score)[::-1]
+            upd = (sc < best[t]) & ~done[t]
+            best[t[upd]], out[t[upd]] = sc[upd], qf[fin[upd]]
+            done[S.tgt[ok]] = True
+            stalled[t[(stop & (S.it < S.cap))[fin]]] = True  # some attempt ended in a local minimum
+            S.keep(~ended & ~done[S.tgt])
+            cand = np.unique(t[~done[t]])
+        if S.tgt.size + cand.size <= SMALL_BATCH // 8:
+            cand = np.union1d(cand, S.tgt)  # few left: every target gets seeds side by side
+        if cand.size:
+            _reseed(S, cand, B, n_restarts, restarts, limits, rng, L, max(int(max_iter * RESTART_ITERATIONS), 1))
+    return out, iters, n_restarts, stalled
+
+
+def _reseed(S, cand, B, n_restarts, restarts, limits, rng, L, cap):
+    """New random seeds for the targets ``cand`` (one each, or several side by side when few are left)."""
+    live = np.bincount(S.tgt, minlength=B)
+    in_flight = np.count_nonzero(live[cand] == 0) + np.count_nonzero(live)
+    k = int(np.clip(SMALL_BATCH // max(in_flight, 1), 1, PARALLEL_SEEDS)) if in_flight * 2 <= SMALL_BATCH else 1
+    m = np.clip(np.minimum(k - live[cand], restarts - n_restarts[cand]), 0, None)
+    tg = np.repeat(cand, m)
+    if tg.size:
+        n_restarts[cand] += m
+        S.add(tg, limits.sample(rng, (tg.size,), L), rng.random(tg.size) < CLIPPED_SEEDS, cap)
+
+
+def _wrap(q, revolute):
+    return np.where(revolute, np.pi - np.mod(np.pi - q, 2 * np.pi), q)
+
+
+def _fold(q, lo, hi, revolute):
+    """Revolute angles wrapped into (−π, π], then shifted by a whole turn into [lo, hi] where that helps."""
+    q = _wrap(q, revolute)
+    shift = np.where(q < lo, 2 * np.pi, np.where(q > hi, -2 * np.pi, 0.0))
+    moved = q + shift
+    return np.where(revolute & (shift != 0) & (moved >= lo) & (moved <= hi), moved, q)
 
 
 def _converged(e, w, tol_p, tol_r, L):
@@ -273,49 +349,8 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     else:
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
     q = limits.project(q)
-    free = _Limits(robot, ignore=True)
-    # first attempt without limits, folded back by whole turns: the clipped iteration is slow and cannot
-    # pass a limit, while the free one converges in a few steps (the fold is checked below like any q)
-    q, done, iters, stalled = _lm(robot, q, Tf, w, free, max_iterations, tol, tol, L)
+    q, iters, n_restarts, stalled = _search(robot, q, Tf, w, limits, max_iterations, restarts, tol, L, rng)
     q = limits.project(q)
-    pe, re = _residuals(robot, q, Tf, w_mask)
-    done = (pe <= tol) & (re <= tol) & limits.inside(q)
-    n_restarts = np.zeros(B, dtype=int)
-    best_q = q.copy()
-    left = restarts
-    while left > 0:
-        todo = np.flatnonzero(~done)
-        if todo.size == 0:
-            break
-        k = min(PARALLEL_SEEDS, left)  # seeds tried side by side for every unsolved target
-        left -= k
-        idx = np.repeat(todo, k)
-        qs = limits.sample(rng, (idx.size,), L)
-        # most seeds run without limits and are folded back by whole turns afterwards: the clipped
-        # iteration cannot pass a limit, so a solution lying beyond it is often reached only this way
-        unlimited = np.tile(np.arange(k) >= k // 4, todo.size)
-        qr = np.empty_like(qs)
-        ir = np.zeros(idx.size, dtype=int)
-        sr = np.zeros(idx.size, dtype=bool)
-        for flag, lim in ((False, limits), (True, free)):
-            sel = np.flatnonzero(unlimited == flag)
-            if sel.size:
-                qr[sel], _, ir[sel], sr[sel] = _lm(robot, qs[sel], Tf[idx[sel]], w, lim, max(max_iterations // 2, 1),
-                                                   tol, tol, L)
-        qr = limits.project(qr)
-        pe_new, re_new = _residuals(robot, qr, Tf[idx], w_mask)
-        ok = (pe_new <= tol) & (re_new <= tol) & limits.inside(qr)
-        n_restarts[todo] += k
-        iters[todo] += ir.reshape(-1, k).sum(axis=1)
-        stalled[todo] = sr.reshape(-1, k).all(axis=1)
-        score = np.where(ok, -1.0, pe_new + L * re_new).reshape(-1, k)
-        pick = np.argmin(score, axis=1)
-        cand = qr.reshape(-1, k, n)[np.arange(todo.size), pick]
-        pe_old, re_old = _residuals(robot, best_q[todo], Tf[todo], w_mask)
-        improve = score[np.arange(todo.size), pick] < pe_old + L * re_old
-        best_q[todo[improve]] = cand[improve]
-        done[todo] = ok.reshape(-1, k).any(axis=1)
-    q = best_q
     pe, re = _residuals(robot, q, Tf, w_mask)
     success = (pe <= tol) & (re <= tol) & limits.inside(q)
     reason = _reasons(robot, q, Tf, mask, success, stalled, tol, rng, respect_limits, max_iterations)

@@ -1,0 +1,130 @@
+"""The inner loop of the IK solvers: pose residual and geometric Jacobian in one pass over the chain.
+
+The chain is the joint-screw form ``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`._ik_chain`.  A batch of poses is
+kept as rotation columns x, y, z and origin p, each of shape (3, B) with the batch contiguous, so a joint
+rotation is two axpy's (``x ← c x + s y``, ``y ← c y − s x``) and a constant ``C_k`` is a handful of them
+(most DH constants are signed permutations: α = ±90°).  The Jacobian needs only the joint axes z_k and
+their origins o_k, which this same pass visits, and the end-effector origin p_e at the end:
+
+    revolute k:  J_k = (z_k × (p_e − o_k), z_k),      prismatic k:  J_k = (z_k, 0)
+
+(Spong, Hutchinson & Vidyasagar 2006, eq. 4.52-4.53), so no second forward-kinematics pass is needed.
+The final success test of the solvers still uses :func:`forward_kinematics`, an independent computation.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from ..model import DHRobot
+from ._ik_chain import chain_of
+
+__all__ = ["Kernel", "kernel_of", "targets_soa"]
+
+_ZERO = 1e-15  # constant entries below this are structural zeros (cos 90° = 6e-17)
+
+
+def _terms(C: np.ndarray) -> tuple:
+    """For each output column of C (x, y, z, p): the (input column, coefficient) pairs that are non-zero."""
+    out = []
+    for col in range(4):
+        out.append(tuple((j, float(C[j, col])) for j in range(3) if abs(C[j, col]) > _ZERO))
+    return tuple(out)
+
+
+def _combine(cols, terms, base=None):
+    acc = base
+    for j, c in terms:
+        t = cols[j] if c == 1.0 else (-cols[j] if c == -1.0 else c * cols[j])
+        acc = t if acc is None else acc + t
+    if acc is None:
+        return np.zeros_like(cols[0]) if base is None else base
+    return acc
+
+
+class Kernel:
+    """Pose residual and Jacobian of one arm, batched; build with :func:`kernel_of` (cached per robot)."""
+
+    def __init__(self, robot: DHRobot) -> None:
+        chain = chain_of(robot)
+        self.n = chain.n
+        self.prismatic = tuple(bool(x) for x in chain.prismatic)
+        self.start = chain.consts[0]
+        self.terms = tuple(_terms(C) for C in chain.consts[1:])
+
+    def pose(self, qT: np.ndarray, keep_axes: bool = False):
+        """Rotation columns x, y, z and origin p (each (3, B)) at joint values qT (n, B); optionally the
+        joint axes z_k and origins o_k (lists of (3, B))."""
+        B = qT.shape[1]
+        x, y, z, p = (np.repeat(self.start[:3, j:j + 1], B, axis=1) for j in range(4))
+        zs, os = [], []
+        for k in range(self.n):
+            if keep_axes:
+                zs.append(z)
+                os.append(p)
+            if self.prismatic[k]:
+                p = p + qT[k] * z
+            else:
+                c, s = np.cos(qT[k]), np.sin(qT[k])
+                x, y = c * x + s * y, c * y - s * x
+            cols = (x, y, z)
+            tx, ty, tz, tp = self.terms[k]
+            p = _combine(cols, tp, p)
+            x, y, z = _combine(cols, tx), _combine(cols, ty), _combine(cols, tz)
+        return x, y, z, p, zs, os
+
+    def residual(self, q: np.ndarray, Rt: np.ndarray, pt: np.ndarray, w: np.ndarray, jacobian: bool = True):
+        """Weighted residual ``e = W (p_t − p, log(R_t Rᵀ))`` (B, 6) and weighted J0 (B, 6, n).
+
+        q (B, n); Rt (3, 3, B) and pt (3, B) the targets in the layout of :func:`targets_soa`.
+        """
+        x, y, z, p, zs, os = self.pose(np.ascontiguousarray(q.T), keep_axes=jacobian)
+        e = np.empty((q.shape[0], 6))
+        e[:, :3] = (pt - p).T
+        Re = np.stack([x, y, z], axis=1)  # (3, 3, B): Re[i, j] = R[i, j]
+        e[:, 3:] = _log_soa(np.einsum("ijb,kjb->ikb", Rt, Re))
+        e *= w
+        if not jacobian:
+            return e, None
+        J = np.zeros((q.shape[0], 6, self.n))
+        for k in range(self.n):
+            if self.prismatic[k]:
+                J[:, :3, k] = zs[k].T
+            else:
+                zk, r = zs[k], p - os[k]
+                J[:, 0, k] = zk[1] * r[2] - zk[2] * r[1]
+                J[:, 1, k] = zk[2] * r[0] - zk[0] * r[2]
+                J[:, 2, k] = zk[0] * r[1] - zk[1] * r[0]
+                J[:, 3:, k] = zk.T
+        J *= w[:, None]
+        return e, J
+
+
+def _log_soa(M: np.ndarray) -> np.ndarray:
+    """Rotation vectors (B, 3) of rotations M (3, 3, B); see ``rotation_log`` (the near-π case is delegated)."""
+    from ._ik_numeric import rotation_log
+
+    cos = np.clip((M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0, -1.0, 1.0)
+    theta = np.arccos(cos)
+    v = np.stack([M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]], axis=-1)  # (B, 3)
+    sin = np.sin(theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        factor = np.where(theta < 1e-6, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(sin == 0, 1, sin)))
+    out = v * factor[:, None]
+    near_pi = cos < -0.9
+    if near_pi.any():
+        out[near_pi] = rotation_log(np.moveaxis(M[:, :, near_pi], -1, 0))
+    return out
+
+
+def targets_soa(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Targets (B, 4, 4) → rotations (3, 3, B) and positions (3, B), batch contiguous."""
+    return np.ascontiguousarray(np.moveaxis(T[:, :3, :3], 0, -1)), np.ascontiguousarray(T[:, :3, 3].T)
+
+
+@lru_cache(maxsize=64)
+def kernel_of(robot: DHRobot) -> Kernel:
+    """The (cached) kernel of a robot."""
+    return Kernel(robot)
