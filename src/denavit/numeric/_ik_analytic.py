@@ -19,7 +19,7 @@ from ..model import DHRobot, JointType
 from ._ik_chain import chain_of, chain_fk, wrap_angle
 from ._ik_numeric import pose_error
 from ._ik_plans import Plan, make_plan
-from ._jacobians import geometric_jacobian
+from ._ik_kernel import kernel_of, targets_soa
 from ._kinematics import forward_kinematics
 from ._transforms import inverse_transform
 
@@ -28,6 +28,7 @@ __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure"]
 VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
 POLISH_STEPS = 30
 DUPLICATE_TOL = 1e-6
+POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished  # joint-space distance under which two solutions are the same [rad, m]
 
 
@@ -96,17 +97,22 @@ def _controlled(P: np.ndarray) -> str:
 
 
 def _polish(robot: DHRobot, q: np.ndarray, T: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Damped Gauss–Newton steps on P·e until converged (restores the digits lost in root finding)."""
+    """Damped Gauss–Newton steps on P·e until converged (restores the digits lost in root finding).
+
+    Residual and Jacobian come from one pass over the chain (:mod:`._ik_kernel`)."""
     n = robot.dof
+    kin = kernel_of(robot)
+    Rt, pt = targets_soa(T)
     q = q.copy()
     act = np.arange(len(q))
+    w = np.ones(6)
     for _ in range(POLISH_STEPS):
-        e = pose_error(T[act], forward_kinematics(robot, q[act])) @ P.T  # (b, 6)
+        e, J = kin.residual(q[act], Rt[..., act], pt[:, act], w)
+        e = e @ P.T  # (b, 6)
         moving = np.max(np.abs(e), axis=-1) > 1e-15
-        act, e = act[moving], e[moving]
+        act, e, J = act[moving], e[moving], P @ J[moving]
         if act.size == 0:
             break
-        J = P @ geometric_jacobian(robot, q[act])  # (b, 6, n)
         Jt = np.swapaxes(J, -1, -2)
         A = Jt @ J + 1e-14 * np.eye(n)
         q[act] += np.linalg.solve(A, np.einsum("bij,bj->bi", Jt, e)[..., None])[..., 0]
@@ -183,12 +189,16 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     q = np.full(cand.shape, np.nan)
     if ok.any():  # false roots are far off: drop them before the (costly) polish
         e0 = pose_error(Tk[ok], forward_kinematics(robot, cand[ok])) @ plan.projector.T
+        size = np.linalg.norm(e0[:, :3], axis=-1) + _reach(robot) * np.linalg.norm(e0[:, 3:], axis=-1)
         near = np.zeros_like(ok)
-        near[ok] = np.linalg.norm(e0[:, :3], axis=-1) + _reach(robot) * np.linalg.norm(e0[:, 3:], axis=-1) \
-            < PREFILTER * max(_reach(robot), 1e-3)
+        near[ok] = size < PREFILTER * max(_reach(robot), 1e-3)
+        rough = np.zeros_like(ok)  # only candidates that lost digits (near double roots) are polished
+        rough[ok] = size > POLISH_ABOVE * max(_reach(robot), 1.0)
         ok &= near
-    if ok.any():
-        q[ok] = _polish(robot, cand[ok], Tk[ok], plan.projector)
+        q[ok] = cand[ok]
+        rough &= ok
+        if rough.any():
+            q[rough] = _polish(robot, cand[rough], Tk[rough], plan.projector)
     ok &= np.all(np.isfinite(q), axis=-1)
     pe = np.full((B, K), np.inf)
     re = np.full((B, K), np.inf)
