@@ -6,7 +6,8 @@ Targets: FK of random joint values uniformly within the joint limits (seeded).  
 within the joint limits and reproduces the target to 1e-6 m and 1e-6 rad, checked with denavit's FK (the same
 check for every library).  Times are wall-clock per solve: for denavit the batch time divided by the number of
 targets (median and p95 over repeated batches of 1,000); for the peers one call per target.
-Peers (skipped when not importable): roboticstoolbox-python ``ets().ik_LM`` (C++), IKPy, ik-geo.
+Peers (skipped when not importable or when they do not model the arm): roboticstoolbox-python ``ets().ik_LM``
+(C++), IKPy (scipy optimiser, seeded at mid-limits), ik-geo (all solutions of 6R arms by subproblems, Rust).
 """
 
 from __future__ import annotations
@@ -99,12 +100,94 @@ def bench_rtb(robot, name, T):
     return float(np.mean(ok)), *_stats(times)
 
 
+def _fold_limits(robot, q):
+    """Revolute angles shifted by whole turns into the limits where that helps (the same for every library)."""
+    q = np.array(q, dtype=float)
+    lim = robot.q_limits
+    for k, t in enumerate(robot.joint_types):
+        if t.value == "revolute":
+            q[k] = (q[k] + np.pi) % (2 * np.pi) - np.pi
+            for sh in (2 * np.pi, -2 * np.pi):
+                if not lim[k, 0] <= q[k] <= lim[k, 1] and lim[k, 0] <= q[k] + sh <= lim[k, 1]:
+                    q[k] += sh
+    return q
+
+
 def bench_ikpy(robot, T):
+    """IKPy (scipy least squares on its own chain): the joint-screw form C0 J1 C1 ⋯ Jn Cn as URDF links."""
     try:
-        import ikpy.chain  # noqa: F401
+        from ikpy.chain import Chain
+        from ikpy.link import OriginLink, URDFLink
     except ImportError:
         return None
-    return None  # IKPy needs a URDF chain; not wired up (see docs/ik.md)
+    from denavit.numeric import rpy_from_rotation
+    from denavit.numeric._ik_chain import chain_of
+
+    ch = chain_of(robot)
+    lim = robot.q_limits
+    links = [OriginLink()]
+    for k in range(ch.n):
+        C = ch.consts[k]
+        kw = {"translation": [0, 0, 1]} if ch.prismatic[k] else {"rotation": [0, 0, 1]}
+        links.append(URDFLink(f"j{k + 1}", C[:3, 3], rpy_from_rotation(C[:3, :3]), bounds=tuple(lim[k]),
+                              joint_type="prismatic" if ch.prismatic[k] else "revolute", **kw))
+    C = ch.consts[-1]
+    links.append(URDFLink("tool", C[:3, 3], rpy_from_rotation(C[:3, :3]), rotation=None, joint_type="fixed"))
+    chain = Chain(links, active_links_mask=[False] + [True] * ch.n + [False])
+    finite = np.isfinite(lim)
+    mid = np.where(finite.all(axis=1), lim.mean(axis=1), 0.0)
+    seed = np.concatenate([[0.0], mid, [0.0]])
+    times, ok = [], []
+    for Tk in T:
+        t0 = time.perf_counter()
+        q = chain.inverse_kinematics_frame(Tk, initial_position=seed, orientation_mode="all")
+        times.append(time.perf_counter() - t0)
+        ok.append(_ok(robot, _fold_limits(robot, q[1:-1]), Tk))
+    return float(np.mean(ok)), *_stats(times)
+
+
+def bench_ikgeo(robot, T):
+    """ik-geo (Elias & Wen 2022, subproblem decomposition, Rust): all solutions of 6R arms it has a class for.
+
+    The arm is given in product-of-exponentials form: axes h_i and points on them at q = 0 (the point shared by
+    intersecting axes), the home rotation R_M = R(FK(0)) taken off the target (ik-geo's home rotation is I).
+    Success: some returned solution (folded into the limits) reproduces the target within the limits.
+    (The binding takes R transposed — checked against its own forward_kinematics and ours.)
+    """
+    try:
+        from ik_geo import Robot
+    except ImportError:
+        return None
+    from denavit.numeric import ik_structure
+    from denavit.numeric._ik_chain import axis_lines, chain_of
+
+    ch = chain_of(robot)
+    kind = ik_structure(robot)
+    if ch.n != 6 or ch.prismatic.any() or kind not in ("pieper", "parallel"):
+        return None
+    pts, h = axis_lines(ch, np.zeros(6))
+    def meet(idx):  # least-squares common point of the axes idx
+        A = sum(np.eye(3) - np.outer(h[i], h[i]) for i in idx)
+        b = sum((np.eye(3) - np.outer(h[i], h[i])) @ pts[i] for i in idx)
+        return np.linalg.lstsq(A, b, rcond=None)[0]
+    P = pts.copy()
+    if kind == "pieper":
+        P[3] = P[4] = P[5] = meet((3, 4, 5))
+        make = Robot.spherical_two_parallel if abs(abs(h[1] @ h[2]) - 1) < 1e-9 else Robot.spherical
+    else:
+        P[4] = P[5] = meet((4, 5))
+        make = Robot.three_parallel_two_intersecting
+    M = forward_kinematics(robot, np.zeros(6))
+    p = np.vstack([P[0], np.diff(P, axis=0), M[:3, 3] - P[5]])  # p01, p12, …, p56, p6T
+    bot = make(h, p)
+    times, ok = [], []
+    for Tk in T:
+        R = (Tk[:3, :3] @ M[:3, :3].T).T  # the Python binding reads the 3x3 in column-major order
+        t0 = time.perf_counter()
+        sols = bot.get_ik(R, Tk[:3, 3])
+        times.append(time.perf_counter() - t0)
+        ok.append(any(not ls and _ok(robot, _fold_limits(robot, q), Tk) for q, ls in sols))
+    return float(np.mean(ok)), *_stats(times)
 
 
 def main(argv=None):
@@ -122,10 +205,14 @@ def main(argv=None):
         rows.append((name, "denavit solve_ik (LM, batched)", args.n, s, med, p95))
         s, med, p95 = bench_denavit_analytic(robot, q, T)
         rows.append((name, "denavit analytic_ik (all solutions, batched)", args.n, s, med, p95))
-        r = bench_rtb(robot, name, T[: args.peer_n])
-        if r is not None:
-            rows.append((name, "roboticstoolbox ets().ik_LM (per call)", args.peer_n, *r))
-        for row in rows[-3:]:
+        start = len(rows) - 2
+        for label, fn in (("roboticstoolbox ets().ik_LM (per call)", lambda: bench_rtb(robot, name, T[: args.peer_n])),
+                          ("IKPy inverse_kinematics_frame (per call)", lambda: bench_ikpy(robot, T[: args.peer_n])),
+                          ("ik-geo get_ik (all solutions, per call)", lambda: bench_ikgeo(robot, T[: args.peer_n]))):
+            r = fn()
+            if r is not None:
+                rows.append((name, label, args.peer_n, *r))
+        for row in rows[start:]:
             print(f"{row[0]:10s} {row[1]:48s} n={row[2]:6d} success {row[3]:.4f}  median {row[4]:8.1f} us  "
                   f"p95 {row[5]:8.1f} us")
     table = ["| arm | solver | targets | success (in limits, 1e-6) | median / solve [µs] | p95 / solve [µs] |",
