@@ -121,13 +121,17 @@ def _run_chain(robot: DHRobot, q, keep_frames: bool):
     return pose, frames, batch
 
 
-def _single_pose(robot: DHRobot, q: np.ndarray) -> np.ndarray:
-    """Unbatched fast path in plain floats (numpy's per-call overhead dominates for one pose)."""
+def _single_frames(robot: DHRobot, q: list[float], keep_frames: bool) -> np.ndarray:
+    """Unbatched fast path in plain floats (numpy's per-call overhead dominates for one pose).
+
+    Returns the world poses of {0} … {N}, shape (N+1, 4, 4), or only {N}, shape (4, 4).
+    """
     from math import cos, sin
 
     B = robot.base
     x, y, z, p = ([B[0][j], B[1][j], B[2][j]] for j in range(4))
     std = robot.convention is Convention.STANDARD
+    rows = [(x, y, z, p)] if keep_frames else []
     for link, (theta, d) in zip(robot.links, _row_values(robot, q)):
         c, s = cos(theta), sin(theta)
         if not std and link.alpha != 0.0:
@@ -144,7 +148,14 @@ def _single_pose(robot: DHRobot, q: np.ndarray) -> np.ndarray:
             if link.alpha != 0.0:
                 ca, sa = cos(link.alpha), sin(link.alpha)
                 y, z = [ca * y[i] + sa * z[i] for i in range(3)], [ca * z[i] - sa * y[i] for i in range(3)]
-    return np.array([[x[0], y[0], z[0], p[0]], [x[1], y[1], z[1], p[1]], [x[2], y[2], z[2], p[2]], [0.0, 0.0, 0.0, 1.0]])
+        if keep_frames:
+            rows.append((x, y, z, p))
+    if not keep_frames:
+        rows = [(x, y, z, p)]
+    out = np.zeros((len(rows), 4, 4))
+    out[:, :3, :] = np.array(rows).transpose(0, 2, 1)  # (frames, 4 columns, 3) → rows × columns
+    out[:, 3, 3] = 1.0
+    return out if keep_frames else out[0]
 
 
 def link_transforms(robot: DHRobot, q) -> np.ndarray:
@@ -159,7 +170,10 @@ def link_transforms(robot: DHRobot, q) -> np.ndarray:
     q : array_like, shape (..., n)
         Joint values [rad for revolute, m for prismatic].
     """
-    _, frames, _ = _run_chain(robot, q, keep_frames=True)
+    qa = as_joint_array(q, robot.dof)
+    if qa.ndim == 1:
+        return _single_frames(robot, qa.tolist(), keep_frames=True)
+    _, frames, _ = _run_chain(robot, qa, keep_frames=True)
     return np.stack(frames, axis=-3)
 
 
@@ -182,7 +196,7 @@ def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
     """
     qa = as_joint_array(q, robot.dof)
     if qa.ndim == 1:
-        T = _single_pose(robot, qa.tolist())
+        T = _single_frames(robot, qa.tolist(), keep_frames=False)
     else:
         pose, _, batch = _run_chain(robot, qa, keep_frames=False)
         T = pose.matrix(batch)
