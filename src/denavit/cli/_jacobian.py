@@ -248,7 +248,7 @@ def _value_text(v: float, revolute: bool, deg: bool) -> str:
         return f"{v:.6g} m"
     if deg:
         return f"{math.degrees(v):.6g}°"
-    return f"{v:.6g} rad"
+    return f"{v:.6g} rad ({math.degrees(v):.6g}°)"
 
 
 def _condition_lines(cond, robot, args, fmt) -> list[str]:
