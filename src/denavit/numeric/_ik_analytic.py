@@ -16,7 +16,7 @@ import numpy as np
 
 from .._validate import as_transform
 from ..model import DHRobot, JointType
-from ._ik_chain import chain_of, chain_fk, wrap_angle
+from ._ik_chain import chain_columns, chain_of, wrap_angle
 from ._ik_numeric import pose_error
 from ._ik_plans import Plan, make_plan
 from ._ik_kernel import kernel_of, targets_soa
@@ -78,13 +78,13 @@ class AnalyticIKResult:
 
 
 @lru_cache(maxsize=64)
-def _plan(robot: DHRobot) -> Plan:
-    return make_plan(robot)
+def _plan(robot: DHRobot, closed_form: bool = True) -> Plan:
+    return make_plan(robot, closed_form)
 
 
 def ik_structure(robot: DHRobot) -> str:
     """Name of the closed-form structure recognised for ``robot`` (raises UnsupportedRobotError if none)."""
-    return _plan(robot).kind
+    return _plan(robot, True).kind
 
 
 def _controlled(P: np.ndarray) -> str:
@@ -133,15 +133,21 @@ def _fold(robot: DHRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray) -> np.ndarray:
-    """Drop later copies of the same solution (angles compared modulo 2π), per pose; q (B, K, n)."""
+    """Drop later copies of the same solution (angles compared modulo 2π), per pose; q (B, K, n).
+
+    A slot is dropped when an earlier kept slot lies within DUPLICATE_TOL of it; only the K(K−1)/2 pairs
+    i < j are compared."""
+    B, K, _ = q.shape
+    if K < 2:
+        return keep
     rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-    d = q[:, :, None, :] - q[:, None, :, :]  # (B, K, K, n)
-    d = np.where(rev, np.abs(wrap_angle(d)), np.abs(d))
-    same = np.nan_to_num(d.max(axis=-1), nan=np.inf) < DUPLICATE_TOL
-    K = q.shape[1]
-    earlier = np.tril(np.ones((K, K), dtype=bool), -1)  # j < i
-    dup = np.any(same & earlier[None] & keep[:, None, :], axis=-1)
-    return keep & ~dup
+    i, j = np.triu_indices(K, 1)
+    d = np.abs(q[:, j] - q[:, i])  # (B, P, n)
+    d = np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), d)
+    same = np.nan_to_num(d.max(axis=-1), nan=np.inf) < DUPLICATE_TOL  # (B, P)
+    hit = np.zeros((B, K, K), dtype=bool)
+    hit[:, j, i] = same & keep[:, i]
+    return keep & ~hit.any(axis=-1)
 
 
 def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
@@ -177,35 +183,16 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     >>> res.solutions.shape[0] <= 8, bool(np.min(np.abs(res.solutions - q).max(axis=1)) < 1e-9)
     (True, True)
     """
-    T = as_transform(T, "T")
-    plan = _plan(robot)
+    return _solve(robot, as_transform(T, "T"), _plan(robot, True))
+
+
+def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
+    """The pipeline of the module notes for one plan (``_plan(robot, False)`` forces the general route)."""
     batch = T.shape[:-2]
     Tf = T.reshape(-1, 4, 4)
-    B, n = len(Tf), robot.dof
+    B = len(Tf)
     cand, free = plan.solve(Tf)  # (B, K, n)
-    K = cand.shape[1]
-    ok = np.all(np.isfinite(cand), axis=-1)
-    Tk = np.broadcast_to(Tf[:, None], (B, K, 4, 4))
-    q = np.full(cand.shape, np.nan)
-    if ok.any():  # false roots are far off: drop them before the (costly) polish
-        e0 = pose_error(Tk[ok], forward_kinematics(robot, cand[ok])) @ plan.projector.T
-        size = np.linalg.norm(e0[:, :3], axis=-1) + _reach(robot) * np.linalg.norm(e0[:, 3:], axis=-1)
-        near = np.zeros_like(ok)
-        near[ok] = size < PREFILTER * max(_reach(robot), 1e-3)
-        rough = np.zeros_like(ok)  # only candidates that lost digits (near double roots) are polished
-        rough[ok] = size > POLISH_ABOVE * max(_reach(robot), 1.0)
-        ok &= near
-        q[ok] = cand[ok]
-        rough &= ok
-        if rough.any():
-            q[rough] = _polish(robot, cand[rough], Tk[rough], plan.projector)
-    ok &= np.all(np.isfinite(q), axis=-1)
-    pe = np.full((B, K), np.inf)
-    re = np.full((B, K), np.inf)
-    if ok.any():
-        e = pose_error(Tk[ok], forward_kinematics(robot, q[ok])) @ plan.projector.T
-        pe[ok], re[ok] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
-    ok &= (pe <= VERIFY_TOL * max(1.0, _reach(robot))) & (re <= VERIFY_TOL)
+    q, ok, pe, re = _verify(robot, plan, Tf, cand)
     # keep only the slots some pose uses: the verified candidates first, the rest dropped
     order = np.argsort(~ok, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
     take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
@@ -216,6 +203,35 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     ok &= inside
     labels = _labels(robot, plan, q, Tf)
     return _pack(batch, q, ok, labels, free, pe, re, outside, plan)
+
+
+def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
+    """FK residual of every candidate; far-off ones dropped, rough ones (roots near double roots) polished and
+    re-checked; the rest are kept as computed.  Returns q (B, K, n) (NaN where dropped), ok, position and
+    orientation residuals (B, K) on the rows the arm controls."""
+    B, K, _ = cand.shape
+    L = _reach(robot)
+    ok = np.all(np.isfinite(cand), axis=-1)
+    Tk = np.broadcast_to(Tf[:, None], (B, K, 4, 4))
+    q = np.full(cand.shape, np.nan)
+    pe = np.full((B, K), np.inf)
+    re = np.full((B, K), np.inf)
+    if ok.any():  # one FK for all candidates; false roots are far off: drop them before the (costly) polish
+        e = pose_error(Tk[ok], forward_kinematics(robot, cand[ok])) @ plan.projector.T
+        pe[ok], re[ok] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
+        size = np.where(ok, pe + L * np.where(ok, re, 0.0), np.inf)
+        near = ok & (size < PREFILTER * max(L, 1e-3))
+        rough = near & (size > POLISH_ABOVE * max(L, 1.0))  # only candidates that lost digits are polished
+        ok = near
+        q[ok] = cand[ok]
+        if rough.any():
+            q[rough] = _polish(robot, cand[rough], Tk[rough], plan.projector)
+            fine = np.all(np.isfinite(q), axis=-1) & rough
+            e = pose_error(Tk[fine], forward_kinematics(robot, q[fine])) @ plan.projector.T
+            pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
+    ok &= np.all(np.isfinite(q), axis=-1)
+    ok &= (pe <= VERIFY_TOL * max(1.0, L)) & (re <= VERIFY_TOL)
+    return q, ok, pe, re
 
 
 def _reach(robot: DHRobot) -> float:
@@ -241,37 +257,40 @@ def _pack(batch, q, ok, labels, free, pe, re, outside, plan) -> AnalyticIKResult
 
 
 def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Branch labels (B, K); definitions in docs/ik.md."""
+    """Branch labels (B, K); definitions in docs/ik.md.
+
+    Each part of a label is a boolean test of q; the label is looked up from the combined bits (no string
+    arithmetic per solution)."""
     B, K, n = q.shape
-    out = np.full((B, K), "", dtype=object)
     chain = chain_of(robot)
     qq = np.nan_to_num(q)
     rev = ~chain.prismatic
     theta = np.array([l.theta for l in robot.joints])
-    parts = []
+    parts = []  # (test (B, K) bool, label where True, label where False)
     if plan.kind.startswith(("pieper", "parallel", "position")) and plan.point_e is not None or plan.kind == "position":
         pe = plan.point_e if plan.point_e is not None else np.zeros(3)
-        X = T[:, None, :3, :3] @ pe + T[:, None, :3, 3]  # (B, 1, 3)
+        X = (T[:, :3, :3] @ pe + T[:, :3, 3]).T[:, :, None]  # (3, B, 1)
         if rev[0]:
-            F1 = chain_fk(chain, qq[..., :1], upto=1)
-            x1 = np.einsum("bkji,bkj->bki", F1[..., :3, :3], X - F1[..., :3, 3])[..., 0]
-            parts.append(np.where(x1 >= 0, "shoulder right", "shoulder left"))
+            x1, _, _, p1 = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1, (3, B, K)
+            parts.append((np.sum(x1 * (X - p1), axis=0) >= 0, "shoulder right", "shoulder left"))
         if n >= 3 and rev[1] and rev[2]:
-            pts = [chain_fk(chain, qq[..., :k], upto=k)[..., :3, 3] if k else np.broadcast_to(chain.consts[0][:3, 3], X.shape)
-                   for k in (1, 2)]
-            S, E = pts
-            up = chain.consts[0][:3, 2]
+            S = chain_columns(chain, qq[..., :1], upto=1)[3]  # (3, B, K)
+            E = chain_columns(chain, qq[..., :2], upto=2)[3]
+            up = chain.consts[0][:3, 2][:, None, None]
             v = X - S
-            v = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-300)
-            u = up - np.sum(up * v, -1, keepdims=True) * v
-            parts.append(np.where(np.sum((E - S) * u, -1) >= 0, "elbow up", "elbow down"))
+            v = v / np.maximum(np.sqrt(np.sum(v * v, axis=0)), 1e-300)
+            u = up - np.sum(up * v, axis=0) * v
+            parts.append((np.sum((E - S) * u, axis=0) >= 0, "elbow up", "elbow down"))
         if n == 6 and rev[4] and plan.kind.startswith(("pieper", "parallel")):
-            parts.append(np.where(np.sin(qq[..., 4] + theta[4]) >= 0, "wrist noflip", "wrist flip"))
+            parts.append((np.sin(qq[..., 4] + theta[4]) >= 0, "wrist noflip", "wrist flip"))
     elif plan.kind == "planar":
         r = np.flatnonzero(rev)
-        parts.append(np.where(np.sin(qq[..., r[1]] + theta[r[1]]) >= 0, "elbow up", "elbow down"))
+        parts.append((np.sin(qq[..., r[1]] + theta[r[1]]) >= 0, "elbow up", "elbow down"))
     elif plan.kind == "wrist":
-        parts.append(np.where(np.sin(qq[..., 1] + theta[1]) >= 0, "wrist noflip", "wrist flip"))
-    for p in parts:
-        out = np.where(out == "", p, out + ", " + p)
-    return out
+        parts.append((np.sin(qq[..., 1] + theta[1]) >= 0, "wrist noflip", "wrist flip"))
+    code = np.zeros((B, K), dtype=np.intp)
+    for i, (test, _, _) in enumerate(parts):
+        code |= np.where(test, 0, 1 << i)
+    table = np.array([", ".join(p[1 + ((c >> i) & 1)] for i, p in enumerate(parts)) for c in range(1 << len(parts))],
+                     dtype=object)
+    return table[code]

@@ -24,7 +24,7 @@ import numpy as np
 from ..model import Convention, DHRobot, JointType
 from ._transforms import inverse_transform
 
-__all__ = ["Chain", "chain_of", "chain_fk", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
+__all__ = ["Chain", "chain_of", "chain_fk", "chain_columns", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
            "wrap_angle", "axis_lines"]
 
 
@@ -109,6 +109,31 @@ def chain_fk(chain: Chain, q: np.ndarray, upto: int | None = None, start: int = 
     for k in range(start, upto):
         T = T @ joint_motion(bool(chain.prismatic[k]), q[..., k - start]) @ chain.consts[k + 1]
     return T
+
+
+def chain_columns(chain: Chain, q: np.ndarray, upto: int) -> tuple[np.ndarray, ...]:
+    """``C0 J1 C1 ⋯ J_upto C_upto`` as its columns x, y, z (rotation) and p (origin), each (3,) + q.shape[:-1].
+
+    The same product as :func:`chain_fk`, computed column-wise with the batch contiguous (a joint rotation is
+    ``x ← c x + s y``, ``y ← c y − s x``; a constant is a few axpy's): no (…, 4, 4) intermediates, which is
+    what makes it several times faster than batched 4×4 products for the IK's short partial chains.
+    """
+    q = np.asarray(q, dtype=float)
+    shape = q.shape[:-1]
+    C0 = chain.consts[0]
+    x, y, z, p = (np.broadcast_to(C0[:3, j].reshape((3,) + (1,) * len(shape)), (3,) + shape) for j in range(4))
+    for k in range(upto):
+        qk = q[..., k]
+        if chain.prismatic[k]:
+            p = p + qk * z
+        else:
+            c, s = np.cos(qk), np.sin(qk)
+            x, y = c * x + s * y, c * y - s * x
+        C = chain.consts[k + 1]
+        cols = (x, y, z)
+        x, y, z = (sum(cols[i] * C[i, j] for i in range(3) if C[i, j] != 0.0) for j in range(3))
+        p = p + sum(cols[i] * C[i, 3] for i in range(3) if C[i, 3] != 0.0)
+    return x, y, z, p
 
 
 def reverse_chain(chain: Chain) -> Chain:

@@ -24,7 +24,8 @@ import numpy as np
 
 from ..errors import UnsupportedRobotError
 from ..model import DHRobot
-from ._ik_chain import Chain, angle_about_z, axis_lines, chain_fk, chain_of, reverse_chain, solve_trig
+from ._ik_closed import closed_position, wrist_angles
+from ._ik_chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
 from ._ik_subproblems import Position3, rotation3, rz_bilinear, trig_coefficients
 from ._transforms import inverse_transform
 
@@ -42,6 +43,7 @@ class Plan:
     solve: Callable  # (B, 4, 4) -> candidates (B, K, n), free (B, K) object array of str
     point_e: np.ndarray | None = None  # wrist / reference point in the end-effector frame, for labels
     notes: list[str] = field(default_factory=list)
+    route: str = ""  # how joints 1-3 of a Pieper arm are found: "closed form (elbow|stanford)" or "resultant"
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -133,13 +135,13 @@ def _merge_coaxial(chain: Chain):
 
 
 def _free_text(mask: np.ndarray, text: str, out: np.ndarray) -> np.ndarray:
-    if not text:
+    if not text or not np.any(mask):
         return out
     add = np.where(out == "", text, out + "; " + text)
     return np.where(mask, add, out)
 
 
-def _pieper(chain: Chain, rng, names, limits3) -> tuple[Callable, np.ndarray]:
+def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tuple[Callable, np.ndarray, str]:
     L = _scale(chain)
     pts, dirs = axis_lines(chain, np.zeros(6))
     X = _common_point(pts[3:], dirs[3:])[0]
@@ -147,16 +149,38 @@ def _pieper(chain: Chain, rng, names, limits3) -> tuple[Callable, np.ndarray]:
     P = (chain.consts[3] @ inverse_transform(F3) @ np.append(X, 1))[:3]
     X_e = (inverse_transform(chain_fk(chain, np.zeros(6))) @ np.append(X, 1))[:3]
     pos = Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng)
+    fast = closed_position(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L) if closed_form else None
     C0i, R4, R5, R6 = inverse_transform(chain.consts[0]), chain.consts[4][:3, :3], chain.consts[5][:3, :3], \
         chain.consts[6][:3, :3]
+
+    def position(W: np.ndarray):
+        """Joints 1-3: the direct closed form where it applies, the resultant route for the other poses."""
+        if fast is None:
+            return pos.solve(W)
+        q123, general = fast.solve(W)  # (B, 4, 3)
+        f123 = np.zeros(q123.shape[:2], dtype=int)
+        if general.any():  # a joint is free at these poses: the general route names the continuum
+            qg, fg = pos.solve(W[general])
+            m = max(q123.shape[1], qg.shape[1])
+            q123 = np.concatenate([q123, np.full((len(W), m - q123.shape[1], 3), np.nan)], axis=1)
+            f123 = np.concatenate([f123, np.zeros((len(W), m - f123.shape[1]), dtype=int)], axis=1)
+            q123[general] = np.nan
+            q123[general, :qg.shape[1]] = qg
+            f123[general] = 0
+            f123[general, :qg.shape[1]] = fg
+        return q123, f123
 
     def solve(T: np.ndarray):
         Xw = T[:, :3, :3] @ X_e + T[:, :3, 3]
         W = Xw @ C0i[:3, :3].T + C0i[:3, 3]
-        q123, f123 = pos.solve(W)  # (B, M, 3)
-        F = chain_fk(chain, np.nan_to_num(q123), upto=3)  # (B, M, 4, 4)
-        M = np.swapaxes(F[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ R6.T
-        q456, sing, sign = rotation3(M, R4, R5)  # (B, M, 2, 3)
+        q123, f123 = position(W)  # (B, M, 3)
+        x, y, z, _ = chain_columns(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
+        Y = T[:, :3, :3] @ R6.T  # (B, 3, 3)
+        M = np.empty(q123.shape[:2] + (3, 3))  # R_0_3ᵀ R R6ᵀ
+        for i, col in enumerate((x, y, z)):
+            for j in range(3):
+                M[..., i, j] = col[0] * Y[:, None, 0, j] + col[1] * Y[:, None, 1, j] + col[2] * Y[:, None, 2, j]
+        q456, sing, sign = wrist_angles(M, R4, R5) if fast is not None else rotation3(M, R4, R5)  # (B, M, 2, 3)
         q = np.concatenate([np.broadcast_to(q123[:, :, None, :], q456.shape), q456], axis=-1)
         free = np.full(q.shape[:-1], "", dtype=object)
         free = _free_text(np.broadcast_to((f123 & 1)[..., None] > 0, free.shape), f"{names[0]} free (wrist centre on axis 1)", free)
@@ -166,7 +190,7 @@ def _pieper(chain: Chain, rng, names, limits3) -> tuple[Callable, np.ndarray]:
         B = len(T)
         return q.reshape(B, -1, 6), free.reshape(B, -1)
 
-    return solve, X_e
+    return solve, X_e, (f"closed form ({fast.kind})" if fast is not None else "resultant")
 
 
 def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
@@ -362,8 +386,11 @@ def _mirrored(solve: Callable) -> Callable:
     return run
 
 
-def make_plan(robot: DHRobot) -> Plan:
+def make_plan(robot: DHRobot, closed_form: bool = True) -> Plan:
     """Recognise the structure of an arm and build its closed-form solver (see module notes).
+
+    ``closed_form=False`` keeps Pieper arms of the elbow and Stanford classes on the general resultant route
+    (:class:`Position3`) instead of the direct formulas of :mod:`._ik_closed` (used to cross-check them).
 
     Raises
     ------
@@ -380,13 +407,13 @@ def make_plan(robot: DHRobot) -> Plan:
     lim = robot.q_limits
     eye = np.eye(6)
     all_rev = not chain.prismatic.any()
-    solve, point, kind, P = None, None, "", eye
+    solve, point, kind, P, route = None, None, "", eye, ""
     if m == 6:
         if not chain.prismatic[3:].any() and _intersect(chain, (3, 4, 5), rng):
-            solve, point = _pieper(chain, rng, names, tuple(lim[reps[2]]))
+            solve, point, route = _pieper(chain, rng, names, tuple(lim[reps[2]]), closed_form)
             kind = "pieper"
         elif not chain.prismatic[:3].any() and _intersect(chain, (0, 1, 2), rng):
-            s, _ = _pieper(rev, rng, rnames, tuple(-lim[reps[3]][::-1]))
+            s, _, route = _pieper(rev, rng, rnames, tuple(-lim[reps[3]][::-1]), closed_form)
             solve, kind = _mirrored(s), "pieper (mirrored: spherical joint at the base)"
     if solve is None and m in (5, 6) and all_rev:
         if _parallel(chain, (1, 2, 3), rng) and (m == 5 or _intersect(chain, (4, 5), rng)):
@@ -423,4 +450,4 @@ def make_plan(robot: DHRobot) -> Plan:
         q, free = solve(T)
         return expand(q), (free if not coaxial else _free_text(np.ones(free.shape, bool), coaxial, free))
 
-    return Plan(kind, P, run, point, [coaxial] if coaxial else [])
+    return Plan(kind, P, run, point, [coaxial] if coaxial else [], route)

@@ -1,0 +1,188 @@
+"""Direct closed forms for the two common Pieper position classes, and a lean three-axis wrist, batched.
+
+The general route of :class:`._ik_subproblems.Position3` finds joints 1–3 of any Pieper arm from the roots of a
+resultant (eigenvalues of a companion matrix) and leaves roots that must be polished.  The two classes most arms
+belong to have textbook closed forms that need only ``atan2``/``arccos``/``sqrt``; here they are written once, in
+the joint-screw form ``W = Rz(q1) C1 J2(q2) C2 J3(q3) P`` of :mod:`._ik_chain` (W: wrist centre in the frame
+before joint 1, P: wrist centre in the frame of joint 3), so both DH conventions, offsets, base and tool are
+covered without case distinctions, and evaluated for all poses × branches at once:
+
+``elbow``     joints R R R, axes 2 and 3 parallel, axis 1 not parallel to them (Puma 560, most industrial arms;
+              Craig 3rd ed. Sec. 4.7, eqs. 4.65–4.76; Spong, Hutchinson & Vidyasagar 2006, Sec. 5.3.2).
+              In the frame after joint 1 every point moved by joints 2, 3 keeps its coordinate along their
+              common axis ``a``: ``(Rz(q1) a)·W = a·p1 + v_z`` — one equation ``α cos q1 + β sin q1 = γ``, two
+              roots (the shoulder offset equation, Craig eq. 4.65).  Then the law of cosines in the plane of
+              joints 2, 3 gives q3 (two roots, the elbow; Craig eq. 4.69), and q2 turns the elbow triangle onto
+              the wrist centre (one ``atan2``).
+``stanford``  joints R R P, axes 1 and 2 meeting at a point O (Stanford arm; Spong et al. 2006, Sec. 5.3.3).
+              Turning about axes 1 and 2 keeps ``|W − O|``, a quadratic in the prismatic q3 (two roots); the
+              height along axis 1 is ``α cos q2 + β sin q2 = γ`` (two roots); q1 turns the point onto W.
+
+Poses where these formulas degenerate (wrist centre on axis 1 or on axis 2: a joint is free) are returned in a
+mask so the caller solves them by the general route, which names the continuum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._ik_chain import solve_trig
+
+__all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
+
+STRUCT_TOL = 1e-9  # relative tolerance of the structural tests (parallel axes, intersecting axes)
+FREE_TOL = 1e-6  # relative distance of the wrist centre to an axis under which the pose goes the general way
+RATIO_TOL = 1e-7  # |c/ρ| up to 1 + this counts as the tangent (double) root, as in the general route
+WRIST_SINGULAR = 1e-9  # |(Ra Rz(q5) Rb e_z)_xy| under which axes 4 and 6 are aligned (as rotation3)
+
+
+def _angle(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.arctan2(y, x)
+
+
+class ElbowPosition:
+    """Joints 1–3 revolute with axes 2 ∥ 3 (see the module notes); ``solve(W)`` → q (B, 4, 3), general (B,)."""
+
+    kind = "elbow"
+
+    def __init__(self, C1: np.ndarray, C2: np.ndarray, P: np.ndarray, scale: float) -> None:
+        self.R1, self.p1 = C1[:3, :3], C1[:3, 3]
+        self.a = C1[:3, 2]  # axis 2 (and 3) in the frame after joint 1
+        R2, p2 = C2[:3, :3], C2[:3, 3]
+        self.R2, self.p2, self.P, self.L = R2, p2, np.asarray(P, float), scale
+        sigma = float(np.sign(R2[2, 2]))
+        self.vz = p2[2] + sigma * self.P[2]  # height of the wrist centre along axis 2, constant
+        self.h = float(self.a @ self.p1 + self.vz)
+        m = R2.T @ p2  # |v|² = |p2|² + |P|² + 2 mᵀ Rz(q3) P
+        self.alpha = m[0] * self.P[0] + m[1] * self.P[1]
+        self.beta = m[1] * self.P[0] - m[0] * self.P[1]
+        self.gamma = m[2] * self.P[2]
+        self.k = float(p2 @ p2 + self.P @ self.P - self.vz**2 + 2 * self.gamma)
+
+    @classmethod
+    def recognise(cls, C1, C2, P, prismatic, scale) -> "ElbowPosition | None":
+        if any(prismatic[:3]):
+            return None
+        a, R2, p2 = C1[:3, 2], C2[:3, :3], C2[:3, 3]
+        if abs(abs(R2[2, 2]) - 1.0) > STRUCT_TOL or np.hypot(a[0], a[1]) < 1e-6:
+            return None  # axes 2, 3 not parallel, or axis 1 parallel to them (planar, not an elbow)
+        m = R2.T @ p2
+        if np.hypot(m[0], m[1]) * np.hypot(P[0], P[1]) < 1e-6 * scale**2:
+            return None  # the elbow does not change the reach: not this class
+        return cls(C1, C2, P, scale)
+
+    def solve(self, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All (q1, q2, q3) placing the wrist centre at W (B, 3): q (B, 4, 3) NaN where none; general (B,)."""
+        a, Wx, Wy, Wz = self.a, W[:, 0], W[:, 1], W[:, 2]
+        # shoulder: (Rz(q1) a)·W = h  (Craig eq. 4.65 in joint-screw form)
+        q1 = solve_trig(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, self.h - a[2] * Wz, tol=RATIO_TOL)  # (B, 2)
+        c1, s1 = np.cos(q1), np.sin(q1)
+        d = np.stack([c1 * Wx[:, None] + s1 * Wy[:, None] - self.p1[0], -s1 * Wx[:, None] + c1 * Wy[:, None]
+                      - self.p1[1], np.broadcast_to(Wz[:, None] - self.p1[2], q1.shape)], -1)  # (B, 2, 3)
+        g = d @ self.R1  # R1ᵀ (Rz(−q1) W − p1): the wrist centre in the frame of joint 2
+        # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P  (Craig eq. 4.69)
+        rhs = 0.5 * (g[..., 0] ** 2 + g[..., 1] ** 2 - self.k)
+        q3 = solve_trig(self.alpha, self.beta, rhs, tol=RATIO_TOL)  # (B, 2, 2)
+        c3, s3 = np.cos(q3), np.sin(q3)
+        P, R2 = self.P, self.R2
+        u = np.stack([c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]], -1)  # Rz(q3) P, xy (z is P_z)
+        vx = self.p2[0] + R2[0, 0] * u[..., 0] + R2[0, 1] * u[..., 1] + R2[0, 2] * P[2]
+        vy = self.p2[1] + R2[1, 0] * u[..., 0] + R2[1, 1] * u[..., 1] + R2[1, 2] * P[2]
+        q2 = _angle(g[..., None, 1], g[..., None, 0]) - _angle(vy, vx)  # (B, 2, 2)
+        q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
+        tiny = FREE_TOL * self.L
+        general = (np.hypot(Wx, Wy) < tiny) | np.any(np.hypot(vx, vy) < tiny, axis=(1, 2))
+        return q, general
+
+
+class StanfordPosition:
+    """Joints R R P with axes 1 and 2 meeting (see the module notes); ``solve(W)`` → q (B, 4, 3), general (B,)."""
+
+    kind = "stanford"
+
+    def __init__(self, C1: np.ndarray, C2: np.ndarray, P: np.ndarray, s0: float, scale: float) -> None:
+        self.R1, p1 = C1[:3, :3], C1[:3, 3]
+        self.O = p1 + s0 * C1[:3, 2]  # the meeting point, on the z axis
+        R2, p2 = C2[:3, :3], C2[:3, 3]
+        self.u = p2 + R2 @ P - np.array([0.0, 0.0, s0])  # wrist centre at q3 = 0, from O, frame of joint 2
+        self.z = R2[:, 2]  # direction of the prismatic joint 3 in the frame of joint 2
+        self.uz = float(self.u @ self.z)
+        self.r = self.R1[2, :]  # axis 1 in the frame of joint 2 (times Rz(q2))
+        self.L = scale
+
+    @classmethod
+    def recognise(cls, C1, C2, P, prismatic, scale) -> "StanfordPosition | None":
+        if prismatic[0] or prismatic[1] or not prismatic[2]:
+            return None
+        a, p1 = C1[:3, 2], C1[:3, 3]
+        n2 = a[0] ** 2 + a[1] ** 2
+        if n2 < 1e-12:
+            return None  # axes 1 and 2 parallel
+        s0 = -(p1[0] * a[0] + p1[1] * a[1]) / n2  # the point of axis 2 nearest to axis 1
+        if np.hypot(p1[0] + s0 * a[0], p1[1] + s0 * a[1]) > STRUCT_TOL * scale:
+            return None  # axes 1 and 2 do not meet
+        return cls(C1, C2, P, float(s0), scale)
+
+    def solve(self, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All (q1, q2, q3) placing the wrist centre at W (B, 3): q (B, 4, 3) NaN where none; general (B,)."""
+        D = W - self.O  # (B, 3)
+        # |W − O|² = |u + q3 z|²: q3² + 2 (u·z) q3 + |u|² − |D|² = 0
+        disc = self.uz**2 - self.u @ self.u + np.sum(D * D, -1)
+        ok = disc >= -1e-12 * self.L**2
+        root = np.sqrt(np.where(ok, np.maximum(disc, 0.0), np.nan))
+        q3 = np.stack([-self.uz + root, -self.uz - root], -1)  # (B, 2)
+        w = self.u + q3[..., None] * self.z  # (B, 2, 3)
+        # height along axis 1: D_z = rᵀ Rz(q2) w
+        r = self.r
+        q2 = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
+                        D[:, None, 2] - r[2] * w[..., 2], tol=RATIO_TOL)  # (B, 2, 2)
+        c2, s2 = np.cos(q2), np.sin(q2)
+        wx, wy, wz = (w[..., None, k] for k in range(3))
+        x, y = c2 * wx - s2 * wy, s2 * wx + c2 * wy  # Rz(q2) w
+        R1 = self.R1
+        ex = R1[0, 0] * x + R1[0, 1] * y + R1[0, 2] * wz  # R1 Rz(q2) w, xy
+        ey = R1[1, 0] * x + R1[1, 1] * y + R1[1, 2] * wz
+        q1 = _angle(D[:, None, None, 1], D[:, None, None, 0]) - _angle(ey, ex)
+        q = np.stack([q1, q2, np.broadcast_to(q3[..., None], q2.shape)], -1).reshape(len(W), 4, 3)
+        tiny = FREE_TOL * self.L
+        general = (np.hypot(D[:, 0], D[:, 1]) < tiny) | np.any(np.hypot(w[..., 0], w[..., 1]) < tiny, axis=1)
+        return q, general
+
+
+def closed_position(C1, C2, P, prismatic, scale):
+    """The direct closed-form solver for joints 1–3 of a Pieper arm, or None when neither class applies."""
+    return ElbowPosition.recognise(C1, C2, P, prismatic, scale) or \
+        StanfordPosition.recognise(C1, C2, P, prismatic, scale)
+
+
+def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
+    """All (qa, qb, qc) with Rz(qa) Ra Rz(qb) Rb Rz(qc) = M, the same result as :func:`rotation3`, elementwise.
+
+    qb from the z-row ``(Raᵀ e_z)ᵀ Rz(qb) (Rb e_z) = M_zz`` (two roots: the wrist flip), qa turns
+    ``v = Ra Rz(qb) Rb e_z`` onto ``M e_z``, qc from ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan subproblems 1
+    and 2; Murray, Li & Sastry 1994, Sec. 3.3; Craig 3rd ed. eq. 2.71 for the orthogonal ZYZ wrist).
+    Written out per component so that no (…, 3, 3) intermediates are built.
+
+    Returns q (..., 2, 3), singular (..., 2), sign (..., 2) as :func:`._ik_subproblems.rotation3`.
+    """
+    r, u = Ra[2, :], Rb[:, 2]
+    qb = solve_trig(r[0] * u[0] + r[1] * u[1], r[1] * u[0] - r[0] * u[1], M[..., 2, 2] - r[2] * u[2])  # (..., 2)
+    cb, sb = np.cos(qb), np.sin(qb)
+
+    def rz_then_ra(x):  # Ra Rz(qb) x for a constant 3-vector x → three (..., 2) arrays
+        rx, ry = cb * x[0] - sb * x[1], sb * x[0] + cb * x[1]
+        return [Ra[i, 0] * rx + Ra[i, 1] * ry + Ra[i, 2] * x[2] for i in range(3)]
+
+    v = rz_then_ra(u)
+    m0, m1 = M[..., None, 0, 2], M[..., None, 1, 2]
+    singular = np.hypot(v[0], v[1]) < WRIST_SINGULAR
+    qa = np.where(singular, 0.0, _angle(m1, m0) - _angle(v[1], v[0]))
+    ca, sa = np.cos(qa), np.sin(qa)
+    n0, n1, n2 = (M[..., None, k, 0] for k in range(3))  # M e_x
+    y0, y1 = ca * n0 + sa * n1, -sa * n0 + ca * n1  # Rz(qa)ᵀ M e_x
+    x0, x1 = (rz_then_ra(Rb[:, j]) for j in (0, 1))  # Ra Rz(qb) Rb e_x, … e_y
+    N00 = x0[0] * y0 + x0[1] * y1 + x0[2] * n2
+    N10 = x1[0] * y0 + x1[1] * y1 + x1[2] * n2
+    qc = _angle(N10, N00)
+    sign = np.where(v[2] >= 0, 1.0, -1.0)
+    return np.stack([qa, qb, qc], -1), singular & np.isfinite(qb), sign
