@@ -22,7 +22,7 @@ import numpy as np
 from .._validate import as_joint_array
 from ..errors import ShapeError
 from ..model import Convention, DHRobot, Frame, JointType
-from ._kinematics import joint_values_per_row, link_transforms
+from ._kinematics import joint_axes_batch, joint_values_per_row, link_transforms
 from ._transforms import dh_transform, rpy_from_rotation, zyz_from_rotation
 
 __all__ = [
@@ -68,7 +68,10 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np
         ``base``: J0, velocities in world/base axes; ``tool``: Je, in end-effector axes.
     """
     frame = Frame(frame)
-    frames = link_transforms(robot, q)  # (..., N+1, 4, 4)
+    q = as_joint_array(q, robot.dof)
+    if q.ndim > 1:
+        return _geometric_jacobian_batch(robot, q, frame)
+    frames = link_transforms(robot, q)  # (N+1, 4, 4)
     T_e = frames[..., -1, :, :] @ robot.tool_matrix  # (..., 4, 4)
     z, o = joint_axes(robot, frames)  # (..., n, 3)
     p_e = T_e[..., None, :3, 3]  # (..., 1, 3)
@@ -80,6 +83,23 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np
         Rt = np.swapaxes(T_e[..., :3, :3], -1, -2)
         J = np.concatenate([Rt @ J[..., :3, :], Rt @ J[..., 3:, :]], axis=-2)
     return J
+
+
+def _geometric_jacobian_batch(robot: DHRobot, q: np.ndarray, frame: Frame) -> np.ndarray:
+    """The same columns as :func:`geometric_jacobian`, computed in the batch-contiguous layout (n, 3, B)."""
+    z, o, xe, ye, ze, pe, batch = joint_axes_batch(robot, q)  # z, o: (n, 3, B)
+    d = pe[None] - o  # (n, 3, B)
+    revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])[:, None, None]
+    cross = np.stack([z[:, 1] * d[:, 2] - z[:, 2] * d[:, 1], z[:, 2] * d[:, 0] - z[:, 0] * d[:, 2],
+                      z[:, 0] * d[:, 1] - z[:, 1] * d[:, 0]], axis=1)  # (n, 3, B)
+    v = np.where(revolute, cross, z)
+    w = np.where(revolute, z, 0.0)
+    if frame is Frame.TOOL:  # rows of R_eᵀ are the end-effector axes
+        axes = np.stack([xe, ye, ze])  # (3 axes, 3, B)
+        v = np.einsum("kib,nib->nkb", axes, v)
+        w = np.einsum("kib,nib->nkb", axes, w)
+    J = np.concatenate([v, w], axis=1)  # (n, 6, B)
+    return np.ascontiguousarray(np.moveaxis(J, (0, 1), (-1, -2))).reshape(batch + (6, robot.dof))
 
 
 def _dh_derivative(convention: Convention, joint: JointType, theta, d, a: float, alpha: float) -> np.ndarray:

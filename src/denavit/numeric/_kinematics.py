@@ -121,6 +121,36 @@ def _run_chain(robot: DHRobot, q, keep_frames: bool):
     return pose, frames, batch
 
 
+def joint_axes_batch(robot: DHRobot, q: np.ndarray):
+    """Joint axes and end-effector pose for a batch, in the batch-contiguous layout.
+
+    Returns ``(z, o, x_e, y_e, z_e, p_e, batch)``: z and o of shape (n, 3, B) (axis direction and a point
+    on it, world axes), and the end-effector frame's columns, each (3, B), tool applied.
+    Standard DH: joint i acts about z_{i-1}; modified: about z_i.
+    """
+    q = as_joint_array(q, robot.dof)
+    batch = q.shape[:-1]
+    size = int(np.prod(batch, dtype=int))
+    qT = np.ascontiguousarray(q.reshape(size, robot.dof).T)  # (n, B)
+    pose = _Pose(robot.base_matrix, size)
+    std = robot.convention is Convention.STANDARD
+    zs, os_ = [], []
+    for link, (theta, d) in zip(robot.links, _row_values(robot, qT)):
+        if std and link.is_joint:
+            zs.append(pose.z)
+            os_.append(pose.p.copy())
+        _apply_row(pose, robot.convention, theta, d, link.a, link.alpha)
+        if not std and link.is_joint:
+            zs.append(pose.z)
+            os_.append(pose.p.copy())
+    tool = robot.tool_matrix
+    cols = [pose.x, pose.y, pose.z]
+    # a rotation column always has a non-zero entry, so each sum is an array
+    xe, ye, ze = (sum(tool[k, j] * cols[k] for k in range(3) if tool[k, j] != 0.0) for j in range(3))
+    pe = pose.p + sum(tool[k, 3] * cols[k] for k in range(3) if tool[k, 3] != 0.0)
+    return np.stack(zs), np.stack(os_), xe, ye, ze, pe, batch
+
+
 def _single_frames(robot: DHRobot, q: list[float], keep_frames: bool) -> np.ndarray:
     """Unbatched fast path in plain floats (numpy's per-call overhead dominates for one pose).
 
