@@ -6,6 +6,9 @@ Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the r
 from ._ik import IKDerivation, IKStep, ik_derivation
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
 from ._jacobians import (
+    analytic_jacobian_sym,
+    angle_rate_matrix_sym,
+    angle_symbols,
     differentiation_jacobian_sym,
     geometric_jacobian_sym,
     jacobian_base_from_tool_sym,
@@ -26,6 +29,9 @@ from ._simplify import POLICIES, shorthand, shorthand_matrix, simplify_expr, sim
 from ._symbols import JointSymbols, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
 
 __all__ = [
+    "analytic_jacobian_sym",
+    "angle_rate_matrix_sym",
+    "angle_symbols",
     "IKDerivation",
     "IKStep",
     "ik_derivation",

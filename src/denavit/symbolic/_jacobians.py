@@ -28,7 +28,8 @@ from ._symbols import joint_symbols, matrix_from_floats
 
 __all__ = ["jacobian_sym", "geometric_jacobian_sym", "differentiation_jacobian_sym", "propagation_jacobian_sym",
            "jacobian_tool_from_base_sym", "jacobian_base_from_tool_sym", "end_effector_pose_sym", "METHODS",
-           "describe_jacobian", "reduce_trig", "simplify_kinematic"]
+           "describe_jacobian", "reduce_trig", "simplify_kinematic", "analytic_jacobian_sym",
+           "angle_rate_matrix_sym", "angle_symbols"]
 
 METHODS = ("geometric", "differentiation", "propagation")
 
@@ -194,3 +195,45 @@ def describe_jacobian(frame: Frame | str) -> str:
     if Frame(frame) is Frame.BASE:
         return "J0: rows (vx, vy, vz, wx, wy, wz) in base/world axes; v is the velocity of the end-effector origin"
     return "Je: rows (vx, vy, vz, wx, wy, wz) in end-effector (tool) axes; v is the velocity of the end-effector origin"
+
+
+def angle_symbols(representation: str) -> tuple[sp.Symbol, sp.Symbol, sp.Symbol]:
+    """The orientation angles as real symbols: (roll, pitch, yaw) or (phi, theta, psi)."""
+    names = {"rpy": "roll pitch yaw", "zyz": "phi theta psi"}
+    if representation not in names:
+        raise ValueError(f"unknown representation {representation!r}; choose one of rpy, zyz")
+    return tuple(sp.symbols(names[representation], real=True))  # type: ignore[return-value]
+
+
+def angle_rate_matrix_sym(representation: str) -> sp.ImmutableMatrix:
+    """E(φ) with ω = E(φ) φ̇ (world axes), Siciliano et al. (2009) eq. 3.64.
+
+    rpy: R = Rz(yaw) Ry(pitch) Rx(roll); zyz: R = Rz(φ) Ry(θ) Rz(ψ).
+    """
+    a, b, c = angle_symbols(representation)
+    if representation == "rpy":  # ω = ẏ z + ṗ Rz(y) y + ṙ Rz(y) Ry(p) x
+        p, y = b, c
+        return sp.ImmutableMatrix([[sp.cos(y) * sp.cos(p), -sp.sin(y), 0],
+                                   [sp.sin(y) * sp.cos(p), sp.cos(y), 0],
+                                   [-sp.sin(p), 0, 1]])
+    ph, th = a, b
+    return sp.ImmutableMatrix([[0, -sp.sin(ph), sp.cos(ph) * sp.sin(th)],
+                               [0, sp.cos(ph), sp.sin(ph) * sp.sin(th)],
+                               [1, 0, sp.cos(th)]])
+
+
+def analytic_jacobian_sym(robot: DHRobot, representation: str = "rpy", simplify: str = "trig",
+                          numeric: bool = False) -> sp.ImmutableMatrix:
+    """Analytic Jacobian Ja = diag(I, E(φ)⁻¹) J0 mapping q̇ to (ṗ, φ̇), Siciliano et al. (2009) eq. 3.66.
+
+    The result is written in the joint symbols q and the angle symbols of :func:`angle_symbols`
+    (the current orientation angles of the end effector); it is undefined where det E = 0
+    (cos pitch = 0 for rpy, sin θ = 0 for zyz).
+    """
+    J0 = jacobian_sym(robot, "geometric", Frame.BASE, simplify, numeric)
+    E_inv = angle_rate_matrix_sym(representation).inv()
+    E_inv = sp.ImmutableMatrix(3, 3, [sp.trigsimp(e) for e in E_inv])
+    angular = E_inv * J0[3:, :]
+    rows = [J0[i, j] for i in range(3) for j in range(J0.shape[1])]
+    rows += [simplify_expr(e, simplify) for e in angular]
+    return sp.ImmutableMatrix(6, J0.shape[1], rows)
