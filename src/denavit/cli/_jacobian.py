@@ -25,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=["geometric", "differentiation", "propagation"], default="geometric",
                    help="route: joint axes of the frames, differentiation of FK, or Craig's velocity propagation")
     p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
-    p.add_argument("--analytic", choices=["rpy", "zyz"], help="numeric analytic Jacobian: rows (xdot, ydot, zdot, angle rates)")
+    p.add_argument("--analytic", choices=["rpy", "zyz"], help="analytic Jacobian: rows (xdot, ydot, zdot, angle rates); numeric with -q, symbolic without")
     p.add_argument("--steps", action="store_true", help="with --method propagation: every omega_i and v_i (symbolic)")
     _sym_format(p)
     p.set_defaults(handler=cmd_jacobian)
@@ -145,10 +145,18 @@ def cmd_jacobian(args: argparse.Namespace):
                   "rows": list(ROWS)}
     lines: list[str] = []
     if args.symbolic or args.q is None:
-        if args.analytic:
-            raise ParseError("--analytic needs joint values -q")
         sdata, lines = _symbolic_jacobian(robot, args)
         data.update(sdata)
+        if args.analytic:
+            from .. import symbolic as S
+            import sympy as sp
+
+            Ja = S.analytic_jacobian_sym(robot, args.analytic, args.simplify)
+            angles = ", ".join(str(a) for a in S.angle_symbols(args.analytic))
+            lines += ["", f"analytic Jacobian Ja ({args.analytic}): rows (xdot, ydot, zdot, rates of {angles}), "
+                      f"in terms of q and the current angles {angles}", "Ja =",
+                      _formatter(args, S.joint_symbols(robot.dof).q)(Ja)]
+            data.update({"Ja_symbolic": Ja, "Ja_latex": sp.latex(Ja), "representation": args.analytic})
     if args.q is not None:
         q = joint_values(args, robot, args.q)
         data["q"] = _q_out(args, robot, q)
