@@ -66,6 +66,12 @@ def test_jacobian_degrees_input(capsys):
     np.testing.assert_allclose(a["q"], [0, 45, -90, 0, 60, 0])
 
 
+def test_symbolic_analytic_jacobian_option(capsys):
+    data = run_json(capsys, "jacobian", "report004-6-wrist3r", "--analytic", "rpy")
+    assert data["representation"] == "rpy" and len(data["Ja_symbolic"]) == 6
+    assert "yaw" in "".join(sum(data["Ja_symbolic"], []))
+
+
 def test_analytic_jacobian_option(capsys):
     data = run_json(capsys, "jacobian", "puma560", "-q", Q_PUMA, "--analytic", "zyz")
     Ja, _ = N.analytic_jacobian(load_robot("puma560"), Q_PUMA_VALUES, "zyz")
@@ -122,7 +128,7 @@ def test_singularities_markdown(capsys):
     (["velocity", "puma560", "-q", Q_PUMA, "--qd", "1,2"], "qd"),
     (["jacobian", "puma560", "-q", "0,0,0"], "q"),
     (["jacobian", "puma560", "-q", "0,0,0,0,0,0", "--frame", "side"], "--frame"),
-    (["jacobian", "puma560", "--analytic", "rpy"], "-q"),
+    (["jacobian", "puma560", "--analytic", "ypr"], "invalid choice"),
     (["jacobian", "puma560", "--steps"], "--steps"),
     (["jacobian", "no-such-robot"], "no-such-robot"),
 ])
