@@ -18,8 +18,8 @@ covered without case distinctions, and evaluated for all poses × branches at on
               Turning about axes 1 and 2 keeps ``|W − O|``, a quadratic in the prismatic q3 (two roots); the
               height along axis 1 is ``α cos q2 + β sin q2 = γ`` (two roots); q1 turns the point onto W.
 
-Poses where these formulas degenerate (wrist centre on axis 1 or on axis 2: a joint is free) are returned in a
-mask so the caller solves them by the general route, which names the continuum.
+Where a formula degenerates — the wrist centre on axis 1 or on axis 2, so that joint is free — the joint is set to
+0 (one representative of the continuum) and flagged, as the general route does.
 """
 
 from __future__ import annotations
@@ -31,7 +31,9 @@ from ._ik_chain import solve_trig
 __all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
 
 STRUCT_TOL = 1e-9  # relative tolerance of the structural tests (parallel axes, intersecting axes)
-FREE_TOL = 1e-6  # relative distance of the wrist centre to an axis under which the pose goes the general way
+FREE_TOL = 1e-10  # relative distance of the wrist centre to axis 1 or 2 under which that joint is free
+# (any value then moves the wrist centre by < 1e-10 L, within the FK check, so 0 is returned and the continuum is
+# named; farther out the joint is determined and computed, however ill-conditioned)
 RATIO_TOL = 1e-7  # |c/ρ| up to 1 + this counts as the tangent (double) root, as in the general route
 WRIST_SINGULAR = 1e-9  # |(Ra Rz(q5) Rb e_z)_xy| under which axes 4 and 6 are aligned (as rotation3)
 
@@ -41,7 +43,7 @@ def _angle(y: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 class ElbowPosition:
-    """Joints 1–3 revolute with axes 2 ∥ 3 (see the module notes); ``solve(W)`` → q (B, 4, 3), general (B,)."""
+    """Joints 1–3 revolute with axes 2 ∥ 3 (see the module notes); ``solve(W)`` → q (B, 4, 3), free (B, 4)."""
 
     kind = "elbow"
 
@@ -72,10 +74,17 @@ class ElbowPosition:
         return cls(C1, C2, P, scale)
 
     def solve(self, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All (q1, q2, q3) placing the wrist centre at W (B, 3): q (B, 4, 3) NaN where none; general (B,)."""
+        """All (q1, q2, q3) placing the wrist centre at W (B, 3).
+
+        Returns q (B, 4, 3), NaN rows where there is none, and free (B, 4) int flags as
+        :meth:`Position3.solve`: bit 1 = q1 free (wrist centre on axis 1), bit 2 = q2 free (on axis 2)."""
         a, Wx, Wy, Wz = self.a, W[:, 0], W[:, 1], W[:, 2]
+        tiny = FREE_TOL * self.L
         # shoulder: (Rz(q1) a)·W = h  (Craig eq. 4.65 in joint-screw form)
-        q1 = solve_trig(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, self.h - a[2] * Wz, tol=RATIO_TOL)  # (B, 2)
+        c = self.h - a[2] * Wz
+        q1 = solve_trig(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, c, tol=RATIO_TOL)  # (B, 2)
+        free1 = (np.hypot(Wx, Wy) < tiny) & (np.abs(c) < tiny)  # on axis 1: every q1 (0 returned)
+        q1 = np.where(free1[:, None], [0.0, np.nan], q1)
         c1, s1 = np.cos(q1), np.sin(q1)
         d = np.stack([c1 * Wx[:, None] + s1 * Wy[:, None] - self.p1[0], -s1 * Wx[:, None] + c1 * Wy[:, None]
                       - self.p1[1], np.broadcast_to(Wz[:, None] - self.p1[2], q1.shape)], -1)  # (B, 2, 3)
@@ -89,14 +98,14 @@ class ElbowPosition:
         vx = self.p2[0] + R2[0, 0] * u[..., 0] + R2[0, 1] * u[..., 1] + R2[0, 2] * P[2]
         vy = self.p2[1] + R2[1, 0] * u[..., 0] + R2[1, 1] * u[..., 1] + R2[1, 2] * P[2]
         q2 = _angle(g[..., None, 1], g[..., None, 0]) - _angle(vy, vx)  # (B, 2, 2)
+        free2 = np.hypot(vx, vy) < tiny  # on axis 2: every q2 (0 returned)
+        q2 = np.where(free2, 0.0, q2)
         q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
-        tiny = FREE_TOL * self.L
-        general = (np.hypot(Wx, Wy) < tiny) | np.any(np.hypot(vx, vy) < tiny, axis=(1, 2))
-        return q, general
+        return q, _flags(q, free1[:, None, None] * 1 + free2 * 2)
 
 
 class StanfordPosition:
-    """Joints R R P with axes 1 and 2 meeting (see the module notes); ``solve(W)`` → q (B, 4, 3), general (B,)."""
+    """Joints R R P with axes 1 and 2 meeting (see the module notes); ``solve(W)`` → q (B, 4, 3), free (B, 4)."""
 
     kind = "stanford"
 
@@ -124,8 +133,9 @@ class StanfordPosition:
         return cls(C1, C2, P, float(s0), scale)
 
     def solve(self, W: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All (q1, q2, q3) placing the wrist centre at W (B, 3): q (B, 4, 3) NaN where none; general (B,)."""
+        """All (q1, q2, q3) placing the wrist centre at W (B, 3); q (B, 4, 3) and free (B, 4) as ElbowPosition."""
         D = W - self.O  # (B, 3)
+        tiny = FREE_TOL * self.L
         # |W − O|² = |u + q3 z|²: q3² + 2 (u·z) q3 + |u|² − |D|² = 0
         disc = self.uz**2 - self.u @ self.u + np.sum(D * D, -1)
         ok = disc >= -1e-12 * self.L**2
@@ -136,17 +146,24 @@ class StanfordPosition:
         r = self.r
         q2 = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
                         D[:, None, 2] - r[2] * w[..., 2], tol=RATIO_TOL)  # (B, 2, 2)
+        free2 = np.hypot(w[..., 0], w[..., 1]) < tiny  # w on axis 2: every q2 (0 returned)
+        q2 = np.where(free2[..., None], [0.0, np.nan], q2)
         c2, s2 = np.cos(q2), np.sin(q2)
         wx, wy, wz = (w[..., None, k] for k in range(3))
         x, y = c2 * wx - s2 * wy, s2 * wx + c2 * wy  # Rz(q2) w
         R1 = self.R1
         ex = R1[0, 0] * x + R1[0, 1] * y + R1[0, 2] * wz  # R1 Rz(q2) w, xy
         ey = R1[1, 0] * x + R1[1, 1] * y + R1[1, 2] * wz
-        q1 = _angle(D[:, None, None, 1], D[:, None, None, 0]) - _angle(ey, ex)
+        free1 = np.broadcast_to((np.hypot(D[:, 0], D[:, 1]) < tiny)[:, None, None], q2.shape)  # W − O on axis 1
+        q1 = np.where(free1, 0.0, _angle(D[:, None, None, 1], D[:, None, None, 0]) - _angle(ey, ex))
         q = np.stack([q1, q2, np.broadcast_to(q3[..., None], q2.shape)], -1).reshape(len(W), 4, 3)
-        tiny = FREE_TOL * self.L
-        general = (np.hypot(D[:, 0], D[:, 1]) < tiny) | np.any(np.hypot(w[..., 0], w[..., 1]) < tiny, axis=1)
-        return q, general
+        return q, _flags(q, free1 * 1 + free2[..., None] * 2)
+
+
+def _flags(q: np.ndarray, bits: np.ndarray) -> np.ndarray:
+    """Free flags (B, 4) of the candidate slots, 0 where the slot holds no solution."""
+    bits = np.broadcast_to(bits, q.shape[:1] + (2, 2)).reshape(len(q), 4)
+    return np.where(np.all(np.isfinite(q), axis=-1), bits, 0)
 
 
 def closed_position(C1, C2, P, prismatic, scale):

@@ -148,32 +148,15 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
     F3 = chain_fk(chain, np.zeros(3), upto=3)
     P = (chain.consts[3] @ inverse_transform(F3) @ np.append(X, 1))[:3]
     X_e = (inverse_transform(chain_fk(chain, np.zeros(6))) @ np.append(X, 1))[:3]
-    pos = Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng)
     fast = closed_position(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L) if closed_form else None
+    pos = fast or Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng)
     C0i, R4, R5, R6 = inverse_transform(chain.consts[0]), chain.consts[4][:3, :3], chain.consts[5][:3, :3], \
         chain.consts[6][:3, :3]
-
-    def position(W: np.ndarray):
-        """Joints 1-3: the direct closed form where it applies, the resultant route for the other poses."""
-        if fast is None:
-            return pos.solve(W)
-        q123, general = fast.solve(W)  # (B, 4, 3)
-        f123 = np.zeros(q123.shape[:2], dtype=int)
-        if general.any():  # a joint is free at these poses: the general route names the continuum
-            qg, fg = pos.solve(W[general])
-            m = max(q123.shape[1], qg.shape[1])
-            q123 = np.concatenate([q123, np.full((len(W), m - q123.shape[1], 3), np.nan)], axis=1)
-            f123 = np.concatenate([f123, np.zeros((len(W), m - f123.shape[1]), dtype=int)], axis=1)
-            q123[general] = np.nan
-            q123[general, :qg.shape[1]] = qg
-            f123[general] = 0
-            f123[general, :qg.shape[1]] = fg
-        return q123, f123
 
     def solve(T: np.ndarray):
         Xw = T[:, :3, :3] @ X_e + T[:, :3, 3]
         W = Xw @ C0i[:3, :3].T + C0i[:3, 3]
-        q123, f123 = position(W)  # (B, M, 3)
+        q123, f123 = pos.solve(W)  # (B, M, 3): the direct closed form where the class allows, else the resultant
         x, y, z, _ = chain_columns(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
         Y = T[:, :3, :3] @ R6.T  # (B, 3, 3)
         M = np.empty(q123.shape[:2] + (3, 3))  # R_0_3ᵀ R R6ᵀ
