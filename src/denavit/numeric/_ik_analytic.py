@@ -82,6 +82,11 @@ def _plan(robot: DHRobot, closed_form: bool = True) -> Plan:
     return make_plan(robot, closed_form)
 
 
+@lru_cache(maxsize=64)
+def _chain(robot: DHRobot):
+    return chain_of(robot)  # read-only use below (labels)
+
+
 def ik_structure(robot: DHRobot) -> str:
     """Name of the closed-form structure recognised for ``robot`` (raises UnsupportedRobotError if none)."""
     return _plan(robot, True).kind
@@ -262,7 +267,7 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
     Each part of a label is a boolean test of q; the label is looked up from the combined bits (no string
     arithmetic per solution)."""
     B, K, n = q.shape
-    chain = chain_of(robot)
+    chain = _chain(robot)
     qq = np.nan_to_num(q)
     rev = ~chain.prismatic
     theta = np.array([l.theta for l in robot.joints])
