@@ -349,3 +349,28 @@ def test_wrist_angles_equal_rotation3_and_reproduce_M():
         assert ok[:, 0].all()  # M is reachable: at least one root
         R = Rz(q[..., 0]) @ Ra @ Rz(q[..., 1]) @ Rb @ Rz(q[..., 2])
         np.testing.assert_allclose(R[ok], np.broadcast_to(M[:, None], R.shape)[ok], atol=1e-12)
+
+
+def test_mirrored_arm_uses_the_closed_form_of_its_reversed_chain():
+    """Spherical joint at the base (axes 1-3 meeting) and an elbow at the tip (axes 4 ∥ 5): the plan solves the
+    reversed chain, whose joints 1-3 are an elbow, by the direct closed form."""
+    rng = np.random.default_rng(77)
+    u = rng.uniform
+    for _ in range(3):
+        links = [DHLink(a=0.0, alpha=0.0, d=u(.2, .5), theta=u(-3, 3)),
+                 DHLink(a=0.0, alpha=u(0.3, 2.8), d=0.0, theta=u(-3, 3)),
+                 DHLink(a=0.0, alpha=u(0.3, 2.8), d=0.0, theta=u(-3, 3)),
+                 DHLink(a=u(-.3, .3), alpha=u(0.3, 2.8), d=u(.2, .4), theta=u(-3, 3)),
+                 DHLink(a=u(.2, .5), alpha=float(rng.choice([0.0, np.pi])), d=u(-.2, .2), theta=u(-3, 3)),
+                 DHLink(a=u(.1, .4), alpha=u(0.3, 2.8), d=u(-.2, .2), theta=u(-3, 3))]
+        robot = DHRobot("mirrored-elbow", tuple(links), convention="modified",
+                        tool=transform_from_xyz_rpy(u(-.2, .2, 3), u(-3, 3, 3)))
+        plan = _plan(robot, True)
+        assert plan.kind.startswith("pieper (mirrored") and plan.route == "closed form (elbow)"
+        q = rng.uniform(-np.pi, np.pi, (40, 6))
+        T = forward_kinematics(robot, q)
+        fast, gen = _routes(robot, T)
+        more = _compare(robot, fast, gen, T, _sigma_min(robot, q) > 1e-2)
+        assert len(more) <= 2
+        d = np.min(np.where(fast.valid, _dist(robot, fast.solutions, q[:, None]), np.inf), axis=1)
+        assert np.all(d < 1e-8)

@@ -1,9 +1,10 @@
 """All inverse-kinematics solutions in closed form, batched over target poses.
 
-Pipeline (the same for every structure): the plan of :mod:`._ik_plans` proposes candidates → a few
-Newton steps polish each (root finding loses digits near double roots) → every candidate is re-checked
-by the forward kinematics → revolute angles are folded by whole turns into the joint limits, those that
-cannot be are set aside → duplicates are merged → each solution gets a branch label.
+Pipeline (the same for every structure): the plan of :mod:`._ik_plans` proposes candidates (the direct closed
+forms of :mod:`._ik_closed` for elbow and Stanford Pieper arms) → one batched forward-kinematics pass checks every
+candidate → only those whose residual shows lost digits (general root finding near double roots) get a few
+Gauss–Newton steps and a second check → revolute angles are folded by whole turns into the joint limits, those
+that cannot be are set aside → duplicates are merged → each solution gets a branch label.
 """
 
 from __future__ import annotations
@@ -21,15 +22,14 @@ from ._ik_numeric import pose_error
 from ._ik_plans import Plan, make_plan
 from ._ik_kernel import kernel_of, targets_soa
 from ._kinematics import forward_kinematics
-from ._transforms import inverse_transform
 
 __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure"]
 
 VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
 POLISH_STEPS = 30
-DUPLICATE_TOL = 1e-6
+DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
 POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
-PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished  # joint-space distance under which two solutions are the same [rad, m]
+PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
 
 
 @dataclass(frozen=True)
