@@ -2,7 +2,9 @@
 
 Run:  python benchmarks/bench_ik.py [--n 10000] [--peer-n 500] [--robot puma560] [--markdown docs/ik_bench.md]
 
-Targets: FK of random joint values uniformly within the joint limits (seeded).  Success = the returned q is
+Targets: FK of random joint values uniformly within the joint limits (seeded).  For Pieper arms of the elbow and
+Stanford classes a row "general resultant route" times the same analytic pipeline forced onto the resultant
+route those arms used before the direct closed forms (same run, for comparison).  Success = the returned q is
 within the joint limits and reproduces the target to 1e-6 m and 1e-6 rad, checked with denavit's FK (the same
 check for every library).  Times are wall-clock per solve: for denavit the batch time divided by the number of
 targets (median and p95 over repeated batches of 1,000); for the peers one call per target.
@@ -70,6 +72,26 @@ def bench_denavit_analytic(robot, q_true, T, chunk=1000):
         res = analytic_ik(robot, T[i:i + chunk])
         per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
         rev = np.array([t.value == "revolute" for t in robot.joint_types])
+        d = res.solutions - q_true[i:i + chunk, None]
+        d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
+        found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
+    return float(np.mean(np.concatenate(found))), *_stats(per)
+
+
+def bench_denavit_resultant(robot, q_true, T, chunk=1000):
+    """The same pipeline forced onto the general resultant route (companion-matrix roots + polish) that Pieper arms
+    used before the direct closed forms; None for arms the closed forms do not cover."""
+    from denavit.numeric._ik_analytic import _plan, _solve
+
+    if not _plan(robot, True).route.startswith("closed form"):
+        return None
+    plan = _plan(robot, False)
+    per, found = [], []
+    rev = np.array([t.value == "revolute" for t in robot.joint_types])
+    for i in range(0, len(T), chunk):
+        t0 = time.perf_counter()
+        res = _solve(robot, T[i:i + chunk], plan)
+        per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
         d = res.solutions - q_true[i:i + chunk, None]
         d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
         found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
@@ -206,6 +228,9 @@ def main(argv=None):
         s, med, p95 = bench_denavit_analytic(robot, q, T)
         rows.append((name, "denavit analytic_ik (all solutions, batched)", args.n, s, med, p95))
         start = len(rows) - 2
+        r = bench_denavit_resultant(robot, q, T)
+        if r is not None:
+            rows.append((name, "denavit analytic_ik, general resultant route", args.n, *r))
         for label, fn in (("roboticstoolbox ets().ik_LM (per call)", lambda: bench_rtb(robot, name, T[: args.peer_n])),
                           ("IKPy inverse_kinematics_frame (per call)", lambda: bench_ikpy(robot, T[: args.peer_n])),
                           ("ik-geo get_ik (all solutions, per call)", lambda: bench_ikgeo(robot, T[: args.peer_n]))):
