@@ -121,7 +121,7 @@ TOPICS = (
 
 
 def _builders() -> dict[str, Callable[..., Section]]:
-    from . import _capabilities, _motion, _sections
+    from . import _capabilities, _dynamics, _ik, _motion, _sections
 
     return {
         "model": _sections.section_model,
@@ -132,8 +132,8 @@ def _builders() -> dict[str, Callable[..., Section]]:
         "velocity": _motion.section_velocity,
         "statics": _motion.section_statics,
         "singularities": _capabilities.section_singularities,
-        "ik": _capabilities.section_ik,
-        "dynamics": _capabilities.section_dynamics,
+        "ik": _ik.section_ik,
+        "dynamics": _dynamics.section_dynamics,
         "figures": _capabilities.section_figures,
     }
 
