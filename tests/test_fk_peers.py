@@ -13,28 +13,8 @@ from _random_robots import random_q, random_robot
 rtb = pytest.importorskip("roboticstoolbox")
 pytestmark = pytest.mark.peer
 
-
-def to_rtb(robot):
-    links = []
-    for link in robot.links:
-        mdh = robot.convention is Convention.MODIFIED
-        if link.joint is JointType.PRISMATIC:
-            cls = rtb.PrismaticMDH if mdh else rtb.PrismaticDH
-            links.append(cls(theta=link.theta, a=link.a, alpha=link.alpha, offset=link.d))
-        else:
-            cls = rtb.RevoluteMDH if mdh else rtb.RevoluteDH
-            links.append(cls(d=link.d, a=link.a, alpha=link.alpha, offset=link.theta))
-    peer = rtb.DHRobot(links)
-    peer.base = robot.base_matrix
-    peer.tool = robot.tool_matrix
-    return peer
-
-
-def expand_q(robot, q):
-    """Joint values for the peer: zeros inserted for fixed rows."""
-    full = np.zeros(robot.n_rows)
-    full[list(robot.joint_rows)] = q
-    return full
+from denavit.peers import expand_q, to_pinocchio  # noqa: E402
+from denavit.peers import to_roboticstoolbox as to_rtb  # noqa: E402
 
 
 @pytest.mark.parametrize("seed", range(200))
@@ -44,6 +24,17 @@ def test_fk_matches_roboticstoolbox_on_random_robots(seed):
     peer = to_rtb(robot)
     for q in random_q(rng, robot, (3,)):
         np.testing.assert_allclose(forward_kinematics(robot, q), peer.fkine(expand_q(robot, q)).A, atol=1e-10)
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_fk_matches_pinocchio_on_random_robots(seed):
+    pin = pytest.importorskip("pinocchio")
+    rng = np.random.default_rng(9000 + seed)
+    robot = random_robot(rng)
+    model, data, fid = to_pinocchio(robot)
+    for q in random_q(rng, robot, (3,)):
+        pin.framesForwardKinematics(model, data, q)
+        np.testing.assert_allclose(forward_kinematics(robot, q), data.oMf[fid].homogeneous, atol=1e-10)
 
 
 @pytest.mark.parametrize("ours, theirs", [("puma560", "Puma560"), ("stanford", "Stanford"), ("panda", "Panda"),
