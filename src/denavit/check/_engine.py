@@ -10,7 +10,7 @@ one unit of the last decimal written for claims written with rounded decimals.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -97,6 +97,10 @@ def _decimals(node: tuple) -> int:
 
 def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
     r, c = len(claimed), len(claimed[0])
+    if len(shape) == 0:
+        if (r, c) != (1, 1):
+            raise ParseError(f"expected one entry, got a {r}×{c} value")
+        return claimed
     if len(shape) == 1:
         if (r, c) == (shape[0], 1):
             return claimed
@@ -170,8 +174,11 @@ def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, d
     wrench = numbers(spec["wrench"], 6, "wrench") if "wrench" in spec else None
     if "wrench" in needs and wrench is None:
         raise ParseError("a torques claim needs 'wrench' (6 numbers f, n)")
-    uses_q = any(n.startswith("q") for n in names)
-    n_q = 1 if fixed_q is not None or not uses_q else N_POINTS
+    uses_q = any(n.startswith("q") and n[1:].isdigit() for n in names)
+    uses_qd = any(n.startswith("qd") and n[2:].isdigit() for n in names)
+    if "qd" in needs and fixed_qd is None and not uses_qd:
+        raise ParseError("this claim needs 'qd' (joint rates) or a formula in the rates")
+    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) else 1
     pts = []
     for r in robots:
         for _ in range(n_q):
@@ -205,6 +212,9 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
             raise ParseError("a claim must be a mapping with at least 'quantity' and 'value'")
         if "value" not in raw:
             raise ParseError("the claim has no 'value'")
+        special = _special(str(raw.get("quantity")))
+        if special is not None:
+            return special(robot, raw, cid, rng, bool(raw.get("deg", deg)))
         qty, extra = quantity(raw.get("quantity"))
         spec = {**extra, **{k: v for k, v in raw.items() if k not in ("id", "quantity", "value")}}
         deg = bool(spec.get("deg", deg))
@@ -214,6 +224,8 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
             for c in row:
                 names |= _expr.names_in(c)
         points = _points(robot, spec, names, qty.needs, rng, deg)
+        if "entry" in spec:  # one entry of the quantity: hints then compare that entry too
+            qty = replace(qty, truth=_entry_of(qty.truth))
         truth = np.array([np.asarray(qty.truth(p, spec), dtype=float) for p in points])  # (P, *shape)
         cells = _shape_to(cells, truth.shape[1:])
         claimed = np.array([_evaluate(cells, p).reshape(truth.shape[1:]) for p in points])
@@ -230,7 +242,52 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
     if ok.all():
         how = "exactly" if ok_tight.all() else "to the decimals written"
         return Verdict(cid, qty.name, "correct", f"correct ({how})", expected=expected, method=method)
+    if qty.name == "coriolis_matrix" and "entry" not in spec and _factorizes_c(claimed, points, tol):
+        return Verdict(cid, qty.name, "correct", "correct as a factorization c = C q̇, though not the Christoffel C "
+                       "(so Ṁ − 2C need not be skew-symmetric)", expected=expected, method=method)
     return _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng)
+
+
+def _factorizes_c(claimed: np.ndarray, points: list[Point], tol: np.ndarray) -> bool:
+    """C q̇ equals the numeric engine's c(q, q̇) at every point (C is not unique; c is)."""
+    from .. import numeric as N
+
+    for C, p in zip(claimed, points):
+        c = N.coriolis_vector(p.robot, p.q, p.qd)
+        if not np.all(np.abs(C @ p.qd - c) <= EXACT_RTOL * np.maximum(1, np.abs(c)) + np.abs(tol) @ np.abs(p.qd)):
+            return False
+    return True
+
+
+def _entry_of(truth):
+    def one(p: Point, spec: dict[str, Any]) -> np.ndarray:
+        v = np.asarray(truth(p, spec), dtype=float)
+        return v[_entry_index(spec["entry"], v.shape)]
+
+    return one
+
+
+def _entry_index(raw: Any, shape: tuple[int, ...]) -> tuple[int, ...]:
+    """``entry: [i, j]`` (1-based) or ``entry: k`` → a 0-based index into a value of ``shape``."""
+    idx = [raw] if isinstance(raw, int) else list(raw) if isinstance(raw, list) else None
+    if idx is None or len(idx) != len(shape) or not all(isinstance(i, int) and not isinstance(i, bool) for i in idx):
+        raise ParseError(f"'entry' must give {len(shape)} index(es) (1-based) into a value of shape {shape}")
+    if not all(1 <= i <= n for i, n in zip(idx, shape)):
+        raise ParseError(f"'entry' {raw!r} is outside a value of shape {shape}")
+    return tuple(i - 1 for i in idx)
+
+
+def _special(name: str):
+    """The checker of a claim kind judged by its own rules (sets and solution sets), or None."""
+    if name in ("singularities", "singular_configurations", "singular"):
+        from ._singular import check_singularities
+
+        return check_singularities
+    if name in ("ik_formula", "ik_solutions"):
+        from . import _ik_claims
+
+        return _ik_claims.check_ik_formula if name == "ik_formula" else _ik_claims.check_ik_solutions
+    return None
 
 
 def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng) -> Verdict:
@@ -241,8 +298,13 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
     own = np.array([p.robot is robot for p in points])
     k = int(np.argmax(np.where(own, err, -1.0))) if (own & (err > 1)).any() else int(np.argmax(err))
     p = points[k]
-    entries = tuple({"entry": list(e), "claimed": float(claimed[k][tuple(i - 1 for i in e)]),
-                     "expected": float(truth[k][tuple(i - 1 for i in e)])} for e in idx)
+    if truth.ndim == 1:  # one entry per point ('entry' claims)
+        e = spec["entry"] if isinstance(spec["entry"], list) else [spec["entry"]]
+        idx = [tuple(e)]
+        entries = ({"entry": list(e), "claimed": float(claimed[k]), "expected": float(truth[k])},)
+    else:
+        entries = tuple({"entry": list(e), "claimed": float(claimed[k][tuple(i - 1 for i in e)]),
+                         "expected": float(truth[k][tuple(i - 1 for i in e)])} for e in idx)
     cex: dict[str, Any] = {"q": p.q.tolist()}
     if p.qd is not None and "qd" in qty.needs:
         cex["qd"] = p.qd.tolist()

@@ -102,7 +102,8 @@ def _dynamics(name: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
             raise ParseError(f"this installation of denavit has no {name}() yet, so this claim cannot be checked")
         if not p.robot.has_dynamics:
             raise ParseError("the robot has no inertial data, so dynamics claims cannot be checked")
-        return np.asarray(fn(p.robot, p.q) if name != "coriolis_vector" else fn(p.robot, p.q, p.qd), dtype=float)
+        rates = name in ("coriolis_vector", "coriolis_matrix")
+        return np.asarray(fn(p.robot, p.q, p.qd) if rates else fn(p.robot, p.q), dtype=float)
 
     return truth
 
@@ -124,10 +125,15 @@ QUANTITIES: dict[str, Quantity] = {
         Quantity("torques", _torques, ("wrench",), about="joint torques τ = Jᵀ F balancing wrench (f, n)"),
         Quantity("mass_matrix", _dynamics("mass_matrix"), about="joint-space inertia matrix M(q)"),
         Quantity("gravity", _dynamics("gravity_torques"), about="gravity torques g(q)"),
+        Quantity("coriolis", _dynamics("coriolis_vector"), ("qd",),
+                 about="velocity torques c(q, q̇) = C(q, q̇) q̇ (Coriolis and centrifugal)"),
+        Quantity("coriolis_matrix", _dynamics("coriolis_matrix"), ("qd",),
+                 about="C(q, q̇) from the Christoffel symbols of M (a whole C with C q̇ = c is accepted too)"),
     )
 }
 _ALIASES = {"A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
-            "J": "jacobian", "J0": "jacobian", "Je": "jacobian", "tau": "torques", "M": "mass_matrix", "g": "gravity"}
+            "J": "jacobian", "J0": "jacobian", "Je": "jacobian", "tau": "torques", "M": "mass_matrix", "g": "gravity",
+            "c": "coriolis", "C": "coriolis_matrix"}
 
 
 def quantity(name: Any) -> tuple[Quantity, dict[str, Any]]:

@@ -1,0 +1,350 @@
+"""Claims about inverse kinematics: a formula for one joint, or the solutions for one target.
+
+``ik_formula``: ``q_1 = \\operatorname{atan2}(p_y, p_x)``, with optional ``where`` definitions evaluated in order
+(``D: (p_x^2 + p_y^2 - L_1^2 - L_2^2)/(2 L_1 L_2)``), ± signs or σ_k = ±1 for branches, and the other joints
+allowed on the right (a formula for q2 that uses q3).  The target names are the entries of the pose of the last DH
+frame in {0}, ``T_0_N = B⁻¹ T E⁻¹`` (as in :func:`denavit.symbolic.ik_derivation`; ``pose: world`` for the
+end-effector pose): ``r_{ij}``, ``p_x p_y p_z`` (also ``n_x … a_z`` for the columns, ``x y z`` and the heading
+``\\phi = atan2(r_21, r_11)``).  The formula is correct when, at random reachable targets, every value it gives
+(for every sign) is the joint's value in an IK solution that agrees with the joints it uses.  Solution sets come
+from :func:`denavit.numeric.analytic_ik` (inside and outside the limits); a value not in that set is still
+accepted if Gauss–Newton with that joint held fixed reaches the target (so a gap in the solver cannot reject a
+correct formula).
+
+``ik_solutions``: a list of q for the target given by ``q`` (its pose) or ``T``.  Each must satisfy FK = T on the
+rows the arm controls (to the decimals written, propagated through J), and every closed-form solution within the
+limits must be listed (missing ones are named with their branch labels).
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any
+
+import numpy as np
+
+from .. import _expr
+from .. import numeric as N
+from ..errors import ParseError
+from ..model import DHRobot, JointType
+from ._latex import parse_math, parse_matrix
+from ._resolve import robot_resolver
+from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
+from ._vectorized import vec_eval
+
+__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS"]
+
+N_TARGETS = 6
+MATCH_TOL = 1e-6
+_TARGET = [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)] + ["px", "py", "pz"]
+_COLS = {"n": 0, "o": 1, "a": 2}
+
+
+def _rev(robot: DHRobot) -> np.ndarray:
+    return np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+
+
+def _dist(robot: DHRobot, a, b) -> np.ndarray:
+    """Joint-wise distance, angles modulo 2π."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    return np.abs(np.where(_rev(robot), (d + np.pi) % (2 * np.pi) - np.pi, d))
+
+
+def target_env(robot: DHRobot, T_world: np.ndarray, pose: str) -> dict[str, float]:
+    """The names a person uses for the target pose, with their values."""
+    T = T_world if pose == "world" else np.linalg.solve(robot.base_matrix, T_world) @ np.linalg.inv(robot.tool_matrix)
+    env = {f"r{i + 1}{j + 1}": T[i, j] for i in range(3) for j in range(3)}
+    env.update(px=T[0, 3], py=T[1, 3], pz=T[2, 3], Px=T[0, 3], Py=T[1, 3], Pz=T[2, 3])
+    for c, j in _COLS.items():
+        env.update({f"{c}{ax}": T[i, j] for i, ax in enumerate("xyz")})
+    env["phi"] = float(np.arctan2(T[1, 0], T[0, 0]))
+    params = {k for k, _ in robot.parameters}
+    env.update({k: T[i, 3] for i, k in enumerate("xyz") if k not in params})
+    return {k: v for k, v in env.items() if k not in params}
+
+
+def _controlled_rows(res: Any) -> list[int]:
+    kind = getattr(res, "controlled", "pose")
+    return {"position": [0, 1, 2], "orientation": [3, 4, 5], "position+heading": [0, 1, 2, 5]}.get(kind, list(range(6)))
+
+
+def _pose_error(robot: DHRobot, q: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """(p_t − p, rotation vector of R_t Rᵀ) in world axes, (6,)."""
+    F = N.forward_kinematics(robot, q)
+    E = T[:3, :3] @ F[:3, :3].T
+    w = np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]) / 2
+    s, c = np.linalg.norm(w), (np.trace(E) - 1) / 2
+    ang = np.arctan2(s, c)
+    rot = w * (ang / s) if s > 1e-300 else w
+    return np.concatenate([T[:3, 3] - F[:3, 3], rot])
+
+
+def reaches(robot: DHRobot, q0: np.ndarray, T: np.ndarray, fixed: list[int], rows: list[int]) -> np.ndarray | None:
+    """Gauss–Newton from q0 on the free joints (``fixed`` held); the solution if it reaches T, else None."""
+    q = q0.astype(float).copy()
+    free = [k for k in range(robot.dof) if k not in fixed]
+    if not free:
+        return q if np.max(np.abs(_pose_error(robot, q, T)[rows])) < 1e-9 else None
+    for _ in range(40):
+        e = _pose_error(robot, q, T)[rows]
+        if np.max(np.abs(e)) < 1e-11:
+            return q
+        J = N.geometric_jacobian(robot, q)[rows][:, free]
+        q[free] += np.linalg.lstsq(J, e, rcond=1e-10)[0]
+    return q if np.max(np.abs(_pose_error(robot, q, T)[rows])) < 1e-9 else None
+
+
+# --- ik_formula ------------------------------------------------------------------------------------------
+
+
+def _read_formula(robot: DHRobot, raw: dict[str, Any]):
+    """(joint index, [(where nodes, rhs node) per ± choice], sign names, names used)."""
+    where = raw.get("where") or {}
+    if not isinstance(where, dict):
+        raise ParseError("'where' must be a mapping of names to formulas, in evaluation order")
+    value = str(raw["value"]).strip().strip("$")
+    joint = raw.get("joint")
+    if "=" in value:
+        lhs, value = split_relation(value)
+        node = parse_math(lhs, robot_resolver(robot), rhs=False)
+        if node[0] != "name" or not node[1].startswith("q") or not node[1][1:].isdigit():
+            raise ParseError(f"the left side {lhs!r} must be one joint variable (q_k or \\theta_k)")
+        j = int(node[1][1:])
+        if joint is not None and int(joint) != j:
+            raise ParseError(f"'joint: {joint}' disagrees with the formula's left side (joint {j})")
+        joint = j
+    if joint is None or isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof:
+        raise ParseError(f"say which joint the formula gives: 'q_k = …' or 'joint: k' (1 to {robot.dof})")
+    names = [str(k) for k in where]
+    signs = [f"sigma{k}" for k in range(1, 10)] + ["sigma"]
+    resolve = robot_resolver(robot, extra=_TARGET + ["Px", "Py", "Pz", "phi", "x", "y", "z"]
+                             + [f"{c}{a}" for c in _COLS for a in "xyz"] + names + signs)
+    texts = [str(where[k]) for k in where] + [value]
+    versions = []
+    for version in expand_pm(texts):
+        nodes = []
+        for name, text in zip(names + ["value"], version):
+            try:
+                nodes.append(parse_math(text, resolve, rhs=False))
+            except ParseError as exc:
+                raise ParseError(f"{'where ' + name if name != 'value' else 'formula'}: {exc}") from None
+        versions.append((nodes[:-1], nodes[-1]))
+    used: set[str] = set()
+    for ws, v in versions:
+        for nd in ws + [v]:
+            used |= _expr.names_in(nd)
+    used_signs = sorted(s for s in signs if s in used)
+    if len(versions) * 2 ** len(used_signs) > MAX_SIGN_COMBOS:
+        raise ParseError("too many sign combinations")
+    return joint - 1, names, versions, used_signs, used
+
+
+def _formula_values(names, versions, used_signs, env: dict) -> np.ndarray:
+    """All values of the formula over ± choices and σ = ±1 (NaN where undefined)."""
+    out = []
+    for ws, v in versions:
+        for sg in itertools.product((1.0, -1.0), repeat=len(used_signs)):
+            e = {**env, **dict(zip(used_signs, sg))}
+            for name, node in zip(names, ws):
+                e[name] = float(vec_eval(node, e))
+            out.append(float(vec_eval(v, e)))
+    return np.array(out)
+
+
+def _targets(robot: DHRobot, rng: np.random.Generator, count: int):
+    """(q_gen, T, analytic result) for random reachable, well-conditioned targets."""
+    lim = robot.q_limits
+    lo = np.maximum(np.where(np.isfinite(lim[:, 0]), lim[:, 0], -np.pi), -np.pi)
+    hi = np.minimum(np.where(np.isfinite(lim[:, 1]), lim[:, 1], np.pi), np.pi)
+    out = []
+    for _ in range(count * 4):
+        q = rng.uniform(lo, hi)
+        T = N.forward_kinematics(robot, q)
+        res = N.analytic_ik(robot, T)
+        J = N.geometric_jacobian(robot, q)[_controlled_rows(res)]
+        s = np.linalg.svd(J, compute_uv=False)
+        if s[-1] > 1e-3 * s[0]:
+            out.append((q, T, res))
+        if len(out) == count:
+            break
+    return out
+
+
+def _solution_set(robot: DHRobot, res: Any) -> tuple[np.ndarray, list[str]]:
+    sols = np.asarray(res.solutions, dtype=float).reshape(-1, robot.dof)
+    outside = np.asarray(res.outside_limits, dtype=float).reshape(-1, robot.dof)
+    return np.concatenate([sols, outside]), list(res.free) + [""] * len(outside)
+
+
+def _free_joints(text: str) -> set[int]:
+    import re
+
+    return {int(m) - 1 for m in re.findall(r"q(\d+)", text or "")}
+
+
+def _decimals_of(nodes) -> int:
+    from ._engine import _decimals
+
+    return max((_decimals(nd) for nd in nodes), default=0)
+
+
+def _formula_hint(robot: DHRobot, j: int, v: float, s_j: float) -> str | None:
+    rev = bool(_rev(robot)[j])
+    wrap = (lambda x: (x + np.pi) % (2 * np.pi) - np.pi) if rev else (lambda x: x)
+    for other, text in ((-s_j, "the opposite sign (a sign slip)"),
+                        (s_j + np.pi, "π away: atan instead of atan2, or both atan2 arguments with the wrong sign"),
+                        (np.pi / 2 - s_j, "π/2 − q: the two atan2 arguments swapped"),
+                        (s_j + np.pi / 2, "π/2 away: a DH angle offset missing or added"),
+                        (s_j - np.pi / 2, "π/2 away: a DH angle offset missing or added")):
+        if abs(wrap(v - other)) < 1e-6 and (rev or other is not s_j + np.pi):
+            return f"it gives q{j + 1} = {v:.6g}, {text} (a solution has q{j + 1} = {s_j:.6g})"
+    return None
+
+
+def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
+    """The verdict on a formula for one joint of the inverse kinematics (see the module notes)."""
+    from ._engine import Verdict
+
+    j, names, versions, used_signs, used = _read_formula(robot, raw)
+    deps = sorted(int(n[1:]) - 1 for n in used if n[:1] == "q" and n[1:].isdigit())
+    if j in deps:
+        raise ParseError(f"the formula for q{j + 1} uses q{j + 1} itself")
+    pose = str(raw.get("pose", "dh"))
+    if pose not in ("dh", "world"):
+        raise ParseError(f"'pose' must be dh (T_0_N, default) or world (end-effector pose), got {pose!r}")
+    try:
+        N.ik_structure(robot)
+    except Exception as exc:
+        raise ParseError(f"IK formulas cannot be checked for this arm: {exc}") from None
+    tol = MATCH_TOL + (10.0 * 10.0 ** -d if (d := _decimals_of([v for _, v in versions])) >= 2 else 0.0)
+    params = dict(robot.parameters)
+    bad, hints, cover, checked = [], [], [], 0
+    for t, (qg, T, res) in enumerate(_targets(robot, rng, N_TARGETS)):
+        S, free = _solution_set(robot, res)
+        usable = [k for k in range(len(S)) if not (_free_joints(free[k]) & set(deps + [j]))]
+        if not usable:
+            continue
+        checked += 1
+        env0 = {**params, **target_env(robot, T, pose)}
+        rows = _controlled_rows(res)
+        hit = set()
+        for s in ([S[k] for k in usable] if deps else [S[usable[0]]]):
+            env = {**env0, **{f"q{i + 1}": s[i] for i in deps}}
+            vals = _formula_values(names, versions, used_signs, env)
+            if not np.isfinite(vals).any():
+                bad.append({"entry": [t + 1], "claimed": float("nan"), "expected": float(s[j]), "q": qg.tolist(),
+                            "note": "undefined (a square root of a negative number, a division by zero, …)"})
+                break
+            same = [k for k in usable if all(_dist(robot, S[k], s)[i] < tol for i in deps)]
+            for v in vals[np.isfinite(vals)]:
+                match = [k for k in same if abs(_dist(robot, [S[k][j]], [v])[0] if _rev(robot)[j] else S[k][j] - v) < tol]
+                if match:
+                    hit |= set(match)
+                    continue
+                q0 = s.copy()
+                q0[j] = v
+                if reaches(robot, q0, T, deps + [j], rows) is not None:
+                    continue
+                near = min(same, key=lambda k: abs(((S[k][j] - v + np.pi) % (2 * np.pi)) - np.pi))
+                bad.append({"entry": [t + 1], "claimed": float(v), "expected": float(S[near][j]), "q": qg.tolist()})
+                if (h := _formula_hint(robot, j, float(v), float(S[near][j]))) is not None:
+                    hints.append(h)
+        distinct = {round(float(S[k][j]), 6) for k in usable}
+        cover.append((len({round(float(S[k][j]), 6) for k in hit}), len(distinct)))
+    if checked == 0:
+        raise ParseError(f"q{j + 1} is not determined by the pose at the targets tried (a continuum of solutions)")
+    method = (f"evaluated at {checked} random reachable target(s) (pose: {pose}); values compared with the closed-form "
+              "solution set (analytic_ik), gaps re-checked by Gauss-Newton with the joint held")
+    extra = {"joint": j + 1, "coverage": cover}
+    if not bad:
+        a, b = min(cover)
+        note = "" if all(x == y for x, y in cover) else f"; it gives {a} of the {b} values of q{j + 1} (one branch)"
+        return Verdict(cid, "ik_formula", "correct", f"correct: every value it gives is q{j + 1} of an IK solution{note}",
+                       method=method, extra=extra)
+    first = bad[0]
+    msg = (f"incorrect: at target {first['entry'][0]} the formula is {first['note']}" if "note" in first else
+           f"incorrect: at target {first['entry'][0]} it gives q{j + 1} = {first['claimed']:.6g}, which is not q{j + 1} "
+           f"of any IK solution (nearest: {first['expected']:.6g})")
+    return Verdict(cid, "ik_formula", "incorrect", msg, tuple(bad[:12]), {"q": first["q"]},
+                   tuple(dict.fromkeys(hints))[:3], None, method, extra)
+
+
+# --- ik_solutions ----------------------------------------------------------------------------------------
+
+
+def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The claimed q vectors, each with the rounding unit of every entry (0 for exact entries)."""
+    from ._engine import _decimals, _no_names
+
+    if isinstance(raw, str) and "\\begin" in raw:
+        rows = parse_matrix(raw, _no_names)
+    else:
+        items = raw if isinstance(raw, list) else [p for p in str(raw).split(";") if p.strip()]
+        rows = []
+        for k, item in enumerate(items, start=1):
+            cells = item if isinstance(item, list) else [c for c in str(item).strip().strip("[]()").split(",")]
+            try:
+                rows.append([_expr.parse(c) if isinstance(c, (int, float)) else parse_math(str(c), _no_names, rhs=False)
+                             for c in cells])
+            except ParseError as exc:
+                raise ParseError(f"solution {k}: {exc}") from None
+    out = []
+    rev = _rev(robot)
+    for k, row in enumerate(rows, start=1):
+        if len(row) != robot.dof:
+            raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
+        q = np.array([_expr.evaluate(c) for c in row])
+        unit = np.array([10.0 ** -d if (d := _decimals(c)) >= 2 else 0.0 for c in row])
+        if deg:
+            q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
+        out.append((q, unit))
+    if not out:
+        raise ParseError("no solution listed (an unreachable target has none: write an empty list [])")
+    return out
+
+
+def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
+    """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
+    from ._engine import Verdict, _joint_values, _no_names, _values
+
+    if "q" in raw:
+        T = N.forward_kinematics(robot, _joint_values(raw["q"], robot, "q", deg))
+    elif "T" in raw:
+        T = np.array([[_expr.evaluate(c) for c in r] for r in _values(raw["T"], _no_names)])
+    else:
+        raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
+    if T.shape != (4, 4):
+        raise ParseError(f"'T' must be 4×4, got {T.shape}")
+    claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
+    try:
+        res = N.analytic_ik(robot, T)
+    except Exception:  # no closed form: each solution is still checked by FK
+        res = None
+    rows = _controlled_rows(res) if res is not None else list(range(6))
+    entries, reach = [], []
+    for k, (q, unit) in enumerate(claimed, start=1):
+        e = _pose_error(robot, q, T)[rows]
+        allowed = 1e-9 + 2.0 * np.abs(N.geometric_jacobian(robot, q)[rows]) @ unit
+        ok = bool(np.all(np.abs(e) <= allowed))
+        reach.append(ok)
+        if not ok:
+            entries.append({"entry": [k], "claimed": float(np.max(np.abs(e))), "expected": 0.0, "q": q.tolist(),
+                            "note": "FK(q) does not reach the target"})
+    missing = []
+    if res is not None:
+        for s, label, free in zip(np.asarray(res.solutions).reshape(-1, robot.dof), res.branches, res.free):
+            keep = [i for i in range(robot.dof) if i not in _free_joints(free)]
+            if not any(r and np.all(_dist(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
+                       for r, (q, unit) in zip(reach, claimed)):
+                missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in s) + "]")
+    method = ("FK of each claimed solution on the rows the arm controls (to the decimals written, through J); "
+              + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
+    extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
+    if not entries and not missing:
+        return Verdict(cid, "ik_solutions", "correct", f"correct: all {len(claimed)} solution(s) reach the target"
+                       + (" and none is missing" if res is not None else ""), method=method, extra=extra)
+    parts = [f"solution {e['entry'][0]} does not reach the target (error {e['claimed']:.3g})" for e in entries]
+    parts += [f"missing {m}" for m in missing]
+    return Verdict(cid, "ik_solutions", "incorrect", "incorrect: " + "; ".join(parts[:8]), tuple(entries),
+                   {"q": entries[0]["q"]} if entries else None, (), extra["solutions"], method, extra)
+

@@ -1,0 +1,82 @@
+"""Small text helpers for claims written as relations: top-level splitting and ± expansion.
+
+Only slicing and joining of the person's text happens here; the pieces are then read by the restricted
+reader (:mod:`denavit.check._latex`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+
+from ..errors import ParseError
+
+__all__ = ["split_top", "split_relation", "expand_pm", "MAX_SIGN_COMBOS"]
+
+MAX_SIGN_COMBOS = 64
+_OPENERS, _CLOSERS = "({[", ")}]"
+
+
+def split_top(text: str, seps: tuple[str, ...]) -> list[str]:
+    """Split ``text`` at any of ``seps`` that stand outside brackets and braces."""
+    out, cur, level, k = [], "", 0, 0
+    while k < len(text):
+        ch = text[k]
+        if ch in _OPENERS:
+            level += 1
+        elif ch in _CLOSERS:
+            level -= 1
+        if level == 0:
+            sep = next((s for s in seps if text.startswith(s, k)), None)
+            if sep is not None:
+                out.append(cur)
+                cur = ""
+                k += len(sep)
+                continue
+        cur += ch
+        k += 1
+    out.append(cur)
+    return out
+
+
+def split_relation(text: str) -> tuple[str, str]:
+    """``lhs = rhs`` → (lhs, rhs); exactly one top-level ``=`` is required."""
+    parts = split_top(text, ("=",))
+    if len(parts) != 2 or not parts[0].strip() or not parts[1].strip():
+        raise ParseError(f"expected one relation 'left = right', got {text.strip()[:60]!r}")
+    return parts[0].strip(), parts[1].strip()
+
+
+_PM = re.compile(r"\\pm(?![A-Za-z])|±|\\mp(?![A-Za-z])|∓")
+
+
+def expand_pm(texts: list[str]) -> list[list[str]]:
+    """Every choice of the ± signs in ``texts`` (jointly): a list of versions of ``texts``.
+
+    Each ``\\pm``/``±`` is an independent sign; each ``\\mp``/``∓`` takes the opposite of the first ±.
+    """
+    marks = [(i, m) for i, t in enumerate(texts) for m in _PM.finditer(t)]
+    n_pm = sum(1 for _, m in marks if m.group(0) in ("\\pm", "±"))
+    n_free = n_pm if n_pm else sum(1 for _ in marks)
+    if 2 ** n_free > MAX_SIGN_COMBOS:
+        raise ParseError(f"too many ± signs ({n_free}; at most {MAX_SIGN_COMBOS.bit_length() - 1})")
+    versions = []
+    for signs in itertools.product("+-", repeat=n_free):
+        out = list(texts)
+        per_text: dict[int, list] = {}
+        order = 0
+        for i, m in marks:
+            is_pm = m.group(0) in ("\\pm", "±") or not n_pm
+            if is_pm:
+                sign = signs[order] if order < n_free else "+"
+                order += 1
+            else:
+                sign = "-" if signs[0] == "+" else "+"
+            per_text.setdefault(i, []).append((m.start(), m.end(), sign))
+        for i, reps in per_text.items():
+            t = out[i]
+            for a, b, sign in sorted(reps, reverse=True):
+                t = t[:a] + f" {sign} " + t[b:]
+            out[i] = t  # replaced from the right, so earlier positions stay valid
+        versions.append(out)
+    return versions
