@@ -257,3 +257,185 @@ def test_cli_check_json_and_errors(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "malformed YAML" in err
     assert main(["check", "planar2r", str(tmp_path / "none.yaml")]) == 2
+
+
+# --- singular configurations -----------------------------------------------------------------------------
+
+
+def _sing(robot, value, rows=None, seed=0):
+    claim = {"quantity": "singularities", "value": value}
+    if rows:
+        claim["rows"] = rows
+    (v,) = _check(robot, [claim], seed=seed)
+    return v
+
+
+def _svd_ratio(robot, q, rows):
+    idx = [["vx", "vy", "vz", "wx", "wy", "wz"].index(r) for r in rows.split(",")] if rows else list(range(6))
+    s = np.linalg.svd(dn.geometric_jacobian(robot, np.asarray(q))[idx], compute_uv=False)
+    return s[-1] / s[0]
+
+
+@pytest.mark.parametrize("value", ["q2 = 0, pi", r"\sin\theta_2 = 0", r"q_2 = 0 \text{ or } q_2 = \pi", "s_2 = 0",
+                                   r"\theta_2 = k\pi", ["q2 = 0", "q2 = -pi"], r"\cos^2 q_2 = 1", "q2 = 0.0000, 3.1416"])
+def test_check_singularities_planar_2r_textbook_forms_accepted(value):
+    """Planar 2R (Spong eq. 4.91): det of the position Jacobian is L1 L2 sin q2: singular iff q2 = 0 or π."""
+    assert _sing(dn.load_robot("planar2r"), value, "vx,vy").verdict == "correct"
+
+
+def test_check_singularities_broken_claims_named_with_counterexamples():
+    robot = dn.load_robot("planar2r")
+    v = _sing(robot, "q2 = 0", "vx,vy")
+    assert v.verdict == "incorrect" and v.extra["missing"] == ["q2 = 3.14159 (from sin(q2) = 0)"]
+    v = _sing(robot, r"q_2 = \pi/2", "vx,vy")
+    assert v.verdict == "incorrect" and v.entries[0]["entry"] == [1] and "not singular" in v.message
+    assert _svd_ratio(robot, v.entries[0]["q"], "vx,vy") > 0.1  # the counterexample really has full rank
+    assert any("π/2 away" in h for h in v.hints)
+    v = _sing(robot, r"\sin(2 q_2) = 0", "vx,vy")  # a superset: q2 = ±π/2 is not singular
+    assert v.verdict == "incorrect" and abs(abs(v.entries[0]["q"][1]) - np.pi / 2) < 1e-9
+    assert _sing(robot, "none", "vx,vy").verdict == "incorrect"
+    assert _sing(robot, "none").verdict == "correct"  # with all six rows a 2R arm never loses rank 2
+
+
+def test_check_singularities_puma_and_stanford():
+    puma = dn.load_robot("puma560")
+    ok = [r"a_3 \sin\theta_3 + d_4 \cos\theta_3 = 0", "s_5 = 0", r"a_2 C_2 + a_3 C_{23} - d_4 S_{23} = 0"]
+    assert _sing(puma, ok).verdict == "correct"
+    assert _sing(puma, ["q3 = -1.5238, 1.6178", r"\theta_5 = 0, \pi", ok[2]]).verdict == "correct"
+    v = _sing(puma, ok[1:])
+    assert v.verdict == "incorrect" and any("q3" in m for m in v.extra["missing"])
+    v = _sing(puma, ok[:2])
+    assert v.verdict == "incorrect" and any("a2*cos(q2)" in m for m in v.extra["missing"])
+    assert _sing(dn.load_robot("stanford"), "sin(q2) = 0; sin(q5) = 0; q3 = 0").verdict == "correct"
+
+
+def test_check_singularities_everywhere_and_unreadable():
+    robot = dn.load_robot("report000-6r")  # joints 1 and 2 coaxial: J0 never has rank 6
+    assert _sing(robot, "everywhere").verdict == "correct"
+    v = _sing(robot, "q3 = 0")
+    assert v.verdict == "incorrect" and "every configuration" in v.extra["missing"][0]
+    assert _sing(dn.load_robot("planar2r"), "everywhere", "vx,vy").verdict == "incorrect"
+    assert _sing(dn.load_robot("planar2r"), "L_1 = 0", "vx,vy").verdict == "unreadable"
+    assert _sing(dn.load_robot("planar2r"), "q2 = 0", "vx,foo").verdict == "unreadable"
+
+
+def _library_forms(robot, rows, rng):
+    """A correct claim written from the symbolic analysis in a random form per condition."""
+    a = S.singularity_analysis(robot, rows=rows)
+    q = S.joint_symbols(robot.dof).q
+    out = []
+    for c in a.conditions:
+        form = rng.integers(4) if c.solutions else 3
+        if form == 0:
+            for s in c.solutions:  # revolute values shifted by a random multiple of 2π
+                turn = 2 * np.pi * (robot.joint_types[int(s.variable[1:]) - 1].value == "revolute")
+                out.append(f"{s.variable} = " + ", ".join(repr(float(v + turn * int(rng.integers(-1, 2))))
+                                                          for v in s.values))
+        elif form == 1:
+            out += [f"{s.variable} = " + ", ".join(f"{v:.6f}" for v in s.values) for s in c.solutions]
+        elif form == 2:
+            out.append(sp.latex(S.shorthand(c.factor, q)) + " = 0")
+        else:
+            k = sp.Rational(int(rng.integers(1, 9)), int(rng.integers(1, 5))) * (-1) ** int(rng.integers(2))
+            out.append(sp.latex(sp.expand(k * c.factor)) + " = 0")
+    return out or ["none"]
+
+
+@settings(max_examples=8 if CI else 20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=st.sampled_from([("planar2r", "vx,vy"), ("report000-planar3r", "vx,vy,wz"), ("puma560", None),
+                             ("stanford", None), ("scara", "vx,vy,vz,wz"), ("planar3r", "vx,vy")]),
+       seed=st.integers(0, 2**31 - 1))
+def test_check_never_rejects_correct_singularity_claims(case, seed):
+    name, rows = case
+    robot = dn.load_robot(name)
+    value = _library_forms(robot, rows, np.random.default_rng(seed))
+    v = _sing(robot, value, rows, seed=seed)
+    assert v.verdict == "correct", (value, v.message)
+
+
+# --- inverse kinematics ----------------------------------------------------------------------------------
+
+
+def _derivation_claims(robot):
+    """Every joint formula of the symbolic derivation as a claim whose 'where' holds the steps before it."""
+    d = S.ik_derivation(robot)
+    where, out = {}, []
+    for lhs, rhs in d.formulas:
+        for sym, e in (list(zip(lhs, rhs)) if isinstance(lhs, sp.MatrixBase) else [(lhs, rhs)]):
+            if sym in d.joints:
+                out.append({"quantity": "ik_formula", "where": dict(where), "value": f"{sp.latex(sym)} = {sp.latex(e)}"})
+            where[sp.latex(sym)] = sp.latex(e)
+    return out
+
+
+@pytest.mark.parametrize("name", ["planar2r", "report000-planar3r", "puma560", "stanford"])
+def test_check_ik_formulas_of_the_derivation_are_accepted(name):
+    robot = dn.load_robot(name)
+    for v in _check(robot, _derivation_claims(robot)):
+        assert v.verdict == "correct", v.message
+
+
+def test_check_ik_formulas_hand_written_forms_and_slips():
+    robot = dn.load_robot("planar2r")
+    D = {"D": "(p_x^2 + p_y^2 - L_1^2 - L_2^2)/(2 L_1 L_2)"}
+    ok = [{"value": r"q_2 = \operatorname{atan2}(\pm\sqrt{1 - D^2}, D)", "where": D},
+          {"value": r"\theta_2 = \arccos D", "where": D},
+          {"value": r"θ1 = atan2(y, x) - atan2(L_2 \sin\theta_2, L_1 + L_2 \cos\theta_2)"},
+          {"joint": 1, "value": r"\operatorname{atan2}(p_y, p_x) - \operatorname{atan2}(L_2 s_2, L_1 + L_2 c_2)"}]
+    bad = [{"value": r"q_1 = atan2(p_y, p_x) + atan2(L_2 s_2, L_1 + L_2 c_2)"},
+           {"value": r"q_1 = \arctan(p_y / p_x) - atan2(L_2 s_2, L_1 + L_2 c_2)"},
+           {"value": r"q_2 = \arccos D", "where": {"D": "(p_x^2 + p_y^2 - L_1^2 + L_2^2)/(2 L_1 L_2)"}}]
+    v = _check(robot, [{"quantity": "ik_formula", **c} for c in ok + bad])
+    assert [x.verdict for x in v] == ["correct"] * 4 + ["incorrect"] * 3, [x.message for x in v]
+    assert "one branch" in v[1].message
+    assert any("atan instead of atan2" in h for h in v[5].hints)
+    e = v[4].entries[0]  # the claimed q1 with the q2 it was computed from really misses the target
+    T = dn.forward_kinematics(robot, np.array(v[4].counterexample["q"]))
+    F = dn.forward_kinematics(robot, np.array([e["claimed"], e["given"]["q2"]]))
+    assert np.linalg.norm(F[:3, 3] - T[:3, 3]) > 1e-3
+    u = _check(robot, [{"quantity": "ik_formula", "value": "q_1 = q_1"}, {"quantity": "ik_formula", "value": "atan2(1, 2)"}])
+    assert [x.verdict for x in u] == ["unreadable"] * 2
+
+
+@pytest.mark.parametrize("name", ["puma560", "planar2r", "scara"])
+def test_check_ik_solutions_complete_and_missing(name):
+    robot = dn.load_robot(name)
+    rng = np.random.default_rng(4)
+    q = _case(robot, rng)
+    res = dn.analytic_ik(robot, dn.forward_kinematics(robot, q))
+    sols = [[f"{x:.6f}" for x in s] for s in res.solutions]
+    qtext = ", ".join(repr(float(x)) for x in q)
+    (v,) = _check(robot, [{"quantity": "ik_solutions", "q": qtext, "value": sols}])
+    assert v.verdict == "correct", v.message
+    if len(sols) > 1:
+        (v,) = _check(robot, [{"quantity": "ik_solutions", "q": qtext, "value": sols[1:]}])
+        assert v.verdict == "incorrect" and v.extra["missing"][0].startswith(res.branches[0])
+    wrong = [list(map(float, s)) for s in sols]
+    wrong[0][0] += 0.1
+    (v,) = _check(robot, [{"quantity": "ik_solutions", "q": qtext, "value": wrong}])
+    assert v.verdict == "incorrect" and v.entries[0]["entry"] == [1] and "does not reach" in v.message
+
+
+# --- dynamics: c and C -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["planar2r", "report000-planar3r"])
+def test_check_coriolis_claims_from_the_symbolic_engine(name):
+    """c and C from the symbolic Lagrangian (Christoffel symbols) are accepted against the numeric engine's CRBA-
+    derivative route; any factorization with C q̇ = c is accepted as a C; a sign slip in c is named."""
+    robot = dn.load_robot(name)
+    t = S.lagrangian_dynamics(robot)
+    tex = lambda M: sp.latex(S.shorthand_matrix(M, t.q), mat_str="bmatrix", mat_delim="")  # noqa: E731
+    other = sp.ImmutableMatrix(t.C + sp.Matrix(robot.dof, robot.dof, lambda i, j: 0)).as_mutable()
+    other[0, 0] += t.qd[1]  # break C, then repair C q̇ = c through column 2
+    other[0, 1] -= t.qd[0]
+    bad_c = t.c.as_mutable()
+    bad_c[1] = -bad_c[1]
+    claims = [{"quantity": "c", "value": tex(t.c)}, {"quantity": "C", "value": tex(t.C)},
+              {"quantity": "C", "entry": [1, 2], "value": sp.latex(t.C[0, 1])},
+              {"quantity": "coriolis_matrix", "value": tex(sp.ImmutableMatrix(other))},
+              {"quantity": "M", "entry": [1, 1], "value": sp.latex(t.M[0, 0])},
+              {"quantity": "c", "value": tex(sp.ImmutableMatrix(bad_c))}]
+    v = _check(robot, claims)
+    assert [x.verdict for x in v] == ["correct"] * 5 + ["incorrect"], [x.message for x in v]
+    assert "factorization" in v[3].message and [e["entry"] for e in v[5].entries] == [[2]]

@@ -19,6 +19,7 @@ limits must be listed (missing ones are named with their branch labels).
 from __future__ import annotations
 
 import itertools
+import re
 from typing import Any
 
 import numpy as np
@@ -115,7 +116,9 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
         joint = j
     if joint is None or isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof:
         raise ParseError(f"say which joint the formula gives: 'q_k = …' or 'joint: k' (1 to {robot.dof})")
-    names = [str(k) for k in where]
+    names = [re.sub(r"[^A-Za-z0-9]", "", str(k)) for k in where]  # x_c, x_{c}, \\delta → xc, delta
+    if any(not n or n[0].isdigit() for n in names):
+        raise ParseError(f"'where' names must start with a letter, got {list(where)}")
     signs = [f"sigma{k}" for k in range(1, 10)] + ["sigma"]
     resolve = robot_resolver(robot, extra=_TARGET + ["Px", "Py", "Pz", "phi", "x", "y", "z"]
                              + [f"{c}{a}" for c in _COLS for a in "xyz"] + names + signs)
@@ -206,7 +209,7 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
     from ._engine import Verdict
 
     j, names, versions, used_signs, used = _read_formula(robot, raw)
-    deps = sorted(int(n[1:]) - 1 for n in used if n[:1] == "q" and n[1:].isdigit())
+    deps = sorted(int(n[1:]) - 1 for n in used if n[:1] == "q" and n[1:].isdigit() and n not in names)
     if j in deps:
         raise ParseError(f"the formula for q{j + 1} uses q{j + 1} itself")
     pose = str(raw.get("pose", "dh"))
@@ -220,6 +223,8 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
     params = dict(robot.parameters)
     bad, hints, cover, checked = [], [], [], 0
     for t, (qg, T, res) in enumerate(_targets(robot, rng, N_TARGETS)):
+        if len(bad) >= 3:
+            break
         S, free = _solution_set(robot, res)
         usable = [k for k in range(len(S)) if not (_free_joints(free[k]) & set(deps + [j]))]
         if not usable:
@@ -246,7 +251,8 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
                 if reaches(robot, q0, T, deps + [j], rows) is not None:
                     continue
                 near = min(same, key=lambda k: abs(((S[k][j] - v + np.pi) % (2 * np.pi)) - np.pi))
-                bad.append({"entry": [t + 1], "claimed": float(v), "expected": float(S[near][j]), "q": qg.tolist()})
+                bad.append({"entry": [t + 1], "claimed": float(v), "expected": float(S[near][j]), "q": qg.tolist(),
+                            "given": {f"q{i + 1}": float(s[i]) for i in deps}})
                 if (h := _formula_hint(robot, j, float(v), float(S[near][j]))) is not None:
                     hints.append(h)
         distinct = {round(float(S[k][j]), 6) for k in usable}

@@ -32,7 +32,7 @@ MAX_TOKENS = 6_000
 GREEK = ("alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta", "vartheta", "iota",
          "kappa", "lambda", "mu", "nu", "xi", "rho", "sigma", "tau", "phi", "varphi", "chi", "psi", "omega", "ell")
 _UNICODE = {"θ": r"\theta ", "α": r"\alpha ", "β": r"\beta ", "π": r"\pi ", "φ": r"\phi ", "ψ": r"\psi ",
-            "ω": r"\omega ", "τ": r"\tau ", "·": r"\cdot ", "×": r"\times ", "−": "-", "–": "-", "√": r"\sqrt ",
+            "ω": r"\omega ", "σ": r"\sigma ", "τ": r"\tau ", "·": r"\cdot ", "×": r"\times ", "−": "-", "–": "-", "√": r"\sqrt ",
             "²": "^2", "³": "^3", "ϑ": r"\vartheta ", "°": r"\degree "}
 FUNCS = {"sin": "sin", "cos": "cos", "tan": "tan", "arcsin": "asin", "arccos": "acos", "arctan": "atan",
          "asin": "asin", "acos": "acos", "atan": "atan", "atan2": "atan2", "arctan2": "atan2", "sqrt": "sqrt",
@@ -69,7 +69,8 @@ Resolver = Callable[[Ident], tuple]
 
 
 def _normalize(text: str) -> str:
-    text = re.sub(r"([θαβφψωτϑ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
+    text = re.sub(r"\\operatorname\{atan\}_\{?2\}?", r"\\operatorname{atan2}", text)  # sympy's atan2
+    text = re.sub(r"([θαβφψωτϑσ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
     for k, v in _UNICODE.items():
         text = text.replace(k, v)
     return text
@@ -295,6 +296,11 @@ class _Parser:
             self.take()
             power = self.exponent()
         t = self.peek()
+        nxt = self.peek(1)
+        wrapped = t is not None and t[1] == "{" and nxt is not None and nxt[1] in ("(", "[")  # f{\left(a, b\right)}
+        if wrapped:
+            self.take("{")
+            t = self.peek()
         if t is not None and t[1] in ("(", "[", "{"):
             self.take()
             args = [self.expr()]
@@ -302,6 +308,8 @@ class _Parser:
                 self.take()
                 args.append(self.expr())
             self.take(_OPEN[t[1]])
+            if wrapped:
+                self.take("}")
         else:
             args = [self.power_free_atom()]
         want = _expr.FUNCTIONS[fname]
