@@ -272,7 +272,7 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
            f"incorrect: at target {first['entry'][0]} it gives q{j + 1} = {first['claimed']:.6g}, which is not q{j + 1} "
            f"of any IK solution (nearest: {first['expected']:.6g})")
     return Verdict(cid, "ik_formula", "incorrect", msg, tuple(bad[:12]), {"q": first["q"]},
-                   tuple(dict.fromkeys(hints))[:3], None, method, extra)
+                   tuple(dict.fromkeys(hints))[:1], None, method, extra)
 
 
 # --- ik_solutions ----------------------------------------------------------------------------------------
