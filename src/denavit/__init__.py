@@ -18,6 +18,7 @@ from ._convert import convert_convention
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
+from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 
 __version__ = "0.1.0"
 
@@ -44,6 +45,12 @@ __all__ = [
     "forward_kinematics",
     "link_transforms",
     "geometric_jacobian",
+    "rnea",
+    "mass_matrix",
+    "coriolis_matrix",
+    "gravity_torques",
+    "forward_dynamics",
+    "simulate",
     "end_effector_twist",
     "force_propagation",
     "joint_torques",

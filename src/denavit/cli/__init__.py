@@ -19,7 +19,7 @@ from ._common import OneLineParser, emit
 __all__ = ["main", "build_parser"]
 
 # Modules that add subcommands, in the order they appear in --help.
-COMMAND_MODULES = ("_model", "_report", "_viz", "_ik", "_jacobian")
+COMMAND_MODULES = ("_model", "_report", "_viz", "_ik", "_jacobian", "_dynamics")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -50,6 +50,7 @@ from ._dynamics import (
     potential_energy,
     rnea,
 )
+from ._simulate import SimulationResult, computed_torque_controller, pd_controller, simulate
 from ._kinematics import forward_kinematics, link_transforms
 from ._trajectory import (
     CartesianPath,
@@ -108,6 +109,10 @@ __all__ = [
     "wrench_base_from_tool",
     "wrench_tool_from_base",
     "rnea",
+    "simulate",
+    "SimulationResult",
+    "pd_controller",
+    "computed_torque_controller",
     "mass_matrix",
     "mass_matrix_derivatives",
     "coriolis_matrix",

@@ -4,6 +4,17 @@ Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the r
 """
 
 from ._ik import IKDerivation, IKStep, ik_derivation
+from ._dynamics import (
+    DynamicsTerms,
+    christoffel_matrix,
+    christoffel_symbols,
+    format_dynamics,
+    inertial_pieces,
+    lagrangian_dynamics,
+)
+from ._dynamics_trig import fourier_form
+from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
+from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
 from ._jacobians import (
     analytic_jacobian_sym,
@@ -35,6 +46,18 @@ __all__ = [
     "IKDerivation",
     "IKStep",
     "ik_derivation",
+    "DynamicsTerms",
+    "christoffel_matrix",
+    "christoffel_symbols",
+    "format_dynamics",
+    "inertial_pieces",
+    "lagrangian_dynamics",
+    "fourier_form",
+    "LagrangeSteps",
+    "lagrange_steps",
+    "time_derivative",
+    "NewtonEulerSteps",
+    "newton_euler_dynamics",
     "dh_matrix_sym",
     "forward_kinematics_sym",
     "link_matrices_sym",

@@ -39,6 +39,7 @@ __all__ = [
 ]
 
 Progress = Callable[[str, int, int], None]
+CSE_AUTO_CHARS = 3000  # format_dynamics pulls out common subexpressions above this total length
 
 
 @dataclass(frozen=True)
@@ -85,7 +86,9 @@ def _field(li, key: str, value: float, syms, subs) -> sp.Expr:
     text = dict(li.symbols).get(key)
     if text is None:
         return _number(value)
-    return _expr.to_sympy(_expr.parse(text), syms).subs(subs) if subs else _expr.to_sympy(_expr.parse(text), syms)
+    e = _expr.to_sympy(_expr.parse(text), syms)
+    e = e.xreplace({f: sp.Rational(repr(float(f))) for f in e.atoms(sp.Float)})  # exact decimals: terms cancel
+    return e.subs(subs) if subs else e
 
 
 def inertial_pieces(robot: DHRobot, numeric: bool = False) -> list[InertialPiece]:
@@ -330,11 +333,12 @@ def _display(e: sp.Expr, q, digits: int | None, short: bool) -> sp.Expr:
     return shorthand(e, q) if short else e
 
 
-def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool = True, short: bool = True,
+def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None = None, short: bool = True,
                     digits: int | None = 6, include: tuple[str, ...] = ("M", "c", "g", "friction")) -> str:
     """The equations of motion as text, LaTeX or Markdown.
 
-    ``cse`` pulls repeated subexpressions out as x0, x1, … (``sympy.cse``); ``short`` writes cos(q1 + q2)
+    ``cse`` pulls repeated subexpressions out as x0, x1, … (``sympy.cse``; ``None``: only when the entries
+    are long, over ``CSE_AUTO_CHARS`` characters in all); ``short`` writes cos(q1 + q2)
     as C12; ``digits`` prints long exact fractions as decimals.
     """
     if style not in ("text", "latex", "markdown"):
@@ -352,6 +356,8 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool = True,
                 entries.append((label, _display(mat[i, j], terms.q, digits, short)))
     exprs = [e for _, e in entries]
     repl: list[tuple[sp.Symbol, sp.Expr]] = []
+    if cse is None:
+        cse = sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS
     if cse:
         repl, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("x"), optimizations="basic")
     pairs = [(str(s), e) for s, e in repl] + [(label, e) for (label, _), e in zip(entries, exprs)]

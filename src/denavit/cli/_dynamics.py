@@ -1,0 +1,195 @@
+"""Subcommands on dynamics: ``dynamics`` (M, C, c, g, τ numeric or symbolic) and ``simulate``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+
+from ..errors import MissingDependencyError, ParseError
+from ._common import add_common, add_q, joint_values, load, matrix_text
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("dynamics", help="equations of motion: M(q), C(q, qd), g(q), friction and joint torques")
+    add_common(p)
+    add_q(p, required=False)
+    p.add_argument("--qd", metavar="QD", help="joint rates (default zeros)")
+    p.add_argument("--qdd", metavar="QDD", help="joint accelerations (default zeros)")
+    p.add_argument("--symbolic", action="store_true", help="the symbolic equations of motion")
+    p.add_argument("--method", choices=["lagrange", "newton-euler", "steps"], default="lagrange",
+                   help="symbolic route: Lagrange in Jacobian form (fast), Newton-Euler, or the literal Lagrange steps")
+    p.add_argument("--format", choices=["text", "latex", "markdown"], default="text", help="symbolic output format")
+    p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
+    p.add_argument("--numeric-params", action="store_true", help="substitute the parameter values symbolically")
+    p.add_argument("--no-cse", action="store_true", help="never pull out common subexpressions (default: only for long results)")
+    p.add_argument("--coriolis", action="store_true", help="also print the matrix C (symbolic)")
+    p.set_defaults(handler=cmd_dynamics)
+
+    p = sub.add_parser("simulate", help="simulate the arm's motion from an initial state")
+    add_common(p)
+    p.add_argument("--q0", required=True, metavar="Q", help="initial joint positions")
+    p.add_argument("--qd0", metavar="QD", help="initial joint rates (default zeros)")
+    p.add_argument("--duration", required=True, metavar="T", help="length of the run [s]")
+    p.add_argument("--tau", metavar="TAU", help="constant joint torques [N m / N] (default zeros)")
+    p.add_argument("--dt", default="0.01", metavar="DT", help="sampling interval of the output [s]")
+    p.add_argument("--no-friction", action="store_true", help="ignore joint friction")
+    p.add_argument("-o", "--output", metavar="PNG", help="plot of the joint trajectories and energy (needs denavit[plot])")
+    p.add_argument("--ignore-limits", action="store_true", help="accept q0 outside the joint limits")
+    p.set_defaults(handler=cmd_simulate)
+
+
+def _number(text: str, what: str, positive: bool = True) -> float:
+    from ..io import parse_values
+
+    value = float(parse_values(text, 1, what=what)[0])
+    if positive and not value > 0:
+        raise ParseError(f"{what}: must be positive, got {value:g}")
+    return value
+
+
+def _rates(args, robot, text, what):
+    return np.zeros(robot.dof) if text is None else joint_values(args, robot, text, what, rates=True)
+
+
+def _progress(stage: str, done: int, total: int) -> None:
+    print(f"denavit dynamics: {stage} {done}/{total}", file=sys.stderr, flush=True)
+
+
+def cmd_dynamics(args: argparse.Namespace):
+    from ..numeric._dynamics import require_dynamics
+
+    robot = load(args)
+    require_dynamics(robot)
+    data: dict = {"robot": robot.name}
+    lines: list[str] = []
+    if args.symbolic:
+        sdata, slines = _symbolic(robot, args)
+        data.update(sdata)
+        lines += slines
+    elif args.q is None:
+        raise ParseError("give joint values with -q (or --symbolic for the equations)")
+    if args.q is not None:
+        ndata, nlines = _numeric(robot, args)
+        data.update(ndata)
+        lines += ([""] if lines else []) + nlines
+    return data, "\n".join(lines)
+
+
+def _numeric(robot, args):
+    from ..numeric import coriolis_matrix, friction_torques, gravity_torques, mass_matrix, rnea
+
+    q = joint_values(args, robot, args.q)
+    qd = _rates(args, robot, args.qd, "qd")
+    qdd = _rates(args, robot, args.qdd, "qdd")
+    M, C = mass_matrix(robot, q), coriolis_matrix(robot, q, qd)
+    c, g, f = C @ qd, gravity_torques(robot, q), friction_torques(robot, qd)
+    tau = rnea(robot, q, qd, qdd)
+    show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
+    unit = "deg" if args.deg else "rad"
+    vec = lambda v: ", ".join(f"{x:.6g}" for x in v)  # noqa: E731
+    lines = [f"{robot.name}: dynamics at q = [{vec(show(q))}] ({unit}), qd = [{vec(show(qd))}], "
+             f"qdd = [{vec(show(qdd))}]",
+             "M(q) [kg m^2 / kg] =", matrix_text(M), "C(q, qd) =", matrix_text(C),
+             f"c = C qd: [{vec(c)}]", f"g(q): [{vec(g)}]", f"friction: [{vec(f)}]",
+             f"tau = M qdd + c + g + friction [N m / N]: [{vec(tau)}]"]
+    data = {"q": show(q), "qd": show(qd), "qdd": show(qdd), "angle_unit": unit,
+            "M": M, "C": C, "c": c, "g": g, "friction": f, "tau": tau}
+    return data, lines
+
+
+def _symbolic(robot, args):
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    t0 = time.perf_counter()
+    kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=_progress)
+    if args.method == "newton-euler":
+        terms = S.newton_euler_dynamics(robot, **kw).terms
+    elif args.method == "steps":
+        terms = S.lagrange_steps(robot, **kw).terms
+    else:
+        terms = S.lagrangian_dynamics(robot, coriolis=args.coriolis, **kw)
+    include = ("M", "C", "c", "g", "friction") if args.coriolis else ("M", "c", "g", "friction")
+    text = S.format_dynamics(terms, args.format, cse=False if args.no_cse else None, include=include)
+    elapsed = time.perf_counter() - t0
+    data = {"M_symbolic": terms.M, "c_symbolic": terms.c, "g_symbolic": terms.g,
+            "friction_symbolic": terms.friction, "symbolic_text": text, "format": args.format,
+            "method": args.method, "seconds": round(elapsed, 3)}
+    if args.coriolis and terms.C is not None:
+        data["C_symbolic"] = terms.C
+    data["M_latex"] = sp.latex(terms.M)
+    return data, [f"{robot.name}: equations of motion ({args.method}, {elapsed:.2f} s)", text]
+
+
+def cmd_simulate(args: argparse.Namespace):
+    from ..numeric._dynamics import require_dynamics
+    from ..numeric._simulate import simulate
+
+    robot = load(args)
+    require_dynamics(robot)
+    q0 = joint_values(args, robot, args.q0, "q0")
+    qd0 = _rates(args, robot, args.qd0, "qd0")
+    duration = _number(args.duration, "--duration")
+    dt = _number(args.dt, "--dt")
+    if duration / dt > 100_000:
+        raise ParseError(f"--duration/--dt gives {duration / dt:.0f} samples; at most 100000")
+    tau = None
+    if args.tau is not None:
+        from ..io import parse_values
+
+        tau = parse_values(args.tau, robot.dof, what="tau")
+    res = simulate(robot, q0, qd0, duration, tau, dt=dt, friction=not args.no_friction)
+    show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
+    rev = np.array([t.value == "revolute" for t in robot.joint_types])
+    conv = lambda a: np.where(rev, show(a), a)  # noqa: E731
+    drift = float(np.abs(res.energy - res.energy[0]).max())
+    data = {"robot": robot.name, "q0": conv(q0), "qd0": conv(qd0), "duration": duration, "dt": dt,
+            "angle_unit": "deg" if args.deg else "rad", "t": res.t, "q": conv(res.q), "qd": conv(res.qd),
+            "tau": res.tau, "kinetic": res.kinetic, "potential": res.potential, "energy": res.energy,
+            "success": res.success, "message": res.message, "energy_drift": drift, "output": args.output}
+    step = max(1, len(res.t) // 10)
+    head = "   t [s]  " + "  ".join(f"{'q' + str(k + 1):>10}" for k in range(robot.dof)) + "      energy [J]"
+    rows = [f"{t:8.3f}  " + "  ".join(f"{v:10.5f}" for v in conv(q)) + f"  {e:14.6g}"
+            for t, q, e in list(zip(res.t, res.q, res.energy))[::step]]
+    lines = [f"{robot.name}: simulated {duration:g} s ({len(res.t)} samples, {res.message})", head, *rows,
+             f"energy drift (max |E - E0|): {drift:.3g} J" + ("" if args.no_friction else " (friction dissipates)")]
+    if args.output:
+        _plot(res, robot, args.output, args.deg)
+        lines.append(f"wrote {args.output}")
+    if not res.success:
+        lines.append(f"warning: the integrator stopped early: {res.message}")
+    return data, "\n".join(lines)
+
+
+def _plot(res, robot, path: str, deg: bool) -> None:
+    try:
+        import matplotlib
+    except ImportError as exc:
+        if exc.name != "matplotlib":
+            raise
+        raise MissingDependencyError("the plot needs matplotlib: pip install 'denavit[plot]'") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    for k in range(robot.dof):
+        ax1.plot(res.t, np.degrees(res.q[:, k]) if deg and robot.joint_types[k].value == "revolute" else res.q[:, k],
+                 label=f"q{k + 1}")
+    ax1.set_ylabel("joint position [deg]" if deg else "joint position [rad, m]")
+    ax1.legend(loc="best", fontsize="small")
+    ax2.plot(res.t, res.kinetic, label="kinetic")
+    ax2.plot(res.t, res.potential, label="potential")
+    ax2.plot(res.t, res.energy, label="total", color="k")
+    ax2.set_xlabel("t [s]")
+    ax2.set_ylabel("energy [J]")
+    ax2.legend(loc="best", fontsize="small")
+    fig.suptitle(f"{robot.name}: simulation")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
