@@ -40,7 +40,7 @@ def _dot_names(expr: Any, n: int) -> dict:
 
 def _tex(ctx: Context, e: Any) -> str:
     """LaTeX with C_12/S_3 shorthand and dotted rates."""
-    e = sp.ImmutableMatrix(e) if isinstance(e, sp.MatrixBase) else sp.sympify(e)
+    e = sp.ImmutableMatrix(e) if isinstance(e, sp.MatrixBase) else sp.sympify(e)  # safe: e comes from the library (sympy or a number), never user text
     e = ctx.short(e)
     return sp.latex(e, mat_str="bmatrix", mat_delim="", symbol_names=_dot_names(e, ctx.robot.dof))
 
