@@ -31,6 +31,7 @@ import numpy as np
 from .._validate import as_joint_array
 from ..errors import ModelError
 from ..model import DHRobot, JointType
+from ._dynamics_fast import joint_columns, mass_matrix_kernel, plan, rnea_kernel, to_array
 from ._jacobians import joint_axes
 from ._kinematics import link_transforms
 
@@ -190,56 +191,11 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
     q, qd, qdd = np.broadcast_arrays(
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(qdd, n, "qdd")
     )
-    st = _State(robot, q)
-    body_f, body_n = _forward_pass(st, qd, qdd, _gravity(robot, gravity), n)
-    tau = _backward_pass(st, body_f, body_n, n)
-    tau = tau + _armature(robot) * qdd
+    g = _gravity(robot, gravity)
+    (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
+    tau = to_array(rnea_kernel(plan(robot), qc, qdc, qddc, g.tolist()), batch, (n,))
     if friction:
         tau = tau + friction_torques(robot, qd)
-    return tau
-
-
-def _forward_pass(st: _State, qd, qdd, g, n):
-    batch = qd.shape[:-1]
-    w = np.zeros(batch + (3,))
-    wd = np.zeros(batch + (3,))
-    acc = np.broadcast_to(-g, batch + (3,))  # base (and every base point) accelerates at −g
-    ref = st.o[..., 0, :]
-    body_f = np.zeros(batch + (n, 3))  # net force on body k
-    body_n = np.zeros(batch + (n, 3))  # net moment on body k about o_k
-    for k in range(n):
-        z, o = st.z[..., k, :], st.o[..., k, :]
-        r = o - ref
-        acc = acc + np.cross(wd, r) + np.cross(w, np.cross(w, r))  # point of body k−1 at o_k
-        qz, qzz = qd[..., k, None] * z, qdd[..., k, None] * z
-        if st.revolute[k]:
-            wd = wd + qzz + np.cross(w, qz)
-            w = w + qz
-        else:
-            acc = acc + qzz + 2.0 * np.cross(w, qz)
-        ref = o
-        for p in np.flatnonzero(st.body == k):
-            rc = st.com[..., p, :] - o  # (..., 3)
-            ac = acc + np.cross(wd, rc) + np.cross(w, np.cross(w, rc))
-            F = st.mass[p] * ac
-            I = st.inertia[..., p, :, :]
-            N = np.einsum("...ij,...j->...i", I, wd) + np.cross(w, np.einsum("...ij,...j->...i", I, w))
-            body_f[..., k, :] += F
-            body_n[..., k, :] += N + np.cross(rc, F)
-    return body_f, body_n
-
-
-def _backward_pass(st: _State, body_f, body_n, n):
-    tau = np.zeros(body_f.shape[:-1])
-    f = np.zeros(body_f.shape[:-2] + (3,))
-    m = np.zeros_like(f)
-    for k in range(n - 1, -1, -1):
-        if k < n - 1:
-            m = m + np.cross(st.o[..., k + 1, :] - st.o[..., k, :], f)  # moment moved from o_{k+1} to o_k
-        f = f + body_f[..., k, :]
-        m = m + body_n[..., k, :]
-        z = st.z[..., k, :]
-        tau[..., k] = np.einsum("...i,...i->...", z, m if st.revolute[k] else f)
     return tau
 
 
@@ -253,17 +209,8 @@ def mass_matrix(robot: DHRobot, q) -> np.ndarray:
     motor inertia on the diagonal.
     """
     q = as_joint_array(q, robot.dof)
-    st = _State(robot, q)
-    return _crba(st, robot.dof) + np.diag(_armature(robot))
-
-
-def _crba(st: _State, n: int) -> np.ndarray:
-    S = st.spatial_axes()  # (..., n, 6)
-    IC = st.composite_inertias(n)  # (..., n, 6, 6)
-    F = np.einsum("...kij,...kj->...ki", IC, S)  # (..., n, 6) force to accelerate bodies k..n
-    M = np.einsum("...ji,...ki->...jk", S, F)  # S_j · F_k
-    upper = np.triu(np.ones((n, n), dtype=bool))
-    return np.where(upper, M, np.swapaxes(M, -1, -2))
+    qc, batch = joint_columns(q)
+    return to_array(mass_matrix_kernel(plan(robot), qc), batch, (robot.dof, robot.dof))
 
 
 def mass_matrix_derivatives(robot: DHRobot, q) -> np.ndarray:
