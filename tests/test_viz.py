@@ -359,3 +359,22 @@ def test_cli_bad_input_is_one_line_exit_2(argv, fragment, tmp_path, capsys):
     code, out, err = _cli(capsys, *[a.replace("{tmp}", str(tmp_path)) for a in argv])
     assert code == 2
     assert len(err.strip().splitlines()) == 1 and fragment in err and "Traceback" not in err
+
+
+def test_animate_mp4_when_ffmpeg_exists(tmp_path):
+    """MP4 goes through ffmpeg: the file has the requested number of frames (read back with ffprobe)."""
+    import shutil
+    import subprocess
+
+    if shutil.which("ffmpeg") is None or shutil.which("ffprobe") is None:
+        pytest.skip("ffmpeg not installed (MP4 output needs it; GIF does not)")
+    from denavit.cli import main
+
+    out = tmp_path / "move.mp4"
+    assert main(["animate", "planar2r", "--from", "0, 0", "--to", "1, 1", "--duration", "1", "--fps", "12",
+                 "-o", str(out)]) == 0
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=nb_read_frames,codec_name", "-of", "csv=p=0", str(out)],
+                           capture_output=True, text=True, check=True).stdout.strip()
+    codec, frames = probe.split(",")
+    assert codec and int(frames) == 13  # 1 s at 12 fps, both end points
