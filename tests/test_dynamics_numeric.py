@@ -287,6 +287,8 @@ def test_catalogue_robots_with_dynamics_are_consistent():
         if np.linalg.eigvalsh(M)[..., 0].min() < 1e-10 * np.abs(M).max():  # e.g. ur5: point masses only
             with pytest.raises(denavit.ModelError, match="singular"):
                 forward_dynamics(robot, q, qd, tau)
+            with pytest.raises(denavit.ModelError, match="singular"):  # the unbatched (float) path too
+                forward_dynamics(robot, q[0], qd[0], tau[0])
             continue
         np.testing.assert_allclose(forward_dynamics(robot, q, qd, tau), qdd, atol=1e-7, err_msg=name)
 

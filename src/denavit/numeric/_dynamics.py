@@ -31,7 +31,7 @@ import numpy as np
 from .._validate import as_joint_array
 from ..errors import ModelError
 from ..model import DHRobot, JointType
-from ._dynamics_fast import joint_columns, mass_matrix_kernel, plan, rnea_kernel, to_array
+from ._dynamics_fast import frames, joint_columns, ldl_solve, mass_matrix_kernel, plan, rnea_kernel, to_array
 from ._jacobians import joint_axes
 from ._kinematics import link_transforms
 
@@ -80,10 +80,6 @@ def require_dynamics(robot: DHRobot) -> None:
         raise ModelError(
             f"robot {robot.name!r} has no inertial data: add 'inertia: {{mass, com, inertia}}' to its joint rows"
         )
-
-
-def _armature(robot: DHRobot) -> np.ndarray:
-    return np.array([link.inertia.motor_inertia if link.inertia else 0.0 for link in robot.joints])
 
 
 def friction_torques(robot: DHRobot, qd) -> np.ndarray:
@@ -279,6 +275,9 @@ def gravity_torques(robot: DHRobot, q, *, gravity=None) -> np.ndarray:
 def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool = True) -> np.ndarray:
     """Joint accelerations q̈ = M⁻¹ (τ − C q̇ − g − τ_f), shape (..., n).
 
+    The bias C q̇ + g comes from the RNEA at q̈ = 0, M from the CRBA on the same frames, and the system is
+    solved by an LDLᵀ factorisation, whose pivots also decide that M is singular (``ModelError``).
+
     Parameters
     ----------
     q, qd, tau : array_like, shape (..., n)
@@ -288,25 +287,24 @@ def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool
     q, qd, tau = np.broadcast_arrays(
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(tau, n, "tau")
     )
-    bias = rnea(robot, q, qd, np.zeros(n), gravity=gravity, friction=friction)
-    M = mass_matrix(robot, q)
-    _check_regular(robot, M)
-    return np.linalg.solve(M, (tau - bias)[..., None])[..., 0]
+    if friction:
+        tau = tau - friction_torques(robot, qd)
+    pl, g = plan(robot), _gravity(robot, gravity).tolist()
+    (qc, batch), (qdc, _), (tc, _) = joint_columns(q), joint_columns(qd), joint_columns(tau)
+    F = frames(pl, qc)
+    bias = rnea_kernel(pl, qc, qdc, [0.0] * n, g, F)
+    qdd = ldl_solve(mass_matrix_kernel(pl, qc, F), [t - b for t, b in zip(tc, bias)], SINGULAR_TOL)
+    if qdd is None:
+        _raise_singular(robot)
+    return to_array(qdd, batch, (n,))
 
 
-def _check_regular(robot: DHRobot, M: np.ndarray) -> None:
-    """Raise ModelError when M is singular (a joint whose subtree has no inertia about its axis)."""
-    try:
-        L = np.linalg.cholesky(M)
-        d = np.diagonal(L, axis1=-2, axis2=-1) ** 2
-        bad = (d.min(axis=-1) <= SINGULAR_TOL * d.max(axis=-1)).any()
-    except np.linalg.LinAlgError:
-        bad = True
-    if bad:
-        raise ModelError(
-            f"robot {robot.name!r}: the mass matrix is singular here, so q̈ is undefined (a joint moves no "
-            "mass or inertia, e.g. point masses on its axis); give the links inertia tensors or motor inertia"
-        )
+def _raise_singular(robot: DHRobot) -> None:
+    """Raise ModelError: M is singular (a joint whose subtree has no inertia about its axis)."""
+    raise ModelError(
+        f"robot {robot.name!r}: the mass matrix is singular here, so q̈ is undefined (a joint moves no "
+        "mass or inertia, e.g. point masses on its axis); give the links inertia tensors or motor inertia"
+    )
 
 
 def kinetic_energy(robot: DHRobot, q, qd) -> np.ndarray:

@@ -182,9 +182,12 @@ def _piece_world(piece: _Piece, F):
 
 
 # --- RNEA -----------------------------------------------------------------------------------------------
-def rnea_kernel(pl: _Plan, qc, qdc, qddc, g) -> list:
-    """τ per joint (floats or (B,) arrays, motor inertia included, no friction) — Craig eqs. 6.45–6.53."""
-    F = frames(pl, qc)
+def rnea_kernel(pl: _Plan, qc, qdc, qddc, g, F=None) -> list:
+    """τ per joint (floats or (B,) arrays, motor inertia included, no friction) — Craig eqs. 6.45–6.53.
+
+    ``F``: the frames of :func:`frames` when already computed for ``qc``.
+    """
+    F = frames(pl, qc) if F is None else F
     n = len(pl.revolute)
     axes = [(F[i][2], F[i][3]) for i in pl.axis_frame]
     w = wd = ZERO3
@@ -242,9 +245,9 @@ def _piece_spatial(piece: _Piece, F):
     return m, _scale(m, c), J
 
 
-def mass_matrix_kernel(pl: _Plan, qc) -> list[list]:
+def mass_matrix_kernel(pl: _Plan, qc, F=None) -> list[list]:
     """M as nested lists of entries: M_jk = S_jᵀ I^C_k S_k (Featherstone 2008, eq. 6.8) + motor inertia."""
-    F = frames(pl, qc)
+    F = frames(pl, qc) if F is None else F
     n = len(pl.revolute)
     axes = [(F[i][2], F[i][3]) for i in pl.axis_frame]
     S = [(_cross(o, z), z) if rev else (z, None) for (z, o), rev in zip(axes, pl.revolute)]
@@ -268,6 +271,38 @@ def mass_matrix_kernel(pl: _Plan, qc) -> list[list]:
             M[k][j] = M[j][k]
         M[k][k] = M[k][k] + pl.armature[k]
     return M
+
+
+def ldl_solve(M, b, tol: float):
+    """x = M⁻¹ b by M = L D Lᵀ on entries (floats or (B,) arrays); None where a pivot is ≤ tol · max pivot.
+
+    Golub & Van Loan, *Matrix Computations*, 4th ed., alg. 4.1.2 (LDLᵀ). The pivots d_j equal the squared
+    diagonal of the Cholesky factor, so the singularity test is the one of the Cholesky route.
+    """
+    n = len(b)
+    L = [[0.0] * n for _ in range(n)]
+    d = [0.0] * n
+    try:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for j in range(n):
+                Ld = [L[j][k] * d[k] for k in range(j)]
+                d[j] = M[j][j] - sum(L[j][k] * Ld[k] for k in range(j))
+                for i in range(j + 1, n):
+                    L[i][j] = (M[i][j] - sum(L[i][k] * Ld[k] for k in range(j))) / d[j]
+            y = []
+            for i in range(n):
+                y.append(b[i] - sum(L[i][k] * y[k] for k in range(i)))
+            x = [0.0] * n
+            for i in range(n - 1, -1, -1):
+                x[i] = y[i] / d[i] - sum(L[k][i] * x[k] for k in range(i + 1, n))
+    except ZeroDivisionError:
+        return None
+    if all(isinstance(v, float) for v in d):
+        ok = min(d) > tol * max(d)
+    else:
+        D = np.array(np.broadcast_arrays(*d))
+        ok = bool(np.all(D.min(axis=0) > tol * D.max(axis=0)))
+    return x if ok else None
 
 
 def to_array(values, batch, trailing: tuple[int, ...]) -> np.ndarray:
