@@ -10,7 +10,8 @@ Timed operations, each for Puma 560 (6 DOF, standard DH) and Panda (7 DOF, modif
   FD          q̈ from τ (denavit: RNEA bias + CRBA + solve; Pinocchio: aba; rtb: accel)
 Single call: one configuration, best of `repeat` × k calls.  Batch: `batch` configurations — denavit in one
 call on (batch, n) arrays, Pinocchio in a Python loop, roboticstoolbox's C RNEA on (batch, n) arrays.
-Symbolic: Puma 560 M, c, g by denavit.symbolic.lagrangian_dynamics (time, and size in characters of str()).
+Symbolic: Puma 560 M, c, g by denavit.symbolic.lagrangian_dynamics (time, and size in characters of str() of
+M, c, g), each case in a fresh process; the coriolis=True row also forms the matrix C (not counted in the size).
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -132,17 +135,28 @@ def numeric_rows(batch: int, repeat: int, number: int):
     return rows
 
 
-def symbolic_rows():
+SYMBOLIC_CASES = (("trig", False), ("none", False), ("trig", True))
+
+
+def symbolic_one(case: int) -> None:
+    """Time one symbolic case (run in a fresh process, so that no case profits from sympy's caches)."""
     from denavit.symbolic import lagrangian_dynamics
 
+    simplify, coriolis = SYMBOLIC_CASES[case]
     robot = denavit.load_robot("puma560")
+    t0 = time.perf_counter()
+    terms = lagrangian_dynamics(robot, simplify=simplify, coriolis=coriolis)
+    dt = time.perf_counter() - t0
+    size = sum(len(str(m)) for m in (terms.M, terms.c, terms.g))
+    print(f"{dt} {size}")
+
+
+def symbolic_rows():
     rows = []
-    for simplify in ("trig", "none"):
-        t0 = time.perf_counter()
-        terms = lagrangian_dynamics(robot, simplify=simplify, coriolis=False)
-        dt = time.perf_counter() - t0
-        size = sum(len(str(m)) for m in (terms.M, terms.c, terms.g))
-        rows.append((simplify, dt, size))
+    for case, (simplify, coriolis) in enumerate(SYMBOLIC_CASES):
+        out = subprocess.run([sys.executable, __file__, "--symbolic-one", str(case)], capture_output=True,
+                             text=True, check=True).stdout.split()
+        rows.append((f"simplify={simplify!r}, coriolis={coriolis}", float(out[0]), int(out[1])))
     return rows
 
 
@@ -157,7 +171,10 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--number", type=int, default=200, help="calls per single-call timing run")
     ap.add_argument("--no-symbolic", action="store_true")
+    ap.add_argument("--symbolic-one", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.symbolic_one is not None:
+        return symbolic_one(args.symbolic_one)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load {load:.2f}, "
           f"Python {platform.python_version()}, numpy {np.__version__}; batch {args.batch}")
@@ -168,8 +185,8 @@ def main() -> None:
         print(f"| {name} | {lib} | {cells} |")
     if not args.no_symbolic:
         print("\n| Puma 560 M, c, g (symbolic) | time [s] | size [chars] |\n|---|---:|---:|")
-        for simplify, dt, size in symbolic_rows():
-            print(f"| denavit lagrangian_dynamics(simplify={simplify!r}) | {dt:.1f} | {size:,} |")
+        for label, dt, size in symbolic_rows():
+            print(f"| denavit lagrangian_dynamics({label}) | {dt:.1f} | {size:,} |")
     print(f"\nload after: {os.getloadavg()[0]:.2f}")
 
 
