@@ -18,6 +18,7 @@ from .._validate import as_joint_array, as_transform
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
 from ._ik_kernel import kernel_of, targets_soa
+from ._ik_seeds import rescue
 from ._kinematics import forward_kinematics
 
 __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
@@ -181,7 +182,7 @@ class _Slots:
             setattr(self, name, getattr(self, name)[mask])
 
 
-def _search(robot, q0, Tf, w, limits, max_iter, restarts, tol, L, rng):
+def _search(robot, q0, Tf, w, limits, max_iter, restarts, tol, L, rng, clip0=None):
     """Levenberg–Marquardt from q0 (B, n), restarting each target from random seeds until it is solved within
     the limits or its restarts are used up.  Every attempt is a row of one batch: an attempt that ends
     (converged outside the limits, stalled, out of iterations) is replaced at once by the target's next seed,
@@ -201,13 +202,14 @@ def _search(robot, q0, Tf, w, limits, max_iter, restarts, tol, L, rng):
     done = np.zeros(B, dtype=bool)
     # first attempt without limits, folded back by whole turns afterwards: the clipped iteration is slow and
     # cannot pass a limit, while the free one converges in a few steps
-    S.add(np.arange(B), q0.copy(), np.zeros(B, dtype=bool), max_iter)
+    S.add(np.arange(B), q0.copy(), np.zeros(B, dtype=bool) if clip0 is None else clip0, max_iter)
     eye = np.eye(n)
     while S.tgt.size:
         Jt = np.swapaxes(S.J, -1, -2)
         dq = np.linalg.solve(Jt @ S.J + S.lam[:, None, None] * eye, np.einsum("bij,bj->bi", Jt, S.e)[..., None])[..., 0]
         q_new = _wrap(S.q + dq, rev)
-        q_new = np.where(S.clip[:, None], np.clip(q_new, lo, hi), q_new)
+        # clipped attempts: folded by whole turns first, so a limit beyond ±π (Panda joint 6) stays reachable
+        q_new = np.where(S.clip[:, None], np.clip(_fold(q_new, lo, hi, rev), lo, hi), q_new)
         e_new, J_new = S.kin.residual(q_new, Rt[..., S.tgt], pt[:, S.tgt], w)
         c_new = np.einsum("bi,bi->b", e_new, e_new)
         better = c_new < S.cost
@@ -349,10 +351,24 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     else:
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
     q = limits.project(q)
+    q_seed = q
     q, iters, n_restarts, stalled = _search(robot, q, Tf, w, limits, max_iterations, restarts, tol, L, rng)
     q = limits.project(q)
     pe, re = _residuals(robot, q, Tf, w_mask)
     success = (pe <= tol) & (re <= tol) & limits.inside(q)
+    if restarts > 0 and not success.all():  # the few left: closed-form and bank seeds, polished by LM
+        fail = np.flatnonzero(~success)
+        def polish(q0, T, clip):
+            return _search(robot, q0, T, w, limits, max_iterations, 0, tol, L, rng, clip)[0]
+
+        polish.tol = tol
+        q_new, used = rescue(robot, Tf[fail], q_seed[fail], w_mask, limits, L, polish)
+        got = np.isfinite(q_new).all(axis=-1)  # the rescue's choice, checked here again by FK
+        pe_n, re_n = _residuals(robot, q_new[got], Tf[fail[got]], w_mask)
+        ok = (pe_n <= tol) & (re_n <= tol) & limits.inside(q_new[got])
+        fix = fail[got][ok]
+        q[fix], pe[fix], re[fix], success[fix] = q_new[got][ok], pe_n[ok], re_n[ok], True
+        n_restarts[fail] += used
     reason = _reasons(robot, q, Tf, mask, success, stalled, tol, rng, respect_limits, max_iterations)
     return _pack(batch, n, q, success, pe, re, iters, n_restarts, reason)
 
