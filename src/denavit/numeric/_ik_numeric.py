@@ -19,6 +19,7 @@ from ..errors import ShapeError
 from ..model import DHRobot, JointType
 from ._ik_kernel import kernel_of, targets_soa
 from ._ik_seeds import rescue
+from ._ik_single import solve_single
 from ._kinematics import forward_kinematics
 
 __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
@@ -352,6 +353,10 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
     q = limits.project(q)
     q_seed = q
+    if batch == ():  # one target: its first attempt in floats; the batched search below if that fails
+        single = solve_single(robot, q[0], Tf[0], w, w_mask, limits, max_iterations, tol, L)
+        if single is not None:
+            return single
     q, iters, n_restarts, stalled = _search(robot, q, Tf, w, limits, max_iterations, restarts, tol, L, rng)
     q = limits.project(q)
     pe, re = _residuals(robot, q, Tf, w_mask)
