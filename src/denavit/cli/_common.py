@@ -11,7 +11,8 @@ import numpy as np
 
 from ..errors import ParseError
 
-__all__ = ["OneLineParser", "add_common", "add_q", "emit", "load", "joint_values", "to_json", "matrix_text"]
+__all__ = ["OneLineParser", "add_common", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite",
+           "to_json", "matrix_text"]
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -40,6 +41,19 @@ def add_q(p: argparse.ArgumentParser, required: bool = True) -> None:
         help='joint values: comma-separated numbers or expressions, e.g. "0, pi/4, 90deg"',
     )
     p.add_argument("--ignore-limits", action="store_true", help="compute even if q is outside the joint limits")
+
+
+def add_force(p: argparse.ArgumentParser) -> None:
+    """--force: allow -o/--output to replace an existing file."""
+    p.add_argument("--force", action="store_true", help="overwrite the output file if it exists")
+
+
+def refuse_overwrite(args: argparse.Namespace, path: str | None) -> None:
+    """ParseError if ``path`` exists and --force was not given (nothing the user has is replaced silently)."""
+    import os
+
+    if path and os.path.lexists(path) and not getattr(args, "force", False):
+        raise ParseError(f"{path!r} exists; not overwriting it (choose another name or pass --force)")
 
 
 def load(args: argparse.Namespace):
@@ -89,11 +103,13 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
 
 
 def to_json(x: Any) -> Any:
-    """Arrays → nested lists, sympy → strings, recursively."""
+    """Arrays → nested lists, sympy → strings, recursively; NaN and ±inf → ``null`` (strict JSON, RFC 8259)."""
     if isinstance(x, np.ndarray):
-        return x.tolist()
+        return to_json(x.tolist()) if x.dtype.kind in "fcO" else x.tolist()
     if isinstance(x, (np.floating, np.integer)):
-        return x.item()
+        x = x.item()
+    if isinstance(x, float):
+        return x if np.isfinite(x) else None
     if isinstance(x, dict):
         return {str(k): to_json(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
@@ -116,7 +132,7 @@ def matrix_text(M: np.ndarray, digits: int = 6, indent: str = "  ") -> str:
 
 def emit(args: argparse.Namespace, data: Any, text: str) -> None:
     if getattr(args, "json", False):
-        json.dump(to_json(data), sys.stdout, indent=2)
+        json.dump(to_json(data), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     elif text:
         sys.stdout.write(text if text.endswith("\n") else text + "\n")

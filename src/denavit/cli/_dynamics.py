@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from ..errors import MissingDependencyError, ParseError
-from ._common import add_common, add_q, joint_values, load, matrix_text
+from ._common import add_common, add_force, add_q, joint_values, load, matrix_text, refuse_overwrite
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -38,6 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-friction", action="store_true", help="ignore joint friction")
     p.add_argument("-o", "--output", metavar="PNG", help="plot of the joint trajectories and energy (needs denavit[plot])")
     p.add_argument("--ignore-limits", action="store_true", help="accept q0 outside the joint limits")
+    add_force(p)
     p.set_defaults(handler=cmd_simulate)
 
 
@@ -131,6 +132,7 @@ def cmd_simulate(args: argparse.Namespace):
 
     robot = load(args)
     require_dynamics(robot)
+    refuse_overwrite(args, args.output)
     q0 = joint_values(args, robot, args.q0, "q0")
     qd0 = _rates(args, robot, args.qd0, "qd0")
     duration = _number(args.duration, "--duration")

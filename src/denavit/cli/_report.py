@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
-from ._common import add_common, add_q, joint_values, load
+from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite
 
 _SPLIT = re.compile(r"[,;\s]+(?![^()]*\))")
 
@@ -22,6 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="report file: .md, .tex, .html or .pdf (Markdown on stdout if absent)")
     p.add_argument("--topics", metavar="LIST", help="comma-separated sections to include (default: all)")
     p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
+    add_force(p)
     p.set_defaults(handler=cmd_report)
 
     p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
@@ -52,6 +53,7 @@ def cmd_report(args: argparse.Namespace):
 
     robot = load(args)
     fmt = format_from_path(args.output) if args.output else "md"
+    refuse_overwrite(args, args.output)
     q = qd = wrench = None
     if args.q is not None:
         joint_values(args, robot, args.q)  # validates count, syntax and limits

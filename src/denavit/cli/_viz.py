@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, joint_values, load
+from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 
@@ -24,6 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--elev", type=float, help="view elevation [deg]")
     p.add_argument("--azim", type=float, help="view azimuth [deg]")
     p.add_argument("--dpi", type=int, default=120, help="resolution of a .png (default 120)")
+    add_force(p)
     p.set_defaults(handler=cmd_plot)
 
     p = sub.add_parser("animate", help="animation of a move between two configurations (.gif, .mp4)")
@@ -37,12 +38,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, default=15.0, help="frames per second (default 15)")
     p.add_argument("--no-frames", action="store_true", help="leave out the DH frame triads")
     p.add_argument("--ignore-limits", action="store_true", help="accept configurations outside the joint limits")
+    add_force(p)
     p.set_defaults(handler=cmd_animate)
 
     p = sub.add_parser("view", help="interactive 3-D viewer as one self-contained HTML file")
     add_common(p)
     add_q(p, required=False)
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="HTML file to write")
+    add_force(p)
     p.set_defaults(handler=cmd_view)
 
     p = sub.add_parser("workspace", help="reachable workspace by sampling: size, volume, picture")
@@ -51,6 +54,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--samples", type=int, default=100_000, help="random configurations (default 100000)")
     p.add_argument("--resolution", type=float, help="voxel edge [m] (default: longest side / 40)")
     p.add_argument("--seed", type=int, help="random seed, for repeatable figures")
+    add_force(p)
     p.set_defaults(handler=cmd_workspace)
 
 
@@ -74,6 +78,7 @@ def cmd_plot(args: argparse.Namespace):
 
     robot = load(args)
     figure_format(args.output)
+    refuse_overwrite(args, args.output)
     q = default_configuration(robot) if args.q is None else joint_values(args, robot, args.q)
     path = None
     if args.path_to is not None:
@@ -109,6 +114,7 @@ def cmd_animate(args: argparse.Namespace):
 
     robot = load(args)
     figure_format(args.output, ("gif", "mp4"))
+    refuse_overwrite(args, args.output)
     if not (math.isfinite(args.duration) and args.duration > 0):
         raise ParseError(f"--duration must be a positive number of seconds, got {args.duration}")
     if not (math.isfinite(args.fps) and 0 < args.fps <= 100):
@@ -142,6 +148,7 @@ def cmd_view(args: argparse.Namespace):
     from ..viz import default_configuration, write_viewer
 
     robot = load(args)
+    refuse_overwrite(args, args.output)
     q = default_configuration(robot) if args.q is None else joint_values(args, robot, args.q)
     path = write_viewer(robot, args.output, q)
     size = path.stat().st_size
@@ -158,6 +165,7 @@ def cmd_workspace(args: argparse.Namespace):
         from ..viz._plot import figure_format
 
         figure_format(args.output)
+        refuse_overwrite(args, args.output)
     if args.samples < 100 or args.samples > 20_000_000:
         raise ParseError(f"--samples must be between 100 and 20000000, got {args.samples}")
     if args.resolution is not None and not (math.isfinite(args.resolution) and args.resolution > 0):

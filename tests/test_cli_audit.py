@@ -1,0 +1,72 @@
+"""Audit of the command line as a user runs it: strict JSON, no silent overwrites, one-line errors.
+
+Regression tests for problems found by running every command on every catalogue robot with good and
+hostile input (see the commit messages).  In-process through ``denavit.cli.main``.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from denavit.cli import main
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _strict(text):
+    """json.loads that rejects NaN / Infinity (RFC 8259), as a browser or jq would."""
+    def bad(c):
+        raise ValueError(f"non-standard JSON constant {c}")
+    return json.loads(text, parse_constant=bad)
+
+
+def test_json_is_strict_at_a_singular_configuration(capsys):
+    # planar 2R stretched out: the force ellipsoid has an infinite radius, which used to print 'Infinity'
+    code, out, _ = run(capsys, "singularities", "planar2r", "-q", "0,0", "--json")
+    assert code == 0
+    data = _strict(out)
+    radii = data["measures"]["force_ellipsoid"]["radii"]
+    assert None in radii                          # the infinite radius is null ...
+    assert all(r is None or math.isfinite(r) for r in radii)
+    code, out, _ = run(capsys, "singularities", "planar2r", "-q", "0,0")
+    assert code == 0 and "inf" in out             # ... and still visible in the text output
+
+
+def test_to_json_maps_nonfinite_to_null():
+    from denavit.cli._common import to_json
+
+    got = to_json({"a": np.array([1.0, np.inf, np.nan]), "b": np.float64(-np.inf), "c": [np.int64(3), 2.5]})
+    assert got == {"a": [1.0, None, None], "b": None, "c": [3, 2.5]}
+    json.dumps(got, allow_nan=False)
+
+
+# Every command that writes -o FILE: an existing file is kept unless --force.
+WRITERS = [
+    ("plot", ["plot", "planar2r", "-q", "0.1,0.2"], ".png"),
+    ("animate", ["animate", "planar2r", "--from", "0,0", "--to", "0.1,0.1", "--duration", "0.2", "--fps", "5"], ".gif"),
+    ("view", ["view", "planar2r"], ".html"),
+    ("workspace", ["workspace", "planar2r", "--samples", "200"], ".png"),
+    ("simulate", ["simulate", "planar2r", "--q0", "0,0", "--duration", "0.05"], ".png"),
+    ("report", ["report", "planar2r", "-q", "0.1,0.2", "--topics", "fk"], ".md"),
+    ("convert", ["convert", "planar2r", "--to", "modified"], ".yaml"),
+]
+
+
+@pytest.mark.parametrize("name,argv,ext", WRITERS, ids=[w[0] for w in WRITERS])
+def test_existing_output_is_not_overwritten_without_force(capsys, tmp_path, name, argv, ext):
+    path = tmp_path / f"mine{ext}"
+    path.write_text("precious\n")
+    code, out, err = run(capsys, *argv, "-o", path)
+    assert code == 2
+    assert path.read_text() == "precious\n"
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "exists" in lines[0] and "--force" in lines[0] and "Traceback" not in err
+    code, out, err = run(capsys, *argv, "-o", path, "--force")
+    assert code == 0, err
+    assert path.read_bytes() != b"precious\n"
