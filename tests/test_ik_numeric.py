@@ -212,3 +212,102 @@ def test_solve_ik_panda_joint6_beyond_pi():
     assert np.all((res.q >= lim[:, 0] - 1e-12) & (res.q <= lim[:, 1] + 1e-12))
     dp, dw = _pose_gap(robot, res.q, T)
     assert dp.max() <= 1e-9 and dw.max() <= 1e-8
+
+
+# ---- single-target fast path (numeric/_ik_single.py) ------------------------------------------------------
+
+SINGLE_ARMS = ["puma560", "puma560-mdh", "ur5", "stanford"]
+
+
+@pytest.mark.parametrize("name", SINGLE_ARMS)
+def test_single_residual_and_jacobian_match_fk_and_geometric_jacobian(name):
+    """Float residual = pose_error(T, FK(q)) and float Jacobian = geometric_jacobian (other modules)."""
+    from denavit.numeric._ik_single import single_chain
+    from denavit.numeric._jacobians import geometric_jacobian
+
+    robot, rng = load_robot(name), np.random.default_rng(11)
+    for q, qt in zip(_random_q(robot, rng, 10), _random_q(robot, rng, 10)):
+        T = forward_kinematics(robot, qt)
+        w = rng.uniform(0.5, 2.0, 6)
+        e, J = single_chain(robot).residual(q.tolist(), T[:3, :3].tolist(), T[:3, 3].tolist(), w.tolist())
+        np.testing.assert_allclose(e, w * pose_error(T, forward_kinematics(robot, q)), atol=1e-12)
+        np.testing.assert_allclose(np.array(J).T, w[:, None] * geometric_jacobian(robot, q), atol=1e-12)
+
+
+def test_single_damped_step_solves_normal_equations():
+    from denavit.numeric._ik_single import damped_step
+
+    rng = np.random.default_rng(5)
+    for n in (1, 3, 6, 7):
+        J, e, lam = rng.normal(size=(6, n)), rng.normal(size=6), 10.0 ** rng.uniform(-9, 1)
+        A, b = J.T @ J + lam * np.eye(n), J.T @ e
+        dq = np.array(damped_step(J.T.tolist(), e.tolist(), lam))
+        # backward error (n = 7 > 6 rows with tiny λ is ill-conditioned: compare residuals, not solutions)
+        assert np.linalg.norm(A @ dq - b) <= 1e-12 * (np.linalg.norm(A) * np.linalg.norm(dq) + np.linalg.norm(b))
+        if n <= 6:
+            np.testing.assert_allclose(dq, np.linalg.solve(A, b), rtol=1e-8, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", SINGLE_ARMS)
+def test_single_call_agrees_with_batched_path(name):
+    """One target (fast path) vs the same target as a batch of one: same success, FK(q) = T, q inside."""
+    robot, rng = load_robot(name), np.random.default_rng(3)
+    m = 12 if CI else 40
+    q_true = _random_q(robot, rng, m)
+    T = forward_kinematics(robot, q_true)
+    near = np.clip(q_true + rng.normal(0, 0.3, q_true.shape), robot.q_limits[:, 0], robot.q_limits[:, 1])
+    far = _random_q(robot, rng, m)  # seeds that often converge outside the limits: batched fallback
+    fast_used = 0
+    for k in range(m):
+        for q0 in (near[k], far[k], None):
+            one = solve_ik(robot, T[k], q0, rng=np.random.default_rng(k))
+            batch = solve_ik(robot, T[k][None], None if q0 is None else q0[None], rng=np.random.default_rng(k))
+            assert one.success == bool(batch.success[0]) and one.success, (k, q0)
+            assert one.q.shape == (robot.dof,)
+            dp, dr = _pose_gap(robot, one.q, T[k])
+            assert dp <= 1e-9 and dr <= 1e-9
+            assert one.position_error <= 1e-9 and one.orientation_error <= 1e-9 and one.reason == ""
+            lim = robot.q_limits
+            assert np.all(one.q >= lim[:, 0] - 1e-12) and np.all(one.q <= lim[:, 1] + 1e-12)
+            fast_used += one.restarts == 0
+    assert fast_used >= m  # the near seeds (at least) are solved by the first attempt
+
+
+@pytest.mark.parametrize("name", SINGLE_ARMS)
+def test_single_call_unreachable_same_reason_as_batched(name):
+    robot, rng = load_robot(name), np.random.default_rng(8)
+    for k in range(2 if CI else 4):
+        T = forward_kinematics(robot, _random_q(robot, rng, 1)[0])
+        T[:3, 3] *= 10.0  # far outside the workspace
+        one = solve_ik(robot, T, restarts=4, rng=np.random.default_rng(k))
+        batch = solve_ik(robot, T[None], restarts=4, rng=np.random.default_rng(k))
+        assert not one.success and not batch.success[0]
+        expected = ("unreachable", "limits") if robot.joint_types.count(denavit.JointType.PRISMATIC) else ("unreachable",)
+        assert one.reason == batch.reason[0] and one.reason in expected  # a prismatic joint may reach beyond its limits
+        np.testing.assert_allclose(one.q, batch.q[0])  # the fallback is the batched search itself
+
+
+def test_single_call_limits_reason_same_as_batched():
+    """Planar 2R, joint 2 limited to [0, 0.1]: the target needs q2 = ±1; single and batched both say 'limits'."""
+    base = load_robot("planar2r")
+    links = list(base.links)
+    links[1] = links[1].__class__(a=links[1].a, alpha=0.0, d=0.0, theta=0.0, q_limits=(0.0, 0.1))
+    robot = base.replace(links=tuple(links))
+    T = forward_kinematics(robot, [0.3, 1.0])
+    for q0 in ([0.3, 0.05], [0.0, 0.0]):  # the first attempt converges to q2 = 1 outside the limits
+        one = solve_ik(robot, T, q0, mask="position", restarts=4, rng=np.random.default_rng(0))
+        batch = solve_ik(robot, T[None], np.array(q0)[None], mask="position", restarts=4, rng=np.random.default_rng(0))
+        assert not one.success and not batch.success[0] and one.reason == batch.reason[0] == "limits"
+        assert 0.0 <= one.q[1] <= 0.1
+
+
+def test_single_call_position_mask():
+    robot = load_robot("puma560")
+    lim = robot.q_limits
+    q = np.array([0.3, 0.2, -0.4, 0.2, 0.5, 0.1])
+    T = forward_kinematics(robot, q)
+    # position-only mask on a single target: FK position matches, fast path used from a near seed
+    res = solve_ik(robot, T, q + 0.05, mask="position")
+    assert res.success and res.restarts == 0
+    assert np.linalg.norm(forward_kinematics(robot, res.q)[:3, 3] - T[:3, 3]) <= 1e-9
+    assert np.all(res.q >= lim[:, 0]) and np.all(res.q <= lim[:, 1])

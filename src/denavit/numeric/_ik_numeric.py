@@ -10,6 +10,7 @@ the returned joint values, never taken from the iteration's own bookkeeping.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, Sequence
 
 import numpy as np
@@ -118,6 +119,7 @@ def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
     return np.concatenate([dp, dw], axis=-1)
 
 
+@lru_cache(maxsize=64)
 def _char_length(robot: DHRobot) -> float:
     """A length scale of the arm [m]: sum of |a| and |d| over the rows and the tool offset (≥ 1 mm)."""
     s = sum(abs(l.a) + abs(l.d) for l in robot.links) + float(np.linalg.norm(robot.tool_matrix[:3, 3]))
@@ -148,6 +150,11 @@ class _Limits:
         lo = np.where(np.isfinite(self.lo), self.lo, np.where(self.revolute, -np.pi, -scale))
         hi = np.where(np.isfinite(self.hi), self.hi, np.where(self.revolute, np.pi, scale))
         return rng.uniform(lo, hi, size=shape + (len(lo),))
+
+
+@lru_cache(maxsize=128)
+def _limits_of(robot: DHRobot, ignore: bool) -> _Limits:
+    return _Limits(robot, ignore)  # read-only after construction: shared between calls
 
 
 class _Slots:
@@ -339,10 +346,9 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     T = as_transform(T, "T")
     batch = T.shape[:-2]
     w_mask = row_mask(mask)
-    rng = np.random.default_rng() if rng is None else rng
     n, L = robot.dof, _char_length(robot)
     w = np.where(w_mask, 1.0, 0.0) * np.array([1, 1, 1, L, L, L])
-    limits = _Limits(robot, ignore=not respect_limits)
+    limits = _limits_of(robot, not respect_limits)
     Tf = T.reshape(-1, 4, 4)
     B = Tf.shape[0]
     if q0 is None:
@@ -357,6 +363,7 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
         single = solve_single(robot, q[0], Tf[0], w, w_mask, limits, max_iterations, tol, L)
         if single is not None:
             return single
+    rng = np.random.default_rng() if rng is None else rng
     q, iters, n_restarts, stalled = _search(robot, q, Tf, w, limits, max_iterations, restarts, tol, L, rng)
     q = limits.project(q)
     pe, re = _residuals(robot, q, Tf, w_mask)

@@ -26,6 +26,7 @@ from math import acos, cos, pi, sin, sqrt
 import numpy as np
 
 from ..model import DHRobot
+from ._ik_chain import chain_of
 from ._ik_kernel import kernel_of
 
 __all__ = ["SingleChain", "single_chain"]
@@ -44,54 +45,53 @@ class SingleChain:
         kern = kernel_of(robot)
         self.n = kern.n
         self.prismatic = kern.prismatic
-        self.start = tuple(tuple(float(v) for v in kern.start[:3, j]) for j in range(4))
-        self.terms = kern.terms
+        C0 = kern.start
+        self.start = tuple(tuple(float(v) for v in C0[i, :4]) for i in range(3))  # rows of [R | p]
+        # C_k as the 12 numbers (C00, C10, C20, C01, …, C23): column j of R·C_k is Σ_m R[:, m] C_k[m, j]
+        self.consts = tuple(tuple(float(C[m, j]) for j in range(4) for m in range(3)) for C in chain_of(robot).consts[1:])
 
     def residual(self, q, Rt, pt, w):
-        """Weighted residual e (6 floats) and weighted Jacobian columns (n lists of 6 floats) at q."""
-        x, y, z, p = (list(c) for c in self.start)
-        zs, os = [], []
+        """Weighted residual e (6 floats) and weighted Jacobian columns (n lists of 6 floats) at q.
+
+        The pose is kept as its three rows (x_i, y_i, z_i, p_i); joint k acts on columns x, y (revolute) or
+        on p (prismatic), then the constant C_k multiplies from the right.
+        """
+        rows = self.start
+        axes = []
         for k in range(self.n):
-            zs.append(z)
-            os.append(p)
+            (x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2) = rows
+            axes.append((z0, z1, z2, p0, p1, p2))
             if self.prismatic[k]:
                 qk = q[k]
-                p = [p[0] + qk * z[0], p[1] + qk * z[1], p[2] + qk * z[2]]
+                p0, p1, p2 = p0 + qk * z0, p1 + qk * z1, p2 + qk * z2
             else:
                 c, s = cos(q[k]), sin(q[k])
-                x, y = ([c * x[i] + s * y[i] for i in range(3)], [c * y[i] - s * x[i] for i in range(3)])
-            cols = (x, y, z)
-            tx, ty, tz, tp = self.terms[k]
-            p = _combine(cols, tp, p)
-            x, y, z = _combine(cols, tx, None), _combine(cols, ty, None), _combine(cols, tz, None)
-        # M = R_t Rᵀ: M[i][j] = Σ_m Rt[i][m] R[j][m], R's columns x, y, z
-        R = (x, y, z)
-        M = [[Rt[i][0] * R[0][j] + Rt[i][1] * R[1][j] + Rt[i][2] * R[2][j] for j in range(3)] for i in range(3)]
-        e = [pt[0] - p[0], pt[1] - p[1], pt[2] - p[2]] + _log(M)
-        e = [e[i] * w[i] for i in range(6)]
+                x0, y0 = c * x0 + s * y0, c * y0 - s * x0
+                x1, y1 = c * x1 + s * y1, c * y1 - s * x1
+                x2, y2 = c * x2 + s * y2, c * y2 - s * x2
+            a0, a1, a2, b0, b1, b2, c0, c1, c2, d0, d1, d2 = self.consts[k]
+            rows = ((x0 * a0 + y0 * a1 + z0 * a2, x0 * b0 + y0 * b1 + z0 * b2, x0 * c0 + y0 * c1 + z0 * c2,
+                     p0 + x0 * d0 + y0 * d1 + z0 * d2),
+                    (x1 * a0 + y1 * a1 + z1 * a2, x1 * b0 + y1 * b1 + z1 * b2, x1 * c0 + y1 * c1 + z1 * c2,
+                     p1 + x1 * d0 + y1 * d1 + z1 * d2),
+                    (x2 * a0 + y2 * a1 + z2 * a2, x2 * b0 + y2 * b1 + z2 * b2, x2 * c0 + y2 * c1 + z2 * c2,
+                     p2 + x2 * d0 + y2 * d1 + z2 * d2))
+        # M = R_t Rᵀ: M[i][j] = Σ_m Rt[i][m] R[j][m]
+        pe = (rows[0][3], rows[1][3], rows[2][3])
+        M = [[Rt[i][0] * R[0] + Rt[i][1] * R[1] + Rt[i][2] * R[2] for R in rows] for i in range(3)]
+        w0, w1, w2, w3, w4, w5 = w
+        r0, r1, r2 = _log(M)
+        e = [(pt[0] - pe[0]) * w0, (pt[1] - pe[1]) * w1, (pt[2] - pe[2]) * w2, r0 * w3, r1 * w4, r2 * w5]
         J = []
         for k in range(self.n):
-            zk = zs[k]
+            z0, z1, z2, o0, o1, o2 = axes[k]
             if self.prismatic[k]:
-                col = [zk[0], zk[1], zk[2], 0.0, 0.0, 0.0]
+                J.append([z0 * w0, z1 * w1, z2 * w2, 0.0, 0.0, 0.0])
             else:
-                r0, r1, r2 = p[0] - os[k][0], p[1] - os[k][1], p[2] - os[k][2]
-                col = [zk[1] * r2 - zk[2] * r1, zk[2] * r0 - zk[0] * r2, zk[0] * r1 - zk[1] * r0, zk[0], zk[1], zk[2]]
-            J.append([col[i] * w[i] for i in range(6)])
+                d0, d1, d2 = pe[0] - o0, pe[1] - o1, pe[2] - o2
+                J.append([(z1 * d2 - z2 * d1) * w0, (z2 * d0 - z0 * d2) * w1, (z0 * d1 - z1 * d0) * w2,
+                          z0 * w3, z1 * w4, z2 * w5])
         return e, J
-
-
-def _combine(cols, terms, base):
-    acc = None if base is None else list(base)
-    for j, c in terms:
-        v = cols[j]
-        if acc is None:
-            acc = [c * v[0], c * v[1], c * v[2]]
-        else:
-            acc[0] += c * v[0]
-            acc[1] += c * v[1]
-            acc[2] += c * v[2]
-    return [0.0, 0.0, 0.0] if acc is None else acc
 
 
 def _log(M) -> list:
@@ -123,24 +123,32 @@ def damped_step(J, e, lam: float) -> list:
             Jj = J[j]
             A[i][j] = Ji[0] * Jj[0] + Ji[1] * Jj[1] + Ji[2] * Jj[2] + Ji[3] * Jj[3] + Ji[4] * Jj[4] + Ji[5] * Jj[5]
         A[i][i] += lam
-    Lc = [[0.0] * n for _ in range(n)]  # A = L Lᵀ
+    Lc = [[0.0] * n for _ in range(n)]  # A = L Lᵀ, row by row
     for i in range(n):
-        Li = Lc[i]
+        Li, Ai = Lc[i], A[i]
         for j in range(i + 1):
             Lj = Lc[j]
-            s = A[i][j] - sum(Li[k] * Lj[k] for k in range(j))
+            s = Ai[j]
+            for k in range(j):
+                s -= Li[k] * Lj[k]
             if i == j:
                 if s <= 0.0:
                     return [0.0] * n  # numerically not positive definite: no step (rejected as not better)
                 Li[i] = sqrt(s)
             else:
                 Li[j] = s / Lj[j]
-    y = [0.0] * n
+    y = [0.0] * n  # L y = b
     for i in range(n):
-        y[i] = (b[i] - sum(Lc[i][k] * y[k] for k in range(i))) / Lc[i][i]
-    x = [0.0] * n
-    for i in reversed(range(n)):
-        x[i] = (y[i] - sum(Lc[k][i] * x[k] for k in range(i + 1, n))) / Lc[i][i]
+        Li, s = Lc[i], b[i]
+        for k in range(i):
+            s -= Li[k] * y[k]
+        y[i] = s / Li[i]
+    x = [0.0] * n  # Lᵀ x = y
+    for i in range(n - 1, -1, -1):
+        s = y[i]
+        for k in range(i + 1, n):
+            s -= Lc[k][i] * x[k]
+        x[i] = s / Lc[i][i]
     return x
 
 
@@ -226,7 +234,19 @@ def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w
     if status != "ok":
         return None
     q = limits.project(np.array(qf))
-    pe, re = ikn._residuals(robot, q, T, w_mask)
+    pe, re = _fk_error(robot, q, T, w_mask.tolist())
     if not (pe <= tol and re <= tol and limits.inside(q)):
         return None
-    return ikn.IKResult(q, True, float(pe), float(re), it, 0, "")
+    return ikn.IKResult(q, True, pe, re, it, 0, "")
+
+
+def _fk_error(robot: DHRobot, q: np.ndarray, T: np.ndarray, mask: list) -> tuple[float, float]:
+    """Position and orientation error norms of ``forward_kinematics(robot, q)`` against T on the masked rows:
+    ``pose_error`` of :mod:`._ik_numeric` for one pose, in floats."""
+    from ._kinematics import forward_kinematics
+
+    F, Tl = forward_kinematics(robot, q).tolist(), T.tolist()
+    dp = [(Tl[i][3] - F[i][3]) if mask[i] else 0.0 for i in range(3)]
+    M = [[Tl[i][0] * F[j][0] + Tl[i][1] * F[j][1] + Tl[i][2] * F[j][2] for j in range(3)] for i in range(3)]
+    dw = [v if mask[3 + i] else 0.0 for i, v in enumerate(_log(M))]
+    return sqrt(dp[0] ** 2 + dp[1] ** 2 + dp[2] ** 2), sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2)
