@@ -270,16 +270,15 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
     chain = _chain(robot)
     qq = np.nan_to_num(q)
     rev = ~chain.prismatic
-    theta = np.array([l.theta for l in robot.joints])
+    theta = _thetas(robot)
     parts = []  # (test (B, K) bool, label where True, label where False)
     if plan.kind.startswith(("pieper", "parallel", "position")) and plan.point_e is not None or plan.kind == "position":
         pe = plan.point_e if plan.point_e is not None else np.zeros(3)
         X = (T[:, :3, :3] @ pe + T[:, :3, 3]).T[:, :, None]  # (3, B, 1)
+        x1, _, _, S = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
         if rev[0]:
-            x1, _, _, p1 = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1, (3, B, K)
-            parts.append((np.sum(x1 * (X - p1), axis=0) >= 0, "shoulder right", "shoulder left"))
+            parts.append((np.sum(x1 * (X - S), axis=0) >= 0, "shoulder right", "shoulder left"))
         if n >= 3 and rev[1] and rev[2]:
-            S = chain_columns(chain, qq[..., :1], upto=1)[3]  # (3, B, K)
             E = chain_columns(chain, qq[..., :2], upto=2)[3]
             up = chain.consts[0][:3, 2][:, None, None]
             v = X - S
@@ -296,6 +295,16 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
     code = np.zeros((B, K), dtype=np.intp)
     for i, (test, _, _) in enumerate(parts):
         code |= np.where(test, 0, 1 << i)
-    table = np.array([", ".join(p[1 + ((c >> i) & 1)] for i, p in enumerate(parts)) for c in range(1 << len(parts))],
-                     dtype=object)
-    return table[code]
+    return _label_table(tuple(p[1:] for p in parts))[code]
+
+
+@lru_cache(maxsize=64)
+def _label_table(names: tuple) -> np.ndarray:
+    """Label of every bit code: bit i set picks the second name of part i."""
+    return np.array([", ".join(p[(c >> i) & 1] for i, p in enumerate(names)) for c in range(1 << len(names))],
+                    dtype=object)
+
+
+@lru_cache(maxsize=64)
+def _thetas(robot: DHRobot) -> np.ndarray:
+    return np.array([l.theta for l in robot.joints])  # read-only use
