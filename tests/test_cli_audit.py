@@ -70,3 +70,21 @@ def test_existing_output_is_not_overwritten_without_force(capsys, tmp_path, name
     code, out, err = run(capsys, *argv, "-o", path, "--force")
     assert code == 0, err
     assert path.read_bytes() != b"precious\n"
+
+
+# Long-running commands report their stages on stderr, and stay quiet with --json (stdout is pure JSON).
+PROGRESS = [
+    (["report", "planar2r", "-q", "0.1,0.2", "--topics", "fk,jacobian"], "section 2/2: jacobian"),
+    (["dynamics", "planar2r", "--symbolic"], "mass matrix"),
+    (["singularities", "planar2r", "--rows", "vx,vy"], "factoring"),
+]
+
+
+@pytest.mark.parametrize("argv,stage", PROGRESS, ids=[p[0][0] for p in PROGRESS])
+def test_progress_on_stderr_only_without_json(capsys, argv, stage):
+    code, out, err = run(capsys, *argv)
+    assert code == 0 and stage in err
+    assert stage not in out
+    code, out, err = run(capsys, *argv, "--json")
+    assert code == 0 and err == ""
+    _strict(out)

@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import ParseError
 
 __all__ = ["OneLineParser", "add_common", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite",
-           "to_json", "matrix_text"]
+           "stage_printer", "to_json", "matrix_text"]
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -54,6 +54,17 @@ def refuse_overwrite(args: argparse.Namespace, path: str | None) -> None:
 
     if path and os.path.lexists(path) and not getattr(args, "force", False):
         raise ParseError(f"{path!r} exists; not overwriting it (choose another name or pass --force)")
+
+
+def stage_printer(args: argparse.Namespace, command: str):
+    """A progress callback printing ``denavit COMMAND: <stage>`` on stderr, or None with --json (quiet)."""
+    if getattr(args, "json", False):
+        return None
+
+    def show(stage: str) -> None:
+        print(f"denavit {command}: {stage}", file=sys.stderr, flush=True)
+
+    return show
 
 
 def load(args: argparse.Namespace):

@@ -107,7 +107,7 @@ def _symbolic(robot, args):
     from .. import symbolic as S
 
     t0 = time.perf_counter()
-    kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=_progress)
+    kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=None if args.json else _progress)
     if args.method == "newton-euler":
         terms = S.newton_euler_dynamics(robot, **kw).terms
     elif args.method == "steps":

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, joint_values, load, matrix_text
+from ._common import add_common, add_q, joint_values, load, matrix_text, stage_printer
 
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 REFERENCE = "end-effector origin (after the tool transform)"
@@ -323,7 +323,7 @@ def cmd_singularities(args: argparse.Namespace):
     except ValueError as exc:
         raise ParseError(f"--rows: {exc}") from None
     rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
-    res = S.singularity_analysis(robot, rows, args.frame)
+    res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
     fmt = _formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)
     lines = [f"{robot.name}: singularities", f"matrix: {res.matrix_note}", f"measure: {res.measure}"]

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
-from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite
+from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite, stage_printer
 
 _SPLIT = re.compile(r"[,;\s]+(?![^()]*\))")
 
@@ -54,6 +54,11 @@ def cmd_report(args: argparse.Namespace):
     robot = load(args)
     fmt = format_from_path(args.output) if args.output else "md"
     refuse_overwrite(args, args.output)
+    if fmt == "pdf":  # fail before the derivation, not after it: one error line, no wasted minutes
+        from ..report._pdf import latex_engine, pdf_from_latex
+
+        if latex_engine() is None:
+            pdf_from_latex("", {})  # raises MissingDependencyError naming the engines looked for
     q = qd = wrench = None
     if args.q is not None:
         joint_values(args, robot, args.q)  # validates count, syntax and limits
@@ -67,7 +72,8 @@ def cmd_report(args: argparse.Namespace):
         parse_values(args.wrench, 6, what="wrench")
         wrench = _parts(args.wrench)
     topics = [t.strip() for t in args.topics.split(",") if t.strip()] if args.topics else None
-    d = derive(robot, q, qd, wrench, topics=topics, simplify=args.simplify, deg=args.deg)
+    d = derive(robot, q, qd, wrench, topics=topics, simplify=args.simplify, deg=args.deg,
+               progress=stage_printer(args, "report"))
     data = derivation_json(d)
     if args.output:
         written = write_report(d, args.output, fmt)

@@ -147,6 +147,7 @@ def derive(
     topics: Sequence[str] | None = None,
     simplify: str = "trig",
     deg: bool = False,
+    progress: Callable[[str], None] | None = None,
 ) -> Derivation:
     """Build the derivation of ``robot`` (data only; render it with :func:`render`).
 
@@ -167,6 +168,9 @@ def derive(
         Simplification policy of the symbolic results.
     deg : bool
         Read revolute joint values in ``q`` (and rates in ``qd``) as degrees.
+    progress : callable, optional
+        Called with a short message before each section is built (the command line prints these on
+        stderr; symbolic sections of a 6- or 7-joint arm take seconds each).
 
     Returns
     -------
@@ -182,6 +186,12 @@ def derive(
         raise ParseError(f"unknown report topic {bad[0]!r}; choose from {', '.join(TOPICS)}")
     ctx = Context.build(robot, q, qd, wrench, simplify=simplify, deg=deg)
     builders = _builders()
-    sections = tuple(builders[t](ctx) for t in TOPICS if t in topics)
+    chosen = [t for t in TOPICS if t in topics]
+    sections = []
+    for k, t in enumerate(chosen, start=1):
+        if progress is not None:
+            progress(f"section {k}/{len(chosen)}: {t}")
+        sections.append(builders[t](ctx))
+    sections = tuple(sections)
     title = f"Kinematics and dynamics of {robot.name}"
     return Derivation(robot=robot, title=title, inputs=ctx.inputs(), sections=sections)

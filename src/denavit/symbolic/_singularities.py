@@ -21,6 +21,7 @@ import itertools
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 import sympy as sp
@@ -394,7 +395,8 @@ def _everywhere_reason(robot: DHRobot, rows: list[int], frame: Frame, rng) -> tu
 
 @lru_cache(maxsize=32)
 def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame | str = Frame.BASE,
-                         simplify: str = "trig") -> SingularityAnalysis:
+                         simplify: str = "trig", progress: Callable[[str], None] | None = None
+                         ) -> SingularityAnalysis:
     """Singular configurations of an arm: the factorized determinant and each factor solved and classified.
 
     Parameters
@@ -405,6 +407,9 @@ def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame |
     frame : Frame or {"base", "tool"}
         Axes of the Jacobian whose ``rows`` are taken (ignored without ``rows``: the rank does not depend on it).
     simplify : {"none", "trig", "full"}
+    progress : callable, optional
+        Called with a short message at each stage (Jacobian, minors, factors, each condition); a 6- or
+        7-joint arm takes seconds to minutes.
 
     Returns
     -------
@@ -421,11 +426,14 @@ def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame |
     q = joint_symbols(robot.dof).q
     idx = select_rows(rows)
     params = {parameter_symbols(robot)[k]: sp.Float(v) for k, v in robot.parameters}
+    say = progress or (lambda msg: None)
+    say("symbolic Jacobian")
     if rows is None:
         M, note = _wrist_frame_jacobian(robot, simplify)
     else:
         M = sp.ImmutableMatrix(geometric_jacobian_sym(robot, frame, simplify).extract(idx, list(range(robot.dof))))
         note = f"rows {', '.join(TWIST_ROWS[i] for i in idx)} of J{'0' if frame is Frame.BASE else 'e'}"
+    say(f"determinant / minors of the {M.shape[0]}x{M.shape[1]} matrix")
     name, measure, minors = _measure(M, q)
     rng = np.random.default_rng(0)
     full = min(M.shape)
@@ -433,9 +441,11 @@ def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame |
         rank, reason = _everywhere_reason(robot, idx, frame, rng)
         return SingularityAnalysis(robot.name, tuple(TWIST_ROWS[i] for i in idx), M, note, name, sp.Integer(0),
                                    (), (), True, rank, full, reason)
+    say("factoring")
     const, facs = _factors(minors, q)
     conds = []
-    for f, _ in facs:
+    for k, (f, _) in enumerate(facs, start=1):
+        say(f"solving and classifying factor {k}/{len(facs)}")
         variables = sorted(int(str(s)[1:]) - 1 for s in f.free_symbols if s in q)
         sols = _solutions(f, variables[0], robot, q, params) if len(variables) == 1 else []
         kind, text = _classify(f, variables, sols, robot, q, params, rng)
