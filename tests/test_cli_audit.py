@@ -88,3 +88,22 @@ def test_progress_on_stderr_only_without_json(capsys, argv, stage):
     code, out, err = run(capsys, *argv, "--json")
     assert code == 0 and err == ""
     _strict(out)
+
+
+def test_values_may_start_with_a_minus_sign(capsys):
+    # argparse alone took "-0.5,0.3" for an unknown option: "--qd: expected one argument"
+    from denavit import load_robot
+    from denavit.numeric import forward_kinematics
+
+    robot = load_robot("planar2r")
+    for text, q in [("-0.5,0.3", [-0.5, 0.3]), ("-pi/4,0.3", [-np.pi / 4, 0.3]), ("-.5,-1e-1", [-0.5, -0.1])]:
+        code, out, err = run(capsys, "fk", "planar2r", "-q", text, "--json")
+        assert code == 0, err
+        assert np.allclose(_strict(out)["T"], forward_kinematics(robot, np.array(q)), atol=1e-12)
+    code, out, err = run(capsys, "dynamics", "planar2r", "-q", "0.1,0.2", "--qd", "-0.5,0.3", "--qdd", "-1,-2", "--json")
+    assert code == 0, err
+    assert _strict(out)["qd"] == [-0.5, 0.3]
+    code, out, err = run(capsys, "fk", "planar2r", "-q1,2", "--json")   # attached short option still works
+    assert code == 0 and _strict(out)["q"] == [1.0, 2.0]
+    code, out, err = run(capsys, "fk", "planar2r", "-q", "-0.5")        # a wrong count is still an error
+    assert code == 2 and len(err.strip().splitlines()) == 1

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from typing import Any
 
@@ -16,7 +17,15 @@ __all__ = ["OneLineParser", "add_common", "add_force", "add_q", "emit", "load", 
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line on stderr and exit code 2."""
+    """argparse, but a usage error is one line on stderr and exit code 2.
+
+    A value that starts with a minus sign is a value, not an option, when it is a number or a list or
+    expression (``-q -0.5,1``, ``--qd -pi/2,0``); argparse alone only accepts a lone negative number.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d|^-[^-].*[,*/()]")
 
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"{self.prog}: error: {message} (see '{self.prog} --help')", file=sys.stderr)
