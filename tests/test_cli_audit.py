@@ -107,3 +107,41 @@ def test_values_may_start_with_a_minus_sign(capsys):
     assert code == 0 and _strict(out)["q"] == [1.0, 2.0]
     code, out, err = run(capsys, "fk", "planar2r", "-q", "-0.5")        # a wrong count is still an error
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+LONG = "x" * 20000
+HOSTILE = [
+    ["fk", LONG, "-q", "0"],                                     # was: internal error OSError (name too long)
+    ["show", LONG],
+    ["convert", "planar2r", "--to", LONG],                       # was: the whole string echoed on stderr
+    ["report", "planar2r", "--topics", LONG],
+    ["fk", "planar2r", "-q", LONG],
+    ["singularities", "planar3r", "-q", "1,2"],                  # was: progress lines, then the error
+    ["dynamics", "planar2r", "--symbolic", "-q", "1"],
+    ["workspace", "planar2r", "--samples", "200", "--seed", "-1"],  # was: internal error ValueError
+    ["check", "planar2r", "examples/claims/planar2r.yaml", "--seed", "-1"],
+    ["ik", "planar2r", "--from-q", "0.1,0.2", "--method", "numeric", "--tol", "1e999"],  # was: accepted
+    ["ik", "planar2r", "--from-q", "0.1,0.2", "--method", "numeric", "--restarts", "-1"],
+    ["plot", "planar2r", "-o", "never.png", "--elev", "nan"],   # was: accepted with RuntimeWarnings
+    ["fk", "planar2r", "-q", '__import__("os"),0'],
+    ["fk", "planar2r", "-q", "9**9**9,0"],
+    ["fk", "planar2r", "-q", "1e999,0"],
+    ["fk", "planar2r", "-q", "nan,0"],
+    ["fk", "planar2r", "-q", ""],
+    ["fk", "nosuchrobot", "-q", "0,0"],
+]
+
+
+@pytest.mark.parametrize("argv", HOSTILE, ids=lambda a: " ".join(a)[:40])
+def test_hostile_input_gives_one_short_line(capsys, tmp_path, monkeypatch, argv):
+    import pathlib
+
+    monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])
+    argv = [str(tmp_path / a) if a == "never.png" else a for a in argv]
+    code, out, err = run(capsys, *argv)
+    lines = err.strip().splitlines()
+    assert code in (1, 2), (code, err[:200])
+    assert len(lines) == 1, err[:500]
+    assert len(lines[0]) < 500 and "internal error" not in err and "Traceback" not in err
+    assert lines[0].startswith("denavit")
+    assert not (tmp_path / "never.png").exists()

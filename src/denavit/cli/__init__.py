@@ -14,7 +14,7 @@ import sys
 from typing import Sequence
 
 from ..errors import DenavitError, MissingDependencyError, ModelError, ParseError, ShapeError
-from ._common import OneLineParser, emit
+from ._common import OneLineParser, emit, one_line
 
 __all__ = ["main", "build_parser"]
 
@@ -56,22 +56,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         emit(args, data, text)
         return 0
     except (ParseError, ShapeError, ModelError) as exc:
-        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
         return 2
     except MissingDependencyError as exc:
-        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except DenavitError as exc:
-        print(f"denavit {args.command}: error: {exc}", file=sys.stderr)
+        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("denavit: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         return 0
+    except OSError as exc:  # a file the user named: unreadable, a directory, a name too long, a full disk ...
+        what = f"{exc.strerror or exc}" + (f": {exc.filename!r}" if exc.filename else "")
+        print(f"denavit {args.command}: error: {one_line(what)}", file=sys.stderr)
+        return 1
     except Exception as exc:  # a bug of ours: one line, the traceback only on request
         if os.environ.get("DENAVIT_DEBUG"):
             raise
-        print(f"denavit {args.command}: internal error: {type(exc).__name__}: {exc} "
+        print(f"denavit {args.command}: internal error: {type(exc).__name__}: {one_line(exc)} "
               "(set DENAVIT_DEBUG=1 for the traceback, and please report it)", file=sys.stderr)
         return 1

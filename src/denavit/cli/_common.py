@@ -12,7 +12,7 @@ import numpy as np
 
 from ..errors import ParseError
 
-__all__ = ["OneLineParser", "add_common", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite",
+__all__ = ["OneLineParser", "add_common", "finite_float", "nonneg_int", "one_line", "positive_float", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite",
            "stage_printer", "to_json", "matrix_text"]
 
 
@@ -28,8 +28,49 @@ class OneLineParser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(r"^-\.?\d|^-[^-].*[,*/()]")
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        print(f"{self.prog}: error: {message} (see '{self.prog} --help')", file=sys.stderr)
+        print(f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')", file=sys.stderr)
         raise SystemExit(2)
+
+
+MAX_MESSAGE = 300
+
+
+def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
+    """An error message as one line of at most about ``limit`` characters (long user text is cut in the middle)."""
+    text = " ".join(str(message).split())
+    if len(text) > limit:
+        text = text[: limit * 2 // 3] + " ... " + text[-(limit // 3):]
+    return text
+
+
+def nonneg_int(text: str) -> int:
+    """argparse type: an integer >= 0 (random seeds, counts)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {value}")
+    return value
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number (no nan, inf or overflow such as 1e999)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not np.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0 (tolerances, durations)."""
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
 
 
 def add_common(p: argparse.ArgumentParser, robot: bool = True) -> None:

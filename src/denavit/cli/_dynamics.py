@@ -66,6 +66,10 @@ def cmd_dynamics(args: argparse.Namespace):
     require_dynamics(robot)
     data: dict = {"robot": robot.name}
     lines: list[str] = []
+    if args.q is not None:  # bad values fail now, not after the symbolic work
+        joint_values(args, robot, args.q)
+        _rates(args, robot, args.qd, "qd")
+        _rates(args, robot, args.qdd, "qdd")
     if args.symbolic:
         sdata, slines = _symbolic(robot, args)
         data.update(sdata)

@@ -7,7 +7,7 @@ import argparse
 import numpy as np
 
 from ..errors import DenavitError, ParseError, UnsupportedRobotError
-from ._common import add_common, emit, joint_values, load, matrix_text
+from ._common import add_common, emit, joint_values, load, matrix_text, nonneg_int, positive_float
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,8 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="numeric: search many seeds and list every distinct solution found (analytic always lists all)")
     p.add_argument("--seed", metavar="Q", help="numeric: starting configuration")
     p.add_argument("--mask", choices=["pose", "position"], default="pose", help="numeric: rows to match")
-    p.add_argument("--tol", type=float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
-    p.add_argument("--restarts", type=int, default=64, help="numeric: random restarts (default 64)")
+    p.add_argument("--tol", type=positive_float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
+    p.add_argument("--restarts", type=nonneg_int, default=64, help="numeric: random restarts (default 64)")
     p.add_argument("--ignore-limits", action="store_true", help="accept --from-q outside the joint limits")
     p.add_argument("--derive", action="store_true",
                    help="print the symbolic derivation of the closed form (spherical-wrist 6-joint and planar 2R/3R "

@@ -323,6 +323,8 @@ def cmd_singularities(args: argparse.Namespace):
     except ValueError as exc:
         raise ParseError(f"--rows: {exc}") from None
     rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
+    if args.q is not None:
+        joint_values(args, robot, args.q)  # a bad -q fails now, not after minutes of symbolic work
     res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
     fmt = _formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
-from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite, stage_printer
+from ._common import add_common, add_force, nonneg_int, add_q, joint_values, load, refuse_overwrite, stage_printer
 
 _SPLIT = re.compile(r"[,;\s]+(?![^()]*\))")
 
@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
     add_common(p)
     p.add_argument("claims", metavar="CLAIMS_FILE", help="YAML claims file (see docs/claims.md)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random test points (default 0)")
+    p.add_argument("--seed", type=nonneg_int, default=0, help="seed of the random test points (default 0)")
     p.set_defaults(handler=cmd_check)
 
     p = sub.add_parser("import-table", help="read a DH table pasted from a document and write a robot file")

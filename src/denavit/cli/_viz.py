@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_force, add_q, joint_values, load, refuse_overwrite
+from ._common import add_common, add_force, finite_float, nonneg_int, add_q, joint_values, load, refuse_overwrite
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 
@@ -21,8 +21,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--path-to", metavar="Q2", help="also draw the end-effector path of a quintic move to Q2")
     p.add_argument("--no-frames", action="store_true", help="leave out the DH frame triads")
     p.add_argument("--no-labels", action="store_true", help="leave out the frame labels")
-    p.add_argument("--elev", type=float, help="view elevation [deg]")
-    p.add_argument("--azim", type=float, help="view azimuth [deg]")
+    p.add_argument("--elev", type=finite_float, help="view elevation [deg]")
+    p.add_argument("--azim", type=finite_float, help="view azimuth [deg]")
     p.add_argument("--dpi", type=int, default=120, help="resolution of a .png (default 120)")
     add_force(p)
     p.set_defaults(handler=cmd_plot)
@@ -53,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="picture to write (.png, .svg, .pdf); numbers only if absent")
     p.add_argument("--samples", type=int, default=100_000, help="random configurations (default 100000)")
     p.add_argument("--resolution", type=float, help="voxel edge [m] (default: longest side / 40)")
-    p.add_argument("--seed", type=int, help="random seed, for repeatable figures")
+    p.add_argument("--seed", type=nonneg_int, help="random seed, for repeatable figures")
     add_force(p)
     p.set_defaults(handler=cmd_workspace)
 
