@@ -135,3 +135,15 @@ def test_singularities_markdown(capsys):
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, what):
     err = run_error(capsys, *argv)
     assert what in err
+
+
+def test_singularities_of_a_non_square_jacobian_without_common_factor_are_not_called_absent(capsys):
+    """A 3-joint arm with all six rows: no common factor of the 3x3 minors does not mean "never singular"."""
+    code = main(["singularities", "report004-3-articulated-rrr", "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert code == 0
+    if not data["conditions"] and not data["everywhere"]:
+        assert data["conditions_complete"] is False
+    main(["singularities", "report004-1-planar2r", "--rows", "vx,vy", "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert data["conditions"] and data["conditions_complete"] is True

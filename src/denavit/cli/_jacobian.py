@@ -340,14 +340,22 @@ def cmd_singularities(args: argparse.Namespace):
         lines += ["", "singular when:"]
         for cond in res.conditions:
             lines += _condition_lines(cond, robot, args, fmt)
+    elif "minors" in res.measure:
+        # Non-square J: a common factor of all minors is sufficient for a rank loss, not necessary. Without
+        # one, singular configurations (if any) are where all minors vanish together: not solved here.
+        lines += ["", "no common factor of the minors: any singular configuration lies where ALL the minors vanish "
+                  "together, which is not solved symbolically here (redundant arms, e.g. 7 joints, do have such "
+                  "configurations); check a configuration with -q (rank, smallest singular value), or pick a "
+                  "square sub-Jacobian with --rows"]
     else:
-        lines += ["", "no singular configuration: the common factor never vanishes"
-                  + ("" if args.rows else " (with fewer joints than rows, try --rows, e.g. vx,vy,vz)")]
+        lines += ["", "no singular configuration: the determinant never vanishes"]
     data = {"robot": robot.name, "rows": list(res.rows), "frame": args.frame, "matrix_note": res.matrix_note,
             "measure": res.measure, "matrix": res.matrix, "determinant": str(res.determinant),
             "determinant_latex": sp.latex(res.determinant), "constant_factors": [str(c) for c in res.constant_factors],
             "everywhere": res.everywhere, "generic_rank": res.generic_rank, "full_rank": res.full_rank,
             "reason": res.reason, "angle_unit": "deg" if args.deg else "rad",
+            # False when J is not square and its minors share no factor: the singular set is not solved then
+            "conditions_complete": not ("minors" in res.measure and not res.conditions and not res.everywhere),
             "conditions": [{"equation": f"{c.factor} = 0", "latex": sp.latex(c.factor) + " = 0",
                             "variables": list(c.variables), "kind": c.kind, "explanation": c.explanation,
                             "solutions": [{"variable": s.variable,
