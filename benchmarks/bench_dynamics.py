@@ -26,20 +26,9 @@ import time
 import numpy as np
 
 import denavit
-from _peers import to_pinocchio
+from _peers import best_time, to_pinocchio
 
 ROBOTS = ("puma560", "panda")
-
-
-def best_time(fn, repeat: int, number: int) -> float:
-    """Best over `repeat` runs of the mean time of `number` calls [s]."""
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - t0) / number)
-    return best
 
 
 def _armature(robot) -> np.ndarray:

@@ -14,20 +14,9 @@ import time
 import numpy as np
 
 import denavit
-from _peers import expand_q, to_pinocchio, to_rtb
+from _peers import best_time, expand_q, to_pinocchio, to_rtb
 
 ROBOTS = ("puma560", "panda", "report000-6r")
-
-
-def best_time(fn, repeat: int, number: int) -> float:
-    """Best over `repeat` runs of the mean time of `number` calls [s]."""
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - t0) / number)
-    return best
 
 
 def bench_robot(name: str, batch: int, repeat: int) -> list[tuple[str, str, float, float]]:
