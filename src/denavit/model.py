@@ -307,6 +307,21 @@ class DHRobot:
         return replace(self, **changes)
 
 
+def inertial_rows(robot: DHRobot) -> list[tuple[int, int, LinkInertia]]:
+    """``(row, body, inertia)`` for every row with inertial data that moves.
+
+    ``body`` is the 0-based joint that carries the row: a fixed row's inertia belongs rigidly to the
+    preceding moving link; rows before the first joint do not move and are left out.
+    """
+    out = []
+    body = -1
+    for row, link in enumerate(robot.links):
+        body += link.is_joint
+        if link.inertia is not None and body >= 0:
+            out.append((row, body, link.inertia))
+    return out
+
+
 def joint_names(robot: DHRobot) -> list[str]:
     """``q1 … qn``."""
     return [f"q{k + 1}" for k in range(robot.dof)]

@@ -30,7 +30,7 @@ import numpy as np
 
 from .._validate import as_joint_array
 from ..errors import ModelError
-from ..model import DHRobot, JointType
+from ..model import DHRobot, JointType, inertial_rows
 from ._dynamics_fast import frames, joint_columns, ldl_solve, mass_matrix_kernel, plan, rnea_kernel, to_array
 from ._jacobians import joint_axes
 from ._kinematics import link_transforms
@@ -63,15 +63,8 @@ class _Piece:
 
 def _pieces(robot: DHRobot) -> list[_Piece]:
     """Inertial pieces attached to moving bodies (see module notes)."""
-    out = []
-    body = -1
-    for r, link in enumerate(robot.links):
-        body += link.is_joint
-        li = link.inertia
-        if li is None or body < 0:
-            continue
-        out.append(_Piece(r, body, li.mass, np.array(li.com, dtype=float), li.inertia_matrix))
-    return out
+    return [_Piece(r, body, li.mass, np.array(li.com, dtype=float), li.inertia_matrix)
+            for r, body, li in inertial_rows(robot)]
 
 
 def require_dynamics(robot: DHRobot) -> None:

@@ -22,7 +22,7 @@ import sympy as sp
 
 from .. import _expr
 from ..errors import ModelError
-from ..model import Convention, DHRobot, JointType
+from ..model import Convention, DHRobot, JointType, inertial_rows
 from ._kinematics import link_matrices_sym, link_transforms_sym
 from ._dynamics_trig import collect_trig, fourier_form
 from ._simplify import POLICIES, shorthand, simplify_expr
@@ -95,12 +95,7 @@ def inertial_pieces(robot: DHRobot, numeric: bool = False) -> list[InertialPiece
     """The inertial data of every moving row, with named parameters kept as symbols (``numeric`` substitutes)."""
     syms, subs = _values(robot, numeric)
     out = []
-    body = -1
-    for r, link in enumerate(robot.links):
-        body += link.is_joint
-        li = link.inertia
-        if li is None or body < 0:
-            continue
+    for r, body, li in inertial_rows(robot):
         m = _field(li, "mass", li.mass, syms, subs)
         com = sp.ImmutableMatrix([_field(li, f"com{i}", li.com[i], syms, subs) for i in range(3)])
         xx, yy, zz, xy, xz, yz = (_field(li, f"inertia{i}", li.inertia[i], syms, subs) for i in range(6))
