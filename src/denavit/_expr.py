@@ -25,7 +25,7 @@ from typing import Any, Callable, Mapping
 
 from .errors import ParseError
 
-__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "MAX_LENGTH", "MAX_DEPTH"]
+__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "fold", "lookup", "MAX_LENGTH", "MAX_DEPTH"]
 
 MAX_LENGTH = 500
 MAX_DEPTH = 30
@@ -208,6 +208,53 @@ def names_in(node: Node) -> set[str]:
     return set()
 
 
+def fold(node: Node, number: Callable[[str], Any], name: Callable[[str], Any],
+         ops: Mapping[str, Callable[..., Any]], funcs: Mapping[str, Callable[..., Any]]) -> Any:
+    """Interpret a tree with one backend (floats, sympy, numpy arrays): the single tree walker.
+
+    ``number(text)`` and ``name(identifier)`` give the leaves; ``ops`` holds ``"neg"`` and the binary
+    operators ``+ - * / ^``; ``funcs`` the functions of :data:`FUNCTIONS`.
+    """
+    kind = node[0]
+    if kind == "num":
+        return number(node[1])
+    if kind == "name":
+        return name(node[1])
+    if kind == "neg":
+        return ops["neg"](fold(node[1], number, name, ops, funcs))
+    if kind == "bin":
+        return ops[node[1]](fold(node[2], number, name, ops, funcs), fold(node[3], number, name, ops, funcs))
+    if kind == "call":
+        return funcs[node[1]](*(fold(a, number, name, ops, funcs) for a in node[2]))
+    raise ParseError(f"malformed expression node {kind!r}")
+
+
+def lookup(env: Mapping[str, Any], pi: Any) -> Callable[[str], Any]:
+    """The leaf function for names: ``pi``, else ``env``, else a ParseError listing what is known."""
+
+    def name(n: str) -> Any:
+        if n == "pi":
+            return pi
+        if n not in env:
+            raise ParseError(f"unknown symbol {n!r} (known: pi, {', '.join(sorted(env)) or 'none'})")
+        return env[n]
+
+    return name
+
+
+def _float_power(a: float, b: float) -> float:
+    if abs(b) > MAX_EXPONENT:
+        raise ParseError(f"exponent {b:g} too large (at most {MAX_EXPONENT:g})")
+    result = a ** b
+    if isinstance(result, complex):
+        raise ValueError("negative number to a fractional power")
+    return float(result)
+
+
+_FLOAT_OPS: dict[str, Callable[..., float]] = {
+    "neg": lambda a: -a, "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b, "^": _float_power,
+}
 _FLOAT_FUNCS: dict[str, Callable[..., float]] = {
     "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
     "atan": math.atan, "atan2": math.atan2, "sqrt": math.sqrt, "exp": math.exp, "log": math.log,
@@ -219,7 +266,7 @@ def evaluate(node: Node, env: Mapping[str, float] | None = None) -> float:
     """Evaluate a tree to a finite float; names are looked up in ``env`` (plus ``pi``)."""
     env = env or {}
     try:
-        value = _eval(node, env)
+        value = float(fold(node, float, lambda n: float(lookup(env, math.pi)(n)), _FLOAT_OPS, _FLOAT_FUNCS))
     except (OverflowError, ZeroDivisionError, ValueError) as exc:
         if isinstance(exc, ParseError):
             raise
@@ -227,42 +274,6 @@ def evaluate(node: Node, env: Mapping[str, float] | None = None) -> float:
     if not math.isfinite(value):
         raise ParseError(f"value of {to_text(node)!r} is not finite")
     return value
-
-
-def _eval(node: Node, env: Mapping[str, float]) -> float:
-    kind = node[0]
-    if kind == "num":
-        return float(node[1])
-    if kind == "name":
-        if node[1] == "pi":
-            return math.pi
-        if node[1] not in env:
-            known = ", ".join(sorted(env)) or "none"
-            raise ParseError(f"unknown symbol {node[1]!r} (known: pi, {known})")
-        return float(env[node[1]])
-    if kind == "neg":
-        return -_eval(node[1], env)
-    if kind == "bin":
-        a, b = _eval(node[2], env), _eval(node[3], env)
-        op = node[1]
-        if op == "+":
-            return a + b
-        if op == "-":
-            return a - b
-        if op == "*":
-            return a * b
-        if op == "/":
-            return a / b
-        if abs(b) > MAX_EXPONENT:
-            raise ParseError(f"exponent {b:g} too large (at most {MAX_EXPONENT:g})")
-        result = a ** b
-        if isinstance(result, complex):
-            raise ValueError("negative number to a fractional power")
-        return float(result)
-    if kind == "call":
-        args = [_eval(a, env) for a in node[2]]
-        return float(_FLOAT_FUNCS[node[1]](*args))
-    raise ParseError(f"malformed expression node {kind!r}")
 
 
 def to_sympy(node: Node, symbols: Mapping[str, Any]) -> Any:
@@ -273,44 +284,25 @@ def to_sympy(node: Node, symbols: Mapping[str, Any]) -> Any:
     """
     import sympy as sp
 
-    kind = node[0]
-    if kind == "num":
-        return sp.Rational(node[1]) if ("e" not in node[1].lower()) else sp.Float(node[1])
-    if kind == "name":
-        if node[1] == "pi":
-            return sp.pi
-        if node[1] not in symbols:
-            known = ", ".join(sorted(symbols)) or "none"
-            raise ParseError(f"unknown symbol {node[1]!r} (known: pi, {known})")
-        return symbols[node[1]]
-    if kind == "neg":
-        return -to_sympy(node[1], symbols)
-    if kind == "bin":
-        a, b = to_sympy(node[2], symbols), to_sympy(node[3], symbols)
-        op = node[1]
-        if op == "+":
-            return a + b
-        if op == "-":
-            return a - b
-        if op == "*":
-            return a * b
-        if op == "/":
-            if b == 0:
-                raise ParseError(f"division by zero in {to_text(node)!r}")
-            return a / b
+    def divide(a: Any, b: Any) -> Any:
+        if b == 0:
+            raise ParseError(f"division by zero in {to_text(node)!r}")
+        return a / b
+
+    def power(a: Any, b: Any) -> Any:
         if not b.is_number or abs(float(b)) > MAX_EXPONENT:
             raise ParseError(f"exponent in {to_text(node)!r} must be a number of size at most {MAX_EXPONENT:g}")
         return a ** b
-    if kind == "call":
-        args = [to_sympy(a, symbols) for a in node[2]]
-        fname = node[1]
-        table: dict[str, Callable[..., Any]] = {
-            "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "asin": sp.asin, "acos": sp.acos,
-            "atan": sp.atan, "atan2": sp.atan2, "sqrt": sp.sqrt, "exp": sp.exp, "log": sp.log,
-            "abs": sp.Abs, "deg": lambda x: x * sp.pi / 180, "rad": lambda x: x,
-        }
-        return table[fname](*args)
-    raise ParseError(f"malformed expression node {kind!r}")
+
+    ops = {"neg": lambda a: -a, "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+           "/": divide, "^": power}
+    funcs = {
+        "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "asin": sp.asin, "acos": sp.acos,
+        "atan": sp.atan, "atan2": sp.atan2, "sqrt": sp.sqrt, "exp": sp.exp, "log": sp.log,
+        "abs": sp.Abs, "deg": lambda x: x * sp.pi / 180, "rad": lambda x: x,
+    }
+    number = lambda t: sp.Rational(t) if "e" not in t.lower() else sp.Float(t)  # noqa: E731
+    return fold(node, number, lookup(symbols, sp.pi), ops, funcs)
 
 
 _PREC = {"+": 1, "-": 1, "*": 2, "/": 2, "^": 4}
