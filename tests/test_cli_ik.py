@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from denavit import forward_kinematics, load_robot
 from denavit.cli import main
@@ -94,3 +95,30 @@ def test_ik_bad_input_one_line_exit_2(capsys):
         code, _, err = _run(capsys, *argv)
         assert code == 2, argv
         assert err.strip() and err.strip().count("\n") == 0 and "Traceback" not in err
+
+
+def test_cli_general_6r_and_lock(tmp_path):
+    """jaco2-6dof goes to the general eigenvalue method; panda --lock q7 gives solutions that keep q7."""
+    import json
+    import subprocess
+    import sys
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "denavit", "ik", *args], capture_output=True, text=True)
+
+    r = run("jaco2-6dof", "--from-q", "0.1,0.2,0.3,0.4,0.5,0.6", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["structure"] == "general" and len(d["solutions"]) >= 2
+    assert min(max(abs(a - b) for a, b in zip(s, [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])) for s in d["solutions"]) < 1e-9
+    r = run("panda", "--deg", "--from-q", "10,20,30,-80,50,100,40", "--lock", "q7=40", "--json")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["locked"] == {"q7": pytest.approx(40.0)}
+    assert all(abs(s[6] - 40.0) < 1e-9 for s in d["solutions"])
+    for bad, msg in ((["--lock", "q9=1"], "not a joint"), (["--lock", "q7=__import__"], "unknown symbol"),
+                     (["--lock", "q7=9"], "outside its limits"), (["--lock", "x"], "not qN=VALUE"),
+                     (["--lock", "q7=1", "--method", "numeric"], "analytic")):
+        r = run("panda", "--from-q", "0.1,0.2,0.3,-1.4,0.5,1.6,0.7", *bad)
+        assert r.returncode == 2 and msg in r.stderr and "Traceback" not in r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1

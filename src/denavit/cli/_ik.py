@@ -27,6 +27,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tol", type=positive_float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
     p.add_argument("--restarts", type=nonneg_int, default=64, help="numeric: random restarts (default 64)")
     p.add_argument("--ignore-limits", action="store_true", help="accept --from-q outside the joint limits")
+    p.add_argument("--lock", metavar="qN=V[,qM=W]", action="append",
+                   help="analytic: hold these joints at these values and solve the others (redundant arms, e.g. "
+                        "panda --lock q7=0.5); repeatable")
     p.add_argument("--derive", action="store_true",
                    help="print the symbolic derivation of the closed form (spherical-wrist 6-joint and planar 2R/3R "
                         "arms) instead of solving a target")
@@ -67,18 +70,47 @@ def _to_unit(robot, q, deg: bool) -> np.ndarray:
     return np.where(rev, np.degrees(q), q) if deg else np.asarray(q)
 
 
+def _locks(args, robot) -> dict[str, float] | None:
+    """``--lock q7=0.5,q3=-1`` → {"q7": 0.5, "q3": -1.0} (values through the restricted reader; --deg for
+    revolute joints)."""
+    import re
+
+    from ..io import parse_values
+    from ..model import JointType
+
+    if not args.lock:
+        return None
+    out = {}
+    for item in ",".join(args.lock).split(","):
+        m = re.fullmatch(r"\s*q(\d+)\s*=\s*(.+?)\s*", item)
+        if not m:
+            raise ParseError(f"--lock: {item.strip()[:40]!r} is not qN=VALUE")
+        k = int(m.group(1))
+        if not 1 <= k <= robot.dof:
+            raise ParseError(f"--lock: q{k} is not a joint of {robot.name} (q1 … q{robot.dof})")
+        rev = robot.joint_types[k - 1] is JointType.REVOLUTE
+        out[f"q{k}"] = float(parse_values(m.group(2), 1, what=f"--lock q{k}", deg=args.deg and rev)[0])
+    return out
+
+
 def _analytic(args, robot, T):
     from ..numeric import analytic_ik
 
-    res = analytic_ik(robot, T)
+    locked = _locks(args, robot)
+    res = analytic_ik(robot, T, locked=locked)
     sols = res.solutions
     data = {"method": "analytic", "structure": res.method, "controlled": res.controlled,
+            "locked": {k: _to_unit(robot, np.where(np.arange(robot.dof) == int(k[1:]) - 1, v, 0.0), args.deg)[int(k[1:]) - 1]
+                       for k, v in (locked or {}).items()},
             "solutions": _to_unit(robot, sols, args.deg), "success": res.count > 0,
             "branches": list(res.branches), "free": list(res.free),
             "residuals": [{"position": float(p), "orientation": float(o)}
                           for p, o in zip(res.position_error, res.orientation_error)],
             "outside_limits": _to_unit(robot, res.outside_limits, args.deg)}
-    lines = [f"closed form ({res.method}; the arm controls: {res.controlled}): {res.count} solution(s)"]
+    how = ("general 6R eigenvalue method (Raghavan-Roth / Manocha-Canny)" if res.method == "general"
+           else f"closed form ({res.method}")
+    lines = [f"{how}; the arm controls: {res.controlled}): {res.count} solution(s)" if res.method != "general"
+             else f"{how}, every real solution; the arm controls: {res.controlled}: {res.count} solution(s)"]
     for k, (q, b, f) in enumerate(zip(sols, res.branches, res.free), start=1):
         lines.append(f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]" + (f"   {b}" if b else ""))
         if f:
@@ -160,6 +192,10 @@ def cmd_ik(args: argparse.Namespace):
         raise ParseError("--latex goes with --derive")
     T = _target(args, robot)
     method = args.method
+    if args.lock and method == "numeric":
+        raise ParseError("--lock goes with the analytic solver (--method analytic or auto)")
+    if args.lock:
+        method = "analytic"
     if method == "auto":
         from ..numeric import ik_structure
 

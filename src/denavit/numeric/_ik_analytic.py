@@ -78,8 +78,8 @@ class AnalyticIKResult:
 
 
 @lru_cache(maxsize=64)
-def _plan(robot: DHRobot, closed_form: bool = True) -> Plan:
-    return make_plan(robot, closed_form)
+def _plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Plan:
+    return make_plan(robot, closed_form, general)
 
 
 @lru_cache(maxsize=64)
@@ -155,7 +155,7 @@ def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray) -> np.ndarray:
     return keep & ~hit.any(axis=-1)
 
 
-def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
+def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> AnalyticIKResult:
     """All inverse-kinematics solutions in closed form, each verified by FK, within the joint limits.
 
     The structure is recognised from the DH table (either convention, offsets, fixed rows, base and tool
@@ -163,11 +163,18 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     three parallel axes (UR family), planar and SCARA arms, 3R wrists and other 3-joint arms.  See
     ``docs/ik.md`` for the derivations and the branch labels.
 
+    Any other 6R arm that can reach general poses is solved exactly by the Raghavan–Roth / Manocha–Canny
+    eigenvalue method (up to 16 solutions; ``method == "general"``).  Redundant arms are solved for given
+    values of the joints named in ``locked`` (IKFast's "free joints"): e.g. Panda with ``{"q7": 0.3}``.
+
     Parameters
     ----------
     robot : DHRobot
     T : array_like, shape (4, 4) or (..., 4, 4)
         Target end-effector pose(s) in the world frame.
+    locked : dict, optional
+        Joint names (``"q1"`` … ``"qN"``, numbered as in the DH table) and the values they are held at
+        [rad, m]; they are returned unchanged in every solution.
 
     Returns
     -------
@@ -188,7 +195,60 @@ def analytic_ik(robot: DHRobot, T) -> AnalyticIKResult:
     >>> res.solutions.shape[0] <= 8, bool(np.min(np.abs(res.solutions - q).max(axis=1)) < 1e-9)
     (True, True)
     """
-    return _solve(robot, as_transform(T, "T"), _plan(robot, True))
+    T = as_transform(T, "T")
+    if locked:
+        return _solve_locked(robot, T, locked)
+    return _solve(robot, T, _plan(robot, True))
+
+
+def _lock(robot: DHRobot, locked: dict[str, float]) -> tuple[DHRobot, list[int], np.ndarray]:
+    """The arm with the named joints turned into fixed rows at their values; their indices and values."""
+    from dataclasses import replace
+
+    from ..errors import ModelError
+
+    idx, vals = [], []
+    for name, value in locked.items():
+        k = int(name[1:]) - 1 if isinstance(name, str) and name[:1] == "q" and name[1:].isdigit() else -1
+        if not 0 <= k < robot.dof:
+            raise ModelError(f"locked: {name!r} is not a joint of {robot.name} (q1 … q{robot.dof})")
+        v = float(value)
+        lo, hi = robot.q_limits[k]
+        if not (np.isfinite(v) and lo - 1e-12 <= v <= hi + 1e-12):
+            raise ModelError(f"locked: {name} = {v:g} is outside its limits [{lo:g}, {hi:g}]")
+        idx.append(k)
+        vals.append(v)
+    rows = [i for i, link in enumerate(robot.links) if link.joint is not JointType.FIXED]
+    links = list(robot.links)
+    for k, v in zip(idx, vals):
+        link = links[rows[k]]
+        rev = link.joint is JointType.REVOLUTE
+        links[rows[k]] = replace(link, theta=link.theta + (v if rev else 0.0), d=link.d + (0.0 if rev else v),
+                                 joint=JointType.FIXED, q_limits=None, symbols=())
+    order = np.argsort(idx)
+    return replace(robot, links=tuple(links)), [idx[i] for i in order], np.array(vals)[order]
+
+
+def _solve_locked(robot: DHRobot, T: np.ndarray, locked: dict[str, float]) -> AnalyticIKResult:
+    reduced, idx, vals = _lock(robot, locked)
+    res = _solve(reduced, T, _plan(reduced, True))
+
+    def widen(q):
+        q = np.asarray(q, dtype=float)
+        for k, v in zip(idx, vals):  # ascending: each insert lands at its final index
+            q = np.insert(q, k, np.where(np.isnan(q[..., :1]).all(axis=-1), np.nan, v) if q.ndim > 2 else v, axis=-1)
+        return q
+
+    names = ", ".join(f"q{k + 1}" for k in idx)
+    outside = res.outside_limits if np.ndim(res.outside_limits) != 2 else widen(res.outside_limits)
+    return replace_result(res, solutions=widen(res.solutions), outside_limits=outside,
+                          method=f"{res.method} ({names} locked)")
+
+
+def replace_result(res: AnalyticIKResult, **kw) -> AnalyticIKResult:
+    from dataclasses import replace
+
+    return replace(res, **kw)
 
 
 def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:

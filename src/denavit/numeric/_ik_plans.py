@@ -10,6 +10,8 @@ A plan is chosen from the geometry of the joint axes (computed from the table, n
 ``planar``    2–4 joints whose axes are all parallel (planar 2R/3R, SCARA, PRRR …): at most one prismatic.
 ``wrist``     3 revolute axes through one point (orientation only).
 ``position``  any other 3-joint arm: the end-effector origin is placed (position only).
+``general``   any other 6R arm: every solution by the Raghavan–Roth / Manocha–Canny eigenvalue method
+              (:mod:`._ik_general`), up to 16.
 
 Coaxial consecutive revolute joints are merged first (their sum is all the pose sees); the result then
 names the free combination.
@@ -25,6 +27,7 @@ import numpy as np
 from ..errors import UnsupportedRobotError
 from ..model import DHRobot
 from ._ik_closed import closed_position, wrist_angles
+from ._ik_general import choose_formulation, loop_of, solve_general
 from ._ik_chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
 from ._ik_subproblems import Position3, rotation3, rz_bilinear, trig_coefficients
 from ._transforms import inverse_transform
@@ -369,11 +372,39 @@ def _mirrored(solve: Callable) -> Callable:
     return run
 
 
-def make_plan(robot: DHRobot, closed_form: bool = True) -> Plan:
+def _generic_rank(chain: Chain, rng) -> int:
+    """Largest rank of the geometric Jacobian over a few random configurations."""
+    best = 0
+    for q in _configs(chain, rng)[1:]:
+        pts, dirs = axis_lines(chain, q)
+        end = chain_fk(chain, q)[:3, 3]
+        cols = [np.concatenate([d, np.zeros(3)]) if pr else np.concatenate([np.cross(d, end - p), d])
+                for p, d, pr in zip(pts, dirs, chain.prismatic)]
+        J = np.array(cols).T
+        best = max(best, int(np.linalg.matrix_rank(J, tol=1e-9 * max(1.0, np.abs(J).max()))))
+    return best
+
+
+def _general_plan(chain: Chain, rng):
+    """The eigenvalue solver of :mod:`._ik_general` for a 6R chain, or None if every formulation degenerates."""
+    form = choose_formulation(chain, rng)
+    if form is None:
+        return None
+
+    def solve(T: np.ndarray):
+        cand, _ = solve_general(loop_of(chain, T), form)
+        return cand, np.full(cand.shape[:-1], "", dtype=object)
+
+    return solve, f"eigenvalue ({'reversed, ' if form.reverse else ''}loop from joint {form.shift + 1})"
+
+
+def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Plan:
     """Recognise the structure of an arm and build its closed-form solver (see module notes).
 
     ``closed_form=False`` keeps Pieper arms of the elbow and Stanford classes on the general resultant route
     (:class:`Position3`) instead of the direct formulas of :mod:`._ik_closed` (used to cross-check them).
+    ``general=True`` sends every 6R arm to the ``general`` eigenvalue solver, closed form or not (the same
+    cross-check for the closed forms of Pieper and UR-type arms).
 
     Raises
     ------
@@ -391,7 +422,15 @@ def make_plan(robot: DHRobot, closed_form: bool = True) -> Plan:
     eye = np.eye(6)
     all_rev = not chain.prismatic.any()
     solve, point, kind, P, route = None, None, "", eye, ""
-    if m == 6:
+    if general:
+        if m != 6 or not all_rev:
+            raise UnsupportedRobotError(f"{robot.name}: the general solver takes 6 revolute joints")
+        found = _general_plan(chain, rng)
+        if found is None:
+            raise UnsupportedRobotError(f"{robot.name}: every formulation of the general 6R solver degenerates")
+        solve, route = found
+        kind = "general"
+    if m == 6 and solve is None:
         if not chain.prismatic[3:].any() and _intersect(chain, (3, 4, 5), rng):
             solve, point, route = _pieper(chain, rng, names, tuple(lim[reps[2]]), closed_form)
             kind = "pieper"
@@ -422,12 +461,22 @@ def make_plan(robot: DHRobot, closed_form: bool = True) -> Plan:
             solve, kind = _position_plan(chain, rng, names, tuple(lim[reps[2]])), "position"
             P = np.zeros((6, 6))
             P[:3, :3] = np.eye(3)
+    if solve is None and m == 6 and all_rev:
+        found = _general_plan(chain, rng)
+        if found is not None:
+            (solve, route), kind = found, "general"
     if solve is None:
         types = "".join("P" if p else "R" for p in full.prismatic)
+        rank = _generic_rank(full, rng)
+        if full.n >= 6 and rank < 6:
+            raise UnsupportedRobotError(
+                f"{robot.name}: this {full.n}-joint {types} arm cannot place its tool in a general pose (its "
+                f"Jacobian has rank {rank} everywhere): no inverse kinematics for full poses; use the numerical "
+                "solver with a position or row mask (solve_ik / --method numeric --mask)")
         raise UnsupportedRobotError(
             f"{robot.name}: no closed-form inverse kinematics for this {full.n}-joint {types} structure "
-            "(known: 6 joints with a spherical wrist, UR-type 6R with three parallel axes, planar/SCARA arms, "
-            "3-joint arms); use the numerical solver (solve_ik / --method numeric)")
+            "(known: 6 joints with a spherical wrist, UR-type 6R with three parallel axes, any other 6R arm, "
+            "planar/SCARA arms, 3-joint arms); use the numerical solver (solve_ik / --method numeric)")
 
     def run(T: np.ndarray):
         q, free = solve(T)

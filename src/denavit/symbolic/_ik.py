@@ -504,4 +504,5 @@ def ik_derivation(robot: DHRobot) -> IKDerivation:
         return _planar(robot)
     raise UnsupportedRobotError(
         f"{robot.name}: the symbolic derivation covers 6-joint arms with a spherical wrist (elbow or Stanford "
-        f"type) and planar 2R/3R arms, not this '{kind}' structure; analytic_ik solves it numerically")
+        f"type) and planar 2R/3R arms, not this '{kind}' structure; analytic_ik solves it numerically"
+        + (" (general 6R eigenvalue method; its steps are in docs/ik.md)" if kind == "general" else ""))
