@@ -48,9 +48,11 @@ _VINV = np.linalg.inv(np.stack([np.ones(3), np.sin(_ANG), np.cos(_ANG)], axis=1)
 # (1, s, c)·(1 + x²) as coefficients of (1, x, x²), x = tan(θ/2)
 _K1 = np.array([[1.0, 0, 1], [0, 2, 0], [1, 0, -1]])
 _K = np.kron(_K1, _K1)
+_V2 = np.kron(_VINV, _VINV)  # 9 samples (θa, θb) → 9 coefficients (a, b)
+_V3 = np.kron(_V2, _VINV)  # 27 samples → 27 coefficients
 REAL_TOL = 1e-6  # |Im x| / (1 + |x|) under which a root of det Σ counts as real
 CLUSTER_TOL = 1e-6  # roots closer than this (relative) are one multiple root
-NULL_TOL = 1e-6  # a second singular value of Σ(x) under this fraction of the largest: null space not 1-D
+_RHS = np.random.default_rng(5).standard_normal((12, 2))  # fixed right-hand sides of the inverse iteration
 PENCIL_RCOND = 1e-11  # reciprocal condition of the leading matrix under which the pencil counts as singular
 
 
@@ -115,8 +117,8 @@ def _lhs_coefficients(G: np.ndarray) -> np.ndarray:
     g = lambda k: G[:, None, None, None, k]  # noqa: E731
     Z = _rz(_ANG)
     T = Z[None, :, None, None] @ g(2) @ Z[None, None, :, None] @ g(3) @ Z[None, None, None, :] @ g(4)
-    F = _quantities(T)  # (B, 3, 3, 3, 14)
-    return np.einsum("ai,bj,ck,zijkq->zqabc", _VINV, _VINV, _VINV, F).reshape(len(G), 14, 3, 9)
+    F = _quantities(T).reshape(len(G), 27, 14)  # samples (θ3, θ4, θ5) in C order
+    return np.swapaxes(_V3 @ F, -1, -2).reshape(len(G), 14, 3, 9)
 
 
 def _rhs_coefficients(G: np.ndarray, W: np.ndarray) -> np.ndarray:
@@ -124,8 +126,8 @@ def _rhs_coefficients(G: np.ndarray, W: np.ndarray) -> np.ndarray:
     Zi = _rz(-_ANG)
     T = (inverse_transform(G[:, None, None, 1]) @ Zi[None, None, :] @ inverse_transform(G[:, None, None, 0])
          @ Zi[None, :, None] @ W[:, None, None])
-    F = _quantities(T)  # (B, 3 (θ1), 3 (θ2), 14)
-    return np.einsum("ai,bj,zijq->zqab", _VINV, _VINV, F).reshape(len(G), 14, 9)
+    F = _quantities(T).reshape(len(G), 9, 14)  # samples (θ1, θ2)
+    return np.swapaxes(_V2 @ F, -1, -2)
 
 
 @dataclass
@@ -146,18 +148,21 @@ def _system(G: np.ndarray, delta: float, rng: np.random.Generator) -> _System:
     R = _rhs_coefficients(G, W)
     P[:, :, 0, 0] -= R[:, :, 0]
     Q = R[:, :, 1:]  # (B, 14, 8)
-    U, s, Vt = np.linalg.svd(Q)
-    rank = np.sum(s > 1e-10 * np.maximum(s[:, :1], 1e-300), axis=-1)
-    N = np.swapaxes(U[:, :, 8:], -1, -2)  # (B, 6, 14): left null space (when rank = 8)
-    low = rank < 8
-    if low.any():  # more than 6 equations are free of θ1, θ2: take 6 random combinations of them
-        for b in np.flatnonzero(low):
-            Nb = U[b, :, rank[b]:].T
-            N[b] = rng.standard_normal((6, len(Nb))) @ Nb
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sinv = np.where(s > 1e-10 * s[:, :1], 1 / s, 0.0)
-    Qpinv = np.swapaxes(Vt, -1, -2) @ (sinv[..., None] * np.swapaxes(U[:, :, :8], -1, -2))
-    E = np.einsum("zpq,zqak->zpak", N, P)  # (B, 6, 3, 9)
+    Qf, Rf = np.linalg.qr(Q, mode="complete")  # (B, 14, 14), (B, 14, 8)
+    diag = np.abs(np.diagonal(Rf[:, :8], axis1=-2, axis2=-1))
+    rank = np.full(len(G), 8)
+    N = np.swapaxes(Qf[:, :, 8:], -1, -2)  # (B, 6, 14): left null space of Q (rank 8)
+    Qpinv = np.empty((len(G), 8, 14))
+    full = diag.min(axis=-1) > 1e-8 * np.maximum(diag.max(axis=-1), 1e-300)
+    if full.any():
+        Qpinv[full] = np.linalg.solve(Rf[full, :8], np.swapaxes(Qf[full, :, :8], -1, -2))
+    for b in np.flatnonzero(~full):  # (nearly) rank-deficient: SVD; more than 6 equations are free of θ1, θ2
+        U, sv, Vt = np.linalg.svd(Q[b])
+        rank[b] = r = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300)))
+        Nb = U[:, r:].T
+        N[b] = Nb[:6] if r == 8 else rng.standard_normal((6, len(Nb))) @ Nb  # 6 random combinations
+        Qpinv[b] = Vt[:r].T @ (U[:, :r] / sv[:r]).T
+    E = (N @ P.reshape(len(G), 14, 27)).reshape(len(G), 6, 3, 9)
     cd, sd = np.cos(delta), np.sin(delta)
     E0, Es, Ec = E[:, :, 0], E[:, :, 1] * cd - E[:, :, 2] * sd, E[:, :, 1] * sd + E[:, :, 2] * cd
 
@@ -175,11 +180,17 @@ def _roots(S: _System) -> tuple[np.ndarray, np.ndarray]:
     """Real roots x3 (B, 24) (NaN elsewhere) of det Σ(x) and whether the pencil was usable (B,)."""
     B = len(S.A)
     x = np.full((B, 24), np.nan)
-    rcond = 1 / np.linalg.cond(S.A)
-    ok = np.isfinite(rcond) & (rcond > PENCIL_RCOND)
+    try:
+        Ai = np.linalg.inv(S.A)
+    except np.linalg.LinAlgError:  # some leading matrix exactly singular: invert one by one
+        Ai = np.stack([np.linalg.pinv(a) for a in S.A])
+    norm1 = lambda M: np.abs(M).sum(axis=-2).max(axis=-1)  # noqa: E731
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rcond = 1 / (norm1(S.A) * norm1(Ai))  # 1-norm reciprocal condition
+    ok = np.isfinite(rcond) & (rcond > PENCIL_RCOND) & np.all(np.isfinite(Ai), axis=(-1, -2))
     if not ok.any():
         return x, ok
-    Ai = np.linalg.inv(S.A[ok])
+    Ai = Ai[ok]
     L = np.zeros((int(ok.sum()), 24, 24))
     L[:, :12, 12:] = np.eye(12)
     L[:, 12:, :12] = -Ai @ S.C[ok]
@@ -191,10 +202,33 @@ def _roots(S: _System) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _null_vectors(S: _System, bi: np.ndarray, xs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Smallest right singular vector ν (N, 12) of Σ(x) at each root, and whether it is the only null vector."""
+    """Null vector ν (N, 12) of Σ(x) at each root, and whether the null space is one-dimensional.
+
+    Inverse iteration: Σ(x)⁻¹ b for two fixed right-hand sides; both results point along the null vector when
+    it is unique (their cosine is 1 to ~σ_min/σ_2), and differ when the null space has more dimensions."""
     x = xs[:, None, None]
-    _, sv, Vt = np.linalg.svd(S.A[bi] * x**2 + S.B[bi] * x + S.C[bi])
-    return Vt[:, -1], sv[:, -2] > NULL_TOL * sv[:, 0]
+    Sig = S.A[bi] * x**2 + S.B[bi] * x + S.C[bi]
+    # a shift of 1e-13 ‖Σ‖ keeps an exactly singular Σ(x) solvable and moves ν by ~1e-13 / σ_2 only
+    Sig = Sig + 1e-13 * np.abs(Sig).max(axis=(-1, -2), keepdims=True) * np.eye(12)
+    with np.errstate(all="ignore"):
+        try:
+            V = np.linalg.solve(Sig, np.broadcast_to(_RHS, (len(xs), 12, 2)))
+        except np.linalg.LinAlgError:  # some Σ(x) exactly singular: per root
+            V = np.stack([_null_pair(M) for M in Sig])
+        V = V / np.linalg.norm(V, axis=-2, keepdims=True)
+        cos = np.abs(np.sum(V[..., 0] * V[..., 1], axis=-1))
+    alone = np.isfinite(cos) & (cos > 1 - 1e-8)
+    return np.nan_to_num(V[..., 0]), alone
+
+
+def _null_pair(M: np.ndarray) -> np.ndarray:
+    """Inverse iteration for one 12×12 Σ(x); if it is exactly singular, its null vector(s) from the SVD (the
+    same vector twice when the null space is one-dimensional)."""
+    try:
+        return np.linalg.solve(M, _RHS)
+    except np.linalg.LinAlgError:
+        _, sv, Vt = np.linalg.svd(M)
+        return Vt[[-1, -1]].T if sv[-2] > 1e-6 * sv[0] else Vt[[-1, -2]].T
 
 
 def _pairs_at(E3: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -290,9 +324,9 @@ def solve_general(G: np.ndarray, form: Formulation, rng: np.random.Generator | N
     rows_b = np.concatenate(rows_b)
     t3, t4, t5 = np.concatenate(rows_t).T
     # θ1, θ2 from the eliminated products: Q n = P(θ3) m(θ4, θ5)
-    m = np.einsum("na,nb->nab", _trig(t4), _trig(t5)).reshape(-1, 9)
-    lhs = np.einsum("nqak,na,nk->nq", S.P[rows_b], _trig(t3), m)
-    n = np.einsum("npq,nq->np", S.Qpinv[rows_b], lhs)  # columns 3d + e − 1 of (1, s1, c1) ⊗ (1, s2, c2)
+    m = (_trig(t4)[:, :, None] * _trig(t5)[:, None, :]).reshape(-1, 9)
+    lhs = ((S.P[rows_b] @ m[:, None, :, None])[..., 0] @ _trig(t3)[..., None])[..., 0]  # (n, 14)
+    n = (S.Qpinv[rows_b] @ lhs[..., None])[..., 0]  # columns 3d + e − 1 of (1, s1, c1) ⊗ (1, s2, c2)
     t1 = np.arctan2(n[:, 2], n[:, 5])
     t2 = np.arctan2(n[:, 0], n[:, 1])
     Gr = Gf[rows_b]
