@@ -148,6 +148,21 @@ def _residual(robot, q: np.ndarray, T: np.ndarray, controlled: str) -> float:
     return max(pos, rot)
 
 
+_GENERAL_STEPS = [Text(
+    "This arm has no spherical wrist and no three parallel axes, so it has no closed form; all its solutions "
+    "(at most 16) are found exactly by the Raghavan-Roth elimination solved as an eigenvalue problem "
+    "(Raghavan & Roth 1993; Manocha & Canny 1994). Step 1: the arm and the target close a loop of six joint "
+    "rotations; looking only at the line of the last joint axis removes q6. Step 2: from a point p and the "
+    "direction l of that line, seen through joints 3-5 on one side and through joints 1-2 and the target on the "
+    "other, the 14 quantities p, l, p.p, p.l, p x l, (p.p) l - 2 (p.l) p are formed; each side is linear in "
+    "products of sines and cosines of its joints. Step 3: the 8 products of q1 and q2 are eliminated, leaving 6 "
+    "equations in q3, q4, q5; with half-angle tangents they become a 12 x 12 matrix quadratic in tan(q3/2). "
+    "Step 4: its determinant vanishes at the real roots of a degree-24 polynomial (8 roots are spurious, +-i), "
+    "found as the eigenvalues of a 24 x 24 matrix. Step 5: q4, q5 follow from the null vector at each root, q1, q2 "
+    "from the eliminated products, q6 from the loop; every candidate is checked by forward kinematics. Which joint "
+    "plays q3 is chosen per arm (12 ways to run the loop).")]
+
+
 def _qtex(q: np.ndarray) -> str:
     return "(" + ",\\ ".join(f"{v:.4f}" for v in q) + ")"
 
@@ -181,13 +196,15 @@ def section_ik(ctx: Context) -> Section:
     steps: list = [Text("Target: the end-effector pose of the numeric case (so at least one solution is known: "
                         "the q of the case)."), Numbers("T_{\\text{target}}", T_world)]
     structure = _capabilities.capability("denavit.numeric", "ik_structure")
+    kind = ""
     if structure is not None:
         try:
-            steps.append(Text(f"Structure recognised from the DH table: {structure[1](robot)}."))
+            kind = structure[1](robot)
+            steps.append(Text(f"Structure recognised from the DH table: {kind}."))
         except Exception as exc:  # UnsupportedRobotError: no closed form at all
             steps.append(Text(f"No closed form: {exc}."))
             return _numeric(ctx, T_world, steps, False)
-    deriv_steps, derived = _derivation_steps(ctx, T_world)
+    deriv_steps, derived = (_GENERAL_STEPS, None) if kind == "general" else _derivation_steps(ctx, T_world)
     steps += deriv_steps
     solutions, branches, free, controlled, outside = _analytic(ctx, T_world, steps)
     if derived is not None:
@@ -200,9 +217,10 @@ def section_ik(ctx: Context) -> Section:
         rows = []
         for k, (s, b, f) in enumerate(zip(solutions, branches, free), start=1):
             err = _residual(robot, s, T_world, controlled)
-            rows.append((str(k), f"\\text{{{b}}}" + (f"\\ \\text{{(a continuum: {f})}}" if f else ""),
+            rows.append((str(k), f"\\text{{{b or '-'}}}" + (f"\\ \\text{{(a continuum: {f})}}" if f else ""),
                          _qtex(s), f"{err:.1e}"))
-        steps.append(Text(f"All {len(solutions)} closed-form solution(s) within the joint limits (analytic_ik), "
+        how = "general 6R eigenvalue method" if kind == "general" else "closed-form"
+        steps.append(Text(f"All {len(solutions)} {how} solution(s) within the joint limits (analytic_ik), "
                           "each checked by forward kinematics:"))
         steps.append(Table(("k", "\\text{branch}", "q_{sol}", "\\text{residual}"), tuple(rows)))
         return Section("ik", "Inverse kinematics", tuple(steps))
