@@ -9,7 +9,11 @@ within the joint limits and reproduces the target to 1e-6 m and 1e-6 rad, checke
 check for every library).  Times are wall-clock per solve: for denavit the batch time divided by the number of
 targets (median and p95 over repeated batches of 1,000); for the peers one call per target.
 Peers (skipped when not importable or when they do not model the arm): roboticstoolbox-python ``ets().ik_LM``
-(C++), IKPy (scipy optimiser, seeded at mid-limits), ik-geo (all solutions of 6R arms by subproblems, Rust).
+(C++), IKPy (scipy optimiser, seeded at mid-limits), ik-geo (all solutions of 6R arms by subproblems, Rust;
+``gen_six_dof``, a 2-D search, for arms with no special structure such as jaco2-6dof).  A row "general 6R
+eigenvalue route" times analytic_ik forced onto the Raghavan–Roth / Manocha–Canny solver on arms that have a
+closed form (on jaco2-6dof it is analytic_ik's own route).  "solutions / target" is the mean number of distinct
+verified solutions returned by the all-solution solvers.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ TOL = 1e-6
 
 def _targets(robot, n, seed=0):
     rng = np.random.default_rng(seed)
-    lim = robot.q_limits
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)  # continuous joints: one turn
     q = rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
     return q, forward_kinematics(robot, q)
 
@@ -66,16 +70,17 @@ def bench_denavit_numeric(robot, T, chunk=1000):
 
 
 def bench_denavit_analytic(robot, q_true, T, chunk=1000):
-    per, found = [], []
+    per, found, count = [], [], []
     for i in range(0, len(T), chunk):
         t0 = time.perf_counter()
         res = analytic_ik(robot, T[i:i + chunk])
         per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
+        count.append(res.count)
         rev = np.array([t.value == "revolute" for t in robot.joint_types])
         d = res.solutions - q_true[i:i + chunk, None]
         d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
         found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
-    return float(np.mean(np.concatenate(found))), *_stats(per)
+    return float(np.mean(np.concatenate(found))), *_stats(per), float(np.mean(np.concatenate(count)))
 
 
 def bench_denavit_resultant(robot, q_true, T, chunk=1000):
@@ -96,6 +101,29 @@ def bench_denavit_resultant(robot, q_true, T, chunk=1000):
         d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
         found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
     return float(np.mean(np.concatenate(found))), *_stats(per)
+
+
+def bench_denavit_general(robot, q_true, T, chunk=1000):
+    """The general 6R eigenvalue route (Raghavan–Roth / Manocha–Canny), forced on any 6R arm (on arms without a
+    closed form it is what analytic_ik uses anyway); also the mean number of solutions per target."""
+    from denavit.errors import UnsupportedRobotError
+    from denavit.numeric._ik_analytic import _plan, _solve
+
+    try:
+        plan = _plan(robot, True, True)
+    except UnsupportedRobotError:
+        return None
+    per, found, count = [], [], []
+    rev = np.array([t.value == "revolute" for t in robot.joint_types])
+    for i in range(0, len(T), chunk):
+        t0 = time.perf_counter()
+        res = _solve(robot, T[i:i + chunk], plan)
+        per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
+        d = res.solutions - q_true[i:i + chunk, None]
+        d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
+        found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
+        count.append(res.count)
+    return float(np.mean(np.concatenate(found))), *_stats(per), float(np.mean(np.concatenate(count)))
 
 
 def bench_rtb(robot, name, T):
@@ -185,7 +213,7 @@ def bench_ikgeo(robot, T):
 
     ch = chain_of(robot)
     kind = ik_structure(robot)
-    if ch.n != 6 or ch.prismatic.any() or kind not in ("pieper", "parallel"):
+    if ch.n != 6 or ch.prismatic.any() or kind not in ("pieper", "parallel", "general"):
         return None
     pts, h = axis_lines(ch, np.zeros(6))
     def meet(idx):  # least-squares common point of the axes idx
@@ -196,20 +224,32 @@ def bench_ikgeo(robot, T):
     if kind == "pieper":
         P[3] = P[4] = P[5] = meet((3, 4, 5))
         make = Robot.spherical_two_parallel if abs(abs(h[1] @ h[2]) - 1) < 1e-9 else Robot.spherical
-    else:
+    elif kind == "parallel":
         P[4] = P[5] = meet((4, 5))
         make = Robot.three_parallel_two_intersecting
+    else:
+        make = Robot.gen_six_dof  # no special structure: ik-geo's 2-D search
     M = forward_kinematics(robot, np.zeros(6))
     p = np.vstack([P[0], np.diff(P, axis=0), M[:3, 3] - P[5]])  # p01, p12, …, p56, p6T
     bot = make(h, p)
-    times, ok = [], []
+    times, ok, count = [], [], []
     for Tk in T:
         R = (Tk[:3, :3] @ M[:3, :3].T).T  # the Python binding reads the 3x3 in column-major order
         t0 = time.perf_counter()
         sols = bot.get_ik(R, Tk[:3, 3])
         times.append(time.perf_counter() - t0)
-        ok.append(any(not ls and _ok(robot, _fold_limits(robot, q), Tk) for q, ls in sols))
-    return float(np.mean(ok)), *_stats(times)
+        good = [q for q, ls in sols if not ls and _ok(robot, _fold_limits(robot, q), Tk)]
+        ok.append(bool(good))
+        count.append(len(_distinct(np.array([_fold_limits(robot, q) for q in good]))) if good else 0)
+    return float(np.mean(ok)), *_stats(times), float(np.mean(count))
+
+
+def _distinct(qs, tol=1e-6):
+    out = []
+    for q in qs:
+        if all(np.abs((q - p + np.pi) % (2 * np.pi) - np.pi).max() > tol for p in out):
+            out.append(q)
+    return out
 
 
 def main(argv=None):
@@ -220,17 +260,19 @@ def main(argv=None):
     ap.add_argument("--markdown", help="also write the table to this Markdown file")
     args = ap.parse_args(argv)
     rows = []
-    for name in args.robot or ["puma560", "ur5", "stanford"]:
+    for name in args.robot or ["puma560", "ur5", "stanford", "jaco2-6dof"]:
         robot = load_robot(name)
         q, T = _targets(robot, args.n)
         s, med, p95 = bench_denavit_numeric(robot, T)
         rows.append((name, "denavit solve_ik (LM, batched)", args.n, s, med, p95))
-        s, med, p95 = bench_denavit_analytic(robot, q, T)
-        rows.append((name, "denavit analytic_ik (all solutions, batched)", args.n, s, med, p95))
+        rows.append((name, "denavit analytic_ik (all solutions, batched)", args.n, *bench_denavit_analytic(robot, q, T)))
         start = len(rows) - 2
         r = bench_denavit_resultant(robot, q, T)
         if r is not None:
             rows.append((name, "denavit analytic_ik, general resultant route", args.n, *r))
+        r = bench_denavit_general(robot, q, T)
+        if r is not None and denavit.numeric.ik_structure(robot) != "general":
+            rows.append((name, "denavit analytic_ik, general 6R eigenvalue route", args.n, *r))
         for label, fn in (("roboticstoolbox ets().ik_LM (per call)", lambda: bench_rtb(robot, name, T[: args.peer_n])),
                           ("IKPy inverse_kinematics_frame (per call)", lambda: bench_ikpy(robot, T[: args.peer_n])),
                           ("ik-geo get_ik (all solutions, per call)", lambda: bench_ikgeo(robot, T[: args.peer_n]))):
@@ -239,10 +281,11 @@ def main(argv=None):
                 rows.append((name, label, args.peer_n, *r))
         for row in rows[start:]:
             print(f"{row[0]:10s} {row[1]:48s} n={row[2]:6d} success {row[3]:.4f}  median {row[4]:8.1f} us  "
-                  f"p95 {row[5]:8.1f} us")
-    table = ["| arm | solver | targets | success (in limits, 1e-6) | median / solve [µs] | p95 / solve [µs] |",
-             "|---|---|---:|---:|---:|---:|"]
-    table += [f"| {a} | {b} | {c} | {d:.4f} | {e:.1f} | {f:.1f} |" for a, b, c, d, e, f in rows]
+                  f"p95 {row[5]:8.1f} us" + (f"  solutions/target {row[6]:.2f}" if len(row) > 6 else ""))
+    table = ["| arm | solver | targets | success (in limits, 1e-6) | median / solve [µs] | p95 / solve [µs] "
+             "| solutions / target |", "|---|---|---:|---:|---:|---:|---:|"]
+    table += [f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.4f} | {r[4]:.1f} | {r[5]:.1f} | "
+              f"{f'{r[6]:.2f}' if len(r) > 6 else '—'} |" for r in rows]
     head = f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} / Python {platform.python_version()} " \
            f"/ numpy {np.__version__} / denavit {denavit.__version__}."
     text = head + "\n\n" + "\n".join(table) + "\n"
