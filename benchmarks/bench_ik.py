@@ -69,21 +69,28 @@ def bench_denavit_numeric(robot, T, chunk=1000):
     return succ, *_stats(per)
 
 
-def bench_denavit_analytic(robot, q_true, T, chunk=1000):
+def _time_all_solutions(robot, q_true, T, solve, chunk=1000):
+    """Time an all-solutions solver over batches; success = the generating q is among the solutions.
+
+    Returns (success, median µs, p95 µs, mean number of solutions per target)."""
     per, found, count = [], [], []
+    rev = np.array([t.value == "revolute" for t in robot.joint_types])
     for i in range(0, len(T), chunk):
         t0 = time.perf_counter()
-        res = analytic_ik(robot, T[i:i + chunk])
+        res = solve(T[i:i + chunk])
         per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
-        count.append(res.count)
-        rev = np.array([t.value == "revolute" for t in robot.joint_types])
         d = res.solutions - q_true[i:i + chunk, None]
         d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
         found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
+        count.append(res.count)
     return float(np.mean(np.concatenate(found))), *_stats(per), float(np.mean(np.concatenate(count)))
 
 
-def bench_denavit_resultant(robot, q_true, T, chunk=1000):
+def bench_denavit_analytic(robot, q_true, T):
+    return _time_all_solutions(robot, q_true, T, lambda Tb: analytic_ik(robot, Tb))
+
+
+def bench_denavit_resultant(robot, q_true, T):
     """The same pipeline forced onto the general resultant route (companion-matrix roots + polish) that Pieper arms
     used before the direct closed forms; None for arms the closed forms do not cover."""
     from denavit.numeric._ik_analytic import _plan, _solve
@@ -91,21 +98,12 @@ def bench_denavit_resultant(robot, q_true, T, chunk=1000):
     if not _plan(robot, True).route.startswith("closed form"):
         return None
     plan = _plan(robot, False)
-    per, found = [], []
-    rev = np.array([t.value == "revolute" for t in robot.joint_types])
-    for i in range(0, len(T), chunk):
-        t0 = time.perf_counter()
-        res = _solve(robot, T[i:i + chunk], plan)
-        per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
-        d = res.solutions - q_true[i:i + chunk, None]
-        d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
-        found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
-    return float(np.mean(np.concatenate(found))), *_stats(per)
+    return _time_all_solutions(robot, q_true, T, lambda Tb: _solve(robot, Tb, plan))[:3]
 
 
-def bench_denavit_general(robot, q_true, T, chunk=1000):
+def bench_denavit_general(robot, q_true, T):
     """The general 6R eigenvalue route (Raghavan–Roth / Manocha–Canny), forced on any 6R arm (on arms without a
-    closed form it is what analytic_ik uses anyway); also the mean number of solutions per target."""
+    closed form it is what analytic_ik uses anyway)."""
     from denavit.errors import UnsupportedRobotError
     from denavit.numeric._ik_analytic import _plan, _solve
 
@@ -113,17 +111,7 @@ def bench_denavit_general(robot, q_true, T, chunk=1000):
         plan = _plan(robot, True, True)
     except UnsupportedRobotError:
         return None
-    per, found, count = [], [], []
-    rev = np.array([t.value == "revolute" for t in robot.joint_types])
-    for i in range(0, len(T), chunk):
-        t0 = time.perf_counter()
-        res = _solve(robot, T[i:i + chunk], plan)
-        per.append((time.perf_counter() - t0) / len(T[i:i + chunk]))
-        d = res.solutions - q_true[i:i + chunk, None]
-        d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d))
-        found.append(np.nanmin(np.where(res.valid, d.max(axis=-1), np.inf), axis=1) < 1e-6)
-        count.append(res.count)
-    return float(np.mean(np.concatenate(found))), *_stats(per), float(np.mean(np.concatenate(count)))
+    return _time_all_solutions(robot, q_true, T, lambda Tb: _solve(robot, Tb, plan))
 
 
 def bench_rtb(robot, name, T):
