@@ -230,25 +230,22 @@ def _lock(robot: DHRobot, locked: dict[str, float]) -> tuple[DHRobot, list[int],
 
 
 def _solve_locked(robot: DHRobot, T: np.ndarray, locked: dict[str, float]) -> AnalyticIKResult:
+    """Solve the arm with the named joints held (fixed rows), then put their values back into every row."""
+    from dataclasses import replace
+
     reduced, idx, vals = _lock(robot, locked)
     res = _solve(reduced, T, _plan(reduced, True))
 
-    def widen(q):
+    def widen(q):  # ascending indices: each insert lands at its final place; unused (NaN) rows stay NaN
         q = np.asarray(q, dtype=float)
-        for k, v in zip(idx, vals):  # ascending: each insert lands at its final index
-            q = np.insert(q, k, np.where(np.isnan(q[..., :1]).all(axis=-1), np.nan, v) if q.ndim > 2 else v, axis=-1)
-        return q
+        unused = np.isnan(q).all(axis=-1, keepdims=True)
+        for k, v in zip(idx, vals):
+            q = np.insert(q, k, v, axis=-1)
+        return np.where(unused, np.nan, q)
 
+    outside = widen(res.outside_limits) if np.ndim(res.outside_limits) == 2 else res.outside_limits
     names = ", ".join(f"q{k + 1}" for k in idx)
-    outside = res.outside_limits if np.ndim(res.outside_limits) != 2 else widen(res.outside_limits)
-    return replace_result(res, solutions=widen(res.solutions), outside_limits=outside,
-                          method=f"{res.method} ({names} locked)")
-
-
-def replace_result(res: AnalyticIKResult, **kw) -> AnalyticIKResult:
-    from dataclasses import replace
-
-    return replace(res, **kw)
+    return replace(res, solutions=widen(res.solutions), outside_limits=outside, method=f"{res.method} ({names} locked)")
 
 
 def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._ik_chain import Chain
+from ._ik_chain import Chain, joint_motion
 from ._transforms import inverse_transform
 
 __all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "solve_general", "MAX_SOLUTIONS"]
@@ -97,12 +97,7 @@ def loop_of(chain: Chain, T: np.ndarray) -> np.ndarray:
 
 
 def _rz(t: np.ndarray) -> np.ndarray:
-    t = np.asarray(t, dtype=float)
-    c, s = np.cos(t), np.sin(t)
-    R = np.zeros(t.shape + (4, 4))
-    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1] = c, -s, s, c
-    R[..., 2, 2] = R[..., 3, 3] = 1.0
-    return R
+    return joint_motion(False, t)
 
 
 def _quantities(T: np.ndarray) -> np.ndarray:
@@ -139,7 +134,6 @@ class _System:
     E: np.ndarray  # (B, 6, 3, 9) the 6 equations: Σ_a,k E[:, :, a, k] t3_a m_k(θ4, θ5) = 0 (θ3 unshifted)
     P: np.ndarray  # (B, 14, 3, 9) with the RHS constant moved in
     Qpinv: np.ndarray  # (B, 8, 14)
-    rank: np.ndarray  # (B,) rank of Q
     W: np.ndarray  # (B, 4, 4)
 
 
@@ -151,7 +145,6 @@ def _system(G: np.ndarray, delta: float, rng: np.random.Generator) -> _System:
     Q = R[:, :, 1:]  # (B, 14, 8)
     Qf, Rf = np.linalg.qr(Q, mode="complete")  # (B, 14, 14), (B, 14, 8)
     diag = np.abs(np.diagonal(Rf[:, :8], axis1=-2, axis2=-1))
-    rank = np.full(len(G), 8)
     N = np.swapaxes(Qf[:, :, 8:], -1, -2)  # (B, 6, 14): left null space of Q (rank 8)
     Qpinv = np.empty((len(G), 8, 14))
     full = diag.min(axis=-1) > 1e-8 * np.maximum(diag.max(axis=-1), 1e-300)
@@ -159,7 +152,7 @@ def _system(G: np.ndarray, delta: float, rng: np.random.Generator) -> _System:
         Qpinv[full] = np.linalg.solve(Rf[full, :8], np.swapaxes(Qf[full, :, :8], -1, -2))
     for b in np.flatnonzero(~full):  # (nearly) rank-deficient: SVD; more than 6 equations are free of θ1, θ2
         U, sv, Vt = np.linalg.svd(Q[b])
-        rank[b] = r = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300)))
+        r = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300)))
         Nb = U[:, r:].T
         N[b] = Nb[:6] if r == 8 else rng.standard_normal((6, len(Nb))) @ Nb  # 6 random combinations
         Qpinv[b] = Vt[:r].T @ (U[:, :r] / sv[:r]).T
@@ -174,7 +167,7 @@ def _system(G: np.ndarray, delta: float, rng: np.random.Generator) -> _System:
         M[:, 6:, 3:] = M6
         return M
 
-    return _System(big(E0 - Ec), big(2 * Es), big(E0 + Ec), E, P, Qpinv, rank, W)
+    return _System(big(E0 - Ec), big(2 * Es), big(E0 + Ec), E, P, Qpinv, W)
 
 
 def _roots(S: _System) -> tuple[np.ndarray, np.ndarray]:
@@ -344,13 +337,6 @@ def solve_general(G: np.ndarray, form: Formulation, rng: np.random.Generator | N
     cand[rb[keep], slot[keep]] = theta[order][keep]
     used = int(slot.max()) + 1 if len(slot) else 0
     return cand[:, : max(MAX_SOLUTIONS, used)], usable
-
-
-def _loop_residual(G: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    M = np.broadcast_to(np.eye(4), theta.shape[:-1] + (4, 4))
-    for k in range(6):
-        M = M @ _rz(theta[..., k]) @ G[..., k, :, :]
-    return np.abs(M - np.eye(4)).max(axis=(-1, -2))
 
 
 def choose_formulation(chain: Chain, rng: np.random.Generator, tries: int = 4) -> Formulation | None:

@@ -372,17 +372,12 @@ def _mirrored(solve: Callable) -> Callable:
     return run
 
 
-def _generic_rank(chain: Chain, rng) -> int:
+def _generic_rank(robot: DHRobot, rng) -> int:
     """Largest rank of the geometric Jacobian over a few random configurations."""
-    best = 0
-    for q in _configs(chain, rng)[1:]:
-        pts, dirs = axis_lines(chain, q)
-        end = chain_fk(chain, q)[:3, 3]
-        cols = [np.concatenate([d, np.zeros(3)]) if pr else np.concatenate([np.cross(d, end - p), d])
-                for p, d, pr in zip(pts, dirs, chain.prismatic)]
-        J = np.array(cols).T
-        best = max(best, int(np.linalg.matrix_rank(J, tol=1e-9 * max(1.0, np.abs(J).max()))))
-    return best
+    from ._jacobians import geometric_jacobian
+
+    J = geometric_jacobian(robot, rng.uniform(-np.pi, np.pi, (3, robot.dof)))
+    return int(max(np.linalg.matrix_rank(Jk, tol=1e-9 * max(1.0, np.abs(Jk).max())) for Jk in J))
 
 
 def _general_plan(chain: Chain, rng):
@@ -467,7 +462,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
             (solve, route), kind = found, "general"
     if solve is None:
         types = "".join("P" if p else "R" for p in full.prismatic)
-        rank = _generic_rank(full, rng)
+        rank = _generic_rank(robot, rng)
         if full.n >= 6 and rank < 6:
             raise UnsupportedRobotError(
                 f"{robot.name}: this {full.n}-joint {types} arm cannot place its tool in a general pose (its "
