@@ -244,3 +244,21 @@ def test_unknown_rows_are_rejected():
 
     with pytest.raises(ValueError, match="choose from vx, vy, vz, wx, wy, wz"):
         singularity_analysis(load_robot("planar2r"), "vx,vq")
+
+
+def test_irrational_constant_factor_is_kept_not_truncated():
+    """A wrist with 60° twists: det of the angular rows is sin α1 sin α2 sin q2 = (3/4) sin q2 (by hand).
+    The constant 3/4 was once truncated to the integer 0, which declared such arms (jaco2-6dof) singular
+    everywhere."""
+    import sympy as sp
+
+    from denavit import Convention, DHLink, DHRobot
+    from denavit.symbolic import joint_symbols, singularity_analysis
+
+    robot = DHRobot(name="wrist60", links=(DHLink(alpha=np.pi / 3), DHLink(alpha=np.pi / 3), DHLink()),
+                    convention=Convention.STANDARD)
+    result = singularity_analysis(robot, "wx,wy,wz")
+    assert not result.everywhere
+    assert sp.simplify(sp.Mul(*result.constant_factors) - sp.Rational(3, 4)) == 0
+    q2 = joint_symbols(3).q[1]
+    assert [c.factor for c in result.conditions] == [sp.sin(q2)]

@@ -146,7 +146,7 @@ def _factors(exprs: list[sp.Expr], q) -> tuple[sp.Expr, list[tuple[sp.Expr, int]
     for p in polys[1:]:
         g = sp.gcd(g, p)
     coeff, facs = sp.factor_list(g)
-    const, out = sp.Integer(coeff), []
+    const, out = (coeff if isinstance(coeff, sp.Basic) else sp.Integer(coeff)), []  # may be √3/4, not an integer
     for f, mult in facs:
         f = reduce_trig(_from_poly(f, q), q)
         if not f.has(*q):
