@@ -1,0 +1,184 @@
+"""The contract every bad input must meet, and a runner that checks it (issue 14).
+
+A bad input — a robot file, a claims file, a pasted table, a command-line value, an output path — must end with
+
+* exit code 2,
+* exactly one line on stderr, naming what and where, with no traceback and no "internal error",
+* nothing on stdout,
+* nothing the user had written or overwritten (every file in the case's folder keeps its bytes; no new file
+  appears unless the case says so),
+* within a time bound (a hang is reported as such) and, for the cases run in a child process, a memory bound.
+
+``run_cli`` runs ``denavit.cli.main`` in this process with stdout/stderr captured and a wall-clock alarm;
+``run_cli_limited`` runs it in a child Python with an address-space limit, for the memory-bomb families.
+``assert_refused`` checks the contract on an outcome.  Hostile test files build cases (hypothesis strategies
+and specific triggers) and call these two.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import io
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping, Sequence
+
+#: Wall-clock bound for one bad input run in-process (generous: the machine is shared and noisy).
+TIME_LIMIT = 10.0
+#: Address-space bound for the child-process runner (bytes).
+MEMORY_LIMIT = 3 * 1024**3
+
+
+class Hang(BaseException):
+    """Raised by the alarm: the case ran past its time bound (BaseException, so ``except Exception`` lets it by)."""
+
+
+@dataclass
+class Outcome:
+    argv: list[str]
+    code: int | None
+    out: str
+    err: str
+    seconds: float
+    hung: bool = False
+    before: dict[str, str] = field(default_factory=dict)   # file name -> sha256 before the run
+    after: dict[str, str] = field(default_factory=dict)    # ... and after
+
+    def describe(self) -> str:
+        return (f"argv={self.argv!r} code={self.code} hung={self.hung} t={self.seconds:.2f}s\n"
+                f"stderr={self.err[:600]!r}\nstdout={self.out[:300]!r}")
+
+
+def _hashes(folder: Path) -> dict[str, str]:
+    found = {}
+    for p in sorted(folder.rglob("*")):
+        if p.is_file() and not p.is_symlink():
+            found[str(p.relative_to(folder))] = hashlib.sha256(p.read_bytes()).hexdigest()
+        elif p.exists() and not p.is_dir():
+            found[str(p.relative_to(folder))] = "special"
+    return found
+
+
+def write_files(folder: Path, files: Mapping[str, str | bytes] | None) -> None:
+    for name, content in (files or {}).items():
+        path = folder / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content, encoding="utf-8", errors="surrogatepass")
+
+
+def run_cli(argv: Sequence[str], folder: Path, files: Mapping[str, str | bytes] | None = None,
+            time_limit: float = TIME_LIMIT) -> Outcome:
+    """Run ``denavit`` with ``argv`` inside ``folder`` (files written there first); never raises."""
+    from denavit.cli import main
+
+    write_files(folder, files)
+    before = _hashes(folder)
+    out, err = io.StringIO(), io.StringIO()
+    old_cwd = os.getcwd()
+    hung = False
+    code: int | None = None
+
+    def alarm(signum, frame):  # noqa: ARG001
+        raise Hang()
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    t0 = time.perf_counter()
+    try:
+        os.chdir(folder)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), warnings.catch_warnings():
+            warnings.simplefilter("default")  # as a user's interpreter would: warnings shown, on stderr
+            signal.setitimer(signal.ITIMER_REAL, time_limit)
+            try:
+                code = main(list(argv))
+            except Hang:
+                hung = True
+            except SystemExit as exc:  # main() should never let one escape; recorded as its code
+                code = exc.code if isinstance(exc.code, int) else 1
+            finally:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+        os.chdir(old_cwd)
+    seconds = time.perf_counter() - t0
+    return Outcome(list(argv), code, out.getvalue(), err.getvalue(), seconds, hung, before, _hashes(folder))
+
+
+_CHILD = r"""
+import json, os, resource, sys, time, io, contextlib
+limit = int(sys.argv[1])
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+argv = json.loads(sys.argv[2])
+from denavit.cli import main
+out, err = io.StringIO(), io.StringIO()
+t0 = time.perf_counter()
+try:
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+except MemoryError:
+    code = "MemoryError"
+print(json.dumps({"code": code, "out": out.getvalue(), "err": err.getvalue(), "t": time.perf_counter() - t0}))
+"""
+
+
+def run_cli_limited(argv: Sequence[str], folder: Path, files: Mapping[str, str | bytes] | None = None,
+                    time_limit: float = 3 * TIME_LIMIT, memory_limit: int = MEMORY_LIMIT) -> Outcome:
+    """Run ``denavit`` in a child Python with an address-space limit; a MemoryError or a kill is a failure."""
+    write_files(folder, files)
+    before = _hashes(folder)
+    t0 = time.perf_counter()
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env.pop("DENAVIT_DEBUG", None)
+    try:
+        proc = subprocess.run([sys.executable, "-c", _CHILD, str(memory_limit), json.dumps(list(argv))],
+                              cwd=folder, capture_output=True, text=True, timeout=time_limit, env=env,
+                              stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        return Outcome(list(argv), None, "", "", time.perf_counter() - t0, True, before, _hashes(folder))
+    seconds = time.perf_counter() - t0
+    try:
+        got = json.loads(proc.stdout.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        return Outcome(list(argv), None, proc.stdout, f"child died (rc {proc.returncode}): {proc.stderr[-800:]}",
+                       seconds, False, before, _hashes(folder))
+    code = got["code"] if isinstance(got["code"], int) else None
+    err = got["err"] if code is not None else f"MemoryError\n{got['err']}"
+    return Outcome(list(argv), code, got["out"], err, got["t"], False, before, _hashes(folder))
+
+
+def assert_refused(o: Outcome, *, mentions: Sequence[str] = (), new_files: Sequence[str] = ()) -> None:
+    """The contract for a bad input (see the module docstring).
+
+    ``mentions``: substrings the error line must contain (case-insensitive), e.g. the file name, the row, the
+    field. ``new_files``: names that may appear (none by default).
+    """
+    assert not o.hung, f"hung past the time bound\n{o.describe()}"
+    assert o.code == 2, f"expected exit code 2\n{o.describe()}"
+    lines = o.err.strip().splitlines()
+    assert len(lines) == 1, f"expected exactly one line on stderr\n{o.describe()}"
+    line = lines[0]
+    assert "Traceback" not in o.err and "internal error" not in line, o.describe()
+    assert "error" in line.lower(), o.describe()
+    assert o.out == "", f"nothing may be printed on stdout\n{o.describe()}"
+    for text in mentions:
+        assert text.lower() in line.lower(), f"error line should mention {text!r}\n{o.describe()}"
+    changed = {k for k in o.before if o.after.get(k) != o.before[k]}
+    assert not changed, f"files changed or removed: {sorted(changed)}\n{o.describe()}"
+    appeared = set(o.after) - set(o.before) - set(new_files)
+    assert not appeared, f"files appeared: {sorted(appeared)}\n{o.describe()}"
+
+
+def assert_accepted_quietly(o: Outcome) -> None:
+    """A good input (the control case of a hostile family): exit 0, no hang, no traceback."""
+    assert not o.hung and o.code == 0, o.describe()
+    assert "Traceback" not in o.err and "internal error" not in o.err, o.describe()
