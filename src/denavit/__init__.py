@@ -19,6 +19,7 @@ from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
+from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 
 __version__ = "0.1.0"
 
@@ -51,6 +52,11 @@ __all__ = [
     "gravity_torques",
     "forward_dynamics",
     "simulate",
+    "coriolis_vector",
+    "friction_torques",
+    "kinetic_energy",
+    "potential_energy",
+    "mass_matrix_derivatives",
     "end_effector_twist",
     "force_propagation",
     "joint_torques",
