@@ -87,3 +87,50 @@ def test_exact_values_stay_exact():
     assert all(e.is_Rational or e.is_Integer for e in T0)
     np.testing.assert_allclose(np.array(T0, dtype=float), forward_kinematics(robot, np.zeros(6)), atol=1e-12)
     assert len(link_matrices_sym(robot)) == robot.n_rows
+
+
+def _shorthand_back(e, q):
+    """Undo the C/S shorthand independently of denavit: C23 → cos(q2 + q3), S1 → sin(q1)."""
+    back = {}
+    for s in e.free_symbols:
+        name = s.name
+        if name[:1] in "CS" and name[1:].isdigit():
+            angle = sum(q[int(d) - 1] for d in name[1:])
+            back[s] = (sp.cos if name[0] == "C" else sp.sin)(angle)
+    return e.xreplace(back)
+
+
+@pytest.mark.parametrize("policy", ["trig", "none"])
+@pytest.mark.parametrize("how", ["JointSymbols", "tuple", "list"])
+def test_shorthand_matrix_on_puma_t06_collapses_sums_and_means_the_same(policy, how):
+    # issue 16: shorthand_matrix(T, joint_symbols(6)) did nothing (it needed .q); with simplify="none" the
+    # products cos(q2)cos(q3) − sin(q2)sin(q3) must still read C23.
+    from denavit.symbolic import shorthand_matrix
+
+    robot = denavit.load_robot("puma560")
+    js = joint_symbols(6)
+    q = js.q
+    T = forward_kinematics_sym(robot, simplify=policy)
+    arg = {"JointSymbols": js, "tuple": tuple(q), "list": list(q)}[how]
+    S = shorthand_matrix(T, arg)
+    assert not S.atoms(sp.cos, sp.sin)  # every sine and cosine became a C/S symbol: no cos(q2 + q3) left
+    assert sp.Symbol("C23", real=True) in S.free_symbols and sp.Symbol("S23", real=True) in S.free_symbols
+    assert not any(t.has(sp.Symbol("C2", real=True)) and t.has(sp.Symbol("C3", real=True))
+                   for t in sp.Add.make_args(sp.expand(S[0, 3])))
+    back = sp.ImmutableMatrix(_shorthand_back(S, q))
+    # equal to the original: exactly (trig identities expanded on both sides), and at random angles
+    assert sp.expand(sp.expand_trig(back - T)) == sp.zeros(4, 4)
+    params = {parameter_symbols(robot)[k]: v for k, v in robot.parameter_values.items()}
+    fb = sp.lambdify([q], back.subs(params), "numpy")
+    ft = sp.lambdify([q], T.subs(params), "numpy")
+    rng = np.random.default_rng(16)
+    for qv in rng.uniform(-np.pi, np.pi, (5, 6)):
+        np.testing.assert_allclose(fb(qv), ft(qv), atol=1e-12)
+        np.testing.assert_allclose(fb(qv), forward_kinematics(robot, qv), atol=1e-9)
+
+
+def test_shorthand_refuses_what_is_not_joint_variables():
+    from denavit.symbolic import shorthand_matrix
+
+    with pytest.raises(TypeError, match="symbols"):
+        shorthand_matrix(sp.eye(2), ["q1", "q2"])

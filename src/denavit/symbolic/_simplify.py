@@ -55,12 +55,44 @@ def _digits(arg: sp.Expr, qs: dict[sp.Symbol, int]) -> str | None:
     return "".join(str(i) for i in idx) if max(idx) < 10 else "_".join(str(i) for i in idx)
 
 
-def shorthand(e: sp.Expr, q: tuple[sp.Symbol, ...], style: str = "C") -> sp.Expr:
+def _joint_variables(q) -> tuple[sp.Symbol, ...]:
+    """The joint variables q1…qn from a JointSymbols object, a tuple/list of symbols or one symbol."""
+    q = getattr(q, "q", q)  # JointSymbols → its q (iterating it would give the (q, qd, qdd) tuples)
+    if isinstance(q, sp.Symbol):
+        return (q,)
+    try:
+        qs = tuple(q)
+    except TypeError:
+        raise TypeError(f"joint variables must be symbols or a JointSymbols object, not {type(q).__name__}") from None
+    bad = [s for s in qs if not isinstance(s, sp.Symbol)]
+    if bad:
+        raise TypeError(f"joint variables must be sympy symbols, got {bad[0]!r}")
+    return qs
+
+
+def shorthand(e: sp.Expr, q, style: str = "C") -> sp.Expr:
     """Replace cos(q1 + q2) by the symbol C12, sin(q3) by S3 (``style="c"`` gives c12, s3).
 
-    For display only: the result uses plain symbols and is not meant to be computed with.
+    ``q`` is the joint variables: a :class:`JointSymbols` object (``joint_symbols(n)``) or a sequence of
+    symbols. Products that are angle sums (cos q2 cos q3 − sin q2 sin q3) are collapsed first (Fu's TR10i),
+    so the result reads C23, not C2*C3 - S2*S3. For display only: the result uses plain symbols and is not
+    meant to be computed with.
+
+    Examples
+    --------
+    >>> import sympy as sp
+    >>> from denavit.symbolic import joint_symbols
+    >>> q1, q2 = joint_symbols(2).q
+    >>> shorthand(sp.cos(q1) * sp.cos(q2) - sp.sin(q1) * sp.sin(q2) + sp.sin(q2), joint_symbols(2))
+    C12 + S2
     """
-    qs = {s: i + 1 for i, s in enumerate(q)}
+    qs = {s: i + 1 for i, s in enumerate(_joint_variables(q))}
+    if isinstance(e, sp.Basic) and e.has(sp.sin, sp.cos):
+        terms = sp.Add.make_args(sp.expand(e))
+        if any(isinstance(t, sp.Mul) and len(t.atoms(sp.sin, sp.cos)) > 1 for t in terms) and not (
+            e.has(sp.Float) and len(terms) > 24  # same bound as the "trig" policy: float geometry stays as is
+        ):
+            e = TR10i(sp.expand(e))
     cname, sname = ("C", "S") if style == "C" else ("c", "s")
     repl: dict[sp.Expr, sp.Expr] = {}
     for f in e.atoms(sp.cos, sp.sin):
@@ -71,7 +103,9 @@ def shorthand(e: sp.Expr, q: tuple[sp.Symbol, ...], style: str = "C") -> sp.Expr
 
 
 def shorthand_matrix(M: sp.MatrixBase, q, style: str = "C") -> sp.ImmutableMatrix:
-    return sp.ImmutableMatrix(M.shape[0], M.shape[1], [shorthand(e, q, style) for e in M])
+    """:func:`shorthand` applied to every entry of ``M`` (``q``: JointSymbols or a sequence of symbols)."""
+    qs = _joint_variables(q)
+    return sp.ImmutableMatrix(M.shape[0], M.shape[1], [shorthand(e, qs, style) for e in M])
 
 
 Simplifier = Callable[[sp.Expr], sp.Expr]
