@@ -66,6 +66,11 @@ class AnalyticIKResult:
     controlled: str
     valid: np.ndarray
 
+    def _repr_html_(self) -> str:
+        from ..display import ik_html
+
+        return ik_html(self)
+
     @property
     def count(self):
         """Number of solutions (per pose for a batch)."""

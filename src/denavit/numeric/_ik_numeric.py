@@ -69,6 +69,11 @@ class IKResult:
     restarts: Any
     reason: Any
 
+    def _repr_html_(self) -> str:
+        from ..display import ik_html
+
+        return ik_html(self)
+
 
 def row_mask(mask: str | Sequence[bool] | None, dof: int | None = None) -> np.ndarray:
     """Which pose rows (x, y, z, ωx, ωy, ωz) to match: ``"pose"``, ``"position"``, or 6 booleans."""

@@ -114,6 +114,11 @@ class Derivation:
                 return s
         raise KeyError(f"no section {key!r}; sections: {', '.join(s.key for s in self.sections)}")
 
+    def _repr_markdown_(self) -> str:
+        from ..display import derivation_markdown
+
+        return derivation_markdown(self)
+
 
 TOPICS = (
     "model", "links", "fk", "case", "jacobian", "velocity", "statics", "singularities", "ik", "dynamics", "figures",

@@ -55,6 +55,11 @@ class DynamicsTerms:
     qd: tuple[sp.Symbol, ...]
     qdd: tuple[sp.Symbol, ...]
 
+    def _repr_latex_(self) -> str:
+        from ..display import dynamics_latex
+
+        return dynamics_latex(self)
+
     @property
     def tau(self) -> sp.ImmutableMatrix:
         """τ = M q̈ + c + g + τ_f."""
@@ -371,5 +376,7 @@ def _tex_label(label: str) -> str:
     if "[" not in label:
         return label.replace("x", "x_{", 1) + "}" if label.startswith("x") else label
     name, idx = label[:-1].split("[")
+    if name == "friction":  # one subscript: \tau_{f}_{1} is a LaTeX error
+        return f"\\tau_{{f,{idx.replace(',', '')}}}"
     name = {"friction": "\\tau_{f}", "M": "M", "c": "c", "g": "g", "C": "C"}[name]
     return f"{name}_{{{idx.replace(',', '')}}}"

@@ -119,6 +119,9 @@ class IKDerivation:
                 out += [f"$$ {_latex(s.lhs)} {_rel(s.relation)} {_latex(s.rhs)} $$", ""]
         return "\n".join(out)
 
+    def _repr_markdown_(self) -> str:
+        return self.to_markdown()
+
 
 def _text(e: Any) -> str:
     if isinstance(e, sp.MatrixBase):
