@@ -79,7 +79,7 @@ def test_analytic_round_trip_and_generating_q(name):
     # the generating configuration is among the solutions (away from singular poses, where two
     # solutions merge and joint values are ill-conditioned)
     dist = np.nanmin(np.where(res.valid, _joint_distance(robot, res.solutions, q[:, None]), np.inf), axis=1)
-    if name == "report000-6r":  # coaxial joints 1, 2: only q1 + q2 is determined
+    if name == "coaxial-6r":  # (was report000-6r) coaxial joints 1, 2: only q1 + q2 is determined
         qs = q.copy()
         qs[:, 0] += qs[:, 1]
         qs[:, 1] = 0.0

@@ -27,8 +27,10 @@ __all__ = [
     "dump_robot",
     "save_robot",
     "catalogue_names",
+    "CATALOGUE_ALIASES",
     "with_parameters",
     "parse_values",
+    "resolve_pose",
 ]
 
 MAX_FILE_BYTES = 1_000_000
@@ -39,6 +41,7 @@ _RESERVED = set(_expr.FUNCTIONS) | {"pi", "q"}
 _ROW_KEYS = {"a", "alpha", "d", "theta", "limits", "inertia", "name"}
 _TOP_KEYS = {
     "name", "description", "convention", "angle_unit", "parameters", "joints", "tool", "base", "gravity", "source",
+    "poses",
 }
 _INERTIA_KEYS = {"mass", "com", "inertia", "motor_inertia", "viscous", "coulomb"}
 
@@ -51,8 +54,18 @@ def _catalogue_dir():
     return resources.files("denavit") / "data" / "robots"
 
 
+# old catalogue names (after the student report each arm came from) -> current names; still loadable
+CATALOGUE_ALIASES = {
+    "report000-6r": "coaxial-6r", "report000-planar3r": "planar3r-lagrange", "report001-6r": "offset-6r",
+    "report003-6r": "elbow-6r-deg", "report004-1-planar2r": "planar2r-mdh", "report004-2-planar3r": "planar3r-mdh",
+    "report004-3-articulated-rrr": "articulated-rrr", "report004-4-rrp": "spherical-rrp",
+    "report004-5-rpp-cylindrical": "cylindrical-rpp", "report004-6-wrist3r": "spherical-wrist",
+    "report004-7-scara-rrrp": "scara-rrrp", "report004-8-prrr": "lift-prrr",
+}
+
+
 def catalogue_names() -> list[str]:
-    """Names of the built-in robots, sorted."""
+    """Names of the built-in robots, sorted (old names in :data:`CATALOGUE_ALIASES` also load)."""
     return sorted(p.name[:-5] for p in _catalogue_dir().iterdir() if p.name.endswith(".yaml"))
 
 
@@ -77,7 +90,7 @@ def load_robot(source: str | Path, **parameters: float) -> DHRobot:
         data = _load_text(text, path.suffix.lower(), str(path))
         robot = robot_from_dict(data, where=str(path))
     else:
-        name = str(source)
+        name = CATALOGUE_ALIASES.get(str(source), str(source))
         if name not in catalogue_names():
             raise ParseError(
                 f"unknown robot {name!r}: not a file and not a built-in name; built-in: {', '.join(catalogue_names())}"
@@ -378,6 +391,7 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
     if not isinstance(gravity, list) or len(gravity) != 3:
         raise ParseError("gravity must be a list of 3 values [m/s²]", where=f"{where}: gravity")
     g = tuple(ctx.number(v, "gravity")[0] for v in gravity)
+    poses = _poses(data.get("poses"), [link.joint for link in links if link.is_joint], ctx)
     try:
         return DHRobot(
             name=str(data.get("name", Path(where).stem)),
@@ -389,9 +403,37 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
             parameters=tuple(params.items()),
             description=str(data.get("description", "")),
             source=str(data.get("source", where)),
+            poses=poses,
         )
     except ModelError as exc:
         raise ParseError(str(exc), where=where) from None
+
+
+def _poses(raw: Any, joints: list[JointType], ctx: _Ctx) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    """``poses: {qr: [...], ...}``: each value read like a DH field (angles in the file's angle_unit)."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict):
+        raise ctx.fail("poses", "'poses' must be a mapping of name: [one value per joint]")
+    out = []
+    for name, values in raw.items():
+        place = f"poses.{str(name)[:40]}"
+        if not isinstance(values, list) or len(values) != len(joints):
+            raise ctx.fail(place, f"expected a list of {len(joints)} values (one per joint)")
+        out.append((str(name), tuple(ctx.number(v, place, angle=j is JointType.REVOLUTE)[0]
+                                     for v, j in zip(values, joints))))
+    return tuple(out)
+
+
+def resolve_pose(robot: DHRobot, text: str) -> np.ndarray | None:
+    """The joint values of the named pose ``text`` of ``robot`` (``"qr"``), or None when it names none.
+
+    >>> resolve_pose(load_robot("puma560"), "qz")
+    array([0., 0., 0., 0., 0., 0.])
+    """
+    poses = dict(robot.poses)
+    key = text.strip() if isinstance(text, str) else None
+    return np.array(poses[key], dtype=float) if key in poses else None
 
 
 def _safe_names(value: Any) -> set[str]:
@@ -517,6 +559,8 @@ def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
     if not np.allclose(robot.base_matrix, np.eye(4)):
         out["base"] = [[float(x) for x in r] for r in robot.base]
     out["gravity"] = list(robot.gravity)
+    if robot.poses:
+        out["poses"] = {k: [_num_text(v) for v in q] for k, q in robot.poses}
     return out
 
 

@@ -213,6 +213,9 @@ class DHRobot:
         Gravity acceleration in the world frame [m/s²].
     parameters : tuple of (name, value)
         Named constants used by the ``symbols`` of links and inertias, with their values.
+    poses : tuple of (name, q)
+        Named configurations (``qz`` zero, ``qr`` ready, …), each ``q`` a tuple of ``dof`` joint values [rad, m]
+        within the joint limits; at most :data:`MAX_POSES`.
     """
 
     name: str
@@ -224,6 +227,7 @@ class DHRobot:
     parameters: tuple[tuple[str, float], ...] = ()
     description: str = ""
     source: str = ""
+    poses: tuple[tuple[str, tuple[float, ...]], ...] = ()
     _joint_rows: tuple[int, ...] = field(init=False, repr=False, compare=False, hash=False, default=())
 
     def __post_init__(self) -> None:
@@ -251,6 +255,7 @@ class DHRobot:
             raise ModelError(f"gravity must have 3 components, got {len(g)}")
         object.__setattr__(self, "gravity", g)
         object.__setattr__(self, "parameters", tuple((str(k), _finite(v, f"parameter {k}")) for k, v in self.parameters))
+        object.__setattr__(self, "poses", _check_poses(self.poses, self.q_limits))
 
     # --- trivial derived properties -------------------------------------------------------------
     @property
@@ -305,6 +310,33 @@ class DHRobot:
     def replace(self, **changes: Any) -> "DHRobot":
         """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
+
+
+#: Most named poses (``qz``, ``qr``, …) one robot may carry, and how far [rad, m] a pose may sit outside a limit.
+MAX_POSES = 64
+POSE_LIMIT_TOL = 1e-9
+
+
+def _check_poses(poses: Any, limits: np.ndarray) -> tuple[tuple[str, tuple[float, ...]], ...]:
+    """Named configurations as ((name, q), ...): names unique, len(q) = dof, finite, within the limits."""
+    poses = tuple(poses.items()) if isinstance(poses, dict) else tuple(poses)
+    if len(poses) > MAX_POSES:
+        raise ModelError(f"too many poses ({len(poses)}; at most {MAX_POSES})")
+    out: dict[str, tuple[float, ...]] = {}
+    for name, q in poses:
+        name = str(name)
+        if not name.isidentifier() or len(name) > 40 or name in out:
+            raise ModelError(f"pose name {name[:40]!r} must be a unique identifier (letters, digits, _)")
+        if not isinstance(q, (tuple, list, np.ndarray)):
+            raise ModelError(f"pose {name} must be a sequence of joint values")
+        q = tuple(_finite(v, f"pose {name}") for v in q)
+        if len(q) != len(limits):
+            raise ModelError(f"pose {name} has {len(q)} values; the arm has {len(limits)} joints")
+        for k, (v, (lo, hi)) in enumerate(zip(q, limits)):
+            if not lo - POSE_LIMIT_TOL <= v <= hi + POSE_LIMIT_TOL:
+                raise ModelError(f"pose {name}: joint {k + 1} = {v:.6g} is outside its limits [{lo:.6g}, {hi:.6g}]")
+        out[name] = q
+    return tuple(out.items())
 
 
 def inertial_rows(robot: DHRobot) -> list[tuple[int, int, LinkInertia]]:

@@ -11,7 +11,10 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 from typing import Sequence
+
+import numpy as np
 
 from ..errors import DenavitError, MissingDependencyError, ModelError, ParseError, ShapeError
 from ._common import OneLineParser, emit, one_line
@@ -51,31 +54,64 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "command", None):
         parser.print_help()
         return 0
+    shown: list[str] = []
     try:
-        data, text = args.handler(args)
-        emit(args, data, text)
+        with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+            warnings.simplefilter("always")
+            try:
+                data, text = args.handler(args)
+            finally:
+                shown = _warning_lines(args.command, caught)
+            emit(args, data, text)
+        for line in shown:
+            print(line, file=sys.stderr)
         return 0
     except (ParseError, ShapeError, ModelError) as exc:
-        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return _fail(args.command, one_line(exc), 2)
     except MissingDependencyError as exc:
-        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
-        return 1
+        return _fail(args.command, one_line(exc), 1)
     except DenavitError as exc:
-        print(f"denavit {args.command}: error: {one_line(exc)}", file=sys.stderr)
-        return 1
+        return _fail(args.command, one_line(exc), 1)
     except KeyboardInterrupt:
         print("denavit: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         return 0
+    except MemoryError:
+        return _fail(args.command, "out of memory (the input asks for more work than this machine can hold)", 1)
     except OSError as exc:  # a file the user named: unreadable, a directory, a name too long, a full disk ...
-        what = f"{exc.strerror or exc}" + (f": {exc.filename!r}" if exc.filename else "")
-        print(f"denavit {args.command}: error: {one_line(what)}", file=sys.stderr)
-        return 1
+        where = exc.filename if exc.filename is not None else None
+        what = (f"{where!r}: " if where else "") + f"{exc.strerror or exc}"
+        return _fail(args.command, one_line(what), 2)
     except Exception as exc:  # a bug of ours: one line, the traceback only on request
         if os.environ.get("DENAVIT_DEBUG"):
             raise
         print(f"denavit {args.command}: internal error: {type(exc).__name__}: {one_line(exc)} "
               "(set DENAVIT_DEBUG=1 for the traceback, and please report it)", file=sys.stderr)
         return 1
+
+
+def _fail(command: str, message: str, code: int) -> int:
+    """The one error line; warnings collected during the failed run are not shown (one line per error)."""
+    print(f"denavit {command}: error: {message}", file=sys.stderr)
+    return code
+
+
+def _warning_lines(command: str, caught) -> list[str]:
+    """Library warnings as one line each, ``denavit CMD: warning: message`` (duplicates once).
+
+    Shown: :class:`denavit.errors.DenavitWarning` (when defined) and UserWarnings raised from denavit's own code;
+    numpy/scipy RuntimeWarnings and third-party noise are dropped (results are checked for finiteness instead).
+    """
+    from .. import errors
+
+    ours = getattr(errors, "DenavitWarning", None)
+    lines: list[str] = []
+    for w in caught:
+        mine = ours is not None and issubclass(w.category, ours)
+        if not mine and issubclass(w.category, UserWarning) and not issubclass(w.category, RuntimeWarning):
+            mine = f"{os.sep}denavit{os.sep}" in str(w.filename)
+        line = f"denavit {command}: warning: {one_line(w.message)}"
+        if mine and line not in lines:
+            lines.append(line)
+    return lines

@@ -14,7 +14,19 @@ import numpy as np
 from ..errors import ParseError
 
 __all__ = ["OneLineParser", "add_common", "finite_float", "nonneg_int", "one_line", "positive_float", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite", "check_output", "output_file",
-           "stage_printer", "to_json", "matrix_text"]
+           "stage_printer", "to_json", "matrix_text", "number_text", "numbers_text", "bounded_int", "bounded_float",
+           "check_values", "require_finite", "require_symbolic_size", "MAX_VALUE", "MAX_SYMBOLIC_JOINTS", "NOISE"]
+
+#: Largest magnitude accepted for a value given on the command line (joint values, rates, wrenches, torques,
+#: poses): beyond it products and squares in the algorithms can overflow to inf/nan. Documented in
+#: docs/conventions.md, "Limits".
+MAX_VALUE = 1e9
+#: Joint count above which the symbolic routes (``fk/jacobian --symbolic``, ``singularities``, symbolic
+#: dynamics) are refused: their expressions grow combinatorially and run for minutes (numeric routes are fine).
+MAX_SYMBOLIC_JOINTS = 12
+#: Printed numbers smaller than this (relative to the largest of their group, or absolutely when all are small)
+#: are rounding noise and are shown as 0.
+NOISE = 1e-12
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -72,6 +84,57 @@ def positive_float(text: str) -> float:
     if value <= 0:
         raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
     return value
+
+
+def bounded_int(lo: int, hi: int):
+    """argparse type: a whole number in [lo, hi] (one line and exit 2 otherwise)."""
+    def parse(text: str) -> int:
+        t = text.strip()
+        if not (t.lstrip("+-").isdigit() and len(t) <= 20):
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{lo}, {hi}], got {text[:40]!r}")
+        value = int(t)
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{lo}, {hi}], got {value}")
+        return value
+    return parse
+
+
+def bounded_float(lo: float, hi: float, *, open_low: bool = False):
+    """argparse type: a finite number in [lo, hi] (or (lo, hi] with ``open_low``)."""
+    span = f"{'(' if open_low else '['}{lo:g}, {hi:g}]"
+
+    def parse(text: str) -> float:
+        value = finite_float(text)
+        if not (value > lo if open_low else value >= lo) or value > hi:
+            raise argparse.ArgumentTypeError(f"expected a number in {span}, got {text[:40]!r}")
+        return value
+    return parse
+
+
+def check_values(values: np.ndarray, what: str, limit: float = MAX_VALUE) -> np.ndarray:
+    """ParseError unless every value is finite with magnitude <= ``limit`` (:data:`MAX_VALUE`)."""
+    values = np.asarray(values, dtype=float)
+    bad = ~(np.abs(values) <= limit)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ParseError(f"{what}: value {k + 1} ({values.flat[k]:.6g}) is beyond the magnitude limit {limit:g}")
+    return values
+
+
+def require_finite(what: str, *arrays) -> None:
+    """ParseError if a result computed from accepted inputs is not finite (inputs too large for float64)."""
+    for a in arrays:
+        if a is not None and not np.all(np.isfinite(np.asarray(a, dtype=float))):
+            raise ParseError(f"{what}: the result is not finite (inf or nan): the robot's or the given values are "
+                             "too large to compute with")
+
+
+def require_symbolic_size(robot, what: str) -> None:
+    """ParseError for a symbolic route on an arm with more than :data:`MAX_SYMBOLIC_JOINTS` joints."""
+    if robot.dof > MAX_SYMBOLIC_JOINTS:
+        raise ParseError(f"{what}: {robot.name} has {robot.dof} joints; symbolic results are limited to "
+                         f"{MAX_SYMBOLIC_JOINTS} joints (their expressions grow too fast); use the numeric route "
+                         "with -q")
 
 
 def add_common(p: argparse.ArgumentParser, robot: bool = True) -> None:
@@ -150,6 +213,9 @@ def output_file(path: str, what: str = "-o"):
     try:
         fd, tmp = tempfile.mkstemp(prefix=".denavit-", suffix=suffix, dir=folder)
         os.close(fd)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as a plain open() would have made it (mkstemp gives 0600)
     except OSError as exc:
         raise ParseError(f"{what} {path!r}: cannot write there ({exc.strerror or exc})") from None
     try:
@@ -198,7 +264,7 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
 
     if text is None:
         raise ParseError(f"{what}: missing (give {robot.dof} values)")
-    vals = parse_values(text, robot.dof, what=what)
+    vals = check_values(parse_values(text, robot.dof, what=what), what)
     if args.deg:
         revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
         vals = np.where(revolute, np.radians(vals), vals)
@@ -238,11 +304,42 @@ def to_json(x: Any) -> Any:
     return x
 
 
+def number_text(x: float, digits: int = 6, scale: float = 0.0) -> str:
+    """One number for text output: ``digits`` significant digits, rounding noise shown as ``0``.
+
+    ``x`` is noise when ``|x| <= NOISE * max(1, |scale|)`` (``scale``: the largest magnitude of the group the
+    number is printed with), so ``-2.16e-18`` next to ``0.5`` prints ``0``; ``-0`` prints ``0``.
+
+    >>> number_text(-2.16e-18), number_text(0.1 + 0.2), number_text(float("inf"))
+    ('0', '0.3', 'inf')
+    """
+    x = float(x)
+    if np.isfinite(x) and abs(x) <= NOISE * max(1.0, abs(scale)):
+        return "0"
+    return f"{x:.{digits}g}"
+
+
+def numbers_text(values, digits: int = 6, sep: str = ", ") -> str:
+    """Numbers joined by ``sep`` through :func:`number_text`, noise judged against the largest of them."""
+    v = np.ravel(np.asarray(values, dtype=float))
+    finite = v[np.isfinite(v)]
+    scale = float(np.abs(finite).max()) if finite.size else 0.0
+    return sep.join(number_text(x, digits, scale) for x in v)
+
+
 def matrix_text(M: np.ndarray, digits: int = 6, indent: str = "  ") -> str:
-    """A numeric matrix as aligned text."""
+    """A numeric matrix as aligned text (fixed decimals; very large entries in exponent form)."""
     M = np.atleast_2d(np.asarray(M, dtype=float))
     M = np.where(np.abs(M) < 0.5 * 10.0 ** (-digits), 0.0, M)
-    cells = [[f"{v:.{digits}f}".rstrip("0").rstrip(".") if v != 0 else "0" for v in row] for row in M]
+
+    def cell(v: float) -> str:
+        if v == 0:
+            return "0"
+        if not np.isfinite(v) or abs(v) >= 1e9:
+            return f"{v:.{digits}g}"
+        return f"{v:.{digits}f}".rstrip("0").rstrip(".")
+
+    cells = [[cell(v) for v in row] for row in M]
     width = max(len(c) for row in cells for c in row)
     return "\n".join(indent + "[ " + "  ".join(c.rjust(width) for c in row) + " ]" for row in cells)
 

@@ -9,7 +9,14 @@ import time
 import numpy as np
 
 from ..errors import MissingDependencyError, ParseError
-from ._common import add_common, add_force, add_q, joint_values, load, matrix_text, refuse_overwrite
+from ._common import (add_common, add_force, add_q, check_output, check_values, joint_values, load, matrix_text,
+                      numbers_text, output_file, require_finite, require_symbolic_size)
+
+#: simulate: most output samples (--duration / --dt) and most evaluations of the dynamics in one run (about
+#: half a minute on a 6-joint arm); beyond it the run is refused with a message, not left to run for hours.
+MAX_SAMPLES = 100_000
+MAX_EVALUATIONS = 50_000
+PLOTS = (".png", ".svg", ".pdf")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,7 +43,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tau", metavar="TAU", help="constant joint torques [N m / N] (default zeros)")
     p.add_argument("--dt", default="0.01", metavar="DT", help="sampling interval of the output [s]")
     p.add_argument("--no-friction", action="store_true", help="ignore joint friction")
-    p.add_argument("-o", "--output", metavar="PNG", help="plot of the joint trajectories and energy (needs denavit[plot])")
+    p.add_argument("-o", "--output", metavar="PNG",
+                   help="plot of the joint trajectories and energy: .png, .svg or .pdf (needs denavit[plot])")
     p.add_argument("--ignore-limits", action="store_true", help="accept q0 outside the joint limits")
     add_force(p)
     p.set_defaults(handler=cmd_simulate)
@@ -45,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _number(text: str, what: str, positive: bool = True) -> float:
     from ..io import parse_values
 
-    value = float(parse_values(text, 1, what=what)[0])
+    value = float(check_values(parse_values(text, 1, what=what), what)[0])
     if positive and not value > 0:
         raise ParseError(f"{what}: must be positive, got {value:g}")
     return value
@@ -71,6 +79,7 @@ def cmd_dynamics(args: argparse.Namespace):
         _rates(args, robot, args.qd, "qd")
         _rates(args, robot, args.qdd, "qdd")
     if args.symbolic:
+        require_symbolic_size(robot, "dynamics --symbolic")
         sdata, slines = _symbolic(robot, args)
         data.update(sdata)
         lines += slines
@@ -92,9 +101,10 @@ def _numeric(robot, args):
     M, C = mass_matrix(robot, q), coriolis_matrix(robot, q, qd)
     c, g, f = C @ qd, gravity_torques(robot, q), friction_torques(robot, qd)
     tau = rnea(robot, q, qd, qdd)
+    require_finite("dynamics", M, C, g, f, tau)
     show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
     unit = "deg" if args.deg else "rad"
-    vec = lambda v: ", ".join(f"{x:.6g}" for x in v)  # noqa: E731
+    vec = numbers_text
     lines = [f"{robot.name}: dynamics at q = [{vec(show(q))}] ({unit}), qd = [{vec(show(qd))}], "
              f"qdd = [{vec(show(qdd))}]",
              "M(q) [kg m^2 / kg] =", matrix_text(M), "C(q, qd) =", matrix_text(C),
@@ -132,23 +142,23 @@ def _symbolic(robot, args):
 
 def cmd_simulate(args: argparse.Namespace):
     from ..numeric._dynamics import require_dynamics
-    from ..numeric._simulate import simulate
 
+    check_output(args, args.output, PLOTS)
     robot = load(args)
     require_dynamics(robot)
-    refuse_overwrite(args, args.output)
     q0 = joint_values(args, robot, args.q0, "q0")
     qd0 = _rates(args, robot, args.qd0, "qd0")
     duration = _number(args.duration, "--duration")
     dt = _number(args.dt, "--dt")
-    if duration / dt > 100_000:
-        raise ParseError(f"--duration/--dt gives {duration / dt:.0f} samples; at most 100000")
-    tau = None
+    if duration / dt > MAX_SAMPLES:
+        raise ParseError(f"--duration/--dt gives {duration / dt:.3g} samples; at most {MAX_SAMPLES}")
+    tau = np.zeros(robot.dof)
     if args.tau is not None:
         from ..io import parse_values
 
-        tau = parse_values(args.tau, robot.dof, what="tau")
-    res = simulate(robot, q0, qd0, duration, tau, dt=dt, friction=not args.no_friction)
+        tau = check_values(parse_values(args.tau, robot.dof, what="--tau"), "--tau")
+    res = _budgeted(robot, q0, qd0, duration, tau, dt, not args.no_friction)
+    require_finite("simulate", res.q, res.qd, res.energy)
     show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
     rev = np.array([t.value == "revolute" for t in robot.joint_types])
     conv = lambda a: np.where(rev, show(a), a)  # noqa: E731
@@ -164,11 +174,36 @@ def cmd_simulate(args: argparse.Namespace):
     lines = [f"{robot.name}: simulated {duration:g} s ({len(res.t)} samples, {res.message})", head, *rows,
              f"energy drift (max |E - E0|): {drift:.3g} J" + ("" if args.no_friction else " (friction dissipates)")]
     if args.output:
-        _plot(res, robot, args.output, args.deg)
+        with output_file(args.output) as tmp:
+            _plot(res, robot, tmp, args.deg)
         lines.append(f"wrote {args.output}")
     if not res.success:
         lines.append(f"warning: the integrator stopped early: {res.message}")
     return data, "\n".join(lines)
+
+
+class _OverBudget(Exception):
+    pass
+
+
+def _budgeted(robot, q0, qd0, duration, tau, dt, friction):
+    """simulate() with at most MAX_EVALUATIONS evaluations of the dynamics (ParseError beyond: exit 2)."""
+    from ..numeric._simulate import simulate
+
+    count = [0]
+    budget = MAX_EVALUATIONS + int(duration / dt) + 2  # + the torques recomputed at the output samples
+
+    def torque(t, q, qd):
+        count[0] += 1
+        if count[0] > budget:
+            raise _OverBudget
+        return tau
+
+    try:
+        return simulate(robot, q0, qd0, duration, torque, dt=dt, friction=friction)
+    except _OverBudget:
+        raise ParseError(f"--duration {duration:g}: the integration needed more than {MAX_EVALUATIONS} evaluations "
+                         "of the dynamics (a fast or stiff motion); shorten --duration or lower --tau") from None
 
 
 def _plot(res, robot, path: str, deg: bool) -> None:

@@ -7,7 +7,12 @@ import argparse
 import numpy as np
 
 from ..errors import DenavitError, ParseError, UnsupportedRobotError
-from ._common import add_common, emit, joint_values, load, matrix_text, nonneg_int, positive_float
+from ._common import (add_common, bounded_int, check_values, emit, joint_values, load, matrix_text, numbers_text,
+                      positive_float, require_finite)
+
+#: ik: most random restarts and LM iterations per solve (numeric route), and the longest --lock joint number.
+MAX_RESTARTS = 1000
+MAX_ITERATIONS = 10_000
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,11 +26,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=["auto", "analytic", "numeric"], default="auto",
                    help="closed form (all solutions), numerical LM, or auto: closed form when the arm has one")
     p.add_argument("--all", action="store_true",
-                   help="numeric: search many seeds and list every distinct solution found (analytic always lists all)")
+                   help="numeric: search many seeds and list every distinct solution found; analytic: also list "
+                        "the solutions outside the joint limits, marked per joint")
     p.add_argument("--seed", metavar="Q", help="numeric: starting configuration")
     p.add_argument("--mask", choices=["pose", "position"], default="pose", help="numeric: rows to match")
     p.add_argument("--tol", type=positive_float, default=1e-9, help="numeric: position [m] / orientation [rad] tolerance")
-    p.add_argument("--restarts", type=nonneg_int, default=64, help="numeric: random restarts (default 64)")
+    p.add_argument("--restarts", type=bounded_int(0, MAX_RESTARTS), default=64,
+                   help=f"numeric: random restarts (default 64, at most {MAX_RESTARTS})")
+    p.add_argument("--max-iterations", type=bounded_int(1, MAX_ITERATIONS), default=100,
+                   help=f"numeric: LM iterations per start (default 100, at most {MAX_ITERATIONS})")
     p.add_argument("--ignore-limits", action="store_true", help="accept --from-q outside the joint limits")
     p.add_argument("--lock", metavar="qN=V[,qM=W]", action="append",
                    help="analytic: hold these joints at these values and solve the others (redundant arms, e.g. "
@@ -43,24 +52,24 @@ def _target(args, robot) -> np.ndarray:
     from ..numeric import forward_kinematics, transform_from_xyz_rpy
 
     if args.pose is not None:
-        v = parse_values(args.pose, 6, what="--pose")
+        v = check_values(parse_values(args.pose, 6, what="--pose"), "--pose")
         rpy = np.radians(v[3:]) if args.deg else v[3:]
         return transform_from_xyz_rpy(v[:3], rpy)
     if args.T is not None:
-        v = parse_values(args.T, 16, what="--T").reshape(4, 4)
+        v = check_values(parse_values(args.T, 16, what="--T"), "--T").reshape(4, 4)
         if not np.allclose(v[3], [0, 0, 0, 1]):
             raise ParseError("--T: the last row must be 0, 0, 0, 1")
         return as_transform(v, "--T")
-    return forward_kinematics(robot, joint_values(args, robot, args.from_q, what="--from-q"))
+    T = forward_kinematics(robot, joint_values(args, robot, args.from_q, what="--from-q"))
+    require_finite("--from-q", T)
+    return T
 
 
 def _fmt_q(robot, q, deg: bool) -> list[str]:
     from ..model import JointType
 
-    out = []
-    for v, t in zip(q, robot.joint_types):
-        out.append(f"{np.degrees(v):.6g}" if deg and t is JointType.REVOLUTE else f"{v:.6g}")
-    return out
+    vals = [np.degrees(v) if deg and t is JointType.REVOLUTE else v for v, t in zip(q, robot.joint_types)]
+    return numbers_text(vals, sep="\n").split("\n")
 
 
 def _to_unit(robot, q, deg: bool) -> np.ndarray:
@@ -73,23 +82,24 @@ def _to_unit(robot, q, deg: bool) -> np.ndarray:
 def _locks(args, robot) -> dict[str, float] | None:
     """``--lock q7=0.5,q3=-1`` → {"q7": 0.5, "q3": -1.0} (values through the restricted reader; --deg for
     revolute joints)."""
-    import re
-
     from ..io import parse_values
     from ..model import JointType
 
     if not args.lock:
         return None
     out = {}
-    for item in ",".join(args.lock).split(","):
-        m = re.fullmatch(r"\s*q(\d+)\s*=\s*(.+?)\s*", item)
-        if not m:
+    for item in ",".join(args.lock).split(","):  # linear: split and strip, no backtracking regex
+        name, eq, value = item.partition("=")
+        name, value = name.strip(), value.strip()
+        digits = name[1:]
+        if not (eq and value and name[:1] == "q" and digits.isascii() and digits.isdigit()):
             raise ParseError(f"--lock: {item.strip()[:40]!r} is not qN=VALUE")
-        k = int(m.group(1))
-        if not 1 <= k <= robot.dof:
-            raise ParseError(f"--lock: q{k} is not a joint of {robot.name} (q1 … q{robot.dof})")
+        if len(digits) > 4 or not 1 <= int(digits) <= robot.dof:
+            raise ParseError(f"--lock: {name[:12]!r} is not a joint of {robot.name} (q1 … q{robot.dof})")
+        k = int(digits)
         rev = robot.joint_types[k - 1] is JointType.REVOLUTE
-        out[f"q{k}"] = float(parse_values(m.group(2), 1, what=f"--lock q{k}", deg=args.deg and rev)[0])
+        v = check_values(parse_values(value, 1, what=f"--lock q{k}", deg=args.deg and rev), f"--lock q{k}")
+        out[f"q{k}"] = float(v[0])
     return out
 
 
@@ -115,8 +125,16 @@ def _analytic(args, robot, T):
         lines.append(f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]" + (f"   {b}" if b else ""))
         if f:
             lines.append(f"     continuum: {f}")
-    if len(res.outside_limits):
-        lines.append(f"  ({len(res.outside_limits)} more outside the joint limits)")
+    outside = np.asarray(res.outside_limits, dtype=float).reshape(-1, robot.dof)
+    if len(outside) and args.all:
+        lim = robot.q_limits
+        lines.append(f"  outside the joint limits ({len(outside)}):")
+        for k, q in enumerate(outside, start=res.count + 1):
+            off = [f"q{j + 1}" for j in range(robot.dof) if not lim[j, 0] - 1e-9 <= q[j] <= lim[j, 1] + 1e-9]
+            lines.append(f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]   outside limits: "
+                         + (", ".join(off) or "(at a limit)"))
+    elif len(outside):
+        lines.append(f"  ({len(outside)} more outside the joint limits; --all lists them)")
     return data, lines
 
 
@@ -127,20 +145,22 @@ def _numeric(args, robot, T):
     rng = np.random.default_rng()
     seed = None
     if args.seed is not None:
-        seed = parse_values(args.seed, robot.dof, what="--seed", deg=args.deg)
+        seed = check_values(parse_values(args.seed, robot.dof, what="--seed", deg=args.deg), "--seed")
     if args.all:
         n = 256
-        lim = robot.q_limits
-        lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
-        seeds = rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
-        res = solve_ik(robot, np.broadcast_to(T, (n, 4, 4)), seeds, mask=args.mask, tol=args.tol, restarts=0, rng=rng)
+        seeds = rng.uniform(*_seed_ranges(robot).T, (n, robot.dof))
+        res = solve_ik(robot, np.broadcast_to(T, (n, 4, 4)), seeds, mask=args.mask, tol=args.tol, restarts=0, rng=rng,
+                       max_iterations=args.max_iterations)
+        require_finite("ik", res.q[res.success])
         sols = _distinct(robot, res.q[res.success])
         data = {"method": "numeric", "solutions": _to_unit(robot, np.array(sols).reshape(-1, robot.dof), args.deg),
                 "success": bool(sols), "seeds": n, "residuals": None}
         lines = [f"numeric search from {n} random seeds: {len(sols)} distinct solution(s)"]
         lines += [f"  {k}: q = [{', '.join(_fmt_q(robot, q, args.deg))}]" for k, q in enumerate(sols, start=1)]
         return data, lines
-    res = solve_ik(robot, T, seed, mask=args.mask, tol=args.tol, restarts=args.restarts, rng=rng)
+    res = solve_ik(robot, T, seed, mask=args.mask, tol=args.tol, restarts=args.restarts, rng=rng,
+                   max_iterations=args.max_iterations)
+    require_finite("ik", res.q if res.success else None)
     data = {"method": "numeric", "solutions": _to_unit(robot, res.q[None], args.deg) if res.success else [],
             "q": _to_unit(robot, res.q, args.deg), "success": res.success,
             "residuals": [{"position": res.position_error, "orientation": res.orientation_error}],
@@ -150,6 +170,28 @@ def _numeric(args, robot, T):
              f"  q = [{', '.join(_fmt_q(robot, res.q, args.deg))}]",
              f"  residual: position {res.position_error:.3g} m, orientation {res.orientation_error:.3g} rad"]
     return data, lines
+
+
+def _seed_ranges(robot) -> np.ndarray:
+    """(n, 2) ranges for random seeds: the limits, one turn of a revolute joint when they are wider or absent,
+    and prismatic ranges within ±MAX_VALUE (limits like ±1e308 would overflow the sampler)."""
+    from ..model import JointType
+    from ._common import MAX_VALUE
+
+    lim = robot.q_limits.copy()
+    for k, kind in enumerate(robot.joint_types):
+        lo, hi = lim[k]
+        if kind is JointType.REVOLUTE:
+            lo, hi = np.clip([lo, hi], -MAX_VALUE, MAX_VALUE)
+            if hi - lo > 2 * np.pi:
+                lo, hi = ((-np.pi, np.pi) if lo <= -np.pi and hi >= np.pi
+                          else (lo, lo + 2 * np.pi) if lo > -np.pi else (hi - 2 * np.pi, hi))
+        else:
+            lo = lo if np.isfinite(lo) else -np.pi
+            hi = hi if np.isfinite(hi) else np.pi
+            lo, hi = np.clip([lo, hi], -MAX_VALUE, MAX_VALUE)
+        lim[k] = lo, hi
+    return lim
 
 
 def _distinct(robot, qs, tol: float = 1e-6) -> list[np.ndarray]:

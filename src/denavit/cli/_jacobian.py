@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, joint_values, load, matrix_text, stage_printer
+from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
+                      require_symbolic_size, stage_printer)
 
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 REFERENCE = "end-effector origin (after the tool transform)"
@@ -106,7 +107,7 @@ def _q_out(args, robot, q):
 
 def _q_text(args, robot, q) -> str:
     unit = "deg for revolute joints" if args.deg else "rad"
-    return f"q = [{', '.join(f'{v:.6g}' for v in _q_out(args, robot, q))}] ({unit})"
+    return f"q = [{numbers_text(_q_out(args, robot, q))}] ({unit})"
 
 
 # --- jacobian ------------------------------------------------------------------------------------------
@@ -117,6 +118,7 @@ def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
 
     from .. import symbolic as S
 
+    require_symbolic_size(robot, "jacobian --symbolic")
     q = S.joint_symbols(robot.dof).q
     fmt = _formatter(args, q)
     J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
@@ -144,6 +146,8 @@ def cmd_jacobian(args: argparse.Namespace):
     data: dict = {"robot": robot.name, "frame": args.frame, "method": args.method, "reference_point": REFERENCE,
                   "rows": list(ROWS)}
     lines: list[str] = []
+    if args.q is not None:  # a bad -q fails now, not after the symbolic work
+        joint_values(args, robot, args.q)
     if args.symbolic or args.q is None:
         sdata, lines = _symbolic_jacobian(robot, args)
         data.update(sdata)
@@ -162,6 +166,7 @@ def cmd_jacobian(args: argparse.Namespace):
         data["q"] = _q_out(args, robot, q)
         if args.analytic:
             Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
+            require_finite("jacobian", Ja, phi)
             names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
             conv = np.degrees(phi) if args.deg else phi
             data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
@@ -172,6 +177,7 @@ def cmd_jacobian(args: argparse.Namespace):
         else:
             J = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
                  "propagation": N.propagation_jacobian}[args.method](robot, q, args.frame)
+            require_finite("jacobian", J)
             data["J"] = J
             if lines:
                 lines.append("")
@@ -190,20 +196,20 @@ def cmd_velocity(args: argparse.Namespace):
     q = joint_values(args, robot, args.q)
     qd = joint_values(args, robot, args.qd, what="qd", rates=True)
     twist = N.end_effector_twist(robot, q, qd, args.frame)
+    require_finite("velocity", twist)
     ang = np.degrees if args.deg else (lambda x: x)
     aunit = "deg/s" if args.deg else "rad/s"
     data = {"robot": robot.name, "q": _q_out(args, robot, q), "qd": _q_out(args, robot, qd), "frame": args.frame,
             "reference_point": REFERENCE, "twist": np.concatenate([twist[:3], ang(twist[3:])]),
             "v": twist[:3], "omega": ang(twist[3:]), "angle_unit": "deg" if args.deg else "rad"}
     lines = [f"{robot.name}: end-effector twist at {_q_text(args, robot, q)}", _header(args.frame, "twist (v, w)"),
-             f"v = [{', '.join(f'{x:.6g}' for x in twist[:3])}] m/s",
-             f"w = [{', '.join(f'{x:.6g}' for x in ang(twist[3:]))}] {aunit}"]
+             f"v = [{numbers_text(twist[:3])}] m/s",
+             f"w = [{numbers_text(ang(twist[3:]))}] {aunit}"]
     if args.steps:
         prop = N.velocity_propagation(robot, q, qd)
         lines += ["", "outward propagation (omega_i, v_i of frame {i} in its own axes):"]
         for lab, w, v in zip(prop.labels, prop.omega, prop.v):
-            lines.append(f"  {{{lab}}}: omega = [{', '.join(f'{x:.6g}' for x in ang(w))}] {aunit}, "
-                         f"v = [{', '.join(f'{x:.6g}' for x in v)}] m/s")
+            lines.append(f"  {{{lab}}}: omega = [{numbers_text(ang(w))}] {aunit}, v = [{numbers_text(v)}] m/s")
         data["steps"] = [{"frame": lab, "omega": ang(w), "v": v} for lab, w, v in zip(prop.labels, prop.omega, prop.v)]
     return data, "\n".join(lines)
 
@@ -215,6 +221,9 @@ def _wrench(text: str) -> np.ndarray:
     from ..io import parse_values
 
     W = parse_values(text, what="--wrench")
+    if W.size > 6:
+        raise ParseError(f"--wrench: expected 3 values (fx, fy, fz) or 6 (fx, fy, fz, nx, ny, nz), got {W.size}")
+    W = check_values(W, "--wrench")
     if W.size not in (3, 6):
         raise ParseError(f"--wrench: expected 3 values (fx, fy, fz) or 6 (fx, fy, fz, nx, ny, nz), got {W.size}")
     return W
@@ -229,21 +238,22 @@ def cmd_statics(args: argparse.Namespace):
     W = _wrench(args.wrench)
     prop = N.force_propagation(robot, q, W, args.frame)
     tau = N.joint_torques(robot, q, W, args.frame) if args.method == "jacobian" else prop.tau
+    require_finite("statics", tau, prop.f, prop.n)
     units = ["N m" if t is JointType.REVOLUTE else "N" for t in robot.joint_types]
     F6 = N.as_wrench(W)
     data = {"robot": robot.name, "q": _q_out(args, robot, q), "wrench": F6, "frame": args.frame,
             "method": args.method, "reference_point": REFERENCE, "tau": tau, "units": units}
     axes = "base/world" if args.frame == "base" else "tool"
     lines = [f"{robot.name}: joint torques at {_q_text(args, robot, q)}",
-             f"wrench (f, n) = [{', '.join(f'{x:.6g}' for x in F6)}] N, N m exerted by the end effector, "
+             f"wrench (f, n) = [{numbers_text(F6)}] N, N m exerted by the end effector, "
              f"in {axes} axes, at the {REFERENCE}",
              f"method: {'tau = J^T F' if args.method == 'jacobian' else 'inward force propagation (Craig 5.80-5.81)'}"]
-    lines += [f"  tau{k + 1} = {t:.6g} {u}" for k, (t, u) in enumerate(zip(tau, units))]
+    tau_text = numbers_text(tau, sep="\n").split("\n")
+    lines += [f"  tau{k + 1} = {t} {u}" for k, (t, u) in enumerate(zip(tau_text, units))]
     if args.steps:
         lines += ["", "inward propagation (f_i, n_i at the origin of {i}, in its axes):"]
         for lab, f, n in zip(prop.labels, prop.f, prop.n):
-            lines.append(f"  {{{lab}}}: f = [{', '.join(f'{x:.6g}' for x in f)}] N, "
-                         f"n = [{', '.join(f'{x:.6g}' for x in n)}] N m")
+            lines.append(f"  {{{lab}}}: f = [{numbers_text(f)}] N, n = [{numbers_text(n)}] N m")
         data["steps"] = [{"frame": lab, "f": f, "n": n} for lab, f, n in zip(prop.labels, prop.f, prop.n)]
     return data, "\n".join(lines)
 
@@ -289,6 +299,7 @@ def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
 
     q = joint_values(args, robot, args.q)
     J = N.geometric_jacobian(robot, q, args.frame)[rows_idx, :]
+    require_finite("singularities", J)
     s = N.singular_values(J)
     lin = [i for i, r in enumerate(rows_idx) if r < 3] or list(range(len(rows_idx)))
     vel, frc = N.velocity_ellipsoid(J[lin]), N.force_ellipsoid(J[lin])
@@ -300,7 +311,7 @@ def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
             "velocity_ellipsoid": {"axes": vel.axes, "radii": vel.radii},
             "force_ellipsoid": {"axes": frc.axes, "radii": frc.radii}}
     lines = ["", f"numeric measures at {_q_text(args, robot, q)} (rows {', '.join(ROWS[i] for i in rows_idx)}):",
-             f"  singular values: {', '.join(f'{x:.6g}' for x in s)}",
+             f"  singular values: {numbers_text(s)}",
              f"  rank {data['rank']} of {min(J.shape)} (threshold 1e-9 · largest singular value)"
              + ("  → SINGULAR" if data["singular"] else ""),
              f"  manipulability (Yoshikawa) sqrt(det J J^T) = {data['manipulability']:.6g}",
@@ -325,6 +336,7 @@ def cmd_singularities(args: argparse.Namespace):
     rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
     if args.q is not None:
         joint_values(args, robot, args.q)  # a bad -q fails now, not after minutes of symbolic work
+    require_symbolic_size(robot, "singularities")
     res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
     fmt = _formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)

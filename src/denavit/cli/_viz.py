@@ -3,14 +3,26 @@
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_force, finite_float, nonneg_int, add_q, joint_values, load, refuse_overwrite
+from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
+                      joint_values, load, nonneg_int, numbers_text, output_file, require_finite)
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
+PICTURES = (".png", ".svg", ".pdf")
+ANIMATIONS = (".gif", ".mp4")
+PAGES = (".html", ".htm")
+#: --dpi range of plot (a 600-dpi picture of the default figure is about 4,800 px square).
+DPI_RANGE = (10, 600)
+#: animate: longest move [s], highest frame rate, and most frames (--duration × --fps) drawn in one run.
+MAX_DURATION = 600.0
+MAX_FPS = 60.0
+MAX_FRAMES = 1000
+#: workspace: --samples range per run, and the --resolution range [m].
+SAMPLES_RANGE = (100, 2_000_000)
+RESOLUTION_RANGE = (1e-6, 1e6)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,7 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-labels", action="store_true", help="leave out the frame labels")
     p.add_argument("--elev", type=finite_float, help="view elevation [deg]")
     p.add_argument("--azim", type=finite_float, help="view azimuth [deg]")
-    p.add_argument("--dpi", type=int, default=120, help="resolution of a .png (default 120)")
+    p.add_argument("--dpi", type=bounded_int(*DPI_RANGE), default=120,
+                   help=f"resolution of a .png (default 120; {DPI_RANGE[0]} to {DPI_RANGE[1]})")
     add_force(p)
     p.set_defaults(handler=cmd_plot)
 
@@ -34,8 +47,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="animation to write: .gif or .mp4")
     p.add_argument("--profile", choices=PROFILES, default="quintic",
                    help="joint-space quintic or trapezoidal velocity, or a straight Cartesian line (IK)")
-    p.add_argument("--duration", type=float, default=2.0, help="length of the move [s] (default 2)")
-    p.add_argument("--fps", type=float, default=15.0, help="frames per second (default 15)")
+    p.add_argument("--duration", type=bounded_float(0, MAX_DURATION, open_low=True), default=2.0,
+                   help=f"length of the move [s] (default 2, at most {MAX_DURATION:g})")
+    p.add_argument("--fps", type=bounded_float(0, MAX_FPS, open_low=True), default=15.0,
+                   help=f"frames per second (default 15, at most {MAX_FPS:g}); duration × fps <= {MAX_FRAMES}")
     p.add_argument("--no-frames", action="store_true", help="leave out the DH frame triads")
     p.add_argument("--ignore-limits", action="store_true", help="accept configurations outside the joint limits")
     add_force(p)
@@ -51,8 +66,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("workspace", help="reachable workspace by sampling: size, volume, picture")
     add_common(p)
     p.add_argument("-o", "--output", metavar="FILE", help="picture to write (.png, .svg, .pdf); numbers only if absent")
-    p.add_argument("--samples", type=int, default=100_000, help="random configurations (default 100000)")
-    p.add_argument("--resolution", type=float, help="voxel edge [m] (default: longest side / 40)")
+    p.add_argument("--samples", type=bounded_int(*SAMPLES_RANGE), default=100_000,
+                   help=f"random configurations (default 100000; {SAMPLES_RANGE[0]} to {SAMPLES_RANGE[1]})")
+    p.add_argument("--resolution", type=bounded_float(*RESOLUTION_RANGE),
+                   help="voxel edge [m] (default: longest side / 40; 1e-6 to 1e6)")
     p.add_argument("--seed", type=nonneg_int, help="random seed, for repeatable figures")
     add_force(p)
     p.set_defaults(handler=cmd_workspace)
@@ -68,28 +85,27 @@ def _out_q(args, robot, q: np.ndarray) -> np.ndarray:
 
 
 def _fmt(v) -> str:
-    return "[" + ", ".join(f"{x:.6g}" for x in np.ravel(v)) + "]"
+    return "[" + numbers_text(v) + "]"
 
 
 def cmd_plot(args: argparse.Namespace):
     from ..numeric import quintic_trajectory
     from ..viz import arm_geometry, default_configuration
-    from ..viz._plot import figure_format, plot_robot, save_figure
+    from ..viz._plot import plot_robot, save_figure
 
+    check_output(args, args.output, PICTURES)
     robot = load(args)
-    figure_format(args.output)
-    refuse_overwrite(args, args.output)
     q = default_configuration(robot) if args.q is None else joint_values(args, robot, args.q)
     path = None
     if args.path_to is not None:
         q2 = joint_values(args, robot, args.path_to, what="--path-to")
         path = quintic_trajectory(q, q2, 40).q
-    if args.dpi <= 0:
-        raise ParseError(f"--dpi must be positive, got {args.dpi}")
+    geom = arm_geometry(robot, q)
+    require_finite("plot", geom.end_effector, geom.joint_positions)
     fig = plot_robot(robot, q, frames=not args.no_frames, labels=not args.no_labels, path=path,
                      elev=args.elev, azim=args.azim)
-    save_figure(fig, args.output, dpi=args.dpi)
-    geom = arm_geometry(robot, q)
+    with output_file(args.output) as tmp:
+        save_figure(fig, tmp, dpi=args.dpi)
     unit = "deg" if args.deg else "rad"
     data = {"robot": robot.name, "q": _out_q(args, robot, q), "angle_unit": unit, "output": args.output,
             "T": geom.end_effector, "joint_positions": geom.joint_positions, "skeleton": geom.skeleton}
@@ -110,21 +126,20 @@ def _move(args, robot, q1: np.ndarray, q2: np.ndarray, k: int):
 def cmd_animate(args: argparse.Namespace):
     from ..numeric import forward_kinematics
     from ..viz import animate_robot
-    from ..viz._plot import figure_format
 
+    check_output(args, args.output, ANIMATIONS)
+    if args.duration * args.fps > MAX_FRAMES:
+        raise ParseError(f"--duration {args.duration:g} × --fps {args.fps:g} gives "
+                         f"{args.duration * args.fps:.0f} frames; at most {MAX_FRAMES} per animation")
     robot = load(args)
-    figure_format(args.output, ("gif", "mp4"))
-    refuse_overwrite(args, args.output)
-    if not (math.isfinite(args.duration) and args.duration > 0):
-        raise ParseError(f"--duration must be a positive number of seconds, got {args.duration}")
-    if not (math.isfinite(args.fps) and 0 < args.fps <= 100):
-        raise ParseError(f"--fps must be in (0, 100], got {args.fps}")
     q1 = joint_values(args, robot, args.q_from, what="--from")
     q2 = joint_values(args, robot, args.q_to, what="--to")
     k = max(2, int(round(args.duration * args.fps)) + 1)
     qs, cp = _move(args, robot, q1, q2, k)
-    animate_robot(robot, qs, args.output, fps=args.fps, frames=not args.no_frames)
     ee = forward_kinematics(robot, qs)[:, :3, 3]
+    require_finite("animate", qs, ee)
+    with output_file(args.output) as tmp:
+        animate_robot(robot, qs, tmp, fps=args.fps, frames=not args.no_frames)
     unit = "deg" if args.deg else "rad"
     data = {"robot": robot.name, "q_from": _out_q(args, robot, q1), "q_to": _out_q(args, robot, q2),
             "angle_unit": unit, "profile": args.profile, "duration": args.duration, "fps": args.fps, "frames": k,
@@ -147,11 +162,15 @@ def cmd_animate(args: argparse.Namespace):
 def cmd_view(args: argparse.Namespace):
     from ..viz import default_configuration, write_viewer
 
+    from pathlib import Path
+
+    check_output(args, args.output, PAGES)
     robot = load(args)
-    refuse_overwrite(args, args.output)
     q = default_configuration(robot) if args.q is None else joint_values(args, robot, args.q)
-    path = write_viewer(robot, args.output, q)
-    size = path.stat().st_size
+    with output_file(args.output) as tmp:
+        write_viewer(robot, tmp, q)
+        size = Path(tmp).stat().st_size
+    path = Path(args.output)
     data = {"robot": robot.name, "q": _out_q(args, robot, q), "angle_unit": "deg" if args.deg else "rad",
             "output": str(path), "bytes": size}
     return data, f"wrote {path} ({size // 1024} KiB, self-contained: open it in any browser, no network needed)"
@@ -160,22 +179,16 @@ def cmd_view(args: argparse.Namespace):
 def cmd_workspace(args: argparse.Namespace):
     from ..viz import plot_workspace, workspace
 
+    check_output(args, args.output, PICTURES)
     robot = load(args)
-    if args.output:
-        from ..viz._plot import figure_format
-
-        figure_format(args.output)
-        refuse_overwrite(args, args.output)
-    if args.samples < 100 or args.samples > 20_000_000:
-        raise ParseError(f"--samples must be between 100 and 20000000, got {args.samples}")
-    if args.resolution is not None and not (math.isfinite(args.resolution) and args.resolution > 0):
-        raise ParseError(f"--resolution must be a positive length in metres, got {args.resolution}")
     rng = np.random.default_rng(args.seed)
     ws = workspace(robot, args.samples, args.resolution, rng)
+    require_finite("workspace", ws.bounds_min, ws.bounds_max, ws.reach)
     if args.output:
         from ..viz._plot import save_figure
 
-        save_figure(plot_workspace(ws, robot.name), args.output)
+        with output_file(args.output) as tmp:
+            save_figure(plot_workspace(ws, robot.name), tmp)
     data = {"robot": robot.name, "output": args.output, "seed": args.seed, **ws.summary()}
     size = (f"area ≈ {ws.area:.4g} m² (planar arm; {ws.voxels} cells of {ws.resolution:.3g} m)" if ws.planar
             else f"volume ≈ {ws.volume:.4g} m³ ({ws.voxels} voxels of {ws.resolution:.3g} m)")
