@@ -49,7 +49,8 @@ def test_fk_json_equals_library(capsys):
     q = [0, np.pi / 4, np.pi / 3, -np.pi / 2, -np.pi / 3, np.pi / 6]
     np.testing.assert_allclose(data["T"], denavit.forward_kinematics(robot, q), atol=1e-12)
     np.testing.assert_allclose(data["frames"], denavit.link_transforms(robot, q), atol=1e-12)
-    assert data["robot"] == "report000-6r" and len(data["q"]) == 6 and len(data["rpy"]) == 3
+    # the old name loads the renamed arm, whose name is echoed
+    assert data["robot"] == "coaxial-6r" and len(data["q"]) == 6 and len(data["rpy"]) == 3
 
 
 def test_fk_degrees(capsys):
