@@ -21,10 +21,18 @@ from ._quantities import QUANTITIES
 from ._resolve import robot_resolver
 
 __all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_text", "parse_math", "parse_matrix",
-           "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_FILE_BYTES"]
+           "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_COSTLY_CLAIMS", "MAX_DETAILED",
+           "MAX_FILE_BYTES"]
 
-MAX_CLAIMS = 500
+#: Most claims in one file (a file is one person's derivation; split a longer one).
+MAX_CLAIMS = 100
+#: Most claims of the kinds that search or solve (singularities, ik_formula, ik_solutions) in one file.
+MAX_COSTLY_CLAIMS = 20
+#: Incorrect claims that get the full explanation (tested hints, the correct formula); later ones get the verdict,
+#: the differing entries and a counterexample only, so the work per file stays bounded.
+MAX_DETAILED = 8
 MAX_FILE_BYTES = 1_000_000
+_COSTLY = ("singularities", "singular_configurations", "singular", "ik_formula", "ik_solutions")
 
 
 @dataclass(frozen=True)
@@ -51,15 +59,37 @@ def check_claims(robot: DHRobot, claims: list[Any], *, seed: int = 0, deg: bool 
     if not isinstance(claims, list):
         raise ParseError("'claims' must be a list of claims", where=source)
     if len(claims) > MAX_CLAIMS:
-        raise ParseError(f"too many claims ({len(claims)}; at most {MAX_CLAIMS})", where=source)
+        raise ParseError(f"too many claims ({len(claims)}; at most {MAX_CLAIMS}: split the file)", where=source)
+    costly = sum(isinstance(c, dict) and str(c.get("quantity")) in _COSTLY for c in claims)
+    if costly > MAX_COSTLY_CLAIMS:
+        raise ParseError(f"too many singularities/IK claims ({costly}; at most {MAX_COSTLY_CLAIMS}: split the file)",
+                         where=source)
     rng = np.random.default_rng(seed)
-    verdicts = tuple(check_claim(robot, c, f"claim {k}", rng, deg) for k, c in enumerate(claims, start=1))
-    return CheckResult(robot.name, source, verdicts)
+    verdicts, detailed, notes = [], 0, []
+    for k, c in enumerate(claims, start=1):
+        v = _judge(robot, c, f"claim {k}", rng, deg, detail=detailed < MAX_DETAILED)
+        detailed += v.verdict == "incorrect"
+        verdicts.append(v)
+    if detailed > MAX_DETAILED:
+        notes.append(f"hints and correct formulas are given for the first {MAX_DETAILED} incorrect claims only")
+    return CheckResult(robot.name, source, tuple(verdicts), tuple(notes))
+
+
+def _judge(robot: DHRobot, raw: Any, label: str, rng: np.random.Generator, deg: bool, detail: bool) -> Verdict:
+    """One claim's verdict; a failure inside the checker is that claim's "unreadable" verdict, never the file's."""
+    try:
+        return check_claim(robot, raw, label, rng, deg, detail=detail)
+    except (ArithmeticError, LookupError, ValueError, TypeError, AttributeError, RecursionError, MemoryError,
+            np.linalg.LinAlgError) as exc:
+        cid = str(raw.get("id", label))[:80] if isinstance(raw, dict) else label
+        qname = str(raw.get("quantity", "?"))[:80] if isinstance(raw, dict) else "?"
+        return Verdict(cid, qname, "unreadable", f"could not be judged: the checker failed on it "
+                       f"({type(exc).__name__}: {str(exc)[:200]}); please report this claim")
 
 
 def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResult:
     """Read a YAML claims file (see ``docs/claims.md``) and judge its claims."""
-    import yaml
+    from ._yaml import load_claims_yaml
 
     path = Path(path)
     where = str(path)
@@ -68,23 +98,29 @@ def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResul
     if path.stat().st_size > MAX_FILE_BYTES:
         raise ParseError(f"claims file too large (at most {MAX_FILE_BYTES} bytes)", where=where)
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8", errors="replace"))
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        raise ParseError(f"malformed YAML{at}: {getattr(exc, 'problem', None) or 'syntax error'}", where=where) from None
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
+    data = load_claims_yaml(text, where)
     if isinstance(data, list):
         data = {"claims": data}
     if not isinstance(data, dict) or "claims" not in data:
         raise ParseError("a claims file is a mapping with a 'claims' list (see docs/claims.md)", where=where)
-    unit = str(data.get("angle_unit", "rad")).lower()
+    unit = data.get("angle_unit", "rad")
     if unit not in ("rad", "deg"):
-        raise ParseError(f"'angle_unit' must be rad or deg, got {unit!r}", where=where)
-    result = check_claims(robot, data["claims"], seed=seed, deg=unit == "deg", source=where)
-    notes = []
+        raise ParseError(f"'angle_unit' must be rad or deg, got {str(unit)[:40]!r}", where=where)
+    claims = data["claims"]
+    if not isinstance(claims, list):
+        raise ParseError("'claims' must be a list of claims", where=where)
+    for k, c in enumerate(claims, start=1):
+        if not isinstance(c, dict):
+            raise ParseError(f"claim {k} is not a mapping (write '- quantity: …' then 'value: …' under it)",
+                             where=where)
+    result = check_claims(robot, claims, seed=seed, deg=unit == "deg", source=where)
+    notes = list(result.notes)
     named = data.get("robot")
     if named is not None and str(named) != robot.name:
-        notes.append(f"the claims file names robot {named!r}; checked against {robot.name!r}")
+        notes.append(f"the claims file names robot {str(named)[:80]!r}; checked against {robot.name!r}")
     return CheckResult(result.robot, result.source, result.verdicts, tuple(notes))
 
 

@@ -203,10 +203,14 @@ def _evaluate(cells: list[list[tuple]], p: Point) -> np.ndarray:
 
 
 def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.Generator,
-                deg: bool = False) -> Verdict:
-    """Read, evaluate and judge one claim (a mapping from the claims file)."""
-    cid = str(raw.get("id", label)) if isinstance(raw, dict) else label
-    qname = str(raw.get("quantity", "?")) if isinstance(raw, dict) else "?"
+                deg: bool = False, *, detail: bool = True) -> Verdict:
+    """Read, evaluate and judge one claim (a mapping from the claims file).
+
+    ``detail=False`` skips the costly part of an incorrect verdict (the search for hints and the correct
+    formula); the verdict itself, the entries and the counterexample are the same.
+    """
+    cid = str(raw.get("id", label))[:80] if isinstance(raw, dict) else label
+    qname = str(raw.get("quantity", "?"))[:80] if isinstance(raw, dict) else "?"
     try:
         if not isinstance(raw, dict):
             raise ParseError("a claim must be a mapping with at least 'quantity' and 'value'")
@@ -245,7 +249,7 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
     if qty.name == "coriolis_matrix" and "entry" not in spec and _factorizes_c(claimed, points, tol):
         return Verdict(cid, qty.name, "correct", "correct as a factorization c = C q̇, though not the Christoffel C "
                        "(so Ṁ − 2C need not be skew-symmetric)", expected=expected, method=method)
-    return _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng)
+    return _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng, detail)
 
 
 def _factorizes_c(claimed: np.ndarray, points: list[Point], tol: np.ndarray) -> bool:
@@ -290,7 +294,7 @@ def _special(name: str):
     return None
 
 
-def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng) -> Verdict:
+def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, method, rng, detail=True) -> Verdict:
     bad = ~ok.all(axis=0)  # entries wrong at some point
     idx = [tuple(int(i) + 1 for i in np.atleast_1d(ix)) for ix in zip(*np.nonzero(np.atleast_1d(bad)))]
     err = np.abs(claimed - truth) / (EXACT_RTOL * np.maximum(1, np.abs(truth)) + tol)
@@ -310,9 +314,9 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
         cex["qd"] = p.qd.tolist()
     if p.robot is not robot:
         cex["parameters"] = dict(p.robot.parameters)
-    hints = hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng)
+    hints = hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng) if detail else ()
     extra = {}
-    if len(points) > 1 and "q" not in spec:  # a formula: give the correct formula too
+    if detail and len(points) > 1 and "q" not in spec:  # a formula: give the correct formula too
         formula = expected_formula(robot, qty.name, spec)
         if formula is not None:
             extra["expected_latex"] = formula

@@ -14,10 +14,12 @@ import numpy as np
 from ..model import Convention, Frame
 from ._quantities import Point
 
-__all__ = ["hints_for"]
+__all__ = ["hints_for", "MAX_PARAMETER_HINTS"]
 
 RTOL = 1e-9
 MAX_HINTS = 6
+#: Parameters tried by the "a wrong parameter value" hint (the first ones of the robot; keeps the search bounded).
+MAX_PARAMETER_HINTS = 8
 
 
 def _close(a: np.ndarray, b: np.ndarray, tol: Any = 0.0) -> bool:
@@ -91,7 +93,7 @@ def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
         if alt is not None and _close(claimed, alt, tol):
             hints.append(f"it is expressed in {other} axes (J{'e' if other == 'tool' else '0'}), not "
                          f"{spec.get('frame', 'base')} axes")
-        if truth.shape[1] == 6:
+        if truth.ndim >= 2 and truth.shape[1] == 6:  # not for one entry (truth is 1-D then)
             perm = [3, 4, 5, 0, 1, 2]
             if _close(claimed, truth[:, perm], tol[perm]):
                 hints.append("the rows are in (ω, v) order; denavit's twists and Jacobians are (v, ω)")
@@ -107,9 +109,9 @@ def _parameter(robot, qty, spec, claimed, truth, tol) -> list[str]:
     if not points or not robot.parameters:
         return []
     hints = []
-    for name, value in robot.parameters:
+    for name, value in robot.parameters[:MAX_PARAMETER_HINTS]:
         span = max(1.0, 3 * abs(value))
-        grid = np.unique(np.concatenate([np.linspace(-span, span, 121), [v for _, v in robot.parameters]]))
+        grid = np.unique(np.concatenate([np.linspace(-span, span, 121), [v for _, v in robot.parameters[:MAX_PARAMETER_HINTS]]]))
         best, best_err = None, np.inf
         for x in grid:
             alt = _alt(qty, spec, points, robot_map=lambda r, x=x: with_parameters(r, **{name: float(x)}))

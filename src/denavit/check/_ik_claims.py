@@ -33,9 +33,11 @@ from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
 from ._vectorized import vec_eval
 
-__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS"]
+__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS", "MAX_WHERE"]
 
 N_TARGETS = 6
+#: Most definitions in an ik_formula's 'where'.
+MAX_WHERE = 20
 MATCH_TOL = 1e-6
 _TARGET = [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)] + ["px", "py", "pz"]
 _COLS = {"n": 0, "o": 1, "a": 2}
@@ -103,15 +105,19 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
     where = raw.get("where") or {}
     if not isinstance(where, dict):
         raise ParseError("'where' must be a mapping of names to formulas, in evaluation order")
+    if len(where) > MAX_WHERE:
+        raise ParseError(f"'where' has {len(where)} definitions; at most {MAX_WHERE}")
     value = str(raw["value"]).strip().strip("$")
     joint = raw.get("joint")
+    if joint is not None and (isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof):
+        raise ParseError(f"'joint' must be an integer from 1 to {robot.dof}, got {str(joint)[:40]!r}")
     if "=" in value:
         lhs, value = split_relation(value)
         node = parse_math(lhs, robot_resolver(robot), rhs=False)
         if node[0] != "name" or not node[1].startswith("q") or not node[1][1:].isdigit():
             raise ParseError(f"the left side {lhs!r} must be one joint variable (q_k or \\theta_k)")
         j = int(node[1][1:])
-        if joint is not None and int(joint) != j:
+        if joint is not None and joint != j:
             raise ParseError(f"'joint: {joint}' disagrees with the formula's left side (joint {j})")
         joint = j
     if joint is None or isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof:

@@ -23,11 +23,17 @@ from typing import Callable
 from .. import _expr
 from ..errors import ParseError
 
-__all__ = ["Ident", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "Resolver"]
+__all__ = ["Ident", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
+           "MAX_DIGITS", "Resolver"]
 
 MAX_CHARS = 20_000
 MAX_DEPTH = 40
 MAX_TOKENS = 6_000
+#: Longest chain of operators in one expression (``1+1+…+1`` with more terms is refused): the trees are walked
+#: recursively, so this keeps every walker far from Python's recursion limit.
+MAX_TREE_DEPTH = 400
+#: Most digits in one number or subscript (a double has about 17 significant digits and overflows past 309).
+MAX_DIGITS = 40
 
 GREEK = ("alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta", "vartheta", "iota",
          "kappa", "lambda", "mu", "nu", "xi", "rho", "sigma", "tau", "phi", "varphi", "chi", "psi", "omega", "ell")
@@ -91,6 +97,10 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         if kind == "ws":
             continue
         tok = m.group(kind)
+        if kind == "num" and len(tok) > MAX_DIGITS:
+            raise ParseError(f"number with more than {MAX_DIGITS} digits at position {m.start() + 1}")
+        if kind == "word" and len(tok) > MAX_DIGITS:
+            raise ParseError(f"name longer than {MAX_DIGITS} characters at position {m.start() + 1}")
         if kind == "cmd" and tok[1:] in _SKIP_CMDS:
             continue
         out.append((kind, tok))
@@ -406,19 +416,47 @@ def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
     node = p.expr()
     if p.peek() is not None:
         raise ParseError(f"unexpected {p.peek()[1]!r} after a complete expression in {text[:60]!r}")
+    if tree_depth(node) > MAX_TREE_DEPTH:
+        raise ParseError(f"expression too long: more than {MAX_TREE_DEPTH} operations in a chain "
+                         "(split it, or group terms in parentheses)")
     return node
 
 
-_ENV = re.compile(r"\\begin\{([bBpvV]?matrix|array)\}(?:\{[^}]*\})?(.*?)\\end\{\1\}", re.S)
+def tree_depth(node: tuple) -> int:
+    """The depth of an expression tree, computed without recursion (so any tree can be measured)."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        nd, d = stack.pop()
+        deepest = max(deepest, d)
+        kind = nd[0]
+        if kind == "neg":
+            stack.append((nd[1], d + 1))
+        elif kind == "bin":
+            stack += [(nd[2], d + 1), (nd[3], d + 1)]
+        elif kind == "call":
+            stack += [(a, d + 1) for a in nd[2]]
+    return deepest
+
+
+_BEGIN = re.compile(r"\\begin\{([bBpvV]?matrix|array)\}(?:\{[^{}]*\})?")
 
 
 def split_matrix(text: str) -> list[list[str]] | None:
-    """The cells of the (first) LaTeX matrix environment in ``text``, or None if there is none."""
+    """The cells of the (first) LaTeX matrix environment in ``text``, or None if there is none.
+
+    Linear time: the first ``\\begin{…matrix}`` is found by one regex search (no backtracking across the
+    text) and its ``\\end`` by a plain substring search; a ``\\begin`` without its ``\\end`` is an error.
+    """
+    if len(text) > MAX_CHARS:
+        raise ParseError(f"expression longer than {MAX_CHARS} characters")
     text = _normalize(text)
-    m = _ENV.search(text)
+    m = _BEGIN.search(text)
     if m is None:
         return None
-    body = m.group(2)
+    end = text.find("\\end{" + m.group(1) + "}", m.end())
+    if end < 0:
+        raise ParseError(f"\\begin{{{m.group(1)}}} without its \\end{{{m.group(1)}}}")
+    body = text[m.end():end]
     rows = [r for r in re.split(r"\\\\(?:\[[^\]]*\])?", body) if r.strip() and not r.strip().startswith("\\hline")]
     return [[c.strip() for c in r.split("&")] for r in rows]
 

@@ -22,10 +22,15 @@ JOINT_BASES = ("theta", "vartheta", "q", "Q")
 _SHORT = {"C": "cos", "c": "cos", "S": "sin", "s": "sin"}
 
 
+def _index(sub: str) -> int | None:
+    """A subscript that is a (short, ASCII) whole number, as an int; None otherwise (``θ_{111…1}`` too)."""
+    return int(sub) if sub.isascii() and sub.isdigit() and len(sub) <= 6 else None
+
+
 def _joint_sum(digits: str, n: int) -> tuple | None:
     """``"123"`` → q1 + q2 + q3 (single digits when n < 10; ``"1,2"`` style separators allowed)."""
     parts = [p for p in re.split(r"[,\s]+", digits) if p] if "," in digits else list(digits)
-    if not parts or not all(p.isdigit() and 1 <= int(p) <= n for p in parts):
+    if not parts or not all((k := _index(p)) is not None and 1 <= k <= n for p in parts):
         return None
     node: tuple = ("name", f"q{parts[0]}")
     for p in parts[1:]:
@@ -51,18 +56,20 @@ def robot_resolver(robot: DHRobot, extra: Iterable[str] = ()):
         if base == "heta":  # "\t" of "\theta" eaten by a text conversion
             base = "theta"
         prefix = {0: "q", 1: "qd", 2: "qdd"}[ident.dots]
-        if base in JOINT_BASES and sub.isdigit() and 1 <= int(sub) <= n:
-            return ("name", f"{prefix}{int(sub)}")
-        if base in ("qd", "qdd", "dq", "ddq") and sub.isdigit() and 1 <= int(sub) <= n and ident.dots == 0:
-            return ("name", f"{'qd' if base in ('qd', 'dq') else 'qdd'}{int(sub)}")
-        if base == "d" and sub.isdigit() and int(sub) in prismatic:
-            return ("name", f"{prefix}{int(sub)}")
+        k = _index(sub)
+        if base in JOINT_BASES and k is not None and 1 <= k <= n:
+            return ("name", f"{prefix}{k}")
+        if base in ("qd", "qdd", "dq", "ddq") and k is not None and 1 <= k <= n and ident.dots == 0:
+            return ("name", f"{'qd' if base in ('qd', 'dq') else 'qdd'}{k}")
+        if base == "d" and k is not None and k in prismatic:
+            return ("name", f"{prefix}{k}")
         if base in _SHORT and ident.dots == 0:
             if ident.sub_tree is not None and sub and not sub.isdigit():
                 return ("call", _SHORT[base], (ident.sub_tree,))
             node = _joint_sum(sub, n)
             if node is not None:
                 return ("call", _SHORT[base], (node,))
+        sub = sub if len(sub) <= 40 else sub[:20] + "…"
         written = base + (f"_{{{sub}}}" if sub else "") if not ident.dots else f"\\dot{{{base}}}_{sub}"
         raise ParseError(f"unknown symbol {written!r}; known: {known()}")
 

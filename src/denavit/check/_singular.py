@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -34,9 +35,15 @@ from ._resolve import robot_resolver
 from ._text import expand_pm, split_relation, split_top
 from ._vectorized import vec_eval
 
-__all__ = ["check_singularities", "SINGULAR_RTOL"]
+__all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_KPI_DIVISOR", "MAX_VALUES", "MAX_CONDITIONS"]
 
 SINGULAR_RTOL = 1e-7
+#: Largest n in ``q_j = k\pi/n`` (each of its 2n values is tested).
+MAX_KPI_DIVISOR = 12
+#: Most values of one joint in one claim (``q_2 = 0, \pi, …``), all conditions together.
+MAX_VALUES = 64
+#: Most conditions (values of a joint, or equations) in one claim.
+MAX_CONDITIONS = 16
 TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 _NONE = {"none", "never", "nowhere", "no singularities", "\\emptyset", "∅", "{}"}
 _ALL = {"all", "always", "everywhere", "every configuration", "all q", "any q"}
@@ -66,9 +73,14 @@ def _rows(spec: dict[str, Any]) -> list[int]:
     rows = spec.get("rows")
     if rows is None or rows == "all":
         return list(range(6))
-    names = [r.strip() for r in (rows.split(",") if isinstance(rows, str) else rows)]
+    if isinstance(rows, str):
+        names = [r.strip() for r in rows.split(",")]
+    elif isinstance(rows, list) and all(isinstance(r, str) for r in rows):
+        names = [r.strip() for r in rows]
+    else:
+        names = []
     bad = [r for r in names if r not in TWIST_ROWS]
-    if bad or not names:
+    if bad or not names or len(set(names)) != len(names):
         raise ParseError(f"'rows' must name rows from {', '.join(TWIST_ROWS)}, got {rows!r}")
     return [TWIST_ROWS.index(r) for r in names]
 
@@ -129,10 +141,17 @@ def _pieces(raw: Any) -> list[str]:
 def _values(rhs: str, resolve, env: dict, rev: bool) -> tuple[list[float], int] | None:
     """``0, \\pi, \\pm\\pi/2`` or ``k\\pi`` → numbers (None if a value depends on the joints)."""
     vals, dec = [], 0
-    for item in split_top(rhs, (",",)):
+    items = split_top(rhs, (",",))
+    if len(items) > MAX_VALUES:
+        raise ParseError(f"too many values in {rhs[:40]!r} ({len(items)}; at most {MAX_VALUES})")
+    for item in items:
         m = _KPI.match(item)
         if m and rev:
-            d = int(m.group(1) or 1)
+            digits = m.group(1) or "1"
+            d = int(digits) if len(digits) <= 6 else MAX_KPI_DIVISOR + 1
+            if not 1 <= d <= MAX_KPI_DIVISOR:
+                raise ParseError(f"k\\pi/{digits[:12]}: the divisor must be from 1 to {MAX_KPI_DIVISOR} "
+                                 "(list the values instead)")
             vals += [k * np.pi / d for k in range(-d + 1, d + 1)]
             continue
         for (version,) in expand_pm([item]):
@@ -152,6 +171,8 @@ def read_conditions(raw: Any, arm: _Arm) -> tuple[list[Cond], str | None]:
         return [], "none" if pieces[0].lower().strip(". ") in _NONE else "everywhere"
     if not pieces:
         raise ParseError("no singular condition given (write 'none' if there is none)")
+    if len(pieces) > MAX_CONDITIONS:
+        raise ParseError(f"too many conditions in one claim ({len(pieces)}; at most {MAX_CONDITIONS})")
     conds = []
     for text in pieces:
         lhs, rhs = split_relation(text)
@@ -167,6 +188,9 @@ def read_conditions(raw: Any, arm: _Arm) -> tuple[list[Cond], str | None]:
             if not any(n.startswith("q") for n in _expr.names_in(node)):
                 raise ParseError(f"condition {text!r} names no joint variable")
             conds.append(Cond(text, node=node, decimals=_decimals(node)))
+    if len(conds) > MAX_CONDITIONS or sum(len(c.values) for c in conds) > MAX_VALUES:
+        raise ParseError(f"too many conditions or values in one claim (at most {MAX_CONDITIONS} conditions and "
+                         f"{MAX_VALUES} joint values)")
     return conds, None
 
 
@@ -306,6 +330,14 @@ def _member(q: np.ndarray, conds: list[Cond], arm: _Arm) -> bool:
     return False
 
 
+@lru_cache(maxsize=8)
+def _analysis(robot: DHRobot, rows: str | None, frame: Frame):
+    """The library's singularity analysis, once per robot, rows and frame (claims of one file share it)."""
+    from .. import symbolic as S
+
+    return S.singularity_analysis(robot, rows=rows, frame=frame)
+
+
 def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str]]:
     """Points of the library's singular set, each confirmed by the rank test: (description, q) pairs;
     whether J is singular everywhere; the library's conditions as text."""
@@ -315,7 +347,7 @@ def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarra
 
     robot = arm.robot
     rows = None if arm.rows == list(range(6)) else ",".join(TWIST_ROWS[i] for i in arm.rows)
-    a = S.singularity_analysis(robot, rows=rows, frame=arm.frame)
+    a = _analysis(robot, rows, arm.frame)
     if a.everywhere or np.all(arm.ratio(arm.random_q(8)) < SINGULAR_RTOL):
         return [], True, [f"every configuration ({a.reason or 'J never has full rank'})"]
     qs = S.joint_symbols(robot.dof).q
