@@ -15,6 +15,8 @@ from .errors import (
 from .io import catalogue_names, dump_robot, load_robot, robot_from_dict, save_robot, with_parameters
 from .model import Convention, DHLink, DHRobot, Frame, JointType, LinkInertia
 from ._convert import convert_convention
+from .build import fixed, prismatic, revolute, robot
+from .display import dh_table
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
@@ -37,6 +39,11 @@ __all__ = [
     "save_robot",
     "with_parameters",
     "convert_convention",
+    "revolute",
+    "prismatic",
+    "fixed",
+    "robot",
+    "dh_table",
     "Convention",
     "Frame",
     "DHLink",
