@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 
 import numpy as np
 import pytest
@@ -22,7 +21,7 @@ from denavit import symbolic as S
 from denavit.check import check_claims, parse_math, robot_resolver
 from denavit.cli import main
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 ARMS = ["report000-6r", "report001-6r", "report004-4-rrp", "scara", "planar3r"]
 
 

@@ -7,7 +7,6 @@ this file from the frames, the two-link formulas are typed in from Spong et al.,
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -26,7 +25,9 @@ from denavit.numeric import (
     rnea,
 )
 
-N_RANDOM = 3 if os.environ.get("CI") == "true" else 8
+from conftest import CI
+
+N_RANDOM = 3 if CI else 8
 ATOL = 1e-9
 
 

@@ -7,7 +7,6 @@ gradients and Pinocchio in test_dynamics_numeric.py) at random states of random 
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -27,7 +26,7 @@ from denavit.symbolic import (  # noqa: E402
     time_derivative,
 )
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 SEEDS = range(3 if CI else 6)
 
 

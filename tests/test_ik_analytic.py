@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -12,7 +11,7 @@ from denavit import (Convention, DHLink, DHRobot, UnsupportedRobotError, analyti
                      forward_kinematics, load_robot, solve_ik)
 from denavit.numeric import ik_structure, transform_from_xyz_rpy
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI, random_q_in_limits as _random_q
 N = 60 if CI else 250
 SUPPORTED = [n for n in denavit.catalogue_names() if n != "panda"]
 CONTROLLED = {  # rows of the pose each kind of arm controls: residual projector built independently here
@@ -20,12 +19,6 @@ CONTROLLED = {  # rows of the pose each kind of arm controls: residual projector
     "position": (np.ones(3), np.zeros(3)),
     "orientation": (np.zeros(3), np.ones(3)),
 }
-
-
-def _random_q(robot, rng, n):
-    lim = robot.q_limits
-    lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
-    return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
 
 
 def _gap(robot, q, T, controlled):

@@ -9,7 +9,6 @@ not with the IK code.  Every solution is also re-checked here by FK.
 
 from __future__ import annotations
 
-import os
 import re
 
 import numpy as np
@@ -22,7 +21,7 @@ from denavit.numeric._ik_analytic import _plan, _solve
 from denavit.numeric._ik_closed import wrist_angles
 from denavit.numeric._ik_subproblems import rotation3
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI, random_q_in_limits as _random_q
 N = 60 if CI else 200
 ARMS = {"puma560": "elbow", "puma560-mdh": "elbow", "report003-6r": "elbow", "report001-6r": "elbow",
         "stanford": "stanford"}
@@ -37,12 +36,6 @@ def _dist(robot, a, b):
     rev = np.array([t.value == "revolute" for t in robot.joint_types])
     d = a - b
     return np.max(np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d)), axis=-1)
-
-
-def _random_q(robot, rng, n):
-    lim = robot.q_limits
-    lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
-    return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
 
 
 def _fk_gap(robot, q, T):

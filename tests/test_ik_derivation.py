@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import os
 
 import numpy as np
 import pytest
@@ -21,7 +20,9 @@ from denavit.errors import UnsupportedRobotError
 from denavit.numeric import transform_from_xyz_rpy
 from denavit.symbolic import IKDerivation, ik_derivation
 
-POSES = 6 if os.environ.get("CI") == "true" else 12
+from conftest import CI, random_q_in_limits as _random_q
+
+POSES = 6 if CI else 12
 ATOL = 1e-9
 SIX = ["puma560", "puma560-mdh", "report003-6r", "report001-6r", "stanford"]
 PLANAR = ["planar2r", "planar3r", "report004-1-planar2r", "report004-2-planar3r", "report000-planar3r"]
@@ -57,11 +58,6 @@ def _wrap_dist(robot, a, b):
     rev = np.array([t.value == "revolute" for t in robot.joint_types])
     d = a - b
     return np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), np.abs(d)).max(axis=-1)
-
-
-def _random_q(robot, rng, n):
-    lim = np.where(np.isfinite(robot.q_limits), robot.q_limits, np.sign(robot.q_limits) * np.pi)
-    return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
 
 
 def _check_against_fk_and_analytic(robot, rng, position_only=False):

@@ -8,7 +8,6 @@ the general route must give the same solution sets as the closed forms.
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -20,7 +19,7 @@ from denavit.numeric import forward_kinematics, solve_ik, transform_from_xyz_rpy
 from denavit.numeric._ik_analytic import _plan, _solve
 from denavit.numeric._ik_numeric import pose_error
 
-CI = bool(os.environ.get("CI"))
+from conftest import CI
 
 
 def random_general_6r(rng: np.random.Generator) -> DHRobot:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 
 import numpy as np
 import pytest
@@ -12,17 +11,11 @@ from denavit import ShapeError, convert_convention, forward_kinematics, load_rob
 from denavit.numeric import transform_from_xyz_rpy
 from denavit.numeric._ik_numeric import pose_error, rotation_log
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI, random_q_in_limits as _random_q
 N = 40 if CI else 150
 ARMS = [n for n in denavit.catalogue_names()]
 # every catalogue arm: 100% (near-singular targets are rescued by closed-form and bank seeds)
 NEAR_SINGULAR_OK: dict[str, float] = {}
-
-
-def _random_q(robot, rng, n):
-    lim = robot.q_limits
-    lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
-    return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
 
 
 def _pose_gap(robot, q, T):

@@ -4,15 +4,13 @@ Truth comes from outside the code under test: central finite differences of forw
 (angular part from Ṙ Rᵀ), roboticstoolbox-python and Pinocchio, and the routes against each other.
 """
 
-import os
-
 import numpy as np
 import pytest
 
 from denavit import Convention, DHLink, DHRobot, Frame, JointType, forward_kinematics, load_robot
 from denavit import numeric as N
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 N_ROBOTS = 120 if CI else 300
 H = 1e-6
 ATOL_FD = 1e-6

@@ -20,7 +20,7 @@ from denavit import numeric as N
 from denavit.report import Equation, Numbers, Table, Text, derive, render, write_report
 from denavit.report import _capabilities
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 ALL = dn.catalogue_names()
 FEW = ["report000-6r", "puma560", "report004-4-rrp", "planar2r"]
 

@@ -1,7 +1,6 @@
 """Singularities: numeric measures against their definitions, symbolic conditions against the rank of J."""
 
 import math
-import os
 
 import numpy as np
 import pytest
@@ -11,7 +10,7 @@ from denavit import numeric as N
 
 from test_jacobians import make_robot
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 ROW_NAMES = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 

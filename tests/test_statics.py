@@ -1,7 +1,5 @@
 """Statics: τ = Jᵀ F against inward force propagation and against virtual work from finite differences."""
 
-import os
-
 import numpy as np
 import pytest
 
@@ -10,7 +8,7 @@ from denavit import numeric as N
 
 from test_jacobians import make_robot
 
-CI = os.environ.get("CI") == "true"
+from conftest import CI
 N_ROBOTS = 100 if CI else 250
 H = 1e-6
 

@@ -23,7 +23,7 @@ pytestmark = pytest.mark.browser
 CHROMIUM = os.environ.get("DENAVIT_CHROMIUM", "/usr/bin/chromium")
 LAUNCH_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                "--disable-component-update", "--disable-sync", "--no-first-run"]
-IN_CI = os.environ.get("CI") == "true"
+from conftest import CI as IN_CI
 READOUT_ATOL = 6e-5  # the visible readout has 4 decimals
 ROBOTS = ["puma560", "stanford", "report004-5-rpp-cylindrical", "panda"]  # standard/modified, prismatic
 

@@ -1,0 +1,70 @@
+"""Shared test settings: the CI flag, hypothesis profiles, random joint values, the seed-report folder.
+
+- ``CI`` (and the ``ci`` fixture): true when the environment variable ``CI`` is ``"true"`` (``.ci/run`` sets it).
+  Tests use it to run fewer random cases on CI's two cores; what each case asserts does not change.
+- Hypothesis profiles: ``ci`` (derandomized, so a CI failure reproduces; no deadline: the machine is shared)
+  and ``dev`` (random, no deadline), chosen by ``CI``; ``HYPOTHESIS_PROFILE=...`` overrides.  Example counts
+  stay those of each test's own ``@settings``.
+- ``random_q_in_limits(robot, rng, n)``: n configurations uniform within the joint limits (±π where a limit
+  is infinite); the ``rng`` fixture is a fresh ``numpy.random.Generator`` per test (seeded, reproducible).
+- ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone); tests that read
+  them take the ``seed_reports`` fixture, which skips with the reason when the folder is absent.
+- Slow tests carry ``@pytest.mark.slow``; tests marked ``browser`` are slow too (a real browser starts), so
+  ``python -m pytest -m "not slow"`` is the quick subset.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+CI = os.environ.get("CI") == "true"
+
+settings.register_profile("ci", deadline=None, derandomize=True, print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("dev", deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if CI else "dev"))
+
+_HERE = Path(__file__).resolve().parent
+#: the project's shared folder of seed reports: ``shared/seeds`` beside the clone (CI clones main with
+#: ``shared/`` next to it); absent in a plain clone, and the tests reading it then skip.
+SEED_REPORTS = next((p for p in (_HERE.parents[1] / "shared" / "seeds", _HERE.parents[2] / "shared" / "seeds")
+                     if p.is_dir()), _HERE.parents[1] / "shared" / "seeds")
+
+
+def random_q_in_limits(robot, rng: np.random.Generator, n: int) -> np.ndarray:
+    """(n, dof) joint values uniform within the robot's limits; an infinite limit counts as ±π."""
+    lim = robot.q_limits
+    lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
+    return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
+
+
+@pytest.fixture
+def ci() -> bool:
+    """True on CI (``CI=true``): run fewer random cases."""
+    return CI
+
+
+@pytest.fixture
+def rng(request) -> np.random.Generator:
+    """A generator seeded from the test's node id: reproducible, different per test."""
+    return np.random.default_rng(sum(request.node.nodeid.encode()) + 16)
+
+
+@pytest.fixture
+def seed_reports() -> Path:
+    """The shared seed-report folder; skips the test when it is absent."""
+    if not SEED_REPORTS.is_dir() or not any(SEED_REPORTS.glob("*.txt")):
+        pytest.skip(f"seed reports not present ({SEED_REPORTS} is outside the repository)")
+    return SEED_REPORTS
+
+
+def pytest_collection_modifyitems(config, items):
+    slow = pytest.mark.slow
+    for item in items:
+        if item.get_closest_marker("browser") is not None:
+            item.add_marker(slow)
