@@ -297,7 +297,7 @@ def dh_table(robot: DHRobot, deg: bool | None = None, fmt: str = "text") -> str:
     Examples
     --------
     >>> import denavit
-    >>> print(denavit.dh_table(denavit.load_robot("planar2r"), fmt="markdown").splitlines()[4])
+    >>> print(denavit.dh_table(denavit.load_robot("planar2r"), fmt="markdown").splitlines()[6])
     | 1 | revolute | L1 | 0 | 0 | q1 | [-π, π] |
     """
     if fmt not in TABLE_FORMATS:

@@ -311,6 +311,28 @@ class DHRobot:
         """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
 
+    # --- presentation (delegated to denavit.display) ---------------------------------------------
+    def __str__(self) -> str:
+        """The DH table as text (see :func:`denavit.dh_table`)."""
+        from .display import dh_table
+
+        return dh_table(self)
+
+    def __repr__(self) -> str:
+        from .display import robot_summary
+
+        return robot_summary(self)
+
+    def _repr_html_(self) -> str:
+        from .display import robot_html
+
+        return robot_html(self)
+
+    def _repr_markdown_(self) -> str:
+        from .display import dh_table
+
+        return dh_table(self, fmt="markdown")
+
 
 #: Most named poses (``qz``, ``qr``, …) one robot may carry, and how far [rad, m] a pose may sit outside a limit.
 MAX_POSES = 64
