@@ -166,7 +166,7 @@ def cmd_jacobian(args: argparse.Namespace):
         data["q"] = _q_out(args, robot, q)
         if args.analytic:
             Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
-            require_finite("jacobian", Ja, phi)
+            require_finite("jacobian", phi)  # rate rows are NaN at a representation singularity (warned)
             names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
             conv = np.degrees(phi) if args.deg else phi
             data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
