@@ -22,12 +22,15 @@ from .model import Convention, DHLink, DHRobot, JointType, LinkInertia
 
 __all__ = ["convert_convention"]
 
+#: Entries below this fraction of the largest one are rounding noise of the frame change and are set to 0.
+_NOISE = 1e-12
+
 
 def _move_inertia(inertia: LinkInertia | None, a: float, alpha: float, inverse: bool) -> LinkInertia | None:
     """Inertial data re-expressed through X = Tx(a) Rx(α): from the frame X maps into (inverse=False)."""
     if inertia is None:
         return None
-    c, s = np.cos(alpha), np.sin(alpha)
+    c, s = (0.0 if abs(v) < 1e-15 else float(v) for v in (np.cos(alpha), np.sin(alpha)))  # cos(pi/2) -> 0
     R = np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
     p = np.array([a, 0.0, 0.0])
     com = np.array(inertia.com)
@@ -36,6 +39,8 @@ def _move_inertia(inertia: LinkInertia | None, a: float, alpha: float, inverse: 
         com, I = R.T @ (com - p), R.T @ I @ R
     else:
         com, I = R @ com + p, R @ I @ R.T
+    com = np.where(np.abs(com) < _NOISE * max(np.abs(com).max(), abs(a)), 0.0, com)  # rounding noise -> 0
+    I = np.where(np.abs(I) < _NOISE * np.abs(I).max(), 0.0, I)
     return LinkInertia(
         mass=inertia.mass, com=tuple(com), inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
         motor_inertia=inertia.motor_inertia, viscous=inertia.viscous, coulomb=inertia.coulomb,

@@ -13,6 +13,7 @@ __all__ = [
     "ParseError",
     "UnsupportedRobotError",
     "MissingDependencyError",
+    "DenavitWarning",
 ]
 
 
@@ -45,3 +46,10 @@ class UnsupportedRobotError(DenavitError):
 
 class MissingDependencyError(DenavitError, ImportError):
     """An optional dependency is missing; the message names the extra to install."""
+
+
+class DenavitWarning(UserWarning):
+    """Input that is accepted but probably not what was meant (e.g. ``alpha: 90`` in a radian file).
+
+    The message says what to write instead; the command line prints it as one ``warning:`` line.
+    """

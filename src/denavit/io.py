@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
@@ -17,8 +18,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import _expr
-from .errors import ModelError, ParseError
-from .model import DH_FIELDS, Convention, DHLink, DHRobot, JointType, LinkInertia
+from ._safeload import MAX_EXPANDED, MAX_INT_DIGITS, MAX_NESTING, MAX_TEXT_BYTES, load_data
+from .errors import DenavitWarning, ModelError, ParseError
+from .model import DH_FIELDS, INERTIA_TOLERANCE, MAX_ANGLE, MAX_MAGNITUDE, Convention, DHLink, DHRobot, JointType, LinkInertia
 
 __all__ = [
     "load_robot",
@@ -33,8 +35,15 @@ __all__ = [
     "resolve_pose",
 ]
 
-MAX_FILE_BYTES = 1_000_000
+#: Largest robot file read (bytes); a 32-joint arm with inertial data is about 10 kB.
+MAX_FILE_BYTES = MAX_TEXT_BYTES
+#: Most DH rows in a file, fixed rows included (joints are capped by :data:`denavit.model.MAX_JOINTS`).
 MAX_ROWS = 64
+#: Most named parameters in a file.
+MAX_PARAMETERS = 256
+#: Most values in one list given on the command line or to :func:`parse_values`, and its length in characters.
+MAX_VALUES = 10_000
+MAX_VALUES_TEXT = 200_000
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z_0-9]*$")
 _QVAR = re.compile(r"^q(\d*)$")
 _RESERVED = set(_expr.FUNCTIONS) | {"pi", "q"}
@@ -86,9 +95,12 @@ def load_robot(source: str | Path, **parameters: float) -> DHRobot:
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
             raise ParseError(f"file too large ({size} bytes; at most {MAX_FILE_BYTES})", where=str(path))
-        text = path.read_text(encoding="utf-8", errors="replace")
-        data = _load_text(text, path.suffix.lower(), str(path))
-        robot = robot_from_dict(data, where=str(path))
+        with path.open("rb") as fh:  # bounded read: the size on disk may lie (special files)
+            raw = fh.read(MAX_FILE_BYTES + 1)
+        if len(raw) > MAX_FILE_BYTES:
+            raise ParseError(f"file too large (more than {MAX_FILE_BYTES} bytes)", where=str(path))
+        data = _load_text(raw.decode("utf-8", errors="replace"), path.suffix.lower(), str(path))
+        robot = robot_from_dict(_override(data, parameters, str(path)), where=str(path))
     else:
         name = CATALOGUE_ALIASES.get(str(source), str(source))
         if name not in catalogue_names():
@@ -96,36 +108,43 @@ def load_robot(source: str | Path, **parameters: float) -> DHRobot:
                 f"unknown robot {name!r}: not a file and not a built-in name; built-in: {', '.join(catalogue_names())}"
             )
         res = _catalogue_dir() / f"{name}.yaml"
-        robot = robot_from_dict(_load_text(res.read_text(encoding="utf-8"), ".yaml", f"catalogue:{name}"), where=name)
+        data = _load_text(res.read_text(encoding="utf-8"), ".yaml", f"catalogue:{name}")
+        robot = robot_from_dict(_override(data, parameters, name), where=name)
         robot = robot.replace(source=f"catalogue:{name}")
-    return with_parameters(robot, **parameters) if parameters else robot
+    return robot
+
+
+def _override(data: dict[str, Any], values: Mapping[str, float], where: str) -> dict[str, Any]:
+    """The file's data with some parameters given new values, so every field is evaluated with them.
+
+    Fields, limits, inertia, gravity, base, tool and parameters defined from the overridden ones all
+    follow, because the whole file is read again with the new values.
+    """
+    if not values:
+        return data
+    params = data.get("parameters")
+    known = [str(k) for k in params] if isinstance(params, dict) else []
+    for k in values:
+        if k not in known:
+            raise ParseError(f"no parameter {k!r}; parameters: {', '.join(known) or 'none'}", where=where)
+    new = dict(params)  # type: ignore[arg-type]
+    for k, v in values.items():
+        new[k] = _param_value(k, v)
+    return {**data, "parameters": new}
+
+
+def _param_value(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ParseError(f"parameter {name}: expected a number, got {value!r:.40}") from None
+    if not math.isfinite(v):
+        raise ParseError(f"parameter {name}: value must be finite, got {v}")
+    return v
 
 
 def _load_text(text: str, suffix: str, where: str) -> dict[str, Any]:
-    if suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ParseError(f"malformed JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", where=where) from None
-    elif suffix == ".toml":
-        try:
-            import tomllib
-        except ModuleNotFoundError:  # Python 3.10
-            import tomli as tomllib  # type: ignore[no-redef]
-        try:
-            data = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ParseError(f"malformed TOML: {exc}", where=where) from None
-    else:
-        import yaml
-
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-            problem = getattr(exc, "problem", None) or "syntax error"
-            raise ParseError(f"malformed YAML{at}: {problem}", where=where) from None
+    data = load_data(text, suffix, where)
     if not isinstance(data, dict):
         raise ParseError("a robot file must be a mapping with at least 'convention' and 'joints'", where=where)
     return data
@@ -142,6 +161,7 @@ class _Ctx:
         self.where = where
         self.params = params
         self.deg = deg
+        self.suspects: list[tuple[str, str]] = []  # (place, text) of bare angles > 2π in a radian file
 
     def fail(self, place: str, message: str) -> ParseError:
         return ParseError(message, where=f"{self.where}: {place}")
@@ -163,15 +183,39 @@ class _Ctx:
         if angle:
             tree = self.angle_tree(tree)
         try:
-            return _expr.evaluate(tree, self.params), _expr.to_text(tree)
+            value = _expr.evaluate(tree, self.params)
         except ParseError as exc:
             raise self.fail(place, str(exc)) from None
+        text = _expr.to_text(tree)
+        if angle and not self.deg and _is_literal(tree) and abs(value) > DEGREE_HINT:
+            self.suspects.append((place, text))
+        return value, text
+
+    def warn_degrees(self) -> None:
+        """One warning for bare angles above 2π in a radian file: probably degrees without ``angle_unit: deg``."""
+        if not self.suspects:
+            return
+        place, text = self.suspects[0]
+        more = f" (and {len(self.suspects) - 1} more such angles)" if len(self.suspects) > 1 else ""
+        warnings.warn(DenavitWarning(
+            f"{self.where}: {place}: {text} is read as {text} rad, more than a full turn{more}; if the file's "
+            f"angles are in degrees, add 'angle_unit: deg' at the top of the file, or write {text}deg"
+        ), stacklevel=3)
 
     def angle_tree(self, tree: _expr.Node) -> _expr.Node:
         """In a degree file a bare angle is in degrees; one that says deg or uses pi is taken as written."""
         if self.deg and not _names_unit(tree):
             return ("call", "deg", (tree,))
         return tree
+
+
+#: A bare angle above this in a radian file draws the "did you mean degrees?" warning.
+DEGREE_HINT = 2 * math.pi + 1e-9
+
+
+def _is_literal(tree: _expr.Node) -> bool:
+    """A plain number, maybe negated (no unit, no pi, no parameter)."""
+    return tree[0] == "num" or (tree[0] == "neg" and tree[1][0] == "num")
 
 
 def _names_unit(tree: _expr.Node) -> bool:
@@ -186,24 +230,13 @@ def _names_unit(tree: _expr.Node) -> bool:
     return False
 
 
-def _subst(tree: _expr.Node, name: str, value: _expr.Node) -> _expr.Node:
-    kind = tree[0]
-    if kind == "name":
-        return value if tree[1] == name else tree
-    if kind == "neg":
-        return ("neg", _subst(tree[1], name, value))
-    if kind == "bin":
-        return ("bin", tree[1], _subst(tree[2], name, value), _subst(tree[3], name, value))
-    if kind == "call":
-        return ("call", tree[1], tuple(_subst(a, name, value) for a in tree[2]))
-    return tree
-
-
 def _parameters(raw: Any, where: str) -> dict[str, float]:
     if raw is None:
         return {}
     if not isinstance(raw, dict):
         raise ParseError("'parameters' must be a mapping name: value", where=f"{where}: parameters")
+    if len(raw) > MAX_PARAMETERS:
+        raise ParseError(f"too many parameters ({len(raw)}; at most {MAX_PARAMETERS})", where=f"{where}: parameters")
     params: dict[str, float] = {}
     for key, value in raw.items():
         key = str(key)
@@ -244,7 +277,10 @@ def _joint_row(raw: Any, row: int, joint_no: int, ctx: _Ctx) -> DHLink:
             tree = _check_linear(tree, qname, fplace, ctx)
         value, text = ctx.number(_expr.to_text(tree), fplace, angle=field in ("alpha", "theta"))
         values[field] = value
-        if text not in ("0", "0.0"):
+        bound, unit = (MAX_ANGLE, "rad") if field in ("alpha", "theta") else (MAX_MAGNITUDE, "m")
+        if abs(value) > bound:
+            raise ctx.fail(fplace, f"{value:.6g} {unit} is out of range (at most {bound:g} {unit} in magnitude)")
+        if value != 0 or _has_names(text):
             texts.append((field, text))
     joint = {None: JointType.FIXED, "theta": JointType.REVOLUTE, "d": JointType.PRISMATIC}[variable]
     limits = None
@@ -255,10 +291,17 @@ def _joint_row(raw: Any, row: int, joint_no: int, ctx: _Ctx) -> DHLink:
             raise ctx.fail(lplace, "limits must be a list [low, high]")
         if joint is JointType.FIXED:
             raise ctx.fail(lplace, "a fixed row (no q) cannot have limits")
-        limits = tuple(ctx.number(v, lplace, angle=joint is JointType.REVOLUTE)[0] for v in lim)
+        got = [ctx.number(v, lplace, angle=joint is JointType.REVOLUTE) for v in lim]
+        limits = (got[0][0], got[1][0])
+        bound, unit = (MAX_ANGLE, "rad") if joint is JointType.REVOLUTE else (MAX_MAGNITUDE, "m")
+        if max(map(abs, limits)) > bound:
+            raise ctx.fail(lplace, f"limits [{limits[0]:.6g}, {limits[1]:.6g}] {unit} are out of range (at most {bound:g} "
+                                   f"{unit} in magnitude)")
+        if any(_has_names(t) for _, t in got):
+            texts += [("limits0", got[0][1]), ("limits1", got[1][1])]
         if limits[0] > limits[1]:
             raise ctx.fail(lplace, f"low limit {limits[0]:g} is above high limit {limits[1]:g}")
-    inertia = _inertia(raw.get("inertia"), f"{place}, field 'inertia'", ctx) if "inertia" in raw else None
+    inertia = _inertia(raw.get("inertia"), place, ctx) if "inertia" in raw else None
     try:
         return DHLink(joint=joint, q_limits=limits, inertia=inertia, symbols=tuple(texts), **values)
     except ModelError as exc:
@@ -266,54 +309,95 @@ def _joint_row(raw: Any, row: int, joint_no: int, ctx: _Ctx) -> DHLink:
 
 
 def _check_linear(tree: _expr.Node, qname: str, place: str, ctx: _Ctx) -> _expr.Node:
-    """Check the field is q + offset (coefficient one) and return the offset tree."""
-    env = dict(ctx.params)
+    """Check the field is exactly ``q + offset`` (q once, coefficient +1, offset free of q); return the offset tree.
+
+    The test is on the expression's structure (a sum of terms, one of which is q itself), not on sample
+    values, so ``abs(q)``, ``sqrt(q^2)``, ``q + sin(2*pi*q)``, ``2*q`` or ``q*q`` are all refused.
+    """
+    terms = _sum_terms(tree)
+    with_q = [(sign, t) for sign, t in terms if qname in _expr.names_in(t)]
+    hint = f"the joint variable must enter as '{qname} + offset' (coefficient 1, offset without {qname})"
+    if len(with_q) != 1:
+        raise ctx.fail(place, f"{hint}; {qname} appears in {len(with_q)} terms")
+    sign, term = with_q[0]
+    if term != ("name", qname):
+        raise ctx.fail(place, f"{hint}; found {_expr.to_text(term)!r}")
+    if sign < 0:
+        raise ctx.fail(place, f"{hint}; found -{qname}")
+    offset: _expr.Node | None = None
+    for sign, t in terms:
+        if t[0] == "name" and t[1] == qname:
+            continue
+        if offset is None:
+            offset = t if sign > 0 else ("neg", t)
+        else:
+            offset = ("bin", "+" if sign > 0 else "-", offset, t)
+    return offset if offset is not None else ("num", "0")
+
+
+def _sum_terms(tree: _expr.Node) -> list[tuple[int, _expr.Node]]:
+    """``a - (b + c)`` as [(+1, a), (-1, b), (-1, c)], left to right (no recursion)."""
+    out: list[tuple[int, _expr.Node]] = []
+    stack: list[tuple[int, _expr.Node]] = [(1, tree)]
+    while stack:
+        sign, node = stack.pop()
+        if node[0] == "bin" and node[1] in "+-":
+            stack.append((sign if node[1] == "+" else -sign, node[3]))
+            stack.append((sign, node[2]))
+        elif node[0] == "neg":
+            stack.append((-sign, node[1]))
+        else:
+            out.append((sign, node))
+    return out
+
+
+def _has_names(text: str) -> bool:
+    """Whether an expression text uses a named parameter (so it must be kept to be re-evaluated)."""
     try:
-        f = [_expr.evaluate(tree, {**env, qname: v}) for v in (0.0, 1.0, 2.5)]
-    except ParseError as exc:
-        raise ctx.fail(place, str(exc)) from None
-    if abs((f[1] - f[0]) - 1.0) > 1e-12 or abs((f[2] - f[0]) - 2.5) > 1e-12:
-        raise ctx.fail(place, f"the joint variable must enter as '{qname} + offset' (coefficient 1)")
-    return _drop_zeros(_subst(tree, qname, ("num", "0")))
+        return bool(_expr.names_in(_expr.parse(text)))
+    except ParseError:
+        return False
 
 
-def _is_zero(node: _expr.Node) -> bool:
-    return node[0] == "num" and float(node[1]) == 0.0
+def _inertia(raw: Any, row_place: str, ctx: _Ctx) -> LinkInertia:
+    """A row's inertial data; errors name e.g. ``row 3, field 'inertia.com[1]'``."""
 
+    def at(key: str = "") -> str:
+        return f"{row_place}, field 'inertia{'.' + key if key else ''}'"
 
-def _drop_zeros(tree: _expr.Node) -> _expr.Node:
-    """Remove the ``0 +`` left where the joint variable was taken out of ``q + offset``."""
-    if tree[0] == "bin" and tree[1] in "+-":
-        left, right = _drop_zeros(tree[2]), _drop_zeros(tree[3])
-        if _is_zero(right):
-            return left
-        if _is_zero(left):
-            return right if tree[1] == "+" else ("neg", right)
-        return ("bin", tree[1], left, right)
-    return tree
-
-
-def _inertia(raw: Any, place: str, ctx: _Ctx) -> LinkInertia:
     if not isinstance(raw, dict):
-        raise ctx.fail(place, "inertia must be a mapping {mass, com, inertia, ...}")
+        raise ctx.fail(at(), "inertia must be a mapping {mass, com, inertia, ...}")
     unknown = set(map(str, raw)) - _INERTIA_KEYS
     if unknown:
-        raise ctx.fail(place, f"unknown key {sorted(unknown)[0]!r}; allowed: {', '.join(sorted(_INERTIA_KEYS))}")
+        raise ctx.fail(at(), f"unknown key {sorted(unknown)[0]!r}; allowed: {', '.join(sorted(_INERTIA_KEYS))}")
     texts: list[tuple[str, str]] = []
 
     def val(key: str, value: Any, sym_key: str) -> float:
-        number, text = ctx.number(value, f"{place}.{key}")
-        if text not in ("0", "0.0"):
+        number, text = ctx.number(value, at(key))
+        if number != 0 or _has_names(text):
             texts.append((sym_key, text))
         return number
 
     def vec(key: str, n: int) -> tuple[float, ...]:
         value = raw.get(key, [0] * n)
-        if key == "inertia" and isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value):
-            value = [value[0][0], value[1][1], value[2][2], value[0][1], value[0][2], value[1][2]]
+        if key == "inertia" and isinstance(value, list) and any(isinstance(r, list) for r in value):
+            return matrix(value)
         if not isinstance(value, (list, tuple)) or len(value) != n:
-            raise ctx.fail(f"{place}.{key}", f"expected a list of {n} values")
+            raise ctx.fail(at(key), f"expected a list of {n} values" + (
+                " (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) or a 3×3 list" if key == "inertia" else ""))
         return tuple(val(f"{key}[{i}]", v, f"{key}{i}") for i, v in enumerate(value))
+
+    def matrix(rows: list[Any]) -> tuple[float, ...]:
+        """A 3×3 tensor: symmetric, read as its 6 distinct entries."""
+        if len(rows) != 3 or not all(isinstance(r, list) and len(r) == 3 for r in rows):
+            raise ctx.fail(at("inertia"), "a 3×3 inertia matrix needs 3 rows of 3 values")
+        M = np.array([[ctx.number(v, at(f"inertia[{i}][{j}]"))[0] for j, v in enumerate(r)] for i, r in enumerate(rows)])
+        if np.abs(M - M.T).max() > INERTIA_TOLERANCE * max(np.abs(M).max(), 1e-300):
+            i, j = np.unravel_index(np.argmax(np.abs(M - M.T)), M.shape)
+            raise ctx.fail(at("inertia"), f"the 3×3 inertia matrix is not symmetric ([{i}][{j}] = {M[i, j]:g} but "
+                                          f"[{j}][{i}] = {M[j, i]:g})")
+        pick = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+        return tuple(val(f"inertia[{i}][{j}]", rows[i][j], f"inertia{k}") for k, (i, j) in enumerate(pick))
 
     mass = val("mass", raw.get("mass", 0), "mass")
     com = vec("com", 3)
@@ -322,16 +406,19 @@ def _inertia(raw: Any, place: str, ctx: _Ctx) -> LinkInertia:
     try:
         return LinkInertia(mass=mass, com=com, inertia=inertia, symbols=tuple(texts), **extra)  # type: ignore[arg-type]
     except ModelError as exc:
-        raise ctx.fail(place, str(exc)) from None
+        raise ctx.fail(at(), str(exc)) from None
 
 
-def _transform(raw: Any, place: str, ctx: _Ctx) -> np.ndarray:
+def _transform(raw: Any, place: str, ctx: _Ctx) -> tuple[np.ndarray, list[tuple[str, str]]]:
+    """A base or tool transform and, when it uses parameters, the expression texts of its entries."""
     from .numeric._transforms import transform_from_xyz_rpy
 
     if isinstance(raw, list):
         if len(raw) != 4 or not all(isinstance(r, list) and len(r) == 4 for r in raw):
             raise ctx.fail(place, "a transform given as a matrix must be 4×4")
-        return np.array([[ctx.number(v, place)[0] for v in r] for r in raw])
+        got = [ctx.number(v, f"{place}[{i}][{j}]") for i, r in enumerate(raw) for j, v in enumerate(r)]
+        texts = [(f"{place}.m{k}", t) for k, (_, t) in enumerate(got)]
+        return np.array([v for v, _ in got]).reshape(4, 4), texts if any(_has_names(t) for _, t in texts) else []
     if not isinstance(raw, dict) or set(map(str, raw)) - {"xyz", "rpy"}:
         raise ctx.fail(place, "expected {xyz: [x, y, z], rpy: [roll, pitch, yaw]}, a 4×4 list, or (tool) a DH row")
     xyz = raw.get("xyz", [0, 0, 0])
@@ -339,9 +426,23 @@ def _transform(raw: Any, place: str, ctx: _Ctx) -> np.ndarray:
     for key, v in (("xyz", xyz), ("rpy", rpy)):
         if not isinstance(v, list) or len(v) != 3:
             raise ctx.fail(f"{place}.{key}", "expected a list of 3 values")
-    return transform_from_xyz_rpy(
-        [ctx.number(v, f"{place}.xyz") [0] for v in xyz], [ctx.number(v, f"{place}.rpy", angle=True)[0] for v in rpy]
-    )
+    p = [ctx.number(v, f"{place}.xyz[{i}]") for i, v in enumerate(xyz)]
+    r = [ctx.number(v, f"{place}.rpy[{i}]", angle=True) for i, v in enumerate(rpy)]
+    texts = [(f"{place}.xyz{i}", t) for i, (_, t) in enumerate(p)] + [(f"{place}.rpy{i}", t) for i, (_, t) in enumerate(r)]
+    T = transform_from_xyz_rpy([v for v, _ in p], [v for v, _ in r])
+    return T, texts if any(_has_names(t) for _, t in texts) else []
+
+
+def _transform_from_texts(texts: Mapping[str, str], place: str, params: Mapping[str, float]) -> np.ndarray | None:
+    """Re-evaluate a transform stored by :func:`_transform` (None when it had no parameters)."""
+    from .numeric._transforms import transform_from_xyz_rpy
+
+    ev = lambda key: _expr.evaluate(_expr.parse(texts[key]), params)  # noqa: E731
+    if f"{place}.m0" in texts:
+        return np.array([ev(f"{place}.m{k}") for k in range(16)]).reshape(4, 4)
+    if f"{place}.xyz0" in texts:
+        return transform_from_xyz_rpy([ev(f"{place}.xyz{i}") for i in range(3)], [ev(f"{place}.rpy{i}") for i in range(3)])
+    return None
 
 
 def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
@@ -377,6 +478,7 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
         joint_no += link.is_joint
         links.append(link)
     tool = np.eye(4)
+    symbols: list[tuple[str, str]] = []
     if "tool" in data and data["tool"] is not None:
         raw_tool = data["tool"]
         if isinstance(raw_tool, dict) and set(map(str, raw_tool)) & set(DH_FIELDS):
@@ -385,28 +487,53 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
                 raise ParseError("the tool row cannot have a joint variable", where=f"{where}: tool")
             links.append(link)
         else:
-            tool = _transform(raw_tool, "tool", ctx)
-    base = _transform(data["base"], "base", ctx) if data.get("base") is not None else np.eye(4)
+            tool, found = _transform(raw_tool, "tool", ctx)
+            symbols += found
+    if data.get("base") is not None:
+        base, found = _transform(data["base"], "base", ctx)
+        symbols += found
+    else:
+        base = np.eye(4)
     gravity = data.get("gravity", [0, 0, -9.81])
     if not isinstance(gravity, list) or len(gravity) != 3:
         raise ParseError("gravity must be a list of 3 values [m/s²]", where=f"{where}: gravity")
-    g = tuple(ctx.number(v, "gravity")[0] for v in gravity)
+    got = [ctx.number(v, f"gravity[{i}]") for i, v in enumerate(gravity)]
+    g = tuple(v for v, _ in got)
+    if any(_has_names(t) for _, t in got):
+        symbols += [(f"gravity{i}", t) for i, (_, t) in enumerate(got)]
     poses = _poses(data.get("poses"), [link.joint for link in links if link.is_joint], ctx)
     try:
-        return DHRobot(
-            name=str(data.get("name", Path(where).stem)),
+        robot = DHRobot(
+            name=_text_field(data, "name", Path(where).stem, where),
             links=tuple(links),
             convention=Convention(conv),
             base=base,  # type: ignore[arg-type]
             tool=tool,  # type: ignore[arg-type]
             gravity=g,  # type: ignore[arg-type]
             parameters=tuple(params.items()),
-            description=str(data.get("description", "")),
-            source=str(data.get("source", where)),
+            description=_text_field(data, "description", "", where),
+            source=_text_field(data, "source", where, where),
             poses=poses,
+            symbols=tuple(symbols),
         )
     except ModelError as exc:
         raise ParseError(str(exc), where=where) from None
+    ctx.warn_degrees()
+    return robot
+
+
+#: Longest name, description or source text in a robot file.
+MAX_TEXT = 2_000
+
+
+def _text_field(data: Mapping[str, Any], key: str, default: str, where: str) -> str:
+    value = data.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise ParseError(f"'{key}' must be text, got {type(value).__name__}", where=f"{where}: {key}")
+    text = str(value)
+    if len(text) > MAX_TEXT:
+        raise ParseError(f"'{key}' is longer than {MAX_TEXT} characters", where=f"{where}: {key}")
+    return text
 
 
 def _poses(raw: Any, joints: list[JointType], ctx: _Ctx) -> tuple[tuple[str, tuple[float, ...]], ...]:
@@ -448,28 +575,61 @@ def _safe_names(value: Any) -> set[str]:
 
 
 def with_parameters(robot: DHRobot, **values: float) -> DHRobot:
-    """The same robot with some named parameters given new values (all fields re-evaluated)."""
+    """The same robot with some named parameters given new values, every field that uses them re-evaluated.
+
+    DH values, joint limits, inertial data, gravity, base and tool written with parameters all follow.
+    Parameters defined in the file from other parameters keep their values here (``load_robot(path, L1=…)``
+    re-reads the file, so they follow too).
+
+    Raises
+    ------
+    ParseError
+        An unknown parameter name (the message lists the robot's parameters), a value that is not a finite
+        number, or a new value that puts a field out of range.
+    """
     params = robot.parameter_values
     for k, v in values.items():
         if k not in params:
             raise ParseError(f"robot {robot.name!r} has no parameter {k!r}; parameters: {', '.join(params) or 'none'}")
-        params[k] = float(v)
+        params[k] = _param_value(k, v)
     ev = lambda text: _expr.evaluate(_expr.parse(text), params)  # noqa: E731
-    links = []
-    for link in robot.links:
-        new = {k: ev(t) for k, t in link.symbols}
-        inertia = link.inertia
-        if inertia is not None and inertia.symbols:
-            s = dict(inertia.symbols)
-            inertia = LinkInertia(
-                mass=ev(s["mass"]) if "mass" in s else inertia.mass,
-                com=tuple(ev(s[f"com{i}"]) if f"com{i}" in s else inertia.com[i] for i in range(3)),  # type: ignore[arg-type]
-                inertia=tuple(ev(s[f"inertia{i}"]) if f"inertia{i}" in s else inertia.inertia[i] for i in range(6)),  # type: ignore[arg-type]
-                **{k: ev(s[k]) if k in s else getattr(inertia, k) for k in ("motor_inertia", "viscous", "coulomb")},
-                symbols=inertia.symbols,
-            )
-        links.append(DHLink(**{**_link_kwargs(link), **new, "inertia": inertia}))
-    return robot.replace(links=tuple(links), parameters=tuple(params.items()))
+    try:
+        links = []
+        for row, link in enumerate(robot.links, start=1):
+            try:
+                links.append(_link_with(link, ev))
+            except ModelError as exc:
+                raise ParseError(f"row {row}: {exc}") from None
+        changes: dict[str, Any] = {"links": tuple(links), "parameters": tuple(params.items())}
+        sym = dict(robot.symbols)
+        if "gravity0" in sym:
+            changes["gravity"] = tuple(ev(sym[f"gravity{i}"]) for i in range(3))
+        for place in ("base", "tool"):
+            T = _transform_from_texts(sym, place, params)
+            if T is not None:
+                changes[place] = T
+        return robot.replace(**changes)
+    except ModelError as exc:
+        raise ParseError(str(exc)) from None
+
+
+def _link_with(link: DHLink, ev: Any) -> DHLink:
+    """A DH row with the fields written with parameters evaluated again by ``ev``."""
+    sym = dict(link.symbols)
+    new: dict[str, Any] = {k: ev(t) for k, t in sym.items() if k in DH_FIELDS}
+    if "limits0" in sym:
+        new["q_limits"] = (ev(sym["limits0"]), ev(sym["limits1"]))
+    inertia = link.inertia
+    if inertia is not None and inertia.symbols:
+        s = dict(inertia.symbols)
+        inertia = LinkInertia(
+            mass=ev(s["mass"]) if "mass" in s else inertia.mass,
+            com=tuple(ev(s[f"com{i}"]) if f"com{i}" in s else inertia.com[i] for i in range(3)),  # type: ignore[arg-type]
+            inertia=tuple(ev(s[f"inertia{i}"]) if f"inertia{i}" in s else inertia.inertia[i] for i in range(6)),  # type: ignore[arg-type]
+            **{k: ev(s[k]) if k in s else getattr(inertia, k) for k in ("motor_inertia", "viscous", "coulomb")},
+            symbols=inertia.symbols,
+        )
+    return DHLink(**{**_link_kwargs(link), **new, "inertia": inertia})
 
 
 def _link_kwargs(link: DHLink) -> dict[str, Any]:
@@ -483,13 +643,22 @@ def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q"
                  env: Mapping[str, float] | None = None) -> np.ndarray:
     """Parse ``"0, pi/4, 90deg"`` (comma or space separated expressions) into floats.
 
+    Values are separated by commas (or semicolons) when there are any outside brackets, else by spaces;
+    the whole list may be wrapped in ``[...]`` or ``(...)``; ``\\pi`` is read as ``pi``.  An empty value
+    (``"1,,2"``, ``"1 2,"``), unbalanced brackets (``"[1,2"``), more than :data:`MAX_VALUES` values or
+    more than :data:`MAX_VALUES_TEXT` characters are refused.  The text is read in one linear pass.
     ``deg=True`` reads plain numbers as degrees (``pi`` or ``deg`` in a value still say their unit).
     Raises ParseError naming the value when something is wrong.
+
+    >>> parse_values("[0 0.5]").tolist(), parse_values("(-\\pi/2, 90deg)").round(4).tolist()
+    ([0.0, 0.5], [-1.5708, 1.5708])
     """
     if isinstance(text, str):
-        parts = [p for p in re.split(r"[,\s;]+(?![^()]*\))", text.strip().strip("[]()")) if p]
+        parts = _split_values(text, what)
     else:
         parts = list(text)
+        if len(parts) > MAX_VALUES:
+            raise ParseError(f"{what}: more than {MAX_VALUES} values")
     if n is not None and len(parts) != n:
         raise ParseError(f"{what}: expected {n} values, got {len(parts)}")
     out = []
@@ -504,46 +673,145 @@ def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q"
     return np.array(out, dtype=float)
 
 
+_CLOSE = {"(": ")", "[": "]"}
+
+
+def _split_values(text: str, what: str) -> list[str]:
+    """The values of a list text (see :func:`parse_values`), checked for balanced brackets and empty values."""
+    if len(text) > MAX_VALUES_TEXT:
+        raise ParseError(f"{what}: longer than {MAX_VALUES_TEXT} characters")
+    t = text.strip().replace("\\pi", "pi")
+    opened: list[int] = []
+    outer_close = -1
+    for i, ch in enumerate(t):
+        if ch in "([":
+            opened.append(i)
+        elif ch in ")]":
+            if not opened or _CLOSE[t[opened[-1]]] != ch:
+                raise ParseError(f"{what}: unbalanced brackets: {ch!r} at position {i + 1} closes nothing")
+            if opened.pop() == 0:
+                outer_close = i
+    if opened:
+        raise ParseError(f"{what}: unbalanced brackets: {t[opened[-1]]!r} at position {opened[-1] + 1} is never closed")
+    if t and outer_close == len(t) - 1:
+        t = t[1:-1].strip()
+    depth = 0
+    commas = False
+    for ch in t:
+        depth += (ch in "([") - (ch in ")]")
+        if depth == 0 and ch in ",;":
+            commas = True
+            break
+    parts: list[str] = []
+    start = depth = 0
+    for i, ch in enumerate(t):
+        depth += (ch in "([") - (ch in ")]")
+        if depth == 0 and (ch in ",;" if commas else ch.isspace()):
+            parts.append(t[start:i].strip())
+            start = i + 1
+            if len(parts) > MAX_VALUES:
+                raise ParseError(f"{what}: more than {MAX_VALUES} values")
+    parts.append(t[start:].strip())
+    if not commas:
+        return [p for p in parts if p]
+    for k, p in enumerate(parts, start=1):
+        if not p:
+            raise ParseError(f"{what}: value {k} is empty (two separators in a row, or one at an end): {text[:60]!r}")
+    return parts
+
+
 # --------------------------------------------------------------------------------------------------
 # robot -> dict / file
 
 
-def _num_text(x: float) -> Any:
+def _num_text(x: float, angle: bool = False) -> Any:
+    """A value for a written file: an int when whole, an exact multiple of π as text (``5*pi/4``), with
+    ``angle=True`` a whole number of degrees as ``170deg``, else the float."""
+    x = float(x)
     if x == int(x) and abs(x) < 1e15:
         return int(x)
-    for k in (1, 2, 3, 4, 6, 12):
-        for s in (1, -1):
-            if abs(x - s * math.pi / k) < 1e-14:
-                return ("-" if s < 0 else "") + ("pi" if k == 1 else f"pi/{k}")
-    return float(x)
+    for k in (1, 2, 3, 4, 6, 8, 12):
+        m = x * k / math.pi
+        num = round(m)
+        if num and abs(m - num) < 1e-12 * max(1.0, abs(m)):
+            coef = {1: "", -1: "-"}.get(num, f"{num}*")
+            return f"{coef}pi" + (f"/{k}" if k != 1 else "")
+    if angle:
+        d = math.degrees(x)
+        if abs(d - round(d)) < 1e-9 and abs(d) <= 3600:
+            return f"{round(d)}deg"
+    return x
+
+
+def _text_value(text: str) -> Any:
+    """A stored expression text as it is best written: a plain number as a number, ``deg(90)`` as ``90deg``."""
+    try:
+        tree = _expr.parse(text)
+    except ParseError:
+        return text
+    if _is_literal(tree):
+        value = _expr.evaluate(tree)
+        return int(value) if value == int(value) and abs(value) < 1e15 else value
+    if tree[0] == "call" and tree[1] == "deg" and _is_literal(tree[2][0]):
+        return f"{_expr.to_text(tree[2][0])}deg"
+    return text
+
+
+def _with_q(offset: Any) -> str:
+    """``q``, ``q + offset`` or ``q - offset`` for a joint field."""
+    if offset in (0, "0"):
+        return "q"
+    text = str(offset)
+    return f"q - {text[1:]}" if text.startswith("-") else f"q + {text}"
+
+
+def _clean(x: float, scale: float = 1.0) -> float:
+    """Rounding noise (|x| below 1e-12 of ``scale``) written as 0."""
+    return 0.0 if abs(x) < 1e-12 * max(scale, 1e-300) else float(x)
+
+
+def _transform_dict(robot: DHRobot, place: str) -> Any:
+    sym = dict(robot.symbols)
+    if f"{place}.m0" in sym:
+        return [[_text_value(sym[f"{place}.m{4 * i + j}"]) for j in range(4)] for i in range(4)]
+    if f"{place}.xyz0" in sym:
+        return {"xyz": [_text_value(sym[f"{place}.xyz{i}"]) for i in range(3)],
+                "rpy": [_text_value(sym[f"{place}.rpy{i}"]) for i in range(3)]}
+    M = getattr(robot, f"{place}_matrix")
+    scale = max(1.0, float(np.abs(M[:3, 3]).max()))
+    return [[_num_text(_clean(x, scale)) for x in r] for r in M]
 
 
 def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
-    """Plain data for a robot file (radians, expressions kept as written)."""
+    """Plain data for a robot file (radians; expressions kept as written, exact multiples of π as such)."""
     rows: list[dict[str, Any]] = []
     for link in robot.links:
         sym = dict(link.symbols)
         row: dict[str, Any] = {}
         for field in DH_FIELDS:
-            v: Any = sym.get(field, _num_text(getattr(link, field)))
-            if link.joint is JointType.REVOLUTE and field == "theta":
-                v = "q" if v in (0, "0") else f"q + {v}"
-            if link.joint is JointType.PRISMATIC and field == "d":
-                v = "q" if v in (0, "0") else f"q + {v}"
+            angle = field in ("alpha", "theta")
+            v: Any = _text_value(sym[field]) if field in sym else _num_text(getattr(link, field), angle)
+            if (link.joint is JointType.REVOLUTE and field == "theta") or (link.joint is JointType.PRISMATIC and field == "d"):
+                v = _with_q(v)
             row[field] = v
         if link.q_limits is not None:
-            row["limits"] = [_num_text(link.q_limits[0]), _num_text(link.q_limits[1])]
+            angle = link.joint is JointType.REVOLUTE
+            row["limits"] = ([_text_value(sym["limits0"]), _text_value(sym["limits1"])] if "limits0" in sym
+                             else [_num_text(link.q_limits[0], angle), _num_text(link.q_limits[1], angle)])
         if link.inertia is not None:
             li = link.inertia
             s = dict(li.symbols)
+            scale = max(abs(x) for x in li.inertia) or 1.0
+            cscale = max(abs(x) for x in li.com) or 1.0
+            get = lambda key, x, sc: _text_value(s[key]) if key in s else _num_text(_clean(x, sc))  # noqa: E731
             inertia: dict[str, Any] = {
-                "mass": s.get("mass", li.mass),
-                "com": [s.get(f"com{i}", c) for i, c in enumerate(li.com)],
-                "inertia": [s.get(f"inertia{i}", c) for i, c in enumerate(li.inertia)],
+                "mass": get("mass", li.mass, 1.0),
+                "com": [get(f"com{i}", c, cscale) for i, c in enumerate(li.com)],
+                "inertia": [get(f"inertia{i}", c, scale) for i, c in enumerate(li.inertia)],
             }
             for k in ("motor_inertia", "viscous", "coulomb"):
                 if getattr(li, k) or k in s:
-                    inertia[k] = s.get(k, getattr(li, k))
+                    inertia[k] = get(k, getattr(li, k), 1.0)
             row["inertia"] = inertia
         rows.append(row)
     out: dict[str, Any] = {"name": robot.name}
@@ -552,33 +820,83 @@ def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
     out["convention"] = robot.convention.value
     out["angle_unit"] = "rad"
     if robot.parameters:
-        out["parameters"] = {k: v for k, v in robot.parameters}
+        out["parameters"] = {k: _num_text(v) if v == int(v) else v for k, v in robot.parameters}
     out["joints"] = rows
-    if not np.allclose(robot.tool_matrix, np.eye(4)):
-        out["tool"] = [[float(x) for x in r] for r in robot.tool]
-    if not np.allclose(robot.base_matrix, np.eye(4)):
-        out["base"] = [[float(x) for x in r] for r in robot.base]
-    out["gravity"] = list(robot.gravity)
+    if robot.symbols and any(k.startswith("tool.") for k, _ in robot.symbols) or not np.allclose(robot.tool_matrix, np.eye(4)):
+        out["tool"] = _transform_dict(robot, "tool")
+    if robot.symbols and any(k.startswith("base.") for k, _ in robot.symbols) or not np.allclose(robot.base_matrix, np.eye(4)):
+        out["base"] = _transform_dict(robot, "base")
+    gsym = dict(robot.symbols)
+    out["gravity"] = ([_text_value(gsym[f"gravity{i}"]) for i in range(3)] if "gravity0" in gsym
+                      else [_num_text(g) for g in robot.gravity])
     if robot.poses:
         out["poses"] = {k: [_num_text(v) for v in q] for k, q in robot.poses}
     return out
 
 
+_PLAIN = re.compile(r"[A-Za-z0-9_.+\-*/^() ]*[A-Za-z0-9_.)]")
+
+
+def _yaml_value(v: Any) -> str:
+    """One value in YAML flow style: numbers unquoted, expressions plain when safe, else double-quoted."""
+    if isinstance(v, bool) or v is None:
+        return json.dumps(v)
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        short = float(f"{v:.15g}")
+        text = repr(short if abs(short - v) <= 2 * math.ulp(v) else v)  # 0.014100000000000003 -> 0.0141
+        return text.replace("e", ".0e") if "e" in text and "." not in text else text  # YAML 1.1 floats need a dot
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{_yaml_value(str(k))}: {_yaml_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_yaml_value(x) for x in v) + "]"
+    text = str(v)
+    if _PLAIN.fullmatch(text) and not text.startswith(("- ", " ")) and _plain_is_text(text):
+        return text
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _plain_is_text(text: str) -> bool:
+    import yaml
+
+    try:
+        return isinstance(yaml.safe_load(text), str)
+    except yaml.YAMLError:
+        return False
+
+
+def _yaml_row(row: Mapping[str, Any]) -> str:
+    """A joint row: the DH values (and limits) on one line, the inertial data on their own lines."""
+    head = ", ".join(f"{k}: {_yaml_value(v)}" for k, v in row.items() if k != "inertia")
+    if "inertia" not in row:
+        return "  - {" + head + "}\n"
+    inertia = row["inertia"]
+    first = ", ".join(f"{k}: {_yaml_value(inertia[k])}" for k in ("mass", "com", "inertia") if k in inertia)
+    rest = ", ".join(f"{k}: {_yaml_value(v)}" for k, v in inertia.items() if k not in ("mass", "com", "inertia"))
+    lines = "  - {" + head + ",\n     inertia: {" + first
+    lines += (",\n               " + rest) if rest else ""
+    return lines + "}}\n"
+
+
 def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
-    """The robot as file text (``yaml`` or ``json``)."""
+    """The robot as file text (``yaml`` or ``json``).
+
+    The YAML is written for people: one line per DH row, inertial data on their own lines, numbers
+    unquoted, expressions and exact multiples of π kept as text, rounding noise written as 0.
+    """
     data = robot_to_dict(robot)
     if fmt == "json":
         return json.dumps(data, indent=2)
-    import yaml
-
-    lines = [f"# {robot.name}: written by denavit"]
-    body = {k: v for k, v in data.items() if k != "joints"}
-    text = yaml.safe_dump(body, sort_keys=False, default_flow_style=None)
-    joints = "joints:\n" + "".join(
-        "  - " + yaml.safe_dump(row, default_flow_style=True, sort_keys=False, width=10_000).strip() + "\n"
-        for row in data["joints"]
-    )
-    return "\n".join(lines) + "\n" + text + joints
+    out = [f"# {robot.name}: written by denavit"]
+    for key, value in data.items():
+        if key == "joints":
+            out.append("joints:\n" + "".join(_yaml_row(row) for row in value).rstrip("\n"))
+        elif key in ("base", "tool") and isinstance(value, list):
+            out.append(f"{key}:\n" + "\n".join(f"  - {_yaml_value(r)}" for r in value))
+        else:
+            out.append(f"{key}: {_yaml_value(value)}")
+    return "\n".join(out) + "\n"
 
 
 def save_robot(robot: DHRobot, path: str | Path, *, overwrite: bool = False) -> None:

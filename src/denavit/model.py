@@ -26,6 +26,11 @@ __all__ = [
     "IDENTITY",
     "DH_FIELDS",
     "INERTIA_ORDER",
+    "MAX_MAGNITUDE",
+    "MAX_ANGLE",
+    "MAX_JOINTS",
+    "INERTIA_TOLERANCE",
+    "TRIANGLE_TOLERANCE",
 ]
 
 IDENTITY: tuple[tuple[float, ...], ...] = (
@@ -69,14 +74,56 @@ class JointType(str, Enum):
     FIXED = "fixed"
 
 
-def _finite(value: float, what: str) -> float:
+#: Bound on every length [m], mass [kg], inertia [kg m²], friction coefficient and gravity component [m/s²]
+#: of a model: far beyond any real arm, and small enough that products in the dynamics (m·L²·q̇², sums over
+#: 32 joints) stay many orders of magnitude below float overflow.
+MAX_MAGNITUDE = 1e6
+#: Bound on every angle [rad] (DH twists and offsets, revolute limits): about 160 turns.  Beyond it an angle
+#: is not a meaningful configuration (and float angles lose their precision).
+MAX_ANGLE = 1e3
+#: Bound on the number of joint variables of one arm (work grows with n² to n⁴ in Jacobians and dynamics).
+MAX_JOINTS = 32
+#: Tolerance on the inertia checks (negative principal moments, asymmetry), relative to the largest moment.
+INERTIA_TOLERANCE = 1e-9
+#: Tolerance on the triangle inequality I1 + I2 >= I3 of principal moments, relative to I3.  Published data
+#: sets are not always consistent (the PUMA 560 link 3 of Armstrong et al. misses it by 9 %), so only a clear
+#: violation is refused.
+TRIANGLE_TOLERANCE = 0.1
+
+
+def _finite(value: float, what: str, bound: float | None = None, unit: str = "") -> float:
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise ModelError(f"{what} must be a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ModelError(f"{what} must be a number, got {value!r:.60}") from None
     if not math.isfinite(v):
-        raise ModelError(f"{what} must be finite, got {value!r}")
+        raise ModelError(f"{what} must be finite, got {value!r:.60}")
+    if bound is not None and abs(v) > bound:
+        raise ModelError(f"{what} = {v:.6g}{unit} is out of range (at most {bound:g}{unit} in magnitude)")
     return v
+
+
+def check_inertia_tensor(I: Any, mass: float = 1.0, what: str = "inertia") -> None:
+    """Refuse a 3×3 inertia tensor that no rigid body has (ModelError naming the reason).
+
+    Checks: symmetric; principal moments non-negative; and, for a body with mass, the triangle
+    inequality I1 + I2 >= I3 of the principal moments (within :data:`TRIANGLE_TOLERANCE`).  A massless
+    row may carry a rotational inertia alone (a lumped rotor, as on the PUMA 560's first link).
+    """
+    I = np.asarray(I, dtype=float)  # (3, 3)
+    scale = float(np.abs(I).max()) if I.size else 0.0
+    if scale == 0.0:
+        return
+    if np.abs(I - I.T).max() > INERTIA_TOLERANCE * scale:
+        raise ModelError(f"{what}: the 3×3 tensor is not symmetric")
+    moments = np.linalg.eigvalsh(I)  # ascending
+    if moments[0] < -INERTIA_TOLERANCE * scale:
+        raise ModelError(f"{what}: a principal moment is negative ({moments[0]:.3g} kg m²); no body has that")
+    if mass > 0 and moments[0] + moments[1] < moments[2] * (1 - TRIANGLE_TOLERANCE):
+        raise ModelError(
+            f"{what}: principal moments {moments[0]:.3g}, {moments[1]:.3g}, {moments[2]:.3g} break the triangle "
+            f"inequality I1 + I2 >= I3; no body has that"
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,17 +157,20 @@ class LinkInertia:
     symbols: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
-        if _finite(self.mass, "mass") < 0:
+        if _finite(self.mass, "mass", MAX_MAGNITUDE, " kg") < 0:
             raise ModelError(f"mass must be non-negative, got {self.mass!r}")
         if len(self.com) != 3:
             raise ModelError(f"com must have 3 values, got {len(self.com)}")
         if len(self.inertia) != 6:
             raise ModelError(f"inertia must have 6 values {INERTIA_ORDER}, got {len(self.inertia)}")
-        object.__setattr__(self, "com", tuple(_finite(c, "com") for c in self.com))
-        object.__setattr__(self, "inertia", tuple(_finite(c, "inertia") for c in self.inertia))
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "com", tuple(_finite(c, "com", MAX_MAGNITUDE, " m") for c in self.com))
+        object.__setattr__(self, "inertia", tuple(_finite(c, "inertia", MAX_MAGNITUDE, " kg m²") for c in self.inertia))
         for name in ("motor_inertia", "viscous", "coulomb"):
-            if _finite(getattr(self, name), name) < 0:
+            if _finite(getattr(self, name), name, MAX_MAGNITUDE) < 0:
                 raise ModelError(f"{name} must be non-negative, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, float(getattr(self, name)))
+        check_inertia_tensor(self.inertia_matrix, self.mass)
 
     @property
     def inertia_matrix(self) -> np.ndarray:
@@ -136,7 +186,8 @@ class DHLink:
     ``a``, ``alpha``, ``d``, ``theta`` are the constant parts [m, rad]; the joint variable q is
     added to ``theta`` (revolute) or ``d`` (prismatic), so a revolute row's ``theta`` is its offset.
     In a ``MODIFIED`` robot, ``a`` and ``alpha`` of row i are a_{i-1} and α_{i-1}.
-    ``symbols`` keeps the expression text of fields written with parameters (``("d", "H1")``).
+    ``symbols`` keeps the expression text of fields written with parameters (``("d", "H1")``; the limits
+    as ``limits0``/``limits1`` when they use parameters), so they can be re-evaluated for new values.
     """
 
     a: float = 0.0
@@ -150,7 +201,9 @@ class DHLink:
 
     def __post_init__(self) -> None:
         for name in DH_FIELDS:
-            object.__setattr__(self, name, _finite(getattr(self, name), name))
+            angle = name in ("alpha", "theta")
+            bound, unit = (MAX_ANGLE, " rad") if angle else (MAX_MAGNITUDE, " m")
+            object.__setattr__(self, name, _finite(getattr(self, name), name, bound, unit))
         if not isinstance(self.joint, JointType):
             try:
                 object.__setattr__(self, "joint", JointType(self.joint))
@@ -162,12 +215,13 @@ class DHLink:
                 raise ModelError("a fixed row has no joint variable, so it cannot have limits")
             if len(self.q_limits) != 2:
                 raise ModelError(f"limits must be [low, high], got {self.q_limits!r}")
-            lo, hi = (_finite(v, "limit") for v in self.q_limits)
+            bound, unit = (MAX_ANGLE, " rad") if self.joint is JointType.REVOLUTE else (MAX_MAGNITUDE, " m")
+            lo, hi = (_finite(v, "limit", bound, unit) for v in self.q_limits)
             if lo > hi:
                 raise ModelError(f"limits low > high: [{lo}, {hi}]")
             object.__setattr__(self, "q_limits", (lo, hi))
         for key, _ in self.symbols:
-            if key not in DH_FIELDS:
+            if key not in DH_FIELDS and key not in ("limits0", "limits1"):
                 raise ModelError(f"unknown DH field {key!r} in symbols")
 
     @property
@@ -191,6 +245,8 @@ def _as_transform(value: Any, what: str) -> tuple[tuple[float, ...], ...]:
         raise ModelError(f"{what} rotation part is not a rotation matrix")
     if not np.allclose(arr[3], [0, 0, 0, 1]):
         raise ModelError(f"{what} last row must be [0, 0, 0, 1]")
+    if np.abs(arr[:3, 3]).max() > MAX_MAGNITUDE:
+        raise ModelError(f"{what} translation is out of range (at most {MAX_MAGNITUDE:g} m in magnitude)")
     return tuple(tuple(float(x) for x in row) for row in arr)
 
 
@@ -216,6 +272,10 @@ class DHRobot:
     poses : tuple of (name, q)
         Named configurations (``qz`` zero, ``qr`` ready, …), each ``q`` a tuple of ``dof`` joint values [rad, m]
         within the joint limits; at most :data:`MAX_POSES`.
+    symbols : tuple of (key, expression)
+        Expression text of gravity and base/tool entries written with parameters (``gravity2`` → ``"-g"``,
+        ``base.xyz0``…``base.rpy2`` or ``base.m0``…``base.m15``, likewise ``tool``), so
+        :func:`denavit.io.with_parameters` can re-evaluate them.
     """
 
     name: str
@@ -228,6 +288,7 @@ class DHRobot:
     description: str = ""
     source: str = ""
     poses: tuple[tuple[str, tuple[float, ...]], ...] = ()
+    symbols: tuple[tuple[str, str], ...] = ()
     _joint_rows: tuple[int, ...] = field(init=False, repr=False, compare=False, hash=False, default=())
 
     def __post_init__(self) -> None:
@@ -247,10 +308,12 @@ class DHRobot:
         rows = tuple(i for i, link in enumerate(links) if link.is_joint)
         if not rows:
             raise ModelError("a robot needs at least one joint (a row with q)")
+        if len(rows) > MAX_JOINTS:
+            raise ModelError(f"too many joints ({len(rows)}; at most {MAX_JOINTS})")
         object.__setattr__(self, "_joint_rows", rows)
         object.__setattr__(self, "base", _as_transform(self.base, "base"))
         object.__setattr__(self, "tool", _as_transform(self.tool, "tool"))
-        g = tuple(_finite(x, "gravity") for x in self.gravity)
+        g = tuple(_finite(x, "gravity", MAX_MAGNITUDE, " m/s²") for x in self.gravity)
         if len(g) != 3:
             raise ModelError(f"gravity must have 3 components, got {len(g)}")
         object.__setattr__(self, "gravity", g)
