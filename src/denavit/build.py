@@ -157,7 +157,8 @@ def _transform_data(value: Any, what: str) -> Any:
 
 def robot(rows: Iterable[Row | DHLink], name: str = "robot", convention: str = "standard", *,
           parameters: Mapping[str, Value] | None = None, tool: Any = None, base: Any = None,
-          gravity: Iterable[Value] = (0.0, 0.0, -9.81), angle_unit: str = "rad", description: str = "") -> DHRobot:
+          gravity: Iterable[Value] = (0.0, 0.0, -9.81), angle_unit: str = "rad", description: str = "",
+          poses: Mapping[str, Iterable[Value]] | None = None) -> DHRobot:
     """Assemble DH rows into a :class:`~denavit.DHRobot`.
 
     Parameters
@@ -179,6 +180,8 @@ def robot(rows: Iterable[Row | DHLink], name: str = "robot", convention: str = "
         Unit of bare angle values (α, θ offsets, revolute limits, rpy); ``"pi/2"`` or ``"90deg"`` say their
         unit themselves.
     description : str
+    poses : mapping of str to joint values, optional
+        Named configurations (``{"qz": [0, 0], "qr": [0, "pi/2"]}``) [rad or ``angle_unit``, m].
 
     Returns
     -------
@@ -212,4 +215,7 @@ def robot(rows: Iterable[Row | DHLink], name: str = "robot", convention: str = "
         data["tool"] = _transform_data(tool, "tool")
     if base is not None:
         data["base"] = _transform_data(base, "base")
+    if poses:
+        data["poses"] = {str(k): [_plain(v) for v in np.asarray(q, dtype=object).reshape(-1)]
+                         for k, q in poses.items()}
     return robot_from_dict(data, where=f"robot {str(name)!r}")
