@@ -9,6 +9,9 @@ Documents write DH tables in many ways; this reader accepts the common ones:
 - the convention from the header: ``a_{i-1}`` or ``\\alpha_{i-1}`` mean modified (Craig), ``a_i``, ``\\alpha_i``
   standard; ``--convention`` decides when the header does not;
 - degrees from the header (``deg``, ``°``) or from the values (a twist of ±90 or 180 is degrees);
+- lengths in millimetres or centimetres when the header says so (``d (mm)``, ``a [cm]``): converted to metres,
+  with a note; a header without a unit over lengths that all look like millimetres (every one above
+  :data:`MM_HINT` in absolute value) gives a warning saying what to write;
 - cells in LaTeX (``$\\theta_1$``, ``$\\frac{\\pi}{2}$``, ``$-d_3$``, ``$\\theta_2 - \\pi/2$``) or plain text; a cell
   ``$H_1 = 0.5$`` defines the parameter ``H1``; other names become parameters (value 1 unless defined,
   with a note);
@@ -16,23 +19,42 @@ Documents write DH tables in many ways; this reader accepts the common ones:
   d cell naming d_i* / q_i (or d_i when no θ variable appears) makes a prismatic one; a row without a
   variable is fixed (e.g. a tool row).
 
-Cells are read by the restricted reader of :mod:`denavit.check._latex` (never ``eval``).
+Cells are read by the restricted reader of :mod:`denavit.check._latex` (never ``eval``).  Sizes are capped
+(:data:`MAX_TABLE_CHARS`, :data:`MAX_TABLE_ROWS`, :data:`MAX_COLUMNS`, :data:`MAX_LINE_CHARS`,
+:data:`MAX_CELL_CHARS`) and every pattern used runs in linear time, whatever the line.
 """
 
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
 from . import _expr
+from . import errors as _errors
 from .errors import ParseError
 from .model import DHRobot
 
-__all__ = ["TableImport", "import_table", "find_table", "table_file_text", "MAX_TABLE_CHARS"]
+__all__ = ["TableImport", "import_table", "find_table", "table_file_text", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS",
+           "MAX_COLUMNS", "MAX_LINE_CHARS", "MAX_CELL_CHARS", "LENGTH_UNITS", "MM_HINT"]
 
+#: Largest pasted text read (characters).
 MAX_TABLE_CHARS = 200_000
+#: Most data rows in one table (as many as a robot file's rows).
+MAX_TABLE_ROWS = 64
+#: Most columns in a table row.
+MAX_COLUMNS = 16
+#: Longest line that can be a table row; longer lines (prose) are skipped when looking for the header.
+MAX_LINE_CHARS = 4_000
+#: Longest cell.
+MAX_CELL_CHARS = 500
+#: Length units understood in a header (``a (mm)``, ``d [cm]``) and their factor to metres.
+LENGTH_UNITS = {"mm": 0.001, "cm": 0.01, "m": 1.0}
+#: Lengths all larger than this (in absolute value), under a header naming no unit, look like millimetres.
+MM_HINT = 10.0
 _COLS = ("a", "alpha", "d", "theta")
+_RULE_CHARS = frozenset(" \t:|-")
 
 
 @dataclass(frozen=True)
@@ -51,10 +73,27 @@ def _cells(line: str) -> list[str]:
     elif s.startswith("|") or s.count("|") >= 3:
         cells = s.strip("|").split("|")
     elif "&" in s:
-        cells = re.sub(r"\\\\\s*(\\hline)?\s*$", "", s).split("&")
+        cells = _strip_row_end(s).split("&")
     else:
         return []
     return [c.strip() for c in cells]
+
+
+def _strip_row_end(s: str) -> str:
+    """A LaTeX row without its trailing ``\\\\`` (and ``\\hline``), by plain string tests (no backtracking)."""
+    t = s.rstrip()
+    if t.endswith("\\hline"):
+        u = t[:-len("\\hline")].rstrip()
+        if u.endswith("\\\\"):
+            return u[:-2]
+    if t.endswith("\\\\"):
+        return t[:-2]
+    return s
+
+
+def _is_rule(line: str) -> bool:
+    """A Markdown rule such as ``|---|:--:|``: only spaces, tabs, ``:``, ``|`` and ``-`` (with a ``-``)."""
+    return "-" in line and set(line) <= _RULE_CHARS
 
 
 def _plain(cell: str) -> str:
@@ -65,7 +104,7 @@ def _plain(cell: str) -> str:
 
 def _column_kind(cell: str) -> str | None:
     """``a``/``alpha``/``d``/``theta``/``index`` from a header cell, or None."""
-    s = re.sub(r"\(.*?\)|\[.*?\]", " ", _plain(cell)).strip()  # drop units and "(z_{i-1})" remarks
+    s = re.sub(r"\([^()]*\)|\[[^\[\]]*\]", " ", _plain(cell)).strip()  # drop units and "(z_{i-1})" remarks
     head = re.match(r"[a-z]+", s)
     word = head.group(0) if head else ""
     if word in ("theta", "vartheta", "heta", "q", "joint_angle") or re.fullmatch(r"q(_?i|_?n)?", s.replace(" ", "")):
@@ -87,19 +126,30 @@ def find_table(text: str) -> tuple[list[str], list[list[str]]]:
         raise ParseError(f"file too large for a table ({len(text)} characters; at most {MAX_TABLE_CHARS})")
     lines = text.splitlines()
     for k, line in enumerate(lines):
+        if len(line) > MAX_LINE_CHARS:
+            continue  # prose, not a header
         cells = _cells(line)
+        if len(cells) > MAX_COLUMNS or any(len(c) > MAX_CELL_CHARS for c in cells):
+            continue
         kinds = [_column_kind(c) for c in cells]
         if len(cells) >= 4 and all(c in kinds for c in _COLS):
             rows = []
-            for nxt in lines[k + 1:]:
-                if re.fullmatch(r"\s*\|?[\s:|-]+\|?\s*", nxt) and "-" in nxt:
+            for n, nxt in enumerate(lines[k + 1:], start=k + 2):
+                if _is_rule(nxt):
                     continue  # Markdown rule
+                if len(nxt) > MAX_LINE_CHARS:
+                    raise ParseError(f"line {n}: longer than {MAX_LINE_CHARS} characters")
                 c = _cells(nxt)
                 if len(c) != len(cells) or not any(x.strip() for x in c):
                     if rows:
                         break
                     continue
+                long = [x for x in c if len(x) > MAX_CELL_CHARS]
+                if long:
+                    raise ParseError(f"line {n}: a cell longer than {MAX_CELL_CHARS} characters")
                 rows.append(c)
+                if len(rows) > MAX_TABLE_ROWS:
+                    raise ParseError(f"line {n}: more than {MAX_TABLE_ROWS} rows in the table")
             if not rows:
                 raise ParseError(f"line {k + 1}: a DH header but no rows under it")
             return cells, rows
@@ -117,7 +167,8 @@ class _Reader:
         from .check._resolve import JOINT_BASES
 
         base = "theta" if ident.base == "heta" else ident.base
-        if base in JOINT_BASES and ident.sub.isdigit() and ident.dots == 0 and not (base == "Q" and False):
+        if base in JOINT_BASES and ident.sub.isascii() and ident.sub.isdigit() and len(ident.sub) <= 6 \
+                and ident.dots == 0:
             return ("name", f"q{int(ident.sub)}")
         name = ident.plain
         if ident.dots or not re.fullmatch(r"[A-Za-z][A-Za-z0-9]*", name):
@@ -192,15 +243,28 @@ def import_table(text: str, name: str = "imported", convention: str | None = Non
     deg = _is_degrees(header, kinds, rows) if degrees is None else degrees
     if deg and degrees is None:
         notes.append("angles read as degrees (from the header or twist values such as 90)")
+    factors = {k: _length_unit(header[col[k]]) for k in ("a", "d")}
+    for k, (unit, _) in factors.items():
+        if unit not in (None, "m"):
+            notes.append(f"column {header[col[k]]!r}: lengths converted from {unit} to metres")
     reader = _Reader()
     joints = []
     for r, raw in enumerate(rows, start=1):
         cells = {k: reader.cell(raw[col[k]], f"{where}: row {r}, column {header[col[k]]!r}") for k in _COLS}
-        joints.append(_row(cells, raw, col, r, where))
+        row = _row(cells, raw, col, r, where)
+        for k, (unit, factor) in factors.items():
+            if factor != 1.0:
+                row[k] = _to_metres(row[k], factor, f"{where}: row {r}, column {header[col[k]]!r}")
+        joints.append(row)
+    if all(unit is None for unit, _ in factors.values()):
+        _warn_if_millimetres(joints, [header[col[k]] for k in ("a", "d")], where)
     used: set[str] = set()
-    for j in joints:
+    for r, j in enumerate(joints, start=1):
         for text_ in j.values():
-            used |= _expr.names_in(_expr.parse(text_ if isinstance(text_, str) else str(text_)))
+            try:
+                used |= _expr.names_in(_expr.parse(text_ if isinstance(text_, str) else str(text_)))
+            except ParseError as exc:
+                raise ParseError(f"row {r}: {exc}", where=where) from None
     params = {}
     for k, v in reader.params.items():
         if k not in used:
@@ -212,6 +276,52 @@ def import_table(text: str, name: str = "imported", convention: str | None = Non
     data = {"name": name, "convention": conv, "angle_unit": "deg" if deg else "rad",
             "parameters": params, "joints": joints}
     return TableImport(robot_from_dict(data, where=where), data, tuple(notes))
+
+
+def _length_unit(cell: str) -> tuple[str | None, float]:
+    """The length unit a header cell names (``d (mm)``, ``a [cm]``, ``a_i / m``) and its factor to metres."""
+    words = set(re.findall(r"[a-z]+", _plain(cell)))
+    for unit, spelled in (("mm", ("mm", "millimeter", "millimeters", "millimetre", "millimetres")),
+                          ("cm", ("cm", "centimeter", "centimeters", "centimetre", "centimetres")),
+                          ("m", ("m", "meter", "meters", "metre", "metres"))):
+        if words & set(spelled):
+            return unit, LENGTH_UNITS[unit]
+    return None, 1.0
+
+
+def _to_metres(value: Any, factor: float, place: str) -> Any:
+    """A length cell (robot-file text or number, joint variable ``q``) times ``factor``, the variable kept."""
+    node = _expr.parse(value)
+
+    def scale(nd: tuple) -> tuple:
+        names = _expr.names_in(nd)
+        if not names:
+            v = _expr.evaluate(nd) * factor
+            num = ("num", f"{abs(v):.15g}")
+            return ("neg", num) if v < 0 else num
+        if nd == ("name", "q"):
+            return nd
+        if nd[0] == "bin" and nd[1] in "+-":
+            return ("bin", nd[1], scale(nd[2]), scale(nd[3]))
+        if nd[0] == "neg":
+            return ("neg", scale(nd[1]))
+        if "q" in names:
+            raise ParseError(f"{place}: cannot convert {_expr.to_text(nd)!r} to metres (the joint variable must "
+                             "appear as q + offset); write this column in metres")
+        return ("bin", "*", ("num", f"{factor:g}"), nd)
+
+    return _number_or_text(_expr.to_text(scale(node)))
+
+
+def _warn_if_millimetres(joints: list[dict[str, Any]], headers: list[str], where: str) -> None:
+    """Warn when every length written as a number is larger than :data:`MM_HINT` (millimetres, probably)."""
+    lengths = [abs(float(j[k])) for j in joints for k in ("a", "d")
+               if isinstance(j[k], (int, float)) and not isinstance(j[k], bool) and j[k] != 0]
+    if lengths and min(lengths) > MM_HINT:
+        warning = getattr(_errors, "DenavitWarning", UserWarning)
+        warnings.warn(f"{where}: the lengths ({min(lengths):g} to {max(lengths):g}) look like millimetres but the "
+                      f"header names no unit, so they are read as metres; if they are millimetres write the unit in "
+                      f"the header, e.g. '{headers[0]} (mm)' and '{headers[1]} (mm)'", warning, stacklevel=3)
 
 
 def _row(cells: dict[str, tuple], raw: list[str], col: dict[str, int], r: int, where: str) -> dict[str, Any]:
@@ -239,8 +349,9 @@ def _number_or_text(text: str) -> Any:
     """``"0"`` → 0, ``"-90"`` → -90, ``"0.5"`` → 0.5; expressions stay text."""
     if re.fullmatch(r"-?\d+", text):
         return int(text)
-    if re.fullmatch(r"-?\d*\.\d+(e-?\d+)?", text):
-        return float(text)
+    if re.fullmatch(r"-?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?", text) and len(text) < 40:
+        value = float(text)
+        return value if value not in (float("inf"), float("-inf")) else text
     return text
 
 

@@ -5,7 +5,7 @@ recursive-descent parser; nothing reaches ``eval``, ``exec``, ``sympify`` or ``p
 is the same tiny tree as :mod:`denavit._expr` (``("num", "0.5")``, ``("name", "q1")``, ``("bin", "+", a, b)``
 ...), so evaluation and conversion to sympy reuse that module.
 
-Accepted: numbers and decimals, ``+ - * / ^``, ``\\cdot``, ``\\times``, implicit multiplication
+Accepted: numbers, decimals and powers of ten (``1e3``, ``2.5E-4``), ``+ - * / ^``, ``\\cdot``, ``\\times``, implicit multiplication
 (``2 L_1 \\cos\\theta_1``), parentheses ``( ) [ ] { } \\left( \\right)``, ``\\frac{a}{b}``, ``\\sqrt{x}``,
 ``\\sin \\cos \\tan \\arctan \\operatorname{atan2}``, ``\\sin^2 x``, ``\\pi``, Greek letters, subscripts
 (``\\theta_1``, ``L_{1}``, ``a_{i-1}``), dots (``\\dot\\theta_1``), shorthand ``C_1``, ``S_{12}``, ``c_{123}``,
@@ -48,7 +48,7 @@ _SKIP_CMDS = {"left", "right", "big", "Big", "bigg", "Bigg", "bigl", "bigr", "Bi
 _WRAP_CMDS = {"mathrm", "text", "mathit", "mathbf", "boldsymbol", "bm", "mathsf", "operatorname", "textrm", "rm"}
 _TOKEN = re.compile(
     r"(?P<ws>\s+|\\[,;:! ]|~)"
-    r"|(?P<num>\d+\.?\d*|\.\d+)"
+    r"|(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"  # 1e3, 2.5E-4: a number, never 1·e3
     r"|(?P<cmd>\\[A-Za-z]+)"
     r"|(?P<word>[A-Za-z]+[0-9]*)"
     r"|(?P<op>\*\*|[-+*/^_(){}\[\],=|&']|\\\\|\\\{|\\\})"
@@ -99,6 +99,8 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         tok = m.group(kind)
         if kind == "num" and len(tok) > MAX_DIGITS:
             raise ParseError(f"number with more than {MAX_DIGITS} digits at position {m.start() + 1}")
+        if kind == "num" and text.startswith(".", pos):
+            raise ParseError(f"malformed number {text[m.start():pos + 1]!r} at position {m.start() + 1}")
         if kind == "word" and len(tok) > MAX_DIGITS:
             raise ParseError(f"name longer than {MAX_DIGITS} characters at position {m.start() + 1}")
         if kind == "cmd" and tok[1:] in _SKIP_CMDS:
