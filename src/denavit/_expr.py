@@ -193,40 +193,58 @@ def parse(text: Any) -> Node:
 
 def names_in(node: Node) -> set[str]:
     """The free names used by a tree (constants such as ``pi`` excluded)."""
-    kind = node[0]
-    if kind == "name":
-        return set() if node[1] in CONSTANTS else {node[1]}
-    if kind == "neg":
-        return names_in(node[1])
-    if kind == "bin":
-        return names_in(node[2]) | names_in(node[3])
-    if kind == "call":
-        out: set[str] = set()
-        for a in node[2]:
-            out |= names_in(a)
-        return out
-    return set()
+    out: set[str] = set()
+    stack = [node]
+    while stack:  # no recursion: a sum of thousands of terms is a tree thousands of levels deep
+        n = stack.pop()
+        kind = n[0]
+        if kind == "name":
+            if n[1] not in CONSTANTS:
+                out.add(n[1])
+        elif kind == "neg":
+            stack.append(n[1])
+        elif kind == "bin":
+            stack += (n[2], n[3])
+        elif kind == "call":
+            stack += n[2]
+    return out
 
 
 def fold(node: Node, number: Callable[[str], Any], name: Callable[[str], Any],
          ops: Mapping[str, Callable[..., Any]], funcs: Mapping[str, Callable[..., Any]]) -> Any:
-    """Interpret a tree with one backend (floats, sympy, numpy arrays): the single tree walker.
+    """Interpret a tree with one backend (floats, sympy, numpy arrays, text): the single tree walker.
 
     ``number(text)`` and ``name(identifier)`` give the leaves; ``ops`` holds ``"neg"`` and the binary
-    operators ``+ - * / ^``; ``funcs`` the functions of :data:`FUNCTIONS`.
+    operators ``+ - * / ^``; ``funcs`` the functions of :data:`FUNCTIONS`.  The walk uses an explicit
+    stack, so a left-deep sum of thousands of terms (``1+1+…+1``) cannot exhaust Python's recursion limit;
+    children are interpreted left to right.
     """
-    kind = node[0]
-    if kind == "num":
-        return number(node[1])
-    if kind == "name":
-        return name(node[1])
-    if kind == "neg":
-        return ops["neg"](fold(node[1], number, name, ops, funcs))
-    if kind == "bin":
-        return ops[node[1]](fold(node[2], number, name, ops, funcs), fold(node[3], number, name, ops, funcs))
-    if kind == "call":
-        return funcs[node[1]](*(fold(a, number, name, ops, funcs) for a in node[2]))
-    raise ParseError(f"malformed expression node {kind!r}")
+    values: list[Any] = []
+    stack: list[tuple[Node, bool]] = [(node, False)]
+    while stack:
+        n, done = stack.pop()
+        kind = n[0]
+        if kind == "num":
+            values.append(number(n[1]))
+        elif kind == "name":
+            values.append(name(n[1]))
+        elif kind not in ("neg", "bin", "call"):
+            raise ParseError(f"malformed expression node {kind!r}")
+        elif not done:
+            stack.append((n, True))
+            children = (n[1],) if kind == "neg" else (n[2], n[3]) if kind == "bin" else tuple(n[2])
+            stack.extend((c, False) for c in reversed(children))
+        elif kind == "neg":
+            values.append(ops["neg"](values.pop()))
+        elif kind == "bin":
+            b = values.pop()
+            values[-1] = ops[n[1]](values[-1], b)
+        else:
+            k = len(n[2])
+            args = values[len(values) - k:]
+            del values[len(values) - k:]
+            values.append(funcs[n[1]](*args))
+    return values[0]
 
 
 def lookup(env: Mapping[str, Any], pi: Any) -> Callable[[str], Any]:
@@ -306,29 +324,37 @@ def to_sympy(node: Node, symbols: Mapping[str, Any]) -> Any:
 
 
 _PREC = {"+": 1, "-": 1, "*": 2, "/": 2, "^": 4}
+_ATOM = 9.0  # precedence of leaves and calls: never parenthesised
+_NEG = 2.5   # a negation is parenthesised under * / ^ and as a base or exponent (context 3 and above)
+
+
+class _AnyFunction(dict):
+    def __missing__(self, fname: str) -> Callable[..., tuple[str, float]]:
+        return lambda *args: (f"{fname}({', '.join(_wrap(a, 0) for a in args)})", _ATOM)
+
+
+def _wrap(part: tuple[str, float], context: float) -> str:
+    text, prec = part
+    return f"({text})" if prec < context else text
+
+
+def _text_bin(op: str) -> Callable[[tuple[str, float], tuple[str, float]], tuple[str, float]]:
+    prec = _PREC[op]
+
+    def join(a: tuple[str, float], b: tuple[str, float]) -> tuple[str, float]:
+        if op == "^":
+            return f"{_wrap(a, 5)}^{_wrap(b, 4)}", prec
+        right = prec + 1 if op in "-/" else prec
+        sep = op if op in "*/" else f" {op} "
+        return f"{_wrap(a, prec)}{sep}{_wrap(b, right)}", prec
+
+    return join
+
+
+_TEXT_OPS = {"neg": lambda a: ("-" + _wrap(a, 3), _NEG), **{op: _text_bin(op) for op in _PREC}}
 
 
 def to_text(node: Node, parent: int = 0) -> str:
-    """Print a tree back as canonical text that :func:`parse` reads to the same tree."""
-    kind = node[0]
-    if kind == "num":
-        return node[1]
-    if kind == "name":
-        return node[1]
-    if kind == "neg":
-        s = "-" + to_text(node[1], 3)
-        return f"({s})" if parent >= 3 else s
-    if kind == "bin":
-        op = node[1]
-        prec = _PREC[op]
-        if op == "^":
-            s = f"{to_text(node[2], 5)}^{to_text(node[3], 4)}"
-        else:
-            right_prec = prec + 1 if op in "-/" else prec
-            s = f"{to_text(node[2], prec)} {op} {to_text(node[3], right_prec)}"
-            if op in "*/":
-                s = f"{to_text(node[2], prec)}{op}{to_text(node[3], right_prec)}"
-        return f"({s})" if prec < parent else s
-    if kind == "call":
-        return f"{node[1]}({', '.join(to_text(a) for a in node[2])})"
-    raise ParseError(f"malformed expression node {kind!r}")
+    """Print a tree back as canonical text that :func:`parse` reads to the same tree (no recursion)."""
+    part = fold(node, lambda t: (t, _ATOM), lambda n: (n, _ATOM), _TEXT_OPS, _AnyFunction())
+    return _wrap(part, parent)
