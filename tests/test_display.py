@@ -333,3 +333,19 @@ def test_ik_derivation_markdown_is_its_own_markdown():
     d = S.ik_derivation(denavit.load_robot("planar2r"))
     md = d._repr_markdown_()
     assert md == d.to_markdown() and md.count("$$") % 2 == 0
+
+
+def test_singularity_analysis_markdown_lists_every_condition():
+    sp = pytest.importorskip("sympy")
+    from denavit import symbolic as S
+
+    a = S.singularity_analysis(denavit.load_robot("puma560"))
+    md = a._repr_markdown_()
+    assert f"$$ {sp.latex(a.determinant)} $$" in md
+    items = [line for line in md.splitlines() if line.startswith("- $")]
+    assert len(items) == len(a.conditions) == 3
+    for line, c in zip(items, a.conditions):
+        assert line.startswith(f"- ${sp.latex(c.factor)} = 0$ ({c.kind}): ")
+        assert line.count("$") % 2 == 0
+        for s in c.solutions:
+            assert sp.latex(s.expression) in line

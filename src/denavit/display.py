@@ -29,6 +29,7 @@ __all__ = [
     "ik_html",
     "dynamics_latex",
     "derivation_markdown",
+    "singularities_markdown",
 ]
 
 TABLE_FORMATS = ("text", "markdown", "latex", "html")
@@ -528,3 +529,34 @@ def derivation_markdown(derivation: Any) -> str:
         uri = "data:image/png;base64," + base64.b64encode(data).decode("ascii")
         text = text.replace(f"]({name})", f"]({uri})")
     return text
+
+
+def singularities_markdown(analysis: Any) -> str:
+    """A singularity analysis (:class:`~denavit.symbolic.SingularityAnalysis`) as Markdown with typeset
+    formulas: the measure, its factored form, and each condition with its kind, explanation and solutions."""
+    import sympy as sp
+
+    a = analysis
+    out = [f"**Singularities of {a.robot}**: {a.matrix_note}; measure: {a.measure}", "",
+           f"$$ {sp.latex(a.determinant)} $$", ""]
+    if a.constant_factors:
+        out += ["Constant factors (assumed non-zero): "
+                + ", ".join(f"${sp.latex(c)}$" for c in a.constant_factors), ""]
+    if a.everywhere:
+        out.append(f"**Singular everywhere**: rank {a.generic_rank} of {a.full_rank} for every q ({a.reason}).")
+    elif a.conditions:
+        out.append("Singular when:")
+        for c in a.conditions:
+            sols = "; ".join(
+                (f"${sp.latex(sp.Symbol(s.variable))} = {sp.latex(s.expression)}$" if s.expression is not None
+                 else f"{s.variable} numerically")
+                + (" at " + ", ".join(_g(v) for v in s.values) if s.values else "")
+                for s in c.solutions)
+            out.append(f"- ${sp.latex(c.factor)} = 0$ ({c.kind}): {c.explanation.rstrip('.')}."
+                       + (f" Solutions: {sols}." if sols else ""))
+    elif "minors" in a.measure:
+        out.append("The minors share no factor: singular configurations, if any, lie where all the minors vanish "
+                   "together, which is not solved symbolically here.")
+    else:
+        out.append("No singular configuration: the determinant never vanishes.")
+    return "\n".join(out)

@@ -82,6 +82,11 @@ class SingularityAnalysis:
     full_rank: int
     reason: str
 
+    def _repr_markdown_(self) -> str:
+        from ..display import singularities_markdown
+
+        return singularities_markdown(self)
+
 
 # --- the matrix --------------------------------------------------------------------------------------
 
