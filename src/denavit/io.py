@@ -32,6 +32,8 @@ __all__ = [
     "CATALOGUE_ALIASES",
     "with_parameters",
     "parse_values",
+    "value_text",
+    "expression_text",
     "resolve_pose",
 ]
 
@@ -297,7 +299,7 @@ def _joint_row(raw: Any, row: int, joint_no: int, ctx: _Ctx) -> DHLink:
         if max(map(abs, limits)) > bound:
             raise ctx.fail(lplace, f"limits [{limits[0]:.6g}, {limits[1]:.6g}] {unit} are out of range (at most {bound:g} "
                                    f"{unit} in magnitude)")
-        if any(_has_names(t) for _, t in got):
+        if not all(_is_literal(_expr.parse(t)) for _, t in got):  # kept as written: 5*pi/4, deg(170), L1
             texts += [("limits0", got[0][1]), ("limits1", got[1][1])]
         if limits[0] > limits[1]:
             raise ctx.fail(lplace, f"low limit {limits[0]:g} is above high limit {limits[1]:g}")
@@ -752,9 +754,28 @@ def _text_value(text: str) -> Any:
     if _is_literal(tree):
         value = _expr.evaluate(tree)
         return int(value) if value == int(value) and abs(value) < 1e15 else value
-    if tree[0] == "call" and tree[1] == "deg" and _is_literal(tree[2][0]):
-        return f"{_expr.to_text(tree[2][0])}deg"
-    return text
+    return _DEG_CALL.sub(r"\1deg", text)
+
+
+_DEG_CALL = re.compile(r"\bdeg\((-?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\)")
+
+
+def value_text(x: float, angle: bool = False) -> str:
+    """A value as it is written in robot files and tables: ``2``, ``0.4318``, ``5*pi/4``, ``-170deg`` (angles).
+
+    >>> value_text(-2.356194490192345, angle=True), value_text(0.4318), value_text(-2.9670597283903604, angle=True)
+    ('-3*pi/4', '0.4318', '-170deg')
+    """
+    return str(_num_text(x, angle))
+
+
+def expression_text(text: str) -> str:
+    """A stored field expression as it is best read: ``deg(-90)`` → ``-90deg``; others unchanged.
+
+    >>> expression_text("deg(-90)"), expression_text("L1 + 0.1")
+    ('-90deg', 'L1 + 0.1')
+    """
+    return str(_text_value(text))
 
 
 def _with_q(offset: Any) -> str:
@@ -900,8 +921,11 @@ def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
 
 
 def save_robot(robot: DHRobot, path: str | Path, *, overwrite: bool = False) -> None:
-    """Write a robot file; refuses to overwrite an existing file unless ``overwrite=True``."""
+    """Write a robot file (``.yaml``, ``.yml`` or ``.json``); refuses to overwrite an existing file unless
+    ``overwrite=True``, and refuses other suffixes (``x.png`` would receive YAML)."""
     path = Path(path)
+    if path.suffix.lower() not in (".yaml", ".yml", ".json"):
+        raise ParseError(f"{str(path)!r}: unsupported file type {path.suffix or '(none)'!r}; expected .yaml, .yml or .json")
     if path.exists() and not overwrite:
         raise ParseError(f"{str(path)!r} exists; not overwriting it (choose another name or pass --force)")
     fmt = "json" if path.suffix.lower() == ".json" else "yaml"

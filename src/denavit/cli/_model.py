@@ -9,12 +9,16 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, joint_values, load, matrix_text
+from ._common import add_common, add_q, check_output, joint_values, load, matrix_text, output_file
+
+#: File types ``convert -o`` writes.
+CONVERT_SUFFIXES = (".yaml", ".yml", ".json")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("robots", help="list the built-in robots")
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.add_argument("--deg", action="store_true", help="accepted like every command's --deg (the list has no angles)")
     p.set_defaults(handler=cmd_robots)
 
     p = sub.add_parser("show", help="DH table, parameters and limits of a robot")
@@ -60,17 +64,36 @@ def cmd_robots(args: argparse.Namespace):
 
 
 def _angle(x: float, deg: bool) -> str:
-    return f"{math.degrees(x):.6g}°" if deg else _pretty_rad(x)
+    """An angle for the table: degrees with --deg; else an exact multiple of pi, whole degrees as ``-90°``, or rad."""
+    from ..io import value_text
+
+    if deg:
+        return f"{math.degrees(x):.6g}°"
+    return _degree_sign(value_text(x, angle=True)) if abs(x) >= 1e-12 else "0"
 
 
-def _pretty_rad(x: float) -> str:
-    for k in (1, 2, 3, 4, 6, 12):
-        for num in range(-12, 13):
-            if num and abs(x - num * math.pi / k) < 1e-12:
-                n = "" if abs(num) == 1 else str(abs(num))
-                s = "-" if num < 0 else ""
-                return f"{s}{n}pi" + (f"/{k}" if k != 1 else "")
-    return f"{x:.6g}"
+def _degree_sign(text: str) -> str:
+    """``-90deg`` → ``-90°`` (display only; files keep ``deg``)."""
+    import re
+
+    return re.sub(r"(\d)deg\b", r"\1°", text)
+
+
+def _field(link, name: str, deg: bool, angle: bool) -> str:
+    """A DH field as written (parameters kept, ``deg(-90)`` shown as ``-90°``), else its value."""
+    from ..io import expression_text
+
+    text = dict(link.symbols).get(name)
+    if text is not None:
+        return _degree_sign(expression_text(text))
+    value = getattr(link, name)
+    return _angle(value, deg) if angle else f"{value:.6g}"
+
+
+def _plus_q(var: str, offset: str) -> str:
+    if offset in ("0", "0°"):
+        return var
+    return f"{var} - {offset[1:]}" if offset.startswith("-") else f"{var} + {offset}"
 
 
 def cmd_show(args: argparse.Namespace):
@@ -83,22 +106,27 @@ def cmd_show(args: argparse.Namespace):
     k = 0
     data_rows = []
     for i, link in enumerate(robot.links, start=1):
-        sym = dict(link.symbols)
-        a = sym.get("a", f"{link.a:.6g}")
-        alpha = sym.get("alpha", _angle(link.alpha, args.deg))
-        d = sym.get("d", f"{link.d:.6g}")
-        theta = sym.get("theta", _angle(link.theta, args.deg))
+        a = _field(link, "a", args.deg, False)
+        alpha = _field(link, "alpha", args.deg, True)
+        d = _field(link, "d", args.deg, False)
+        theta = _field(link, "theta", args.deg, True)
         lim = ""
         if link.is_joint:
             k += 1
             if link.joint is JointType.REVOLUTE:
-                theta = f"q{k}" if theta in ("0", "0°") else f"q{k} + {theta}"
+                theta = _plus_q(f"q{k}", theta)
             else:
-                d = f"q{k}" if d in ("0", "0.0") else f"q{k} + {d}"
+                d = _plus_q(f"q{k}", d)
             if link.q_limits:
+                from ..io import expression_text
+
                 lo, hi = link.q_limits
-                conv = (lambda v: _angle(v, args.deg)) if link.joint is JointType.REVOLUTE else (lambda v: f"{v:.6g} m")
-                lim = f"[{conv(lo)}, {conv(hi)}]"
+                texts = dict(link.symbols)
+                if "limits0" in texts and not args.deg:
+                    lim = "[" + ", ".join(_degree_sign(expression_text(texts[f"limits{i}"])) for i in (0, 1)) + "]"
+                else:
+                    conv = (lambda v: _angle(v, args.deg)) if link.joint is JointType.REVOLUTE else (lambda v: f"{v:.6g} m")
+                    lim = f"[{conv(lo)}, {conv(hi)}]"
         table.append([str(i), a, alpha, d, theta, link.joint.value, lim])
         data_rows.append({"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta,
                           "joint": link.joint.value, "limits": list(link.q_limits) if link.q_limits else None,
@@ -190,13 +218,15 @@ def cmd_fk(args: argparse.Namespace):
 
 def cmd_convert(args: argparse.Namespace):
     from .._convert import convert_convention
-    from ..io import dump_robot, robot_to_dict, save_robot
+    from ..io import dump_robot, robot_to_dict
 
+    check_output(args, args.output, CONVERT_SUFFIXES)  # before any work: x.png is refused, not filled with YAML
     robot = load(args)
     out = convert_convention(robot, args.to)
     if args.output:
         path = Path(args.output)
-        save_robot(out, path, overwrite=args.force)
+        with output_file(args.output) as tmp:
+            Path(tmp).write_text(dump_robot(out, "json" if path.suffix.lower() == ".json" else "yaml"), encoding="utf-8")
         text = f"wrote {path} ({out.convention.value} DH, {out.n_rows} rows)"
     else:
         text = dump_robot(out)
