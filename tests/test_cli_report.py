@@ -70,8 +70,11 @@ def test_cli_report_pdf_needs_an_engine(tmp_path, capsys, monkeypatch):
         assert main(["report", "planar2r", "--topics", "model,links,fk", "-o", str(out)]) == 0
         assert out.read_bytes().startswith(b"%PDF")
     monkeypatch.setenv("PATH", str(tmp_path))  # no engine on PATH
-    assert main(["report", "planar2r", "--topics", "model", "-o", str(out)]) == 1
+    capsys.readouterr()
+    out2 = tmp_path / "r2.pdf"  # a new name: an existing r.pdf would be refused first (exists, no --force)
+    assert main(["report", "planar2r", "--topics", "model", "-o", str(out2)]) == 1
     _one_line_error(capsys, "LaTeX engine")
+    assert not out2.exists()
 
 
 @pytest.mark.parametrize("example", sorted(p.name for p in EXAMPLES.glob("*.yaml")))

@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 import argparse
-import re
+import os
 from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
-from ._common import add_common, add_force, nonneg_int, add_q, joint_values, load, refuse_overwrite, stage_printer
+from ._common import (add_common, add_force, check_output, nonneg_int, add_q, joint_values, load, output_file,
+                      stage_printer)
 
-_SPLIT = re.compile(r"[,;\s]+(?![^()]*\))")
+#: Suffixes of a report file (the format follows the suffix).
+REPORT_SUFFIXES = (".md", ".markdown", ".tex", ".html", ".htm", ".pdf")
+#: Suffixes of a robot file written by import-table.
+ROBOT_SUFFIXES = (".yaml", ".yml", ".json")
+#: Largest table file import-table reads (bytes).
+MAX_TABLE_FILE_BYTES = 1_000_000
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -43,17 +49,57 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _parts(text: str | None) -> list[str] | None:
+    """``"0, pi/4; 1"`` → ``["0", "pi/4", "1"]``: split at commas, semicolons and spaces outside parentheses
+    (one pass, linear time)."""
     if text is None:
         return None
-    return [p for p in _SPLIT.split(text.strip().strip("[]()")) if p]
+    parts, cur, level = [], [], 0
+    for ch in text.strip().strip("[]()"):
+        if ch == "(":
+            level += 1
+        elif ch == ")":
+            level = max(level - 1, 0)
+        if level == 0 and (ch in ",;" or ch.isspace()):
+            parts.append("".join(cur))
+            cur = []
+        else:
+            cur.append(ch)
+    parts.append("".join(cur))
+    return [p for p in parts if p]
+
+
+def _figure_names(args: argparse.Namespace, robot, fmt: str) -> list[str]:
+    """The picture files a .md/.tex report writes beside itself (checked before any work)."""
+    if fmt not in ("md", "tex") or not args.output:
+        return []
+    topics = [t.strip() for t in args.topics.split(",")] if args.topics else None
+    if topics is not None and "figures" not in topics:
+        return []
+    return [f"{Path(args.output).stem}-{robot.name}-arm.png"]
+
+
+def _check_beside(args: argparse.Namespace, names: list[str]) -> list[str]:
+    """The paths of files written beside -o; each refused like -o itself (exists without --force, not a file)."""
+    if not names:
+        return []
+    folder = os.path.dirname(args.output) or "."
+    paths = []
+    for name in names:
+        if os.path.basename(name) != name or name in (".", ".."):
+            raise ParseError(f"-o {args.output!r}: cannot write a picture named {name!r} beside it")
+        path = os.path.join(folder, name)
+        check_output(args, path, (), what="picture")
+        paths.append(path)
+    return paths
 
 
 def cmd_report(args: argparse.Namespace):
-    from ..report import derive, format_from_path, render_markdown, write_report
+    from ..report import derive, format_from_path, pdf_from_latex, render, render_latex, render_markdown
 
     robot = load(args)
     fmt = format_from_path(args.output) if args.output else "md"
-    refuse_overwrite(args, args.output)
+    check_output(args, args.output, REPORT_SUFFIXES)
+    _check_beside(args, _figure_names(args, robot, fmt))
     if fmt == "pdf":  # fail before the derivation, not after it: one error line, no wasted minutes
         from ..report._pdf import latex_engine, pdf_from_latex
 
@@ -76,7 +122,20 @@ def cmd_report(args: argparse.Namespace):
                progress=stage_printer(args, "report"))
     data = derivation_json(d)
     if args.output:
-        written = write_report(d, args.output, fmt)
+        prefix = Path(args.output).stem + "-"
+        if fmt == "pdf":
+            tex, files = render_latex(d, prefix)
+            main_bytes, beside = pdf_from_latex(tex, files), {}
+        else:
+            text, beside = render(d, fmt, prefix)
+            main_bytes = text.encode("utf-8")
+        paths = _check_beside(args, list(beside))  # again, now that the names are known: nothing is overwritten
+        for path, blob in zip(paths, beside.values()):
+            with output_file(path, what="picture") as tmp:
+                Path(tmp).write_bytes(blob)
+        with output_file(args.output) as tmp:
+            Path(tmp).write_bytes(main_bytes)
+        written = [Path(args.output)] + [Path(p) for p in paths]
         data["output"] = [str(p) for p in written]
         done = sum(s.status == "done" for s in d.sections)
         text = (f"wrote {written[0]} ({fmt}, {done} of {len(d.sections)} sections complete"
@@ -122,10 +181,11 @@ def cmd_import_table(args: argparse.Namespace):
     from ..tables import import_table, table_file_text
 
     path = Path(args.file)
+    check_output(args, args.output, ROBOT_SUFFIXES)
     if not path.is_file():
         raise ParseError(f"no such file: {str(path)!r}")
-    if path.stat().st_size > 1_000_000:
-        raise ParseError(f"{str(path)!r} is too large for a DH table (at most 1 MB)")
+    if path.stat().st_size > MAX_TABLE_FILE_BYTES:
+        raise ParseError(f"{str(path)!r} is too large for a DH table (at most {MAX_TABLE_FILE_BYTES} bytes)")
     text = path.read_text(encoding="utf-8", errors="replace")
     result = import_table(text, name=args.name or path.stem, convention=args.convention,
                           degrees=True if args.deg else None, where=str(path))
@@ -134,11 +194,8 @@ def cmd_import_table(args: argparse.Namespace):
     fmt = "json" if out is not None and out.suffix.lower() == ".json" else "yaml"
     file_text = table_file_text(result, fmt, source=path.name)
     if out is not None:
-        if out.suffix.lower() not in (".yaml", ".yml", ".json"):
-            raise ParseError(f"-o {str(out)!r}: a robot file ends in .yaml, .yml or .json")
-        if out.exists() and not args.force:
-            raise ParseError(f"{str(out)!r} exists; not overwriting it (choose another name or pass --force)")
-        out.write_text(file_text, encoding="utf-8")
+        with output_file(str(out)) as tmp:
+            Path(tmp).write_text(file_text, encoding="utf-8")
         msg = f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} rows, {robot.dof} joints)"
         msg += "".join(f"\nnote: {n}" for n in result.notes)
     else:
