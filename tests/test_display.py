@@ -140,6 +140,10 @@ def test_dh_table_text_and_markdown_carry_the_same_rows(name):
     for key, value in robot.parameters:
         assert f"{key} = {value:.6g}" in text
     assert "gravity: (" in text
+    for pose, q in dict(robot.poses).items():  # named poses read back, each value in its joint's unit
+        line = next(x for x in lines if x.startswith(f"pose {pose}: "))
+        cells = line.split(": ", 1)[1].strip("()").split(", ")
+        np.testing.assert_allclose([_value(c, robot, False) for c in cells], q, rtol=1e-5, atol=1e-9)
 
 
 @pytest.mark.parametrize("seed", range(25))
@@ -197,9 +201,16 @@ def test_robot_repr_is_short():
 @pytest.mark.parametrize("name", CATALOGUE)
 def test_robot_repr_html_of_every_catalogue_arm(name):
     robot = denavit.load_robot(name)
-    page = parse_html(denavit.display.robot_html(robot, picture=False))
+    page = parse_html(robot._repr_html_())
     assert len(page.tables) == 1 and len(page.tables[0]) == robot.n_rows + 1
+    assert len(page.images) == (1 if "matplotlib" in sys.modules or _has_matplotlib() else 0)
     assert robot._repr_markdown_() == denavit.dh_table(robot, fmt="markdown")
+
+
+def _has_matplotlib() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("matplotlib") is not None
 
 
 def test_robot_repr_html_embeds_a_png_of_the_arm():
