@@ -360,3 +360,14 @@ def test_singularity_analysis_markdown_lists_every_condition():
         assert line.count("$") % 2 == 0
         for s in c.solutions:
             assert sp.latex(s.expression) in line
+
+
+def test_robot_text_from_the_file_is_escaped_in_html_and_markdown():
+    robot = denavit.load_robot("planar2r").replace(name="<script>alert(1)</script> | x", description="a & b <i>")
+    page = robot._repr_html_()
+    assert "<script" not in page and "<i>" not in page and "&lt;script&gt;" in page
+    parse_html(page)
+    md = denavit.dh_table(robot, fmt="markdown")
+    assert "\\| x" in md
+    tex = denavit.dh_table(robot.replace(name="arm\n\\input{/etc/passwd}"), fmt="latex")
+    assert tex.splitlines()[0].startswith("% arm") and not any(x.startswith("\\input") for x in tex.splitlines())

@@ -87,3 +87,15 @@ def test_initial_q_and_its_shape():
     np.testing.assert_allclose(_readout_matrix(panel), denavit.forward_kinematics(robot, [0.3, -0.4]), atol=1e-6)
     with pytest.raises(denavit.ShapeError, match="expected 2 joint values"):
         teach(robot, q=[0.1, 0.2, 0.3], picture=False)
+
+
+def test_an_unlimited_revolute_joint_gets_a_full_turn_slider():
+    pytest.importorskip("ipywidgets")
+    from denavit.notebook import teach
+
+    robot = denavit.robot([denavit.revolute(a=0.5), denavit.prismatic(limits=(0.0, 0.2))])
+    panel = teach(robot, picture=False)
+    assert (panel.sliders[0].min, panel.sliders[0].max) == pytest.approx((-180.0, 180.0))
+    assert (panel.sliders[1].min, panel.sliders[1].max) == pytest.approx((0.0, 0.2))
+    panel.sliders[1].value = 0.15
+    np.testing.assert_allclose(_readout_matrix(panel), denavit.forward_kinematics(robot, [0.0, 0.15]), atol=1e-6)

@@ -173,7 +173,8 @@ def _latex_table(title, head, rows, notes) -> str:
             return _tex_text(c[0])
         return f"${c[1]}$"
 
-    lines = [f"% {title[0]}", "\\begin{tabular}{cl" + "l" * (len(head) - 2) + "}", "\\hline"]
+    # the title as one comment line, whatever the name holds
+    lines = ["% " + " ".join(title[0].split()), "\\begin{tabular}{cl" + "l" * (len(head) - 2) + "}", "\\hline"]
     lines.append(" & ".join(_tex_text(c[0]) if k < 2 else f"${c[1]}$" for k, c in enumerate(head)) + " \\\\")
     lines.append("\\hline")
     lines += [" & ".join(cell(c, k) for k, c in enumerate(r)) + " \\\\" for r in rows]
