@@ -143,3 +143,58 @@ def test_viewer_mouse_orbit_and_zoom_change_the_picture(browser, tmp_path):
         assert problems == []
     finally:
         page.close()
+
+
+def _overlap(a, b) -> bool:
+    return not (a[2] < b[0] or a[0] > b[2] or a[3] < b[1] or a[1] > b[3])
+
+
+@pytest.mark.parametrize("name, pose", [("puma560", "qn"), ("puma560", "qr"), ("ur5", "qr"), ("stanford", None),
+                                        ("panda", "qr")])
+def test_viewer_frame_labels_do_not_overprint(browser, tmp_path, name, pose):
+    """Frame labels are placed apart: frames sharing an axis get one merged label (z5,6), and no two placed
+    label boxes overlap; every frame's axis letters are still named."""
+    robot = denavit.load_robot(name)
+    q = dict(robot.poses)[pose] if pose else None
+    path = write_viewer(robot, tmp_path / f"{name}.html", q=q)
+    page, problems, _ = _open(browser, path)
+    try:
+        labels = json.loads(page.locator("#view").get_attribute("data-labels"))
+        boxes = [b for _, b, free in labels if free]
+        assert len(boxes) >= 0.9 * len(labels), labels
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                assert not _overlap(boxes[i], boxes[j]), (labels[i], labels[j])
+        named = {(text[0], k) for text, _, _ in labels for k in text[1:].split(",")}
+        frames = robot.n_rows + 1 + (0 if np.allclose(robot.tool_matrix, np.eye(4)) else 1)
+        assert len(named) == 3 * frames  # x, y, z of every frame, merged or not
+        assert problems == []
+    finally:
+        page.close()
+
+
+def test_report_html_fits_the_window(browser, tmp_path):
+    """The report's widest pieces (the IK tables of a 6-joint arm) fit a 1,280 px window: no table is wider than
+    its column, the page does not scroll sideways, and no IK residual wraps inside its cell."""
+    from denavit.report import derive, write_report
+
+    robot = denavit.load_robot("puma560")
+    q = dict(robot.poses)["qn"]
+    out = tmp_path / "r.html"
+    write_report(derive(robot, q, topics=["ik"]), out)
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    try:
+        page.goto(out.as_uri())
+        page.wait_for_function("document.querySelectorAll('.katex').length > 0")
+        sizes = page.evaluate("""Array.from(document.querySelectorAll('table')).map(t => [t.scrollWidth,
+            t.closest('section').clientWidth, Math.ceil(t.getBoundingClientRect().right)])""")
+        assert len(sizes) >= 2
+        for width, column, right in sizes:
+            assert width <= column and right <= 1280, sizes
+        assert page.evaluate("document.documentElement.scrollWidth") <= 1280
+        heights = page.evaluate("""Array.from(document.querySelectorAll('td.num')).map(td => td.getClientRects()
+            .length ? td.querySelector('*') === null && td.getBoundingClientRect().height : 0)""")
+        line = page.evaluate("parseFloat(getComputedStyle(document.querySelector('td.num')).lineHeight)")
+        assert heights and max(heights) < 2.5 * line  # one line of text plus padding: nothing wrapped
+    finally:
+        page.close()

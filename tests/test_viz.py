@@ -226,6 +226,31 @@ def test_animate_gif_frames(tmp_path):
     assert np.abs(first - last).sum(axis=-1).astype(bool).mean() > 0.005, "the arm did not move"
 
 
+
+@pytest.mark.parametrize("name", ["puma560", "ur5", "planar3r", "scara"])
+def test_animation_frames_are_large_and_nothing_is_clipped(tmp_path, name):
+    """GIF frames are at least 600 px square and the drawing (arm, ticks, the z [m] label) keeps off the
+    right and bottom edges: a clipped label would leave ink in the outermost pixel columns or rows."""
+    pytest.importorskip("matplotlib")
+    from PIL import Image
+
+    from denavit.viz import animate_robot
+
+    robot = denavit.load_robot(name)
+    rng = np.random.default_rng(7)
+    lo, hi = np.maximum(robot.q_limits.T[0], -np.pi), np.minimum(robot.q_limits.T[1], np.pi)
+    out = animate_robot(robot, rng.uniform(lo, hi, (2, robot.dof)), tmp_path / "m.gif", fps=5)
+    with Image.open(out) as im:
+        assert min(im.size) >= 600
+        for k in range(im.n_frames):
+            im.seek(k)
+            ink = np.asarray(im.convert("L"), dtype=float) < 160  # (h, w): dark pixels: text, lines, arm
+            h, w = ink.shape
+            margin = int(0.01 * w)
+            assert not ink[:, w - margin:].any() and not ink[h - margin:, :].any(), f"drawing clipped, frame {k}"
+            assert not ink[:, :margin].any()
+
+
 # ---- workspace ----------------------------------------------------------------------------------------
 
 def test_workspace_planar_2r_area_is_the_disc():

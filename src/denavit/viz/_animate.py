@@ -33,7 +33,7 @@ def _writer(fmt: str, fps: float):
 
 def animate_robot(robot: DHRobot, q_path, output: str | Path, *, fps: float = 20.0, frames: bool = True,
                   labels: bool = False, trace: bool = True, title: str | None = None,
-                  figsize: tuple[float, float] = (5.0, 5.0), dpi: int = 80) -> Path:
+                  figsize: tuple[float, float] = (6.4, 6.4), dpi: int = 100) -> Path:
     """Write an animation of the arm following a joint trajectory.
 
     Parameters
@@ -47,6 +47,8 @@ def animate_robot(robot: DHRobot, q_path, output: str | Path, *, fps: float = 20
         Frames per second.
     frames, labels, trace : bool
         Draw the DH frame triads, their labels, and the end-effector trace so far.
+    figsize, dpi
+        Frame size in inches and dots per inch: 640 × 640 pixels by default.
 
     Returns
     -------

@@ -27,6 +27,7 @@ AXIS_COLORS = ("#d62728", "#2ca02c", "#1f77b4")  # x, y, z
 PATH_COLOR = "#9c27b0"
 TRIAD_FRACTION = 0.12  # triad length as a fraction of the arm's scale
 GLYPH_FRACTION = 0.035  # joint glyph radius as a fraction of the arm's scale
+BOX_ZOOM = 0.9  # the 3-D box drawn at 90 % of its axes, so the tick and axis labels (z [m]) stay inside the figure
 
 
 def new_figure(figsize: tuple[float, float] = (6.4, 6.4), dpi: int = 100, ncols: int = 1):
@@ -123,7 +124,7 @@ def set_equal_axes(ax, points: np.ndarray, margin: float = 0.08) -> None:
     ax.set_xlim(centre[0] - half, centre[0] + half)
     ax.set_ylim(centre[1] - half, centre[1] + half)
     ax.set_zlim(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
+    ax.set_box_aspect((1, 1, 1), zoom=BOX_ZOOM)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")

@@ -108,6 +108,44 @@
     for (var f = 0; f < 6; f++) poly(list, faces[f].map(function (k) { return c[k]; }), fill, stroke);
   }
 
+  // Frame labels without overprinting: labels of one axis letter whose anchors (nearly) coincide are merged
+  // ("z5,6": frames sharing an axis), then each label takes the first free spot among offsets around its
+  // anchor (greedy, in drawing order); a label with no free spot keeps its first choice.
+  var LABEL_MERGE_PX = 6, LABEL_FONT = "11px sans-serif";
+  function placeLabels(raw) {
+    ctx.font = LABEL_FONT;
+    var merged = [];
+    raw.forEach(function (l) {
+      var m = null;
+      for (var i = 0; i < merged.length && !m; i++) {
+        var o = merged[i];
+        if (o.letter === l[1][0] && Math.abs(o.ax - l[0][0]) < LABEL_MERGE_PX &&
+            Math.abs(o.ay - l[0][1]) < LABEL_MERGE_PX) m = o;
+      }
+      if (m) m.ids.push(l[1].slice(1));
+      else merged.push({letter: l[1][0], ids: [l[1].slice(1)], ax: l[0][0], ay: l[0][1], color: l[2]});
+    });
+    var placed = [], out = [];
+    merged.forEach(function (l) {
+      var text = l.letter + l.ids.join(","), w = ctx.measureText(text).width, h = 11;
+      var offs = [[3, -3], [3, h + 1], [-w - 3, -3], [-w - 3, h + 1], [-w / 2, -h - 2], [-w / 2, 2 * h],
+                  [10, -10], [-w - 10, -10], [10, h + 8], [-w - 10, h + 8], [-w / 2, -2 * h - 2], [-w / 2, 3 * h]];
+      var best = null;
+      for (var k = 0; k < offs.length && !best; k++) {
+        var x = l.ax + offs[k][0], y = l.ay + offs[k][1], box = [x - 1, y - h, x + w + 1, y + 2];
+        var free = placed.every(function (b) { return box[2] < b[0] || box[0] > b[2] || box[3] < b[1] || box[1] > b[3]; });
+        if (free) best = [x, y, box];
+      }
+      var free = !!best;
+      if (!best) { var x0 = l.ax + 3, y0 = l.ay - 3; best = [x0, y0, [x0 - 1, y0 - h, x0 + w + 1, y0 + 2]]; }
+      placed.push(best[2]);
+      out.push({text: text, x: best[0], y: best[1], color: l.color, box: best[2], free: free});
+    });
+    // the placed boxes, for tests and tools: [text, [x0, y0, x1, y1], found a free spot]
+    canvas.setAttribute("data-labels", JSON.stringify(out.map(function (l) { return [l.text, l.box, l.free]; })));
+    return out;
+  }
+
   function draw() {
     var dpr = window.devicePixelRatio || 1, w = canvas.clientWidth, h = canvas.clientHeight;
     if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
@@ -160,8 +198,10 @@
         ctx.strokeStyle = e.color; ctx.lineWidth = e.width; ctx.stroke();
       }
     });
-    ctx.font = "11px sans-serif";
-    labels.forEach(function (l) { ctx.fillStyle = l[2]; ctx.fillText(l[1], l[0][0] + 2, l[0][1] - 2); });
+    placeLabels(labels).forEach(function (l) {
+      ctx.lineWidth = 3; ctx.strokeStyle = "rgba(255,255,255,0.85)"; ctx.strokeText(l.text, l.x, l.y);
+      ctx.fillStyle = l.color; ctx.fillText(l.text, l.x, l.y);
+    });
     ctx.fillStyle = "#111"; var pe = P(col(g.Te, 3));
     ctx.beginPath(); ctx.arc(pe[0], pe[1], 3.5, 0, 2 * Math.PI); ctx.fill();
     return g;
