@@ -1,0 +1,251 @@
+"""The README and docs/*.md run: every ```python block, every `denavit ...` line of a ```bash / ```console block.
+
+- Python: the blocks of one file run in order in one fresh namespace (so a later block may use an earlier
+  block's names), in a temporary working directory holding the files the docs refer to (``my_arm.yaml``,
+  ``my_claims.yaml``, ``table.txt``, …, see ``FIXTURES``), with matplotlib's Agg backend.
+- Shell: each line starting with ``denavit `` (after an optional ``$ `` prompt) runs through
+  ``denavit.cli.main`` in-process in such a directory; it must exit 0.  Other lines (``pip install``,
+  ``python -m pytest``, …) are not run.  In a ```console block, the lines under a ``$`` command up to the next
+  ``$`` are the output shown in the docs and must appear, line by line (spaces normalised), in the output.
+- A block is skipped only with a marker on the line before it: ``<!-- skip-test: the reason -->``.  A block
+  preceded by ``<!-- slow -->`` runs under the ``slow`` marker; ``SLOW_COMMANDS`` lists shell lines that are
+  slow (symbolic 6-DOF work, big reports).
+- Fences without a language (command synopses with ``[options]``, error messages, output) and data blocks
+  (```yaml, ```json) are text, not run; yaml blocks that are whole robot files are loaded (``load_robot``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import shlex
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC_FILES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
+
+#: Files the docs' commands and code name as "your own" files; written into the working directory.
+FIXTURES = {
+    "my_arm.yaml": """\
+name: my-arm
+convention: standard
+angle_unit: deg
+parameters: {L1: 0.4, L2: 0.3, L3: 0.2}
+joints:
+  - {a: 0,  alpha: 90, d: L1, theta: q}
+  - {a: L2, alpha: 0,  d: 0,  theta: q}
+  - {a: L3, alpha: 0,  d: 0,  theta: q}
+""",
+    "table.txt": "i\ta_{i-1}\talpha_{i-1}\td_i\ttheta_i\n1\t0\t0\t0\tq1\n2\t0.4\t0\t0\tq2\n",
+    "table.md": "| i | a | alpha | d | theta |\n|---|---|---|---|---|\n| 1 | 0.4 | 0 | 0 | q1 |\n| 2 | 0.3 | 0 | 0 | q2 |\n",
+}
+#: Shipped files copied into the working directory under the names the docs use.
+COPIES = {"my_claims.yaml": "examples/claims/report000-fk.yaml", "examples": "examples"}
+
+#: Shell lines (prefixes) that take more than a few seconds: run only in the full suite.
+SLOW_COMMANDS = (
+    "denavit report ",
+    "denavit dynamics puma560 --symbolic",
+    "denavit ik puma560 --derive",
+    "denavit animate ",
+    "denavit workspace ",
+)
+#: Files whose python blocks take more than a few seconds together (the reason), run only in the full suite.
+SLOW_PYTHON = {"docs/pictures.md": "an animated GIF and a 100 000-sample workspace (~25 s on CI)",
+               "docs/report.md": "a full Puma 560 derivation and its HTML (~6 s)"}
+
+
+@dataclass
+class Block:
+    path: Path
+    line: int  # 1-based line of the opening fence
+    lang: str
+    text: str
+    skip: str | None  # the reason, when marked skip-test
+    slow: bool
+
+
+_FENCE = re.compile(r"^(\s*)```\s*([A-Za-z0-9_+-]*)\s*$")
+_SKIP = re.compile(r"<!--\s*skip-test\s*(?::\s*(.*?))?\s*-->")
+_SLOW = re.compile(r"<!--\s*slow\s*-->")
+
+
+def doc_blocks(path: Path) -> list[Block]:
+    """Fenced code blocks of a Markdown file, with the marker comment of the line before each."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    out, i = [], 0
+    while i < len(lines):
+        m = _FENCE.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        indent, lang = len(m.group(1)), m.group(2).lower()
+        prev = next((lines[k] for k in range(i - 1, -1, -1) if lines[k].strip()), "")
+        j = i + 1
+        while j < len(lines) and not _FENCE.match(lines[j]):
+            j += 1
+        body = "\n".join(line[indent:] for line in lines[i + 1:j])
+        skip = _SKIP.search(prev)
+        out.append(Block(path, i + 1, lang, body, (skip.group(1) or "no reason given") if skip else None,
+                         bool(_SLOW.search(prev))))
+        i = j + 1
+    return out
+
+
+def _rel(path: Path) -> str:
+    return path.relative_to(ROOT).as_posix()
+
+
+def _workdir(tmp_path: Path) -> Path:
+    for name, text in FIXTURES.items():
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    for name, src in COPIES.items():
+        s = ROOT / src
+        if s.is_dir():
+            shutil.copytree(s, tmp_path / name)
+        else:
+            shutil.copy(s, tmp_path / name)
+    return tmp_path
+
+
+# ---------------------------------------------------------------------------------------------------------
+# python blocks
+
+def _python_cases():
+    cases = []
+    for path in DOC_FILES:
+        blocks = [b for b in doc_blocks(path) if b.lang in ("python", "py", "pycon")]
+        if blocks:
+            slow = _rel(path) in SLOW_PYTHON or any(b.slow for b in blocks if not b.skip)
+            marks = [pytest.mark.slow] if slow else []
+            cases.append(pytest.param(path, blocks, id=_rel(path), marks=marks))
+    return cases
+
+
+@pytest.mark.parametrize(("path", "blocks"), _python_cases())
+def test_python_blocks_run(path, blocks, tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.chdir(_workdir(tmp_path))
+    namespace: dict = {"__name__": f"docs:{_rel(path)}"}
+    ran = 0
+    for b in blocks:
+        if b.skip:
+            continue
+        code = compile(b.text, f"{_rel(path)}:{b.line}", "exec")  # tracebacks name the doc file and line
+        with contextlib.redirect_stdout(io.StringIO()):
+            exec(code, namespace)  # noqa: S102 - the project's own documentation, not user input
+        ran += 1
+    assert ran > 0
+
+
+# ---------------------------------------------------------------------------------------------------------
+# shell lines
+
+@dataclass
+class Command:
+    block: Block
+    line: str
+    expected: list[str]  # output lines the docs show under the command (console blocks)
+
+
+def shell_commands(block: Block) -> list[Command]:
+    cmds: list[Command] = []
+    current = None
+    for raw in block.text.splitlines():
+        line = raw.rstrip()
+        prompt = line.startswith("$ ")
+        if prompt:
+            line = line[2:]
+        if block.lang == "console" and not prompt:
+            if current is not None and line.strip():
+                current.expected.append(line)
+            continue
+        current = None
+        if line.startswith("denavit "):
+            current = Command(block, line, [])
+            cmds.append(current)
+    return cmds
+
+
+def _shell_cases():
+    cases = []
+    for path in DOC_FILES:
+        for b in doc_blocks(path):
+            if b.lang not in ("bash", "sh", "shell", "console") or b.skip:
+                continue
+            for c in shell_commands(b):
+                slow = b.slow or c.line.startswith(SLOW_COMMANDS)
+                ident = f"{_rel(path)}:{b.line}:{c.line[8:48]}"
+                cases.append(pytest.param(c, id=ident, marks=[pytest.mark.slow] if slow else []))
+    return cases
+
+
+def _norm(s: str) -> str:
+    return " ".join(s.split())
+
+
+@pytest.mark.parametrize("cmd", _shell_cases())
+def test_shell_commands_run(cmd, tmp_path, monkeypatch):
+    from denavit.cli import main
+
+    if any(w in cmd.line for w in ("plot ", "animate ", "workspace ", "report ")):
+        pytest.importorskip("matplotlib")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.chdir(_workdir(tmp_path))
+    argv = shlex.split(cmd.line, comments=True)
+    assert argv[0] == "denavit"
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv[1:])
+    assert code == 0, f"{cmd.line!r} exited {code}: {err.getvalue().strip()[:500]}"
+    shown = [_norm(line) for line in out.getvalue().splitlines()]
+    for line in cmd.expected:
+        assert _norm(line) in shown, f"{cmd.line!r}: the docs show {line!r}, the command did not print it"
+
+
+# ---------------------------------------------------------------------------------------------------------
+# the harness itself, and robot files shown in full
+
+def test_every_doc_has_been_parsed_and_markers_give_reasons():
+    seen = 0
+    for path in DOC_FILES:
+        for b in doc_blocks(path):
+            seen += 1
+            assert b.skip != "no reason given", f"{_rel(path)}:{b.line}: <!-- skip-test: say why -->"
+    assert seen > 10
+
+
+def test_console_blocks_pair_output_with_their_command():
+    b = Block(Path("x.md"), 1, "console", "$ denavit robots --json  # all\n{\"a\": 1}\n\n$ echo hi\nhi\n", None, False)
+    (c,) = shell_commands(b)
+    assert c.line == "denavit robots --json  # all" and c.expected == ['{"a": 1}']
+    assert shlex.split(c.line, comments=True) == ["denavit", "robots", "--json"]
+
+
+def _robot_yaml_cases():
+    cases = []
+    for path in DOC_FILES:
+        for b in doc_blocks(path):
+            if b.lang in ("yaml", "yml") and not b.skip and re.search(r"^joints:", b.text, re.M) \
+                    and re.search(r"^convention:", b.text, re.M):
+                cases.append(pytest.param(b, id=f"{_rel(path)}:{b.line}"))
+    return cases
+
+
+@pytest.mark.parametrize("block", _robot_yaml_cases())
+def test_robot_files_shown_in_the_docs_load(block, tmp_path):
+    import denavit
+
+    f = tmp_path / "shown.yaml"
+    f.write_text(block.text, encoding="utf-8")
+    robot = denavit.load_robot(str(f))
+    import numpy as np
+
+    T = denavit.forward_kinematics(robot, np.zeros(robot.dof))
+    assert robot.dof > 0 and T.shape == (4, 4) and np.all(np.isfinite(T))
