@@ -41,6 +41,7 @@ def _equations(sec, lhs):
 
 
 @pytest.mark.parametrize("name", ALL)
+@pytest.mark.slow
 def test_report_every_arm_renders_markdown(name):
     robot = dn.load_robot(name)
     d = derive(robot, qd=[0.5] * robot.dof, wrench=[1, 2, 3, 0.1, 0.2, 0.3])
@@ -56,6 +57,7 @@ def test_report_every_arm_renders_markdown(name):
 
 @pytest.mark.parametrize("name", FEW[:2] if CI else FEW)
 @pytest.mark.parametrize("fmt", ["html", "tex"])
+@pytest.mark.slow
 def test_report_renders_html_and_latex(name, fmt, tmp_path):
     robot = dn.load_robot(name)
     d = derive(robot, qd=[1] * robot.dof, wrench=[0, 0, -10, 0, 0, 0])
@@ -71,6 +73,7 @@ def test_report_renders_html_and_latex(name, fmt, tmp_path):
         assert text.count(r"\begin{center}") == text.count(r"\end{center}")
 
 
+@pytest.mark.slow
 def test_report_numbers_equal_the_library():
     rng = np.random.default_rng(7)
     for name in ["report000-6r", "report001-6r", "stanford", "report004-8-prrr"]:
@@ -113,6 +116,7 @@ def test_report_exact_case_is_exact_and_agrees_with_numeric():
     np.testing.assert_allclose(np.array(T_exact.evalf(30), dtype=float), dn.forward_kinematics(robot, qf), atol=1e-14)
 
 
+@pytest.mark.slow
 def test_report_symbolic_jacobian_matches_numeric_at_random_points():
     """The report's symbolic J0 (z_i × (p_e − p_i) from symbolic frames), evaluated at random q, equals
     central finite differences of the numeric FK position (an independent route)."""
@@ -164,6 +168,7 @@ def test_report_bad_inputs_raise_parse_errors():
 
 
 @pytest.mark.skipif(shutil.which("node") is None, reason="node not installed")
+@pytest.mark.slow
 def test_report_every_formula_is_valid_katex(tmp_path):
     """Every formula of the HTML report is parsed by the bundled KaTeX with throwOnError."""
     js = Path(dn.__file__).parent / "report" / "assets" / "katex" / "katex.min.js"
@@ -202,6 +207,7 @@ def _wrapped(robot, a, b):
 
 
 @pytest.mark.parametrize("name", ["puma560", "stanford", "planar2r", "report000-planar3r"])
+@pytest.mark.slow
 def test_report_ik_derivation_branches_reproduce_every_analytic_solution(name):
     """The derivation's formulas, evaluated at the target for every sign, each land on a solution of the
     analytic solver (a different algorithm) or outside the limits, with an FK residual ~1e-16; every analytic
@@ -247,6 +253,7 @@ def test_report_ik_without_derivation_shows_analytic_or_numeric_solutions():
 
 
 @pytest.mark.parametrize("name", ["planar2r", "report000-planar3r"])
+@pytest.mark.slow
 def test_report_dynamics_printed_formulas_equal_the_numeric_library(name):
     """The M, c, g printed in the report (LaTeX, C_12 shorthand, dotted rates), read back by the claims reader
     and evaluated at random q, q̇, equal the numeric engine's CRBA mass matrix, Christoffel c and gravity
