@@ -11,6 +11,7 @@ from denavit.symbolic import analytic_jacobian_sym, angle_symbols, joint_symbols
 
 @pytest.mark.parametrize("name", ["puma560", "report004-6-wrist3r", "stanford"])
 @pytest.mark.parametrize("rep", ["rpy", "zyz"])
+@pytest.mark.slow
 def test_symbolic_analytic_jacobian_equals_numeric_and_finite_differences(name, rep):
     robot = denavit.load_robot(name)
     Ja = analytic_jacobian_sym(robot, rep)

@@ -308,6 +308,7 @@ def test_check_singularities_puma_and_stanford():
     assert _sing(dn.load_robot("stanford"), "sin(q2) = 0; sin(q5) = 0; q3 = 0").verdict == "correct"
 
 
+@pytest.mark.slow
 def test_check_singularities_everywhere_and_unreadable():
     robot = dn.load_robot("report000-6r")  # joints 1 and 2 coaxial: J0 never has rank 6
     assert _sing(robot, "everywhere").verdict == "correct"
@@ -344,6 +345,7 @@ def _library_forms(robot, rows, rng):
 @given(case=st.sampled_from([("planar2r", "vx,vy"), ("report000-planar3r", "vx,vy,wz"), ("puma560", None),
                              ("stanford", None), ("scara", "vx,vy,vz,wz"), ("planar3r", "vx,vy")]),
        seed=st.integers(0, 2**31 - 1))
+@pytest.mark.slow
 def test_check_never_rejects_correct_singularity_claims(case, seed):
     name, rows = case
     robot = dn.load_robot(name)

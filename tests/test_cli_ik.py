@@ -97,6 +97,7 @@ def test_ik_bad_input_one_line_exit_2(capsys):
         assert err.strip() and err.strip().count("\n") == 0 and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_cli_general_6r_and_lock(tmp_path):
     """jaco2-6dof goes to the general eigenvalue method; panda --lock q7 gives solutions that keep q7."""
     import json

@@ -23,6 +23,7 @@ def _one_line_error(capsys, *words):
 
 
 @pytest.mark.parametrize("suffix", ["md", "html", "tex"])
+@pytest.mark.slow
 def test_cli_report_writes_each_format(tmp_path, capsys, suffix):
     out = tmp_path / f"r.{suffix}"
     code = main(["report", "planar3r", "-q", "0, pi/4, -pi/2", "--qd", "1, 0, 0", "--wrench", "1,0,0,0,0,0",
@@ -78,6 +79,7 @@ def test_cli_report_pdf_needs_an_engine(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize("example", sorted(p.name for p in EXAMPLES.glob("*.yaml")))
+@pytest.mark.slow
 def test_cli_check_examples_run_and_judge_every_claim(example, capsys):
     import yaml
 

@@ -71,6 +71,7 @@ def evaluate(expr, robot, terms, q, qd, qdd=None):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.slow
 def test_lagrange_newton_euler_and_numeric_rnea_agree(seed):
     rng = np.random.default_rng(seed)
     robot = random_robot(rng)
@@ -149,6 +150,7 @@ def test_lagrange_steps_of_report000_planar3r_follow_the_hand_derivation():
     assert not fast.M.has(q1)
 
 
+@pytest.mark.slow
 def test_puma560_mass_matrix_and_gravity_match_numeric():
     robot = denavit.load_robot("puma560")
     t = lagrangian_dynamics(robot, numeric=True, coriolis=False)

@@ -28,6 +28,7 @@ def _numeric(robot, M):
 
 
 @pytest.mark.parametrize("name", denavit.catalogue_names())
+@pytest.mark.slow
 def test_symbolic_fk_equals_numeric_on_catalogue(name):
     robot = denavit.load_robot(name)
     T_sym = forward_kinematics_sym(robot)
@@ -42,6 +43,7 @@ def test_symbolic_fk_equals_numeric_on_catalogue(name):
 
 
 @pytest.mark.parametrize("seed", range(12))
+@pytest.mark.slow
 def test_symbolic_fk_equals_numeric_on_random_robots(seed):
     rng = np.random.default_rng(seed)
     robot = random_robot(rng, n_rows=int(rng.integers(2, 6)))

@@ -92,6 +92,7 @@ def test_derived_branches_reproduce_target_and_match_analytic_ik(name):
 
 
 @pytest.mark.parametrize("name", ["puma560", "puma560-mdh", "stanford", "report001-6r", "planar3r"])
+@pytest.mark.slow
 def test_random_parameters_base_and_tool(name):
     """Random link lengths/offsets (named parameters re-drawn) and a random base and tool."""
     rng = np.random.default_rng(11)

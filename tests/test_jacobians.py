@@ -307,6 +307,7 @@ def _lambdify(robot, expr, extra=()):
 
 
 @pytest.mark.parametrize("name", SYMBOLIC_ROBOTS)
+@pytest.mark.slow
 def test_symbolic_routes_match_numeric_on_catalogue(name):
     from denavit.symbolic import jacobian_sym
 
@@ -348,6 +349,7 @@ def test_planar_2r_symbolic_jacobian_equals_hand_derivation():
 
 
 @pytest.mark.parametrize("name", ["report004-3-articulated-rrr", "report004-4-rrp", "puma560", "report000-6r"])
+@pytest.mark.slow
 def test_symbolic_propagation_steps_match_numeric_steps(name):
     from denavit.symbolic import force_propagation_sym, joint_symbols, velocity_propagation_sym, wrench_symbols
 

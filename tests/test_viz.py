@@ -339,6 +339,7 @@ def test_cli_plot_json_and_file(tmp_path, capsys):
     _assert_not_blank(_png_pixels(out))
 
 
+@pytest.mark.slow
 def test_cli_animate_view_workspace(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     code, stdout, err = _cli(capsys, "animate", "planar3r", "--from", "0, 0.5, 0.5", "--to", "1, 1, -0.5",
@@ -386,6 +387,7 @@ def test_cli_bad_input_is_one_line_exit_2(argv, fragment, tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1 and fragment in err and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_animate_mp4_when_ffmpeg_exists(tmp_path):
     """MP4 goes through ffmpeg: the file has the requested number of frames (read back with ffprobe)."""
     import shutil
