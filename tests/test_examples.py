@@ -29,7 +29,12 @@ def test_every_example_is_listed_here_and_in_the_index():
     assert all(f"]({n})" in index for n in names)
 
 
-@pytest.mark.parametrize("script", SCRIPTS, ids=[p.stem for p in SCRIPTS])
+#: scripts that take more than a few seconds (sympy work): run in the full suite only
+SLOW = {"symbolic_derivation.py", "checking_claims.py"}
+
+
+@pytest.mark.parametrize("script", [pytest.param(p, id=p.stem, marks=[pytest.mark.slow] if p.name in SLOW else [])
+                                    for p in SCRIPTS])
 def test_example_runs_and_checks_itself(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
     done = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True,
