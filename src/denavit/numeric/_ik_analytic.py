@@ -231,7 +231,7 @@ def _lock(robot: DHRobot, locked: dict[str, float]) -> tuple[DHRobot, list[int],
         links[rows[k]] = replace(link, theta=link.theta + (v if rev else 0.0), d=link.d + (0.0 if rev else v),
                                  joint=JointType.FIXED, q_limits=None, symbols=())
     order = np.argsort(idx)
-    return replace(robot, links=tuple(links)), [idx[i] for i in order], np.array(vals)[order]
+    return replace(robot, links=tuple(links), poses=()), [idx[i] for i in order], np.array(vals)[order]
 
 
 def _solve_locked(robot: DHRobot, T: np.ndarray, locked: dict[str, float]) -> AnalyticIKResult:
@@ -338,15 +338,20 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
         pe = plan.point_e if plan.point_e is not None else np.zeros(3)
         X = (T[:, :3, :3] @ pe + T[:, :3, 3]).T[:, :, None]  # (3, B, 1)
         x1, _, _, S = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
-        if rev[0]:
-            parts.append((np.sum(x1 * (X - S), axis=0) >= 0, "shoulder right", "shoulder left"))
+        if rev[0]:  # measured from axis 1 (not from S, which a shoulder offset a1 moves along x1)
+            O1 = chain.consts[0][:3, 3][:, None, None]  # a point of axis 1
+            parts.append((np.sum(x1 * (X - O1), axis=0) >= 0, "shoulder right", "shoulder left"))
         if n >= 3 and rev[1] and rev[2]:
-            E = chain_columns(chain, qq[..., :2], upto=2)[3]
+            # in the plane normal to axis 2 the two elbows are mirror images across the line from the shoulder S
+            # to the point W the joints 2-3 place (the wrist centre; UR: a point of axis 4, parallel to axis 2):
+            # the side of that line, with n = a2 × (W − S) oriented towards axis 1, tells them apart
+            a2 = chain_columns(chain, qq[..., :1], upto=1)[2]  # axis 2, (3, B, K)
+            E = chain_columns(chain, qq[..., :2], upto=2)[3]  # a point of axis 3
+            W = chain_columns(chain, qq[..., :3], upto=3)[3] if plan.kind.startswith("parallel") and n >= 4 else X
             up = chain.consts[0][:3, 2][:, None, None]
-            v = X - S
-            v = v / np.maximum(np.sqrt(np.sum(v * v, axis=0)), 1e-300)
-            u = up - np.sum(up * v, axis=0) * v
-            parts.append((np.sum((E - S) * u, axis=0) >= 0, "elbow up", "elbow down"))
+            nrm = np.cross(a2, W - S, axis=0)
+            towards = np.where(np.sum(up * nrm, axis=0) >= 0, 1.0, -1.0)
+            parts.append((np.sum((E - S) * nrm, axis=0) * towards >= 0, "elbow up", "elbow down"))
         if n == 6 and rev[4] and plan.kind.startswith(("pieper", "parallel")):
             parts.append((np.sin(qq[..., 4] + theta[4]) >= 0, "wrist noflip", "wrist flip"))
     elif plan.kind == "planar":

@@ -103,9 +103,11 @@ def _symbolic(ctx: Context, steps: list) -> Any:
         steps.append(Text("The symbolic Lagrange derivation is not available in this installation."))
         return None
     if robot.dof > SYMBOLIC_MAX_DOF:
-        steps.append(Text(f"The symbolic derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints (for "
-                          f"{robot.dof} joints it is long and slow); denavit.symbolic.lagrangian_dynamics derives it. "
-                          "The values at the numeric case follow."))
+        steps.append(Text(f"The symbolic Lagrange derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints; "
+                          f"for {robot.dof} joints it runs to pages and takes minutes (the function "
+                          "lagrangian_dynamics of denavit.symbolic derives it). Shown instead: the same quantities "
+                          "at the numeric case, from the numeric engine: the energies $K$ and $P$, then $M$, $C$, "
+                          "$c$ and $g$, with $c + g$ checked against the recursive Newton-Euler torques."))
         return None
     try:
         st = found[1](robot, ctx.simplify)
@@ -159,6 +161,10 @@ def section_dynamics(ctx: Context) -> Section:
     steps.append(Text(f"Values {rate}, from the numeric engine (mass matrix by the composite-rigid-body algorithm, "
                       "c from the Christoffel symbols of the exact $\\partial M/\\partial q$, g from the potential "
                       "energy gradient):"))
+    if terms is None and callable(getattr(N, "potential_energy", None)):
+        steps.append(Numbers("K = \\tfrac12\\,\\dot q^T M(q)\\,\\dot q", np.array(0.5 * qd @ M @ qd),
+                             note="kinetic energy [J]"))
+        steps.append(Numbers("P", np.array(float(N.potential_energy(robot, q))), note="potential energy [J]"))
     steps.append(Numbers("M(q)", M))
     if ctx.qd is not None:
         steps.append(Numbers("\\dot q", qd))

@@ -27,7 +27,7 @@ from . import _capabilities
 from ._context import Context
 from ._derivation import Equation, Numbers, Section, Table, Text
 
-__all__ = ["section_ik", "derived_branches", "MAX_STEP_CHARS"]
+__all__ = ["section_ik", "derived_branches", "MAX_STEP_CHARS", "unique_labels", "residual_text"]
 
 MAX_STEP_CHARS = 6_000  # a derivation step longer than this (LaTeX) is named, not printed
 MATCH_TOL = 1e-7  # rad or m: a derived branch equals an analytic solution
@@ -90,7 +90,8 @@ def _derivation_steps(ctx: Context, T_world: np.ndarray) -> tuple[list, Any]:
     try:
         d = found[1](ctx.robot)
     except UnsupportedRobotError as exc:
-        return [Text(f"No symbolic closed-form derivation for this arm: {exc}.")], None
+        return [Text(f"The step-by-step symbolic derivation is not printed for this arm ({exc}); the solver's "
+                     "solutions follow.")], None
     kind = ("kinematic decoupling at the wrist centre (Pieper 1968; Spong et al. 2006, sec. 5.3-5.4; "
             "Craig 2005, sec. 4.7)" if d.kind == "decoupled"
             else "the planar law of cosines (Spong et al. 2006, sec. 5.2; Craig 2005, example 4.1)")
@@ -118,17 +119,17 @@ def _branch_rows(ctx: Context, derived: Any, solutions: list[np.ndarray], T_worl
     rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
     rows = []
     for sg, qv in zip(signs, cand):
-        label = ", ".join(f"{sp.latex(b)} = {'+' if v > 0 else '-'}1" for b, v in zip(d.branches, sg))
+        label = "(" + ", ".join(f"{'+' if v > 0 else '−'}1" for v in sg) + ")"
         if not np.all(np.isfinite(qv)):
-            rows.append((label, "\\text{no real value (out of reach on this branch)}", "-", "-"))
+            rows.append((label, "no real value (out of reach on this branch)", "-", "-"))
             continue
         err = _residual(robot, qv, T_world, controlled)
         match = [k for k, s in enumerate(solutions, start=1)
                  if np.max(np.abs(_wrap(qv - s, rev))) < MATCH_TOL]
         if not match and any(np.max(np.abs(_wrap(qv - s, rev))) < MATCH_TOL for s in outside):
-            rows.append((label, _qtex(qv), f"{err:.1e}", "\\text{outside the joint limits}"))
+            rows.append((label, _qtext(qv), residual_text(err), "outside the joint limits"))
             continue
-        rows.append((label, _qtex(qv), f"{err:.1e}", ", ".join(map(str, match)) if match else "\\text{none}"))
+        rows.append((label, _qtext(qv), residual_text(err), ", ".join(map(str, match)) if match else "none"))
     return rows
 
 
@@ -163,8 +164,35 @@ _GENERAL_STEPS = [Text(
     "plays q3 is chosen per arm (12 ways to run the loop).")]
 
 
-def _qtex(q: np.ndarray) -> str:
-    return "(" + ",\\ ".join(f"{v:.4f}" for v in q) + ")"
+def _qtext(q: np.ndarray) -> str:
+    """A joint vector as plain text, 4 decimals, trailing zeros dropped (a table cell that may wrap)."""
+    from ._render import number_text
+
+    return "(" + ", ".join(number_text(float(v)).replace("-", "−") for v in q) + ")"
+
+
+def residual_text(err: float) -> str:
+    """A residual as plain text (``4.9e-16``), so that no renderer typesets it as a subtraction."""
+    return f"{err:.1e}"
+
+
+def unique_labels(labels: list[str]) -> list[str]:
+    """Branch labels made unique: a label given to several solutions gets " (1 of 2)", " (2 of 2)", …
+
+    An empty or ``"-"`` label (no branch names, as for the general 6R method) is left as it is: the row number
+    names the solution.  Distinct solutions can share a label where its geometric tests do not separate them (e.g. coaxial joints,
+    or two solutions on one side of every test); the table must still name each one once.
+
+    >>> unique_labels(["elbow up", "elbow down", "elbow up"])
+    ['elbow up (1 of 2)', 'elbow down', 'elbow up (2 of 2)']
+    """
+    count = {b: labels.count(b) for b in labels}
+    seen: dict[str, int] = {}
+    out = []
+    for b in labels:
+        seen[b] = seen.get(b, 0) + 1
+        out.append(f"{b} ({seen[b]} of {count[b]})" if count[b] > 1 and b not in ("", "-") else b)
+    return out
 
 
 def _analytic(ctx: Context, T_world: np.ndarray, steps: list) -> tuple[list, list, list, str, np.ndarray]:
@@ -208,21 +236,23 @@ def section_ik(ctx: Context) -> Section:
     steps += deriv_steps
     solutions, branches, free, controlled, outside = _analytic(ctx, T_world, steps)
     if derived is not None:
+        signs = "(" + ", ".join(f"${sp.latex(b)}$" for b in derived[0].branches) + ")"
         steps.append(Text("The derived formulas evaluated at the target, for every sign combination; the residual "
                           "is the position [m] / rotation [rad] error by forward kinematics, and the last column names "
                           "the analytic solver's solution (below) that the branch reproduces:"))
-        steps.append(Table(("\\text{signs}", "q", "\\text{residual}", "\\text{solution}"),
-                           tuple(_branch_rows(ctx, derived, solutions, T_world, controlled, outside))))
+        steps.append(Table((signs, "$q$ [rad, m]", "residual", "solution"),
+                           tuple(_branch_rows(ctx, derived, solutions, T_world, controlled, outside)), math=False))
     if solutions:
         rows = []
-        for k, (s, b, f) in enumerate(zip(solutions, branches, free), start=1):
+        labels = unique_labels([b or "-" for b in branches])
+        for k, (s, b, f) in enumerate(zip(solutions, labels, free), start=1):
             err = _residual(robot, s, T_world, controlled)
-            rows.append((str(k), f"\\text{{{b or '-'}}}" + (f"\\ \\text{{(a continuum: {f})}}" if f else ""),
-                         _qtex(s), f"{err:.1e}"))
-        how = "general 6R eigenvalue method" if kind == "general" else "closed-form"
-        steps.append(Text(f"All {len(solutions)} {how} solution(s) within the joint limits (analytic_ik), "
+            rows.append((str(k), b + (f" (a continuum: {f})" if f else ""), _qtext(s), residual_text(err)))
+        how = ("the general 6R eigenvalue method" if kind == "general"
+               else f"closed form, {kind} structure" if kind else "closed form")
+        steps.append(Text(f"All {len(solutions)} solution(s) within the joint limits from analytic_ik ({how}), "
                           "each checked by forward kinematics:"))
-        steps.append(Table(("k", "\\text{branch}", "q_{sol}", "\\text{residual}"), tuple(rows)))
+        steps.append(Table(("$k$", "branch", "$q_{sol}$ [rad, m]", "residual"), tuple(rows), math=False))
         return Section("ik", "Inverse kinematics", tuple(steps))
     return _numeric(ctx, T_world, steps, derived is not None)
 

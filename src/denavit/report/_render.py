@@ -119,7 +119,11 @@ def render_markdown(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[s
 # LaTeX
 
 _TEX_SPECIAL = {"&": r"\&", "%": r"\%", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}",
-                "^": r"\textasciicircum{}", "\\": r"\textbackslash{}", "→": r"$\to$", "≈": r"$\approx$"}
+                "^": r"\textasciicircum{}", "\\": r"\textbackslash{}", "→": r"$\to$", "≈": r"$\approx$",
+                "−": r"$-$", "±": r"$\pm$", "×": r"$\times$", "σ": r"$\sigma$", "δ": r"$\delta$", "ω": r"$\omega$",
+                "θ": r"$\theta$", "α": r"$\alpha$", "π": r"$\pi$", "≥": r"$\geq$", "≤": r"$\leq$", "≠": r"$\neq$",
+                "²": r"$^2$", "ᵀ": r"$^T$", "√": r"$\surd$", "⇔": r"$\Leftrightarrow$", "·": r"$\cdot$",
+                "–": "--", "—": "---", "…": r"\ldots{}", "∥": r"$\parallel$", "⟂": r"$\perp$"}
 
 
 def _tex_text(s: str) -> str:
@@ -137,6 +141,7 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
         r"\usepackage[margin=2cm]{geometry}",
         r"\usepackage{amsmath,amssymb,graphicx,adjustbox}",
         r"\setcounter{MaxMatrixCols}{20}",
+        r"\sloppy",  # long identifiers (function names) move to the next line instead of into the margin
         r"\renewcommand{\arraystretch}{1.4}",
         rf"\title{{{_tex_text(d.title)}}}",
         r"\author{denavit}",
@@ -159,10 +164,11 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
                         + math_of(step) + r"$\end{adjustbox}\end{center}", ""]
             elif isinstance(step, Table):
                 cell = (lambda c: f"${c}$") if step.math else _tex_text
-                out += [r"\begin{center}", r"\begin{tabular}{" + "c" * len(step.header) + "}", r"\hline",
+                out += [r"\begin{center}\small", r"\begin{adjustbox}{max width=\linewidth}",
+                        r"\begin{tabular}{" + "c" * len(step.header) + "}", r"\hline",
                         " & ".join(cell(h) for h in step.header) + r" \\ \hline"]
                 out += [" & ".join(cell(c) for c in row) + r" \\" for row in step.rows]
-                out += [r"\hline", r"\end{tabular}"]
+                out += [r"\hline", r"\end{tabular}", r"\end{adjustbox}"]
                 if step.caption:
                     out.append(r"\\[2pt] \emph{" + _tex_text(step.caption) + "}")
                 out += [r"\end{center}", ""]
@@ -184,10 +190,14 @@ body { font-family: system-ui, -apple-system, "Segoe UI", sans-serif; max-width:
 h1 { font-size: 1.7rem; } h2 { margin-top: 2.2rem; border-bottom: 1px solid #ddd; padding-bottom: .2rem; }
 .math-display { overflow-x: auto; overflow-y: hidden; padding: .3rem 0; }
 .status { background: #fff6d6; border-left: 4px solid #e0b000; padding: .4rem .8rem; }
-table.dh { border-collapse: collapse; margin: .8rem 0; } table.dh td, table.dh th { border: 1px solid #ccc;
-       padding: .25rem .7rem; text-align: center; }
+.table-wrap { max-width: 100%; overflow-x: auto; }
+table.dh { border-collapse: collapse; margin: .8rem 0; font-size: .92rem; } table.dh td, table.dh th {
+       border: 1px solid #ccc; padding: .25rem .6rem; text-align: center; }
+table.dh.text td { white-space: normal; } table.dh .num { white-space: nowrap; font-variant-numeric: tabular-nums; }
 figure img { max-width: 100%; } .meta { color: #555; }
 """
+
+_NUMBER = re.compile(r"[-+−]?[0-9.]+(e[-+][0-9]+)?")  # a plain-text number cell: kept on one line
 
 _STRETCH = "\\def\\arraystretch{1.45}"  # room for fractions inside matrices
 
@@ -231,12 +241,14 @@ def _html_step(step: Any) -> str:
     if isinstance(step, (Equation, Numbers)):
         return f'<div class="math-display">{html.escape(_STRETCH + math_of(step))}</div>'
     if isinstance(step, Table):
-        cell = ((lambda c: f'<span class="math-inline">{html.escape(c)}</span>') if step.math
-                else (lambda c: html.escape(c)))
+        cell = ((lambda c: f'<span class="math-inline">{html.escape(c)}</span>') if step.math else _html_text)
+        td = (lambda c: "<td>" if step.math or not _NUMBER.fullmatch(c) else '<td class="num">')
         head = "".join(f"<th>{cell(h)}</th>" for h in step.header)
-        body = "".join("<tr>" + "".join(f"<td>{cell(c)}</td>" for c in row) + "</tr>" for row in step.rows)
+        body = "".join("<tr>" + "".join(f"{td(c)}{cell(c)}</td>" for c in row) + "</tr>" for row in step.rows)
         cap = f"<caption>{html.escape(step.caption)}</caption>" if step.caption else ""
-        return f'<table class="dh">{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>'
+        kind = "dh" if step.math else "dh text"
+        return (f'<div class="table-wrap"><table class="{kind}">{cap}<thead><tr>{head}</tr></thead>'
+                f"<tbody>{body}</tbody></table></div>")
     if isinstance(step, Figure):
         data = base64.b64encode(step.png).decode("ascii")
         return (f'<figure><img alt="{html.escape(step.caption)}" src="data:image/png;base64,{data}">'
