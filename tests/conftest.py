@@ -7,8 +7,8 @@
   stay those of each test's own ``@settings``.
 - ``random_q_in_limits(robot, rng, n)``: n configurations uniform within the joint limits (±π where a limit
   is infinite); the ``rng`` fixture is a fresh ``numpy.random.Generator`` per test (seeded, reproducible).
-- ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone); tests that read
-  them take the ``seed_reports`` fixture, which skips with the reason when the folder is absent.
+- ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone, outside the
+  repository); the tests that read them (test_import_table.py) skip with a reason when they are absent.
 - Slow tests carry ``@pytest.mark.slow``; tests marked ``browser`` are slow too (a real browser starts), so
   ``python -m pytest -m "not slow"`` is the quick subset.
 """
@@ -53,14 +53,6 @@ def ci() -> bool:
 def rng(request) -> np.random.Generator:
     """A generator seeded from the test's node id: reproducible, different per test."""
     return np.random.default_rng(sum(request.node.nodeid.encode()) + 16)
-
-
-@pytest.fixture
-def seed_reports() -> Path:
-    """The shared seed-report folder; skips the test when it is absent."""
-    if not SEED_REPORTS.is_dir() or not any(SEED_REPORTS.glob("*.txt")):
-        pytest.skip(f"seed reports not present ({SEED_REPORTS} is outside the repository)")
-    return SEED_REPORTS
 
 
 def pytest_collection_modifyitems(config, items):
