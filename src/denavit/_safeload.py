@@ -9,6 +9,7 @@ with one :class:`~denavit.errors.ParseError` naming the file (and the line where
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 from typing import Any
@@ -116,6 +117,7 @@ def _bracket_depth(text: str, fmt: str) -> int:
     return deepest
 
 
+@functools.lru_cache(maxsize=1)
 def _yaml_loader() -> type:
     import yaml
 
@@ -163,7 +165,10 @@ def _yaml_loader() -> type:
 def _load_yaml(text: str) -> Any:
     import yaml
 
-    loader = _yaml_loader()(text)
+    try:
+        loader = _yaml_loader()(text)  # the reader refuses control characters here already
+    except yaml.YAMLError as exc:
+        raise ParseError(f"malformed YAML: {' '.join(str(exc).split())[:120]}") from None
     try:
         root = loader.get_single_node()
         if root is None:

@@ -430,6 +430,10 @@ def _transform(raw: Any, place: str, ctx: _Ctx) -> tuple[np.ndarray, list[tuple[
             raise ctx.fail(f"{place}.{key}", "expected a list of 3 values")
     p = [ctx.number(v, f"{place}.xyz[{i}]") for i, v in enumerate(xyz)]
     r = [ctx.number(v, f"{place}.rpy[{i}]", angle=True) for i, v in enumerate(rpy)]
+    for key, got, bound, unit in (("xyz", p, MAX_MAGNITUDE, "m"), ("rpy", r, MAX_ANGLE, "rad")):
+        for i, (v, _) in enumerate(got):
+            if abs(v) > bound:
+                raise ctx.fail(f"{place}.{key}[{i}]", f"{v:.6g} {unit} is out of range (at most {bound:g} {unit} in magnitude)")
     texts = [(f"{place}.xyz{i}", t) for i, (_, t) in enumerate(p)] + [(f"{place}.rpy{i}", t) for i, (_, t) in enumerate(r)]
     T = transform_from_xyz_rpy([v for v, _ in p], [v for v, _ in r])
     return T, texts if any(_has_names(t) for _, t in texts) else []
@@ -530,6 +534,8 @@ MAX_TEXT = 2_000
 
 def _text_field(data: Mapping[str, Any], key: str, default: str, where: str) -> str:
     value = data.get(key, default)
+    if value is None:  # "description:" left empty
+        value = default
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise ParseError(f"'{key}' must be text, got {type(value).__name__}", where=f"{where}: {key}")
     text = str(value)
@@ -893,11 +899,9 @@ def _yaml_row(row: Mapping[str, Any]) -> str:
     if "inertia" not in row:
         return "  - {" + head + "}\n"
     inertia = row["inertia"]
-    first = ", ".join(f"{k}: {_yaml_value(inertia[k])}" for k in ("mass", "com", "inertia") if k in inertia)
-    rest = ", ".join(f"{k}: {_yaml_value(v)}" for k, v in inertia.items() if k not in ("mass", "com", "inertia"))
-    lines = "  - {" + head + ",\n     inertia: {" + first
-    lines += (",\n               " + rest) if rest else ""
-    return lines + "}}\n"
+    groups = [("mass", "com"), ("inertia",), tuple(k for k in inertia if k not in ("mass", "com", "inertia"))]
+    parts = [", ".join(f"{k}: {_yaml_value(inertia[k])}" for k in g if k in inertia) for g in groups]
+    return "  - {" + head + ",\n     inertia: {" + ",\n               ".join(p for p in parts if p) + "}}\n"
 
 
 def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
@@ -915,6 +919,8 @@ def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
             out.append("joints:\n" + "".join(_yaml_row(row) for row in value).rstrip("\n"))
         elif key in ("base", "tool") and isinstance(value, list):
             out.append(f"{key}:\n" + "\n".join(f"  - {_yaml_value(r)}" for r in value))
+        elif isinstance(value, dict) and len(_yaml_value(value)) > 100:  # many parameters or poses: one per line
+            out.append(f"{key}:\n" + "\n".join(f"  {_yaml_value(str(k))}: {_yaml_value(v)}" for k, v in value.items()))
         else:
             out.append(f"{key}: {_yaml_value(value)}")
     return "\n".join(out) + "\n"
