@@ -162,3 +162,24 @@ def test_model_checks_poses_given_in_python():
     with pytest.raises(ModelError):
         robot.replace(poses=[("a", (0, 0)), ("a", (0, 0))])
     assert resolve_pose(robot, "nope") is None
+
+
+ARM = """convention: standard
+angle_unit: deg
+joints:
+  - {a: 1, alpha: 0, d: 0, theta: q, limits: [-90, 90]}
+  - {a: 0, alpha: 0, d: q, theta: 0, limits: [0, 0.5]}
+"""
+
+
+@pytest.mark.parametrize("poses, words", [
+    ("poses: {qr: [0]}", ["arm.yaml", "poses.qr"]),
+    ("poses: {qr: [120, 0]}", ["arm.yaml", "pose qr", "limits"]),
+    ("poses: {qr: [\"__import__('os').system('x')\", 0]}", ["arm.yaml", "poses.qr"]),
+    ("poses: [1, 2]", ["arm.yaml", "poses"]),
+    ("poses: {qr: [1e400, 0]}", ["arm.yaml"]),
+])
+def test_cli_refuses_bad_poses_in_one_line(tmp_path, poses, words):
+    from _hostile import assert_refused, run_cli
+
+    assert_refused(run_cli(["show", "arm.yaml"], tmp_path, {"arm.yaml": ARM + poses + "\n"}), mentions=words)
