@@ -310,18 +310,13 @@ def test_reason_is_never_limits_when_the_limits_allow_every_angle():
     """An arm whose revolute limits span a full turn cannot fail because of them; the reason pass used to
     re-solve every failed target with restarts and the bank rescue (50 s on 200 seeds at one singular pose
     of elbow-6r-deg) and then blamed the limits for what few iterations had not reached."""
-    import time
-
     robot = load_robot("elbow-6r-deg")
     lim = robot.q_limits
     assert np.all(lim[:, 1] - lim[:, 0] >= 2 * np.pi)  # the premise: limits restrict nothing
     rng = np.random.default_rng(3)
     q = _random_q(robot, rng, 40)
     T = forward_kinematics(robot, q)
-    t0 = time.perf_counter()
     res = solve_ik(robot, T, _random_q(robot, rng, 40), restarts=0, max_iterations=2, rng=rng)
-    elapsed = time.perf_counter() - t0
     assert (~res.success).sum() > 0  # two iterations from random seeds: most fail
     assert not np.any(res.reason == "limits"), set(res.reason)
     assert np.all(np.isin(res.reason[~res.success], ["iterations", "unreachable"]))
-    assert elapsed < 10  # bounded: measured ~0.01 s (was seconds: a rescue of ~260 seeds per failed target)
