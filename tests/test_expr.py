@@ -104,3 +104,19 @@ def test_text_round_trip_preserves_value(tree):
     except ParseError:
         return
     assert evaluate(parse(text), env) == pytest.approx(v1, rel=1e-12, abs=1e-12)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.lists(st.integers(-9, 9), min_size=500, max_size=4000), st.sampled_from("+-*"))
+def test_long_chains_fold_without_recursion(values, op):
+    """A left-deep chain of thousands of terms (``1+1+…+1``): every walker finishes, with the exact result."""
+    tree = ("num", str(values[0]))
+    for v in values[1:]:
+        tree = ("bin", op, tree, ("num", str(abs(v))) if op == "*" else ("num", str(v)))
+    text = to_text(tree)
+    assert names_in(tree) == set()
+    if op == "*":
+        return  # the product overflows or is zero; the point is that it is walked at all
+    want = values[0] + sum(values[1:]) * (1 if op == "+" else -1)
+    assert evaluate(tree) == want
+    assert text.count(op) >= len(values) - 1

@@ -173,3 +173,120 @@ def test_parse_values():
 def test_robot_from_dict_directly():
     r = robot_from_dict({"convention": "standard", "joints": [{"a": 1, "theta": "q"}, {"a": 1, "theta": "q"}]})
     np.testing.assert_allclose(forward_kinematics(r, [0, 0])[:3, 3], [2, 0, 0])
+
+
+# --------------------------------------------------------------------------------------------------
+# issue 14: property tests of the hardened reader (library level, fast)
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from denavit import LinkInertia, ModelError  # noqa: E402
+from denavit._safeload import MAX_NESTING, load_data  # noqa: E402
+
+FAST = settings(max_examples=250, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+
+_scalars = st.one_of(st.integers(-10**6, 10**6), st.floats(-1e6, 1e6), st.text(st.characters(codec="utf-8",
+                     exclude_categories=("Cs", "Cc")), max_size=12), st.booleans(), st.none())
+_plain_data = st.recursive(_scalars, lambda c: st.one_of(st.lists(c, max_size=4),
+                           st.dictionaries(st.text("abcxyz_", min_size=1, max_size=5), c, max_size=4)), max_leaves=25)
+
+
+@FAST
+@given(_plain_data)
+def test_safe_loader_reads_plain_data_like_the_standard_parsers(data):
+    """Within the limits the safe loader returns what json/yaml return (an independent parser as reference)."""
+    import yaml
+
+    assert load_data(json.dumps(data), ".json", "f.json") == json.loads(json.dumps(data))
+    text = yaml.safe_dump(data)
+    assert load_data(text, ".yaml", "f.yaml") == yaml.safe_load(text)
+
+
+@FAST
+@given(st.dictionaries(st.text("abcdef", min_size=1, max_size=3), st.integers(), min_size=1, max_size=5), st.data())
+def test_safe_loader_refuses_a_repeated_key(mapping, draw):
+    key = draw.draw(st.sampled_from(sorted(mapping)))
+    body = ", ".join(f'"{k}": {v}' for k, v in mapping.items())
+    for text, suffix in ((f"{{{body}, \"{key}\": 1}}", ".json"), ("{" + body.replace('"', "") + f", {key}: 1}}", ".yaml")):
+        with pytest.raises(ParseError, match=f"'{key}' given twice"):
+            load_data(text, suffix, "f")
+
+
+@FAST
+@given(st.integers(MAX_NESTING + 1, 3000), st.sampled_from([".json", ".yaml", ".toml"]))
+def test_safe_loader_refuses_deep_nesting_quickly(depth, suffix):
+    text = ("x = " if suffix == ".toml" else "") + "[" * depth + "]" * depth
+    with pytest.raises(ParseError, match="nested"):
+        load_data(text, suffix, "f")
+
+
+def _rotation(seed: int) -> np.ndarray:
+    Q, R = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    Q = Q * np.sign(np.diag(R))
+    return Q if np.linalg.det(Q) > 0 else -Q
+
+
+def _six(I):
+    return (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
+
+
+@FAST
+@given(st.floats(1e-3, 10), st.floats(1e-3, 10), st.floats(0, 1), st.integers(0, 2**32 - 1), st.floats(0.01, 100))
+def test_inertia_of_a_real_body_is_accepted_in_any_frame(p1, p2, t, seed, mass):
+    """Principal moments within the triangle inequality, rotated arbitrarily: accepted, tensor kept."""
+    p3 = abs(p1 - p2) + t * (p1 + p2 - abs(p1 - p2))
+    R = _rotation(seed)
+    I = R @ np.diag([p1, p2, p3]) @ R.T
+    li = LinkInertia(mass=mass, inertia=_six(I))
+    np.testing.assert_allclose(np.linalg.eigvalsh(li.inertia_matrix), sorted([p1, p2, p3]), rtol=1e-9, atol=1e-12)
+
+
+@FAST
+@given(st.floats(1e-3, 10), st.floats(1e-3, 10), st.floats(1.2, 50), st.integers(0, 2**32 - 1), st.booleans())
+def test_inertia_no_body_has_is_refused_in_any_frame(p1, p2, factor, seed, negative):
+    """A negative principal moment, or I3 > (I1 + I2) by more than the documented 10 %: ModelError."""
+    moments = [-p1, p2, p2] if negative else [p1, p2, (p1 + p2) * factor]
+    R = _rotation(seed)
+    with pytest.raises(ModelError, match="negative" if negative else "triangle"):
+        LinkInertia(mass=1.0, inertia=_six(R @ np.diag(moments) @ R.T))
+
+
+@FAST
+@given(st.lists(st.floats(-1e3, 1e3).map(lambda x: round(x, 6)), min_size=1, max_size=12),
+       st.sampled_from([", ", ",", "; ", " ", "  "]), st.sampled_from(["{}", "[{}]", "({})", "  {}  "]))
+def test_parse_values_reads_every_accepted_form(values, sep, wrap):
+    text = wrap.format(sep.join(repr(v) for v in values))
+    np.testing.assert_array_equal(parse_values(text), values)
+    assert parse_values(text, len(values)).shape == (len(values),)
+
+
+@FAST
+@given(st.lists(st.integers(-99, 99).map(str), min_size=2, max_size=8), st.data())
+def test_parse_values_refuses_empty_values_and_unbalanced_brackets(values, draw):
+    k = draw.draw(st.integers(0, len(values)))
+    broken = draw.draw(st.sampled_from([
+        ", ".join(values[:k] + [""] + values[k:]),          # 1,,2 or ,1,2 or 1,2,
+        "[" + ", ".join(values),                               # [1,2
+        ", ".join(values) + ")",                               # 1,2)
+        " ".join(values) + ",",                                # 1 2,
+        "(" + ", ".join(values) + "]",                         # (1,2]
+    ]))
+    with pytest.raises(ParseError):
+        parse_values(broken)
+
+
+_OFFSETS = {  # form -> the offset it means, computed by Python's math (an independent route)
+    "q + {c}": lambda c, d: c, "{c} + q": lambda c, d: c, "q - {c}": lambda c, d: -c,
+    "{c} - {d} + q": lambda c, d: c - d, "q + {c}*{d}": lambda c, d: c * d,
+    "(q) + sin({c})": lambda c, d: math.sin(c), "q + ({c} - {d})": lambda c, d: c - d,
+}
+
+
+@FAST
+@given(st.floats(-3, 3), st.floats(-3, 3), st.sampled_from(sorted(_OFFSETS)))
+def test_q_plus_any_constant_gives_that_constant(c, d, form):
+    """The offset read from ``q + f`` equals f."""
+    text = form.format(c=f"({c!r})", d=f"({d!r})")
+    r = robot_from_dict({"convention": "standard", "joints": [{"theta": text}]})
+    assert r.links[0].theta == pytest.approx(_OFFSETS[form](c, d), abs=1e-12)
