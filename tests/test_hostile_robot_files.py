@@ -542,3 +542,17 @@ def test_catalogue_converted_files_are_clean_and_round_trip(tmp_path, name, targ
     if a.has_dynamics:
         from denavit import mass_matrix
         np.testing.assert_allclose(mass_matrix(b, q), mass_matrix(a, q), atol=1e-9)
+
+
+def test_parameter_inertia_is_checked_with_its_values(tmp_path):
+    """Inertia written with parameters is checked once the values are in: from the file and after --param."""
+    text = ("convention: standard\nparameters: {Ia: 1, Ib: 1, Ic: 1.5}\n"
+            "joints:\n  - {a: 1, theta: q, inertia: {mass: 1, inertia: [Ia, Ib, Ic, 0, 0, 0]}}\n")
+    o = run_cli(["fk", "r.yaml", "-q", "0"], tmp_path, {"r.yaml": text})
+    assert_accepted_quietly(o)
+    o = run_cli(["fk", "r.yaml", "-q", "0", "--param", "Ic=5"], tmp_path, {"r.yaml": text})
+    assert_refused(o, mentions=["r.yaml", "row 1", "inertia", "triangle"])
+    o = run_cli(["fk", "r.yaml", "-q", "0", "--param", "Ia=-1"], tmp_path, {"r.yaml": text})
+    assert_refused(o, mentions=["r.yaml", "row 1", "negative"])
+    with pytest.raises(denavit.ParseError, match="triangle"):
+        denavit.with_parameters(load_robot(tmp_path / "r.yaml"), Ic=5)
