@@ -5,6 +5,8 @@
 - Hypothesis profiles: ``ci`` (derandomized, so a CI failure reproduces; no deadline: the machine is shared)
   and ``dev`` (random, no deadline), chosen by ``CI``; ``HYPOTHESIS_PROFILE=...`` overrides.  Example counts
   stay those of each test's own ``@settings``.
+- ``robots(**options)``: a hypothesis strategy of random DH arms (``_random_robots.random_robot``: both
+  conventions, prismatic joints, offsets, fixed rows, base and tool), drawn from a seed so a failure reproduces.
 - ``random_q_in_limits(robot, rng, n)``: n configurations uniform within the joint limits (±π where a limit
   is infinite); the ``rng`` fixture is a fresh ``numpy.random.Generator`` per test (seeded, reproducible).
 - ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone, outside the
@@ -21,6 +23,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
+from hypothesis import strategies as st
+
+from _random_robots import random_robot
 
 CI = os.environ.get("CI") == "true"
 
@@ -41,6 +46,11 @@ def random_q_in_limits(robot, rng: np.random.Generator, n: int) -> np.ndarray:
     lim = robot.q_limits
     lim = np.where(np.isfinite(lim), lim, np.sign(lim) * np.pi)
     return rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))
+
+
+def robots(**options) -> st.SearchStrategy:
+    """Random arms for ``@given``; ``options`` go to ``random_robot`` (convention, n_rows, fixed_rows, base_tool)."""
+    return st.integers(0, 2**32 - 1).map(lambda seed: random_robot(np.random.default_rng(seed), **options))
 
 
 @pytest.fixture
