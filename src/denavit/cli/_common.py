@@ -40,6 +40,12 @@ class OneLineParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(r"^-\.?\d|^-[^-].*[,*/()]")
 
+    def _get_values(self, action, arg_strings):  # type: ignore[override]
+        # ``--dpi=--``: argparse drops the lone '--' and would hand the option an empty list, unconverted
+        if arg_strings == ["--"] and action.nargs in (None, "?") and action.option_strings:
+            self.error(f"argument {'/'.join(action.option_strings)}: expected one argument")
+        return super()._get_values(action, arg_strings)
+
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')", file=sys.stderr)
         raise SystemExit(2)
