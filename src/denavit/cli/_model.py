@@ -156,6 +156,9 @@ def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:
     from .. import symbolic as S
     import sympy as sp
 
+    from ._common import require_symbolic_size
+
+    require_symbolic_size(robot, "fk --symbolic")
     q = S.joint_symbols(robot.dof).q
     if args.markdown:
         fmt = lambda M: "$$\n" + sp.latex(M) + "\n$$"  # noqa: E731
