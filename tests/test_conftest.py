@@ -1,12 +1,13 @@
 """The shared test helpers of conftest.py do what the tests rely on."""
 
 import numpy as np
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 import denavit
 from conftest import CI, random_q_in_limits, robots
 
 
+@settings(max_examples=30)
 @given(robot=robots(), seed=st.integers(0, 2**32 - 1))
 def test_random_q_in_limits_stays_inside_and_fills_them(robot, seed):
     rng = np.random.default_rng(seed)
