@@ -173,6 +173,8 @@ def parse(text: Any) -> Node:
     """Parse ``text`` (a string or a plain number) into a syntax tree; raise ParseError if malformed."""
     if isinstance(text, bool):
         raise ParseError(f"expected a number or expression, got {text!r}")
+    if isinstance(text, int) and text.bit_length() > 1100:  # beyond float range (and Python's 4,300-digit str limit)
+        raise ParseError(f"integer of about {int(text.bit_length() * 0.30103)} digits is too large")
     if isinstance(text, (int, float)):
         if not math.isfinite(text):
             raise ParseError(f"value must be finite, got {text!r}")
