@@ -236,7 +236,7 @@ WRITERS = {
 }
 ALLOWED = {"plot": {".png", ".svg", ".pdf"}, "workspace": {".png", ".svg", ".pdf"}, "simulate": {".png", ".svg", ".pdf"},
            "animate": {".gif", ".mp4"}, "view": {".html", ".htm"}}
-_KINDS = ["dir", "missing", "long", "fifo", "symlink", "existing", "suffix", "empty-suffix", "dev"]
+_KINDS = ["dir", "missing", "long", "fifo", "symlink", "existing", "suffix", "empty-suffix", "dev", "empty"]
 
 
 def _make(folder, kind: str, ext: str, tag: str) -> tuple[str, list[str]]:
@@ -266,6 +266,8 @@ def _make(folder, kind: str, ext: str, tag: str) -> tuple[str, list[str]]:
         return f"out-{tag}.txt", [f"out-{tag}.txt"]
     if kind == "empty-suffix":
         return f"out{tag}", [f"out{tag}"]
+    if kind == "empty":
+        return "", ["-o"]
     return "/dev/null", ["/dev/null"]
 
 
@@ -324,6 +326,18 @@ def test_full_disk_leaves_nothing(command, tmp_path, monkeypatch):
     o = run_cli(argv + ["-o", f"out{ext}"], tmp_path)
     assert_refused(o, mentions=[f"out{ext}", "space"])
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv", [
+    ["workspace", "planar2r", "--samples", "20000000"],
+    ["plot", "planar2r", "--dpi", "100000", "-o", "p.png"],
+    ["animate", "planar2r", "--from", "0,0", "--to", "1,1", "--duration", "100000", "-o", "a.gif"],
+    ["simulate", "planar2r", "--q0", "0,0", "--duration", "1000", "--dt", "1e-6"],
+])
+def test_memory_bombs_refused_under_a_memory_limit(tmp_path, argv):
+    from _hostile import run_cli_limited
+
+    assert_refused(run_cli_limited(argv, tmp_path), mentions=[argv[-3] if argv[-2] == "-o" else argv[-2]])
 
 
 def test_os_error_on_a_named_file_is_exit_2(tmp_path, monkeypatch):

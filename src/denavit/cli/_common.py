@@ -185,7 +185,7 @@ def check_output(args: argparse.Namespace, path: str | None, suffixes: Sequence[
     """
     import os
 
-    if not path:
+    if path is None:
         return
     name = os.path.basename(path)
     suffix = os.path.splitext(name)[1].lower()
