@@ -229,6 +229,15 @@ def _is_degrees(header: list[str], kinds: list[str | None], rows: list[list[str]
 def import_table(text: str, name: str = "imported", convention: str | None = None,
                  degrees: bool | None = None, where: str = "<table>") -> TableImport:
     """Read the first DH table in ``text`` into a robot (see the module notes for what is accepted)."""
+    try:
+        return _import(text, name, convention, degrees, where)
+    except ParseError as exc:
+        if str(exc).startswith(where):
+            raise
+        raise ParseError(str(exc), where=where) from None
+
+
+def _import(text: str, name: str, convention: str | None, degrees: bool | None, where: str) -> TableImport:
     from .io import robot_from_dict
 
     header, rows = find_table(text)

@@ -11,6 +11,7 @@ one unit of the last decimal written for claims written with rounded decimals.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -331,10 +332,19 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
 
 def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | None:
     """The correct formula in LaTeX (C_12/S_3 shorthand) from the symbolic engine, when it is cheap."""
+    keys = tuple(spec.get(k) for k in ("index", "from", "to"))
+    if not all(k is None or (isinstance(k, int) and not isinstance(k, bool)) for k in keys):
+        return None
+    return _expected_formula(robot, name, *keys)
+
+
+@lru_cache(maxsize=64)
+def _expected_formula(robot: DHRobot, name: str, index: int | None, frm: int | None, to: int | None) -> str | None:
     import sympy as sp
 
     from .. import symbolic as S
 
+    spec = {k: v for k, v in (("index", index), ("from", frm), ("to", to)) if v is not None}
     try:
         if name == "link_transform":
             M = S.simplify_matrix(S.link_matrices_sym(robot)[int(spec["index"]) - 1])

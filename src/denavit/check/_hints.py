@@ -28,10 +28,19 @@ def _close(a: np.ndarray, b: np.ndarray, tol: Any = 0.0) -> bool:
 
 def _alt(qty, spec, points, robot_map=None, spec_change=None) -> np.ndarray | None:
     """The truth with one change (a different robot per point, or a changed spec), or None if undefined."""
+    mapped: dict[int, Any] = {}  # one changed robot per distinct robot (building one re-reads its table)
+
+    def robot_of(r):
+        if robot_map is None:
+            return r
+        if id(r) not in mapped:
+            mapped[id(r)] = robot_map(r)
+        return mapped[id(r)]
+
     try:
         s = {**spec, **(spec_change or {})}
-        return np.array([np.asarray(qty.truth(Point(robot_map(p.robot) if robot_map else p.robot, p.q, p.qd,
-                                                    p.wrench), s), dtype=float) for p in points])
+        return np.array([np.asarray(qty.truth(Point(robot_of(p.robot), p.q, p.qd, p.wrench), s), dtype=float)
+                         for p in points])
     except Exception:  # e.g. an index out of range for the changed spec: no hint
         return None
 

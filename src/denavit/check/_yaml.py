@@ -99,8 +99,9 @@ def load_claims_yaml(text: str, where: str) -> Any:
     """The data of a claims file's text (see the module notes); ParseError naming ``where`` if refused."""
     import yaml
 
-    loader = _loader_class()(text)
+    loader = None
     try:
+        loader = _loader_class()(text)  # the reader already refuses control characters here
         root = loader.get_single_node()
         if root is None:
             return None
@@ -116,4 +117,5 @@ def load_claims_yaml(text: str, where: str) -> Any:
     except (RecursionError, ValueError, OverflowError) as exc:  # a scalar the constructors cannot read
         raise ParseError(f"unreadable YAML ({type(exc).__name__})", where=where) from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
