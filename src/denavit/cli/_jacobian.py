@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
+from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, number_text, numbers_text,
+                      require_finite,
                       require_symbolic_size, stage_printer)
 
 ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
@@ -93,7 +94,8 @@ def _header(frame: str, what: str = "J") -> str:
 
 def _labelled(M: np.ndarray, labels=ROWS) -> str:
     body = matrix_text(M).split("\n")
-    return "\n".join(f"{lab:>2} {row}" for lab, row in zip(labels, body))
+    width = max(len(lab) for lab in labels)
+    return "\n".join(f"{lab:>{width}} {row}" for lab, row in zip(labels, body))
 
 
 def _q_out(args, robot, q):
@@ -172,7 +174,7 @@ def cmd_jacobian(args: argparse.Namespace):
             data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
             lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {_q_text(args, robot, q)}",
                       f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
-                      f"angles: {', '.join(f'{n} = {v:.6g}' for n, v in zip(names[3:], conv))} "
+                      f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
                       f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
         else:
             J = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
@@ -263,10 +265,10 @@ def cmd_statics(args: argparse.Namespace):
 
 def _value_text(v: float, revolute: bool, deg: bool) -> str:
     if not revolute:
-        return f"{v:.6g} m"
+        return f"{number_text(v)} m"
     if deg:
-        return f"{math.degrees(v):.6g}°"
-    return f"{v:.6g} rad ({math.degrees(v):.6g}°)"
+        return f"{number_text(math.degrees(v))}°"
+    return f"{number_text(v)} rad ({number_text(math.degrees(v))}°)"
 
 
 def _condition_lines(cond, robot, args, fmt) -> list[str]:
@@ -314,10 +316,12 @@ def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
              f"  singular values: {numbers_text(s)}",
              f"  rank {data['rank']} of {min(J.shape)} (threshold 1e-9 · largest singular value)"
              + ("  → SINGULAR" if data["singular"] else ""),
-             f"  manipulability (Yoshikawa) sqrt(det J J^T) = {data['manipulability']:.6g}",
-             f"  condition number = {data['condition_number']:.6g}, smallest singular value = {s[-1]:.6g}",
-             f"  velocity ellipsoid (rows {which}, |qd| <= 1): radii {', '.join(f'{x:.6g}' for x in vel.radii)}",
-             f"  force ellipsoid (rows {which}, |tau| <= 1): radii {', '.join(f'{x:.6g}' for x in frc.radii)}",
+             f"  manipulability (Yoshikawa) sqrt(det J J^T) = "
+             f"{number_text(data['manipulability'], scale=float(np.prod(s[:-1])) if len(s) > 1 else 1.0)}",
+             f"  condition number = {number_text(data['condition_number'])}, smallest singular value = "
+             f"{number_text(s[-1], scale=s[0])}",
+             f"  velocity ellipsoid (rows {which}, |qd| <= 1): radii {numbers_text(vel.radii)}",
+             f"  force ellipsoid (rows {which}, |tau| <= 1): radii {numbers_text(frc.radii)}",
              "  axes (columns, same for both):", matrix_text(vel.axes, indent="    ")]
     return data, lines
 

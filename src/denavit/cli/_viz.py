@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import ParseError
 from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
-                      joint_values, load, nonneg_int, numbers_text, output_file, require_finite)
+                      joint_values, load, nonneg_int, number_text, numbers_text, output_file, require_finite)
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 PICTURES = (".png", ".svg", ".pdf")
@@ -192,10 +192,12 @@ def cmd_workspace(args: argparse.Namespace):
     data = {"robot": robot.name, "output": args.output, "seed": args.seed, **ws.summary()}
     size = (f"area ≈ {ws.area:.4g} m² (planar arm; {ws.voxels} cells of {ws.resolution:.3g} m)" if ws.planar
             else f"volume ≈ {ws.volume:.4g} m³ ({ws.voxels} voxels of {ws.resolution:.3g} m)")
+    big = float(max(np.abs(ws.bounds_min).max(), np.abs(ws.bounds_max).max()))
+    b = lambda x: number_text(x, 4, big)  # noqa: E731
     lines = [f"{robot.name} workspace from {ws.samples} samples within the joint limits",
-             f"x: [{ws.bounds_min[0]:.4g}, {ws.bounds_max[0]:.4g}] m   y: [{ws.bounds_min[1]:.4g}, "
-             f"{ws.bounds_max[1]:.4g}] m   z: [{ws.bounds_min[2]:.4g}, {ws.bounds_max[2]:.4g}] m",
-             f"extent: {ws.extent[0]:.4g} × {ws.extent[1]:.4g} × {ws.extent[2]:.4g} m, reach from base origin "
+             f"x: [{b(ws.bounds_min[0])}, {b(ws.bounds_max[0])}] m   y: [{b(ws.bounds_min[1])}, "
+             f"{b(ws.bounds_max[1])}] m   z: [{b(ws.bounds_min[2])}, {b(ws.bounds_max[2])}] m",
+             f"extent: {b(ws.extent[0])} × {b(ws.extent[1])} × {b(ws.extent[2])} m, reach from base origin "
              f"{ws.reach:.4g} m", size]
     if args.output:
         lines.append(f"wrote {args.output}")
