@@ -433,3 +433,13 @@ def test_readme_first_command_shows_a_well_known_arm_with_every_section_filled(t
     assert len(solutions.rows) >= 2 and len({r[1] for r in solutions.rows}) == len(solutions.rows)
     texts = " ".join(s.text for s in ik.steps if isinstance(s, Text))
     assert "no closed form" not in texts.lower()
+
+
+def test_report_takes_a_named_pose():
+    """derive(robot, "qn") is the report at robot's named pose qn: the same numbers as the pose's values."""
+    robot = dn.load_robot("puma560")
+    for name, q in robot.poses:
+        d = derive(robot, name, topics=["case"])
+        T = _numbers(d.section("case"), "{}^{0}T_{6}")
+        np.testing.assert_allclose(T[-1].values, dn.forward_kinematics(robot, np.array(q)), atol=1e-12)
+        assert [float(sp.sympify(v)) for v in d.inputs["q_exact"]] == pytest.approx(q, abs=1e-12)

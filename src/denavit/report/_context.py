@@ -107,7 +107,15 @@ class Context:
             raise ParseError(f"unknown simplification policy {simplify!r}; choose one of {', '.join(S.POLICIES)}")
         revolute = [t is JointType.REVOLUTE for t in robot.joint_types]
         mask = revolute if deg else None
-        q_exact = default_q(robot) if q is None else exact_values(q, robot.dof, "q", mask)
+        pose = None
+        if isinstance(q, str):  # a named pose of the robot ("qr"): its values, made exact where they are simple
+            from ..io import resolve_pose
+
+            pose = resolve_pose(robot, q)
+        if pose is not None:
+            q_exact = tuple(sp.nsimplify(float(v), [sp.pi], tolerance=1e-12) for v in pose)
+        else:
+            q_exact = default_q(robot) if q is None else exact_values(q, robot.dof, "q", mask)
         qd_exact = None if qd is None else exact_values(qd, robot.dof, "qd", mask)
         w_exact = None if wrench is None else exact_values(wrench, 6, "wrench")
         return cls(robot, q_exact, qd_exact, w_exact, simplify, q is not None, deg)

@@ -163,6 +163,7 @@ def derive(
         Joint values of the numeric case.  Strings (``"pi/4"``) are read exactly by the restricted
         expression parser, so cos(π/4) appears as √2/2; floats are used as given.  ``None`` picks a
         default configuration (π/6 for revolute joints, the middle of the stroke for prismatic ones).
+        A pose name of the robot (``"qr"``, see ``robot.poses``) picks that named configuration.
     qd : sequence, shape (n,), optional
         Joint rates for the velocity section [rad/s or m/s].
     wrench : sequence, shape (6,), optional

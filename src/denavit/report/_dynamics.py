@@ -178,6 +178,8 @@ def section_dynamics(ctx: Context) -> Section:
     if callable(getattr(N, "rnea", None)):
         tau0 = N.rnea(robot, q, qd, np.zeros(robot.dof))
         fr = N.friction_torques(robot, qd) if callable(getattr(N, "friction_torques", None)) else 0.0
+        if np.any(fr != 0):
+            steps.append(Numbers("\\tau_f(\\dot q)", fr, note="joint friction: viscous and Coulomb"))
         steps.append(Numbers("\\tau(q, \\dot q, \\ddot q = 0)", tau0,
                              note="recursive Newton-Euler: the torques that hold this motion without acceleration"))
         steps.append(Text(f"Second route: Newton-Euler $\\tau(q, \\dot q, 0)$ vs $c + g + \\tau_f$: "

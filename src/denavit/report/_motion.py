@@ -146,7 +146,7 @@ def section_velocity(ctx: Context) -> Section:
         if len(str(tw_exact)) <= MAX_EXACT_CHARS:
             steps.append(Equation("\\nu", tw_exact, note="exact"))
         steps.append(Text(f"Check, exact vs numeric: {_agree(_max_diff(tw_exact.evalf(), tw))}."))
-    steps.append(Numbers("\\nu", tw, note="($v$ [m/s], $\\omega$ [rad/s]) in base axes, numeric engine"))
+    steps.append(Numbers("\\nu", tw, note="$v$ in m/s, $\\omega$ in rad/s, base axes; numeric engine"))
     prop = getattr(N, "velocity_propagation", None)
     if prop is not None:
         vp = prop(robot, ctx.q, ctx.qd)
@@ -183,7 +183,7 @@ def section_statics(ctx: Context) -> Section:
         if len(str(tau_exact)) <= MAX_EXACT_CHARS:
             steps.append(Equation("\\tau", tau_exact, note="exact, route 1: $J^T F$"))
         steps.append(Text(f"Check, exact vs numeric: {_agree(_max_diff(tau_exact.evalf(), tau))}."))
-    steps.append(Numbers("\\tau", tau, note="[N m or N], numeric engine"))
+    steps.append(Numbers("\\tau", tau, note="N m or N; numeric engine"))
     prop = getattr(N, "force_propagation", None)
     if prop is None:
         steps.append(Text("Route 2 (force propagation) is not available in this installation."))
