@@ -539,6 +539,10 @@ def _text_field(data: Mapping[str, Any], key: str, default: str, where: str) -> 
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise ParseError(f"'{key}' must be text, got {type(value).__name__}", where=f"{where}: {key}")
     text = str(value)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        raise ParseError(f"'{key}' is not valid Unicode (a lone surrogate?)", where=f"{where}: {key}") from None
     if len(text) > MAX_TEXT:
         raise ParseError(f"'{key}' is longer than {MAX_TEXT} characters", where=f"{where}: {key}")
     return text
