@@ -290,3 +290,23 @@ def test_q_plus_any_constant_gives_that_constant(c, d, form):
     text = form.format(c=f"({c!r})", d=f"({d!r})")
     r = robot_from_dict({"convention": "standard", "joints": [{"theta": text}]})
     assert r.links[0].theta == pytest.approx(_OFFSETS[form](c, d), abs=1e-12)
+
+
+@pytest.mark.parametrize("name", denavit.catalogue_names())
+def test_convert_keeps_inertia_expressions_that_still_hold(name):
+    """After a convention change every kept expression still evaluates to the stored value."""
+    from denavit._convert import convert_convention
+    from denavit import _expr
+
+    robot = load_robot(name)
+    for target in ("standard", "modified"):
+        out = convert_convention(robot, target)
+        for link in out.links:
+            if link.inertia is None:
+                continue
+            li = link.inertia
+            values = {"mass": li.mass, "motor_inertia": li.motor_inertia, "viscous": li.viscous,
+                      "coulomb": li.coulomb, **{f"com{i}": c for i, c in enumerate(li.com)},
+                      **{f"inertia{i}": c for i, c in enumerate(li.inertia)}}
+            for key, text in li.symbols:
+                assert _expr.evaluate(_expr.parse(text), robot.parameter_values) == pytest.approx(values[key], abs=1e-12)

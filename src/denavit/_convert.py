@@ -44,8 +44,21 @@ def _move_inertia(inertia: LinkInertia | None, a: float, alpha: float, inverse: 
     return LinkInertia(
         mass=inertia.mass, com=tuple(com), inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
         motor_inertia=inertia.motor_inertia, viscous=inertia.viscous, coulomb=inertia.coulomb,
-        symbols=tuple((k, v) for k, v in inertia.symbols if k in ("mass", "motor_inertia", "viscous", "coulomb")),
+        symbols=tuple((k, v) for k, v in inertia.symbols if _kept(k, a, alpha)),
     )
+
+
+def _kept(key: str, a: float, alpha: float) -> bool:
+    """Whether a parameter expression of the inertial data still holds after the frame change Tx(a) Rx(α).
+
+    Mass and actuator terms always do; with α = 0 the axes do not turn, so the tensor and the com's y and z
+    keep their expressions too; with a = 0 as well the com's x does.
+    """
+    if key in ("mass", "motor_inertia", "viscous", "coulomb"):
+        return True
+    if alpha != 0.0:
+        return False
+    return key != "com0" or a == 0.0
 
 
 def _with(link: DHLink, a: float, alpha: float, a_text: str | None, alpha_text: str | None,
