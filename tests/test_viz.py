@@ -369,7 +369,7 @@ def test_cli_animate_view_workspace(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv,fragment", [
     (["plot", "puma560", "-q", "1, 2", "-o", "{tmp}/a.png"], "expected 6 values"),
-    (["plot", "puma560", "-o", "{tmp}/a.jpg"], "unsupported picture format"),
+    (["plot", "puma560", "-o", "{tmp}/a.jpg"], "'.jpg'"),
     (["plot", "puma560", "-o", "{tmp}/missing/a.png"], "does not exist"),
     (["plot", "puma560", "-q", "0, 0, 0, 0, 0, 9", "-o", "{tmp}/a.png"], "outside its limits"),
     (["animate", "planar2r", "--from", "0, 0", "--to", "1, x", "-o", "{tmp}/a.gif"], "--to"),
