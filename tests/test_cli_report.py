@@ -92,3 +92,54 @@ def test_cli_check_examples_run_and_judge_every_claim(example, capsys):
     for c in data["claims"]:
         if c["verdict"] == "incorrect":  # which entries differ, or which solutions/configurations are missing
             assert (c["entries"] and c["counterexample"]["q"]) or c.get("missing")
+
+
+# --- output paths (issue 14): checked before any work, nothing overwritten without --force -------------------------
+
+def _hostile():
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import _hostile
+
+    return _hostile
+
+
+@pytest.mark.parametrize("suffix", ["md", "tex"])
+def test_cli_report_refuses_to_overwrite_its_picture(tmp_path, suffix):
+    """``report -o r.md`` writes r-planar2r-arm.png beside it: an existing one is refused (before the derivation)."""
+    h = _hostile()
+    o = h.run_cli(["report", "planar2r", "-o", f"r.{suffix}"], tmp_path, {"r-planar2r-arm.png": b"my picture"})
+    h.assert_refused(o, mentions=["r-planar2r-arm.png", "exists", "--force"])
+    assert o.seconds < 3, o.describe()  # refused before any work
+
+
+def test_cli_report_writes_the_picture_it_names(tmp_path):
+    h = _hostile()
+    o = h.run_cli(["report", "planar2r", "--topics", "model,figures", "-o", "r.md"], tmp_path, {})
+    assert o.code == 0, o.describe()
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["r-planar2r-arm.png", "r.md"], names  # the name checked beforehand is the one written
+    assert "(r-planar2r-arm.png)" in (tmp_path / "r.md").read_text()
+    o = h.run_cli(["report", "planar2r", "--topics", "model,figures", "-o", "r.md", "--force"], tmp_path, {})
+    assert o.code == 0 and sorted(p.name for p in tmp_path.iterdir()) == names, o.describe()
+
+
+@pytest.mark.parametrize("out, files, words", [
+    ("r.docx", {}, ["r.docx", ".md"]),
+    ("missing/r.md", {}, ["missing"]),
+    ("r.md", {"r.md": "my notes"}, ["r.md", "exists"]),
+    ("d.md", {"d.md/keep": "x"}, ["not a regular file"]),
+])
+def test_cli_report_bad_output_refused_before_the_work(tmp_path, out, files, words):
+    h = _hostile()
+    o = h.run_cli(["report", "report000-6r", "-o", out], tmp_path, files)
+    h.assert_refused(o, mentions=words)
+    assert o.seconds < 3, o.describe()
+
+
+def test_cli_report_topics_without_figures_ignore_an_existing_picture(tmp_path):
+    h = _hostile()
+    o = h.run_cli(["report", "planar2r", "--topics", "model", "-o", "r.md"], tmp_path, {"r-planar2r-arm.png": b"x"})
+    assert o.code == 0, o.describe()
+    assert (tmp_path / "r-planar2r-arm.png").read_bytes() == b"x"
