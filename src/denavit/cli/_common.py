@@ -176,7 +176,8 @@ def refuse_overwrite(args: argparse.Namespace, path: str | None) -> None:
         raise ParseError(f"{path!r} exists; not overwriting it (choose another name or pass --force)")
 
 
-def check_output(args: argparse.Namespace, path: str | None, suffixes: Sequence[str], what: str = "-o") -> None:
+def check_output(args: argparse.Namespace, path: str | None, suffixes: Sequence[str], what: str = "-o",
+                 kind: str = "file type") -> None:
     """Refuse a bad output path *before* any work is done (ParseError → exit 2, one line naming the path).
 
     Checks, in order: the suffix is one of ``suffixes`` (lower-case, with the dot); the folder exists and is a
@@ -190,7 +191,7 @@ def check_output(args: argparse.Namespace, path: str | None, suffixes: Sequence[
     name = os.path.basename(path)
     suffix = os.path.splitext(name)[1].lower()
     if suffixes and suffix not in suffixes:
-        raise ParseError(f"{what} {path!r}: unsupported file type {suffix or '(none)'!r}; expected one of "
+        raise ParseError(f"{what} {path!r}: unsupported {kind} {suffix or '(none)'!r}; expected one of "
                          + ", ".join(suffixes))
     folder = os.path.dirname(path) or "."
     if not os.path.isdir(folder):

@@ -143,7 +143,7 @@ def _symbolic(robot, args):
 def cmd_simulate(args: argparse.Namespace):
     from ..numeric._dynamics import require_dynamics
 
-    check_output(args, args.output, PLOTS)
+    check_output(args, args.output, PLOTS, kind="picture format")
     robot = load(args)
     require_dynamics(robot)
     q0 = joint_values(args, robot, args.q0, "q0")

@@ -93,7 +93,7 @@ def cmd_plot(args: argparse.Namespace):
     from ..viz import arm_geometry, default_configuration
     from ..viz._plot import plot_robot, save_figure
 
-    check_output(args, args.output, PICTURES)
+    check_output(args, args.output, PICTURES, kind="picture format")
     robot = load(args)
     q = default_configuration(robot) if args.q is None else joint_values(args, robot, args.q)
     path = None
@@ -127,7 +127,7 @@ def cmd_animate(args: argparse.Namespace):
     from ..numeric import forward_kinematics
     from ..viz import animate_robot
 
-    check_output(args, args.output, ANIMATIONS)
+    check_output(args, args.output, ANIMATIONS, kind="animation format")
     if args.duration * args.fps > MAX_FRAMES:
         raise ParseError(f"--duration {args.duration:g} × --fps {args.fps:g} gives "
                          f"{args.duration * args.fps:.0f} frames; at most {MAX_FRAMES} per animation")
@@ -179,7 +179,7 @@ def cmd_view(args: argparse.Namespace):
 def cmd_workspace(args: argparse.Namespace):
     from ..viz import plot_workspace, workspace
 
-    check_output(args, args.output, PICTURES)
+    check_output(args, args.output, PICTURES, kind="picture format")
     robot = load(args)
     rng = np.random.default_rng(args.seed)
     ws = workspace(robot, args.samples, args.resolution, rng)
