@@ -89,9 +89,10 @@ def _derivation_steps(ctx: Context, T_world: np.ndarray) -> tuple[list, Any]:
 
     try:
         d = found[1](ctx.robot)
-    except UnsupportedRobotError as exc:
-        return [Text(f"The step-by-step symbolic derivation is not printed for this arm ({exc}); the solver's "
-                     "solutions follow.")], None
+    except UnsupportedRobotError:
+        return [Text("The step-by-step symbolic derivation covers 6-joint arms with a spherical wrist (elbow or "
+                     "Stanford type) and planar 2R/3R arms, so the derivation is not printed for this arm; the "
+                     "solver's solutions follow.")], None
     kind = ("kinematic decoupling at the wrist centre (Pieper 1968; Spong et al. 2006, sec. 5.3-5.4; "
             "Craig 2005, sec. 4.7)" if d.kind == "decoupled"
             else "the planar law of cosines (Spong et al. 2006, sec. 5.2; Craig 2005, example 4.1)")
