@@ -18,7 +18,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import _expr
-from ._safeload import MAX_EXPANDED, MAX_INT_DIGITS, MAX_NESTING, MAX_TEXT_BYTES, load_data
+from ._safeload import MAX_TEXT_BYTES, load_data
 from .errors import DenavitWarning, ModelError, ParseError
 from .model import DH_FIELDS, INERTIA_TOLERANCE, MAX_ANGLE, MAX_MAGNITUDE, Convention, DHLink, DHRobot, JointType, LinkInertia
 
