@@ -25,7 +25,7 @@ from typing import Any, Callable, Mapping
 
 from .errors import ParseError
 
-__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "fold", "lookup", "MAX_LENGTH", "MAX_DEPTH"]
+__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "is_literal", "fold", "lookup", "MAX_LENGTH", "MAX_DEPTH"]
 
 MAX_LENGTH = 500
 MAX_DEPTH = 30
@@ -191,6 +191,11 @@ def parse(text: Any) -> Node:
         tok = p.toks[p.i]
         raise ParseError(f"unexpected {tok.text!r} at position {tok.pos + 1} in {text!r}")
     return node
+
+
+def is_literal(node: Node) -> bool:
+    """Whether a tree is a plain number, maybe negated (no unit, no ``pi``, no name)."""
+    return node[0] == "num" or (node[0] == "neg" and node[1][0] == "num")
 
 
 def names_in(node: Node) -> set[str]:

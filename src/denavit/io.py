@@ -7,7 +7,6 @@ Degrees are converted to radians here and nowhere else.
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import warnings
@@ -19,6 +18,7 @@ import numpy as np
 
 from . import _expr
 from ._safeload import MAX_TEXT_BYTES, load_data
+from ._write import dump_robot, expression_text, robot_to_dict, save_robot, value_text
 from .errors import DenavitWarning, ModelError, ParseError
 from .model import DH_FIELDS, INERTIA_TOLERANCE, MAX_ANGLE, MAX_MAGNITUDE, Convention, DHLink, DHRobot, JointType, LinkInertia
 
@@ -189,7 +189,7 @@ class _Ctx:
         except ParseError as exc:
             raise self.fail(place, str(exc)) from None
         text = _expr.to_text(tree)
-        if angle and not self.deg and _is_literal(tree) and abs(value) > DEGREE_HINT:
+        if angle and not self.deg and _expr.is_literal(tree) and abs(value) > DEGREE_HINT:
             self.suspects.append((place, text))
         return value, text
 
@@ -213,11 +213,6 @@ class _Ctx:
 
 #: A bare angle above this in a radian file draws the "did you mean degrees?" warning.
 DEGREE_HINT = 2 * math.pi + 1e-9
-
-
-def _is_literal(tree: _expr.Node) -> bool:
-    """A plain number, maybe negated (no unit, no pi, no parameter)."""
-    return tree[0] == "num" or (tree[0] == "neg" and tree[1][0] == "num")
 
 
 def _names_unit(tree: _expr.Node) -> bool:
@@ -299,7 +294,7 @@ def _joint_row(raw: Any, row: int, joint_no: int, ctx: _Ctx) -> DHLink:
         if max(map(abs, limits)) > bound:
             raise ctx.fail(lplace, f"limits [{limits[0]:.6g}, {limits[1]:.6g}] {unit} are out of range (at most {bound:g} "
                                    f"{unit} in magnitude)")
-        if not all(_is_literal(_expr.parse(t)) for _, t in got):  # kept as written: 5*pi/4, deg(170), L1
+        if not all(_expr.is_literal(_expr.parse(t)) for _, t in got):  # kept as written: 5*pi/4, deg(170), L1
             texts += [("limits0", got[0][1]), ("limits1", got[1][1])]
         if limits[0] > limits[1]:
             raise ctx.fail(lplace, f"low limit {limits[0]:g} is above high limit {limits[1]:g}")
@@ -730,213 +725,3 @@ def _split_values(text: str, what: str) -> list[str]:
         if not p:
             raise ParseError(f"{what}: value {k} is empty (two separators in a row, or one at an end): {text[:60]!r}")
     return parts
-
-
-# --------------------------------------------------------------------------------------------------
-# robot -> dict / file
-
-
-def _num_text(x: float, angle: bool = False) -> Any:
-    """A value for a written file: an int when whole, an exact multiple of π as text (``5*pi/4``), with
-    ``angle=True`` a whole number of degrees as ``170deg``, else the float."""
-    x = float(x)
-    if x == int(x) and abs(x) < 1e15:
-        return int(x)
-    for k in (1, 2, 3, 4, 6, 8, 12):
-        m = x * k / math.pi
-        num = round(m)
-        if num and abs(m - num) < 1e-12 * max(1.0, abs(m)):
-            coef = {1: "", -1: "-"}.get(num, f"{num}*")
-            return f"{coef}pi" + (f"/{k}" if k != 1 else "")
-    if angle:
-        d = math.degrees(x)
-        if abs(d - round(d)) < 1e-9 and abs(d) <= 3600:
-            return f"{round(d)}deg"
-    return x
-
-
-def _text_value(text: str) -> Any:
-    """A stored expression text as it is best written: a plain number as a number, ``deg(90)`` as ``90deg``."""
-    try:
-        tree = _expr.parse(text)
-    except ParseError:
-        return text
-    if _is_literal(tree):
-        value = _expr.evaluate(tree)
-        return int(value) if value == int(value) and abs(value) < 1e15 else value
-    return _DEG_CALL.sub(r"\1deg", text)
-
-
-_DEG_CALL = re.compile(r"\bdeg\((-?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\)")
-
-
-def value_text(x: float, angle: bool = False) -> str:
-    """A value as it is written in robot files and tables: ``2``, ``0.4318``, ``5*pi/4``, ``-170deg`` (angles).
-
-    >>> value_text(-2.356194490192345, angle=True), value_text(0.4318), value_text(-2.9670597283903604, angle=True)
-    ('-3*pi/4', '0.4318', '-170deg')
-    """
-    return str(_num_text(x, angle))
-
-
-def expression_text(text: str) -> str:
-    """A stored field expression as it is best read: ``deg(-90)`` → ``-90deg``; others unchanged.
-
-    >>> expression_text("deg(-90)"), expression_text("L1 + 0.1")
-    ('-90deg', 'L1 + 0.1')
-    """
-    return str(_text_value(text))
-
-
-def _with_q(offset: Any) -> str:
-    """``q``, ``q + offset`` or ``q - offset`` for a joint field."""
-    if offset in (0, "0"):
-        return "q"
-    text = str(offset)
-    return f"q - {text[1:]}" if text.startswith("-") else f"q + {text}"
-
-
-def _clean(x: float, scale: float = 1.0) -> float:
-    """Rounding noise (|x| below 1e-12 of ``scale``) written as 0."""
-    return 0.0 if abs(x) < 1e-12 * max(scale, 1e-300) else float(x)
-
-
-def _transform_dict(robot: DHRobot, place: str) -> Any:
-    sym = dict(robot.symbols)
-    if f"{place}.m0" in sym:
-        return [[_text_value(sym[f"{place}.m{4 * i + j}"]) for j in range(4)] for i in range(4)]
-    if f"{place}.xyz0" in sym:
-        return {"xyz": [_text_value(sym[f"{place}.xyz{i}"]) for i in range(3)],
-                "rpy": [_text_value(sym[f"{place}.rpy{i}"]) for i in range(3)]}
-    M = getattr(robot, f"{place}_matrix")
-    scale = max(1.0, float(np.abs(M[:3, 3]).max()))
-    return [[_num_text(_clean(x, scale)) for x in r] for r in M]
-
-
-def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
-    """Plain data for a robot file (radians; expressions kept as written, exact multiples of π as such)."""
-    rows: list[dict[str, Any]] = []
-    for link in robot.links:
-        sym = dict(link.symbols)
-        row: dict[str, Any] = {}
-        for field in DH_FIELDS:
-            angle = field in ("alpha", "theta")
-            v: Any = _text_value(sym[field]) if field in sym else _num_text(getattr(link, field), angle)
-            if (link.joint is JointType.REVOLUTE and field == "theta") or (link.joint is JointType.PRISMATIC and field == "d"):
-                v = _with_q(v)
-            row[field] = v
-        if link.q_limits is not None:
-            angle = link.joint is JointType.REVOLUTE
-            row["limits"] = ([_text_value(sym["limits0"]), _text_value(sym["limits1"])] if "limits0" in sym
-                             else [_num_text(link.q_limits[0], angle), _num_text(link.q_limits[1], angle)])
-        if link.inertia is not None:
-            li = link.inertia
-            s = dict(li.symbols)
-            scale = max(abs(x) for x in li.inertia) or 1.0
-            cscale = max(abs(x) for x in li.com) or 1.0
-            get = lambda key, x, sc: _text_value(s[key]) if key in s else _num_text(_clean(x, sc))  # noqa: E731
-            inertia: dict[str, Any] = {
-                "mass": get("mass", li.mass, 1.0),
-                "com": [get(f"com{i}", c, cscale) for i, c in enumerate(li.com)],
-                "inertia": [get(f"inertia{i}", c, scale) for i, c in enumerate(li.inertia)],
-            }
-            for k in ("motor_inertia", "viscous", "coulomb"):
-                if getattr(li, k) or k in s:
-                    inertia[k] = get(k, getattr(li, k), 1.0)
-            row["inertia"] = inertia
-        rows.append(row)
-    out: dict[str, Any] = {"name": robot.name}
-    if robot.description:
-        out["description"] = robot.description
-    out["convention"] = robot.convention.value
-    out["angle_unit"] = "rad"
-    if robot.parameters:
-        out["parameters"] = {k: _num_text(v) if v == int(v) else v for k, v in robot.parameters}
-    out["joints"] = rows
-    if robot.symbols and any(k.startswith("tool.") for k, _ in robot.symbols) or not np.allclose(robot.tool_matrix, np.eye(4)):
-        out["tool"] = _transform_dict(robot, "tool")
-    if robot.symbols and any(k.startswith("base.") for k, _ in robot.symbols) or not np.allclose(robot.base_matrix, np.eye(4)):
-        out["base"] = _transform_dict(robot, "base")
-    gsym = dict(robot.symbols)
-    out["gravity"] = ([_text_value(gsym[f"gravity{i}"]) for i in range(3)] if "gravity0" in gsym
-                      else [_num_text(g) for g in robot.gravity])
-    if robot.poses:
-        out["poses"] = {k: [_num_text(v) for v in q] for k, q in robot.poses}
-    return out
-
-
-_PLAIN = re.compile(r"[A-Za-z0-9_.+\-*/^() ]*[A-Za-z0-9_.)]")
-
-
-def _yaml_value(v: Any) -> str:
-    """One value in YAML flow style: numbers unquoted, expressions plain when safe, else double-quoted."""
-    if isinstance(v, bool) or v is None:
-        return json.dumps(v)
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        short = float(f"{v:.15g}")
-        text = repr(short if abs(short - v) <= 2 * math.ulp(v) else v)  # 0.014100000000000003 -> 0.0141
-        return text.replace("e", ".0e") if "e" in text and "." not in text else text  # YAML 1.1 floats need a dot
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{_yaml_value(str(k))}: {_yaml_value(x)}" for k, x in v.items()) + "}"
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_yaml_value(x) for x in v) + "]"
-    text = str(v)
-    if _PLAIN.fullmatch(text) and not text.startswith(("- ", " ")) and _plain_is_text(text):
-        return text
-    return json.dumps(text, ensure_ascii=False)
-
-
-def _plain_is_text(text: str) -> bool:
-    import yaml
-
-    try:
-        return isinstance(yaml.safe_load(text), str)
-    except yaml.YAMLError:
-        return False
-
-
-def _yaml_row(row: Mapping[str, Any]) -> str:
-    """A joint row: the DH values (and limits) on one line, the inertial data on their own lines."""
-    head = ", ".join(f"{k}: {_yaml_value(v)}" for k, v in row.items() if k != "inertia")
-    if "inertia" not in row:
-        return "  - {" + head + "}\n"
-    inertia = row["inertia"]
-    groups = [("mass", "com"), ("inertia",), tuple(k for k in inertia if k not in ("mass", "com", "inertia"))]
-    parts = [", ".join(f"{k}: {_yaml_value(inertia[k])}" for k in g if k in inertia) for g in groups]
-    return "  - {" + head + ",\n     inertia: {" + ",\n               ".join(p for p in parts if p) + "}}\n"
-
-
-def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
-    """The robot as file text (``yaml`` or ``json``).
-
-    The YAML is written for people: one line per DH row, inertial data on their own lines, numbers
-    unquoted, expressions and exact multiples of π kept as text, rounding noise written as 0.
-    """
-    data = robot_to_dict(robot)
-    if fmt == "json":
-        return json.dumps(data, indent=2)
-    out = [f"# {robot.name}: written by denavit"]
-    for key, value in data.items():
-        if key == "joints":
-            out.append("joints:\n" + "".join(_yaml_row(row) for row in value).rstrip("\n"))
-        elif key in ("base", "tool") and isinstance(value, list):
-            out.append(f"{key}:\n" + "\n".join(f"  - {_yaml_value(r)}" for r in value))
-        elif isinstance(value, dict) and len(_yaml_value(value)) > 100:  # many parameters or poses: one per line
-            out.append(f"{key}:\n" + "\n".join(f"  {_yaml_value(str(k))}: {_yaml_value(v)}" for k, v in value.items()))
-        else:
-            out.append(f"{key}: {_yaml_value(value)}")
-    return "\n".join(out) + "\n"
-
-
-def save_robot(robot: DHRobot, path: str | Path, *, overwrite: bool = False) -> None:
-    """Write a robot file (``.yaml``, ``.yml`` or ``.json``); refuses to overwrite an existing file unless
-    ``overwrite=True``, and refuses other suffixes (``x.png`` would receive YAML)."""
-    path = Path(path)
-    if path.suffix.lower() not in (".yaml", ".yml", ".json"):
-        raise ParseError(f"{str(path)!r}: unsupported file type {path.suffix or '(none)'!r}; expected .yaml, .yml or .json")
-    if path.exists() and not overwrite:
-        raise ParseError(f"{str(path)!r} exists; not overwriting it (choose another name or pass --force)")
-    fmt = "json" if path.suffix.lower() == ".json" else "yaml"
-    path.write_text(dump_robot(robot, fmt), encoding="utf-8")
