@@ -33,11 +33,13 @@ from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
 from ._vectorized import vec_eval
 
-__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS", "MAX_WHERE"]
+__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS", "MAX_WHERE", "MAX_SOLUTIONS"]
 
 N_TARGETS = 6
 #: Most definitions in an ik_formula's 'where'.
 MAX_WHERE = 20
+#: Most solutions listed in an ik_solutions claim (a 6R arm has at most 16).
+MAX_SOLUTIONS = 64
 MATCH_TOL = 1e-6
 _TARGET = [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)] + ["px", "py", "pz"]
 _COLS = {"n": 0, "o": 1, "a": 2}
@@ -292,6 +294,8 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
         rows = parse_matrix(raw, _no_names)
     else:
         items = raw if isinstance(raw, list) else [p for p in str(raw).split(";") if p.strip()]
+        if len(items) > MAX_SOLUTIONS:
+            raise ParseError(f"{len(items)} solutions listed; at most {MAX_SOLUTIONS}")
         rows = []
         for k, item in enumerate(items, start=1):
             cells = item if isinstance(item, list) else [c for c in str(item).strip().strip("[]()").split(",")]
@@ -300,6 +304,8 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
                              for c in cells])
             except ParseError as exc:
                 raise ParseError(f"solution {k}: {exc}") from None
+    if len(rows) > MAX_SOLUTIONS:
+        raise ParseError(f"{len(rows)} solutions listed; at most {MAX_SOLUTIONS}")
     out = []
     rev = _rev(robot)
     for k, row in enumerate(rows, start=1):
