@@ -313,7 +313,7 @@ GARBAGE = st.one_of(
 )
 
 
-@settings(max_examples=300, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=250, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
 @given(data=GARBAGE)
 def test_corpus_garbage_files_are_judged_or_refused(tmp_path_factory, data):
     folder = tmp_path_factory.mktemp("g")
@@ -341,3 +341,14 @@ def test_a_correct_claim_is_never_rejected(tmp_path_factory, q, style, spaces):
     o = _check(tmp_path_factory.mktemp("ok"), _file(claim))
     (v,) = _verdicts(o)
     assert v["verdict"] == "correct", v
+
+
+def test_claims_path_that_is_not_a_file_is_refused(tmp_path):
+    import os
+
+    os.mkfifo(tmp_path / "fifo.yaml")
+    o = run_cli(["check", ROBOT, "fifo.yaml"], tmp_path, {})
+    assert_refused(o, mentions=["fifo.yaml", "not a regular file"])
+    (tmp_path / "dir.yaml").mkdir()
+    assert_refused(run_cli(["check", ROBOT, "dir.yaml"], tmp_path, {}), mentions=["dir.yaml"])
+    assert_refused(run_cli(["check", ROBOT, "missing.yaml"], tmp_path, {}), mentions=["missing.yaml"])

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParseError
+from ..errors import DenavitError, ParseError
 from ..model import DHRobot
 from ._engine import Verdict, check_claim
 from ._latex import parse_math, parse_matrix, split_matrix
@@ -79,10 +79,12 @@ def _judge(robot: DHRobot, raw: Any, label: str, rng: np.random.Generator, deg: 
     """One claim's verdict; a failure inside the checker is that claim's "unreadable" verdict, never the file's."""
     try:
         return check_claim(robot, raw, label, rng, deg, detail=detail)
-    except (ArithmeticError, LookupError, ValueError, TypeError, AttributeError, RecursionError, MemoryError,
-            np.linalg.LinAlgError) as exc:
+    except (DenavitError, ArithmeticError, LookupError, ValueError, TypeError, AttributeError, RuntimeError,
+            MemoryError, np.linalg.LinAlgError) as exc:
         cid = str(raw.get("id", label))[:80] if isinstance(raw, dict) else label
         qname = str(raw.get("quantity", "?"))[:80] if isinstance(raw, dict) else "?"
+        if isinstance(exc, DenavitError):
+            return Verdict(cid, qname, "unreadable", f"could not be judged: {str(exc)[:300]}")
         return Verdict(cid, qname, "unreadable", f"could not be judged: the checker failed on it "
                        f"({type(exc).__name__}: {str(exc)[:200]}); please report this claim")
 
@@ -93,8 +95,10 @@ def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResul
 
     path = Path(path)
     where = str(path)
-    if not path.is_file():
+    if not path.exists():
         raise ParseError(f"no such claims file: {where!r}")
+    if not path.is_file():
+        raise ParseError(f"the claims file {where!r} is not a regular file")
     if path.stat().st_size > MAX_FILE_BYTES:
         raise ParseError(f"claims file too large (at most {MAX_FILE_BYTES} bytes)", where=where)
     try:
