@@ -556,3 +556,14 @@ def test_parameter_inertia_is_checked_with_its_values(tmp_path):
     assert_refused(o, mentions=["r.yaml", "row 1", "negative"])
     with pytest.raises(denavit.ParseError, match="triangle"):
         denavit.with_parameters(load_robot(tmp_path / "r.yaml"), Ic=5)
+
+
+@pytest.mark.parametrize("suffix", [".json", ".yml"])
+def test_convert_writes_json_and_yml_that_load_back(tmp_path, suffix):
+    o = run_cli(["convert", "puma560", "--to", "modified", "-o", f"c{suffix}"], tmp_path)
+    assert_accepted_quietly(o)
+    a, b = load_robot("puma560"), load_robot(tmp_path / f"c{suffix}")
+    q = np.random.default_rng(3).uniform(-1, 1, (5, 6))
+    np.testing.assert_allclose(forward_kinematics(b, q), forward_kinematics(a, q), atol=1e-12)
+    again = run_cli(["convert", "puma560", "--to", "modified", "-o", f"c{suffix}"], tmp_path)
+    assert_refused(again, mentions=[f"c{suffix}", "not overwriting"])
