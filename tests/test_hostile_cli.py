@@ -475,18 +475,26 @@ def test_ik_all_lists_solutions_outside_the_limits(tmp_path):
 
 
 def test_ik_all_with_huge_limits(tmp_path):
-    yaml = ("name: wide\nconvention: standard\njoints:\n"
-            "  - {a: 1, alpha: 0, d: 0, theta: q, limits: [-1e308, 1e308]}\n"
-            "  - {a: 1, alpha: 0, d: 0, theta: q, limits: [-1e308, 1e308]}\n")
-    for method in ("numeric", "analytic"):
-        o = run_cli(["ik", "wide.yaml", "--pose", "1,1,0,0,0,0", "--all", "--method", method, "--json"], tmp_path,
-                    files={"wide.yaml": yaml})
-        assert_accepted_quietly(o)
-        sols = np.array(json.loads(o.out)["solutions"])
-        assert len(sols) >= 1 and np.all(np.isfinite(sols))
-        for s in sols:  # each reaches (1, 1): independent check by the planar 2R formula
-            assert np.allclose([np.cos(s[0]) + np.cos(s[0] + s[1]), np.sin(s[0]) + np.sin(s[0] + s[1])], [1, 1],
-                               atol=1e-6)
+    """Limits far beyond a turn (±1000 rad, the most a robot file allows): seeds stay finite, solutions right.
+    Limits of ±1e308 (an internal error once) are refused by the robot file's checks, or solved the same way."""
+    def wide(x):
+        return ("name: wide\nconvention: standard\njoints:\n"
+                f"  - {{a: 1, alpha: 0, d: 0, theta: q, limits: [-{x}, {x}]}}\n"
+                f"  - {{a: 1, alpha: 0, d: 0, theta: q, limits: [-{x}, {x}]}}\n")
+
+    for x in ("1000", "1e308"):
+        for method in ("numeric", "analytic"):
+            o = run_cli(["ik", "wide.yaml", "--pose", "1,1,0,0,0,0", "--all", "--method", method, "--json"],
+                        tmp_path, files={"wide.yaml": wide(x)})
+            if x == "1e308" and o.code == 2:
+                assert_refused(o, mentions=["wide.yaml"])
+                continue
+            assert_accepted_quietly(o)
+            sols = np.array(json.loads(o.out)["solutions"])
+            assert len(sols) >= 1 and np.all(np.isfinite(sols))
+            for s in sols:  # each reaches (1, 1): independent check by the planar 2R formula
+                assert np.allclose([np.cos(s[0]) + np.cos(s[0] + s[1]), np.sin(s[0]) + np.sin(s[0] + s[1])],
+                                   [1, 1], atol=1e-6)
 
 
 @pytest.mark.parametrize("command", ["jacobian", "velocity", "statics", "singularities", "ik", "dynamics",
@@ -497,3 +505,37 @@ def test_every_command_takes_json_and_deg(command):
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     opts = {s for a in sub.choices[command]._actions for s in a.option_strings}
     assert {"--json", "--deg"} <= opts
+
+
+def test_non_finite_results_are_refused_not_printed():
+    """The last guard: a result that is inf/NaN from accepted values is a ParseError (exit 2), never printed."""
+    from denavit.cli._common import check_values, require_finite
+    from denavit.errors import ParseError
+
+    require_finite("x", np.eye(3), None)
+    for bad in (np.array([1.0, np.inf]), np.array([[np.nan]])):
+        with pytest.raises(ParseError, match="not finite"):
+            require_finite("x", np.eye(2), bad)
+    assert check_values(np.array([1e9, -1e9]), "v").tolist() == [1e9, -1e9]
+    with pytest.raises(ParseError, match="v: value 2"):
+        check_values(np.array([0.0, 1.0000001e9]), "v")
+
+
+def test_degrees_warning_from_a_robot_file_is_one_line(tmp_path):
+    """A newcomer's slip (alpha: 90 without angle_unit: deg) warns once, in the CLI's one-line format."""
+    from denavit import errors
+
+    if not hasattr(errors, "DenavitWarning"):
+        pytest.skip("DenavitWarning not defined yet")
+    yaml = ("name: slip\nconvention: standard\njoints:\n"
+            "  - {a: 1, alpha: 90, d: 0, theta: q}\n  - {a: 1, alpha: 0, d: 0, theta: q}\n")
+    for extra in ([], ["--json"]):
+        o = run_cli(["jacobian", "slip.yaml", "-q", "0.1,0.2"] + extra, tmp_path, files={"slip.yaml": yaml})
+        assert_accepted_quietly(o)
+        lines = o.err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("denavit jacobian: warning: ") and "deg" in lines[0], o.err
+        if extra:
+            json.loads(o.out)
+    # with an error as well, only the error line is printed
+    o = run_cli(["jacobian", "slip.yaml", "-q", "0.1,x"], tmp_path, files={"slip.yaml": yaml})
+    assert_refused(o, mentions=["q"])

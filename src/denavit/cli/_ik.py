@@ -109,6 +109,7 @@ def _analytic(args, robot, T):
     locked = _locks(args, robot)
     res = analytic_ik(robot, T, locked=locked)
     sols = res.solutions
+    require_finite("ik", sols)
     data = {"method": "analytic", "structure": res.method, "controlled": res.controlled,
             "locked": {k: _to_unit(robot, np.where(np.arange(robot.dof) == int(k[1:]) - 1, v, 0.0), args.deg)[int(k[1:]) - 1]
                        for k, v in (locked or {}).items()},
