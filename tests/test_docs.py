@@ -2,7 +2,7 @@
 
 - Python: the blocks of one file run in order in one fresh namespace (so a later block may use an earlier
   block's names), in a temporary working directory holding the files the docs refer to (``my_arm.yaml``,
-  ``my_claims.yaml``, ``table.txt``, …, see ``FIXTURES``), with matplotlib's Agg backend.
+  ``table.txt``, …, see ``FIXTURES``; ``examples/`` is copied there too), with matplotlib's Agg backend.
 - Shell: each line starting with ``denavit `` (after an optional ``$ `` prompt) runs through
   ``denavit.cli.main`` in-process in such a directory; it must exit 0.  Other lines (``pip install``,
   ``python -m pytest``, …) are not run.  In a ```console block, the lines under a ``$`` command up to the next
@@ -30,7 +30,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DOC_FILES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
-#: Files the docs' commands and code name as "your own" files; written into the working directory.
+#: Files the docs' commands and code name as "your own" files (my_arm.yaml, a pasted table.txt / table.md),
+#: written into the working directory.
 FIXTURES = {
     "my_arm.yaml": """\
 name: my-arm
@@ -46,7 +47,7 @@ joints:
     "table.md": "| i | a | alpha | d | theta |\n|---|---|---|---|---|\n| 1 | 0.4 | 0 | 0 | q1 |\n| 2 | 0.3 | 0 | 0 | q2 |\n",
 }
 #: Shipped files copied into the working directory under the names the docs use.
-COPIES = {"my_claims.yaml": "examples/claims/report000-fk.yaml", "examples": "examples"}
+COPIES = {"examples": "examples"}
 
 #: Shell lines (prefixes) that take more than a few seconds: run only in the full suite.
 SLOW_COMMANDS = (
