@@ -25,9 +25,11 @@ from ._latex import parse_math, parse_matrix
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver
 
-__all__ = ["Verdict", "check_claim", "N_POINTS", "EXACT_RTOL"]
+__all__ = ["Verdict", "check_claim", "N_POINTS", "EXACT_RTOL", "MAX_ENTRIES"]
 
 N_POINTS = 6
+#: Most entries in one claimed value (a 64-joint mass matrix has 4096).
+MAX_ENTRIES = 4096
 N_PARAM_SETS = 2
 EXACT_RTOL = 1e-9
 
@@ -66,6 +68,8 @@ def _values(raw: Any, resolve) -> list[list[tuple]]:
             rows = raw
         else:
             rows = [[v] for v in raw]
+        if sum(len(r) for r in rows) > MAX_ENTRIES:
+            raise ParseError(f"the value has more than {MAX_ENTRIES} entries")
         out = []
         for i, row in enumerate(rows, start=1):
             cells = []

@@ -28,7 +28,7 @@ from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
 from ..model import DHRobot, JointType
-from ._latex import parse_math, parse_matrix
+from ._latex import MAX_CHARS, parse_math, parse_matrix
 from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
 from ._vectorized import vec_eval
@@ -110,6 +110,8 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
     if len(where) > MAX_WHERE:
         raise ParseError(f"'where' has {len(where)} definitions; at most {MAX_WHERE}")
     value = str(raw["value"]).strip().strip("$")
+    if len(value) + sum(len(str(v)) for v in where.values()) > MAX_CHARS:
+        raise ParseError(f"the formula and its 'where' are longer than {MAX_CHARS} characters")
     joint = raw.get("joint")
     if joint is not None and (isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof):
         raise ParseError(f"'joint' must be an integer from 1 to {robot.dof}, got {str(joint)[:40]!r}")

@@ -30,7 +30,7 @@ from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
 from ..model import DHRobot, Frame, JointType
-from ._latex import parse_math
+from ._latex import MAX_CHARS, parse_math
 from ._resolve import robot_resolver
 from ._text import expand_pm, split_relation, split_top
 from ._vectorized import vec_eval
@@ -123,6 +123,9 @@ class _Arm:
 
 def _pieces(raw: Any) -> list[str]:
     items = [str(x) for x in raw] if isinstance(raw, list) else [str(raw)]
+    if len(items) > MAX_CONDITIONS or sum(len(x) for x in items) > MAX_CHARS:
+        raise ParseError(f"too many conditions, or longer than {MAX_CHARS} characters in all (at most "
+                         f"{MAX_CONDITIONS} conditions)")
     out = []
     for item in items:
         for part in split_top(item.strip().strip("$"), _SEPS):
