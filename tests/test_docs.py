@@ -1,7 +1,7 @@
 """The README and docs/*.md run: every ```python block, every `denavit ...` line of a ```bash / ```console block.
 
 - Python: the blocks of one file run in order in one fresh namespace (so a later block may use an earlier
-  block's names), in a temporary working directory holding the files the docs refer to (``my_arm.yaml``,
+  block's names; a ``print(...)  # -> text`` line must print that text), in a temporary working directory holding the files the docs refer to (``my_arm.yaml``,
   ``table.txt``, …, see ``FIXTURES``; ``examples/`` is copied there too), with matplotlib's Agg backend.
 - Shell: each line starting with ``denavit `` (after an optional ``$ `` prompt) runs through
   ``denavit.cli.main`` in-process in such a directory; it must exit 0.  Other lines (``pip install``,
@@ -118,6 +118,9 @@ def _workdir(tmp_path: Path) -> Path:
 # ---------------------------------------------------------------------------------------------------------
 # python blocks
 
+_PRINTS = re.compile(r"^\s*print\(.*\)\s*#\s*(?:->|→)\s*(.+?)\s*$", re.M)
+
+
 def _python_cases():
     cases = []
     for path in DOC_FILES:
@@ -140,8 +143,12 @@ def test_python_blocks_run(path, blocks, tmp_path, monkeypatch):
         if b.skip:
             continue
         code = compile(b.text, f"{_rel(path)}:{b.line}", "exec")  # tracebacks name the doc file and line
-        with contextlib.redirect_stdout(io.StringIO()):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
             exec(code, namespace)  # noqa: S102 - the project's own documentation, not user input
+        printed = [_norm(line) for line in out.getvalue().splitlines()]
+        for shown in _PRINTS.findall(b.text):  # print(...)  # -> what the docs say it prints
+            assert _norm(shown) in printed, f"{_rel(path)}:{b.line}: the docs show {shown!r}, printed {printed}"
         ran += 1
     assert ran > 0
 
