@@ -31,7 +31,7 @@ _NONFINITE = st.sampled_from(["nan", "inf", "-inf", "NaN", "Infinity", "1e400", 
                               "9" * 400, "1e308+1e308", "10**400", "0/0", "1/0"])
 _GARBAGE = st.one_of(
     st.text(min_size=1, max_size=30).map(lambda t: t + "@"),             # random unicode text, never valid
-    st.sampled_from(["@", "__import__('os')", "q1", "x", "sin(", "()", "$", "1e", "--",
+    st.sampled_from(["@", "__import__('os')", "q1", "x", "sin(", "()", "[1,2", "1,,2", "(1,2", ",", "$", "1e", "--",
                      "\u00b5", "\ud800", "\x00", "1 2 3 4 5", "e3", "2**1000000"]),
     st.integers(1000, 5000).map(lambda k: "1" + "+1" * k + "+"),          # a long expression, cut short
     st.integers(10_000, 60_000).map(lambda k: "x" * k),                   # a very long token
