@@ -217,6 +217,7 @@ def test_puma560_has_wrist_elbow_and_shoulder_singularities():
     assert kinds["shoulder"].variables == ("q2", "q3") and not kinds["shoulder"].solutions  # kept as an equation
 
 
+@pytest.mark.slow
 def test_coaxial_joints_make_the_arm_singular_everywhere():
     from denavit.symbolic import singularity_analysis
 
