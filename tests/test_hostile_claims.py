@@ -165,9 +165,11 @@ BAD_FILES = {
     "claim not a mapping": ("claims:\n- 3\n", ["claim 1"]),
     "bad angle_unit": ("angle_unit: grad\nclaims: []\n", ["angle_unit"]),
     "angle_unit list": ("angle_unit: [deg]\nclaims: []\n", ["angle_unit"]),
-    "deep nesting": ("claims: " + "[" * 1000 + "]" * 1000 + "\n", ["nested"]),
-    "deep mappings": ("claims:\n- " + "{a: " * 300 + "1" + "}" * 300 + "\n", ["nested"]),
+    "deep nesting": ("claims: " + "[" * 1000 + "]" * 1000 + "\n", ["nest"]),
+    "deep mappings": ("claims:\n- " + "{a: " * 300 + "1" + "}" * 300 + "\n", ["nest"]),
     "alias bomb": (ALIAS_BOMB, ["aliases"]),
+    "block nesting": ("claims:\n" + "".join("  " * k + "- \n" for k in range(60)) + "  " * 60 + "- 1\n", ["nest"]),
+    "many entries": ("claims:\n- quantity: position\n  value: [" + ", ".join(["1"] * 60_000) + "]\n", ["entries"]),
     "recursive alias": ("claims: &a\n- *a\n", ["recursive"]),
     "duplicate key": ("claims:\n- quantity: position\n  value: [1, 2, 3]\n  value: [1, 2, 4]\n", ["'value'", "twice"]),
     "duplicate top key": ("claims: []\nclaims: []\n", ["twice"]),
@@ -352,3 +354,27 @@ def test_claims_path_that_is_not_a_file_is_refused(tmp_path):
     (tmp_path / "dir.yaml").mkdir()
     assert_refused(run_cli(["check", ROBOT, "dir.yaml"], tmp_path, {}), mentions=["dir.yaml"])
     assert_refused(run_cli(["check", ROBOT, "missing.yaml"], tmp_path, {}), mentions=["missing.yaml"])
+
+
+N_BIG = 60_000
+
+
+@pytest.mark.parametrize("claim", [
+    {"quantity": "singularities", "value": "q_1 = 0, q_2 = 0" + ", 0" * N_BIG},
+    {"quantity": "singularities", "value": "q_1 = 0 or " * N_BIG},
+    {"quantity": "singularities", "value": "q_1 = 0;" * N_BIG},
+    {"quantity": "ik_formula", "value": "q_1 = " + "\\pm 1 " * N_BIG},
+    {"quantity": "ik_solutions", "q": "0.3, 0.9", "value": "0.3, 0.9;" * N_BIG},
+    {"quantity": "position", "q": "0," * N_BIG, "value": [1, 2, 0]},
+    {"quantity": "position", "value": ["1"] * N_BIG},
+    {"quantity": "position", "value": "\\begin{bmatrix}" + "1 \\\\ " * N_BIG + "\\end{bmatrix}"},
+    {"quantity": "position", "value": "{" * N_BIG},
+])
+def test_a_claim_near_the_file_size_limit_is_refused_quickly(tmp_path, claim):
+    o = _check(tmp_path, _file(claim))
+    assert o.seconds < 3, o.describe()
+    if o.code == 2:  # a file of more YAML entries than the limit
+        assert_refused(o, mentions=["claims.yaml", "entries"])
+    else:
+        (v,) = _verdicts(o)
+        assert v["verdict"] == "unreadable", v
