@@ -183,3 +183,22 @@ def test_cli_refuses_bad_poses_in_one_line(tmp_path, poses, words):
     from _hostile import assert_refused, run_cli
 
     assert_refused(run_cli(["show", "arm.yaml"], tmp_path, {"arm.yaml": ARM + poses + "\n"}), mentions=words)
+
+
+def test_replace_links_keeps_only_the_poses_that_still_fit():
+    """A catalogue arm with narrower limits keeps the poses inside them and drops the others; poses given
+    explicitly must fit (a pose outside the limits is refused)."""
+    from denavit.errors import ModelError
+
+    base = load_robot("planar2r")
+    assert base.poses
+    links = list(base.links)
+    links[1] = links[1].__class__(a=links[1].a, alpha=0.0, d=0.0, theta=0.0, q_limits=(0.0, 0.1))
+    narrow = base.replace(links=tuple(links))
+    lim = narrow.q_limits
+    kept = dict(narrow.poses)
+    for name, q in base.poses:
+        inside = all(lo - 1e-9 <= v <= hi + 1e-9 for v, (lo, hi) in zip(q, lim))
+        assert (name in kept) == inside, name
+    with pytest.raises(ModelError, match="outside its limits"):
+        base.replace(links=tuple(links), poses=(("bad", (0.0, 1.0)),))

@@ -132,7 +132,7 @@ def test_wrist_centre_is_p_minus_d6_R_z():
     assert sp.simplify(sp.Matrix(rhs) - (p - d6 * R[:, 2])) == sp.zeros(3, 1)
 
 
-@pytest.mark.parametrize("name", ["ur5", "panda", "scara", "report004-3-articulated-rrr", "report004-6-wrist3r"])
+@pytest.mark.parametrize("name", ["ur5", "panda", "scara", "articulated-rrr", "spherical-wrist"])
 def test_uncovered_arms_raise(name):
     with pytest.raises(UnsupportedRobotError, match=name):
         ik_derivation(load_robot(name))

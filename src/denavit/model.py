@@ -371,7 +371,19 @@ class DHRobot:
         return all(link.inertia is not None for link in self.joints)
 
     def replace(self, **changes: Any) -> "DHRobot":
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        Named poses belong to the arm they were written for: when ``links`` change and ``poses`` is not given,
+        the copy keeps only the poses that still fit its joints and limits (a pose given explicitly must fit).
+        """
+        if "links" in changes and "poses" not in changes and self.poses:
+            probe = replace(self, poses=(), **changes)
+            lim = probe.q_limits
+            changes["poses"] = tuple(
+                (name, q) for name, q in self.poses
+                if len(q) == len(lim) and all(lo - POSE_LIMIT_TOL <= v <= hi + POSE_LIMIT_TOL
+                                              for v, (lo, hi) in zip(q, lim))
+            )
         return replace(self, **changes)
 
     # --- presentation (delegated to denavit.display) ---------------------------------------------
