@@ -140,6 +140,8 @@ def _gravity(robot: DHRobot, gravity) -> np.ndarray:
     g = np.asarray(robot.gravity if gravity is None else gravity, dtype=float)
     if g.shape != (3,):
         raise ModelError(f"gravity must have 3 components [m/s²], got shape {g.shape}")
+    if not np.all(np.isfinite(g)):
+        raise ModelError(f"gravity must be finite [m/s²], got {g.tolist()}")
     return g
 
 

@@ -257,7 +257,12 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
     """The pipeline of the module notes for one plan (``_plan(robot, False)`` forces the general route)."""
     batch = T.shape[:-2]
     Tf = T.reshape(-1, 4, 4)
-    B = len(Tf)
+    if len(Tf) == 0:  # an empty batch: the same arrays with no pose (and no slot)
+        n = robot.dof
+        return AnalyticIKResult(np.zeros(batch + (0, n)), np.zeros(batch + (0,), dtype=object),
+                                np.zeros(batch + (0,), dtype=object), np.zeros(batch + (0,)), np.zeros(batch + (0,)),
+                                np.zeros(batch, dtype=int), plan.kind, _controlled(plan.projector),
+                                np.zeros(batch + (0,), dtype=bool))
     cand, free = plan.solve(Tf)  # (B, K, n)
     q, ok, pe, re = _verify(robot, plan, Tf, cand)
     # keep only the slots some pose uses: the verified candidates first, the rest dropped

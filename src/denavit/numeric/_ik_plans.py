@@ -171,6 +171,8 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
         free = np.full(q.shape[:-1], "", dtype=object)
         free = _free_text(np.broadcast_to((f123 & 1)[..., None] > 0, free.shape), f"{names[0]} free (wrist centre on axis 1)", free)
         free = _free_text(np.broadcast_to((f123 & 2)[..., None] > 0, free.shape), f"{names[1]} free", free)
+        free = _free_text(np.broadcast_to((f123 & 4)[..., None] > 0, free.shape),
+                          f"{names[2]} free (wrist centre on axis 3; the wrist follows)", free)
         free = _free_text(sing & (sign > 0), f"{names[3]} + {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
         free = _free_text(sing & (sign < 0), f"{names[3]} - {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
         B = len(T)
@@ -302,14 +304,22 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
         Tq = C0i @ chain_fk(chain, qfull)
         return (Tq[..., :3, :3] @ Q_e + Tq[..., :3, 3])[..., :2] - c1
 
+    probe = np.zeros((3, n))
+    probe[:, r2] = (0.0, np.pi / 2, np.pi)
+    A, Bc, Cc = trig_coefficients(*(np.sum(point(p) ** 2) for p in probe))
+    # the point on the second revolute axis (modified DH without a tool offset, say): that joint does not move it,
+    # only the heading; it is then taken from the target's heading and named free (for the position)
+    on_axis2 = np.hypot(A, Bc) < 1e-9 * _scale(chain) ** 2
+
     def solve(T: np.ndarray):
         B = len(T)
         Tl = C0i @ T
         Qt = (Tl[:, :3, :3] @ Q_e + Tl[:, :3, 3])[:, :2] - c1  # (B, 2)
-        probe = np.zeros((3, n))
-        probe[:, r2] = (0.0, np.pi / 2, np.pi)
-        A, Bc, Cc = trig_coefficients(*(np.sum(point(p) ** 2) for p in probe))
-        q2 = solve_trig(A, Bc, np.sum(Qt**2, -1) - Cc, tol=1e-7)  # (B, 2)
+        if on_axis2:
+            q2 = np.where(np.abs(np.sum(Qt**2, -1) - Cc) <= 1e-7 * max(abs(Cc), 1e-12), 0.0, np.nan)[:, None] \
+                + np.array([0.0, np.nan])
+        else:
+            q2 = solve_trig(A, Bc, np.sum(Qt**2, -1) - Cc, tol=1e-7)  # (B, 2)
         q = np.zeros((B, 2, n))
         q[..., r2] = q2
         q[..., r1] = s1 * angle_about_z(np.concatenate([point(np.nan_to_num(q)), np.zeros((B, 2, 1))], -1),
@@ -327,8 +337,16 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
             post = chain_fk(chain, qq[..., r3 + 1:], start=r3 + 1)
             Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
             q[..., r3] = _rot_z_angle(Rz)
+        free = np.full((B, 2), "", dtype=object)
+        if on_axis2:  # the representative with the target's heading
+            qq = np.nan_to_num(q)
+            pre = chain_fk(chain, qq[..., :r2], upto=r2)
+            post = chain_fk(chain, qq[..., r2 + 1:], start=r2 + 1)
+            Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
+            q[..., r2] = _rot_z_angle(Rz)
+            free[:] = f"{names[r2]} free (point on axis {r2 + 1})"
         q[~np.isfinite(q2)] = np.nan
-        return q, np.full((B, 2), "", dtype=object)
+        return q, free
 
     n_world = chain.consts[0][:3, 2]
     return solve, Q_e, n_world
@@ -359,6 +377,7 @@ def _position_plan(chain: Chain, rng, names, limits3) -> Callable:
         free = np.full(q.shape[:-1], "", dtype=object)
         free = _free_text((f & 1) > 0, f"{names[0]} free (point on axis 1)", free)
         free = _free_text((f & 2) > 0, f"{names[1]} free", free)
+        free = _free_text((f & 4) > 0, f"{names[2]} free (point on axis 3)", free)
         return q, free
 
     return solve
@@ -432,7 +451,8 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
         elif not chain.prismatic[:3].any() and _intersect(chain, (0, 1, 2), rng):
             s, _, route = _pieper(rev, rng, rnames, tuple(-lim[reps[3]][::-1]), closed_form)
             solve, kind = _mirrored(s), "pieper (mirrored: spherical joint at the base)"
-    if solve is None and m in (5, 6) and all_rev:
+    if solve is None and m in (5, 6) and all_rev and _generic_rank(robot, rng) == m:
+        # (full rank only: with all five axes parallel, say, the parallel joints leave a continuum unsolved)
         if _parallel(chain, (1, 2, 3), rng) and (m == 5 or _intersect(chain, (4, 5), rng)):
             solve, point = _parallel_plan(chain, names)
             kind = "parallel"
@@ -468,6 +488,11 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
                 f"{robot.name}: this {full.n}-joint {types} arm cannot place its tool in a general pose (its "
                 f"Jacobian has rank {rank} everywhere): no inverse kinematics for full poses; use the numerical "
                 "solver with a position or row mask (solve_ik / --method numeric --mask)")
+        if rank < full.n:
+            raise UnsupportedRobotError(
+                f"{robot.name}: the joints of this {full.n}-joint {types} arm are redundant (its Jacobian has "
+                f"rank {rank} everywhere): every reachable target is reached along a continuum the closed forms "
+                "do not resolve; use the numerical solver (solve_ik / --method numeric, with a row mask)")
         raise UnsupportedRobotError(
             f"{robot.name}: no closed-form inverse kinematics for this {full.n}-joint {types} structure "
             "(known: 6 joints with a spherical wrist, UR-type 6R with three parallel axes, any other 6R arm, "

@@ -103,8 +103,22 @@ class Position3:
             self.nodes = 2 * np.pi * np.arange(2 * _KMAX + 1) / (2 * _KMAX + 1)
         self.coef = self._coefficients(self.nodes)  # (2, 3, N): rows k, (A, B, C)
         self.degree = self._effective_degree(rng)
+        # the point on axis 3 (revolute): q3 does not move it, q1 and q2 place it, q3 is free (a continuum)
+        self.free3 = self.degree < 0 and not self.pr3 and self._on_axis3(rng)
+        if self.degree < 0 and not self.free3:
+            from ..errors import UnsupportedRobotError
+
+            raise UnsupportedRobotError("joints 1-3 cannot place the point independently (every target reached is "
+                                        "reached along a continuum the closed form does not resolve); use the "
+                                        "numerical solver (solve_ik / --method numeric)")
 
     # -- robot-only parts ------------------------------------------------------------------------
+    def _on_axis3(self, rng) -> bool:
+        """Does the point stay put when q3 turns (it lies on axis 3)?"""
+        q2 = rng.uniform(-3, 3, 4)
+        g0, g1 = self.g(q2, 0.0), self.g(q2, rng.uniform(-3, 3, 4))
+        return bool(np.max(np.abs(g1 - g0)) < FREE_EPS * self.L)
+
     def _axis_foot(self) -> np.ndarray:
         """Foot on axis 1 (the z axis) of the common normal with axis 2; origin if they are parallel."""
         o, d = self.C1[:3, 3], self.C1[:3, 2]
@@ -188,12 +202,14 @@ class Position3:
         """All (q1, q2, q3) placing the point at W (B, 3).
 
         Returns q (B, M, 3) with NaN rows for unused slots and free (B, M) int flags:
-        bit 1 = q1 undetermined (point on axis 1), bit 2 = q2 undetermined.
+        bit 1 = q1 undetermined (point on axis 1), bit 2 = q2 undetermined, bit 4 = q3 undetermined (point on
+        axis 3: 0 is returned).
         """
         w = self.invariants(W)
-        if self.degree < 0:
-            raise ValueError("joints 1-3 do not determine the point (continuum)")
-        q3 = self._q3_candidates(w) if self.degree > 0 else np.full((len(W), 1), np.nan)
+        if self.free3:
+            q3 = np.zeros((len(W), 1))
+        else:
+            q3 = self._q3_candidates(w) if self.degree > 0 else np.full((len(W), 1), np.nan)
         q2, free2 = self._q2_candidates(q3, w)  # (B, M, 2)
         q3 = np.broadcast_to(q3[..., None], q2.shape)
         g = self.g(np.nan_to_num(q2), np.nan_to_num(q3))  # (B, M, 2, 3)
@@ -207,8 +223,8 @@ class Position3:
         q = np.stack([q1, q2, q3], axis=-1).reshape(len(W), -1, 3)
         bad = ~np.all(np.isfinite(q), axis=-1)
         q[bad] = np.nan
-        free = (free1 * 1 + free2 * 2).reshape(len(W), -1)
-        return q, free
+        free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
+        return q, np.where(bad, 0, free)
 
     def _q2_candidates(self, q3: np.ndarray, w: np.ndarray):
         co = self._coefficients(np.nan_to_num(q3))  # (2, 3, B, M)

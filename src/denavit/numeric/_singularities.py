@@ -48,9 +48,26 @@ def select_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[int]:
     return out
 
 
+def _svd(J: np.ndarray, compute_uv: bool):
+    """np.linalg.svd with NaN results (not LinAlgError) for the matrices of a batch that hold NaN or ±inf."""
+    bad = ~np.all(np.isfinite(J), axis=(-2, -1))
+    if not bad.any():
+        return np.linalg.svd(J, full_matrices=False, compute_uv=compute_uv)
+    out = np.linalg.svd(np.where(bad[..., None, None], 0.0, J), full_matrices=False, compute_uv=compute_uv)
+    if not compute_uv:
+        return np.where(bad[..., None], np.nan, out)
+    U, s, Vt = out
+    return np.where(bad[..., None, None], np.nan, U), np.where(bad[..., None], np.nan, s), Vt
+
+
 def singular_values(J) -> np.ndarray:
-    """Singular values (..., min(m, n)) in decreasing order."""
-    return np.linalg.svd(_as_matrix(J), compute_uv=False)
+    """Singular values (..., min(m, n)) in decreasing order.
+
+    A Jacobian with a NaN or infinite entry gets NaN singular values (and NaN manipulability, condition
+    number, σ_min and ellipsoids; its numerical rank counts as 0), not an exception: one bad configuration
+    of a batch does not stop the others.
+    """
+    return _svd(_as_matrix(J), False)
 
 
 def manipulability(J) -> np.ndarray:
@@ -61,14 +78,14 @@ def manipulability(J) -> np.ndarray:
     J = _as_matrix(J)
     s = singular_values(J)
     w = np.prod(s, axis=-1)
-    return np.where(J.shape[-2] > J.shape[-1], 0.0, w)
+    return np.where(J.shape[-2] > J.shape[-1], np.where(np.isnan(w), np.nan, 0.0), w)
 
 
 def condition_number(J) -> np.ndarray:
     """σ_max / σ_min (..., ); inf at a singularity."""
     s = singular_values(_as_matrix(J))
     with np.errstate(divide="ignore"):
-        return np.where(s[..., -1] > 0, s[..., 0] / np.where(s[..., -1] > 0, s[..., -1], 1.0), np.inf)
+        return np.where(np.isnan(s[..., -1]), np.nan, np.where(s[..., -1] > 0, s[..., 0] / np.where(s[..., -1] > 0, s[..., -1], 1.0), np.inf))
 
 
 def smallest_singular_value(J) -> np.ndarray:
@@ -101,13 +118,13 @@ def velocity_ellipsoid(J) -> Ellipsoid:
 
     Only the k = min(m, n) axes in the range of J are returned; along the others the radius is 0.
     """
-    U, s, _ = np.linalg.svd(_as_matrix(J), full_matrices=False)
+    U, s, _ = _svd(_as_matrix(J), True)
     return Ellipsoid(U, s)
 
 
 def force_ellipsoid(J) -> Ellipsoid:
     """{F : |Jᵀ F| ≤ 1}: same axes as the velocity ellipsoid, radii 1/σ_i (inf where σ_i = 0) (kineto-static duality)."""
-    U, s, _ = np.linalg.svd(_as_matrix(J), full_matrices=False)
+    U, s, _ = _svd(_as_matrix(J), True)
     with np.errstate(divide="ignore"):
-        radii = np.where(s > 0, 1.0 / np.where(s > 0, s, 1.0), np.inf)
+        radii = np.where(np.isnan(s), np.nan, np.where(s > 0, 1.0 / np.where(s > 0, s, 1.0), np.inf))
     return Ellipsoid(U, radii)

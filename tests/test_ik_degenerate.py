@@ -1,0 +1,215 @@
+"""Analytic IK at the edges: degenerate arms, continua, poses at and near singular sets (issue 18).
+
+Methodology of IKFast's tests (Diankov 2010, ch. 4): sample configurations — including the degenerate angles
+0, ±π/2, π and ±1e-k next to the singular sets — compute the pose by forward kinematics, run the analytic IK,
+check every solution by FK (1e-9) and require the generating configuration among them: equal modulo 2π, or a
+member of the continuum a solution row reports (its ``free`` text names which joints, or which sum of joints,
+are free; the test reads that text independently and checks the determined part).
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit import (Convention, DHLink, DHRobot, JointType, ModelError, UnsupportedRobotError, analytic_ik,
+                     forward_kinematics, rnea)
+from denavit.numeric import manipulability, transform_from_xyz_rpy
+
+from conftest import CI
+
+FK_TOL = 1e-9
+FOUND_TOL = 1e-6  # joint-space distance [rad, m] at which the generating q counts as found
+
+
+# --------------------------------------------------------------------------------------------------------------
+# independent checks: FK residual on the controlled rows, membership in a reported continuum
+
+
+def _fk_residual(robot, q, T, controlled):
+    F = forward_kinematics(robot, q)
+    pos = np.linalg.norm(F[..., :3, 3] - T[..., :3, 3], axis=-1)
+    R = np.swapaxes(F[..., :3, :3], -1, -2) @ T[..., :3, :3]
+    v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
+    ang = np.arctan2(np.linalg.norm(v, axis=-1) / 2, (np.trace(R, axis1=-2, axis2=-1) - 1) / 2)
+    if controlled == "position":
+        return pos
+    if controlled == "orientation":
+        return ang
+    # "pose"; "position+heading" (planar 3R) too: the targets come from FK, so their whole rotation is reachable
+    return pos + ang
+
+
+def _wrap(x):
+    return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
+
+
+def _free_parts(text):
+    """(joints excluded from the comparison, [(signs by joint, …)] sums that must agree) from a ``free`` text."""
+    excluded, sums = set(), []
+    for part in filter(None, (p.strip() for p in text.split(";"))):
+        named = [int(k) - 1 for k in re.findall(r"q(\d+)", part)]
+        head = part.split("(")[0]
+        if " fixed" in head and "coupled" not in head:  # "qa + qb - qc fixed": that signed sum is determined
+            terms = re.findall(r"([+-]?)\s*q(\d+)", head)
+            sums.append({int(k) - 1: (-1.0 if s == "-" else 1.0) for s, k in terms})
+            excluded.update(named)
+        else:  # "qk free", "qa and qb + qc coupled": those joints are not compared
+            excluded.update(named)
+            if "wrist follows" in part:
+                excluded.update(range(named[0], 99))
+    return excluded, sums
+
+
+def _member(robot, row, free, q):
+    """Is q the row (isolated) or a member of the continuum the row reports?"""
+    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    d = np.where(rev, np.abs(_wrap(row - q)), np.abs(row - q))
+    excluded, sums = _free_parts(free)
+    keep = np.array([k not in excluded for k in range(len(q))])
+    if np.any(d[keep] > FOUND_TOL):
+        return False
+    return all(abs(_wrap(sum(s * (row[k] - q[k]) for k, s in terms.items()))) < FOUND_TOL for terms in sums)
+
+
+def _check(robot, Q, label="", require=True):
+    """IK of FK(Q) (one batch): every solution reproduces its pose, and the generating q is among them.
+
+    Returns the number of poses where the generating q is missing (0 when ``require``)."""
+    T = forward_kinematics(robot, Q)
+    res = analytic_ik(robot, T)
+    missing = []
+    for b, q in enumerate(Q):
+        sols = res.solutions[b][res.valid[b]]
+        free = res.free[b][res.valid[b]]
+        if len(sols):
+            r = _fk_residual(robot, sols, np.broadcast_to(T[b], (len(sols), 4, 4)), res.controlled)
+            assert np.all(r < 2 * FK_TOL * max(1.0, _reach(robot))), (label, b, q, r)
+        if not any(_member(robot, s, f, q) for s, f in zip(sols, free)):
+            missing.append((b, q.tolist(), sols.round(6).tolist(), list(free)))
+    if require:
+        assert not missing, (label, res.method, missing[:3])
+    return len(missing)
+
+
+def _reach(robot):
+    return sum(abs(l.a) + abs(l.d) for l in robot.links)
+
+
+# --------------------------------------------------------------------------------------------------------------
+# item 1: no bare exception escapes; continua are reported
+
+
+def _arm3_point_on_axis3(rng, convention):
+    """A random 3R arm whose end-effector origin lies on axis 3 (no offset after joint 3)."""
+    links = [DHLink(a=float(rng.uniform(0.1, 1)), alpha=float(rng.choice([np.pi / 2, -np.pi / 2, rng.uniform(-3, 3)])),
+                    d=float(rng.uniform(-0.5, 0.5))) for _ in range(2)]
+    if convention == "standard":  # row 3: no a, no d (the end effector sits on axis 3)
+        links.append(DHLink(a=0.0, alpha=float(rng.uniform(-3, 3)), d=0.0))
+        links[0] = DHLink(a=links[0].a, alpha=links[0].alpha, d=links[0].d)
+    else:  # modified: frame 3 lies on axis 3 whenever d3 = 0
+        links.append(DHLink(a=float(rng.uniform(0.1, 1)), alpha=float(rng.uniform(-3, 3)), d=0.0))
+    return DHRobot(name="arm3", links=tuple(links), convention=Convention(convention))
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_three_joint_arm_with_the_point_on_axis_3_is_a_named_continuum(convention):
+    rng = np.random.default_rng(18)
+    for _ in range(4 if CI else 12):
+        robot = _arm3_point_on_axis3(rng, convention)
+        Q = rng.uniform(-np.pi, np.pi, (20, 3))
+        Q[:5, 1] = [0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-8]
+        _check(robot, Q, convention)
+        res = analytic_ik(robot, forward_kinematics(robot, Q))
+        assert res.method == "position"
+        assert np.all(np.char.find(res.free[res.valid].astype(str), "q3 free") >= 0)
+
+
+def test_empty_batch_gives_an_empty_result():
+    for name in ("puma560", "ur5", "planar2r"):
+        robot = denavit.load_robot(name)
+        res = analytic_ik(robot, np.zeros((0, 4, 4)))
+        assert res.solutions.shape[0] == 0 and res.solutions.shape[-1] == robot.dof
+        assert res.valid.shape[0] == 0 and np.size(res.count) == 0
+        res = analytic_ik(robot, np.zeros((3, 0, 4, 4)))
+        assert res.solutions.shape[:2] == (3, 0)
+
+
+def test_rnea_refuses_non_finite_gravity():
+    robot = denavit.load_robot("puma560")
+    for g in ([np.nan, 0, 0], [0, np.inf, -9.81]):
+        with pytest.raises(ModelError, match="gravity"):
+            rnea(robot, np.zeros(6), np.zeros(6), np.zeros(6), gravity=g)
+
+
+def test_manipulability_of_a_non_finite_jacobian_is_nan_and_the_batch_goes_on():
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(3, 6, 6))
+    J[1, 2, 4] = np.nan
+    J[2, 0, 0] = np.inf
+    w = manipulability(J)
+    assert np.isnan(w[1]) and np.isnan(w[2])
+    assert w[0] == pytest.approx(np.sqrt(np.linalg.det(J[0] @ J[0].T)), rel=1e-9)
+
+
+# --------------------------------------------------------------------------------------------------------------
+# item 2: planar arms in both conventions, with and without tool offsets
+
+
+def _planar(rng, convention, tool, prismatic=False, n_rev=None):
+    n_rev = n_rev or int(rng.integers(2, 4))
+    links = []
+    for k in range(n_rev):
+        links.append(DHLink(a=float(rng.uniform(0.2, 1)) if (k or convention == "standard") else 0.0,
+                            alpha=float(rng.choice([0.0, np.pi])), d=float(rng.uniform(-0.3, 0.3)),
+                            theta=float(rng.uniform(-1, 1))))
+    if prismatic:
+        links.insert(int(rng.integers(0, n_rev + 1)), DHLink(a=float(rng.uniform(0, 0.5)), alpha=0.0,
+                                                             joint=JointType.PRISMATIC, q_limits=(-1.0, 1.0)))
+    T_tool = np.eye(4)
+    if tool:
+        T_tool = transform_from_xyz_rpy([rng.uniform(0.1, 0.5), rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2)],
+                                        [0.0, 0.0, rng.uniform(-3, 3)])
+    return DHRobot(name="planar", links=tuple(links), convention=Convention(convention),
+                   tool=tuple(map(tuple, T_tool)))
+
+
+def test_modified_planar_2r_with_the_end_effector_on_axis_2():
+    """The issue's arm: modified DH, a0 = 0, a1 = L1, no tool: the point sits on axis 2 and q2 only turns it."""
+    robot = DHRobot(name="p2m", links=(DHLink(a=0.0, alpha=0.0), DHLink(a=0.7, alpha=0.0)),
+                    convention=Convention.MODIFIED)
+    q = np.array([0.3, 0.4])
+    res = analytic_ik(robot, forward_kinematics(robot, q))
+    assert res.count == 1 and "q2 free" in res.free[0]
+    np.testing.assert_allclose(res.solutions[0], q, atol=1e-12)  # the representative keeps the target's heading
+    rng = np.random.default_rng(0)
+    _check(robot, rng.uniform(-np.pi, np.pi, (30, 2)))
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("tool", [False, True])
+@pytest.mark.parametrize("prismatic", [False, True])
+def test_random_planar_arms_find_the_generating_q(convention, tool, prismatic):
+    rng = np.random.default_rng([2, convention == "standard", tool, prismatic])
+    for _ in range(6 if CI else 25):
+        robot = _planar(rng, convention, tool, prismatic)
+        Q = rng.uniform(-np.pi, np.pi, (16, robot.dof))
+        for k, t in enumerate(robot.joint_types):
+            if t is JointType.PRISMATIC:
+                Q[:, k] = rng.uniform(-1, 1, 16)
+            else:
+                Q[:6, k] = [0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-8, -1e-12]
+        _check(robot, Q, (convention, tool, prismatic, robot.links))
+
+
+# --------------------------------------------------------------------------------------------------------------
+# item 3: rank-deficient arms are refused with the reason and a pointer to the numerical solver
+
+
+def test_five_parallel_axes_are_refused_with_the_reason():
+    robot = DHRobot(name="p5", links=tuple(DHLink(a=0.3, alpha=0.0) for _ in range(5)))
+    with pytest.raises(UnsupportedRobotError, match=r"rank 3.*solve_ik"):
+        analytic_ik(robot, forward_kinematics(robot, np.full(5, 0.2)))
