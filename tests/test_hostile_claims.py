@@ -295,12 +295,22 @@ CORPUS = settings(max_examples=600, deadline=None, derandomize=True, database=No
 
 
 @CORPUS
-@given(claims=st.lists(mutated_claim(), min_size=1, max_size=3))
-def test_corpus_mutated_claims_are_judged_or_refused(tmp_path_factory, claims):
+@given(claims=st.lists(mutated_claim(), min_size=1, max_size=3), as_text=st.booleans())
+def test_corpus_mutated_claims_are_judged_or_refused(tmp_path_factory, claims, as_text):
     folder = tmp_path_factory.mktemp("c")
     try:
         text = yaml.safe_dump({"claims": claims}, allow_unicode=True, width=10**9)
     except (yaml.YAMLError, UnicodeEncodeError):
+        return
+    if as_text:  # the text report: every verdict printed, no traceback
+        o = run_cli(["check", "arm.yaml", "claims.yaml"], folder, {"arm.yaml": ARM, "claims.yaml": text})
+        assert not o.hung, o.describe()
+        if o.code == 2:
+            assert_refused(o, mentions=["claims.yaml"])
+        else:
+            assert o.code == 0 and "Traceback" not in o.err and "internal error" not in o.err, o.describe()
+            assert o.out.startswith("arm: ") and o.out.count("\n[") == len(claims), o.describe()
+            assert "checker failed" not in o.out, o.describe()
         return
     _judged_or_refused(_check_arm(folder, text), len(claims))
 
