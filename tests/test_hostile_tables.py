@@ -238,3 +238,22 @@ def test_corpus_numeric_tables_import_their_numbers_in_si(tmp_path_factory, valu
     qq = np.array(q[: len(values)])
     want = _fk(a * factor, np.radians(al), d * factor, np.radians(th), qq)
     np.testing.assert_allclose(dn.forward_kinematics(robot, qq), want, atol=1e-9)
+
+
+def test_degrees_in_joint_offsets_are_recognised(tmp_path):
+    """A newcomer's slip: degrees with no unit and no 90° twist; an offset of -90 cannot be radians."""
+    o = _import(tmp_path, HEAD + "| 1 | 0.5 | 0 | 0 | \\theta_1 |\n| 2 | 0.4 | 0 | 0 | \\theta_2 - 90 |\n")
+    robot = _imported(o, tmp_path)
+    assert "angles read as degrees" in o.out
+    q = np.array([0.3, -0.6])
+    np.testing.assert_allclose(dn.forward_kinematics(robot, q),
+                               _fk([0.5, 0.4], [0, 0], [0, 0], [0, -np.pi / 2], q), atol=1e-12)
+
+
+def test_radian_offsets_stay_radians(tmp_path):
+    o = _import(tmp_path, HEAD + "| 1 | 0.5 | 0 | 0 | \\theta_1 |\n| 2 | 0.4 | \\pi/2 | 0 | \\theta_2 - \\pi/2 |\n")
+    robot = _imported(o, tmp_path)
+    assert "degrees" not in o.out
+    q = np.array([0.3, -0.6])
+    np.testing.assert_allclose(dn.forward_kinematics(robot, q),
+                               _fk([0.5, 0.4], [0, np.pi / 2], [0, 0], [0, -np.pi / 2], q), atol=1e-12)

@@ -257,7 +257,7 @@ def _import(text: str, name: str, convention: str | None, degrees: bool | None, 
         if unit not in (None, "m"):
             notes.append(f"column {header[col[k]]!r}: lengths converted from {unit} to metres")
     reader = _Reader()
-    joints = []
+    joints, angles = [], []
     for r, raw in enumerate(rows, start=1):
         cells = {k: reader.cell(raw[col[k]], f"{where}: row {r}, column {header[col[k]]!r}") for k in _COLS}
         row = _row(cells, raw, col, r, where)
@@ -265,6 +265,12 @@ def _import(text: str, name: str, convention: str | None, degrees: bool | None, 
             if factor != 1.0:
                 row[k] = _to_metres(row[k], factor, f"{where}: row {r}, column {header[col[k]]!r}")
         joints.append(row)
+        angles.append((cells["alpha"], cells["theta"]))
+    says_rad = any(k in ("alpha", "theta") and re.search(r"rad", h.lower()) for h, k in zip(header, kinds))
+    if degrees is None and not deg and not says_rad and _large_angle(angles):
+        deg = True
+        notes.append("angles read as degrees (a twist or joint offset larger than 2π in magnitude, such as "
+                     "θ - 90; write (rad) in the header if they really are radians)")
     if all(unit is None for unit, _ in factors.values()):
         _warn_if_millimetres(joints, [header[col[k]] for k in ("a", "d")], where)
     used: set[str] = set()
@@ -285,6 +291,24 @@ def _import(text: str, name: str, convention: str | None, degrees: bool | None, 
     data = {"name": name, "convention": conv, "angle_unit": "deg" if deg else "rad",
             "parameters": params, "joints": joints}
     return TableImport(robot_from_dict(data, where=where), data, tuple(notes))
+
+
+def _large_angle(angles: list[tuple[tuple, tuple]]) -> bool:
+    """Some constant twist or joint offset (joint variables at 0, no other names) exceeds 2π in magnitude."""
+    import math
+
+    for cells in angles:
+        for node in cells:
+            names = _expr.names_in(node)
+            if names - _joint_names(node):
+                continue
+            try:
+                value = _expr.evaluate(node, {n: 0.0 for n in names})
+            except ParseError:
+                continue
+            if abs(value) > 2 * math.pi + 1e-9:
+                return True
+    return False
 
 
 def _length_unit(cell: str) -> tuple[str | None, float]:
