@@ -250,7 +250,7 @@ def test_shoulder_singular_pose_goes_the_general_way_in_a_mixed_batch():
     fast, gen = _routes(robot, T)
     _compare(robot, fast, gen, T, _sigma_min(robot, Q) > 1e-2)
     free = fast.free[3][fast.valid[3]]
-    assert len(free) == 4 and all(f == "q1 free (wrist centre on axis 1)" for f in free)  # 2 elbows × 2 wrists
+    assert len(free) == 4 and all(f == "q1 free (wrist centre on axis 1; q4, q5, q6 follow)" for f in free)  # 2 elbows × 2 wrists
     np.testing.assert_allclose(fast.solutions[3][fast.valid[3], 0], 0.0, atol=0)  # the representative q1 = 0
     for i in range(len(T)):
         one = _solve(robot, T[i], _plan(robot, True))

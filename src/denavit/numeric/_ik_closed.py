@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._ik_chain import solve_trig
+from ._ik_subproblems import ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, split_aligned
 
 __all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
 
@@ -35,7 +36,6 @@ FREE_TOL = 1e-10  # relative distance of the wrist centre to axis 1 or 2 under w
 # (any value then moves the wrist centre by < 1e-10 L, within the FK check, so 0 is returned and the continuum is
 # named; farther out the joint is determined and computed, however ill-conditioned)
 RATIO_TOL = 1e-7  # |c/ρ| up to 1 + this counts as the tangent (double) root, as in the general route
-WRIST_SINGULAR = 1e-9  # |(Ra Rz(q5) Rb e_z)_xy| under which axes 4 and 6 are aligned (as rotation3)
 
 
 def _angle(y: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -183,7 +183,7 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     Returns q (..., 2, 3), singular (..., 2), sign (..., 2) as :func:`._ik_subproblems.rotation3`.
     """
     r, u = Ra[2, :], Rb[:, 2]
-    qb = solve_trig(r[0] * u[0] + r[1] * u[1], r[1] * u[0] - r[0] * u[1], M[..., 2, 2] - r[2] * u[2])  # (..., 2)
+    qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
     cb, sb = np.cos(qb), np.sin(qb)
 
     def rz_then_ra(x):  # Ra Rz(qb) x for a constant 3-vector x → three (..., 2) arrays
@@ -192,8 +192,9 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
 
     v = rz_then_ra(u)
     m0, m1 = M[..., None, 0, 2], M[..., None, 1, 2]
-    singular = np.hypot(v[0], v[1]) < WRIST_SINGULAR
-    qa = np.where(singular, 0.0, _angle(m1, m0) - _angle(v[1], v[0]))
+    vxy = np.hypot(v[0], v[1])
+    singular = vxy < AXES_ALIGNED_TOL
+    qa = np.where(vxy < ALIGNED_EXACT, 0.0, _angle(m1, m0) - _angle(v[1], v[0]))
     ca, sa = np.cos(qa), np.sin(qa)
     n0, n1, n2 = (M[..., None, k, 0] for k in range(3))  # M e_x
     y0, y1 = ca * n0 + sa * n1, -sa * n0 + ca * n1  # Rz(qa)ᵀ M e_x
@@ -202,4 +203,8 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     N10 = x1[0] * y0 + x1[1] * y1 + x1[2] * n2
     qc = _angle(N10, N00)
     sign = np.where(v[2] >= 0, 1.0, -1.0)
+    exact = vxy < ALIGNED_EXACT
+    if exact.any():  # the continuum's representative in the middle of the family (inside the wrist limits)
+        qa0, qc = split_aligned(exact, sign, qc)
+        qa = np.where(exact, qa0, qa)
     return np.stack([qa, qb, qc], -1), singular & np.isfinite(qb), sign

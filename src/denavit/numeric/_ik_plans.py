@@ -29,7 +29,8 @@ from ..model import DHRobot
 from ._ik_closed import closed_position, wrist_angles
 from ._ik_general import choose_formulation, loop_of, solve_general
 from ._ik_chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
-from ._ik_subproblems import Position3, rotation3, rz_bilinear, trig_coefficients
+from ._ik_subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
+                              trig_coefficients)
 from ._transforms import inverse_transform
 
 __all__ = ["Plan", "make_plan"]
@@ -169,10 +170,13 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
         q456, sing, sign = wrist_angles(M, R4, R5) if fast is not None else rotation3(M, R4, R5)  # (B, M, 2, 3)
         q = np.concatenate([np.broadcast_to(q123[:, :, None, :], q456.shape), q456], axis=-1)
         free = np.full(q.shape[:-1], "", dtype=object)
-        free = _free_text(np.broadcast_to((f123 & 1)[..., None] > 0, free.shape), f"{names[0]} free (wrist centre on axis 1)", free)
-        free = _free_text(np.broadcast_to((f123 & 2)[..., None] > 0, free.shape), f"{names[1]} free", free)
+        wrist = f"{names[3]}, {names[4]}, {names[5]} follow"  # the wrist turns with a free joint 1, 2 or 3
+        free = _free_text(np.broadcast_to((f123 & 1)[..., None] > 0, free.shape),
+                          f"{names[0]} free (wrist centre on axis 1; {wrist})", free)
+        free = _free_text(np.broadcast_to((f123 & 2)[..., None] > 0, free.shape),
+                          f"{names[1]} free (wrist centre on axis 2; {wrist})", free)
         free = _free_text(np.broadcast_to((f123 & 4)[..., None] > 0, free.shape),
-                          f"{names[2]} free (wrist centre on axis 3; the wrist follows)", free)
+                          f"{names[2]} free (wrist centre on axis 3; {wrist})", free)
         free = _free_text(sing & (sign > 0), f"{names[3]} + {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
         free = _free_text(sing & (sign < 0), f"{names[3]} - {names[5]} fixed (wrist singular: axes 4 and 6 aligned)", free)
         B = len(T)
@@ -237,13 +241,17 @@ def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
         free = np.full((B, 2, 2), "", dtype=object)
         if n == 6:
             r, u = C[4][2, :3], C[5][:3, 2]
-            al, be, ga = rz_bilinear(r, u)
-            d_last = RL[..., :, 2]  # axis 6 in F1 axes... z component is (RL e_z)_z
-            q5 = solve_trig(al, be, sigma * d_last[..., 2] - ga, tol=1e-7)  # (B, 2, 2)
+            d_last = RL[..., :, 2]  # axis 6 in F1 axes: (RL e_z); its z component is fixed by q5
+            m = np.concatenate([d_last[..., :2], sigma * d_last[..., 2:]], -1)
+            q5 = axis_angle_roots(r, u, m, tol=1e-7)  # (B, 2, 2), digits kept next to the singularity
             y = sigma * np.einsum("j,...jk,kl->...l", C[4][2, :3], _rz(q5), C[5][:3, :3])
             ell2 = np.broadcast_to(ell[..., None, :], y.shape)
-            sing = np.hypot(y[..., 0], y[..., 1]) < 1e-9
-            q6 = np.where(sing, 0.0, -angle_about_z(y, ell2))
+            yxy = np.hypot(y[..., 0], y[..., 1])
+            sing = yxy < AXES_ALIGNED_TOL
+            exact = yxy < ALIGNED_EXACT
+            q6 = np.where(exact, 0.0, -angle_about_z(y, ell2))
+            if exact.any():  # q6 free: the representative whose planar 3R problem is best inside its workspace
+                q6 = np.where(exact, _aligned_q6(T, F1, q5, C, exact), q6)
             free = _free_text(sing, f"{names[5]} and {names[1]} + {names[2]} + {names[3]} coupled "
                               "(axis 6 parallel to axes 2-4)", free)
             tail = C[4] @ _jz(q5) @ C[5] @ _jz(q6) @ C[6]
@@ -268,6 +276,21 @@ def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
         return q, free
 
     return solve, Q_e
+
+
+def _aligned_q6(T, F1, q5, C, exact, samples: int = 24) -> np.ndarray:
+    """q6 for the continuum of a UR-type arm with axis 6 parallel to axes 2-4 (every q6 gives a pose of the
+    same family, the planar joints follow): of ``samples`` values the one whose planar 3R problem has the
+    law-of-cosines ratio farthest inside ±1 (so the representative is reachable whenever the family is)."""
+    t = 2 * np.pi * np.arange(samples) / samples
+    tail = C[4] @ _jz(q5[..., None]) @ C[5] @ _jz(t) @ C[6]  # (B, 2, 2, S, 4, 4)
+    X = inverse_transform(F1)[:, :, None, None] @ T[:, None, None, None] @ inverse_transform(tail)
+    a, b, g = rz_bilinear(C[2][:3, :3].T @ C[2][:3, 3], C[3][:3, 3])
+    p2, p3, R2 = C[2][:3, 3], C[3][:3, 3], C[2][:3, :3]
+    vz = p2[2] + R2[2, 2] * p3[2]
+    rhs = np.sum(X[..., :2, 3] ** 2, -1) - p2 @ p2 - p3 @ p3 + vz**2 - 2 * g
+    ratio = np.abs(rhs) / max(2 * np.hypot(a, b), 1e-300)
+    return t[np.argmin(np.nan_to_num(ratio, nan=np.inf), axis=-1)]
 
 
 def _rz(t):
@@ -309,7 +332,8 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
     A, Bc, Cc = trig_coefficients(*(np.sum(point(p) ** 2) for p in probe))
     # the point on the second revolute axis (modified DH without a tool offset, say): that joint does not move it,
     # only the heading; it is then taken from the target's heading and named free (for the position)
-    on_axis2 = np.hypot(A, Bc) < 1e-9 * _scale(chain) ** 2
+    L = _scale(chain)
+    on_axis2 = np.hypot(A, Bc) < 1e-9 * L**2
 
     def solve(T: np.ndarray):
         B = len(T)
@@ -338,13 +362,17 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
             Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
             q[..., r3] = _rot_z_angle(Rz)
         free = np.full((B, 2), "", dtype=object)
+        on_axis1 = np.broadcast_to((np.hypot(Qt[:, 0], Qt[:, 1]) < 1e-10 * L)[:, None], (B, 2))
+        if on_axis1.any():  # the point on the first revolute axis: that joint is free (the third follows)
+            follow = f"; {names[rev[2]]} follows" if len(rev) == 3 else ""
+            free = _free_text(on_axis1 & np.isfinite(q2), f"{names[r1]} free (point on axis {r1 + 1}{follow})", free)
         if on_axis2:  # the representative with the target's heading
             qq = np.nan_to_num(q)
             pre = chain_fk(chain, qq[..., :r2], upto=r2)
             post = chain_fk(chain, qq[..., r2 + 1:], start=r2 + 1)
             Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
             q[..., r2] = _rot_z_angle(Rz)
-            free[:] = f"{names[r2]} free (point on axis {r2 + 1})"
+            free = _free_text(np.isfinite(q2), f"{names[r2]} free (point on axis {r2 + 1})", free)
         q[~np.isfinite(q2)] = np.nan
         return q, free
 

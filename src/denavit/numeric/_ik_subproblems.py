@@ -10,11 +10,42 @@ import numpy as np
 
 from ._ik_chain import angle_about_z, joint_motion, solve_trig
 
-__all__ = ["Position3", "rotation3", "trig_coefficients", "rz_bilinear"]
+__all__ = ["Position3", "rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "split_aligned",
+           "AXES_ALIGNED_TOL", "ALIGNED_EXACT"]
 
 _KMAX = 6  # harmonics sampled for a revolute sweep joint (the resultant has degree ≤ 4)
 _PMAX = 8  # polynomial degree sampled for a prismatic sweep joint (the resultant has degree ≤ 6)
 FREE_EPS = 1e-9  # relative size under which an equation is taken not to depend on a joint
+ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
+AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
+# parallel axes of a UR-type arm) under which a solution is reported as the continuum of the aligned axes
+
+
+def axis_angle_roots(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """All θ with ``rᵀ Rz(θ) u = m_z`` for unit vectors r, u (3,) and unit m (..., 3), shape (..., 2).
+
+    The same roots as ``solve_trig`` on ``a cos θ + b sin θ = m_z − r_z u_z`` (θ = base ± x), but x is computed
+    from the angle φ = ∠(m, e_z), taken from all of m with atan2, instead of from arccos(m_z): next to the double
+    root (the aligned axes of a wrist singularity, φ ≈ |β_r − β_u|) arccos loses half the digits (x = 1e-8
+    comes out as ±1.5e-8), this keeps them.  With β_r, β_u the angles of r and u to the z axis,
+    ``(1 − cos x)/2 = sin((φ + Δ)/2) sin((φ − Δ)/2) / (sin β_r sin β_u)``, Δ = β_r − β_u, and
+    ``(1 + cos x)/2`` likewise with Σ = β_r + β_u; the smaller one gives x.  NaN where there is no root.
+    """
+    a, b, _ = rz_bilinear(r, u)
+    rho = float(np.hypot(a, b))
+    base = float(np.arctan2(b, a))
+    phi = np.arctan2(np.hypot(m[..., 0], m[..., 1]), m[..., 2])
+    if rho < 1e-12:
+        return np.full(phi.shape + (2,), np.nan)
+    br, bu = np.arctan2(np.hypot(r[0], r[1]), r[2]), np.arctan2(np.hypot(u[0], u[1]), u[2])
+    dm, sm = br - bu, br + bu
+    lo = np.sin((phi + dm) / 2) * np.sin((phi - dm) / 2) / rho  # (1 − cos x) / 2
+    hi = np.sin((sm + phi) / 2) * np.sin((sm - phi) / 2) / rho  # (1 + cos x) / 2
+    ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
+    x = np.where(lo <= hi, 2 * np.arcsin(np.sqrt(np.clip(lo, 0.0, 1.0))),
+                 np.pi - 2 * np.arcsin(np.sqrt(np.clip(hi, 0.0, 1.0))))
+    out = np.stack([base + x, base - x], axis=-1)
+    return np.where(ok[..., None], out, np.nan)
 
 
 def rz_bilinear(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -46,22 +77,35 @@ def rotation3(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     Returns
     -------
     q : (..., 2, 3) with NaN rows where there is no solution
-    singular : (..., 2) bool — axes a and c aligned: only qa ± qc is determined (qa is set to 0)
+    singular : (..., 2) bool — axes a and c aligned within AXES_ALIGNED_TOL: only qa ± qc is determined (a
+        continuum).  The row is the exact solution there; qa is set to 0 only where the axes are aligned
+        within ALIGNED_EXACT (then any qa with the same qa ± qc reproduces M as well)
     sign : (..., 2) — +1 where qa + qc is the determined combination at the singularity, −1 for qa − qc
     """
     r, u = Ra[2, :], Rb[:, 2]  # Raᵀ e_z and Rb e_z
-    a, b, g = rz_bilinear(r, u)
-    qb = solve_trig(a, b, M[..., 2, 2] - g)  # (..., 2)
+    qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2)
     Rzb = _rz3(qb)  # (..., 2, 3, 3)
     v = np.einsum("ij,...jk,k->...i", Ra, Rzb, u)  # Ra Rz(qb) u, (..., 2, 3)
     m = np.broadcast_to(M[..., None, :, 2], v.shape)
-    singular = np.hypot(v[..., 0], v[..., 1]) < 1e-9
-    qa = np.where(singular, 0.0, angle_about_z(v, m))
+    vxy = np.hypot(v[..., 0], v[..., 1])
+    singular = vxy < AXES_ALIGNED_TOL  # reported as the continuum; qa = 0 only where that changes nothing
+    qa = np.where(vxy < ALIGNED_EXACT, 0.0, angle_about_z(v, m))
     W = _rz3(qa) @ Ra @ Rzb @ Rb  # (..., 2, 3, 3)
     N = np.swapaxes(W, -1, -2) @ M[..., None, :, :]
     qc = np.arctan2(N[..., 1, 0], N[..., 0, 0])
     sign = np.where(v[..., 2] >= 0, 1.0, -1.0)
+    exact = vxy < ALIGNED_EXACT
+    qa0, qc = split_aligned(exact, sign, qc)
+    qa = np.where(exact, qa0, qa)
     return np.stack([qa, qb, qc], axis=-1), singular & np.isfinite(qb), sign
+
+
+def split_aligned(exact: np.ndarray, sign: np.ndarray, qc: np.ndarray):
+    """The representative of an aligned-axes continuum computed with qa = 0 (so qc carries the determined
+    qa ± qc), moved to the middle of the family: qa = ±w/2, qc = w/2 with w = qc wrapped into (−π, π] (both
+    within ±π/2, so inside usual wrist limits).  Returns (qa, qc); unchanged where ``exact`` is False."""
+    w = np.pi - np.mod(np.pi - qc, 2 * np.pi)
+    return np.where(exact, sign * w / 2, 0.0), np.where(exact, w / 2, qc)
 
 
 def _rz3(t: np.ndarray) -> np.ndarray:
