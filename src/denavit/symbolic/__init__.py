@@ -37,7 +37,7 @@ from ._propagation import (
 )
 from ._singularities import SingularCondition, SingularityAnalysis, SingularSolution, singularity_analysis
 from ._simplify import POLICIES, shorthand, shorthand_matrix, simplify_expr, simplify_matrix
-from ._symbols import JointSymbols, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
+from ._symbols import JointSymbols, exact_or_float, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
 
 __all__ = [
     "analytic_jacobian_sym",
@@ -86,6 +86,7 @@ __all__ = [
     "JointSymbols",
     "joint_symbols",
     "matrix_from_floats",
+    "exact_or_float",
     "parameter_symbols",
     "row_expressions",
 ]

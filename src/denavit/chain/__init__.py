@@ -1,0 +1,31 @@
+"""The arm as one chain ``C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn`` and its one walker.
+
+The only code that knows DH conventions, where a joint variable enters its row, fixed rows, base and tool,
+and which frame carries each joint's axis.  The numeric and symbolic engines ask it.
+
+>>> import denavit
+>>> from denavit.chain import chain_of, walk, FLOATS
+>>> chain = chain_of(denavit.load_robot("planar2r"))
+>>> chain.axis_frame, chain.revolute
+((0, 1), (True, True))
+>>> x, y, z, p = walk(chain, [0.0, 0.0], FLOATS)
+"""
+
+from ._chain import ROW_ORDER, Chain, Row, chain_of, dh_transform, joint_motion
+from ._walk import FLOATS, IDENTITY_COLUMNS, Batch, Floats, Symbolic, pack, walk
+
+__all__ = [
+    "Chain",
+    "Row",
+    "chain_of",
+    "joint_motion",
+    "dh_transform",
+    "ROW_ORDER",
+    "walk",
+    "Floats",
+    "Batch",
+    "Symbolic",
+    "FLOATS",
+    "IDENTITY_COLUMNS",
+    "pack",
+]
