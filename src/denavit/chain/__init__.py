@@ -14,12 +14,23 @@ and which frame carries each joint's axis.  The numeric and symbolic engines ask
 from ._chain import ROW_ORDER, Chain, Row, chain_of, dh_transform, joint_motion
 from ._walk import FLOATS, IDENTITY_COLUMNS, Batch, Floats, Symbolic, pack, walk
 
+
+
+def __getattr__(name: str):
+    if name == "dh_matrix_sym":  # sympy is imported on first use, not with the package
+        from ._symbolic import dh_matrix_sym
+
+        return dh_matrix_sym
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = [
     "Chain",
     "Row",
     "chain_of",
     "joint_motion",
     "dh_transform",
+    "dh_matrix_sym",
     "ROW_ORDER",
     "walk",
     "Floats",

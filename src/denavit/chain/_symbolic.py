@@ -12,7 +12,6 @@ import sympy as sp
 
 from .. import _expr
 from ..model import Convention, DHLink
-from ..symbolic import exact_or_float, parameter_symbols
 
 __all__ = ["dh_matrix_sym", "row_constants_sym", "constants_sym"]
 
@@ -31,6 +30,8 @@ def dh_matrix_sym(convention: Convention, a, alpha, d, theta) -> sp.ImmutableMat
 
 
 def _field(link: DHLink, field: str, syms: dict[str, sp.Symbol]) -> sp.Expr:
+    from ..symbolic import exact_or_float  # (denavit.symbolic imports this module: names taken on use)
+
     text = dict(link.symbols).get(field)
     if text is None:
         return exact_or_float(getattr(link, field))
@@ -39,6 +40,8 @@ def _field(link: DHLink, field: str, syms: dict[str, sp.Symbol]) -> sp.Expr:
 
 def row_constants_sym(chain, numeric: bool) -> tuple[dict, ...]:
     """Each row's constant (a, alpha, d, theta) as sympy (see module notes)."""
+    from ..symbolic import parameter_symbols
+
     syms = parameter_symbols(chain)  # uses only .parameters
     values = {syms[k]: sp.Rational(repr(v)) for k, v in chain.parameters}
     out = []

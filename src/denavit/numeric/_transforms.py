@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Convention
+from ..chain import dh_transform  # the DH row matrix lives with the chain; re-exported here
 
 __all__ = [
     "dh_transform",
@@ -20,29 +20,6 @@ __all__ = [
     "rotation_from_rpy",
     "rotation_from_zyz",
 ]
-
-
-def dh_transform(convention: Convention, theta, d, a, alpha) -> np.ndarray:
-    """One DH link transform A_i, shape (..., 4, 4) broadcast over the inputs.
-
-    Notes
-    -----
-    standard: :math:`A_i = R_z(\\theta_i) T_z(d_i) T_x(a_i) R_x(\\alpha_i)` (Spong 2nd ed. eq. 3.10);
-    modified: :math:`A_i = R_x(\\alpha_{i-1}) T_x(a_{i-1}) R_z(\\theta_i) T_z(d_i)` (Craig 3rd ed. eq. 3.6).
-    """
-    theta, d, a, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (theta, d, a, alpha)))
-    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    A = np.zeros(theta.shape + (4, 4))
-    A[..., 3, 3] = 1.0
-    if Convention(convention) is Convention.STANDARD:
-        A[..., 0, :] = np.stack([ct, -st * ca, st * sa, a * ct], axis=-1)
-        A[..., 1, :] = np.stack([st, ct * ca, -ct * sa, a * st], axis=-1)
-        A[..., 2, 1], A[..., 2, 2], A[..., 2, 3] = sa, ca, d
-    else:
-        A[..., 0, :] = np.stack([ct, -st, np.zeros_like(ct), a], axis=-1)
-        A[..., 1, :] = np.stack([st * ca, ct * ca, -sa, -sa * d], axis=-1)
-        A[..., 2, :] = np.stack([st * sa, ct * sa, ca, ca * d], axis=-1)
-    return A
 
 
 def inverse_transform(T: np.ndarray) -> np.ndarray:
