@@ -6,8 +6,8 @@ from functools import lru_cache
 
 import sympy as sp
 
-from .. import _expr
-from ..model import DHLink, DHRobot, JointType
+from ..chain import chain_of, joint_motion
+from ..model import DHRobot
 
 __all__ = ["JointSymbols", "joint_symbols", "parameter_symbols", "row_expressions", "matrix_from_floats", "exact_or_float"]
 
@@ -52,34 +52,19 @@ def exact_or_float(x: float) -> sp.Expr:
     return sp.Float(x)
 
 
-def _field(link: DHLink, field: str, syms: dict[str, sp.Symbol]) -> sp.Expr:
-    text = dict(link.symbols).get(field)
-    if text is None:
-        return exact_or_float(getattr(link, field))
-    return _expr.to_sympy(_expr.parse(text), syms)
-
-
 def row_expressions(robot: DHRobot, numeric: bool = False) -> list[dict[str, sp.Expr]]:
     """Each row's (a, alpha, d, theta) as sympy, the joint variable included (qk added to θ or d).
 
-    With ``numeric=True`` parameters are replaced by their values (exact rationals).
+    Parameters the robot file named stay symbols; with ``numeric=True`` they are replaced by their values
+    (exact rationals).  The rows and the joint rule come from the chain (:mod:`denavit.chain`).
     """
-    syms = parameter_symbols(robot)
+    chain = chain_of(robot)
     q = joint_symbols(robot.dof).q
-    values = {s: sp.Rational(repr(v)) for s, v in zip(syms.values(), robot.parameter_values.values())}
     rows = []
-    k = 0
-    for link in robot.links:
-        row = {f: _field(link, f, syms) for f in ("a", "alpha", "d", "theta")}
-        if link.joint is JointType.REVOLUTE:
-            row["theta"] = q[k] + row["theta"]
-            k += 1
-        elif link.joint is JointType.PRISMATIC:
-            row["d"] = q[k] + row["d"]
-            k += 1
-        if numeric:
-            row = {f: e.subs(values) for f, e in row.items()}
-        rows.append(row)
+    for row, const in zip(chain.rows, chain.rows_sym(numeric)):
+        r = dict(const)
+        r["theta"], r["d"] = joint_motion(row, q, const["theta"], const["d"])
+        rows.append(r)
     return rows
 
 
