@@ -10,6 +10,7 @@ are free; the test reads that text independently and checks the determined part)
 from __future__ import annotations
 
 import re
+import zlib
 
 import numpy as np
 import pytest
@@ -57,10 +58,8 @@ def _free_parts(text):
             terms = re.findall(r"([+-]?)\s*q(\d+)", head)
             sums.append({int(k) - 1: (-1.0 if s == "-" else 1.0) for s, k in terms})
             excluded.update(named)
-        else:  # "qk free", "qa and qb + qc coupled": those joints are not compared
+        else:  # "qk free (…; qa, qb follow)", "qa and qb + qc coupled": those joints are not compared
             excluded.update(named)
-            if "wrist follows" in part:
-                excluded.update(range(named[0], 99))
     return excluded, sums
 
 
@@ -213,3 +212,100 @@ def test_five_parallel_axes_are_refused_with_the_reason():
     robot = DHRobot(name="p5", links=tuple(DHLink(a=0.3, alpha=0.0) for _ in range(5)))
     with pytest.raises(UnsupportedRobotError, match=r"rank 3.*solve_ik"):
         analytic_ik(robot, forward_kinematics(robot, np.full(5, 0.2)))
+
+
+# --------------------------------------------------------------------------------------------------------------
+# item 6: IKFast methodology over every catalogue arm the analytic solver accepts
+
+DEGENERATE = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-4, -1e-4, 1e-8, -1e-8, 1e-12, -1e-12)
+
+
+def _accepted():
+    out = []
+    for name in denavit.catalogue_names():
+        try:
+            denavit.numeric.ik_structure(denavit.load_robot(name))
+        except UnsupportedRobotError:
+            continue
+        out.append(name)
+    return out
+
+
+def _task_jacobian(robot, q, controlled):
+    """The rows of J0 the arm controls (square for every accepted arm), from the Jacobian module."""
+    J = denavit.geometric_jacobian(robot, q)
+    z = np.array(robot.base)[:3, 2]
+    plane = np.linalg.svd(np.eye(3) - np.outer(z, z))[0][:, :2].T  # two directions normal to the base z axis
+    if controlled == "position" and robot.dof == 2:  # a planar arm: the rows in its plane
+        return plane @ J[..., :3, :]
+    if controlled == "position+heading" and robot.dof == 3:
+        return np.concatenate([plane @ J[..., :3, :], np.einsum("i,...ij->...j", z, J[..., 3:, :])[..., None, :]], -2)
+    if controlled == "position":
+        return J[..., :3, :]
+    if controlled == "orientation":
+        return J[..., 3:, :]
+    if controlled == "position+heading":
+        return np.concatenate([J[..., :3, :], np.einsum("i,...ij->...j", z, J[..., 3:, :])[..., None, :]], -2)
+    return J
+
+
+def _inside(robot, Q):
+    lim = robot.q_limits
+    return np.all((Q >= lim[:, 0]) & (Q <= lim[:, 1]), axis=-1)
+
+
+def _uniform(robot, rng, k):
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    return rng.uniform(lim[:, 0], lim[:, 1], (k, robot.dof))
+
+
+def _degenerate_configs(robot, rng, k):
+    """Random q with one or two joints at 0, ±π/2, π, ±1e-4, ±1e-8, ±1e-12 (inside the limits)."""
+    Q = _uniform(robot, rng, k)
+    for row in Q:
+        for j in rng.choice(robot.dof, size=min(2, robot.dof), replace=False):
+            row[j] = rng.choice(DEGENERATE)
+    return Q[_inside(robot, Q)]
+
+
+def _near_singular_configs(robot, rng, controlled, k):
+    """Points of the singular set (det of the controlled rows of J = 0, found by bisection along random
+    segments) and points 1e-4, 1e-8, 1e-12 from them."""
+    det = lambda Q: np.linalg.det(_task_jacobian(robot, Q, controlled))  # noqa: E731
+    out = []
+    for _ in range(20 * k):
+        if len(out) >= 4 * k:
+            break
+        a, b = _uniform(robot, rng, 2)
+        da, db = det(a), det(b)
+        if not (np.isfinite(da) and np.isfinite(db)) or da * db >= 0:
+            continue
+        for _ in range(60):
+            m = 0.5 * (a + b)
+            if det(m) * da > 0:
+                a = m
+            else:
+                b = m
+        step = rng.normal(size=robot.dof)
+        step /= np.linalg.norm(step)
+        out += [m] + [m + s * 10.0 ** -e * step for e in (4, 8, 12) for s in (1, -1)][: 3]
+    Q = np.array(out).reshape(-1, robot.dof)
+    return Q[_inside(robot, Q)]
+
+
+KNOWN_MISSES = {  # open: the resultant route (Position3) returns q3 roots next to a double root too roughly for
+    # the polish to recover the generating q within 1e-6 (poses 1e-4 … 1e-12 from q3 = 0, the point near axis 2)
+    "spherical-rrp": "near-double q3 roots of the resultant route are polished to a neighbour (issue 18, open)",
+}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=KNOWN_MISSES[n], strict=False))
+                                  if n in KNOWN_MISSES else n for n in _accepted()])
+def test_catalogue_arm_finds_the_generating_q_at_degenerate_and_near_singular_configs(name):
+    robot = denavit.load_robot(name)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    controlled = analytic_ik(robot, forward_kinematics(robot, np.zeros(robot.dof))).controlled
+    k = 12 if CI else 40
+    Q = np.concatenate([_uniform(robot, rng, k), _degenerate_configs(robot, rng, k),
+                        _near_singular_configs(robot, rng, controlled, k // 2)])
+    _check(robot, Q, name)

@@ -30,6 +30,9 @@ POLISH_STEPS = 30
 DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
 POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
+FOLD_SIGMA = 1e-2  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
+FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
+FOLD_STEPS = np.array([1e-1, 1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
 
 
 @dataclass(frozen=True)
@@ -264,7 +267,18 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
                                 np.zeros(batch, dtype=int), plan.kind, _controlled(plan.projector),
                                 np.zeros(batch + (0,), dtype=bool))
     cand, free = plan.solve(Tf)  # (B, K, n)
-    q, ok, pe, re = _verify(robot, plan, Tf, cand)
+    q, ok, pe, re, rough = _verify(robot, plan, Tf, cand)
+    fold = ok & rough & (free == "")
+    if fold.any():  # roots near a double root that needed polishing: look for the partner of the pair
+        extra = _fold_partners(robot, plan, Tf, q, fold)
+        if extra is not None:
+            q2, ok2, pe2, re2, _ = _verify(robot, plan, Tf, extra)
+            # a true partner is a regular root: Newton lands on it to rounding; a seed that crawls towards the
+            # fold itself stops at a residual ~ its distance to the target, which must not pass as a solution
+            ok2 &= (pe2 <= FOLD_RESIDUAL * max(1.0, _reach(robot))) & (re2 <= FOLD_RESIDUAL)
+            q, ok = np.concatenate([q, q2], 1), np.concatenate([ok, ok2], 1)
+            pe, re = np.concatenate([pe, pe2], 1), np.concatenate([re, re2], 1)
+            free = np.concatenate([free, np.full(ok2.shape, "", dtype=object)], 1)
     # keep only the slots some pose uses: the verified candidates first, the rest dropped
     order = np.argsort(~ok, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
     take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
@@ -301,9 +315,38 @@ def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
             fine = np.all(np.isfinite(q), axis=-1) & rough
             e = pose_error(Tk[fine], forward_kinematics(robot, q[fine])) @ plan.projector.T
             pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
+    else:
+        rough = np.zeros_like(ok)
     ok &= np.all(np.isfinite(q), axis=-1)
     ok &= (pe <= VERIFY_TOL * max(1.0, L)) & (re <= VERIFY_TOL)
-    return q, ok, pe, re
+    return q, ok, pe, re, rough
+
+
+def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fold: np.ndarray):
+    """Candidates for the second root of a pair that nearly coincide (a pose within ~FOLD_SIGMA of a
+    singularity, where root finding returns one root for two): from each polished solution whose controlled
+    Jacobian has σ_min < FOLD_SIGMA · σ_max, Newton steps from q ± t v (v: the singular direction, t = FOLD_STEPS).
+    Returns candidates (B, E, n) for :func:`_verify`, or None when no solution is that close to a singularity."""
+    from ._jacobians import geometric_jacobian
+
+    b, k = np.nonzero(fold)
+    J = plan.projector @ geometric_jacobian(robot, q[b, k])
+    n = q.shape[-1]
+    _, sv, Vt = np.linalg.svd(J)
+    near = sv[:, n - 1] < FOLD_SIGMA * sv[:, 0]
+    if not near.any():
+        return None
+    b, k, v = b[near], k[near], Vt[near, n - 1]  # (m,), (m, n)
+    steps = np.concatenate([FOLD_STEPS, -FOLD_STEPS])
+    seeds = q[b, k][:, None] + steps[None, :, None] * v[:, None]  # (m, S, n)
+    m, S = seeds.shape[:2]
+    flat = _polish(robot, seeds.reshape(-1, n), np.repeat(Tf[b], S, axis=0), plan.projector)
+    # per pose: the seeds of all its near-singular solutions, in extra slots
+    per = np.bincount(b, minlength=len(Tf)) * S
+    out = np.full((len(Tf), int(per.max()), n), np.nan)
+    slot = np.arange(m * S) - np.repeat(np.concatenate([[0], np.cumsum(per)[:-1]])[b], S)
+    out[np.repeat(b, S), slot] = flat
+    return out
 
 
 def _reach(robot: DHRobot) -> float:

@@ -263,7 +263,9 @@ class Position3:
             free1 = np.zeros(q1.shape, dtype=bool)
         else:
             free1 = (np.hypot(g[..., 0], g[..., 1]) < 1e-9 * self.L) & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-7 * self.L)
-            q1 = np.where(free1, 0.0, angle_about_z(g, np.broadcast_to(Wb, g.shape)))
+            # the continuum is named within 1e-7 L of axis 1, but the row stays the exact solution off the axis
+            exact = free1 & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-12 * self.L)
+            q1 = np.where(exact, 0.0, angle_about_z(g, np.broadcast_to(Wb, g.shape)))
         q = np.stack([q1, q2, q3], axis=-1).reshape(len(W), -1, 3)
         bad = ~np.all(np.isfinite(q), axis=-1)
         q[bad] = np.nan
@@ -283,7 +285,12 @@ class Position3:
         if self.pr2:
             lin = np.abs(Ak) < FREE_EPS * np.abs(Bk)
             disc = Bk**2 - 4 * Ak * Ck
-            sq = np.sqrt(np.where(disc >= -1e-12 * Bk**2, np.maximum(disc, 0.0), np.nan))
+            # a double root (the point at the turning height of q2) leaves disc ≈ 0 up to the error of Ck, which
+            # carries that of the q3 root (~1e-8 relative): the tolerance scales with A L² too, not with B² alone
+            # (B = 0 there, say); as for the revolute case the candidates are re-checked by FK
+            wk = pick(np.broadcast_to(np.abs(np.moveaxis(w, -1, 0))[:, :, None], A.shape), k)
+            sq = np.sqrt(np.where(disc >= -1e-7 * (Bk**2 + np.abs(Ak) * (self.L**2 + wk)), np.maximum(disc, 0.0),
+                                  np.nan))
             with np.errstate(divide="ignore", invalid="ignore"):
                 quad = np.stack([(-Bk + sq) / (2 * Ak), (-Bk - sq) / (2 * Ak)], axis=-1)
                 line = np.stack([-Ck / Bk, np.full(Ck.shape, np.nan)], axis=-1)
