@@ -358,18 +358,30 @@ def _chain(n: int) -> str:
     return f"name: chain{n}\nconvention: standard\njoints:\n{rows}\n"
 
 
-@pytest.mark.parametrize("argv,name", [
-    (["jacobian", "big.yaml", "--symbolic"], "jacobian"),
-    (["jacobian", "big.yaml"], "jacobian"),
-    (["jacobian", "big.yaml", "--analytic", "rpy"], "jacobian"),
-    (["singularities", "big.yaml"], "singularities"),
-    (["singularities", "big.yaml", "--rows", "vx,vy,vz"], "singularities"),
-    (["fk", "big.yaml", "--symbolic"], "fk"),
+@pytest.mark.parametrize("argv,limit", [
+    (["jacobian", "big.yaml", "--symbolic"], 8),
+    (["jacobian", "big.yaml"], 8),
+    (["jacobian", "big.yaml", "--analytic", "rpy"], 8),
+    (["fk", "big.yaml", "--symbolic"], 8),
+    (["singularities", "big.yaml"], 7),
+    (["singularities", "big.yaml", "--rows", "vx,vy,vz"], 7),
 ])
-@pytest.mark.parametrize("n", [13, 32])
-def test_symbolic_routes_refuse_large_arms(tmp_path, argv, name, n):
+@pytest.mark.parametrize("extra", [1, 4, 24])
+def test_symbolic_routes_refuse_large_arms(tmp_path, argv, limit, extra):
+    from denavit.cli._common import MAX_SYMBOLIC_ANALYSIS_JOINTS, MAX_SYMBOLIC_JOINTS
+
+    assert limit == (MAX_SYMBOLIC_JOINTS if argv[0] in ("fk", "jacobian") else MAX_SYMBOLIC_ANALYSIS_JOINTS)
+    n = limit + extra
     o = run_cli(argv, tmp_path, files={"big.yaml": _chain(n)}, time_limit=5)
-    assert_refused(o, mentions=[f"{n} joints", "12"])
+    assert_refused(o, mentions=[f"{n} joints", f"limited to {limit}"])
+
+
+def test_symbolic_dynamics_refuses_large_arms(tmp_path):
+    rows = "\n".join(f"  - {{a: 0.1, alpha: pi/2, d: 0, theta: q, inertia: {{mass: 1, com: [0, 0, 0], "
+                     f"inertia: [0.01, 0.01, 0.01, 0, 0, 0]}}}}" for _ in range(8))
+    o = run_cli(["dynamics", "d8.yaml", "--symbolic"], tmp_path, time_limit=5,
+                files={"d8.yaml": f"name: d8\nconvention: standard\njoints:\n{rows}\n"})
+    assert_refused(o, mentions=["8 joints", "limited to 7"])
 
 
 def test_numeric_jacobian_of_a_large_arm_is_quick_and_right(tmp_path):

@@ -15,15 +15,19 @@ from ..errors import ParseError
 
 __all__ = ["OneLineParser", "add_common", "finite_float", "nonneg_int", "one_line", "positive_float", "add_force", "add_q", "emit", "load", "joint_values", "refuse_overwrite", "check_output", "output_file",
            "stage_printer", "to_json", "matrix_text", "number_text", "numbers_text", "bounded_int", "bounded_float",
-           "check_values", "require_finite", "require_symbolic_size", "MAX_VALUE", "MAX_SYMBOLIC_JOINTS", "NOISE"]
+           "check_values", "require_finite", "require_symbolic_size", "MAX_VALUE", "MAX_SYMBOLIC_JOINTS",
+           "MAX_SYMBOLIC_ANALYSIS_JOINTS", "NOISE"]
 
 #: Largest magnitude accepted for a value given on the command line (joint values, rates, wrenches, torques,
 #: poses): beyond it products and squares in the algorithms can overflow to inf/nan. Documented in
 #: docs/conventions.md, "Limits".
 MAX_VALUE = 1e9
-#: Joint count above which the symbolic routes (``fk/jacobian --symbolic``, ``singularities``, symbolic
-#: dynamics) are refused: their expressions grow combinatorially and run for minutes (numeric routes are fine).
-MAX_SYMBOLIC_JOINTS = 12
+#: Joint counts above which the symbolic routes are refused: their expressions grow combinatorially (a general
+#: 8-joint chain takes about 40 s through ``jacobian --symbolic``, 12 joints many minutes). ``fk`` and
+#: ``jacobian`` symbolic: 8 joints; ``singularities`` (determinant or minors) and ``dynamics --symbolic``: 7
+#: (Panda). Numeric routes take every arm a robot file allows.
+MAX_SYMBOLIC_JOINTS = 8
+MAX_SYMBOLIC_ANALYSIS_JOINTS = 7
 #: Printed numbers smaller than this (relative to the largest of their group, or absolutely when all are small)
 #: are rounding noise and are shown as 0.
 NOISE = 1e-12
@@ -135,12 +139,11 @@ def require_finite(what: str, *arrays) -> None:
                              "too large to compute with")
 
 
-def require_symbolic_size(robot, what: str) -> None:
-    """ParseError for a symbolic route on an arm with more than :data:`MAX_SYMBOLIC_JOINTS` joints."""
-    if robot.dof > MAX_SYMBOLIC_JOINTS:
-        raise ParseError(f"{what}: {robot.name} has {robot.dof} joints; symbolic results are limited to "
-                         f"{MAX_SYMBOLIC_JOINTS} joints (their expressions grow too fast); use the numeric route "
-                         "with -q")
+def require_symbolic_size(robot, what: str, limit: int = MAX_SYMBOLIC_JOINTS) -> None:
+    """ParseError for a symbolic route on an arm with more than ``limit`` joints (:data:`MAX_SYMBOLIC_JOINTS`)."""
+    if robot.dof > limit:
+        raise ParseError(f"{what}: {robot.name} has {robot.dof} joints; this symbolic result is limited to "
+                         f"{limit} joints (its expressions grow too fast to finish); use the numeric route with -q")
 
 
 def add_common(p: argparse.ArgumentParser, robot: bool = True) -> None:

@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from ..errors import MissingDependencyError, ParseError
-from ._common import (add_common, add_force, add_q, check_output, check_values, joint_values, load, matrix_text,
+from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_force, add_q, check_output, check_values, joint_values, load, matrix_text,
                       numbers_text, output_file, require_finite, require_symbolic_size)
 
 #: simulate: most output samples (--duration / --dt) and most evaluations of the dynamics in one run (about
@@ -79,7 +79,7 @@ def cmd_dynamics(args: argparse.Namespace):
         _rates(args, robot, args.qd, "qd")
         _rates(args, robot, args.qdd, "qdd")
     if args.symbolic:
-        require_symbolic_size(robot, "dynamics --symbolic")
+        require_symbolic_size(robot, "dynamics --symbolic", MAX_SYMBOLIC_ANALYSIS_JOINTS)
         sdata, slines = _symbolic(robot, args)
         data.update(sdata)
         lines += slines

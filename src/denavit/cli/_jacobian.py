@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from ..errors import ParseError
-from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, number_text, numbers_text,
+from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_q, check_values, joint_values, load, matrix_text, number_text, numbers_text,
                       require_finite,
                       require_symbolic_size, stage_printer)
 
@@ -340,7 +340,7 @@ def cmd_singularities(args: argparse.Namespace):
     rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
     if args.q is not None:
         joint_values(args, robot, args.q)  # a bad -q fails now, not after minutes of symbolic work
-    require_symbolic_size(robot, "singularities")
+    require_symbolic_size(robot, "singularities", MAX_SYMBOLIC_ANALYSIS_JOINTS)
     res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
     fmt = _formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)
