@@ -21,8 +21,9 @@ from typing import Callable
 import sympy as sp
 
 from .. import _expr
+from ..chain import chain_of
 from ..errors import ModelError
-from ..model import Convention, DHRobot, JointType, inertial_rows
+from ..model import DHRobot, JointType, inertial_rows
 from ._kinematics import link_matrices_sym, link_transforms_sym
 from ._dynamics_trig import collect_trig, fourier_form
 from ._simplify import POLICIES, shorthand, simplify_expr
@@ -129,9 +130,8 @@ def gravity_base(robot: DHRobot) -> sp.ImmutableMatrix:
 
 
 def joint_axes_sym(robot: DHRobot, T: tuple[sp.ImmutableMatrix, ...]) -> list[tuple[sp.Matrix, sp.Matrix]]:
-    """(z, o) of each joint in {0}: standard z_{i-1}, o_{i-1}; modified z_i, o_i."""
-    shift = 0 if robot.convention is Convention.STANDARD else 1
-    return [(T[r + shift][:3, 2], T[r + shift][:3, 3]) for r in robot.joint_rows]
+    """(z, o) of each joint in {0}: standard z_{i-1}, o_{i-1}; modified z_i, o_i (the chain's axis frames)."""
+    return [(T[f][:3, 2], T[f][:3, 3]) for f in chain_of(robot).axis_frame]
 
 
 def friction_vector(robot: DHRobot, qd, numeric: bool = False) -> sp.ImmutableMatrix:
@@ -215,12 +215,13 @@ def lagrangian_dynamics(robot: DHRobot, simplify: str = "trig", numeric: bool = 
 
 
 class _Chain:
-    """Relative transforms T_a_b = A_{a+1} ⋯ A_b between DH frames, built once and simplified."""
+    """Relative transforms T_a_b = A_{a+1} ⋯ A_b between DH frames, built once (rows and axis frames from
+    :mod:`denavit.chain`)."""
 
     def __init__(self, robot: DHRobot, numeric: bool) -> None:
         self.A = link_matrices_sym(robot, numeric)
         self.cache: dict[tuple[int, int], sp.ImmutableMatrix] = {}
-        self.axis_frame = [r + (0 if robot.convention is Convention.STANDARD else 1) for r in robot.joint_rows]
+        self.axis_frame = list(chain_of(robot).axis_frame)
 
     def __call__(self, a: int, b: int) -> sp.ImmutableMatrix:
         if (a, b) not in self.cache:
