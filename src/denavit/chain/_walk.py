@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from ..model import Convention
 from ._chain import Chain, joint_motion
 
 __all__ = ["walk", "Floats", "Batch", "Symbolic", "FLOATS", "pack", "IDENTITY_COLUMNS"]
@@ -177,6 +178,19 @@ class Symbolic:
         r = self.rows[i]
         theta, d = joint_motion(chain.rows[i], q, r["theta"], r["d"])
         return self.dh(chain.convention, r["a"], r["alpha"], d, theta)
+
+    def split(self, chain: Chain, i: int, q):
+        """(head, tail) with A_i = head · tail and the joint's motion in the head, tail constant:
+        standard Rz(θ) Tz(d) · Tx(a) Rx(α); modified the whole row · I.  The head ends in the frame where
+        the joint's axis is z: standard {i-1} moved by the joint, modified {i}."""
+        r = self.rows[i]
+        theta, d = joint_motion(chain.rows[i], q, r["theta"], r["d"])
+        if chain.standard:
+            return (self.dh(chain.convention, 0, 0, d, theta),
+                    self.dh(Convention.MODIFIED, r["a"], r["alpha"], 0, 0))  # Tx(a) Rx(α) = Rx(α) Tx(a)
+        import sympy as sp
+
+        return self.dh(chain.convention, r["a"], r["alpha"], d, theta), sp.ImmutableMatrix(sp.eye(4))
 
     def row(self, chain: Chain, pose, i: int, q):
         T = pose * self.matrix(chain, i, q)

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..model import Convention, DHRobot, JointType
+from ..chain import Symbolic, chain_of
+from ..model import DHRobot, JointType
 from ._dynamics import (
     DynamicsTerms,
     Progress,
@@ -32,8 +33,7 @@ from ._dynamics import (
     make_simplifier,
     terms_from_tau,
 )
-from ._kinematics import dh_matrix_sym
-from ._symbols import joint_symbols, row_expressions
+from ._symbols import joint_symbols
 
 __all__ = ["NewtonEulerSteps", "newton_euler_dynamics"]
 
@@ -62,28 +62,22 @@ class NewtonEulerSteps:
     terms: DynamicsTerms
 
 
-def _rz_tz(theta, d) -> sp.Matrix:
-    return sp.Matrix(dh_matrix_sym(Convention.STANDARD, 0, 0, d, theta))
-
-
-def _tx_rx(a, alpha) -> sp.Matrix:
-    return sp.Matrix(dh_matrix_sym(Convention.MODIFIED, a, alpha, 0, 0))
-
-
 def _body_frames(robot: DHRobot, numeric: bool):
-    """T_{B_{k−1},B_k} for every joint, and each row's frame {r} relative to its body frame."""
-    rows = row_expressions(robot, numeric=numeric)
-    A = [sp.Matrix(dh_matrix_sym(robot.convention, r["a"], r["alpha"], r["d"], r["theta"])) for r in rows]
-    std = robot.convention is Convention.STANDARD
+    """T_{B_{k−1},B_k} for every joint, and each row's frame {r} relative to its body frame.
+
+    The body frame B_k ends the head of joint k's row (:meth:`denavit.chain.Symbolic.split`)."""
+    chain = chain_of(robot)
+    rows = Symbolic(chain, numeric)
+    q = joint_symbols(robot.dof).q
     steps, in_body = [], {}
     current = sp.eye(4)  # pose of the frame reached so far, relative to the last body frame
-    jr = set(robot.joint_rows)
-    for i, r in enumerate(rows):
-        if i in jr:
-            steps.append(current * (_rz_tz(r["theta"], r["d"]) if std else A[i]))
-            current = _tx_rx(r["a"], r["alpha"]) if std else sp.eye(4)
+    for i, row in enumerate(chain.rows):
+        if row.joint >= 0:
+            head, tail = rows.split(chain, i, q)
+            steps.append(current * sp.Matrix(head))
+            current = sp.Matrix(tail)
         else:
-            current = current * A[i]
+            current = current * sp.Matrix(rows.matrix(chain, i, q))
         in_body[i] = current  # frame {i} relative to the body frame of its joint
     return steps, in_body
 
