@@ -28,7 +28,9 @@ __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure"]
 VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
 POLISH_STEPS = 30
 DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
-POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
+MERGE_RADIUS = 1e-5  # up to this distance two solutions are also the same when their midpoint reproduces the pose
+# (copies of one root found to ~√ε; two exact solutions of a pose 1e-4 from a singularity lie ~1e-4 apart and stay)
+POLISH_ABOVE = 1e-14  # residual [m] under which a closed-form candidate is kept as it is
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
 FOLD_SIGMA = 1e-2  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
 FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
@@ -145,11 +147,13 @@ def _fold(robot: DHRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return q, inside
 
 
-def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray) -> np.ndarray:
+def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray, T: np.ndarray | None = None,
+            P: np.ndarray | None = None) -> np.ndarray:
     """Drop later copies of the same solution (angles compared modulo 2π), per pose; q (B, K, n).
 
     A slot is dropped when an earlier kept slot lies within DUPLICATE_TOL of it; only the K(K−1)/2 pairs
-    i < j are compared."""
+    i < j are compared.  With the targets T and projector P, a pair up to MERGE_RADIUS apart is also one solution
+    when the midpoint reproduces the target within VERIFY_TOL (merged by FK, not by angle alone)."""
     B, K, _ = q.shape
     if K < 2:
         return keep
@@ -160,7 +164,23 @@ def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray) -> np.ndarray:
     same = np.nan_to_num(d.max(axis=-1), nan=np.inf) < DUPLICATE_TOL  # (B, P)
     hit = np.zeros((B, K, K), dtype=bool)
     hit[:, j, i] = same & keep[:, i]
-    return keep & ~hit.any(axis=-1)
+    keep = keep & ~hit.any(axis=-1)
+    # next to a singularity one solution comes out as several copies a little farther apart (roots that merge
+    # are found to ~√ε): pairs within MERGE_RADIUS whose midpoint reproduces the pose too are one solution
+    dmax = np.nan_to_num(d.max(axis=-1), nan=np.inf)
+    close = (dmax >= DUPLICATE_TOL) & (dmax < MERGE_RADIUS) & keep[:, i] & keep[:, j]
+    if close.any() and T is not None:
+        b, p = np.nonzero(close)
+        qi, qj = q[b, i[p]], q[b, j[p]]
+        step = np.where(rev, wrap_angle(qj - qi), qj - qi)
+        mid = qi + 0.5 * step
+        e = pose_error(T[b], forward_kinematics(robot, mid)) @ P.T
+        L = max(1.0, _reach(robot))
+        one = (np.linalg.norm(e[:, :3], axis=-1) <= VERIFY_TOL * L) & (np.linalg.norm(e[:, 3:], axis=-1) <= VERIFY_TOL)
+        for bb, jj, ii in zip(b[one], j[p[one]], i[p[one]]):  # in slot order: a later copy goes, once
+            if keep[bb, ii]:
+                keep[bb, jj] = False
+    return keep
 
 
 def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> AnalyticIKResult:
@@ -284,7 +304,7 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
     take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
     q, ok, free, pe, re = take(q), take(ok), take(free), take(pe), take(re)
     q, inside = _fold(robot, np.where(ok[..., None], q, 0.0))
-    ok = _dedupe(robot, np.where(ok[..., None], q, np.nan), ok)
+    ok = _dedupe(robot, np.where(ok[..., None], q, np.nan), ok, Tf, plan.projector)
     outside = ok & ~inside
     ok &= inside
     labels = _labels(robot, plan, q, Tf)

@@ -40,7 +40,7 @@ import numpy as np
 from ._ik_chain import Chain, joint_motion
 from ._transforms import inverse_transform
 
-__all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "solve_general", "MAX_SOLUTIONS"]
+__all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "rank_formulations", "solve_general", "MAX_SOLUTIONS"]
 
 MAX_SOLUTIONS = 16
 _ANG = 2 * np.pi * np.arange(3) / 3
@@ -346,19 +346,26 @@ def choose_formulation(chain: Chain, rng: np.random.Generator, tries: int = 4) -
     distance between a generating configuration and its nearest candidate (before any polishing).  Special
     arms make some formulations singular and others ill-conditioned (every root double, as when the joint
     playing θ3 cannot tell a wrist flip); the lowest score wins, and only a score under 1e-6 counts."""
+    ranked = rank_formulations(chain, rng, tries)
+    return ranked[0] if ranked else None
+
+
+def rank_formulations(chain: Chain, rng: np.random.Generator, tries: int = 4) -> list[Formulation]:
+    """Every formulation that solves the ``tries`` test targets (score under 1e-6, see
+    :func:`choose_formulation`), best first.  The later ones are the fall-backs for targets where the first one's
+    pencil is singular: on special arms (axes 2-4 parallel, say) a formulation can be regular for most poses
+    and singular for a few, which the test targets need not show."""
     from ._ik_chain import chain_fk
 
     q = rng.uniform(-np.pi, np.pi, (tries, 6))
     G = loop_of(chain, chain_fk(chain, q))
-    best, best_score = None, 1e-6
+    scored = []
     for form in formulations():
         cand, usable = solve_general(G, form, np.random.default_rng(11))
         if not usable.all():
             continue
         d = np.abs(np.angle(np.exp(1j * (cand - q[:, None])))).max(axis=-1)
         score = float(np.max(np.min(np.where(np.isfinite(d), d, np.inf), axis=1)))
-        if score < best_score:
-            best, best_score = form, score
-        if score < 1e-12:
-            break
-    return best
+        if score < 1e-6:
+            scored.append((score, len(scored), form))
+    return [f for _, _, f in sorted(scored)]

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import UnsupportedRobotError
 from ..model import DHRobot
 from ._ik_closed import closed_position, wrist_angles
-from ._ik_general import choose_formulation, loop_of, solve_general
+from ._ik_general import loop_of, rank_formulations, solve_general
 from ._ik_chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
 from ._ik_subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
                               trig_coefficients)
@@ -428,15 +428,30 @@ def _generic_rank(robot: DHRobot, rng) -> int:
 
 
 def _general_plan(chain: Chain, rng):
-    """The eigenvalue solver of :mod:`._ik_general` for a 6R chain, or None if every formulation degenerates."""
-    form = choose_formulation(chain, rng)
-    if form is None:
+    """The eigenvalue solver of :mod:`._ik_general` for a 6R chain, or None if every formulation degenerates.
+
+    Targets where the best formulation's pencil is singular are solved again with the next one (and so on):
+    one formulation chosen on a few random targets can be singular on a few per cent of others."""
+    forms = rank_formulations(chain, rng)
+    if not forms:
         return None
 
     def solve(T: np.ndarray):
-        cand, _ = solve_general(loop_of(chain, T), form)
+        G = loop_of(chain, T)
+        cand, usable = solve_general(G, forms[0])
+        for form in forms[1:]:
+            bad = np.flatnonzero(~usable)
+            if bad.size == 0:
+                break
+            c2, u2 = solve_general(G[bad], form)
+            if c2.shape[1] > cand.shape[1]:
+                cand = np.concatenate([cand, np.full((len(cand), c2.shape[1] - cand.shape[1], 6), np.nan)], 1)
+            cand[bad] = np.nan
+            cand[bad, : c2.shape[1]] = c2
+            usable[bad] = u2
         return cand, np.full(cand.shape[:-1], "", dtype=object)
 
+    form = forms[0]
     return solve, f"eigenvalue ({'reversed, ' if form.reverse else ''}loop from joint {form.shift + 1})"
 
 
