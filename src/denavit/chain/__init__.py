@@ -12,7 +12,7 @@ and which frame carries each joint's axis.  The numeric and symbolic engines ask
 """
 
 from ._chain import ROW_ORDER, Chain, Row, chain_of, dh_transform, joint_motion
-from ._walk import FLOATS, IDENTITY_COLUMNS, Batch, Floats, Symbolic, pack, walk
+from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
 
 
@@ -34,6 +34,8 @@ __all__ = [
     "ROW_ORDER",
     "walk",
     "Floats",
+    "Components",
+    "COMPONENTS",
     "Batch",
     "Symbolic",
     "FLOATS",

@@ -2,6 +2,8 @@
 
 - :class:`Floats`: one configuration, poses as column tuples (x, y, z, p) of 3-tuples of Python floats
   (no numpy call per step: for one pose numpy's call overhead is most of the cost);
+- :class:`Components`: one configuration or a batch, each column a 3-tuple of components (floats or (B,)
+  arrays, mixed: constants stay floats), the layout of the dynamics kernels;
 - :class:`Batch`: a batch of B configurations, columns as (3, B) arrays (every component contiguous);
 - :class:`Symbolic`: sympy, poses as 4×4 ImmutableMatrix, each step ``simplify(T · A_i)``.
 
@@ -19,7 +21,7 @@ import numpy as np
 from ..model import Convention
 from ._chain import Chain, joint_motion
 
-__all__ = ["walk", "Floats", "Batch", "Symbolic", "FLOATS", "pack", "IDENTITY_COLUMNS"]
+__all__ = ["walk", "Floats", "Components", "Batch", "Symbolic", "FLOATS", "COMPONENTS", "pack", "IDENTITY_COLUMNS"]
 
 IDENTITY_COLUMNS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (0.0, 0.0, 0.0))
 
@@ -40,15 +42,19 @@ def walk(chain: Chain, q, algebra, *, frames=False, base: bool = True, first: in
         for i in range(first, stop):
             pose = step(chain, pose, i, q)
         return pose
-    wanted = None if frames is True else set(frames)
-    out = {first: keep(pose)} if wanted is None or first in wanted else {}
+    if frames is True:
+        out = [keep(pose) if keep else pose]
+        for i in range(first, stop):
+            pose = step(chain, pose, i, q)
+            out.append(keep(pose) if keep else pose)
+        return out
+    wanted = set(frames)
+    kept = {first: keep(pose) if keep else pose} if first in wanted else {}
     for i in range(first, stop):
         pose = step(chain, pose, i, q)
-        if wanted is None or i + 1 in wanted:
-            out[i + 1] = keep(pose)
-    if wanted is None:
-        return list(out.values())
-    return [out[f] for f in frames], pose
+        if i + 1 in wanted:
+            kept[i + 1] = keep(pose) if keep else pose
+    return [kept[f] for f in frames], pose
 
 
 class Floats:
@@ -58,9 +64,7 @@ class Floats:
     def start(chain: Chain, base: bool):
         return chain.base_columns if base else IDENTITY_COLUMNS
 
-    @staticmethod
-    def keep(pose):
-        return pose
+    keep = None  # poses are never changed in place
 
     @staticmethod
     def row(chain: Chain, pose, i: int, q):
@@ -92,6 +96,57 @@ class Floats:
 
 
 FLOATS = Floats()
+
+
+class Components:
+    """Floats or a batch, one code: ``q`` one value per joint, each a float or a contiguous (B,) array; a
+    pose is (x, y, z, p), each a 3-tuple of components that are floats or (B,) arrays.
+
+    A component stays a float until a joint motion reaches it (the base's columns, the z column through
+    turns about z), which spares the dynamics kernels that consume these frames work on constants.
+    """
+
+    @staticmethod
+    def start(chain: Chain, base: bool):
+        return chain.base_columns if base else IDENTITY_COLUMNS
+
+    keep = None  # components are never changed in place
+
+    @staticmethod
+    def row(chain: Chain, pose, i: int, q):
+        row = chain.rows[i]
+        theta, d = joint_motion(row, q, row.theta, row.d)
+        x, y, z, p = pose
+        if isinstance(theta, float):
+            c, s = cos(theta), sin(theta)
+        else:
+            c, s = np.cos(theta), np.sin(theta)
+        if not chain.standard:  # Rx(α) Tx(a) first
+            if row.rot_x:
+                y, z = _axpy(row.ca, y, _scale(row.sa, z)), _axpy(row.ca, z, _scale(-row.sa, y))
+            if row.a != 0.0:
+                p = _axpy(row.a, x, p)
+        x, y = _axpy(c, x, _scale(s, y)), _axpy(c, y, _scale(-s, x))
+        if not isinstance(d, float) or d != 0.0:
+            p = _axpy(d, z, p)
+        if chain.standard:  # then Tx(a) Rx(α)
+            if row.a != 0.0:
+                p = _axpy(row.a, x, p)
+            if row.rot_x:
+                y, z = _axpy(row.ca, y, _scale(row.sa, z)), _axpy(row.ca, z, _scale(-row.sa, y))
+        return x, y, z, p
+
+
+def _scale(s, a):
+    return (s * a[0], s * a[1], s * a[2])
+
+
+def _axpy(s, a, b):
+    """s·a + b on component 3-tuples."""
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+COMPONENTS = Components()
 
 
 class Batch:
@@ -160,9 +215,7 @@ class Symbolic:
         self.dh = dh_matrix_sym
         self.simplify = simplify
 
-    @staticmethod
-    def keep(pose):
-        return pose
+    keep = None
 
     def start(self, chain: Chain, base: bool):
         import sympy as sp

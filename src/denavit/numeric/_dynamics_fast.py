@@ -15,29 +15,17 @@ J. J. Craig, *Introduction to Robotics*, 3rd ed., sec. 6.5 (iterative Newton–E
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from ..model import Convention, DHRobot, JointType
+from ..chain import COMPONENTS, FLOATS, Chain, chain_of, walk
+from ..model import DHRobot
 
 __all__ = ["rnea_kernel", "mass_matrix_kernel", "joint_columns", "to_array"]
 
 ZERO3 = (0.0, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class _Row:
-    joint: int  # joint index (0-based) or -1 for a fixed row
-    prismatic: bool
-    theta: float
-    d: float
-    a: float
-    ca: float  # cos α, sin α (1, 0 when α = 0)
-    sa: float
-    rot_x: bool
 
 
 @dataclass(frozen=True)
@@ -52,9 +40,7 @@ class _Piece:
 class _Plan:
     """Constants of a robot needed by the kernels (derived once per distinct robot value)."""
 
-    std: bool
-    rows: tuple[_Row, ...]
-    base: tuple[tuple[float, float, float], ...]  # columns x, y, z, p of the base pose
+    chain: Chain  # rows, base, joint rule
     axis_frame: tuple[int, ...]  # per joint: index (0 = base, r + 1 = after row r) of the frame holding its axis
     revolute: tuple[bool, ...]
     pieces: tuple[tuple[_Piece, ...], ...]  # per body (joint)
@@ -64,27 +50,19 @@ class _Plan:
 @lru_cache(maxsize=64)
 def plan(robot: DHRobot) -> _Plan:
     """The kernel constants of ``robot`` (a pure function of the robot value, hence cached)."""
-    rows, body, k = [], -1, 0
+    body = -1
     pieces: list[list[_Piece]] = [[] for _ in range(robot.dof)]
     for r, link in enumerate(robot.links):
-        is_joint = link.is_joint
-        body += is_joint
-        rows.append(_Row(k if is_joint else -1, link.joint is JointType.PRISMATIC, float(link.theta),
-                         float(link.d), float(link.a), math.cos(link.alpha), math.sin(link.alpha),
-                         link.alpha != 0.0))
-        k += is_joint
+        body += link.is_joint
         li = link.inertia
         if li is not None and body >= 0:
             I = tuple(tuple(float(v) for v in row) for row in li.inertia_matrix)
             pieces[body].append(_Piece(r, float(li.mass), tuple(float(c) for c in li.com), I))
-    std = robot.convention is Convention.STANDARD
-    B = robot.base_matrix
+    chain = chain_of(robot)
     return _Plan(
-        std=std,
-        rows=tuple(rows),
-        base=tuple(tuple(float(B[i, j]) for i in range(3)) for j in range(4)),
-        axis_frame=tuple(r if std else r + 1 for r in robot.joint_rows),
-        revolute=tuple(t is JointType.REVOLUTE for t in robot.joint_types),
+        chain=chain,
+        axis_frame=chain.axis_frame,
+        revolute=chain.revolute,
         pieces=tuple(tuple(p) for p in pieces),
         armature=tuple(link.inertia.motor_inertia if link.inertia else 0.0 for link in robot.joints),
     )
@@ -136,35 +114,8 @@ def joint_columns(q: np.ndarray):
 
 
 def frames(pl: _Plan, qcols) -> list[tuple]:
-    """World frames {0} … {N} as (x, y, z, p) column tuples."""
-    x, y, z, p = pl.base
-    out = [(x, y, z, p)]
-    for row in pl.rows:
-        theta, d = row.theta, row.d
-        if row.joint >= 0:
-            if row.prismatic:
-                d = qcols[row.joint] + d
-            else:
-                theta = qcols[row.joint] + theta
-        if isinstance(theta, float):
-            c, s = math.cos(theta), math.sin(theta)
-        else:
-            c, s = np.cos(theta), np.sin(theta)
-        if not pl.std:  # Rx(α) Tx(a) first
-            if row.rot_x:
-                y, z = _axpy(row.ca, y, _scale(row.sa, z)), _axpy(row.ca, z, _scale(-row.sa, y))
-            if row.a != 0.0:
-                p = _axpy(row.a, x, p)
-        x, y = _axpy(c, x, _scale(s, y)), _axpy(c, y, _scale(-s, x))
-        if not isinstance(d, float) or d != 0.0:
-            p = _axpy(d, z, p)
-        if pl.std:  # then Tx(a) Rx(α)
-            if row.a != 0.0:
-                p = _axpy(row.a, x, p)
-            if row.rot_x:
-                y, z = _axpy(row.ca, y, _scale(row.sa, z)), _axpy(row.ca, z, _scale(-row.sa, y))
-        out.append((x, y, z, p))
-    return out
+    """World frames {0} … {N} as (x, y, z, p) column tuples, walked by the chain (:mod:`denavit.chain`)."""
+    return walk(pl.chain, qcols, FLOATS if isinstance(qcols[0], float) else COMPONENTS, frames=True)
 
 
 def _piece_world(piece: _Piece, F):
