@@ -202,3 +202,37 @@ def test_replace_links_keeps_only_the_poses_that_still_fit():
         assert (name in kept) == inside, name
     with pytest.raises(ModelError, match="outside its limits"):
         base.replace(links=tuple(links), poses=(("bad", (0.0, 1.0)),))
+
+
+@pytest.mark.parametrize("name", ["puma560", "panda", "ur5"])
+def test_cli_q_accepts_a_named_pose(capsys, name):
+    """``-q qr`` on the command line means the arm's named pose; FK equals the library at the stored values."""
+    robot = load_robot(name)
+    for pose, q in robot.poses:
+        assert main(["fk", name, "-q", pose, "--json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        np.testing.assert_allclose(data["T"], denavit.forward_kinematics(robot, np.array(q)), atol=1e-12)
+        # --deg changes how numbers are read and shown, not what a pose name means
+        assert main(["fk", name, "-q", pose, "--deg", "--json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        np.testing.assert_allclose(data["T"], denavit.forward_kinematics(robot, np.array(q)), atol=1e-12)
+
+
+def test_cli_unknown_pose_name_lists_the_poses(capsys):
+    code = main(["fk", "puma560", "-q", "qx"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "'qx'" in lines[0] and "qz, qr, qs, qn" in lines[0]
+
+
+def test_cli_report_at_a_named_pose(capsys, tmp_path):
+    robot = load_robot("puma560")
+    path = tmp_path / "r.md"
+    assert main(["report", "puma560", "-q", "qn", "--topics", "fk", "-o", str(path)]) == 0
+    capsys.readouterr()
+    from denavit.io import parse_values
+
+    text = path.read_text()
+    shown = text.split("q = (", 1)[1].split(")", 1)[0]  # the configuration the report states it used
+    np.testing.assert_allclose(parse_values(shown, robot.dof), dict(robot.poses)["qn"], atol=1e-12)

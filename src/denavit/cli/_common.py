@@ -269,13 +269,25 @@ def load(args: argparse.Namespace):
 def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = "q", check_limits: bool = True,
                  rates: bool = False) -> np.ndarray:
     """Parse a joint vector from the command line (degrees with --deg for revolute joints)."""
-    from ..io import parse_values
+    from ..io import parse_values, resolve_pose
     from ..model import JointType
 
     if text is None:
         raise ParseError(f"{what}: missing (give {robot.dof} values)")
-    vals = check_values(parse_values(text, robot.dof, what=what), what)
-    if args.deg:
+    pose = None if rates else resolve_pose(robot, text)
+    if pose is not None:  # a named configuration of the arm (qz, qr, ...): radians/metres as stored
+        vals = pose
+    else:
+        try:
+            vals = check_values(parse_values(text, robot.dof, what=what), what)
+        except ParseError:
+            name = text.strip()
+            if not rates and name.isidentifier() and len(name) <= 40:
+                known = ", ".join(p for p, _ in robot.poses) or "none"
+                raise ParseError(f"{what}: {name!r} is neither {robot.dof} joint values nor a named pose of "
+                                 f"{robot.name} (its poses: {known})") from None
+            raise
+    if args.deg and pose is None:
         revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
         vals = np.where(revolute, np.radians(vals), vals)
     if check_limits and not rates and not getattr(args, "ignore_limits", False):

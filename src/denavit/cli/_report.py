@@ -107,8 +107,10 @@ def cmd_report(args: argparse.Namespace):
             pdf_from_latex("", {})  # raises MissingDependencyError naming the engines looked for
     q = qd = wrench = None
     if args.q is not None:
-        joint_values(args, robot, args.q)  # validates count, syntax and limits
-        q = _parts(args.q)
+        joint_values(args, robot, args.q)  # validates count, syntax and limits (or a named pose: qr, ...)
+        from ..io import resolve_pose
+
+        q = args.q.strip() if resolve_pose(robot, args.q) is not None else _parts(args.q)
     if args.qd is not None:
         joint_values(args, robot, args.qd, what="qd", rates=True)
         qd = _parts(args.qd)
