@@ -30,11 +30,11 @@ POLISH_STEPS = 30
 DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
 MERGE_RADIUS = 1e-5  # up to this distance two solutions are also the same when their midpoint reproduces the pose
 # (copies of one root found to ~√ε; two exact solutions of a pose 1e-4 from a singularity lie ~1e-4 apart and stay)
-POLISH_ABOVE = 1e-14  # residual [m] under which a closed-form candidate is kept as it is
+POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
-FOLD_SIGMA = 1e-2  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
+FOLD_SIGMA = 1e-3  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
 FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
-FOLD_STEPS = np.array([1e-1, 1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
+FOLD_STEPS = np.array([1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
 
 
 @dataclass(frozen=True)
@@ -161,13 +161,13 @@ def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray, T: np.ndarray | Non
     i, j = np.triu_indices(K, 1)
     d = np.abs(q[:, j] - q[:, i])  # (B, P, n)
     d = np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), d)
-    same = np.nan_to_num(d.max(axis=-1), nan=np.inf) < DUPLICATE_TOL  # (B, P)
+    dmax = np.nan_to_num(d.max(axis=-1), nan=np.inf)  # (B, P)
+    same = dmax < DUPLICATE_TOL
     hit = np.zeros((B, K, K), dtype=bool)
     hit[:, j, i] = same & keep[:, i]
     keep = keep & ~hit.any(axis=-1)
     # next to a singularity one solution comes out as several copies a little farther apart (roots that merge
     # are found to ~√ε): pairs within MERGE_RADIUS whose midpoint reproduces the pose too are one solution
-    dmax = np.nan_to_num(d.max(axis=-1), nan=np.inf)
     close = (dmax >= DUPLICATE_TOL) & (dmax < MERGE_RADIUS) & keep[:, i] & keep[:, j]
     if close.any() and T is not None:
         b, p = np.nonzero(close)
@@ -352,11 +352,11 @@ def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fo
     b, k = np.nonzero(fold)
     J = plan.projector @ geometric_jacobian(robot, q[b, k])
     n = q.shape[-1]
-    _, sv, Vt = np.linalg.svd(J)
+    sv = np.linalg.svd(J, compute_uv=False)
     near = sv[:, n - 1] < FOLD_SIGMA * sv[:, 0]
     if not near.any():
         return None
-    b, k, v = b[near], k[near], Vt[near, n - 1]  # (m,), (m, n)
+    b, k, v = b[near], k[near], np.linalg.svd(J[near])[2][:, n - 1]  # (m,), (m, n)
     steps = np.concatenate([FOLD_STEPS, -FOLD_STEPS])
     seeds = q[b, k][:, None] + steps[None, :, None] * v[:, None]  # (m, S, n)
     m, S = seeds.shape[:2]
