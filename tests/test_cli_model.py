@@ -131,3 +131,14 @@ def test_console_script_runs_as_a_process():
     proc = subprocess.run([sys.executable, "-m", "denavit", "fk", "planar2r", "-q", "0"],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
+
+
+def test_fk_text_prints_no_rounding_noise_and_no_negative_zero(capsys):
+    """At qr the Puma's tool points straight up: pitch is -0.0 and some entries are ~1e-17 in floating point.
+    The text shows them as 0 (the JSON keeps the raw numbers)."""
+    import re
+
+    assert main(["fk", "puma560", "-q", "qr"]) == 0
+    out = capsys.readouterr().out
+    assert not re.search(r"(?<![\w.])-0(?![.\d])", out), out
+    assert not re.search(r"e-1[0-9]", out), out

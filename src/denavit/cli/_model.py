@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, check_output, joint_values, load, matrix_text, output_file
+from ._common import add_common, add_q, check_output, joint_values, load, matrix_text, numbers_text, output_file
 
 #: File types ``convert -o`` writes.
 CONVERT_SUFFIXES = (".yaml", ".yml", ".json")
@@ -206,11 +206,11 @@ def cmd_fk(args: argparse.Namespace):
                      "rpy": conv(rpy), "zyz": conv(zyz)})
         if lines:
             lines.append("")
-        lines += [f"{robot.name}: end-effector pose at q = [{', '.join(f'{v:.6g}' for v in (conv(q) if args.deg else q))}]"
+        lines += [f"{robot.name}: end-effector pose at q = [{numbers_text(conv(q) if args.deg else q)}]"
                   f" ({unit})", "T_0_e =", matrix_text(T),
-                  f"position [m]: {', '.join(f'{v:.6g}' for v in T[:3, 3])}",
-                  f"RPY (roll, pitch, yaw) [{unit}]: {', '.join(f'{v:.6g}' for v in conv(rpy))}",
-                  f"ZYZ (phi, theta, psi) [{unit}]: {', '.join(f'{v:.6g}' for v in conv(zyz))}"]
+                  f"position [m]: {numbers_text(T[:3, 3])}",
+                  f"RPY (roll, pitch, yaw) [{unit}]: {numbers_text(conv(rpy))}",
+                  f"ZYZ (phi, theta, psi) [{unit}]: {numbers_text(conv(zyz))}"]
         if args.frames:
             frames = link_transforms(robot, q)
             data["frames"] = frames
