@@ -21,6 +21,7 @@ import numpy as np
 
 from .._validate import as_joint_array
 from ..errors import ShapeError
+from ..chain import chain_of
 from ..model import Convention, DHRobot, Frame, JointType
 from ._kinematics import joint_axes_batch, joint_values_per_row, link_transforms
 from ._transforms import dh_transform, rpy_from_rotation, zyz_from_rotation
@@ -46,10 +47,10 @@ REPRESENTATION_SINGULAR_TOL = 1e-9
 def joint_axes(robot: DHRobot, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Axis direction z and a point o on it for every joint, in world axes, each (..., n, 3).
 
-    Standard DH: joint i moves about/along z_{i-1} through o_{i-1}; modified DH: z_i through o_i.
+    Standard DH: joint i moves about/along z_{i-1} through o_{i-1}; modified DH: z_i through o_i
+    (:attr:`denavit.chain.Chain.axis_frame`).
     """
-    shift = 0 if robot.convention is Convention.STANDARD else 1
-    idx = [r + shift for r in robot.joint_rows]
+    idx = list(chain_of(robot).axis_frame)
     sel = np.take(frames, idx, axis=-3)  # (..., n, 4, 4)
     return sel[..., :3, 2], sel[..., :3, 3]
 

@@ -18,7 +18,8 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from ..model import Convention, DHRobot, Frame, JointType
+from ..chain import chain_of
+from ..model import DHRobot, Frame, JointType
 from ._kinematics import forward_kinematics_sym, link_transforms_sym
 from ._propagation import velocity_propagation_sym
 from sympy.simplify.fu import TR10i
@@ -109,10 +110,9 @@ def geometric_jacobian_sym(robot: DHRobot, frame: Frame | str = Frame.BASE, simp
     Ts = link_transforms_sym(robot, simplify, numeric)  # T_0_0 … T_0_N without base
     T_e = Ts[-1] * matrix_from_floats(robot.tool_matrix)
     p_e = T_e[:3, 3]
-    shift = 0 if robot.convention is Convention.STANDARD else 1
     cols = []
-    for r, jt in zip(robot.joint_rows, robot.joint_types):
-        T = Ts[r + shift]
+    for f, jt in zip(chain_of(robot).axis_frame, robot.joint_types):
+        T = Ts[f]
         z, o = T[:3, 2], T[:3, 3]
         if jt is JointType.REVOLUTE:
             cols.append(sp.Matrix.vstack(z.cross(p_e - o), z))
