@@ -16,7 +16,7 @@ from hypothesis import given, settings
 
 import denavit
 from denavit import Convention, JointType
-from denavit.chain import FLOATS, Batch, Symbolic, chain_of, pack, walk
+from denavit.chain import COMPONENTS, FLOATS, Batch, Symbolic, chain_of, pack, walk
 from denavit.symbolic import joint_symbols
 
 from _random_robots import random_q, random_robot
@@ -78,6 +78,23 @@ def test_float_and_batch_walkers_equal_the_elementary_product(robot):
         assert np.allclose(batch[b], frames, atol=ATOL)
         last = pack([walk(chain, q.tolist(), FLOATS)], None)[0]
         assert np.allclose(last, frames[-1], atol=ATOL)
+
+
+@settings(max_examples=60)
+@given(robots())
+def test_components_walker_equals_the_elementary_product(robot):
+    """Components: floats and (B,) arrays mixed (constants stay floats), one configuration or a batch."""
+    rng = np.random.default_rng(robot.n_rows + 3)
+    Q = random_q(rng, robot, (3,))
+    chain = chain_of(robot)
+    poses = walk(chain, list(np.ascontiguousarray(Q.T)), COMPONENTS, frames=True)
+    for b, q in enumerate(Q):
+        _, frames = oracle(robot, q)
+        one = walk(chain, q.tolist(), COMPONENTS, frames=True)
+        for f, (pose_b, pose_1) in enumerate(zip(poses, one)):
+            got_b = np.array([[np.broadcast_to(c, (len(Q),))[b] for c in col] for col in pose_b]).T  # (3, 4)
+            assert np.allclose(got_b, frames[f][:3, :], atol=ATOL)
+            assert np.allclose(np.array(pose_1).T, frames[f][:3, :], atol=ATOL)
 
 
 @settings(max_examples=60)
