@@ -6,13 +6,14 @@ pictures in :mod:`denavit.viz` (matplotlib).
 
 from .errors import (
     DenavitError,
+    DenavitWarning,
     MissingDependencyError,
     ModelError,
     ParseError,
     ShapeError,
     UnsupportedRobotError,
 )
-from .io import catalogue_names, dump_robot, load_robot, robot_from_dict, save_robot, with_parameters
+from .io import catalogue_names, dump_robot, load_robot, resolve_pose, robot_from_dict, save_robot, with_parameters
 from .model import Convention, DHLink, DHRobot, Frame, JointType, LinkInertia
 from ._convert import convert_convention
 from .build import fixed, prismatic, revolute, robot
@@ -27,6 +28,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "DenavitError",
+    "DenavitWarning",
     "MissingDependencyError",
     "ModelError",
     "ParseError",
@@ -35,6 +37,7 @@ __all__ = [
     "catalogue_names",
     "dump_robot",
     "load_robot",
+    "resolve_pose",
     "robot_from_dict",
     "save_robot",
     "with_parameters",

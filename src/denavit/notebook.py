@@ -167,7 +167,7 @@ def teach(robot: DHRobot, q=None, *, picture: bool = True) -> Any:
         ipywidgets (``denavit[notebook]``) or, with ``picture=True``, matplotlib is not installed.
     """
     from .viz import default_configuration
-    from .viz._html import slider_limits
+    from .viz import slider_limits
 
     cls = _panel_class()
     lim = slider_limits(robot)

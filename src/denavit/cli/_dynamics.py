@@ -68,7 +68,7 @@ def _progress(stage: str, done: int, total: int) -> None:
 
 
 def cmd_dynamics(args: argparse.Namespace):
-    from ..numeric._dynamics import require_dynamics
+    from ..numeric import require_dynamics
 
     robot = load(args)
     require_dynamics(robot)
@@ -141,7 +141,7 @@ def _symbolic(robot, args):
 
 
 def cmd_simulate(args: argparse.Namespace):
-    from ..numeric._dynamics import require_dynamics
+    from ..numeric import require_dynamics
 
     check_output(args, args.output, PLOTS, kind="picture format")
     robot = load(args)
@@ -188,7 +188,7 @@ class _OverBudget(Exception):
 
 def _budgeted(robot, q0, qd0, duration, tau, dt, friction):
     """simulate() with at most MAX_EVALUATIONS evaluations of the dynamics (ParseError beyond: exit 2)."""
-    from ..numeric._simulate import simulate
+    from ..numeric import simulate
 
     count = [0]
     budget = MAX_EVALUATIONS + int(duration / dt) + 2  # + the torques recomputed at the output samples

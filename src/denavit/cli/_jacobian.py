@@ -330,7 +330,7 @@ def cmd_singularities(args: argparse.Namespace):
     import sympy as sp
 
     from .. import symbolic as S
-    from ..numeric._singularities import select_rows
+    from ..numeric import select_rows
 
     robot = load(args)
     try:

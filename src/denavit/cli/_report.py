@@ -101,7 +101,7 @@ def cmd_report(args: argparse.Namespace):
     check_output(args, args.output, REPORT_SUFFIXES)
     _check_beside(args, _figure_names(args, robot, fmt))
     if fmt == "pdf":  # fail before the derivation, not after it: one error line, no wasted minutes
-        from ..report._pdf import latex_engine, pdf_from_latex
+        from ..report import latex_engine, pdf_from_latex
 
         if latex_engine() is None:
             pdf_from_latex("", {})  # raises MissingDependencyError naming the engines looked for

@@ -27,6 +27,7 @@ from ._singularities import (
     is_singular,
     jacobian_rank,
     manipulability,
+    select_rows,
     singular_values,
     smallest_singular_value,
     velocity_ellipsoid,
@@ -48,6 +49,7 @@ from ._dynamics import (
     mass_matrix,
     mass_matrix_derivatives,
     potential_energy,
+    require_dynamics,
     rnea,
 )
 from ._simulate import SimulationResult, computed_torque_controller, pd_controller, simulate
@@ -110,6 +112,8 @@ __all__ = [
     "wrench_tool_from_base",
     "rnea",
     "simulate",
+    "select_rows",
+    "require_dynamics",
     "SimulationResult",
     "pd_controller",
     "computed_torque_controller",

@@ -15,7 +15,7 @@ from typing import Any
 from ..errors import MissingDependencyError
 from ._geometry import ArmGeometry, arm_geometry, default_configuration, robot_scale
 from ._workspace import Workspace, plot_workspace, sample_workspace, workspace
-from ._html import viewer_html, write_viewer
+from ._html import slider_limits, viewer_html, write_viewer
 
 __all__ = [
     "ArmGeometry",
@@ -25,6 +25,7 @@ __all__ = [
     "Workspace",
     "sample_workspace",
     "workspace",
+    "slider_limits",
     "viewer_html",
     "write_viewer",
     "plot_robot",
