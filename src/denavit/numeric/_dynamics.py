@@ -155,7 +155,8 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
     q, qd, qdd : array_like, shape (..., n)
         Joint positions [rad, m], rates [rad/s, m/s], accelerations [rad/s², m/s²]; broadcast together.
     gravity : array_like, shape (3,), optional
-        Gravity in the world frame [m/s²]; default ``robot.gravity``.  Pass zeros to drop it.
+        Gravity in the world frame [m/s²]; default ``robot.gravity``.  Pass zeros to drop it.  NaN or ±inf
+        raises ModelError (it would turn every torque into NaN).
     friction : bool
         Add τ_f = viscous·q̇ + coulomb·sign(q̇).
 
