@@ -113,11 +113,14 @@ class Chain:
     base_identity, tool_identity : bool
     links, parameters
         The robot's rows and named parameters (for the symbolic constants).
+    memo : dict
+        Other constants derived from the same robot by other modules, by name (e.g. the dynamics kernels'
+        plan): they live as long as the robot, found without hashing it.
     """
 
     __slots__ = ("convention", "standard", "rows", "dof", "n_rows", "joint_rows", "revolute", "prismatic",
                  "axis_frame", "base", "tool", "base_identity", "tool_identity", "base_columns", "links",
-                 "parameters", "_constants", "_sym")
+                 "parameters", "memo", "_constants", "_sym")
 
     def __init__(self, robot: DHRobot) -> None:
         self.convention = robot.convention
@@ -143,6 +146,7 @@ class Chain:
         self.base_columns = tuple(tuple(float(B[i][j]) for i in range(3)) for j in range(4))  # x, y, z, p
         self.links: tuple[DHLink, ...] = robot.links
         self.parameters = robot.parameters
+        self.memo: dict = {}
         self._constants = None
         self._sym: dict = {}
 

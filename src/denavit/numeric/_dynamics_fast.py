@@ -16,7 +16,6 @@ J. J. Craig, *Introduction to Robotics*, 3rd ed., sec. 6.5 (iterative Newton–E
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
@@ -47,9 +46,16 @@ class _Plan:
     armature: tuple[float, ...]
 
 
-@lru_cache(maxsize=64)
 def plan(robot: DHRobot) -> _Plan:
-    """The kernel constants of ``robot`` (a pure function of the robot value, hence cached)."""
+    """The kernel constants of ``robot`` (a pure function of the robot, kept with its chain)."""
+    memo = chain_of(robot).memo
+    pl = memo.get("dynamics_fast.plan")
+    if pl is None:
+        pl = memo["dynamics_fast.plan"] = _make_plan(robot)
+    return pl
+
+
+def _make_plan(robot: DHRobot) -> _Plan:
     body = -1
     pieces: list[list[_Piece]] = [[] for _ in range(robot.dof)]
     for r, link in enumerate(robot.links):
