@@ -11,16 +11,30 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import as_joint_array
-from ..chain import FLOATS, Batch, chain_of, joint_motion, pack, walk
-from ..model import DHRobot
+from ..chain import FLOATS, Batch, chain_of, pack, walk
+from ..model import DHRobot, JointType
 
 __all__ = ["forward_kinematics", "link_transforms", "joint_values_per_row"]
 
 
 def joint_values_per_row(robot: DHRobot, q: np.ndarray) -> list[tuple[object, object]]:
-    """(θ, d) of every row for joint values q (..., n): arrays where a joint acts, floats elsewhere."""
-    cols = [q[..., k] for k in range(q.shape[-1])]
-    return [joint_motion(row, cols, row.theta, row.d) for row in chain_of(robot).rows]
+    """(θ, d) of every row for joint values q (..., n): arrays where a joint acts, floats elsewhere.
+
+    Written out here rather than taken from the chain: the routes that use it (Jacobian by differentiation
+    and by propagation) are the independent checks of the chain's walk.
+    """
+    out: list[tuple[object, object]] = []
+    k = 0
+    for link in robot.links:
+        if link.joint is JointType.REVOLUTE:
+            out.append((q[..., k] + link.theta, link.d))
+            k += 1
+        elif link.joint is JointType.PRISMATIC:
+            out.append((link.theta, q[..., k] + link.d))
+            k += 1
+        else:
+            out.append((link.theta, link.d))
+    return out
 
 
 def _walk_batch(robot: DHRobot, q: np.ndarray, frames: bool):
