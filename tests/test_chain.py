@@ -213,3 +213,14 @@ def test_chain_is_built_once_per_robot_and_dropped_with_it():
     del robot
     gc.collect()
     assert key not in _chain._CACHE
+
+
+def test_import_chain_stays_light():
+    """The chain's numeric side loads without sympy; the symbolic constants load it on use."""
+    import subprocess
+    import sys
+
+    code = ("import sys, denavit.chain as c; r = c.chain_of(__import__('denavit').load_robot('puma560')); "
+            "c.walk(r, [0.0] * 6, c.FLOATS); r.constants; print('sympy' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False"]
