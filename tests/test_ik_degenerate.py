@@ -48,18 +48,45 @@ def _wrap(x):
     return (np.asarray(x) + np.pi) % (2 * np.pi) - np.pi
 
 
+def _signed_terms(expr):
+    """{joint index: ±1} of a signed sum such as ``q4 - (q6 - q7)`` (parentheses name merged coaxial joints)."""
+    out, stack, sign = {}, [1.0], 1.0
+    for tok in re.findall(r"[+-]|\(|\)|q\d+", expr):
+        if tok in "+-":
+            sign = 1.0 if tok == "+" else -1.0
+        elif tok == "(":
+            stack.append(stack[-1] * sign)
+            sign = 1.0
+        elif tok == ")":
+            stack.pop()
+        else:
+            out[int(tok[1:]) - 1] = stack[-1] * sign
+            sign = 1.0
+    return out
+
+
+def _top_level_parts(text):
+    """The ``;``-separated parts of a free text, ignoring ``;`` inside parentheses."""
+    parts, depth, cur = [], 0, ""
+    for ch in text:
+        depth += (ch == "(") - (ch == ")")
+        if ch == ";" and depth == 0:
+            parts.append(cur.strip())
+            cur = ""
+        else:
+            cur += ch
+    return [p for p in parts + [cur.strip()] if p]
+
+
 def _free_parts(text):
-    """(joints excluded from the comparison, [(signs by joint, …)] sums that must agree) from a ``free`` text."""
+    """(joints excluded from the comparison, [{joint: sign}] sums that must agree) from a ``free`` text."""
     excluded, sums = set(), []
-    for part in filter(None, (p.strip() for p in text.split(";"))):
-        named = [int(k) - 1 for k in re.findall(r"q(\d+)", part)]
-        head = part.split("(")[0]
-        if " fixed" in head and "coupled" not in head:  # "qa + qb - qc fixed": that signed sum is determined
-            terms = re.findall(r"([+-]?)\s*q(\d+)", head)
-            sums.append({int(k) - 1: (-1.0 if s == "-" else 1.0) for s, k in terms})
-            excluded.update(named)
-        else:  # "qk free (…; qa, qb follow)", "qa and qb + qc coupled": those joints are not compared
-            excluded.update(named)
+    for part in _top_level_parts(text):
+        excluded.update(int(k) - 1 for k in re.findall(r"q(\d+)", part))
+        m = re.match(r"(.*?) (free|fixed|coupled)\b", part)
+        if m and m.group(2) == "fixed":  # "qa + qb - qc fixed (…)": that signed sum is determined
+            sums.append(_signed_terms(m.group(1)))
+        # "qk free (…; qa, qb follow)", "qa and qb + qc coupled (…)": those joints are not compared
     return excluded, sums
 
 
@@ -459,3 +486,25 @@ def test_near_singular_poses_miss_nothing_a_dense_search_finds(name, q5):
         for f in _distinct(robot, num.q[num.success]):
             assert _same_blob(robot, an.solutions, f, T, "pose") or \
                 any(_member(robot, s, fr, f) for s, fr in zip(an.solutions, an.free)), (name, q, f, an.solutions)
+
+
+def test_random_arms_of_any_structure_are_solved_completely_or_refused_by_name():
+    """Random DH tables (1-7 rows, both conventions, prismatic and fixed rows, base and tool, coaxial and
+    parallel axes by chance: tests/_random_robots.py): analytic_ik raises UnsupportedRobotError or finds the
+    generating q of every target (no other exception; found a coaxial group on axis 3 named twice, a
+    non-orthogonal wrist left unsolved behind a free q3, two parallel prismatic joints answered with nothing)."""
+    from _random_robots import random_robot
+
+    rng = np.random.default_rng(1818)
+    solved = 0
+    for _ in range(120 if CI else 600):
+        robot = random_robot(rng)
+        try:
+            kind = analytic_ik(robot, forward_kinematics(robot, np.zeros(robot.dof))).method
+        except UnsupportedRobotError:
+            continue
+        solved += 1
+        Q = _uniform(robot, rng, 6)
+        Q[:2, rng.integers(robot.dof)] = rng.choice(DEGENERATE, 2)
+        _check(robot, Q[_inside(robot, Q)], (kind, robot))
+    assert solved >= (15 if CI else 80)

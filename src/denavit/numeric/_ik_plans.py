@@ -101,7 +101,8 @@ def _parallel(chain: Chain, idx, rng) -> bool:
 
 
 def _merge_coaxial(chain: Chain):
-    """Merge consecutive coaxial revolute joints; returns (chain, expand(q_reduced) -> q, notes, free)."""
+    """Merge consecutive coaxial revolute joints; returns (chain, expand(q_reduced) -> q, [(group name, text)] of
+    the merged groups, representative joint of each reduced joint, name of each reduced joint)."""
     consts, pris = list(chain.consts), list(chain.prismatic)
     groups: list[list[tuple[int, float]]] = [[(0, 1.0)]]
     k = 0
@@ -118,11 +119,14 @@ def _merge_coaxial(chain: Chain):
         groups.append([(groups[-1][-1][0] + 1, 1.0)])
         k += 1
     n = chain.n
-    free = []
+    free, gnames = [], []
     for g in groups:
         if len(g) > 1:
             terms = f"q{g[0][0] + 1}" + "".join(f" {'+' if s > 0 else '-'} q{i + 1}" for i, s in g[1:])
-            free.append(f"{terms} fixed (coaxial joints)")
+            free.append((f"({terms})", f"{terms} fixed (coaxial joints)"))
+            gnames.append(f"({terms})")  # what the reduced joint stands for, in the free texts of the solvers
+        else:
+            gnames.append(f"q{g[0][0] + 1}")
 
     def expand(qr: np.ndarray) -> np.ndarray:
         out = np.zeros(qr.shape[:-1] + (n,))
@@ -131,7 +135,7 @@ def _merge_coaxial(chain: Chain):
         return out
 
     reps = [g[0][0] for g in groups]
-    return Chain(np.array(consts), np.array(pris)), expand, "; ".join(free), reps
+    return Chain(np.array(consts), np.array(pris)), expand, free, reps, gnames
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -161,8 +165,11 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
         Xw = T[:, :3, :3] @ X_e + T[:, :3, 3]
         W = Xw @ C0i[:3, :3].T + C0i[:3, 3]
         q123, f123 = pos.solve(W)  # (B, M, 3): the direct closed form where the class allows, else the resultant
-        x, y, z, _ = chain_columns(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
         Y = T[:, :3, :3] @ R6.T  # (B, 3, 3)
+        if getattr(pos, "free3", False):  # wrist centre on axis 3: q3 free, but the wrist must reach what is left
+            q123 = q123.copy()
+            q123[..., 2] = _free_q3(chain, q123, Y, R4, R5)
+        x, y, z, _ = chain_columns(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
         M = np.empty(q123.shape[:2] + (3, 3))  # R_0_3ᵀ R R6ᵀ
         for i, col in enumerate((x, y, z)):
             for j in range(3):
@@ -183,6 +190,21 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
         return q.reshape(B, -1, 6), free.reshape(B, -1)
 
     return solve, X_e, (f"closed form ({fast.kind})" if fast is not None else "resultant")
+
+
+def _free_q3(chain: Chain, q123: np.ndarray, Y: np.ndarray, R4: np.ndarray, R5: np.ndarray, samples: int = 24):
+    """q3 for a Pieper arm whose wrist centre lies on axis 3 (q3 does not move it; the wrist follows): of
+    ``samples`` values the one that puts the wrist's z-row equation ``a cos q5 + b sin q5 = M_zz − g`` farthest
+    inside its range (a non-orthogonal wrist cannot reach every rotation, so q3 = 0 may leave no solution)."""
+    t = 2 * np.pi * np.arange(samples) / samples
+    q = np.broadcast_to(np.nan_to_num(q123)[..., None, :], q123.shape[:2] + (samples, 3)).copy()
+    q[..., 2] = t
+    z = chain_columns(chain, q, upto=3)[2]  # (3, B, M, S)
+    Mzz = sum(z[i] * Y[:, None, None, i, 2] for i in range(3))
+    r, u = R4[2, :], R5[:, 2]
+    rho = max(float(np.hypot(r[0] * u[0] + r[1] * u[1], r[1] * u[0] - r[0] * u[1])), 1e-300)
+    ratio = np.abs(Mzz - r[2] * u[2]) / rho
+    return np.where(np.isfinite(q123[..., 2]), t[np.argmin(ratio, axis=-1)], np.nan)
 
 
 def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
@@ -394,9 +416,25 @@ def _wrist_plan(chain: Chain, names) -> Callable:
     return solve
 
 
+def _position_rank(chain: Chain, rng) -> int:
+    """Largest rank of the 3×3 position Jacobian of a 3-joint chain's end point over three configurations
+    (finite differences of chain_fk, steps 1e-6: rank is decided at 1e-4 relative)."""
+    best = 0
+    for q in _configs(chain, rng):
+        p0 = chain_fk(chain, q)[:3, 3]
+        J = np.stack([(chain_fk(chain, q + 1e-6 * e)[:3, 3] - p0) / 1e-6 for e in np.eye(3)], axis=1)
+        best = max(best, int(np.linalg.matrix_rank(J, tol=1e-4 * max(np.abs(J).max(), 1e-12))))
+    return best
+
+
 def _position_plan(chain: Chain, rng, names, limits3) -> Callable:
     C = chain.consts
     pos = Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng)
+    if _position_rank(chain, rng) < 3 - pos.free3:  # e.g. two prismatic joints along one direction
+        raise UnsupportedRobotError(
+            "the joints of this 3-joint arm cannot place its end point in 3-D (the position rows of its Jacobian "
+            "have lower rank everywhere): every reachable point is reached along a continuum the closed forms do "
+            "not resolve; use the numerical solver (solve_ik / --method numeric --mask position)")
     C0i = inverse_transform(C[0])
 
     def solve(T: np.ndarray):
@@ -470,9 +508,9 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
     """
     rng = np.random.default_rng(20240601)  # fixed: the structural tests must not depend on call order
     full = chain_of(robot)
-    chain, expand, coaxial, reps = _merge_coaxial(full)
+    chain, expand, groups, reps, names = _merge_coaxial(full)
+    coaxial = "; ".join(text for _, text in groups)
     m = chain.n
-    names = [f"q{r + 1}" for r in reps]
     rnames = names[::-1]
     rev = reverse_chain(chain)
     lim = robot.q_limits
@@ -543,6 +581,9 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
 
     def run(T: np.ndarray):
         q, free = solve(T)
-        return expand(q), (free if not coaxial else _free_text(np.ones(free.shape, bool), coaxial, free))
+        for gname, text in groups:  # the sum of coaxial joints is fixed, unless the solver found it free
+            named_free = np.array([f"{gname} free" in f for f in free.ravel()], dtype=bool).reshape(free.shape)
+            free = _free_text(~named_free, text, free)
+        return expand(q), free
 
     return Plan(kind, P, run, point, [coaxial] if coaxial else [], route)

@@ -148,7 +148,7 @@ class Position3:
         self.coef = self._coefficients(self.nodes)  # (2, 3, N): rows k, (A, B, C)
         self.degree = self._effective_degree(rng)
         # the point on axis 3 (revolute): q3 does not move it, q1 and q2 place it, q3 is free (a continuum)
-        self.free3 = self.degree < 0 and not self.pr3 and self._on_axis3(rng)
+        self.free3 = self.degree <= 0 and not self.pr3 and self._on_axis3(rng)  # (≡ 0, or constant in q3)
         if self.degree < 0 and not self.free3:
             from ..errors import UnsupportedRobotError
 
