@@ -11,7 +11,7 @@ and which frame carries each joint's axis.  The numeric and symbolic engines ask
 >>> x, y, z, p = walk(chain, [0.0, 0.0], FLOATS)
 """
 
-from ._chain import ROW_ORDER, Chain, Row, chain_of, dh_transform, joint_motion
+from ._chain import Chain, Row, chain_of, dh_transform, joint_motion
 from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
 
@@ -31,7 +31,6 @@ __all__ = [
     "joint_motion",
     "dh_transform",
     "dh_matrix_sym",
-    "ROW_ORDER",
     "walk",
     "Floats",
     "Components",

@@ -25,10 +25,7 @@ import numpy as np
 
 from ..model import Convention, DHLink, DHRobot, JointType
 
-__all__ = ["Row", "Chain", "chain_of", "ROW_ORDER", "joint_motion", "dh_transform"]
-
-#: The elementary motions of one DH row, left to right, per convention.
-ROW_ORDER = {Convention.STANDARD: ("rz", "tz", "tx", "rx"), Convention.MODIFIED: ("rx", "tx", "rz", "tz")}
+__all__ = ["Row", "Chain", "chain_of", "joint_motion", "dh_transform"]
 
 
 def joint_motion(row: "Row", q, theta, d):
