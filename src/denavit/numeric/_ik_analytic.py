@@ -32,6 +32,7 @@ MERGE_RADIUS = 1e-5  # up to this distance two solutions are also the same when 
 # (copies of one root found to ~√ε; two exact solutions of a pose 1e-4 from a singularity lie ~1e-4 apart and stay)
 POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
+FOLD_ROUGH = 1e-10  # candidate residual [m, rad] (relative to the reach) above which a root lost ~half its digits
 FOLD_SIGMA = 1e-3  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
 FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
 FOLD_STEPS = np.array([1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
@@ -287,8 +288,8 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
                                 np.zeros(batch, dtype=int), plan.kind, _controlled(plan.projector),
                                 np.zeros(batch + (0,), dtype=bool))
     cand, free = plan.solve(Tf)  # (B, K, n)
-    q, ok, pe, re, rough = _verify(robot, plan, Tf, cand)
-    fold = ok & rough & (free == "")
+    q, ok, pe, re, lost = _verify(robot, plan, Tf, cand)
+    fold = ok & lost & (free == "")
     if fold.any():  # roots near a double root that needed polishing: look for the partner of the pair
         extra = _fold_partners(robot, plan, Tf, q, fold)
         if extra is not None:
@@ -296,9 +297,14 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
             # a true partner is a regular root: Newton lands on it to rounding; a seed that crawls towards the
             # fold itself stops at a residual ~ its distance to the target, which must not pass as a solution
             ok2 &= (pe2 <= FOLD_RESIDUAL * max(1.0, _reach(robot))) & (re2 <= FOLD_RESIDUAL)
-            q, ok = np.concatenate([q, q2], 1), np.concatenate([ok, ok2], 1)
-            pe, re = np.concatenate([pe, pe2], 1), np.concatenate([re, re2], 1)
-            free = np.concatenate([free, np.full(ok2.shape, "", dtype=object)], 1)
+            ok2 &= _new(robot, q, ok, q2, ok2)  # most seeds land back on a solution already there
+            if ok2.any():
+                keep = np.argsort(~ok2, axis=1, kind="stable")[:, : int(ok2.sum(axis=1).max())]
+                pick = lambda a: np.take_along_axis(a, keep.reshape(keep.shape + (1,) * (a.ndim - 2)), 1)  # noqa
+                q2, ok2, pe2, re2 = pick(q2), pick(ok2), pick(pe2), pick(re2)
+                q, ok = np.concatenate([q, q2], 1), np.concatenate([ok, ok2], 1)
+                pe, re = np.concatenate([pe, pe2], 1), np.concatenate([re, re2], 1)
+                free = np.concatenate([free, np.full(ok2.shape, "", dtype=object)], 1)
     # keep only the slots some pose uses: the verified candidates first, the rest dropped
     order = np.argsort(~ok, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
     take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
@@ -328,6 +334,7 @@ def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
         size = np.where(ok, pe + L * np.where(ok, re, 0.0), np.inf)
         near = ok & (size < PREFILTER * max(L, 1e-3))
         rough = near & (size > POLISH_ABOVE * max(L, 1.0))  # only candidates that lost digits are polished
+        lost = near & (size > FOLD_ROUGH * max(L, 1.0))  # lost about half the digits: maybe one of a merged pair
         ok = near
         q[ok] = cand[ok]
         if rough.any():
@@ -336,10 +343,23 @@ def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
             e = pose_error(Tk[fine], forward_kinematics(robot, q[fine])) @ plan.projector.T
             pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
     else:
-        rough = np.zeros_like(ok)
+        lost = np.zeros_like(ok)
     ok &= np.all(np.isfinite(q), axis=-1)
     ok &= (pe <= VERIFY_TOL * max(1.0, L)) & (re <= VERIFY_TOL)
-    return q, ok, pe, re, rough
+    return q, ok, pe, re, lost
+
+
+def _new(robot: DHRobot, q: np.ndarray, ok: np.ndarray, q2: np.ndarray, ok2: np.ndarray) -> np.ndarray:
+    """Which of the extra solutions q2 (B, E, n) are farther than DUPLICATE_TOL from every solution of q (B, K, n)
+    of their pose (the extras among themselves are left to :func:`_dedupe`)."""
+    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    b = np.flatnonzero(ok2.any(axis=1))
+    d = np.abs(q2[b][:, :, None] - q[b][:, None])  # (b, E, K, n)
+    d = np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), d).max(axis=-1)
+    dup = (np.where(ok[b][:, None], np.nan_to_num(d, nan=np.inf), np.inf) < DUPLICATE_TOL).any(axis=-1)
+    out = ok2.copy()
+    out[b] &= ~dup
+    return out
 
 
 def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fold: np.ndarray):
