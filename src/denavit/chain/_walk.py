@@ -250,8 +250,12 @@ class Symbolic:
         return self.simplify(T) if self.simplify is not None else T
 
 
-def pack(poses, batch: tuple[int, ...] | None):
-    """Poses (column tuples) → array (F, 4, 4) (``batch`` None: float poses) or batch + (F, 4, 4)."""
+def pack(poses, batch: tuple[int, ...] | None, contiguous: bool = True):
+    """Poses (column tuples) → array (F, 4, 4) (``batch`` None: float poses) or batch + (F, 4, 4).
+
+    A batch is filled as (F, 4, 4, B) with contiguous writes; ``contiguous=False`` returns the transposed view
+    of that (one pass less; what a single end-effector pose needs), else a C-ordered copy.
+    """
     F = len(poses)
     if batch is None:
         out = np.zeros((F, 4, 4))
@@ -264,4 +268,5 @@ def pack(poses, batch: tuple[int, ...] | None):
         for j in range(4):
             T[f, :3, j] = cols[j]
     T[:, 3, 3] = 1.0
-    return np.ascontiguousarray(T.transpose(3, 0, 1, 2)).reshape(batch + (F, 4, 4))
+    T = T.transpose(3, 0, 1, 2)  # (B, F, 4, 4)
+    return (np.ascontiguousarray(T) if contiguous else T).reshape(batch + (F, 4, 4))

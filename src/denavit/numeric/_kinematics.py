@@ -107,7 +107,7 @@ def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
         T = pack([walk(chain, qa.tolist(), FLOATS)], None)[0]
     else:
         pose, batch = _walk_batch(robot, qa, frames=False)
-        T = pack([pose], batch)[..., 0, :, :]
+        T = pack([pose], batch, contiguous=False)[..., 0, :, :]
     if not chain.tool_identity:
         T = T @ chain.tool
     return T
