@@ -337,10 +337,7 @@ def _near_singular_configs(robot, rng, controlled, k):
     return Q[_inside(robot, Q)]
 
 
-KNOWN_MISSES = {  # open: the resultant route (Position3) returns q3 roots next to a double root too roughly for
-    # the polish to recover the generating q within 1e-6 (poses 1e-4 … 1e-12 from q3 = 0, the point near axis 2)
-    "spherical-rrp": "near-double q3 roots of the resultant route are polished to a neighbour (issue 18, open)",
-}
+KNOWN_MISSES: dict[str, str] = {}  # arm name -> reason, for an arm marked xfail here (none left)
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=KNOWN_MISSES[n], strict=False))

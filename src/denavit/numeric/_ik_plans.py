@@ -429,8 +429,12 @@ def _position_rank(chain: Chain, rng) -> int:
 
 def _position_plan(chain: Chain, rng, names, limits3) -> Callable:
     C = chain.consts
-    pos = Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng)
-    if _position_rank(chain, rng) < 3 - pos.free3:  # e.g. two prismatic joints along one direction
+    # the direct closed forms where the class allows (articulated RRR with axes 2 ∥ 3, spherical RRP), as for the
+    # wrist centre of a Pieper arm: the resultant has multiple roots on some of these (spherical-rrp: a 6-fold one
+    # next to q3 = 0, whose roots came out 1e-2 apart), else the resultant route
+    pos = closed_position(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain)) or \
+        Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng)
+    if _position_rank(chain, rng) < 3 - getattr(pos, "free3", False):  # e.g. two prismatic joints along one direction
         raise UnsupportedRobotError(
             "the joints of this 3-joint arm cannot place its end point in 3-D (the position rows of its Jacobian "
             "have lower rank everywhere): every reachable point is reached along a continuum the closed forms do "
