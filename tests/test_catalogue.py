@@ -66,7 +66,7 @@ RTB_POSES = {
     "ur5": ("UR5", ["qz", "qr"]),
     "panda": ("Panda", ["qr"]),
     "scara": ("Cobra600", ["qz", "qr"]),
-    "planar2r": ("TwoLink", ["qz", "qr", "qn", "q1", "q2"]),
+    "planar2r": ("TwoLink", ["qz", "qr", "qn"]),  # RTB's q1, q2 would read as joint variables: left out
     "planar3r": ("Planar3", ["qz", "qr"]),
 }
 
@@ -236,3 +236,11 @@ def test_cli_report_at_a_named_pose(capsys, tmp_path):
     text = path.read_text()
     shown = text.split("q = (", 1)[1].split(")", 1)[0]  # the configuration the report states it used
     np.testing.assert_allclose(parse_values(shown, robot.dof), dict(robot.poses)["qn"], atol=1e-12)
+
+
+@pytest.mark.parametrize("bad", ["q1", "q12", "pi", "deg", "q"])
+def test_pose_names_that_read_as_joint_values_are_refused(bad):
+    """``-q q1`` must never mean a pose: names of joint variables and constants are refused as pose names."""
+    base = load_robot("planar2r")
+    with pytest.raises(ModelError, match="taken"):
+        base.replace(poses=((bad, (0.0, 0.0)),))

@@ -8,6 +8,7 @@ is kept in ``DHLink.symbols`` so the symbolic engine can keep ``H1`` as a symbol
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import Any, Iterable
@@ -411,6 +412,8 @@ class DHRobot:
 
 #: Most named poses (``qz``, ``qr``, …) one robot may carry, and how far [rad, m] a pose may sit outside a limit.
 MAX_POSES = 64
+#: Pose names that would read as a joint variable (``q3``) where a joint vector is expected.
+_RESERVED_POSE_NAME = re.compile(r"q\d+")
 POSE_LIMIT_TOL = 1e-9
 
 
@@ -424,6 +427,9 @@ def _check_poses(poses: Any, limits: np.ndarray) -> tuple[tuple[str, tuple[float
         name = str(name)
         if not name.isidentifier() or len(name) > 40 or name in out:
             raise ModelError(f"pose name {name[:40]!r} must be a unique identifier (letters, digits, _)")
+        if _RESERVED_POSE_NAME.fullmatch(name) or name in ("pi", "deg", "q"):
+            raise ModelError(f"pose name {name!r} is taken: q, qN (joint variables), pi and deg mean "
+                             "something else in joint values; choose another name")
         if not isinstance(q, (tuple, list, np.ndarray)):
             raise ModelError(f"pose {name} must be a sequence of joint values")
         q = tuple(_finite(v, f"pose {name}") for v in q)
