@@ -34,6 +34,7 @@ POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
 FOLD_ROUGH = 1e-10  # candidate residual [m, rad] (relative to the reach) above which a root lost ~half its digits
 FOLD_SIGMA = 1e-3  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
+SINGULAR_RCOND = 1e-8  # σ_min/σ_max of such a solution under which it is on the singularity: named a continuum
 FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
 FOLD_STEPS = np.array([1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
 
@@ -291,7 +292,9 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
     q, ok, pe, re, lost = _verify(robot, plan, Tf, cand)
     fold = ok & lost & (free == "")
     if fold.any():  # roots near a double root that needed polishing: look for the partner of the pair
-        extra = _fold_partners(robot, plan, Tf, q, fold)
+        extra, (sb, sk, null) = _fold_partners(robot, plan, Tf, q, fold)
+        if len(sb):  # polished onto a singularity: a continuum the plan could not name; named by J's null space
+            free[sb, sk] = [_null_text(v) for v in null]
         if extra is not None:
             q2, ok2, pe2, re2, _ = _verify(robot, plan, Tf, extra)
             # a true partner is a regular root: Newton lands on it to rounding; a seed that crawls towards the
@@ -305,8 +308,11 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
                 q, ok = np.concatenate([q, q2], 1), np.concatenate([ok, ok2], 1)
                 pe, re = np.concatenate([pe, pe2], 1), np.concatenate([re, re2], 1)
                 free = np.concatenate([free, np.full(ok2.shape, "", dtype=object)], 1)
-    # keep only the slots some pose uses: the verified candidates first, the rest dropped
-    order = np.argsort(~ok, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
+    # keep only the slots some pose uses: the verified candidates first (continua first), the rest dropped
+    # continuum representatives before isolated rows, so that a copy of one (a root next to the singular set)
+    # is merged into the named continuum, not the other way round
+    rank = np.where(ok, np.where(free != "", 0, 1), 2)
+    order = np.argsort(rank, axis=1, kind="stable")[:, : max(int(ok.sum(axis=1).max()), 1)]
     take = lambda a: np.take_along_axis(a, order.reshape(order.shape + (1,) * (a.ndim - 2)), 1)  # noqa: E731
     q, ok, free, pe, re = take(q), take(ok), take(free), take(pe), take(re)
     q, inside = _fold(robot, np.where(ok[..., None], q, 0.0))
@@ -366,16 +372,20 @@ def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fo
     """Candidates for the second root of a pair that nearly coincide (a pose within ~FOLD_SIGMA of a
     singularity, where root finding returns one root for two): from each polished solution whose controlled
     Jacobian has σ_min < FOLD_SIGMA · σ_max, Newton steps from q ± t v (v: the singular direction, t = FOLD_STEPS).
-    Returns candidates (B, E, n) for :func:`_verify`, or None when no solution is that close to a singularity."""
+    Returns candidates (B, E, n) for :func:`_verify` (None when no solution is that close to a singularity), and
+    the solutions that sit on a singularity (σ_min < SINGULAR_RCOND · σ_max): pose and slot indices and the
+    null direction of J, for the name of their continuum."""
     from ._jacobians import geometric_jacobian
 
     b, k = np.nonzero(fold)
     J = plan.projector @ geometric_jacobian(robot, q[b, k])
     n = q.shape[-1]
     sv = np.linalg.svd(J, compute_uv=False)
-    near = sv[:, n - 1] < FOLD_SIGMA * sv[:, 0]
+    at = sv[:, n - 1] < SINGULAR_RCOND * sv[:, 0]  # on the singularity (to rounding): a continuum, no partner
+    near = ~at & (sv[:, n - 1] < FOLD_SIGMA * sv[:, 0])
+    singular = (b[at], k[at], np.linalg.svd(J[at])[2][:, n - 1] if at.any() else np.zeros((0, n)))
     if not near.any():
-        return None
+        return None, singular
     b, k, v = b[near], k[near], np.linalg.svd(J[near])[2][:, n - 1]  # (m,), (m, n)
     steps = np.concatenate([FOLD_STEPS, -FOLD_STEPS])
     seeds = q[b, k][:, None] + steps[None, :, None] * v[:, None]  # (m, S, n)
@@ -386,7 +396,16 @@ def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fo
     out = np.full((len(Tf), int(per.max()), n), np.nan)
     slot = np.arange(m * S) - np.repeat(np.concatenate([[0], np.cumsum(per)[:-1]])[b], S)
     out[np.repeat(b, S), slot] = flat
-    return out
+    return out, singular
+
+
+def _null_text(v: np.ndarray) -> str:
+    """The continuum through a solution where J is singular, named by its null direction v (unit, (n,)):
+    e.g. ``0.71 q4 - 0.71 q6 free (J singular: its null direction)``."""
+    v = v * np.sign(v[np.argmax(np.abs(v))])
+    terms = [(c, k) for k, c in enumerate(v) if abs(c) > 0.05]
+    text = " ".join(f"{'-' if c < 0 else '+'} {abs(c):.2f} q{k + 1}" for c, k in terms).lstrip("+ ")
+    return f"{text} free (J singular: its null direction)"
 
 
 def _reach(robot: DHRobot) -> float:

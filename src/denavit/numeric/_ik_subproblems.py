@@ -17,6 +17,8 @@ _KMAX = 6  # harmonics sampled for a revolute sweep joint (the resultant has deg
 _PMAX = 8  # polynomial degree sampled for a prismatic sweep joint (the resultant has degree ≤ 6)
 FREE_EPS = 1e-9  # relative size under which an equation is taken not to depend on a joint
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
+REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
+REFINE_STEPS = 4
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
 # parallel axes of a UR-type arm) under which a solution is reported as the continuum of the aligned axes
 
@@ -262,7 +264,7 @@ class Position3:
             q1 = Wb[..., 2] - g[..., 2]
             free1 = np.zeros(q1.shape, dtype=bool)
         else:
-            free1 = (np.hypot(g[..., 0], g[..., 1]) < 1e-9 * self.L) & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-7 * self.L)
+            free1 = (np.hypot(g[..., 0], g[..., 1]) < 1e-7 * self.L) & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-7 * self.L)
             # the continuum is named within 1e-7 L of axis 1, but the row stays the exact solution off the axis
             exact = free1 & (np.hypot(Wb[..., 0], Wb[..., 1]) < 1e-12 * self.L)
             q1 = np.where(exact, 0.0, angle_about_z(g, np.broadcast_to(Wb, g.shape)))
@@ -270,7 +272,41 @@ class Position3:
         bad = ~np.all(np.isfinite(q), axis=-1)
         q[bad] = np.nan
         free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
+        q = self._refine(q, W, free)
         return q, np.where(bad, 0, free)
+
+    def point(self, q: np.ndarray) -> np.ndarray:
+        """J1(q1) C1 J2(q2) C2 J3(q3) P, (..., 3)."""
+        g = self.g(q[..., 1], q[..., 2])
+        if self.pr1:
+            return g + np.stack([np.zeros_like(q[..., 0]), np.zeros_like(q[..., 0]), q[..., 0]], -1)
+        c, s = np.cos(q[..., 0]), np.sin(q[..., 0])
+        return np.stack([c * g[..., 0] - s * g[..., 1], s * g[..., 0] + c * g[..., 1], g[..., 2]], -1)
+
+    def _refine(self, q: np.ndarray, W: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """A few Newton steps on the three position equations for roots that lost digits (REFINE_ABOVE · L):
+        what follows them (the wrist of a Pieper arm) is then solved from an accurate q1-q3, which a later
+        polish on the whole pose cannot always recover at a wrist singularity (J singular there).  The Jacobian
+        by central differences (step 1e-6: error ~1e-12, so each step gains ~12 digits)."""
+        Wb = np.broadcast_to(W[:, None], q.shape)
+        r = self.point(np.nan_to_num(q)) - Wb
+        todo = np.all(np.isfinite(q), -1) & (np.linalg.norm(r, axis=-1) > REFINE_ABOVE * self.L) & (free == 0)
+        if not todo.any():
+            return q
+        x, w = q[todo], Wb[todo]
+        h = 1e-6
+        for _ in range(REFINE_STEPS):
+            e = self.point(x) - w
+            if np.max(np.abs(e)) <= 1e-15 * self.L:
+                break
+            J = np.stack([(self.point(x + h * d) - self.point(x - h * d)) / (2 * h) for d in np.eye(3)], -1)
+            Jt = np.swapaxes(J, -1, -2)
+            dx = np.linalg.solve(Jt @ J + 1e-14 * self.L**2 * np.eye(3), (Jt @ e[..., None]))[..., 0]
+            x = x - dx
+        out = q.copy()
+        out[todo] = np.where(np.linalg.norm(self.point(x) - w, axis=-1)[:, None]
+                             <= np.linalg.norm(self.point(q[todo]) - w, axis=-1)[:, None], x, q[todo])
+        return out
 
     def _q2_candidates(self, q3: np.ndarray, w: np.ndarray):
         co = self._coefficients(np.nan_to_num(q3))  # (2, 3, B, M)
