@@ -25,6 +25,7 @@ from .errors import ModelError, ParseError
 from .model import DH_FIELDS, DHLink, DHRobot, LinkInertia
 
 __all__ = [
+    "load_data",
     "load_robot",
     "robot_from_dict",
     "robot_to_dict",
