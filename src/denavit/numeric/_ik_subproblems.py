@@ -17,6 +17,9 @@ _KMAX = 6  # harmonics sampled for a revolute sweep joint (the resultant has deg
 _PMAX = 8  # polynomial degree sampled for a prismatic sweep joint (the resultant has degree ≤ 6)
 FREE_EPS = 1e-9  # relative size under which an equation is taken not to depend on a joint
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
+WEAK_Q2 = 1e-3  # relative dependence on q2 under which a q3 without a q2 root still gets q2 = 0, π to refine
+FREE_AXIS = 1e-10  # distance to axis 1 or 2, relative to the arm's size, under which that joint is named free (as
+# FREE_TOL of the closed forms)
 REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
 REFINE_STEPS = 4
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
@@ -273,7 +276,23 @@ class Position3:
         q[bad] = np.nan
         free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
         q = self._refine(q, W, free)
+        free = self._free_after(q, W, free)
         return q, np.where(bad, 0, free)
+
+    def _free_after(self, q: np.ndarray, W: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """The free flags again from the refined joints: the point within FREE_AXIS · L of axis 2 (q2 revolute)
+        or, with the target, of axis 1 (q1 revolute) — the flags first set from roots that lost digits can miss."""
+        qq = np.nan_to_num(q)
+        out = free.copy()
+        if not self.pr2:  # distance of C2 J3(q3) P from axis 2 (the z axis of the frame of joint 2)
+            v = (self.C2 @ joint_motion(self.pr3, qq[..., 2]) @ self.P)[..., :2]
+            out |= 2 * (np.hypot(v[..., 0], v[..., 1]) < FREE_AXIS * self.L)
+        if not self.pr1:
+            Wb = np.broadcast_to(W[:, None], q.shape)
+            g = self.g(qq[..., 1], qq[..., 2])
+            out |= 1 * ((np.hypot(g[..., 0], g[..., 1]) < FREE_AXIS * self.L)
+                        & (np.hypot(Wb[..., 0], Wb[..., 1]) < FREE_AXIS * self.L))
+        return np.where(np.all(np.isfinite(q), -1), out, free)
 
     def point(self, q: np.ndarray) -> np.ndarray:
         """J1(q1) C1 J2(q2) C2 J3(q3) P, (..., 3)."""
@@ -342,6 +361,10 @@ class Position3:
                 other = Ao[..., None] * np.cos(q2) + Bo[..., None] * np.sin(q2) + Co[..., None]
             ok = np.abs(other) <= 1e-2 * (np.abs(Ao) + np.abs(Bo) + np.abs(Co) + scale)[..., None]
         q2 = np.where(ok | free[..., None], q2, np.nan)
+        if not self.pr2:  # a q3 next to a multiple root with q2 nearly free (the point ~1e-6 from axis 2): no root
+            # of a slightly wrong equation; 0 and π are tried instead, refined with q1-q3 and checked by FK later
+            weak = ~np.isfinite(q2).any(-1) & np.isfinite(q3) & (pick(size, k) < WEAK_Q2 * np.maximum(scale, 1e-12))
+            q2 = np.where(weak[..., None], np.array([0.0, np.pi]), q2)
         return q2, np.broadcast_to(free[..., None], q2.shape)
 
 
