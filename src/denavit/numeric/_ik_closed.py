@@ -35,6 +35,7 @@ STRUCT_TOL = 1e-9  # relative tolerance of the structural tests (parallel axes, 
 FREE_TOL = 1e-10  # relative distance of the wrist centre to axis 1 or 2 under which that joint is free
 # (any value then moves the wrist centre by < 1e-10 L, within the FK check, so 0 is returned and the continuum is
 # named; farther out the joint is determined and computed, however ill-conditioned)
+NEAR_FREE = 1e-7  # relative distance of the point to axis 2 (Stanford class) under which q2 is named free
 RATIO_TOL = 1e-7  # |c/ρ| up to 1 + this counts as the tangent (double) root, as in the general route
 
 
@@ -60,6 +61,8 @@ class ElbowPosition:
         self.beta = m[1] * self.P[0] - m[0] * self.P[1]
         self.gamma = m[2] * self.P[2]
         self.k = float(p2 @ p2 + self.P @ self.P - self.vz**2 + 2 * self.gamma)
+        self.na, self.nb = float(np.hypot(p2[0], p2[1])), float(np.hypot(self.P[0], self.P[1]))
+        self.base = float(np.arctan2(self.beta, self.alpha))
 
     @classmethod
     def recognise(cls, C1, C2, P, prismatic, scale) -> "ElbowPosition | None":
@@ -89,9 +92,11 @@ class ElbowPosition:
         d = np.stack([c1 * Wx[:, None] + s1 * Wy[:, None] - self.p1[0], -s1 * Wx[:, None] + c1 * Wy[:, None]
                       - self.p1[1], np.broadcast_to(Wz[:, None] - self.p1[2], q1.shape)], -1)  # (B, 2, 3)
         g = d @ self.R1  # R1ᵀ (Rz(−q1) W − p1): the wrist centre in the frame of joint 2
-        # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P  (Craig eq. 4.69)
-        rhs = 0.5 * (g[..., 0] ** 2 + g[..., 1] ** 2 - self.k)
-        q3 = solve_trig(self.alpha, self.beta, rhs, tol=RATIO_TOL)  # (B, 2, 2)
+        # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P  (Craig eq. 4.69), i.e.
+        # |g_xy|² = |a|² + |b|² + 2|a||b| cos x, x = q3 − atan2(β, α), |a| = |p2_xy|, |b| = |P_xy|; written with
+        # (1 ∓ cos x)/2 as products (Kahan's triangle angles) so that a folded or stretched elbow (x ≈ π or 0,
+        # the wrist centre next to axis 2 or at full reach) keeps its digits: arccos lost half of them there
+        q3 = _elbow_angles(np.hypot(g[..., 0], g[..., 1]), self.na, self.nb, self.base)  # (B, 2, 2)
         c3, s3 = np.cos(q3), np.sin(q3)
         P, R2 = self.P, self.R2
         u = np.stack([c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]], -1)  # Rz(q3) P, xy (z is P_z)
@@ -102,6 +107,19 @@ class ElbowPosition:
         q2 = np.where(free2, 0.0, q2)
         q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
         return q, _flags(q, free1[:, None, None] * 1 + free2 * 2)
+
+
+def _elbow_angles(g: np.ndarray, na: float, nb: float, base: float) -> np.ndarray:
+    """q3 = base ± x with g² = na² + nb² + 2 na nb cos x (the elbow's law of cosines), (..., 2); NaN where g is
+    out of reach (beyond RATIO_TOL)."""
+    den = 4 * na * nb
+    s, d = na + nb, abs(na - nb)
+    lo = (s - g) * (s + g) / den  # (1 − cos x)/2
+    hi = (g - d) * (g + d) / den  # (1 + cos x)/2
+    ok = (lo >= -0.5 * RATIO_TOL) & (hi >= -0.5 * RATIO_TOL)
+    x = np.where(lo <= hi, 2 * np.arcsin(np.sqrt(np.clip(lo, 0.0, 1.0))),
+                 np.pi - 2 * np.arcsin(np.sqrt(np.clip(hi, 0.0, 1.0))))
+    return np.where(ok[..., None], np.stack([base + x, base - x], -1), np.nan)
 
 
 class StanfordPosition:
@@ -116,6 +134,7 @@ class StanfordPosition:
         self.u = p2 + R2 @ P - np.array([0.0, 0.0, s0])  # wrist centre at q3 = 0, from O, frame of joint 2
         self.z = R2[:, 2]  # direction of the prismatic joint 3 in the frame of joint 2
         self.uz = float(self.u @ self.z)
+        self.uperp = float(np.linalg.norm(self.u - self.uz * self.z))  # distance of the prismatic axis from O
         self.r = self.R1[2, :]  # axis 1 in the frame of joint 2 (times Rz(q2))
         self.L = scale
 
@@ -136,8 +155,10 @@ class StanfordPosition:
         """All (q1, q2, q3) placing the wrist centre at W (B, 3); q (B, 4, 3) and free (B, 4) as ElbowPosition."""
         D = W - self.O  # (B, 3)
         tiny = FREE_TOL * self.L
-        # |W − O|² = |u + q3 z|²: q3² + 2 (u·z) q3 + |u|² − |D|² = 0
-        disc = self.uz**2 - self.u @ self.u + np.sum(D * D, -1)
+        # |W − O|² = |u + q3 z|²: q3² + 2 (u·z) q3 + |u|² − |D|² = 0; the discriminant |D|² − |u⊥|² written as
+        # (|D| − |u⊥|)(|D| + |u⊥|) keeps its digits next to the double root (the point at its nearest to O)
+        nD = np.linalg.norm(D, axis=-1)
+        disc = (nD - self.uperp) * (nD + self.uperp)
         ok = disc >= -1e-12 * self.L**2
         root = np.sqrt(np.where(ok, np.maximum(disc, 0.0), np.nan))
         q3 = np.stack([-self.uz + root, -self.uz - root], -1)  # (B, 2)
@@ -146,8 +167,16 @@ class StanfordPosition:
         r = self.r
         q2 = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
                         D[:, None, 2] - r[2] * w[..., 2], tol=RATIO_TOL)  # (B, 2, 2)
-        free2 = np.hypot(w[..., 0], w[..., 1]) < tiny  # w on axis 2: every q2 (0 returned)
-        q2 = np.where(free2[..., None], [0.0, np.nan], q2)
+        wxy = np.hypot(w[..., 0], w[..., 1])
+        # next to axis 2 (within NEAR_FREE · L: q3 there is known only to ~√ε L, the double root above) q2 is named
+        # free; the row stays the solution of the equation as computed, its tangent root if rounding left none
+        near2 = wxy < NEAR_FREE * self.L
+        if near2.any():
+            loose = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
+                               D[:, None, 2] - r[2] * w[..., 2], tol=np.inf)
+            q2 = np.where((near2 & ~np.isfinite(q2).any(-1))[..., None], loose, q2)
+        q2 = np.where((wxy < tiny)[..., None], [0.0, np.nan], q2)  # w on axis 2: every q2 (0 returned)
+        free2 = near2
         c2, s2 = np.cos(q2), np.sin(q2)
         wx, wy, wz = (w[..., None, k] for k in range(3))
         x, y = c2 * wx - s2 * wy, s2 * wx + c2 * wy  # Rz(q2) w
