@@ -372,3 +372,19 @@ def test_robot_text_from_the_file_is_escaped_in_html_and_markdown():
     assert "\\| x" in md
     tex = denavit.dh_table(robot.replace(name="arm\n\\input{/etc/passwd}"), fmt="latex")
     assert tex.splitlines()[0].startswith("% arm") and not any(x.startswith("\\input") for x in tex.splitlines())
+
+
+def test_print_uses_the_angle_unit_the_file_was_written_in(tmp_path):
+    """The same arm written in degrees and in radians: the same kinematics, each printed in its file's unit."""
+    rows = [{"a": 0.3, "alpha": 90, "d": 0.1, "theta": "q"}, {"a": 0.2, "alpha": 0, "d": 0, "theta": "q - 30"}]
+    deg = denavit.robot_from_dict({"name": "two", "convention": "standard", "angle_unit": "deg", "joints": rows})
+    rad = denavit.robot_from_dict({"name": "two", "convention": "standard", "joints": [
+        {"a": 0.3, "alpha": "pi/2", "d": 0.1, "theta": "q"}, {"a": 0.2, "alpha": 0, "d": 0, "theta": "q - pi/6"}]})
+    q = np.array([0.4, -0.7])
+    np.testing.assert_allclose(denavit.forward_kinematics(deg, q), denavit.forward_kinematics(rad, q), atol=1e-15)
+    other = deg.replace(angle_unit="rad")  # the unit is presentation: not part of equality or the hash
+    assert other == deg and hash(other) == hash(deg) and "π/2" in str(other)
+    assert (deg.angle_unit, rad.angle_unit) == ("deg", "rad")
+    assert "90°" in str(deg) and "q2 - 30°" in str(deg) and "degrees" in str(deg)
+    assert "π/2" in str(rad) and "q2 - π/6" in str(rad) and "90°" not in str(rad)
+    assert "π/2" in denavit.dh_table(deg, deg=False)  # an explicit choice wins

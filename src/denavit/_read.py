@@ -396,6 +396,7 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
             source=_text_field(data, "source", where, where),
             poses=poses,
             symbols=tuple(symbols),
+            angle_unit="deg" if ctx.deg else "rad",
         )
     except ModelError as exc:
         raise ParseError(str(exc), where=where) from None

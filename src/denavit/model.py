@@ -290,9 +290,14 @@ class DHRobot:
     source: str = ""
     poses: tuple[tuple[str, tuple[float, ...]], ...] = ()
     symbols: tuple[tuple[str, str], ...] = ()
+    #: The angle unit the robot's file was written in ("rad" or "deg"): how tables show angles to people.
+    #: Presentation only: the model holds radians, and two robots differing only here are equal.
+    angle_unit: str = field(default="rad", compare=False)
     _joint_rows: tuple[int, ...] = field(init=False, repr=False, compare=False, hash=False, default=())
 
     def __post_init__(self) -> None:
+        if self.angle_unit not in ("rad", "deg"):
+            raise ModelError(f"angle_unit must be 'rad' or 'deg', got {str(self.angle_unit)[:20]!r}")
         if not isinstance(self.convention, Convention):
             try:
                 object.__setattr__(self, "convention", Convention(self.convention))
