@@ -31,6 +31,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping, Sequence
 
+def corpus(n: int) -> int:
+    """How many generated cases a hostile corpus runs: all ``n``, or a fifth in the quick subset
+    (``pytest -m "not slow"``, flagged by tests/conftest.py); what each case asserts is the same."""
+    return max(5, n // 5) if os.environ.get("DENAVIT_QUICK_TESTS") == "1" else n
+
+
 #: Wall-clock bound for one bad input run in-process (generous: the machine is shared and noisy).
 TIME_LIMIT = 10.0
 #: Address-space bound for the child-process runner (bytes).

@@ -1,7 +1,8 @@
 """Shared test settings: the CI flag, hypothesis profiles, random joint values, the seed-report folder.
 
 - ``CI`` (and the ``ci`` fixture): true when the environment variable ``CI`` is ``"true"`` (``.ci/run`` sets it).
-  Tests use it to run fewer random cases on CI's two cores; what each case asserts does not change.
+  ``REDUCED``: true on CI and in the quick subset; tests use it to run fewer random cases (what each case
+  asserts does not change).
 - Hypothesis profiles: ``ci`` (derandomized, so a CI failure reproduces; no deadline: the machine is shared)
   and ``dev`` (random, no deadline), chosen by ``CI``; ``HYPOTHESIS_PROFILE=...`` overrides.  Example counts
   stay those of each test's own ``@settings``.
@@ -12,7 +13,9 @@
 - ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone, outside the
   repository); the tests that read them (test_import_table.py) skip with a reason when they are absent.
 - Slow tests carry ``@pytest.mark.slow``; tests marked ``browser`` are slow too (a real browser starts), so
-  ``python -m pytest -m "not slow"`` is the quick subset.
+  ``python -m pytest -m "not slow"`` is the quick subset.  In the quick subset the generated hostile-input
+  corpora (tests/test_hostile_*.py) run a fifth of their cases (``_hostile.corpus``); the full suite, and CI,
+  run them all.
 """
 
 from __future__ import annotations
@@ -28,6 +31,9 @@ from hypothesis import strategies as st
 from _random_robots import random_robot
 
 CI = os.environ.get("CI") == "true"
+#: Run fewer random cases (what each asserts is the same): on CI, and in the quick subset (set in pytest_configure,
+#: which runs before the test modules import it).
+REDUCED = CI
 
 settings.register_profile("ci", deadline=None, derandomize=True, print_blob=True,
                           suppress_health_check=[HealthCheck.too_slow])
@@ -55,14 +61,23 @@ def robots(**options) -> st.SearchStrategy:
 
 @pytest.fixture
 def ci() -> bool:
-    """True on CI (``CI=true``): run fewer random cases."""
-    return CI
+    """True on CI and in the quick subset: run fewer random cases."""
+    return REDUCED
 
 
 @pytest.fixture
 def rng(request) -> np.random.Generator:
     """A generator seeded from the test's node id: reproducible, different per test."""
     return np.random.default_rng(sum(request.node.nodeid.encode()) + 16)
+
+
+def pytest_configure(config):
+    """The quick subset (``-m "not slow"``) runs the reduced random case counts of CI, and the hostile corpora a
+    fifth of their cases."""
+    global REDUCED
+    if "not slow" in " ".join((config.getoption("markexpr", "") or "").split()):
+        os.environ["DENAVIT_QUICK_TESTS"] = "1"
+        REDUCED = True
 
 
 def pytest_collection_modifyitems(config, items):

@@ -21,7 +21,7 @@ from denavit import symbolic as S
 from denavit.check import check_claims, parse_math, robot_resolver
 from denavit.cli import main
 
-from conftest import CI
+from conftest import REDUCED
 ARMS = ["report000-6r", "report001-6r", "report004-4-rrp", "scara", "planar3r"]
 
 
@@ -123,7 +123,7 @@ def _case(robot, rng):
     return rng.uniform(lo, hi)
 
 
-@settings(max_examples=12 if CI else 30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=12 if REDUCED else 30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(ARMS), style=st.sampled_from(["plain", "shorthand", "expanded", "theta", "decimal"]),
        seed=st.integers(0, 2**31 - 1), which=st.sampled_from(["A", "T", "position"]))
 def test_check_never_calls_a_correct_claim_incorrect(name, style, seed, which):
@@ -341,7 +341,7 @@ def _library_forms(robot, rows, rng):
     return out or ["none"]
 
 
-@settings(max_examples=8 if CI else 20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=8 if REDUCED else 20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=st.sampled_from([("planar2r", "vx,vy"), ("report000-planar3r", "vx,vy,wz"), ("puma560", None),
                              ("stanford", None), ("scara", "vx,vy,vz,wz"), ("planar3r", "vx,vy")]),
        seed=st.integers(0, 2**31 - 1))

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings, strategies as st
 
 import denavit
-from conftest import CI, random_q_in_limits, robots
+from conftest import CI, REDUCED, random_q_in_limits, robots
 
 
 @settings(max_examples=30)
@@ -33,8 +33,13 @@ def test_robots_strategy_gives_both_conventions_and_prismatic_joints():
     assert {"standard", "modified", "revolute", "prismatic"} <= seen
 
 
-def test_ci_fixture_is_the_flag(ci):
-    assert ci is CI
+def test_ci_fixture_is_the_flag(ci, request):
+    """The fixture says "fewer random cases": on CI, and in the quick subset (-m "not slow")."""
+    import os
+
+    quick = "not slow" in " ".join((request.config.getoption("markexpr", "") or "").split())
+    assert ci is REDUCED and REDUCED == (CI or quick)
+    assert (os.environ.get("DENAVIT_QUICK_TESTS") == "1") == quick
 
 
 def test_rng_fixture_is_seeded_per_test(rng, request):

@@ -25,9 +25,9 @@ from denavit.numeric import (
     rnea,
 )
 
-from conftest import CI
+from conftest import REDUCED
 
-N_RANDOM = 3 if CI else 8
+N_RANDOM = 3 if REDUCED else 8
 ATOL = 1e-9
 
 

@@ -26,8 +26,8 @@ from denavit.symbolic import (  # noqa: E402
     time_derivative,
 )
 
-from conftest import CI
-SEEDS = range(3 if CI else 6)
+from conftest import REDUCED
+SEEDS = range(3 if REDUCED else 6)
 
 
 def _rotation(rng):

@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import denavit as dn
-from _hostile import TIME_LIMIT, assert_refused, run_cli, run_cli_limited
+from _hostile import TIME_LIMIT, assert_refused, run_cli, run_cli_limited, corpus
 
 ROBOT = "planar2r"
 L1, L2 = dict(dn.load_robot(ROBOT).parameters)["L1"], dict(dn.load_robot(ROBOT).parameters)["L2"]
@@ -290,7 +290,7 @@ def _judged_or_refused(o, n_claims: int | None) -> None:
         assert len(claims) == n_claims
 
 
-CORPUS = settings(max_examples=600, deadline=None, derandomize=True, database=None,
+CORPUS = settings(max_examples=corpus(600), deadline=None, derandomize=True, database=None,
                   suppress_health_check=list(HealthCheck))
 
 
@@ -325,7 +325,7 @@ GARBAGE = st.one_of(
 )
 
 
-@settings(max_examples=250, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=corpus(250), deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
 @given(data=GARBAGE)
 def test_corpus_garbage_files_are_judged_or_refused(tmp_path_factory, data):
     folder = tmp_path_factory.mktemp("g")
@@ -333,7 +333,7 @@ def test_corpus_garbage_files_are_judged_or_refused(tmp_path_factory, data):
     _judged_or_refused(_check_arm(folder, text), None)
 
 
-@settings(max_examples=100, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=corpus(100), deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
 @given(q=st.lists(st.floats(-3, 3), min_size=2, max_size=2), style=st.sampled_from(range(4)),
        spaces=st.sampled_from(["", " ", "  ", "\\,"]))
 def test_a_correct_claim_is_never_rejected(tmp_path_factory, q, style, spaces):

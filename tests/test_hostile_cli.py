@@ -20,7 +20,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _hostile import assert_accepted_quietly, assert_refused, run_cli
+from _hostile import assert_accepted_quietly, assert_refused, run_cli, corpus
 
 N = 2  # planar2r: two revolute joints, limits ±pi, inertia given
 
@@ -65,8 +65,8 @@ def folder(tmp_path_factory):
     return tmp_path_factory.mktemp("hostile_cli")
 
 
-MANY = settings(max_examples=120, deadline=None, derandomize=True)
-SOME = settings(max_examples=60, deadline=None, derandomize=True)
+MANY = settings(max_examples=corpus(120), deadline=None, derandomize=True)
+SOME = settings(max_examples=corpus(60), deadline=None, derandomize=True)
 
 
 # --- joint vectors and other value lists -------------------------------------------------------------------
@@ -99,7 +99,7 @@ VALUE_CASES = [
                          ids=[f"{c[0][0]}{c[1]}" + ("-big" if c[0][-1] == "--ignore-limits" else "")
                               for c in VALUE_CASES])
 def test_bad_value_lists(folder, head, option, tail, n, limit, name):
-    @settings(max_examples=80 if n > 2 else 100, deadline=None, derandomize=True)
+    @settings(max_examples=corpus(80 if n > 2 else 100), deadline=None, derandomize=True)
     @given(bad_list(n, limit, (3,) if option == "--wrench" else ()))
     def case(text):
         _check(folder, head + [option, text] + tail, mentions=[name])
@@ -151,7 +151,7 @@ SCALAR_CASES = [
 
 @pytest.mark.parametrize("head,option,lo,hi,integer", SCALAR_CASES, ids=[c[1] for c in SCALAR_CASES])
 def test_bad_scalars(folder, head, option, lo, hi, integer):
-    @settings(max_examples=70, deadline=None, derandomize=True)
+    @settings(max_examples=corpus(70), deadline=None, derandomize=True)
     @given(_bad_number(lo, hi, integer))
     def case(text):
         if option == "--seed" and text.strip().isdigit():
@@ -275,7 +275,7 @@ def _make(folder, kind: str, ext: str, tag: str) -> tuple[str, list[str]]:
 def test_bad_output_paths(folder, command):
     argv, ext = WRITERS[command]
 
-    @settings(max_examples=45, deadline=None, derandomize=True)
+    @settings(max_examples=corpus(45), deadline=None, derandomize=True)
     @given(st.sampled_from(_KINDS), st.text(alphabet="abcdefghij0123456789-_", min_size=1, max_size=12),
            st.sampled_from(["", ".PNG", ".svg", ".pdf", ".gif", ".mp4", ".html", ".yaml", ".png.txt"]))
     def case(kind, tag, other_ext):
@@ -428,7 +428,7 @@ def test_no_runtime_warning_at_a_singular_configuration(tmp_path):
 _NUMBER = re.compile(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.])")
 
 
-@settings(max_examples=12, deadline=None, derandomize=True)
+@settings(max_examples=corpus(12), deadline=None, derandomize=True)
 @given(st.lists(st.floats(-1.5, 1.5), min_size=6, max_size=6), st.sampled_from(["base", "tool"]))
 def test_no_rounding_noise_in_text(tmp_path_factory, qs, frame):
     folder = tmp_path_factory.mktemp("noise")
@@ -446,7 +446,7 @@ def test_no_rounding_noise_in_text(tmp_path_factory, qs, frame):
             assert v == 0 or abs(v) > 1e-12, f"rounding noise {tok!r} printed\n{o.out}"
 
 
-@settings(max_examples=200, deadline=None, derandomize=True)
+@settings(max_examples=corpus(200), deadline=None, derandomize=True)
 @given(st.lists(st.one_of(st.floats(-1e6, 1e6), st.floats(-1e-15, 1e-15)), min_size=1, max_size=8))
 def test_numbers_text(values):
     from denavit.cli._common import NOISE, numbers_text

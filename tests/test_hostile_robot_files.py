@@ -22,14 +22,14 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from _hostile import assert_accepted_quietly, assert_refused, run_cli, run_cli_limited
+from _hostile import assert_accepted_quietly, assert_refused, run_cli, run_cli_limited, corpus
 
 import denavit
 from denavit import forward_kinematics, load_robot
 
-CASES = settings(max_examples=50, deadline=None, derandomize=True,
+CASES = settings(max_examples=corpus(50), deadline=None, derandomize=True,
                  suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
-MANY = settings(CASES, max_examples=80)
+MANY = settings(CASES, max_examples=corpus(80))
 
 # --------------------------------------------------------------------------------------------------
 # valid arms and how they are written
@@ -444,7 +444,7 @@ gravity: [0, 0, -g]
 """
 
 
-@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=corpus(40), deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.floats(0.1, 3.0), st.floats(0.5, 20.0), st.floats(0.5, 5.0))
 def test_param_reevaluates_every_field(tmp_path, L, g, m):
     """--param L=… equals the file with the value written in (an independent route through the loader)."""

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 import denavit as dn
 from denavit.tables import MAX_CELL_CHARS, MAX_LINE_CHARS, MAX_TABLE_ROWS
-from _hostile import TIME_LIMIT, assert_refused, run_cli
+from _hostile import TIME_LIMIT, assert_refused, run_cli, corpus
 
 HEAD = "| i | a | alpha | d | theta |\n|---|---|---|---|---|\n"
 
@@ -207,7 +207,7 @@ def pasted_table(draw) -> str:
     return prose + "\n".join(lines) + draw(st.sampled_from(["", "\n", "\n\nmore text | with | bars | here\n"]))
 
 
-@settings(max_examples=400, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=corpus(400), deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
 @given(text=pasted_table())
 def test_corpus_pasted_tables_are_imported_or_refused(tmp_path_factory, text):
     folder = tmp_path_factory.mktemp("t")
@@ -219,7 +219,7 @@ def test_corpus_pasted_tables_are_imported_or_refused(tmp_path_factory, text):
         _imported(o, folder)  # exit 0 and a robot file denavit loads
 
 
-@settings(max_examples=150, deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=corpus(150), deadline=None, derandomize=True, database=None, suppress_health_check=list(HealthCheck))
 @given(values=st.lists(st.tuples(st.integers(-900, 900), st.sampled_from([-90, 0, 90, 180]), st.integers(-900, 900),
                                  st.sampled_from([-90, 0, 90])), min_size=1, max_size=6),
        unit=st.sampled_from([("mm", 1e-3), ("cm", 1e-2), ("m", 1.0)]), sep=st.sampled_from(["|", "\t"]),

@@ -11,8 +11,8 @@ from denavit import (Convention, DHLink, DHRobot, UnsupportedRobotError, analyti
                      forward_kinematics, load_robot, solve_ik)
 from denavit.numeric import ik_structure, transform_from_xyz_rpy
 
-from conftest import CI, random_q_in_limits as _random_q
-N = 60 if CI else 250
+from conftest import REDUCED, random_q_in_limits as _random_q
+N = 60 if REDUCED else 250
 SUPPORTED = [n for n in denavit.catalogue_names() if n != "panda"]
 CONTROLLED = {  # rows of the pose each kind of arm controls: residual projector built independently here
     "pose": (np.ones(3), np.ones(3)),
@@ -95,7 +95,7 @@ def _distinct(robot, qs, tol=1e-5):
 def test_analytic_count_equals_dense_numeric_search(name):
     robot = load_robot(name)
     rng = np.random.default_rng(5)
-    poses, seeds = (2, 150) if CI else (4, 400)
+    poses, seeds = (2, 150) if REDUCED else (4, 400)
     res_kind = analytic_ik(robot, forward_kinematics(robot, _random_q(robot, rng, 1))[0])
     mask = {"pose": "pose", "position": "position", "position+heading": [1, 1, 1, 0, 0, 1]}[res_kind.controlled]
     for q in _random_q(robot, rng, poses):
@@ -146,7 +146,7 @@ def _random_pieper(rng, convention):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_random_pieper_arms(convention):
     rng = np.random.default_rng(17 if convention == "standard" else 18)
-    for _ in range(4 if CI else 10):
+    for _ in range(4 if REDUCED else 10):
         robot = _random_pieper(rng, convention)
         assert ik_structure(robot) == "pieper"
         q = rng.uniform(-np.pi, np.pi, (30, 6))

@@ -21,8 +21,8 @@ from denavit.numeric._ik_analytic import _plan, _solve
 from denavit.numeric._ik_closed import wrist_angles
 from denavit.numeric._ik_subproblems import rotation3
 
-from conftest import CI, random_q_in_limits as _random_q
-N = 60 if CI else 200
+from conftest import REDUCED, random_q_in_limits as _random_q
+N = 60 if REDUCED else 200
 ARMS = {"puma560": "elbow", "puma560-mdh": "elbow", "report003-6r": "elbow", "report001-6r": "elbow",
         "stanford": "stanford"}
 MATCH = 1e-6  # joint-space distance [rad, m] under which two solutions are the same (the de-duplication tol)
@@ -178,7 +178,7 @@ def test_singular_and_near_singular_poses_same_solutions(name):
     robot = load_robot(name)
     rng = np.random.default_rng(7)
     k = 1 if robot.joint_types[2].value == "prismatic" else 2
-    qs = _singular_configs(robot, rng, k, 4 if CI else 8)
+    qs = _singular_configs(robot, rng, k, 4 if REDUCED else 8)
     for d in (0.0, 1e-7, 1e-5, 1e-3):
         Q = qs + d * np.eye(6)[k]
         T = forward_kinematics(robot, Q)
@@ -298,7 +298,7 @@ def _random_arm(rng, convention, kind):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_random_arms_same_solutions_as_general_route(kind, convention):
     rng = np.random.default_rng({"elbow": 31, "stanford": 32}[kind] + (convention == "modified"))
-    for _ in range(3 if CI else 8):
+    for _ in range(3 if REDUCED else 8):
         robot = _random_arm(rng, convention, kind)
         assert _plan(robot, True).route == f"closed form ({kind})"
         q = _random_q(robot, rng, 40)

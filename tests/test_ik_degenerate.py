@@ -20,7 +20,7 @@ from denavit import (Convention, DHLink, DHRobot, JointType, ModelError, Unsuppo
                      forward_kinematics, rnea)
 from denavit.numeric import manipulability, transform_from_xyz_rpy
 
-from conftest import CI
+from conftest import REDUCED
 
 FK_TOL = 1e-9
 FOUND_TOL = 1e-6  # joint-space distance [rad, m] at which the generating q counts as found
@@ -161,7 +161,7 @@ def _arm3_point_on_axis3(rng, convention):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_three_joint_arm_with_the_point_on_axis_3_is_a_named_continuum(convention):
     rng = np.random.default_rng(18)
-    for _ in range(4 if CI else 12):
+    for _ in range(4 if REDUCED else 12):
         robot = _arm3_point_on_axis3(rng, convention)
         Q = rng.uniform(-np.pi, np.pi, (20, 3))
         Q[:5, 1] = [0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-8]
@@ -237,7 +237,7 @@ def test_modified_planar_2r_with_the_end_effector_on_axis_2():
 @pytest.mark.parametrize("prismatic", [False, True])
 def test_random_planar_arms_find_the_generating_q(convention, tool, prismatic):
     rng = np.random.default_rng([2, convention == "standard", tool, prismatic])
-    for _ in range(6 if CI else 25):
+    for _ in range(6 if REDUCED else 25):
         robot = _planar(rng, convention, tool, prismatic)
         Q = rng.uniform(-np.pi, np.pi, (16, robot.dof))
         for k, t in enumerate(robot.joint_types):
@@ -346,7 +346,7 @@ def test_catalogue_arm_finds_the_generating_q_at_degenerate_and_near_singular_co
     robot = denavit.load_robot(name)
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     controlled = analytic_ik(robot, forward_kinematics(robot, np.zeros(robot.dof))).controlled
-    k = 12 if CI else 40
+    k = 12 if REDUCED else 40
     Q = np.concatenate([_uniform(robot, rng, k), _degenerate_configs(robot, rng, k),
                         _near_singular_configs(robot, rng, controlled, k // 2)])
     _check(robot, Q, name)
@@ -389,7 +389,7 @@ def _configs(robot, rng, k):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_random_pieper_arms_at_and_near_singular_configs(convention):
     rng = np.random.default_rng([6, convention == "standard"])
-    for _ in range(3 if CI else 12):
+    for _ in range(3 if REDUCED else 12):
         robot = _pieper(rng, convention)
         assert analytic_ik(robot, forward_kinematics(robot, np.zeros(6))).method.startswith("pieper")
         _check(robot, _configs(robot, rng, 12), robot.links)
@@ -398,7 +398,7 @@ def test_random_pieper_arms_at_and_near_singular_configs(convention):
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_random_ur_type_arms_at_and_near_singular_configs(convention):
     rng = np.random.default_rng([7, convention == "standard"])
-    for _ in range(3 if CI else 12):
+    for _ in range(3 if REDUCED else 12):
         robot = _axes_234_parallel(rng, convention, meet56=True)
         assert analytic_ik(robot, forward_kinematics(robot, np.zeros(6))).method.startswith("parallel")
         _check(robot, _configs(robot, rng, 12), robot.links)
@@ -410,10 +410,10 @@ def test_axes_2_to_4_parallel_with_axes_5_and_6_apart_general_route(convention):
     (the formulation chosen on four random targets had a singular pencil on others); now the next-ranked
     formulation solves those."""
     rng = np.random.default_rng([4, convention == "standard"])
-    for _ in range(3 if CI else 12):
+    for _ in range(3 if REDUCED else 12):
         robot = _axes_234_parallel(rng, convention, meet56=False)
         assert analytic_ik(robot, forward_kinematics(robot, np.zeros(6))).method == "general"
-        _check(robot, _uniform(robot, rng, 10 if CI else 30), robot.links)
+        _check(robot, _uniform(robot, rng, 10 if REDUCED else 30), robot.links)
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
@@ -436,7 +436,7 @@ def test_wrist_at_and_near_its_singularity_keeps_every_branch(name, q5):
     and isolated at 1e-4."""
     robot = denavit.load_robot(name)
     rng = np.random.default_rng(zlib.crc32(f"{name}{q5}".encode()))
-    Q = _uniform(robot, rng, 10 if CI else 40)
+    Q = _uniform(robot, rng, 10 if REDUCED else 40)
     Q[:, 4] = q5
     assert np.linalg.matrix_rank(denavit.geometric_jacobian(robot, np.where(np.arange(6) == 4, 0.0, Q[0])),
                                  tol=1e-9) < 6
@@ -474,7 +474,7 @@ def test_near_singular_poses_miss_nothing_a_dense_search_finds(name, q5):
     else:
         Q = _uniform(robot, rng, 2)
         Q[:, 4] = q5
-    seeds = 150 if CI else 600
+    seeds = 150 if REDUCED else 600
     for q in Q:
         T = forward_kinematics(robot, q)
         an = analytic_ik(robot, T)
@@ -498,7 +498,7 @@ def test_random_arms_of_any_structure_are_solved_completely_or_refused_by_name()
 
     rng = np.random.default_rng(1818)
     solved = 0
-    for _ in range(120 if CI else 600):
+    for _ in range(120 if REDUCED else 600):
         robot = random_robot(rng)
         try:
             kind = analytic_ik(robot, forward_kinematics(robot, np.zeros(robot.dof))).method
@@ -508,4 +508,4 @@ def test_random_arms_of_any_structure_are_solved_completely_or_refused_by_name()
         Q = _uniform(robot, rng, 6)
         Q[:2, rng.integers(robot.dof)] = rng.choice(DEGENERATE, 2)
         _check(robot, Q[_inside(robot, Q)], (kind, robot))
-    assert solved >= (15 if CI else 80)
+    assert solved >= (15 if REDUCED else 80)

@@ -20,9 +20,9 @@ from denavit.errors import UnsupportedRobotError
 from denavit.numeric import transform_from_xyz_rpy
 from denavit.symbolic import IKDerivation, ik_derivation
 
-from conftest import CI, random_q_in_limits as _random_q
+from conftest import REDUCED, random_q_in_limits as _random_q
 
-POSES = 6 if CI else 12
+POSES = 6 if REDUCED else 12
 ATOL = 1e-9
 SIX = ["puma560", "puma560-mdh", "report003-6r", "report001-6r", "stanford"]
 PLANAR = ["planar2r", "planar3r", "report004-1-planar2r", "report004-2-planar3r", "report000-planar3r"]

@@ -19,7 +19,7 @@ from denavit.numeric import forward_kinematics, solve_ik, transform_from_xyz_rpy
 from denavit.numeric._ik_analytic import _plan, _solve
 from denavit.numeric._ik_numeric import pose_error
 
-from conftest import CI
+from conftest import REDUCED
 
 
 def random_general_6r(rng: np.random.Generator) -> DHRobot:
@@ -59,7 +59,7 @@ def check_batch(robot: DHRobot, q: np.ndarray, res) -> None:
     assert np.all(res.count % 2 == 0)  # real roots of a degree-16 polynomial with real coefficients
 
 
-@pytest.mark.parametrize("seed", range(6 if CI else 20))
+@pytest.mark.parametrize("seed", range(6 if REDUCED else 20))
 def test_random_general_arms(seed):
     rng = np.random.default_rng(1000 + seed)
     robot = random_general_6r(rng)
@@ -78,13 +78,13 @@ def distinct(qs: np.ndarray, tol: float = 1e-6) -> list[np.ndarray]:
     return out
 
 
-@pytest.mark.parametrize("seed", range(3 if CI else 8))
+@pytest.mark.parametrize("seed", range(3 if REDUCED else 8))
 def test_count_equals_dense_numeric_search(seed):
     rng = np.random.default_rng(2000 + seed)
     robot = random_general_6r(rng) if seed % 2 == 0 else denavit.load_robot("jaco2-6dof")
     T = forward_kinematics(robot, rng.uniform(-np.pi, np.pi, 6))
     res = denavit.analytic_ik(robot, T)
-    n = 1500 if CI else 4000
+    n = 1500 if REDUCED else 4000
     num = solve_ik(robot, np.broadcast_to(T, (n, 4, 4)), rng.uniform(-np.pi, np.pi, (n, 6)), restarts=0, tol=1e-10,
                    respect_limits=False)
     found = distinct(num.q[num.success])
@@ -98,7 +98,7 @@ def test_general_route_agrees_with_closed_forms(name):
     robot = denavit.load_robot(name)
     rng = np.random.default_rng(7)
     lim = np.clip(robot.q_limits, -np.pi, np.pi)
-    q = lim[:, 0] + (lim[:, 1] - lim[:, 0]) * rng.random((120 if CI else 400, 6))
+    q = lim[:, 0] + (lim[:, 1] - lim[:, 0]) * rng.random((120 if REDUCED else 400, 6))
     T = forward_kinematics(robot, q)
     closed = denavit.analytic_ik(robot, T)
     general = _solve(robot, T, _plan(robot, True, True))
@@ -121,13 +121,13 @@ def test_jaco2_catalogue_arm():
                                                      -k * (0.0741 + 0.0741), -(k * 0.0741 + 0.16)], atol=1e-15)
     assert denavit.numeric.ik_structure(robot) == "general"
     rng = np.random.default_rng(3)
-    q = rng.uniform(-np.pi, np.pi, (300 if CI else 1500, 6))
+    q = rng.uniform(-np.pi, np.pi, (300 if REDUCED else 1500, 6))
     res = denavit.analytic_ik(robot, forward_kinematics(robot, q))
     check_batch(robot, q, res)
     assert res.count.max() >= 10  # this arm has poses with 10 and 12 real solutions
 
 
-@pytest.mark.parametrize("seed", range(2 if CI else 5))
+@pytest.mark.parametrize("seed", range(2 if REDUCED else 5))
 def test_industrial_style_arms_without_closed_form(seed):
     rng = np.random.default_rng(3000 + seed)
     tested = 0
@@ -230,7 +230,7 @@ def test_general_arm_at_and_near_singular_poses():
     (to the accuracy a double root allows) and every returned solution must reproduce the target."""
     robot = denavit.load_robot("jaco2-6dof")
     rng = np.random.default_rng(11)
-    qs = _singular_configs(robot, rng, 10 if CI else 30)
+    qs = _singular_configs(robot, rng, 10 if REDUCED else 30)
     sv = np.linalg.svd(denavit.geometric_jacobian(robot, qs), compute_uv=False)
     assert np.all(sv[:, -1] < 1e-9 * sv[:, 0])  # really on the singular set
     for eps in (0.0, 1e-6, 1e-3):  # on it, and just off it

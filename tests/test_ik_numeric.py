@@ -11,8 +11,8 @@ from denavit import ShapeError, convert_convention, forward_kinematics, load_rob
 from denavit.numeric import transform_from_xyz_rpy
 from denavit.numeric._ik_numeric import pose_error, rotation_log
 
-from conftest import CI, random_q_in_limits as _random_q
-N = 40 if CI else 150
+from conftest import REDUCED, random_q_in_limits as _random_q
+N = 40 if REDUCED else 150
 ARMS = [n for n in denavit.catalogue_names()]
 # every catalogue arm: 100% (near-singular targets are rescued by closed-form and bank seeds)
 NEAR_SINGULAR_OK: dict[str, float] = {}
@@ -167,7 +167,7 @@ def test_solve_ik_near_singular_targets_report003():
     every such target must still be solved (checked by FK on the matrices)."""
     robot = load_robot("report003-6r")
     rng = np.random.default_rng(21)
-    n = 12 if CI else 40
+    n = 12 if REDUCED else 40
     q = _random_q(robot, rng, n)
     q[:, 2] = np.pi / 2 + rng.uniform(-1e-4, 1e-4, n)  # d4 along a2: elbow singular
     # put the wrist centre on the shoulder axis: with q3 = π/2 it lies at radius |a2 cos q2 − d4 sin(q2+q3)...|,
@@ -195,7 +195,7 @@ def test_solve_ik_panda_joint6_beyond_pi():
     iteration folds angles by whole turns before clipping) and stay within the limits."""
     robot = load_robot("panda")
     rng = np.random.default_rng(4)
-    n = 15 if CI else 40
+    n = 15 if REDUCED else 40
     q = _random_q(robot, rng, n)
     q[:, 5] = rng.uniform(3.3, 3.74, n)
     T = forward_kinematics(robot, q)
@@ -245,7 +245,7 @@ def test_single_damped_step_solves_normal_equations():
 def test_single_call_agrees_with_batched_path(name):
     """One target (fast path) vs the same target as a batch of one: same success, FK(q) = T, q inside."""
     robot, rng = load_robot(name), np.random.default_rng(3)
-    m = 12 if CI else 40
+    m = 12 if REDUCED else 40
     q_true = _random_q(robot, rng, m)
     T = forward_kinematics(robot, q_true)
     near = np.clip(q_true + rng.normal(0, 0.3, q_true.shape), robot.q_limits[:, 0], robot.q_limits[:, 1])
@@ -269,7 +269,7 @@ def test_single_call_agrees_with_batched_path(name):
 @pytest.mark.parametrize("name", SINGLE_ARMS)
 def test_single_call_unreachable_same_reason_as_batched(name):
     robot, rng = load_robot(name), np.random.default_rng(8)
-    for k in range(2 if CI else 4):
+    for k in range(2 if REDUCED else 4):
         T = forward_kinematics(robot, _random_q(robot, rng, 1)[0])
         T[:3, 3] *= 10.0  # far outside the workspace
         one = solve_ik(robot, T, restarts=4, rng=np.random.default_rng(k))

@@ -10,8 +10,8 @@ import pytest
 from denavit import Convention, DHLink, DHRobot, Frame, JointType, forward_kinematics, load_robot
 from denavit import numeric as N
 
-from conftest import CI
-N_ROBOTS = 120 if CI else 300
+from conftest import REDUCED
+N_ROBOTS = 120 if REDUCED else 300
 H = 1e-6
 ATOL_FD = 1e-6
 ROUTES = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
@@ -227,7 +227,7 @@ def _to_rtb(rtb, robot):
 def test_random_robots_match_roboticstoolbox_jacob0_jacobe():
     rtb = pytest.importorskip("roboticstoolbox")
     rng = np.random.default_rng(13)
-    for _ in range(40 if CI else 100):
+    for _ in range(40 if REDUCED else 100):
         robot = make_robot(rng)
         peer = _to_rtb(rtb, robot)
         q = rng.uniform(-np.pi, np.pi, robot.dof)
@@ -276,7 +276,7 @@ def _to_pinocchio(pin, robot):
 def test_random_robots_match_pinocchio_frame_jacobians():
     pin = pytest.importorskip("pinocchio")
     rng = np.random.default_rng(15)
-    for _ in range(40 if CI else 100):
+    for _ in range(40 if REDUCED else 100):
         robot = make_robot(rng)
         model, fid = _to_pinocchio(pin, robot)
         data = model.createData()
@@ -325,7 +325,7 @@ def test_symbolic_routes_match_numeric_on_random_robots():
     from denavit.symbolic import jacobian_sym
 
     rng = np.random.default_rng(31)
-    for _ in range(6 if CI else 15):
+    for _ in range(6 if REDUCED else 15):
         robot = make_nice_robot(rng)
         q = rng.uniform(-np.pi, np.pi, robot.dof)
         for method in ("geometric", "differentiation", "propagation"):

@@ -20,7 +20,7 @@ from denavit import numeric as N
 from denavit.report import Equation, Numbers, Table, Text, derive, render, write_report
 from denavit.report import _capabilities
 
-from conftest import CI
+from conftest import CI, REDUCED
 ALL = dn.catalogue_names()
 FEW = ["report000-6r", "puma560", "report004-4-rrp", "planar2r"]
 
@@ -55,7 +55,7 @@ def test_report_every_arm_renders_markdown(name):
     assert "DISAGREE" not in text
 
 
-@pytest.mark.parametrize("name", FEW[:2] if CI else FEW)
+@pytest.mark.parametrize("name", FEW[:2] if REDUCED else FEW)
 @pytest.mark.parametrize("fmt", ["html", "tex"])
 @pytest.mark.slow
 def test_report_renders_html_and_latex(name, fmt, tmp_path):
@@ -347,7 +347,7 @@ def test_ik_branch_labels_are_unique_per_solution_set(name):
     robot = dn.load_robot(name)
     rng = np.random.default_rng(16)
     lo, hi = np.maximum(robot.q_limits.T[0], -np.pi), np.minimum(robot.q_limits.T[1], np.pi)
-    q = rng.uniform(lo, hi, (150 if not CI else 60, robot.dof))
+    q = rng.uniform(lo, hi, (150 if not REDUCED else 60, robot.dof))
     res = dn.analytic_ik(robot, dn.forward_kinematics(robot, q))
     for labels, valid, sols in zip(res.branches, res.valid, res.solutions):
         names = [b for b, v in zip(labels, valid) if v]

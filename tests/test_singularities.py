@@ -10,7 +10,7 @@ from denavit import numeric as N
 
 from test_jacobians import make_robot
 
-from conftest import CI
+from conftest import REDUCED
 ROW_NAMES = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 

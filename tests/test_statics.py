@@ -8,8 +8,8 @@ from denavit import numeric as N
 
 from test_jacobians import make_robot
 
-from conftest import CI
-N_ROBOTS = 100 if CI else 250
+from conftest import REDUCED
+N_ROBOTS = 100 if REDUCED else 250
 H = 1e-6
 
 
