@@ -103,6 +103,7 @@ def test_statics_tau(capsys, method):
     assert force_only["units"] == ["N m", "N m"]
 
 
+@pytest.mark.slow
 def test_singularities_json(capsys):
     data = run_json(capsys, "singularities", "report004-1-planar2r", "--rows", "vx,vy", "--deg")
     (cond,) = data["conditions"]

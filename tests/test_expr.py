@@ -106,6 +106,7 @@ def test_text_round_trip_preserves_value(tree):
     assert evaluate(parse(text), env) == pytest.approx(v1, rel=1e-12, abs=1e-12)
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, derandomize=True)
 @given(st.lists(st.integers(-9, 9), min_size=500, max_size=4000), st.sampled_from("+-*"))
 def test_long_chains_fold_without_recursion(values, op):

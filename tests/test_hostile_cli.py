@@ -179,6 +179,7 @@ def test_simulate_dt(folder, text):
     _check(folder, SIM + ["--duration", "0.1", "--dt", text], mentions=["dt"])
 
 
+@pytest.mark.slow
 def test_simulate_work_is_capped(folder):
     """Torques within the magnitude bound but making the arm spin wildly: refused after a bounded budget."""
     o = run_cli(SIM + ["--duration", "1", "--tau", "1e8,-1e8"], folder, time_limit=90)

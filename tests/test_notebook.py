@@ -36,7 +36,8 @@ def test_require_ipywidgets_raises_missing_dependency(monkeypatch):
         require_ipywidgets()
 
 
-@pytest.mark.parametrize("name", ["puma560", "stanford", "panda"])
+@pytest.mark.parametrize("name", ["puma560", pytest.param("stanford", marks=pytest.mark.slow),
+                                  pytest.param("panda", marks=pytest.mark.slow)])
 def test_moving_sliders_updates_the_pose_readout(name):
     widgets = pytest.importorskip("ipywidgets")
     pytest.importorskip("matplotlib")

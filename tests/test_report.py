@@ -392,6 +392,7 @@ def _readme_first_command():
     return shlex.split(first.split("&&", 1)[1])
 
 
+@pytest.mark.slow
 def test_readme_first_command_shows_a_well_known_arm_with_every_section_filled(tmp_path, capsys):
     """The README's main command: a catalogue arm with dynamics, at a regular configuration, every section
     done (none skipped), its dynamics numbers the numeric library's at the same q, and quick."""
