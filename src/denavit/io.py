@@ -224,7 +224,7 @@ def _link_kwargs(link: DHLink) -> dict[str, Any]:
 
 def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q", deg: bool = False,
                  env: Mapping[str, float] | None = None) -> np.ndarray:
-    """Parse ``"0, pi/4, 90deg"`` (comma or space separated expressions) into floats.
+    r"""Parse ``"0, pi/4, 90deg"`` (comma or space separated expressions) into floats.
 
     Values are separated by commas (or semicolons) when there are any outside brackets, else by spaces;
     the whole list may be wrapped in ``[...]`` or ``(...)``; ``\\pi`` is read as ``pi``.  An empty value
