@@ -227,7 +227,7 @@ def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q"
     r"""Parse ``"0, pi/4, 90deg"`` (comma or space separated expressions) into floats.
 
     Values are separated by commas (or semicolons) when there are any outside brackets, else by spaces;
-    the whole list may be wrapped in ``[...]`` or ``(...)``; ``\\pi`` is read as ``pi``.  An empty value
+    the whole list may be wrapped in ``[...]`` or ``(...)``; ``\pi`` is read as ``pi``.  An empty value
     (``"1,,2"``, ``"1 2,"``), unbalanced brackets (``"[1,2"``), more than :data:`MAX_VALUES` values or
     more than :data:`MAX_VALUES_TEXT` characters are refused.  The text is read in one linear pass.
     ``deg=True`` reads plain numbers as degrees (``pi`` or ``deg`` in a value still say their unit).
