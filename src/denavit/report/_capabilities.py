@@ -92,7 +92,9 @@ def _singular_result_steps(result: Any) -> list:
         rows.append((latex(factor) + " = 0" if hasattr(factor, "free_symbols") else str(factor),
                      f"\\text{{{getattr(c, 'kind', '')}}}", f"\\text{{{sols or '-'}}}"))
         if getattr(c, "explanation", ""):
-            steps.append(Text(f"${latex(factor)} = 0$ ({getattr(c, 'kind', '')}): {c.explanation}"))
+            kind = getattr(c, "kind", "")
+            said = c.explanation.split(":", 1)[0].split("/")[0] == kind  # "shoulder: ..." names its kind already
+            steps.append(Text(f"${latex(factor)} = 0$" + (f": {c.explanation}" if said else f" ({kind}): {c.explanation}")))
     if rows:
         steps.insert(len(steps) - sum(isinstance(s, Text) and s.text.startswith("$") for s in steps),
                      Table(("\\text{condition}", "\\text{kind}", "\\text{solutions [rad or m]}"), tuple(rows),
