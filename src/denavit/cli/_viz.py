@@ -91,7 +91,7 @@ def _fmt(v) -> str:
 def cmd_plot(args: argparse.Namespace):
     from ..numeric import quintic_trajectory
     from ..viz import arm_geometry, default_configuration
-    from ..viz._plot import plot_robot, save_figure
+    from ..viz import plot_robot, save_figure
 
     check_output(args, args.output, PICTURES, kind="picture format")
     robot = load(args)
@@ -185,7 +185,7 @@ def cmd_workspace(args: argparse.Namespace):
     ws = workspace(robot, args.samples, args.resolution, rng)
     require_finite("workspace", ws.bounds_min, ws.bounds_max, ws.reach)
     if args.output:
-        from ..viz._plot import save_figure
+        from ..viz import save_figure
 
         with output_file(args.output) as tmp:
             save_figure(plot_workspace(ws, robot.name), tmp)

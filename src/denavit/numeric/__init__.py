@@ -21,6 +21,8 @@ from ._propagation import (
     velocity_propagation,
 )
 from ._singularities import (
+    RANK_RTOL,
+    TWIST_ROWS,
     Ellipsoid,
     condition_number,
     force_ellipsoid,
@@ -114,6 +116,8 @@ __all__ = [
     "simulate",
     "select_rows",
     "require_dynamics",
+    "RANK_RTOL",
+    "TWIST_ROWS",
     "SimulationResult",
     "pd_controller",
     "computed_torque_controller",

@@ -27,9 +27,8 @@ import numpy as np
 import sympy as sp
 
 from ..model import Convention, DHRobot, Frame, JointType
-from ..numeric._jacobians import geometric_jacobian, joint_axes
-from ..numeric._kinematics import link_transforms
-from ..numeric._singularities import RANK_RTOL, TWIST_ROWS, jacobian_rank, select_rows
+from ..numeric import (RANK_RTOL, TWIST_ROWS, geometric_jacobian, jacobian_rank, joint_axes, link_transforms,
+                       select_rows)
 from ._jacobians import geometric_jacobian_sym, reduce_trig, simplify_kinematic
 from ._kinematics import link_transforms_sym
 from ._symbols import joint_symbols, parameter_symbols
