@@ -11,8 +11,9 @@ import sympy as sp
 
 from .. import _expr
 from .. import symbolic as S
+from ..chain import chain_of
 from ..errors import ParseError
-from ..model import Convention, DHRobot, JointType
+from ..model import DHRobot, JointType
 
 __all__ = ["Context", "exact_values", "EXACT_TOL", "MAX_SYMBOLIC_CHARS"]
 
@@ -220,10 +221,9 @@ class Context:
     @cached_property
     def joint_frames_sym(self) -> list[tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]]:
         """(z_i, p_i) of every joint axis in world axes: standard DH z_{i-1}, o_{i-1}; modified z_i, o_i."""
-        shift = 0 if self.robot.convention is Convention.STANDARD else 1
         out = []
-        for row in self.robot.joint_rows:
-            F = self.base_exact * self.frames_sym[row + shift]
+        for f in chain_of(self.robot).axis_frame:
+            F = self.base_exact * self.frames_sym[f]
             out.append((sp.ImmutableMatrix(F[:3, 2]), sp.ImmutableMatrix(F[:3, 3])))
         return out
 

@@ -14,6 +14,7 @@ import sympy as sp
 
 from .. import numeric as N
 from .. import symbolic as S
+from ..chain import chain_of
 from ..model import JointType
 from ._context import EXACT_TOL, Context
 from ._derivation import Equation, Numbers, Section, Table, Text
@@ -55,12 +56,11 @@ def jacobian_case(ctx: Context) -> sp.ImmutableMatrix:
     cached = getattr(ctx, "_J_case", None)
     if cached is not None:
         return cached
-    shift = 0 if ctx.robot.convention.value == "standard" else 1
     frames = ctx.frames_case
     p_e = sp.ImmutableMatrix((frames[-1] * ctx.tool_exact)[:3, 3])
     cols = []
-    for row, jt in zip(ctx.robot.joint_rows, ctx.robot.joint_types):
-        z, p = frames[row + shift][:3, 2], frames[row + shift][:3, 3]
+    for f, jt in zip(chain_of(ctx.robot).axis_frame, ctx.robot.joint_types):
+        z, p = frames[f][:3, 2], frames[f][:3, 3]
         cols.append(list(z.cross(p_e - p)) + list(z) if jt is JointType.REVOLUTE else list(z) + [0, 0, 0])
     J = sp.ImmutableMatrix(sp.Matrix(cols).T.applyfunc(lambda e: sp.radsimp(sp.expand(e))))
     ctx._J_case = J  # type: ignore[attr-defined]

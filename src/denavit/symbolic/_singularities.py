@@ -26,7 +26,8 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
-from ..model import Convention, DHRobot, Frame, JointType
+from ..chain import chain_of
+from ..model import DHRobot, Frame, JointType
 from ..numeric import (RANK_RTOL, TWIST_ROWS, geometric_jacobian, jacobian_rank, joint_axes, link_transforms,
                        select_rows)
 from ._jacobians import geometric_jacobian_sym, reduce_trig, simplify_kinematic
@@ -93,8 +94,7 @@ class SingularityAnalysis:
 def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMatrix, str]:
     """J in the axes of the frame of joint 3's axis, reference point on the last joint axis."""
     Ts = link_transforms_sym(robot, simplify)
-    shift = 0 if robot.convention is Convention.STANDARD else 1
-    axis = [r + shift for r in robot.joint_rows]
+    axis = chain_of(robot).axis_frame
     k, m = axis[min(2, robot.dof - 1)], axis[-1]
     Rk, p = Ts[k][:3, :3], Ts[m][:3, 3]
     cols = []

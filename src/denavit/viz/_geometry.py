@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import as_joint_array
+from ..chain import chain_of
 from ..model import Convention, DHRobot, JointType
 from ..numeric import link_transforms
 
@@ -123,8 +124,7 @@ def arm_geometry(robot: DHRobot, q) -> ArmGeometry:
     skel[..., 1:-1:2, :] = knees
     skel[..., 2:-1:2, :] = o[..., 1:, :]
     skel[..., -1, :] = T_e[..., :3, 3]
-    shift = 0 if robot.convention is Convention.STANDARD else 1
-    joint_frames = np.take(frames, [r + shift for r in robot.joint_rows], axis=-3)  # (..., n, 4, 4)
+    joint_frames = np.take(frames, chain_of(robot).axis_frame, axis=-3)  # (..., n, 4, 4)
     triads = [frames]
     labels = [str(i) for i in range(n_rows + 1)]
     if not np.allclose(robot.base_matrix, np.eye(4)):
