@@ -1,16 +1,10 @@
-"""The joint-screw form of a DH chain and the small subproblems the analytic IK is built from.
+"""The joint-screw form of a DH chain, as arrays, and the small subproblems the analytic IK is built from.
 
-Every DH row, in either convention, factors into constant transforms and one elementary joint motion about
-or along a local z axis:
-
-    standard, revolute   Rz(q+θ) Tz(d) Tx(a) Rx(α)       = Rz(q) · [Rz(θ) Tz(d) Tx(a) Rx(α)]
-    standard, prismatic  Rz(θ) Tz(q+d) Tx(a) Rx(α)       = Tz(q) · [Rz(θ) Tz(d) Tx(a) Rx(α)]
-    modified, revolute   Rx(α) Tx(a) Rz(q+θ) Tz(d)       = [Rx(α) Tx(a)] · Rz(q) · [Rz(θ) Tz(d)]
-    modified, prismatic  Rx(α) Tx(a) Rz(θ) Tz(q+d)       = [Rx(α) Tx(a)] · Tz(q) · [Rz(θ) Tz(d)]
-
-so the whole arm, base, fixed rows and tool included, is ``T_w_e = C0 J1(q1) C1 J2(q2) ⋯ Jn(qn) Cn`` with
-constant ``C_k`` (the product-of-exponentials form in local coordinates, Lynch & Park 2017, Sec. 4.1).
-The IK solvers work on this form only, so they treat both conventions, offsets and fixed rows alike
+The arm, base, fixed rows and tool included, is ``T_w_e = C0 J1(q1) C1 J2(q2) ⋯ Jn(qn) Cn`` with constant
+``C_k`` and J_k = Rz(q) or Tz(q) (the product-of-exponentials form in local coordinates, Lynch & Park 2017,
+Sec. 4.1).  The constants and joint kinds are those of :mod:`denavit.chain` (the one place that splits DH rows
+of either convention into constants and joint motions); :func:`chain_of` only stacks them into arrays for the
+batched IK code.  The IK solvers work on this form only, so they treat both conventions, offsets and fixed rows alike
 (no per-convention derivation to get wrong).  The subproblems are those of Paden (1986) and Kahan,
 as collected in Murray, Li & Sastry (1994), Sec. 3.3.
 """
@@ -21,33 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Convention, DHRobot, JointType
+from ..chain import chain_of as _chain_of
+from ..model import DHRobot
 from ._transforms import inverse_transform
 
 __all__ = ["Chain", "chain_of", "chain_fk", "chain_columns", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
            "wrap_angle", "axis_lines"]
-
-
-def _rz(t: float) -> np.ndarray:
-    c, s = np.cos(t), np.sin(t)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def _rx(t: float) -> np.ndarray:
-    c, s = np.cos(t), np.sin(t)
-    return np.array([[1.0, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1]])
-
-
-def _tz(d: float) -> np.ndarray:
-    T = np.eye(4)
-    T[2, 3] = d
-    return T
-
-
-def _tx(a: float) -> np.ndarray:
-    T = np.eye(4)
-    T[0, 3] = a
-    return T
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,24 +36,10 @@ class Chain:
 
 
 def chain_of(robot: DHRobot) -> Chain:
-    """The joint-screw form of a robot (base, fixed rows and tool folded into the constants)."""
-    consts = []
-    cur = robot.base_matrix
-    std = robot.convention is Convention.STANDARD
-    for link in robot.links:
-        after = _rz(link.theta) @ _tz(link.d)
-        if std:
-            after = after @ _tx(link.a) @ _rx(link.alpha)
-        else:
-            cur = cur @ _rx(link.alpha) @ _tx(link.a)
-        if link.joint is JointType.FIXED:
-            cur = cur @ after
-        else:
-            consts.append(cur)
-            cur = after
-    consts.append(cur @ robot.tool_matrix)
-    prismatic = np.array([t is JointType.PRISMATIC for t in robot.joint_types])
-    return Chain(np.array(consts), prismatic)
+    """The joint-screw form of a robot as arrays: :attr:`denavit.chain.Chain.constants` (base, fixed rows and
+    tool folded in) stacked, and the joints' prismatic mask."""
+    chain = _chain_of(robot)
+    return Chain(np.array(chain.constants), np.array(chain.prismatic, dtype=bool))
 
 
 def joint_motion(prismatic: bool, q: np.ndarray) -> np.ndarray:
