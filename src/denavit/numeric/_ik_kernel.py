@@ -1,9 +1,9 @@
 """The inner loop of the IK solvers: pose residual and geometric Jacobian in one pass over the chain.
 
-The chain is the joint-screw form ``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`._ik_chain`.  A batch of poses is
-kept as rotation columns x, y, z and origin p, each of shape (3, B) with the batch contiguous, so a joint
-rotation is two axpy's (``x ← c x + s y``, ``y ← c y − s x``) and a constant ``C_k`` is a handful of them
-(most DH constants are signed permutations: α = ±90°).  The Jacobian needs only the joint axes z_k and
+The chain is the joint-screw form ``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain` (its constants read
+here).  A batch of poses is kept as rotation columns x, y, z and origin p, each of shape (3, B) with the batch
+contiguous, so a joint rotation is two axpy's (``x ← c x + s y``, ``y ← c y − s x``) and a constant ``C_k`` is
+a handful of them (most DH constants are signed permutations: α = ±90°).  The Jacobian needs only the joint axes z_k and
 their origins o_k, which this same pass visits, and the end-effector origin p_e at the end:
 
     revolute k:  J_k = (z_k × (p_e − o_k), z_k),      prismatic k:  J_k = (z_k, 0)
@@ -14,12 +14,10 @@ The final success test of the solvers still uses :func:`forward_kinematics`, an 
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
+from ..chain import chain_of
 from ..model import DHRobot
-from ._ik_chain import chain_of
 
 __all__ = ["Kernel", "kernel_of", "targets_soa"]
 
@@ -49,10 +47,10 @@ class Kernel:
 
     def __init__(self, robot: DHRobot) -> None:
         chain = chain_of(robot)
-        self.n = chain.n
-        self.prismatic = tuple(bool(x) for x in chain.prismatic)
-        self.start = chain.consts[0]
-        self.terms = tuple(_terms(C) for C in chain.consts[1:])
+        self.n = chain.dof
+        self.prismatic = chain.prismatic
+        self.start = chain.constants[0]
+        self.terms = tuple(_terms(C) for C in chain.constants[1:])
 
     def pose(self, qT: np.ndarray, keep_axes: bool = False):
         """Rotation columns x, y, z and origin p (each (3, B)) at joint values qT (n, B); optionally the
@@ -124,7 +122,10 @@ def targets_soa(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(np.moveaxis(T[:, :3, :3], 0, -1)), np.ascontiguousarray(T[:, :3, 3].T)
 
 
-@lru_cache(maxsize=64)
 def kernel_of(robot: DHRobot) -> Kernel:
-    """The (cached) kernel of a robot."""
-    return Kernel(robot)
+    """The kernel of a robot (a pure function of the robot, kept with its chain: found without hashing it)."""
+    memo = chain_of(robot).memo
+    kern = memo.get("ik_kernel")
+    if kern is None:
+        kern = memo["ik_kernel"] = Kernel(robot)
+    return kern

@@ -4,7 +4,8 @@ For one target, numpy's fixed cost per call (~1–5 µs per ufunc on arrays of 3
 batched solver of :mod:`._ik_numeric`: one iteration there is ~60 small array operations.  This module runs
 the *first* attempt of that solver — from the seed, joint limits ignored during the iteration and the end
 point folded by whole turns — with lists of floats and ``math``: the same joint-screw chain
-``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` as :class:`._ik_kernel.Kernel`, the same residual and geometric Jacobian
+``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain` as :class:`._ik_kernel.Kernel`, the same residual and
+geometric Jacobian
 
     e = W (p_t − p, log(R_t Rᵀ)),   revolute k: J_k = (z_k × (p_e − o_k), z_k),  prismatic k: J_k = (z_k, 0)
 
@@ -20,14 +21,12 @@ solution within the limits, so the quality of the result is that of the batched 
 
 from __future__ import annotations
 
-from functools import lru_cache
 from math import acos, cos, pi, sin, sqrt
 
 import numpy as np
 
+from ..chain import chain_of
 from ..model import DHRobot
-from ._ik_chain import chain_of
-from ._ik_kernel import kernel_of
 
 __all__ = ["SingleChain", "single_chain"]
 
@@ -42,13 +41,13 @@ class SingleChain:
     """Float data of one arm's chain (build with :func:`single_chain`, cached per robot)."""
 
     def __init__(self, robot: DHRobot) -> None:
-        kern = kernel_of(robot)
-        self.n = kern.n
-        self.prismatic = kern.prismatic
-        C0 = kern.start
+        chain = chain_of(robot)
+        self.n = chain.dof
+        self.prismatic = chain.prismatic
+        C0 = chain.constants[0]
         self.start = tuple(tuple(float(v) for v in C0[i, :4]) for i in range(3))  # rows of [R | p]
         # C_k as the 12 numbers (C00, C10, C20, C01, …, C23): column j of R·C_k is Σ_m R[:, m] C_k[m, j]
-        self.consts = tuple(tuple(float(C[m, j]) for j in range(4) for m in range(3)) for C in chain_of(robot).consts[1:])
+        self.consts = tuple(tuple(float(C[m, j]) for j in range(4) for m in range(3)) for C in chain.constants[1:])
 
     def residual(self, q, Rt, pt, w):
         """Weighted residual e (6 floats) and weighted Jacobian columns (n lists of 6 floats) at q.
@@ -216,10 +215,13 @@ def _fold(q, lo, hi, revolute):
     return out
 
 
-@lru_cache(maxsize=64)
 def single_chain(robot: DHRobot) -> SingleChain:
-    """The (cached) float chain of a robot."""
-    return SingleChain(robot)
+    """The float chain of a robot (kept with its :func:`denavit.chain.chain_of`: found without hashing it)."""
+    memo = chain_of(robot).memo
+    single = memo.get("ik_single")
+    if single is None:
+        single = memo["ik_single"] = SingleChain(robot)
+    return single
 
 
 def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w_mask: np.ndarray, limits,
