@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from ..chain import chain_of
 from ..errors import UnsupportedRobotError
 from ..model import Convention, DHRobot, JointType
 from ._kinematics import link_matrices_sym, link_transforms_sym
@@ -200,9 +201,8 @@ def _numeric_zero(expr, robot: DHRobot, qs, rng: np.random.Generator, tol: float
 
 
 def _axis_frame(robot: DHRobot, T, k: int):
-    """The frame whose z axis is joint k (1-based): {row−1} in the standard convention, {row} in modified."""
-    row = robot.joint_rows[k - 1]
-    return T[row] if robot.convention is Convention.STANDARD else T[row + 1]
+    """The frame whose z axis is joint k (1-based), by the chain's rule (:attr:`denavit.chain.Chain.axis_frame`)."""
+    return T[chain_of(robot).axis_frame[k - 1]]
 
 
 def _check_prefix(robot: DHRobot) -> None:
@@ -269,7 +269,6 @@ def _decoupled(robot: DHRobot) -> IKDerivation:
         raise UnsupportedRobotError(f"{robot.name}: the derivation needs the six joints in DH rows 1-6")
     if robot.joint_types[1] is not JointType.REVOLUTE or any(t is not JointType.REVOLUTE for t in robot.joint_types[3:]):
         raise UnsupportedRobotError(f"{robot.name}: joints 2, 4, 5, 6 must be revolute")
-    std = robot.convention is Convention.STANDARD
     rng = np.random.default_rng(7)
     q = joint_symbols(6).q
     N = robot.n_rows
@@ -280,8 +279,9 @@ def _decoupled(robot: DHRobot) -> IKDerivation:
     steps = _target_steps(robot, target, N)
 
     # wrist centre: axis 4 ∩ axis 5, in frame {3} (Spong eq. 5.12: o_c = o − d6 R k)
-    f4 = _at_zero(sp.eye(4) if std else A[3], q)
-    f5 = _at_zero(_prod(A[3:4] if std else A[3:5]), q)
+    ax = chain_of(robot).axis_frame  # frames of axes 4 and 5 relative to {3}: A_4 ⋯ A_ax
+    f4 = _at_zero(_prod(A[3:ax[3]]), q)
+    f5 = _at_zero(_prod(A[3:ax[4]]), q)
     p1, d1, p2, d2 = f4[:3, 3], f4[:3, 2], f5[:3, 3], f5[:3, 2]
     n12 = d1.cross(d2)
     t = sp.simplify((p2 - p1).cross(d2).dot(n12) / n12.dot(n12))
