@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
 from ._ik_chain import chain_columns, chain_of, wrap_angle
@@ -248,13 +249,13 @@ def _lock(robot: DHRobot, locked: dict[str, float]) -> tuple[DHRobot, list[int],
             raise ModelError(f"locked: {name} = {v:g} is outside its limits [{lo:g}, {hi:g}]")
         idx.append(k)
         vals.append(v)
-    rows = [i for i, link in enumerate(robot.links) if link.joint is not JointType.FIXED]
+    chain = dh_chain.chain_of(robot)
     links = list(robot.links)
     for k, v in zip(idx, vals):
-        link = links[rows[k]]
-        rev = link.joint is JointType.REVOLUTE
-        links[rows[k]] = replace(link, theta=link.theta + (v if rev else 0.0), d=link.d + (0.0 if rev else v),
-                                 joint=JointType.FIXED, q_limits=None, symbols=())
+        i = chain.joint_rows[k]
+        link = links[i]
+        theta, d = dh_chain.joint_motion(chain.rows[i], {k: v}, link.theta, link.d)  # v into θ or d
+        links[i] = replace(link, theta=theta, d=d, joint=JointType.FIXED, q_limits=None, symbols=())
     order = np.argsort(idx)
     return replace(robot, links=tuple(links), poses=()), [idx[i] for i in order], np.array(vals)[order]
 
