@@ -1,8 +1,8 @@
 """The same DH robot built in the peer libraries Pinocchio and roboticstoolbox-python.
 
-Chain algebra used (q enters through a pure z rotation/translation J(q) that commutes with Tz/Rz):
-standard rows  A_i = J(q_i) C_i   with C_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i);
-modified rows  A_i = C_i J(q_i)   with C_i = Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ_i) Tz(d_i).
+The Pinocchio model is the chain ``C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn`` of :mod:`denavit.chain` (joint k placed
+at C_{k-1}, the tool in C_n); each body sits in its DH link frame, reached from its joint's axis frame by the
+row constants in between (standard: the joint's own row; modified: none).
 
 Useful for comparing results, and for moving an arm described here into those libraries' tools.
 Neither library is a dependency of denavit: install them with ``pip install "denavit[peers]"``.
@@ -12,15 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .chain import chain_of
 from .errors import MissingDependencyError
 from .model import Convention, DHRobot, JointType
-from .numeric import dh_transform
 
 __all__ = ["to_pinocchio", "to_roboticstoolbox", "expand_q"]
-
-
-def _constant(robot, link):
-    return dh_transform(robot.convention, link.theta, link.d, link.a, link.alpha)
 
 
 def _need(module: str):
@@ -42,27 +38,22 @@ def to_pinocchio(robot: DHRobot):
     """
     pin = _need("pinocchio")
 
+    chain = chain_of(robot)
+    C = chain.constants
     model = pin.Model()
     parent = 0
-    pending = robot.base_matrix
-    std = robot.convention is Convention.STANDARD
-    for k, link in enumerate(robot.links):
-        C = _constant(robot, link)
-        if not link.is_joint:
-            pending = pending @ C
-            continue
-        if not std:
-            pending = pending @ C
-        jmodel = pin.JointModelRZ() if link.joint is JointType.REVOLUTE else pin.JointModelPZ()
-        parent = model.addJoint(parent, jmodel, pin.SE3(pending[:3, :3].copy(), pending[:3, 3].copy()), f"j{k}")
-        body_in_joint = C if std else np.eye(4)
-        if link.inertia is not None:
-            li = link.inertia
+    for k, r in enumerate(chain.joint_rows):
+        jmodel = pin.JointModelRZ() if chain.revolute[k] else pin.JointModelPZ()
+        parent = model.addJoint(parent, jmodel, pin.SE3(C[k][:3, :3].copy(), C[k][:3, 3].copy()), f"j{r}")
+        li = robot.links[r].inertia
+        if li is not None:
+            body_in_joint = np.eye(4)  # DH frame {r+1} seen from the axis frame
+            for i in range(chain.axis_frame[k], r + 1):
+                body_in_joint = body_in_joint @ chain.row_constant(i)
             inertia = pin.Inertia(li.mass, np.array(li.com), li.inertia_matrix)
             X = pin.SE3(body_in_joint[:3, :3].copy(), body_in_joint[:3, 3].copy())
             model.appendBodyToJoint(parent, X.act(inertia), pin.SE3.Identity())
-        pending = C if std else np.eye(4)
-    ee = pending @ robot.tool_matrix
+    ee = C[-1]
     fid = model.addFrame(pin.Frame("ee", parent, 0, pin.SE3(ee[:3, :3].copy(), ee[:3, 3].copy()), pin.FrameType.OP_FRAME))
     model.gravity.linear = np.array(robot.gravity)
     return model, model.createData(), fid
