@@ -20,42 +20,10 @@ from denavit.chain import COMPONENTS, FLOATS, Batch, Symbolic, chain_of, pack, w
 from denavit.symbolic import joint_symbols
 
 from _random_robots import random_q, random_robot
+from test_fk import elementary_fk as oracle  # T_w_e and frames {0}…{N} by 4×4 elementary products
 from conftest import robots
 
 ATOL = 1e-10
-
-
-def _rz(t):
-    c, s = np.cos(t), np.sin(t)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def _rx(t):
-    c, s = np.cos(t), np.sin(t)
-    return np.array([[1, 0, 0, 0], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
-
-
-def _t(axis, v):
-    T = np.eye(4)
-    T[axis, 3] = v
-    return T
-
-
-def oracle(robot, q):
-    """(T_w_e with tool, DH frames {0} … {N} with base) by 4×4 products of elementary motions."""
-    T, k, out = robot.base_matrix, 0, [robot.base_matrix]
-    for link in robot.links:
-        theta, d = link.theta, link.d
-        if link.joint is JointType.REVOLUTE:
-            theta, k = theta + q[k], k + 1
-        elif link.joint is JointType.PRISMATIC:
-            d, k = d + q[k], k + 1
-        if robot.convention is Convention.STANDARD:
-            T = T @ _rz(theta) @ _t(2, d) @ _t(0, link.a) @ _rx(link.alpha)
-        else:
-            T = T @ _rx(link.alpha) @ _t(0, link.a) @ _rz(theta) @ _t(2, d)
-        out.append(T)
-    return T @ robot.tool_matrix, np.array(out)
 
 
 def _batch_walk(robot, Q):
