@@ -143,3 +143,16 @@ def test_cli_report_topics_without_figures_ignore_an_existing_picture(tmp_path):
     o = h.run_cli(["report", "planar2r", "--topics", "model", "-o", "r.md"], tmp_path, {"r-planar2r-arm.png": b"x"})
     assert o.code == 0, o.describe()
     assert (tmp_path / "r-planar2r-arm.png").read_bytes() == b"x"
+
+
+@pytest.mark.parametrize("q_text", ["0 , pi / 4", "0, (pi/2)", "[0; pi/4]", "(0 0.5)"])
+def test_cli_report_reads_q_as_every_other_command_does(tmp_path, capsys, q_text):
+    """The report's numeric case is the q that ``fk`` reads from the same text (the report used its own splitter,
+    which cut ``pi / 4`` at the spaces and dropped the closing bracket of ``(pi/2)``)."""
+    from denavit.io import parse_values
+
+    out = tmp_path / "r.md"
+    assert main(["report", "planar2r", "-q", q_text, "--topics", "fk", "-o", str(out)]) == 0
+    capsys.readouterr()
+    shown = out.read_text().split("q = (", 1)[1].split(")", 1)[0]
+    np.testing.assert_allclose(parse_values(shown, 2), parse_values(q_text, 2), atol=1e-12)

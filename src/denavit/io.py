@@ -26,6 +26,7 @@ from .model import DH_FIELDS, DHLink, DHRobot, LinkInertia
 
 __all__ = [
     "load_data",
+    "split_values",
     "load_robot",
     "robot_from_dict",
     "robot_to_dict",
@@ -237,7 +238,7 @@ def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q"
     ([0.0, 0.5], [-1.5708, 1.5708])
     """
     if isinstance(text, str):
-        parts = _split_values(text, what)
+        parts = split_values(text, what)
     else:
         parts = list(text)
         if len(parts) > MAX_VALUES:
@@ -259,8 +260,13 @@ def parse_values(text: str | list[Any], n: int | None = None, *, what: str = "q"
 _CLOSE = {"(": ")", "[": "]"}
 
 
-def _split_values(text: str, what: str) -> list[str]:
-    """The values of a list text (see :func:`parse_values`), checked for balanced brackets and empty values."""
+def split_values(text: str, what: str = "values") -> list[str]:
+    """The values of a list text as written (see :func:`parse_values`), checked for balanced brackets and empty
+    values; commas (or semicolons) separate when there are any outside brackets, else spaces.
+
+    >>> split_values("[0, pi/4; (pi/2)]"), split_values("0 -pi/3")
+    (['0', 'pi/4', '(pi/2)'], ['0', '-pi/3'])
+    """
     if len(text) > MAX_VALUES_TEXT:
         raise ParseError(f"{what}: longer than {MAX_VALUES_TEXT} characters")
     t = text.strip().replace("\\pi", "pi")

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
+from ..io import parse_values, resolve_pose, split_values
 from ._common import (add_common, add_force, check_output, nonneg_int, add_q, joint_values, load, output_file,
                       stage_printer)
 
@@ -48,26 +49,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=cmd_import_table)
 
 
-def _parts(text: str | None) -> list[str] | None:
-    """``"0, pi/4; 1"`` → ``["0", "pi/4", "1"]``: split at commas, semicolons and spaces outside parentheses
-    (one pass, linear time)."""
-    if text is None:
-        return None
-    parts, cur, level = [], [], 0
-    for ch in text.strip().strip("[]()"):
-        if ch == "(":
-            level += 1
-        elif ch == ")":
-            level = max(level - 1, 0)
-        if level == 0 and (ch in ",;" or ch.isspace()):
-            parts.append("".join(cur))
-            cur = []
-        else:
-            cur.append(ch)
-    parts.append("".join(cur))
-    return [p for p in parts if p]
-
-
 def _figure_names(args: argparse.Namespace, robot, fmt: str) -> list[str]:
     """The picture files a .md/.tex report writes beside itself (checked before any work)."""
     if fmt not in ("md", "tex") or not args.output:
@@ -101,24 +82,20 @@ def cmd_report(args: argparse.Namespace):
     check_output(args, args.output, REPORT_SUFFIXES)
     _check_beside(args, _figure_names(args, robot, fmt))
     if fmt == "pdf":  # fail before the derivation, not after it: one error line, no wasted minutes
-        from ..report import latex_engine, pdf_from_latex
+        from ..report import latex_engine
 
         if latex_engine() is None:
             pdf_from_latex("", {})  # raises MissingDependencyError naming the engines looked for
     q = qd = wrench = None
     if args.q is not None:
         joint_values(args, robot, args.q)  # validates count, syntax and limits (or a named pose: qr, ...)
-        from ..io import resolve_pose
-
-        q = args.q.strip() if resolve_pose(robot, args.q) is not None else _parts(args.q)
+        q = args.q.strip() if resolve_pose(robot, args.q) is not None else split_values(args.q, "q")
     if args.qd is not None:
         joint_values(args, robot, args.qd, what="qd", rates=True)
-        qd = _parts(args.qd)
+        qd = split_values(args.qd, "qd")
     if args.wrench is not None:
-        from ..io import parse_values
-
         parse_values(args.wrench, 6, what="wrench")
-        wrench = _parts(args.wrench)
+        wrench = split_values(args.wrench, "wrench")
     topics = [t.strip() for t in args.topics.split(",") if t.strip()] if args.topics else None
     d = derive(robot, q, qd, wrench, topics=topics, simplify=args.simplify, deg=args.deg,
                progress=stage_printer(args, "report"))
