@@ -142,3 +142,17 @@ def test_fk_text_prints_no_rounding_noise_and_no_negative_zero(capsys):
     out = capsys.readouterr().out
     assert not re.search(r"(?<![\w.])-0(?![.\d])", out), out
     assert not re.search(r"e-1[0-9]", out), out
+
+
+def test_show_is_the_dh_table_of_print_robot(capsys):
+    """One presenter: ``denavit show`` prints ``print(robot)``'s table (limits as the file wrote them: the Puma
+    file writes -160deg in a radian file), plus whether inertial data is there."""
+    import denavit
+
+    robot = denavit.load_robot("puma560")
+    assert main(["show", "puma560"]) == 0
+    out = capsys.readouterr().out
+    assert out == str(robot) + "\ninertial data: yes\n"
+    assert "[-160°, 160°]" in out
+    assert main(["show", "puma560", "--deg"]) == 0  # --deg: every angle in degrees
+    assert "90°" in capsys.readouterr().out

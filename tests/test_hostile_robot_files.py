@@ -500,7 +500,8 @@ def test_show_is_readable(tmp_path):
     assert "deg(" not in o.out and "+ 0" not in o.out
     row1 = next(line for line in o.out.splitlines() if line.startswith("1 "))
     row2 = next(line for line in o.out.splitlines() if line.startswith("2 "))
-    assert row1.split()[2] == "-90°" and row1.split()[4] == "q1" and "[-170°, 170°]" in row1
+    # columns of the DH table (denavit.dh_table): j, joint, a, α, d, θ, limits
+    assert row1.split()[3] == "-90°" and row1.split()[5] == "q1" and "[-170°, 170°]" in row1
     assert "q2 - 30°" in row2
 
 

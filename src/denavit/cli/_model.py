@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
 import numpy as np
@@ -63,93 +62,20 @@ def cmd_robots(args: argparse.Namespace):
     return {"robots": rows}, "\n".join(lines)
 
 
-def _angle(x: float, deg: bool) -> str:
-    """An angle for the table: degrees with --deg; else an exact multiple of pi, whole degrees as ``-90°``, or rad."""
-    from ..io import value_text
-
-    if deg:
-        return f"{math.degrees(x):.6g}°"
-    return _degree_sign(value_text(x, angle=True)) if abs(x) >= 1e-12 else "0"
-
-
-def _degree_sign(text: str) -> str:
-    """``-90deg`` → ``-90°`` (display only; files keep ``deg``)."""
-    import re
-
-    return re.sub(r"(\d)deg\b", r"\1°", text)
-
-
-def _field(link, name: str, deg: bool, angle: bool) -> str:
-    """A DH field as written (parameters kept, ``deg(-90)`` shown as ``-90°``), else its value."""
-    from ..io import expression_text
-
-    text = dict(link.symbols).get(name)
-    if text is not None:
-        return _degree_sign(expression_text(text))
-    value = getattr(link, name)
-    return _angle(value, deg) if angle else f"{value:.6g}"
-
-
-def _plus_q(var: str, offset: str) -> str:
-    if offset in ("0", "0°"):
-        return var
-    return f"{var} - {offset[1:]}" if offset.startswith("-") else f"{var} + {offset}"
-
-
 def cmd_show(args: argparse.Namespace):
+    """The DH table as ``print(robot)`` shows it (``denavit.dh_table``), and the model as JSON."""
+    from ..display import dh_table
+
     robot = load(args)
-    from ..model import JointType
-
-    head = ["i", "a_{i-1}" if robot.convention.value == "modified" else "a_i",
-            "alpha_{i-1}" if robot.convention.value == "modified" else "alpha_i", "d_i", "theta_i", "joint", "limits"]
-    table = []
-    k = 0
-    data_rows = []
-    for i, link in enumerate(robot.links, start=1):
-        a = _field(link, "a", args.deg, False)
-        alpha = _field(link, "alpha", args.deg, True)
-        d = _field(link, "d", args.deg, False)
-        theta = _field(link, "theta", args.deg, True)
-        lim = ""
-        if link.is_joint:
-            k += 1
-            if link.joint is JointType.REVOLUTE:
-                theta = _plus_q(f"q{k}", theta)
-            else:
-                d = _plus_q(f"q{k}", d)
-            if link.q_limits:
-                from ..io import expression_text
-
-                lo, hi = link.q_limits
-                texts = dict(link.symbols)
-                if "limits0" in texts and not args.deg:
-                    lim = "[" + ", ".join(_degree_sign(expression_text(texts[f"limits{i}"])) for i in (0, 1)) + "]"
-                else:
-                    conv = (lambda v: _angle(v, args.deg)) if link.joint is JointType.REVOLUTE else (lambda v: f"{v:.6g} m")
-                    lim = f"[{conv(lo)}, {conv(hi)}]"
-        table.append([str(i), a, alpha, d, theta, link.joint.value, lim])
-        data_rows.append({"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta,
-                          "joint": link.joint.value, "limits": list(link.q_limits) if link.q_limits else None,
-                          "expressions": dict(link.symbols)})
-    widths = [max(len(r[c]) for r in [head] + table) for c in range(len(head))]
-    lines = [f"{robot.name}: {robot.description}".rstrip(": "),
-             f"convention: {robot.convention.value} "
-             + ("(A_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i))" if robot.convention.value == "standard"
-                else "(A_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i))"),
-             f"joints: {robot.dof} ({', '.join(t.value for t in robot.joint_types)})", ""]
-    lines.append("  ".join(h.ljust(w) for h, w in zip(head, widths)))
-    lines += ["  ".join(c.ljust(w) for c, w in zip(r, widths)) for r in table]
-    if robot.parameters:
-        lines += ["", "parameters: " + ", ".join(f"{k} = {v:g}" for k, v in robot.parameters)]
-    if not np.allclose(robot.base_matrix, np.eye(4)):
-        lines += ["", "base:", matrix_text(robot.base_matrix)]
-    if not np.allclose(robot.tool_matrix, np.eye(4)):
-        lines += ["", "tool:", matrix_text(robot.tool_matrix)]
-    lines += ["", f"gravity: {list(robot.gravity)} m/s^2", f"inertial data: {'yes' if robot.has_dynamics else 'no'}"]
+    text = dh_table(robot, deg=True if args.deg else None)
+    text += f"\ninertial data: {'yes' if robot.has_dynamics else 'no'}"
+    data_rows = [{"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta, "joint": link.joint.value,
+                  "limits": list(link.q_limits) if link.q_limits else None, "expressions": dict(link.symbols)}
+                 for link in robot.links]
     data = {"robot": robot.name, "convention": robot.convention.value, "dof": robot.dof, "rows": data_rows,
             "parameters": dict(robot.parameters), "base": robot.base_matrix, "tool": robot.tool_matrix,
             "gravity": list(robot.gravity), "dynamics": robot.has_dynamics}
-    return data, "\n".join(lines)
+    return data, text
 
 
 def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:

@@ -110,7 +110,11 @@ def _node(node: _expr.Node, parent: int = 0) -> Cell:
         return t, x
     name, args = node[1], [_node(a) for a in node[2]]
     if name == "deg":
-        t, x = _node(node[2][0], 3)
+        arg = node[2][0]
+        if arg[0] == "neg" and arg[1][0] in ("num", "name"):  # deg(-170) → -170°, not (-170)°
+            t, x = _node(arg[1], 3)
+            return f"-{t}°", f"-{x}^\\circ"
+        t, x = _node(arg, 3)
         return f"{t}°", f"{x}^\\circ"
     t = f"{name}({', '.join(a[0] for a in args)})"
     inner = ", ".join(a[1] for a in args)
@@ -154,10 +158,18 @@ def _joint_value(x: float, kind: JointType, deg: bool) -> Cell:
     return _angle(x, deg) if kind is JointType.REVOLUTE else _length(x)
 
 
-def _limits(link: Any, deg: bool) -> Cell:
+def _limits(link: Any, deg: bool, as_written: bool = False) -> Cell:
+    """``[lo, hi]``; ``as_written``: as the file wrote them when it did (``-160deg`` in a radian file → -160°)."""
     if link.q_limits is None:
         return "", ""
-    lo, hi = (_joint_value(v, link.joint, deg) for v in link.q_limits)
+    texts = dict(link.symbols)
+    if as_written and "limits0" in texts and "limits1" in texts:
+        try:
+            lo, hi = _expression(texts["limits0"]), _expression(texts["limits1"])
+        except ParseError:
+            lo, hi = (_joint_value(v, link.joint, deg) for v in link.q_limits)
+    else:
+        lo, hi = (_joint_value(v, link.joint, deg) for v in link.q_limits)
     unit = " m" if link.joint is JointType.PRISMATIC else ""
     return f"[{lo[0]}, {hi[0]}]{unit}", f"[{lo[1]}, {hi[1]}]" + ("\\,\\mathrm{m}" if unit else "")
 

@@ -22,7 +22,7 @@ PICTURE_DPI = 72
 # the DH table
 
 
-def _rows(robot: DHRobot, deg: bool) -> list[list[Cell]]:
+def _rows(robot: DHRobot, deg: bool, as_written: bool = False) -> list[list[Cell]]:
     rows = []
     k = 0
     for link in robot.links:
@@ -37,7 +37,7 @@ def _rows(robot: DHRobot, deg: bool) -> list[list[Cell]]:
             j: Cell = (str(k), str(k))
         else:
             j = ("-", "-")
-        rows.append([j, (link.joint.value, link.joint.value), a, alpha, d, theta, _limits(link, deg)])
+        rows.append([j, (link.joint.value, link.joint.value), a, alpha, d, theta, _limits(link, deg, as_written)])
     return rows
 
 
@@ -127,7 +127,7 @@ def dh_table(robot: DHRobot, deg: bool | None = None, fmt: str = "text") -> str:
     if fmt not in TABLE_FORMATS:
         raise ValueError(f"unknown table format {fmt!r}; choose one of {', '.join(TABLE_FORMATS)}")
     use_deg = _use_degrees(robot, deg)
-    rows = _rows(robot, use_deg)
+    rows = _rows(robot, use_deg, as_written=deg is None)  # no unit asked for: limits as the file wrote them
     head = _header(robot)
     notes = _notes(robot, use_deg)
     title = _title(robot, use_deg)
