@@ -79,8 +79,7 @@ def _judge(robot: DHRobot, raw: Any, label: str, rng: np.random.Generator, deg: 
     """One claim's verdict; a failure inside the checker is that claim's "unreadable" verdict, never the file's."""
     try:
         return check_claim(robot, raw, label, rng, deg, detail=detail)
-    except (DenavitError, ArithmeticError, LookupError, ValueError, TypeError, AttributeError, RuntimeError,
-            MemoryError, np.linalg.LinAlgError) as exc:
+    except Exception as exc:  # noqa: BLE001 - a bug of ours on one claim must not abort the file
         cid = str(raw.get("id", label))[:80] if isinstance(raw, dict) else label
         qname = str(raw.get("quantity", "?"))[:80] if isinstance(raw, dict) else "?"
         if isinstance(exc, DenavitError):

@@ -21,7 +21,8 @@ from ..errors import ParseError
 from ..io import with_parameters
 from ..model import DHRobot, JointType
 from ._hints import hints_for
-from ._latex import parse_math, parse_matrix
+from ._latex import RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix
+from ._text import split_top
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver
 
@@ -62,7 +63,10 @@ def _values(raw: Any, resolve) -> list[list[tuple]]:
     if isinstance(raw, (int, float)) and not isinstance(raw, bool):
         return [[_expr.parse(raw)]]
     if isinstance(raw, str):
-        return parse_matrix(raw, resolve)
+        try:
+            return parse_matrix(raw, resolve)
+        except RaggedMatrix as exc:
+            raise ShapeMismatch(str(exc)) from None
     if isinstance(raw, list) and raw:
         if all(isinstance(r, list) for r in raw):
             rows = raw
@@ -80,7 +84,7 @@ def _values(raw: Any, resolve) -> list[list[tuple]]:
                     raise ParseError(f"entry ({i}, {j}) {str(v)[:40]!r}: {exc}") from None
             out.append(cells)
         if len({len(r) for r in out}) != 1:
-            raise ParseError("rows of different lengths in the value")
+            raise ShapeMismatch(f"rows of different lengths {[len(r) for r in out]} in the value")
         return out
     raise ParseError("'value' must be a formula (string) or a list of entries / rows")
 
@@ -100,40 +104,90 @@ def _decimals(node: tuple) -> int:
     return 0
 
 
-def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
+class ShapeMismatch(ParseError):
+    """The claimed value has another shape than the quantity: a wrong result (verdict "incorrect: shape …")."""
+
+
+def _describe(shape: tuple[int, ...]) -> str:
+    if len(shape) == 0:
+        return "one entry"
+    if len(shape) == 1:
+        return f"a vector of {shape[0]} entries"
+    return f"a {shape[0]}×{shape[1]} matrix"
+
+
+def _fits(claimed: list[list[tuple]], shape: tuple[int, ...]) -> bool:
     r, c = len(claimed), len(claimed[0])
     if len(shape) == 0:
-        if (r, c) != (1, 1):
-            raise ParseError(f"expected one entry, got a {r}×{c} value")
-        return claimed
+        return (r, c) == (1, 1)
     if len(shape) == 1:
-        if (r, c) == (shape[0], 1):
-            return claimed
-        if (r, c) == (1, shape[0]):
-            return [[x] for x in claimed[0]]
-        raise ParseError(f"expected a vector of {shape[0]} entries, got a {r}×{c} value")
-    if (r, c) != shape:
-        raise ParseError(f"expected a {shape[0]}×{shape[1]} matrix, got {r}×{c}")
+        return (r, c) in ((shape[0], 1), (1, shape[0]))
+    return (r, c) == shape
+
+
+def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
+    r, c = len(claimed), len(claimed[0])
+    if not _fits(claimed, shape):
+        raise ShapeMismatch(f"expected {_describe(shape)}, got a {r}×{c} value")
+    if len(shape) == 1 and (r, c) == (1, shape[0]) and shape[0] != 1:
+        return [[x] for x in claimed[0]]
     return claimed
+
+
+_ROW_NAMES = ("vx", "vy", "vz", "ωx", "ωy", "ωz")
+
+
+def _readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: list[list[tuple]]):
+    """Ways to read a value of another shape as part of the quantity: [(label or None, function on one truth)].
+
+    A 3×4 value of a pose is its top rows [R | p]; a 3-row (or 2-row) Jacobian or twist written without 'rows' is
+    read as its linear rows, its angular rows, or the rows (vx, vy, ωz) of a planar arm.  None fits: ShapeMismatch.
+    """
+    if _fits(cells, shape):
+        return [(None, lambda t: t)]
+    r, c = len(cells), len(cells[0])
+    out = []
+    if qty.fk_like and shape == (4, 4) and (r, c) == (3, 4):
+        out.append(("the top 3 rows [R | p] of the 4×4 transform", lambda t: t[:3]))
+    six = (len(shape) >= 1 and shape[0] == 6 and qty.name in ("jacobian", "twist") and "rows" not in spec
+           and "entry" not in spec)
+    if six:
+        tail = shape[1:]
+        width_ok = (c == tail[0]) if tail else (c == 1 or r == 1)
+        m = r if tail or c == 1 else c
+        if width_ok and m in (2, 3):
+            sets = [(0, 1, 2), (0, 1, 5), (3, 4, 5)] if m == 3 else [(0, 1)]
+            for rows in sets:
+                out.append((f"the rows ({', '.join(_ROW_NAMES[i] for i in rows)})",
+                            lambda t, rows=rows: t[list(rows)]))
+    if not out:
+        r, c = len(cells), len(cells[0])
+        what = {"jacobian": " (rows v, ω; one column per joint)", "twist": " (v, ω)",
+                "torques": " (one per joint)"}.get(qty.name, "")
+        raise ShapeMismatch(f"expected {_describe(shape)}{what}, got a {r}×{c} value")
+    return out
 
 
 def _no_names(ident) -> tuple:
     raise ParseError(f"unknown symbol {ident.plain!r} (joint values are numbers; pi is allowed)")
 
 
-def numbers(raw: Any, n: int, what: str) -> np.ndarray:
-    """``"-pi/3, 0, \\frac{\\pi}{2}"`` or a YAML list → floats, read by the restricted LaTeX/plain reader."""
+def numbers(raw: Any, n: int, what: str, *, marked: list[bool] | None = None) -> np.ndarray:
+    """``"-pi/3, 0, \\frac{\\pi}{2}"`` or a YAML list → floats, read by the restricted LaTeX/plain reader.
+
+    The list may be wrapped in ``[ ]`` or ``( )`` as pasted from a report; an entry written with a degree mark
+    (``30^\\circ``, ``30^{\\circ}``, ``30°``) is converted to radians (``marked`` receives, per entry, whether
+    it had one).
+    """
     if isinstance(raw, str):
-        parts, level, cur = [], 0, ""
-        for ch in raw.strip().strip("[]").strip():
-            level += ch in "({[" and 1 or 0
-            level -= ch in ")}]" and 1 or 0
-            if ch in ",;" and level == 0:
-                parts.append(cur)
-                cur = ""
-            else:
-                cur += ch
-        parts.append(cur)
+        text = raw.strip().strip("$").strip()
+        text = after_last_equals(text)
+        for a, b in (("\\left(", "\\right)"), ("\\left[", "\\right]")):
+            if text.startswith(a) and text.endswith(b):
+                text = text[len(a) - 1:len(text) - len(b)] + b[-1]
+        if len(text) >= 2 and (text[0], text[-1]) in (("(", ")"), ("[", "]")) and encloses(text):
+            text = text[1:-1]
+        parts = split_top(text, (",", ";"))
         items: list[Any] = [p for p in parts if p.strip()]
     elif isinstance(raw, list):
         items = raw
@@ -148,13 +202,26 @@ def numbers(raw: Any, n: int, what: str) -> np.ndarray:
             out.append(_expr.evaluate(node))
         except ParseError as exc:
             raise ParseError(f"{what}: value {i} ({str(v)[:40]!r}): {exc}") from None
+        if marked is not None:
+            marked.append(_has_degrees(node))
     return np.array(out, dtype=float)
 
 
+def _has_degrees(node: tuple) -> bool:
+    if node[0] == "call":
+        return node[1] == "deg" or any(_has_degrees(a) for a in node[2])
+    if node[0] == "neg":
+        return _has_degrees(node[1])
+    if node[0] == "bin":
+        return _has_degrees(node[2]) or _has_degrees(node[3])
+    return False
+
+
 def _joint_values(raw: Any, robot: DHRobot, what: str, deg: bool) -> np.ndarray:
-    vals = numbers(raw, robot.dof, what)
-    if deg:
-        rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+    marked: list[bool] = []
+    vals = numbers(raw, robot.dof, what, marked=marked)
+    if deg:  # angle_unit: deg - except entries that carry their own degree mark (already in radians)
+        rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types]) & ~np.array(marked, dtype=bool)
         vals = np.where(rev, np.radians(vals), vals)
     return vals
 
@@ -236,10 +303,39 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         if "entry" in spec:  # one entry of the quantity: hints then compare that entry too
             qty = replace(qty, truth=_entry_of(qty.truth))
         truth = np.array([np.asarray(qty.truth(p, spec), dtype=float) for p in points])  # (P, *shape)
+        try:
+            readings = _readings(qty, spec, truth.shape[1:], cells)
+        except ShapeMismatch as exc:
+            return Verdict(cid, qty.name, "incorrect", f"incorrect: shape: {exc}", expected=truth[0].tolist(),
+                           method="the shape of the value compared with the quantity's")
+    except ShapeMismatch as exc:
+        return Verdict(cid, qname, "incorrect", f"incorrect: shape: {exc}",
+                       method="the shape of the value compared with the quantity's")
+    except ParseError as exc:
+        return Verdict(cid, qname, "unreadable", str(exc))
+    if len(readings) == 1 and readings[0][0] is None:
+        return _compare(robot, cid, qty, spec, cells, points, truth, rng, detail)
+    verdicts = []
+    for label, fn in readings:
+        q2 = replace(qty, truth=lambda p, s, f=fn, t=qty.truth: f(np.asarray(t(p, s), dtype=float)))
+        t2 = np.array([fn(t) for t in truth])
+        v = _compare(robot, cid, q2, spec, _shape_to(cells, t2.shape[1:]), points, t2, rng, False)
+        if v.verdict == "correct":
+            return replace(v, message=f"{v.message}, read as {label}")
+        verdicts.append((len(v.entries), label, q2, t2))
+    _, label, q2, t2 = min(verdicts, key=lambda x: x[0])
+    v = _compare(robot, cid, q2, spec, _shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
+    others = "; ".join(lb for _, lb, _, _ in verdicts if lb != label)
+    return replace(v, message=f"{v.message}, read as {label}" + (f" (also wrong read as {others})" if others else ""))
+
+
+def _compare(robot, cid, qty, spec, cells, points, truth, rng, detail) -> Verdict:
+    """The verdict on claimed cells (already of the truth's shape) against the truth at the points."""
+    try:
         cells = _shape_to(cells, truth.shape[1:])
         claimed = np.array([_evaluate(cells, p).reshape(truth.shape[1:]) for p in points])
     except ParseError as exc:
-        return Verdict(cid, qname, "unreadable", str(exc))
+        return Verdict(cid, qty.name, "unreadable", str(exc))
     dec = np.array([[_decimals(c) for c in row] for row in cells]).reshape(truth.shape[1:])
     tol = np.where(dec >= 2, 10.0 ** (-dec.astype(float)), 0.0)  # one unit of the last decimal written
     scale = np.maximum(1.0, np.abs(truth))

@@ -23,7 +23,7 @@ from typing import Callable
 from .. import _expr
 from ..errors import ParseError
 
-__all__ = ["Ident", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
+__all__ = ["Ident", "RaggedMatrix", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
            "MAX_DIGITS", "Resolver"]
 
 MAX_CHARS = 20_000
@@ -55,6 +55,10 @@ _TOKEN = re.compile(
 )
 
 
+class RaggedMatrix(ParseError):
+    """A matrix whose rows have different lengths (for a claim: a value of the wrong shape, not unreadable)."""
+
+
 @dataclass(frozen=True)
 class Ident:
     """A name as written: ``base`` (``"theta"``, ``"L"``, ``"C"``), ``sub`` (subscript text, e.g. ``"12"``),
@@ -74,12 +78,17 @@ class Ident:
 Resolver = Callable[[Ident], tuple]
 
 
+_JOINT_SPACE = re.compile(r"(\\(?:var)?theta|\\dot\{?\\theta\}?|\\ddot\{?\\theta\}?)\s+(\d)(?![\d.])")
+_OF_TIME = re.compile(r"(?<=[A-Za-z0-9}])\s*\(\s*t\s*\)")
+
+
 def _normalize(text: str) -> str:
     text = re.sub(r"\\operatorname\{atan\}_\{?2\}?", r"\\operatorname{atan2}", text)  # sympy's atan2
     text = re.sub(r"([θαβφψωτϑσ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
     for k, v in _UNICODE.items():
         text = text.replace(k, v)
-    return text
+    text = _JOINT_SPACE.sub(lambda m: f"{m.group(1)}_{{{m.group(2)}}}", text)  # \\theta 2 → \\theta_{2}
+    return _OF_TIME.sub("", text)  # \\theta_1(t) → \\theta_1
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
@@ -198,9 +207,22 @@ class _Parser:
 
     def power(self) -> tuple:
         base = self.atom()
-        while (t := self.peek()) is not None and t[1] in ("^", "**"):
+        while (t := self.peek()) is not None and t[1] in ("^", "**", "\\degree"):
             self.take()
-            base = ("bin", "^", base, self.exponent())
+            if t[1] == "\\degree":  # 30° (a degree sign: the value in radians)
+                base = ("call", "deg", (base,))
+                continue
+            nxt, nxt2 = self.peek(), self.peek(1)
+            if nxt is not None and nxt[1] == "\\circ":  # 30^\circ
+                self.take()
+                base = ("call", "deg", (base,))
+            elif nxt is not None and nxt[1] == "{" and nxt2 is not None and nxt2[1] == "\\circ":  # 30^{\circ}
+                self.take()
+                self.take()
+                self.take("}")
+                base = ("call", "deg", (base,))
+            else:
+                base = ("bin", "^", base, self.exponent())
         if (t := self.peek()) is not None and t[1] == "'":
             raise ParseError("primes (') are not supported; write derivatives with \\dot")
         return base
@@ -324,6 +346,8 @@ class _Parser:
                 self.take("}")
         else:
             args = [self.power_free_atom()]
+        if fname == "atan" and len(args) == 2:  # \\arctan(y, x): the two-argument arctangent
+            fname = "atan2"
         want = _expr.FUNCTIONS[fname]
         if len(args) != want:
             raise ParseError(f"{fname} takes {want} argument(s), got {len(args)}")
@@ -463,14 +487,82 @@ def split_matrix(text: str) -> list[list[str]] | None:
     return [[c.strip() for c in r.split("&")] for r in rows]
 
 
+_ENV = re.compile(r"\\(begin|end)\{[A-Za-z*]+\}")
+
+
+def after_last_equals(text: str) -> str:
+    """What follows the last ``=`` outside brackets and matrix environments (``J = [\\begin…] = \\begin…``)."""
+    level, cut, k = 0, -1, 0
+    while k < len(text):
+        m = _ENV.match(text, k)
+        if m:
+            level += 1 if m.group(1) == "begin" else -1
+            k = m.end()
+            continue
+        ch = text[k]
+        if ch in "({[":
+            level += 1
+        elif ch in ")}]":
+            level -= 1
+        elif ch == "=" and level == 0:
+            cut = k
+        k += 1
+    return text[cut + 1:] if cut >= 0 else text
+
+
+def split_list(text: str) -> list[list[str]] | None:
+    """``[a, b, c]`` / ``(a, b, c)`` (a column) or ``[a, b; c, d]`` / ``[[a, b], [c, d]]`` (rows), else None."""
+    t = text.strip()
+    for a, b in (("\\left[", "\\right]"), ("\\left(", "\\right)")):
+        if t.startswith(a) and t.endswith(b):
+            t = t[len(a) - 1:len(t) - len(b)] + b[-1]
+    if len(t) < 2 or (t[0], t[-1]) not in (("[", "]"), ("(", ")")) or not encloses(t):
+        return None
+    from ._text import split_top
+
+    body = t[1:-1]
+    rows = split_top(body, (";", "\\\\"))
+    if len(rows) > 1:
+        return [[c.strip() for c in split_top(r, (",", "&"))] for r in rows if r.strip()]
+    items = [c.strip() for c in split_top(body, (",",))]
+    if len(items) < 2:
+        return None
+    if all(len(i) >= 2 and i[0] == "[" and i[-1] == "]" and encloses(i) for i in items):
+        return [[c.strip() for c in split_top(i[1:-1], (",",))] for i in items]
+    return [[c] for c in items]
+
+
+def encloses(t: str) -> bool:
+    """The first bracket of ``t`` closes at its last character."""
+    level = 0
+    for k, ch in enumerate(t):
+        level += ch in "([{"
+        level -= ch in ")]}"
+        if level == 0:
+            return k == len(t) - 1
+    return False
+
+
 def parse_matrix(text: str, resolve: Resolver) -> list[list[tuple]]:
-    """A LaTeX matrix (or a single expression, as a 1×1 matrix) → rows of trees; errors name the entry."""
+    """A LaTeX matrix (or a single expression, as a 1×1 matrix) → rows of trees; errors name the entry.
+
+    Only the part after the last ``=`` counts (a definition pasted before it is skipped); a bracketed list
+    ``[a, b, c]`` is a column and ``[a, b; c, d]`` a matrix.  Rows of different lengths raise
+    :class:`RaggedMatrix`.
+    """
+    if len(text) > MAX_CHARS:
+        raise ParseError(f"expression longer than {MAX_CHARS} characters")
+    text = after_last_equals(text.strip().strip("$"))
     cells = split_matrix(text)
     if cells is None:
+        cells = split_list(_normalize(text))
+    if cells is None:
         return [[parse_math(text, resolve)]]
+    if not cells:
+        raise ParseError("empty matrix")
     width = max(len(r) for r in cells)
     if any(len(r) != width for r in cells):
-        raise ParseError(f"rows of different lengths {[len(r) for r in cells]} in the matrix")
+        raise RaggedMatrix(f"rows of different lengths {[len(r) for r in cells]} in the matrix")
     out = []
     for i, row in enumerate(cells, start=1):
         out_row = []

@@ -78,17 +78,25 @@ def _frame(spec: dict[str, Any]) -> Frame:
 
 def _jacobian(p: Point, spec: dict[str, Any]) -> np.ndarray:
     J = N.geometric_jacobian(p.robot, p.q, frame=_frame(spec))
-    rows = spec.get("rows", "all")
-    if rows not in ("all", "linear", "angular"):
-        raise ParseError(f"'rows' must be all, linear or angular, got {rows!r}")
-    J = J[:3] if rows == "linear" else J[3:] if rows == "angular" else J
+    J = J[_rows(spec)]
     if "column" in spec:
         return J[:, _index(spec, "column", 1, p.robot.dof) - 1]
     return J
 
 
+def _rows(spec: dict[str, Any]) -> list[int]:
+    """The task rows a claim names: all, linear, angular, planar (vx, vy, ωz) or names such as ``vx,vy,wz``."""
+    rows = spec.get("rows", "all")
+    named = {"all": "vx,vy,vz,wx,wy,wz", "linear": "vx,vy,vz", "angular": "wx,wy,wz", "planar": "vx,vy,wz"}
+    try:
+        return N.select_rows(named.get(rows, rows) if isinstance(rows, str) else rows)
+    except (ValueError, TypeError, AttributeError):
+        raise ParseError(f"'rows' must be all, linear, angular, planar or row names such as vx,vy,wz; got "
+                         f"{str(rows)[:40]!r}") from None
+
+
 def _twist(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)) @ p.qd
+    return (N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)) @ p.qd)[_rows(spec)]
 
 
 def _torques(p: Point, spec: dict[str, Any]) -> np.ndarray:
