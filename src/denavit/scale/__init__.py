@@ -1,0 +1,36 @@
+"""Workspace and reachability at scale: streamed sampling, voxel occupancy, volume with an interval.
+
+The same task functions run in this process, in a thread or process pool, or on a ``dask.distributed``
+cluster given by address (the optional extra ``denavit[scale]``); results depend on the seed only, not on
+the number of workers or the chunk size.  See ``docs/workspace.md``.
+
+Importing this package needs numpy only; dask is imported when a cluster or a dask array is asked for.
+"""
+
+from ._sampler import BLOCK, FINE_CELLS, MAX_CELLS, Grid, PositionFK, reach_bound, sampling_limits
+from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
+from ._volume import VolumeEstimate, estimate_volume
+from ._occupancy import (DEFAULT_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy, new_seed, occupancy,
+                         sample_positions)
+
+__all__ = [
+    "BLOCK",
+    "CONNECT_TIMEOUT",
+    "DEFAULT_CHUNK",
+    "FINE_CELLS",
+    "LOCAL_SCHEDULERS",
+    "MAX_CELLS",
+    "MAX_SAMPLES",
+    "Grid",
+    "Occupancy",
+    "PositionFK",
+    "VolumeEstimate",
+    "check_scheduler",
+    "estimate_volume",
+    "load_occupancy",
+    "new_seed",
+    "occupancy",
+    "reach_bound",
+    "sample_positions",
+    "sampling_limits",
+]

@@ -1,0 +1,214 @@
+"""The streaming workspace: voxel occupancy counts of any number of samples, in bounded memory."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model import DHRobot
+from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
+from ._schedule import Progress, run
+from ._volume import VolumeEstimate, estimate_volume
+
+__all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
+           "new_seed"]
+
+#: Most samples in one run (10¹⁰ ≈ 1 h here with the default FK; bounded time).
+MAX_SAMPLES = 10**10
+#: Default samples per task (4 random blocks; about 60 MB of scratch per worker with the default FK).
+DEFAULT_CHUNK = 4 * BLOCK
+#: Most samples per task.
+MAX_CHUNK = 64 * BLOCK
+
+
+def new_seed() -> int:
+    """A fresh 63-bit seed (reported with the results so the run can be repeated)."""
+    return int(np.random.SeedSequence().generate_state(2, np.uint64)[0] >> np.uint64(1))
+
+
+@dataclass(frozen=True)
+class Occupancy:
+    """Sample counts per cell of the reach box, and the figures derived from them (world frame, metres).
+
+    Attributes
+    ----------
+    counts : ndarray of uint64, shape (side,) * dim
+        Samples per cell at the finest edge ``grid.resolution``; cell index i ↔ coordinates lo + h·[i, i+1)
+        along ``grid.basis`` from ``grid.centre``.
+    grid : Grid
+    samples, seed : int
+    bounds_min, bounds_max : ndarray (3,)
+        Axis-aligned bounds of the samples [m].
+    reach : float
+        Largest distance of a sample from the base origin [m].
+    estimate : VolumeEstimate
+        Narrowest-interval volume (area when ``planar``) over the grid levels.
+    levels : list of VolumeEstimate
+        The estimate at each level (finest first).
+    """
+
+    counts: np.ndarray
+    grid: Grid
+    samples: int
+    seed: int
+    bounds_min: np.ndarray
+    bounds_max: np.ndarray
+    reach: float
+    estimate: VolumeEstimate
+    levels: list = field(default_factory=list)
+
+    @property
+    def planar(self) -> bool:
+        return self.grid.dim == 2
+
+    @property
+    def extent(self) -> np.ndarray:
+        return self.bounds_max - self.bounds_min
+
+    def occupied_centres(self) -> np.ndarray:
+        """World coordinates (k, 3) of the centres of the occupied cells at the finest edge."""
+        return self.grid.cell_centres(np.argwhere(self.counts > 0))
+
+    def summary(self) -> dict:
+        """The figures as plain data (the keys of ``workspace --json``)."""
+        e = self.estimate
+        size = {"volume": 0.0 if self.planar else e.value, "area": e.value if self.planar else 0.0}
+        return {"samples": self.samples, "seed": self.seed, "resolution": e.resolution,
+                "bounds_min": self.bounds_min.tolist(), "bounds_max": self.bounds_max.tolist(),
+                "extent": self.extent.tolist(), "reach": self.reach, "voxels": e.occupied,
+                "planar": self.planar, **size, "interval": [e.low, e.high], "interior_voxels": e.interior,
+                "unseen_voxels": e.unseen, "finest_resolution": self.grid.resolution}
+
+    def save(self, path) -> None:
+        """Write the counts and grid to a ``.npz`` file (read back with :func:`load_occupancy`)."""
+        g, e = self.grid, self.estimate
+        np.savez_compressed(path, counts=self.counts, centre=g.centre, basis=g.basis,
+                            resolution=g.resolution, side=g.side, levels=g.levels, samples=self.samples,
+                            seed=np.uint64(self.seed), bounds_min=self.bounds_min, bounds_max=self.bounds_max,
+                            reach=self.reach, estimate=np.array([e.value, e.low, e.high, e.resolution]))
+
+
+def load_occupancy(path) -> Occupancy:
+    """An :class:`Occupancy` saved by :meth:`Occupancy.save` (plain arrays; no pickle)."""
+    with np.load(path, allow_pickle=False) as z:
+        grid = Grid(z["centre"], z["basis"], float(z["resolution"]), int(z["side"]), int(z["levels"]))
+        counts = z["counts"]
+        best, levels = estimate_volume(counts, grid.resolution, grid.levels)
+        return Occupancy(counts, grid, int(z["samples"]), int(z["seed"]), z["bounds_min"], z["bounds_max"],
+                         float(z["reach"]), best, levels)
+
+
+def _tasks(samples: int, chunk: int):
+    blocks = -(-samples // BLOCK)
+    per = max(1, chunk // BLOCK)
+    for first in range(0, blocks, per):
+        yield first, min(per, blocks - first)
+
+
+def _check_sizes(samples: int, chunk: int) -> None:
+    if isinstance(samples, bool) or int(samples) != samples or not 1 <= samples <= MAX_SAMPLES:
+        raise ModelError(f"samples must be a whole number from 1 to {MAX_SAMPLES:.0e}, got {samples}")
+    if isinstance(chunk, bool) or int(chunk) != chunk or not BLOCK <= chunk <= MAX_CHUNK:
+        raise ModelError(f"chunk must be a whole number of samples from {BLOCK} to {MAX_CHUNK}, got {chunk}")
+
+
+def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None = None, seed: int | None = None,
+              *, scheduler: Any = "threads", workers: int | None = None, chunk: int = DEFAULT_CHUNK,
+              fk: Callable | None = None, progress: bool | None = False) -> Occupancy:
+    """Stream ``samples`` uniform joint configurations through FK into voxel counts; volume with an interval.
+
+    Parameters
+    ----------
+    robot : DHRobot
+    samples : int
+        Configurations, uniform inside the joint limits (unlimited revolute joints: [−π, π]); 1 … 10¹⁰.
+    resolution : float, optional
+        Cell edge [m].  Default: the reach box / 256 (3-D) or / 2048 (planar), and coarser levels ×2, ×4 …
+        from which the narrowest volume interval is reported.  Given: that edge only.
+    seed : int, optional
+        Seed of the counter-based random stream; ``None`` draws one (returned in the result).
+    scheduler : {"threads", "processes", "synchronous"}, str address or distributed.Client
+        Where the tasks run; ``"tcp://host:8786"`` connects to a dask.distributed scheduler.
+    workers : int, optional
+        Local pool size (default: the CPU count).
+    chunk : int
+        Samples per task (rounded down to whole blocks of 65 536).  Results do not depend on it.
+    fk : callable, optional
+        Joint values (m, n) → end-effector origins (m, 3) or poses (m, 4, 4); default
+        :class:`PositionFK` (``denavit.forward_kinematics``).
+    progress : bool or None
+        Progress line with ETA on stderr (``None``: when stderr is a terminal).
+
+    Returns
+    -------
+    Occupancy
+
+    Examples
+    --------
+    >>> import denavit
+    >>> from denavit.scale import occupancy
+    >>> ws = occupancy(denavit.load_robot("planar2r"), 200_000, seed=1, scheduler="synchronous")
+    >>> ws.planar, ws.estimate.low <= 3.1416 * 2.0**2 <= ws.estimate.high
+    (True, True)
+    """
+    _check_sizes(samples, chunk)
+    seed = new_seed() if seed is None else int(seed)
+    if seed < 0:
+        raise ModelError(f"seed must be a whole number >= 0, got {seed}")
+    job = make_job(robot, int(samples), resolution, seed, fk)
+    g = job.grid
+    counts = np.zeros(g.shape, dtype=np.uint64)
+    flat = counts.reshape(-1)
+    lo, hi, reach = np.full(3, np.inf), np.full(3, -np.inf), 0.0
+    bar = Progress(int(samples), "samples", progress)
+    try:
+        for idx, cnt, bmin, bmax, r, m in run(run_task, ((job, f, c) for f, c in _tasks(job.samples, chunk)),
+                                              scheduler, workers):
+            flat[idx] += cnt  # idx is unique within a task
+            lo, hi, reach = np.minimum(lo, bmin), np.maximum(hi, bmax), max(reach, r)
+            bar.update(m)
+    finally:
+        bar.close()
+    best, levels = estimate_volume(counts, g.resolution, g.levels)
+    return Occupancy(counts, g, int(samples), seed, lo, hi, reach, best, levels)
+
+
+def sample_positions(robot: DHRobot, samples: int, seed: int = 0, *, fk: Callable | None = None,
+                     as_dask: bool = False, chunk: int = DEFAULT_CHUNK):
+    """End-effector origins (samples, 3) of the same random stream :func:`occupancy` uses.
+
+    With ``as_dask=True`` a lazy ``dask.array`` of the same values, one chunk per task (needs
+    ``denavit[scale]``); compute it on any scheduler.
+    """
+    _check_sizes(samples, chunk)
+    job = Job(*_job_args(robot, int(samples), int(seed), fk))
+    spans = list(_tasks(job.samples, chunk))
+    if not as_dask:
+        return np.concatenate([positions_block(job, b) for f, c in spans for b in range(f, f + c)])
+    try:
+        import dask
+        import dask.array as da
+    except ImportError:
+        from ..errors import MissingDependencyError
+
+        raise MissingDependencyError("as_dask needs dask: pip install 'denavit[scale]'") from None
+    parts = []
+    for f, c in spans:
+        rows = min((f + c) * BLOCK, job.samples) - f * BLOCK
+        block = dask.delayed(_span_positions)(job, f, c)
+        parts.append(da.from_delayed(block, shape=(rows, 3), dtype=float))
+    return da.concatenate(parts)
+
+
+def _span_positions(job: Job, first: int, count: int) -> np.ndarray:
+    return np.concatenate([positions_block(job, b) for b in range(first, first + count)])
+
+
+def _job_args(robot, samples, seed, fk):
+    from ._sampler import PositionFK, sampling_limits
+
+    return (PositionFK(robot) if fk is None else fk, sampling_limits(robot), seed, samples,
+            Grid(np.zeros(3), np.eye(3), 1.0, 1, 1), np.array(robot.base_matrix[:3, 3], dtype=float))

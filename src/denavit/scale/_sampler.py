@@ -1,0 +1,211 @@
+"""Streaming workspace sampler: counter-based random blocks → FK → voxel counts.
+
+The unit of randomness is the *block* of :data:`BLOCK` samples: block ``b`` draws its joint values from
+``numpy.random.Philox`` seeded by ``SeedSequence(seed, spawn_key=(b,))``, so sample ``i`` is the same number
+whichever task, worker or chunk size computes it.  A *task* is any run of whole blocks; tasks return sparse
+voxel counts (sorted cell index, count) that the driver adds into one grid.  Integer sums commute, so the
+counts, bounds and reach are bit-identical for any number of workers and any chunk size.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..errors import DenavitError, ModelError
+from ..model import DHRobot, JointType
+
+__all__ = ["BLOCK", "Grid", "Job", "PositionFK", "make_job", "reach_bound", "sampling_limits", "positions_block",
+           "run_task", "FINE_CELLS", "MAX_CELLS", "FLAT_TOLERANCE", "PILOT"]
+
+#: Samples per random block: the unit of randomness (fixed, independent of chunking and workers).
+BLOCK = 65_536
+#: Samples of block 0 used to decide whether the workspace is planar (same for every run with a seed).
+PILOT = 4096
+#: Relative thickness (smallest / largest singular value of the pilot cloud) below which the arm is planar.
+FLAT_TOLERANCE = 1e-9
+#: Default cells along a side of the finest grid (3-D, 2-D).
+FINE_CELLS = {3: 256, 2: 2048}
+#: Most cells in the finest grid (uint64 counts: 128 MiB).
+MAX_CELLS = 2**24
+#: Coarsest level kept: at least this many cells along a side.
+MIN_CELLS = 8
+
+
+def sampling_limits(robot: DHRobot) -> np.ndarray:
+    """Per-joint sampling ranges, shape (n, 2): the limits, [−π, π] for an unlimited revolute joint.
+
+    Raises
+    ------
+    ModelError
+        A prismatic joint has no limits (its workspace is unbounded).
+    """
+    lim = np.array(robot.q_limits, dtype=float)  # (n, 2)
+    for k, kind in enumerate(robot.joint_types):
+        if not np.all(np.isfinite(lim[k])):
+            if kind is JointType.PRISMATIC:
+                raise ModelError(f"joint {k + 1} is prismatic without limits: give it limits to sample a workspace")
+            lim[k] = np.clip(lim[k], -np.pi, np.pi)
+    return lim
+
+
+def reach_bound(robot: DHRobot) -> tuple[np.ndarray, float]:
+    """Centre c (3,) and radius R [m] of a ball that holds every end-effector origin within the limits.
+
+    With the chain T = C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn (J a rotation about z or a translation along z),
+    |p − t(C0)| ≤ Σ_{k≥1} |t(C_k)| + Σ_prismatic max |q_k|  (rotations keep lengths).
+    """
+    from ..chain import chain_of
+
+    chain = chain_of(robot)
+    C = chain.constants
+    lim = sampling_limits(robot)
+    R = sum(float(np.linalg.norm(M[:3, 3])) for M in C[1:])
+    R += sum(float(np.abs(lim[k]).max()) for k in range(robot.dof) if chain.prismatic[k])
+    return np.array(C[0][:3, 3], dtype=float), R
+
+
+class PositionFK:
+    """The default FK callable: joint values (m, n) → end-effector origins (m, 3) by ``forward_kinematics``.
+
+    Any callable with the same contract may replace it (e.g. a compiled kernel); one returning (m, 4, 4)
+    poses is accepted too.  It must be picklable for the ``processes`` and cluster schedulers.
+    """
+
+    def __init__(self, robot: DHRobot) -> None:
+        self.robot = robot
+
+    def __call__(self, q: np.ndarray) -> np.ndarray:
+        from ..numeric import forward_kinematics
+
+        return forward_kinematics(self.robot, q)[:, :3, 3]
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A regular grid of cubic (or, for a planar arm, square) cells in the workspace's coordinates.
+
+    Coordinates are u = (p − centre) · basisᵀ (basis rows orthonormal; the world axes for a 3-D workspace);
+    cell i spans lo + h·[i, i+1) on every axis; shape is (side,) * dim.
+    """
+
+    centre: np.ndarray  # (3,)
+    basis: np.ndarray  # (dim, 3)
+    resolution: float
+    side: int
+    levels: int
+
+    @property
+    def dim(self) -> int:
+        return int(self.basis.shape[0])
+
+    @property
+    def lo(self) -> float:
+        return -0.5 * self.side * self.resolution
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return (self.side,) * self.dim
+
+    def cell_centres(self, index: np.ndarray, level: int = 0) -> np.ndarray:
+        """World coordinates (k, 3) of the centres of cells with integer indices (k, dim) at a level."""
+        h = self.resolution * 2**level
+        u = self.lo + (np.asarray(index, dtype=float) + 0.5) * h  # (k, dim)
+        return self.centre + u @ self.basis
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything a task needs (picklable): sampler, FK callable and grid."""
+
+    fk: Callable
+    limits: np.ndarray  # (n, 2)
+    entropy: int
+    samples: int
+    grid: Grid
+    base_origin: np.ndarray  # (3,)
+
+
+def positions_block(job: Job, block: int, rows: int | None = None) -> np.ndarray:
+    """End-effector origins (m, 3) of random block ``block`` (its first ``rows`` samples)."""
+    m = min(BLOCK, job.samples - block * BLOCK) if rows is None else rows
+    rng = np.random.Generator(np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))))
+    lo, hi = job.limits[:, 0], job.limits[:, 1]
+    q = lo + rng.random((m, len(lo))) * (hi - lo)  # (m, n); a prefix of the block's stream
+    return _positions(job.fk(q))
+
+
+def _positions(out) -> np.ndarray:
+    p = np.asarray(out, dtype=float)
+    if p.ndim == 3 and p.shape[1:] == (4, 4):
+        p = p[:, :3, 3]
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise DenavitError(f"the FK callable returned shape {p.shape}; expected (m, 3) or (m, 4, 4)")
+    return p
+
+
+def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, int]:
+    """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples."""
+    g = job.grid
+    parts = [positions_block(job, b) for b in range(first, first + count)]
+    p = np.concatenate(parts) if len(parts) > 1 else parts[0]  # (m, 3)
+    if not np.all(np.isfinite(p)):
+        raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
+    u = (p - g.centre) @ g.basis.T  # (m, dim)
+    cell = np.floor((u - g.lo) / g.resolution).astype(np.int64)  # (m, dim)
+    if cell.min() < 0 or cell.max() >= g.side:
+        raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
+    flat = np.ravel_multi_index(tuple(cell.T), g.shape)
+    idx, cnt = np.unique(flat, return_counts=True)
+    reach = float(np.sqrt(((p - job.base_origin) ** 2).sum(axis=1).max()))
+    return idx, cnt.astype(np.uint32), p.min(axis=0), p.max(axis=0), reach, len(p)
+
+
+def _plane(points: np.ndarray) -> np.ndarray | None:
+    """Orthonormal basis (2, 3) of the plane holding the pilot cloud, or None if it has thickness."""
+    centred = points - points.mean(axis=0)
+    _, sv, Vt = np.linalg.svd(centred, full_matrices=False)
+    if len(sv) < 3 or sv[2] > FLAT_TOLERANCE * max(sv[0], 1e-300):
+        return None
+    normal = Vt[2]
+    axis = int(np.argmax(np.abs(normal)))
+    if abs(normal[axis]) > 1 - 1e-9:  # a world coordinate plane: keep the other two world axes
+        return np.delete(np.eye(3), axis, axis=0)
+    return Vt[:2]
+
+
+def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, fk: Callable | None = None) -> Job:
+    """Sampler, grid (finest resolution, levels) and FK callable for one run."""
+    limits = sampling_limits(robot)
+    centre, R = reach_bound(robot)
+    fk = PositionFK(robot) if fk is None else fk
+    base_origin = np.array(robot.base_matrix[:3, 3], dtype=float)
+    probe = Job(fk, limits, seed, max(samples, PILOT), Grid(centre, np.eye(3), 1.0, 1, 1), base_origin)
+    pilot = positions_block(probe, 0, rows=PILOT)
+    if not np.all(np.isfinite(pilot)):
+        raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
+    basis = _plane(pilot)
+    basis = np.eye(3) if basis is None else basis
+    dim = basis.shape[0]
+    R = R * (1 + 1e-9) + 1e-12
+    if R <= 1e-12 * (1 + float(np.abs(centre).max())):
+        raise ModelError(f"{robot.name}: the end effector does not move, so it has no workspace to measure")
+    cap = int(round(MAX_CELLS ** (1 / dim)))
+    if resolution is None:
+        side = FINE_CELLS[dim]
+        h = 2 * R / side
+        levels = int(math.log2(side // MIN_CELLS)) + 1
+    else:
+        h = float(resolution)
+        if not (h > 0 and math.isfinite(h)):
+            raise ModelError(f"resolution must be a positive length in metres, got {resolution}")
+        cells = 2 * R / h
+        if cells > cap:
+            raise ModelError(f"resolution {h:g} m gives {cells:.3g} cells along the {2 * R:.4g} m reach box "
+                             f"(at most {cap} per side, {MAX_CELLS} in all): use a resolution of at least "
+                             f"{2 * R / cap:.3g} m")
+        side, levels = max(1, math.ceil(cells)), 1
+    return Job(fk, limits, seed, samples, Grid(centre, basis, h, side, levels), base_origin)

@@ -1,0 +1,160 @@
+"""Where tasks run: in this process, a thread or process pool, or a ``dask.distributed`` cluster.
+
+Every scheduler runs the same task functions and the driver merges results as they arrive; at most
+``IN_FLIGHT`` tasks per worker are submitted at a time, so memory stays bounded whatever the task count.
+Ctrl-C cancels what is pending and shuts the pool down before ``KeyboardInterrupt`` propagates.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import os
+import re
+import signal
+import sys
+import time
+from typing import Any, Callable, Iterable, Iterator
+
+from ..errors import MissingDependencyError, ParseError
+
+__all__ = ["LOCAL_SCHEDULERS", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
+
+#: Schedulers that need no cluster: in this process, a thread pool, a process pool.
+LOCAL_SCHEDULERS = ("synchronous", "threads", "processes")
+#: Seconds to wait for a dask.distributed scheduler to answer.
+CONNECT_TIMEOUT = 10.0
+#: Tasks submitted ahead per worker (bounds the results held at once).
+IN_FLIGHT = 2
+#: Most local workers.
+MAX_WORKERS = 256
+_ADDRESS = re.compile(r"^(?:(tcp|tls|ucx|inproc)://)?([A-Za-z0-9_.\-]{1,253}|\[[0-9A-Fa-f:.]{2,45}\]):(\d{1,5})$")
+
+
+def check_scheduler(scheduler: Any) -> None:
+    """Refuse a scheduler that is neither a local name, a ``host:port`` address nor a Client (ParseError)."""
+    if not isinstance(scheduler, str):
+        return
+    if scheduler in LOCAL_SCHEDULERS:
+        return
+    m = _ADDRESS.match(scheduler)
+    if not m or not 0 < int(m.group(3)) < 65536:
+        shown = scheduler if len(scheduler) <= 60 else scheduler[:57] + "..."
+        raise ParseError(f"scheduler {shown!r}: expected one of {', '.join(LOCAL_SCHEDULERS)} or a dask "
+                         "scheduler address such as tcp://127.0.0.1:8786")
+
+
+def _quiet_worker() -> None:  # process-pool workers leave Ctrl-C to the driver
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class _Inline:
+    """A pool of one that runs each task when submitted."""
+
+    def submit(self, fn, *args):
+        f: cf.Future = cf.Future()
+        try:
+            f.set_result(fn(*args))
+        except BaseException as exc:  # noqa: BLE001 - re-raised by result()
+            if isinstance(exc, KeyboardInterrupt):
+                raise
+            f.set_exception(exc)
+        return f
+
+
+def _client(address: str):
+    try:
+        from distributed import Client
+    except ImportError:
+        raise MissingDependencyError("a cluster scheduler needs dask.distributed: pip install 'denavit[scale]'") \
+            from None
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise ParseError(f"scheduler {address}: no dask scheduler answered within {CONNECT_TIMEOUT:g} s "
+                         f"({type(exc).__name__})") from None
+
+
+def _wait(client, pending: set):
+    if client is None:
+        return cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+    from distributed import wait
+
+    return wait(list(pending), return_when="FIRST_COMPLETED")
+
+
+def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
+        ) -> Iterator[Any]:
+    """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler."""
+    check_scheduler(scheduler)
+    client, own, pool = None, False, None
+    if not isinstance(scheduler, str):
+        client = scheduler
+    elif scheduler not in LOCAL_SCHEDULERS:
+        client, own = _client(scheduler), True
+    if client is not None:
+        width = max(1, sum(client.nthreads().values()))
+        submit = lambda *a: client.submit(*a, pure=False)  # noqa: E731
+    else:
+        width = workers or os.cpu_count() or 1
+        if scheduler == "synchronous":
+            pool, width = _Inline(), 1
+        elif scheduler == "threads":
+            pool = cf.ThreadPoolExecutor(width)
+        else:
+            pool = cf.ProcessPoolExecutor(width, initializer=_quiet_worker)
+        submit = pool.submit
+    it, pending = iter(tasks), set()
+    try:
+        for task in it:
+            pending.add(submit(fn, *task))
+            while len(pending) >= IN_FLIGHT * width:
+                done, pending = _wait(client, pending)
+                pending = set(pending)
+                for f in done:
+                    yield f.result()
+        while pending:
+            done, pending = _wait(client, pending)
+            pending = set(pending)
+            for f in done:
+                yield f.result()
+    finally:
+        for f in pending:
+            f.cancel()
+        if isinstance(pool, cf.Executor):
+            pool.shutdown(wait=True, cancel_futures=True)
+        if own:
+            client.close()
+
+
+class Progress:
+    """A one-line progress report with rate and ETA on stderr, redrawn at most every ``every`` seconds."""
+
+    def __init__(self, total: int, unit: str, enabled: bool | None = None, every: float = 0.5) -> None:
+        self.total, self.unit, self.every = total, unit, every
+        self.enabled = sys.stderr.isatty() if enabled is None else enabled
+        self.done, self.t0, self.shown = 0, time.perf_counter(), 0.0
+
+    def update(self, n: int) -> None:
+        self.done += n
+        now = time.perf_counter()
+        if self.enabled and (now - self.shown >= self.every or self.done >= self.total):
+            self.shown = now
+            dt = max(now - self.t0, 1e-9)
+            rate = self.done / dt
+            eta = (self.total - self.done) / rate if rate > 0 else float("inf")
+            pct = 100.0 * self.done / max(self.total, 1)
+            sys.stderr.write(f"\r{pct:5.1f}%  {self.done:.3g}/{self.total:.3g} {self.unit}  "
+                             f"{rate:.3g} {self.unit}/s  ETA {_clock(eta)}   ")
+            sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def _clock(seconds: float) -> str:
+    if seconds != seconds or seconds == float("inf"):
+        return "--:--"
+    s = int(round(seconds))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}" if s >= 3600 else f"{s // 60}:{s % 60:02d}"

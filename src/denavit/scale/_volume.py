@@ -1,0 +1,125 @@
+"""Volume (or area) of the reachable set from voxel counts, with an interval.
+
+At a cell edge h, let O be the occupied cells (at least one sample), I ⊂ O the *interior* cells (every one of
+the 3^d − 1 neighbours occupied too) and m̂ the Chao1 estimate of cells that meet the reachable set W but have
+not been hit yet (from the cells hit once, f1, and twice, f2; Chao 1984, bias-corrected form, Chao 2005):
+
+    m̂ = f1 (f1 − 1) / (2 (f2 + 1)),   var m̂ = Chao (2005) eq. for the bias-corrected form.
+
+Bounds:  |I| h^d ≤ vol W ≤ (|O| + m̂ + 2 sd(m̂)) h^d.
+
+Why: every cell meeting W together covers W (upper), and a cell that sticks out of W through a boundary that
+is flat at the scale of 3h has a whole neighbour outside W, so it is not interior (lower).  Empty cells inside
+W only move cells from I to the boundary (the lower bound stays a lower bound).  The estimate is the interval's
+midpoint.  Counts are kept at the finest edge and added up 2×2×2 for each coarser level; among the levels
+whose Good–Turing sample coverage 1 − f1/N is at least MIN_COVERAGE (Chao1 is only trusted there: at low
+coverage it under-counts the unseen cells badly) the one with the narrowest interval is reported, so the interval shrinks as samples fill finer levels (width ≈ boundary area ×
+3h).  Assumptions (stated in docs/workspace.md): a boundary smooth at the scale of 3h (thin slivers and holes
+narrower than a cell are not resolved) and the Chao1 model for the unseen cells.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["VolumeEstimate", "estimate_volume", "coarsen", "interior", "MIN_COVERAGE"]
+
+#: Least Good–Turing coverage 1 − f1/N at which a level's interval is used (else only as a last resort).
+MIN_COVERAGE = 0.99
+
+
+@dataclass(frozen=True)
+class VolumeEstimate:
+    """Size of the reachable set at one cell edge.
+
+    Attributes
+    ----------
+    value, low, high : float
+        Estimate (midpoint) and bounds [m³, or m² for a planar arm].
+    resolution : float
+        Cell edge of the level used [m].
+    occupied, interior : int
+        Occupied cells and those whose every neighbour is occupied.
+    unseen : float
+        Chao1 estimate of cells meeting the workspace that no sample hit yet.
+    dim : int
+        3 (volume) or 2 (area of a planar arm).
+    coverage : float
+        Good–Turing sample coverage 1 − f1/N at this level (the share of the sampling density's mass in cells
+        already hit; below MIN_COVERAGE the interval is not trusted).
+    """
+
+    value: float
+    low: float
+    high: float
+    resolution: float
+    occupied: int
+    interior: int
+    unseen: float
+    dim: int
+    coverage: float
+
+    @property
+    def half_width(self) -> float:
+        return 0.5 * (self.high - self.low)
+
+    def summary(self) -> dict:
+        return {"value": self.value, "low": self.low, "high": self.high, "resolution": self.resolution,
+                "occupied": self.occupied, "interior": self.interior, "unseen": self.unseen, "dim": self.dim,
+                "coverage": self.coverage}
+
+
+def coarsen(counts: np.ndarray) -> np.ndarray:
+    """Sum 2×2(×2) blocks of cells (an odd last row is dropped into a padded zero row)."""
+    pad = [(0, s % 2) for s in counts.shape]
+    c = np.pad(counts, pad) if any(p for _, p in pad) else counts
+    shape = []
+    for s in c.shape:
+        shape += [s // 2, 2]
+    return c.reshape(shape).sum(axis=tuple(range(1, 2 * c.ndim, 2)), dtype=np.uint64)
+
+
+def interior(occupied: np.ndarray) -> np.ndarray:
+    """Occupied cells whose 3^d − 1 neighbours are all occupied (erosion by a full 3×…×3 block)."""
+    out = occupied.copy()
+    for ax in range(occupied.ndim):  # the full block is separable: AND of shifts along each axis in turn
+        cur = np.pad(out, [(1, 1) if a == ax else (0, 0) for a in range(out.ndim)])
+        sl = [slice(None)] * out.ndim
+        left, mid, right = list(sl), list(sl), list(sl)
+        left[ax], mid[ax], right[ax] = slice(0, -2), slice(1, -1), slice(2, None)
+        out = cur[tuple(left)] & cur[tuple(mid)] & cur[tuple(right)]
+    return out
+
+
+def _chao1(f1: int, f2: int) -> tuple[float, float]:
+    """Bias-corrected Chao1 unseen count and its standard deviation (Chao 2005)."""
+    f1, f2 = float(f1), float(f2)
+    m = max(f1 * (f1 - 1) / (2 * (f2 + 1)), 0.0)
+    var = m + f1 * (2 * f1 - 1) ** 2 / (4 * (f2 + 1) ** 2) + f1**2 * f2 * (f1 - 1) ** 2 / (4 * (f2 + 1) ** 4)
+    return m, float(np.sqrt(max(var, 0.0)))
+
+
+def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
+    occ = counts > 0
+    n_occ = int(occ.sum())
+    n_in = int(interior(occ).sum())
+    f1 = int((counts == 1).sum())
+    m, sd = _chao1(f1, int((counts == 2).sum()))
+    cell = h ** counts.ndim
+    low, high = n_in * cell, (n_occ + m + 2 * sd) * cell
+    coverage = 1.0 - f1 / max(float(counts.sum()), 1.0)
+    return VolumeEstimate(0.5 * (low + high), low, high, h, n_occ, n_in, m, counts.ndim, coverage)
+
+
+def estimate_volume(counts: np.ndarray, resolution: float, levels: int) -> tuple[VolumeEstimate, list]:
+    """The narrowest-interval estimate over ``levels`` cell edges (resolution·2^j) and all of them."""
+    found, c, h = [], counts, resolution
+    for j in range(levels):
+        if j:
+            c, h = coarsen(c), 2 * h
+        found.append(_at_level(c, h))
+    trusted = [e for e in found if e.coverage >= MIN_COVERAGE] or found[-1:]
+    best = min(trusted, key=lambda e: (e.high - e.low, -e.resolution))
+    return best, found
