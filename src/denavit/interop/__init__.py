@@ -1,0 +1,35 @@
+"""Talking to the rest of robotics: URDF in (DH extraction), URDF and MJCF out.
+
+XML from strangers is parsed safely (:mod:`denavit.interop._xml`: no DTD, no entities, bounded size and depth).
+Importing this package loads no XML library beyond the standard library's expat.
+"""
+
+from ._urdf_in import (
+    CHECK_SAMPLES,
+    INTERSECT_TOL,
+    PARALLEL_TOL,
+    ROW_CASES,
+    UrdfImport,
+    from_urdf,
+    import_urdf,
+    urdf_chain_fk,
+)
+from ._urdf_read import MAX_URDF_LINKS, chain_path, read_urdf
+from ._xml import MAX_XML_BYTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
+
+__all__ = [
+    "from_urdf",
+    "import_urdf",
+    "UrdfImport",
+    "read_urdf",
+    "chain_path",
+    "urdf_chain_fk",
+    "PARALLEL_TOL",
+    "INTERSECT_TOL",
+    "CHECK_SAMPLES",
+    "ROW_CASES",
+    "MAX_XML_BYTES",
+    "MAX_XML_DEPTH",
+    "MAX_XML_ELEMENTS",
+    "MAX_URDF_LINKS",
+]

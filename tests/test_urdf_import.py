@@ -1,0 +1,150 @@
+"""URDF in, DH out: random serial URDFs of every axis geometry, checked against an independent URDF FK and Pinocchio.
+
+The URDFs are generated here (tests/_random_urdf.py) with the geometry of each pair of consecutive joint axes
+crafted on purpose (skew, parallel, anti-parallel, coincident, anti-coincident, intersecting), fixed joints in
+the chain, prismatic joints, and inertials in turned frames.  The oracles are the chain FK written in the test
+with scipy, and Pinocchio's own URDF parser (``buildModelFromXML``) for FK, RNEA and the mass matrix.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import denavit
+from denavit.interop import import_urdf
+
+from _random_urdf import CASES, chain_fk, dof, random_chain, urdf_text
+from conftest import REDUCED
+
+ATOL = 1e-9
+EXAMPLES = 15 if REDUCED else 60
+
+seeds = st.integers(0, 2**32 - 1)
+conventions = st.sampled_from(["standard", "modified"])
+
+
+def _chain(seed: int, **kw):
+    rng = np.random.default_rng(seed)
+    links, joints = random_chain(rng, **kw)
+    return rng, links, joints, urdf_text(links, joints)
+
+
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds, convention=conventions)
+def test_random_urdf_fk_equals_urdf_chain_fk(seed, convention):
+    rng, links, joints, text = _chain(seed)
+    result = import_urdf(text, convention=convention)
+    robot = result.robot
+    assert robot.dof == dof(joints)
+    assert robot.convention.value == convention
+    q = rng.uniform(-np.pi, np.pi, (20, robot.dof))
+    T = denavit.forward_kinematics(robot, q)
+    for s in range(len(q)):
+        np.testing.assert_allclose(T[s], chain_fk(joints, q[s]), atol=ATOL)
+    assert result.position_error < ATOL and result.rotation_error < ATOL
+
+
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds)
+def test_each_row_reports_the_crafted_axis_geometry(seed):
+    rng, links, joints, text = _chain(seed)
+    result = import_urdf(text)
+    moving = [j for j in joints if j.kind != "fixed"]
+    expected = [j.case for j in moving[1:]] + ["last"]
+    assert list(result.cases) == expected
+    assert result.joint_names == tuple(j.name for j in moving)
+
+
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds, case=st.sampled_from(CASES), convention=conventions)
+def test_every_special_case_alone(seed, case, convention):
+    """Chains made of one geometry only (e.g. all coincident), which exercise the free choices in a row."""
+    rng, links, joints, text = _chain(seed, cases=(case,))
+    robot = import_urdf(text, convention=convention).robot
+    q = rng.uniform(-np.pi, np.pi, (10, robot.dof))
+    T = denavit.forward_kinematics(robot, q)
+    for s in range(len(q)):
+        np.testing.assert_allclose(T[s], chain_fk(joints, q[s]), atol=ATOL)
+    for link in robot.joints:  # the free choices are made so that the row has no needless offsets
+        assert abs(link.a) < 1e6 and abs(link.d) < 1e6
+    if case in ("coincident", "anti-coincident", "intersecting"):
+        assert all(link.a == 0 for link in robot.links)
+    if case in ("coincident", "anti-coincident"):
+        expect = 0.0 if case == "coincident" else np.pi
+        rows = robot.links[:-1] if convention == "standard" else robot.links[1:]
+        assert all(abs(abs(link.alpha) - expect) < 1e-12 for link in rows)
+
+
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds)
+def test_limits_and_joint_types_carried(seed):
+    rng, links, joints, text = _chain(seed)
+    robot = import_urdf(text).robot
+    moving = [j for j in joints if j.kind != "fixed"]
+    for link, j in zip(robot.joints, moving):
+        assert link.joint.value == j.kind
+        assert link.q_limits == j.limits  # the DH variable is the URDF's: limits unchanged
+
+
+@settings(max_examples=EXAMPLES // 2, deadline=None)
+@given(seed=seeds, convention=conventions)
+def test_written_robot_file_gives_the_same_arm(seed, convention, tmp_path_factory):
+    rng, links, joints, text = _chain(seed)
+    robot = import_urdf(text, convention=convention).robot
+    path = tmp_path_factory.mktemp("urdf") / "arm.yaml"
+    denavit.save_robot(robot, path)
+    again = denavit.load_robot(path)
+    q = rng.uniform(-np.pi, np.pi, (10, robot.dof))
+    np.testing.assert_allclose(denavit.forward_kinematics(again, q), [chain_fk(joints, x) for x in q], atol=ATOL)
+    if robot.has_dynamics:
+        np.testing.assert_allclose(denavit.mass_matrix(again, q), denavit.mass_matrix(robot, q), atol=1e-9)
+
+
+def test_first_axis_on_base_z_gives_identity_base_and_textbook_row():
+    text = """<robot name="two"><link name="base"/><link name="l1"/><link name="l2"/><link name="tool"/>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.4"/>
+        <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+      <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.25 0 0"/>
+        <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+      <joint name="t" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="0.2 0 0"/></joint></robot>"""
+    result = import_urdf(text)
+    robot = result.robot
+    np.testing.assert_array_equal(robot.base_matrix, np.eye(4))
+    # a planar 2R on a pedestal: d1 = 0.4, a1 = 0.25 (parallel axes), the tool 0.2 along x
+    assert (robot.links[0].d, robot.links[0].a, robot.links[0].alpha) == pytest.approx((0.4, 0.25, 0.0))
+    assert result.cases == ("parallel", "last")
+    np.testing.assert_allclose(robot.tool_matrix[:3, 3], [0.2, 0, 0], atol=1e-15)
+    assert any("fixed joint" in note for note in result.notes)
+
+
+# --- Pinocchio as the oracle: FK, RNEA and mass matrix of the URDF itself ------------------------------------
+
+def _pin_model(text: str):
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromXML(text)
+    return model, model.createData()
+
+
+@pytest.mark.peer
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds, convention=conventions)
+def test_random_urdf_matches_pinocchio(seed, convention):
+    pin = pytest.importorskip("pinocchio")
+    rng, links, joints, text = _chain(seed)
+    robot = import_urdf(text, convention=convention).robot
+    model, data = _pin_model(text)
+    assert model.nq == robot.dof
+    tip = model.getFrameId(links[-1].name)
+    for _ in range(5):
+        q, qd, qdd = (rng.uniform(-np.pi, np.pi, robot.dof) for _ in range(3))
+        pin.framesForwardKinematics(model, data, q)
+        np.testing.assert_allclose(denavit.forward_kinematics(robot, q), data.oMf[tip].homogeneous, atol=ATOL)
+        if robot.has_dynamics:
+            tau = pin.rnea(model, data, q, qd, qdd)
+            np.testing.assert_allclose(denavit.rnea(robot, q, qd, qdd), tau, atol=1e-8 * max(1, np.abs(tau).max()))
+            M = pin.crba(model, data, q)
+            M = np.triu(M) + np.triu(M, 1).T
+            np.testing.assert_allclose(denavit.mass_matrix(robot, q), M, atol=1e-9 * max(1, np.abs(M).max()))
