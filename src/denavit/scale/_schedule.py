@@ -27,7 +27,8 @@ CONNECT_TIMEOUT = 10.0
 IN_FLIGHT = 2
 #: Most local workers.
 MAX_WORKERS = 256
-_ADDRESS = re.compile(r"^(?:(tcp|tls|ucx|inproc)://)?([A-Za-z0-9_.\-]{1,253}|\[[0-9A-Fa-f:.]{2,45}\]):(\d{1,5})$")
+_ADDRESS = re.compile(r"^(?:(tcp|tls|ucx)://)?([A-Za-z0-9_.\-]{1,253}|\[[0-9A-Fa-f:.]{2,45}\]):(\d{1,5})$")
+_INPROC = re.compile(r"^inproc://[A-Za-z0-9_.\-]{1,253}(/\d{1,12}){1,3}$")  # an in-process LocalCluster
 
 
 def check_scheduler(scheduler: Any) -> None:
@@ -37,6 +38,8 @@ def check_scheduler(scheduler: Any) -> None:
     if scheduler in LOCAL_SCHEDULERS:
         return
     m = _ADDRESS.match(scheduler)
+    if _INPROC.match(scheduler):
+        return
     if not m or not 0 < int(m.group(3)) < 65536:
         shown = scheduler if len(scheduler) <= 60 else scheduler[:57] + "..."
         raise ParseError(f"scheduler {shown!r}: expected one of {', '.join(LOCAL_SCHEDULERS)} or a dask "

@@ -1,0 +1,220 @@
+"""denavit.scale: streamed workspace sampling, voxel counts, volume with an interval, schedulers.
+
+Oracles: closed-form areas/volumes (2R annulus, RRP spherical shell), a brute-force Moore-neighbourhood
+erosion, voxel counts rebuilt from the raw sample positions, and the same run on other schedulers,
+worker counts and chunk sizes (bit-identical).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import denavit
+from denavit import DHLink, DHRobot, JointType
+from denavit.errors import ModelError, ParseError
+from denavit.scale import BLOCK, load_occupancy, occupancy, reach_bound, sample_positions
+from denavit.scale._volume import coarsen, interior
+
+from _random_robots import random_robot
+
+
+def planar_2r(L1: float, L2: float) -> DHRobot:
+    return DHRobot("2r", (DHLink(a=L1, q_limits=(-np.pi, np.pi)), DHLink(a=L2, q_limits=(-np.pi, np.pi))))
+
+
+def spherical_rrp(r0: float, r1: float) -> DHRobot:
+    return DHRobot("sph", (
+        DHLink(alpha=np.pi / 2, q_limits=(-np.pi, np.pi)),
+        DHLink(alpha=np.pi / 2, q_limits=(-np.pi, np.pi), theta=np.pi / 2),
+        DHLink(joint=JointType.PRISMATIC, q_limits=(r0, r1)),
+    ))
+
+
+# ---- volume against closed forms -------------------------------------------------------------------------
+
+@settings(max_examples=4, deadline=None, derandomize=True)
+@given(st.floats(0.3, 1.5), st.floats(0.1, 1.5), st.integers(0, 2**40))
+def test_planar_2r_annulus_area_in_the_interval(L1, L2, seed):
+    ws = occupancy(planar_2r(L1, L2), 400_000, seed=seed, scheduler="synchronous")
+    exact = np.pi * ((L1 + L2) ** 2 - (L1 - L2) ** 2)
+    e = ws.estimate
+    assert ws.planar and e.dim == 2 and ws.summary()["volume"] == 0.0
+    assert e.low <= exact <= e.high, (e, exact)
+    assert e.high - e.low < 0.12 * exact  # the interval says something
+    assert ws.reach == pytest.approx(L1 + L2, abs=5e-3) and ws.reach <= L1 + L2 + 1e-12
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("r0,r1,seed", [(0.3, 0.8, 2), (0.1, 0.5, 7)])
+def test_spherical_shell_volume_in_the_interval(r0, r1, seed):
+    exact = 4 / 3 * np.pi * (r1**3 - r0**3)
+    widths = []
+    for n in (200_000, 2_000_000):
+        e = occupancy(spherical_rrp(r0, r1), n, seed=seed).estimate
+        assert not e.dim == 2 and e.low <= exact <= e.high, (n, e, exact)
+        widths.append(e.high - e.low)
+    assert widths[1] < 0.8 * widths[0]  # the interval shrinks with the samples
+
+
+def test_more_samples_narrow_the_interval():
+    robot = planar_2r(1.0, 0.6)
+    w = [(lambda e: e.high - e.low)(occupancy(robot, n, seed=5, scheduler="synchronous").estimate)
+         for n in (30_000, 300_000)]
+    assert w[1] < 0.7 * w[0]
+
+
+def test_given_resolution_is_the_only_level():
+    ws = occupancy(spherical_rrp(0.3, 0.8), 100_000, resolution=0.1, seed=1, scheduler="synchronous")
+    assert ws.estimate.resolution == pytest.approx(0.1) and len(ws.levels) == 1
+
+
+# ---- the counts are the samples' cells ---------------------------------------------------------------------
+
+def test_counts_are_the_histogram_of_the_sampled_positions():
+    robot = denavit.load_robot("puma560")
+    n = 3 * BLOCK + 123
+    ws = occupancy(robot, n, seed=11, scheduler="synchronous")
+    p = sample_positions(robot, n, seed=11)
+    g = ws.grid
+    assert p.shape == (n, 3) and int(ws.counts.sum()) == n
+    hist, _ = np.histogramdd(p - g.centre, bins=g.side, range=[(g.lo, -g.lo)] * 3)  # independent binning
+    assert np.array_equal(hist.astype(np.uint64), ws.counts)
+    np.testing.assert_array_equal(ws.bounds_min, p.min(axis=0))
+    assert ws.reach == pytest.approx(np.linalg.norm(p - robot.base_matrix[:3, 3], axis=1).max())
+    # joint values are uniform in the limits: FK of the limits' box contains every sample
+    assert np.all(np.linalg.norm(p - g.centre, axis=1) <= reach_bound(robot)[1] + 1e-9)
+
+
+def test_a_shorter_run_is_a_prefix_of_a_longer_one():
+    robot = denavit.load_robot("ur5")
+    a = sample_positions(robot, BLOCK + 10, seed=3)
+    b = sample_positions(robot, 2 * BLOCK + 77, seed=3)
+    np.testing.assert_array_equal(a, b[: len(a)])
+    assert not np.array_equal(a, sample_positions(robot, BLOCK + 10, seed=4))
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_reach_bound_holds_on_random_arms(s):
+    rng = np.random.default_rng(s)
+    robot = random_robot(rng)
+    links = tuple(dataclasses.replace(k, q_limits=(-1.0, 1.5)) if k.joint is JointType.PRISMATIC else k
+                  for k in robot.links)
+    robot = robot.replace(links=links)
+    c, R = reach_bound(robot)
+    p = sample_positions(robot, 5000, seed=s)
+    assert np.all(np.linalg.norm(p - c, axis=1) <= R * (1 + 1e-12) + 1e-12)
+
+
+# ---- the estimator's parts ----------------------------------------------------------------------------------
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]))
+def test_interior_is_the_moore_erosion(s, dim):
+    rng = np.random.default_rng(s)
+    occ = rng.random((7,) * dim) < rng.uniform(0.5, 0.98)
+    got = interior(occ)
+    padded = np.pad(occ, 1)
+    for idx in np.ndindex(occ.shape):
+        window = padded[tuple(slice(i, i + 3) for i in idx)]
+        assert got[idx] == window.all()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]))
+def test_coarsen_adds_blocks(s, dim):
+    rng = np.random.default_rng(s)
+    c = rng.integers(0, 5, (6,) * dim).astype(np.uint64)
+    got = coarsen(c)
+    for idx in np.ndindex(got.shape):
+        assert got[idx] == c[tuple(slice(2 * i, 2 * i + 2) for i in idx)].sum()
+
+
+# ---- same results on every scheduler ------------------------------------------------------------------------
+
+def _same(a, b):
+    assert a.seed == b.seed and a.samples == b.samples
+    assert np.array_equal(a.counts, b.counts)
+    assert np.array_equal(a.bounds_min, b.bounds_min) and np.array_equal(a.bounds_max, b.bounds_max)
+    assert a.reach == b.reach and a.estimate == b.estimate
+
+
+def test_identical_for_workers_chunks_and_schedulers():
+    robot = denavit.load_robot("stanford")
+    n = 5 * BLOCK + 999
+    ref = occupancy(robot, n, seed=42, scheduler="synchronous", chunk=BLOCK)
+    _same(ref, occupancy(robot, n, seed=42, scheduler="threads", workers=1, chunk=3 * BLOCK))
+    _same(ref, occupancy(robot, n, seed=42, scheduler="threads", workers=2, chunk=2 * BLOCK))
+    _same(ref, occupancy(robot, n, seed=42, scheduler="processes", workers=2, chunk=BLOCK))
+    other = occupancy(robot, n, seed=43, scheduler="synchronous")
+    assert not np.array_equal(ref.counts, other.counts)
+
+
+def test_local_dask_cluster_gives_the_same_counts():
+    distributed = pytest.importorskip("distributed")
+    robot = denavit.load_robot("puma560")
+    n = 3 * BLOCK
+    ref = occupancy(robot, n, seed=9, scheduler="synchronous")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) \
+            as cluster, distributed.Client(cluster) as client:
+        _same(ref, occupancy(robot, n, seed=9, scheduler=client, chunk=BLOCK))
+        _same(ref, occupancy(robot, n, seed=9, scheduler=cluster.scheduler_address, chunk=2 * BLOCK))
+
+
+def test_dask_array_of_positions():
+    pytest.importorskip("dask.array")
+    robot = denavit.load_robot("scara")
+    lazy = sample_positions(robot, 2 * BLOCK + 5, seed=8, as_dask=True, chunk=BLOCK)
+    assert lazy.shape == (2 * BLOCK + 5, 3) and lazy.npartitions == 3
+    np.testing.assert_array_equal(lazy.compute(scheduler="synchronous"), sample_positions(robot, 2 * BLOCK + 5, 8))
+
+
+def test_save_and_load(tmp_path):
+    ws = occupancy(denavit.load_robot("planar3r"), 50_000, seed=1, scheduler="synchronous")
+    ws.save(tmp_path / "w.npz")
+    back = load_occupancy(tmp_path / "w.npz")
+    _same(ws, back)
+    assert back.planar and np.array_equal(back.grid.basis, ws.grid.basis)
+
+
+# ---- refusals --------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("bad", ["thread", "tcp://", "localhost", "tcp://host:0", "tcp://h:99999", "a b:1", ""])
+def test_bad_scheduler_names_are_refused(bad):
+    with pytest.raises(ParseError, match="scheduler"):
+        occupancy(denavit.load_robot("planar2r"), 1000, seed=0, scheduler=bad)
+
+
+def test_unreachable_scheduler_is_refused_in_bounded_time(monkeypatch):
+    pytest.importorskip("distributed")
+    import socket
+
+    import denavit.scale._schedule as sched
+
+    monkeypatch.setattr(sched, "CONNECT_TIMEOUT", 1.0)
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    t0 = time.perf_counter()
+    with pytest.raises(ParseError, match=f"127.0.0.1:{port}"):
+        occupancy(denavit.load_robot("planar2r"), 1000, seed=0, scheduler=f"tcp://127.0.0.1:{port}")
+    assert time.perf_counter() - t0 < 15
+
+
+@pytest.mark.parametrize("kw", [{"samples": 0}, {"samples": 10**11}, {"samples": 2.5}, {"chunk": 10},
+                                {"resolution": 1e-6}, {"resolution": -1.0}, {"seed": -3}])
+def test_absurd_sizes_are_refused(kw):
+    args = {"samples": 1000, "seed": 0, **kw}
+    with pytest.raises(ModelError):
+        occupancy(denavit.load_robot("puma560"), args.pop("samples"), scheduler="synchronous", **args)
+
+
+def test_unlimited_prismatic_joint_is_refused():
+    robot = DHRobot("p", (DHLink(joint=JointType.PRISMATIC),))
+    with pytest.raises(ModelError, match="prismatic"):
+        occupancy(robot, 1000, seed=0)
