@@ -11,7 +11,7 @@ and which frame carries each joint's axis.  The numeric and symbolic engines ask
 >>> x, y, z, p = walk(chain, [0.0, 0.0], FLOATS)
 """
 
-from ._chain import Chain, Row, chain_of, dh_transform, joint_motion
+from ._chain import Chain, Row, chain_of, cos_sin, dh_transform, joint_motion
 from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
 
@@ -30,6 +30,7 @@ __all__ = [
     "chain_of",
     "joint_motion",
     "dh_transform",
+    "cos_sin",
     "dh_matrix_sym",
     "walk",
     "Floats",

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..model import Convention, DHLink, DHRobot, JointType
 
-__all__ = ["Row", "Chain", "chain_of", "joint_motion", "dh_transform"]
+__all__ = ["Row", "Chain", "chain_of", "joint_motion", "dh_transform", "cos_sin"]
 
 
 def joint_motion(row: "Row", q, theta, d):
@@ -54,6 +54,18 @@ class Row:
     ca: float  # cos α (1 when α = 0)
     sa: float  # sin α (0 when α = 0)
     rot_x: bool  # α ≠ 0: the row turns about x
+
+
+def cos_sin(angle: float) -> tuple[float, float]:
+    """(cos, sin) of an angle, exact (0, ±1) at the multiples of π/2 that floats can write (α = ±π/2 rows).
+
+    ``math.cos(math.pi / 2)`` is 6.1e-17, not 0: with exact values a ±π/2 twist folds away in the
+    generated kernels (:mod:`denavit.codegen`) and leaves no 1e-17 residue in the numeric walkers.
+    """
+    k = round(angle / (math.pi / 2))
+    if k != 0 and angle == k * (math.pi / 2):
+        return ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[k % 4]
+    return math.cos(angle), math.sin(angle)
 
 
 def dh_transform(convention: Convention, theta, d, a, alpha) -> np.ndarray:
@@ -126,9 +138,9 @@ class Chain:
         for link in robot.links:
             joint = k if link.is_joint else -1
             k += link.is_joint
+            ca, sa = cos_sin(float(link.alpha))
             rows.append(Row(joint, link.joint is JointType.PRISMATIC, float(link.theta), float(link.d),
-                            float(link.a), float(link.alpha), math.cos(link.alpha), math.sin(link.alpha),
-                            link.alpha != 0.0))
+                            float(link.a), float(link.alpha), ca, sa, link.alpha != 0.0))
         self.rows = tuple(rows)
         self.dof, self.n_rows = k, len(rows)
         self.joint_rows = tuple(robot.joint_rows)

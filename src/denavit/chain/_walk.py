@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 from ..model import Convention
-from ._chain import Chain, joint_motion
+from ._chain import Chain, cos_sin, joint_motion
 
 __all__ = ["walk", "Floats", "Components", "Batch", "Symbolic", "FLOATS", "COMPONENTS", "pack", "IDENTITY_COLUMNS"]
 
@@ -117,8 +117,8 @@ class Components:
         row = chain.rows[i]
         theta, d = joint_motion(row, q, row.theta, row.d)
         x, y, z, p = pose
-        if isinstance(theta, float):
-            c, s = cos(theta), sin(theta)
+        if isinstance(theta, float):  # a fixed row: exact at multiples of π/2
+            c, s = cos_sin(theta)
         else:
             c, s = np.cos(theta), np.sin(theta)
         if not chain.standard:  # Rx(α) Tx(a) first
