@@ -54,6 +54,9 @@ from ._dynamics import (
     require_dynamics,
     rnea,
 )
+from ._dynamics import SINGULAR_TOL
+from ._dynamics_fast import ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
+from ._dynamics_fast import plan as dynamics_plan
 from ._simulate import SimulationResult, computed_torque_controller, pd_controller, simulate
 from ._kinematics import forward_kinematics, link_transforms
 from ._trajectory import (
@@ -113,6 +116,11 @@ __all__ = [
     "wrench_base_from_tool",
     "wrench_tool_from_base",
     "rnea",
+    "SINGULAR_TOL",
+    "dynamics_plan",
+    "rnea_kernel",
+    "mass_matrix_kernel",
+    "ldl_pivots_solve",
     "simulate",
     "select_rows",
     "require_dynamics",

@@ -22,7 +22,8 @@ import numpy as np
 from ..chain import COMPONENTS, FLOATS, Chain, chain_of, walk
 from ..model import DHRobot
 
-__all__ = ["rnea_kernel", "mass_matrix_kernel", "joint_columns", "to_array"]
+__all__ = ["plan", "rnea_kernel", "mass_matrix_kernel", "ldl_pivots_solve", "ldl_solve", "joint_columns", "to_array",
+           "frames"]
 
 ZERO3 = (0.0, 0.0, 0.0)
 
@@ -230,28 +231,39 @@ def mass_matrix_kernel(pl: _Plan, qc, F=None) -> list[list]:
     return M
 
 
-def ldl_solve(M, b, tol: float):
-    """x = M⁻¹ b by M = L D Lᵀ on entries (floats or (B,) arrays); None where a pivot is ≤ tol · max pivot.
+def ldl_pivots_solve(M, b):
+    """``(x, d)``: x = M⁻¹ b and the pivots d of M = L D Lᵀ, on entries (floats, (B,) arrays or traced values).
 
-    Golub & Van Loan, *Matrix Computations*, 4th ed., alg. 4.1.2 (LDLᵀ). The pivots d_j equal the squared
-    diagonal of the Cholesky factor, so the singularity test is the one of the Cholesky route.
+    Golub & Van Loan, *Matrix Computations*, 4th ed., alg. 4.1.2 (LDLᵀ), arithmetic only (no test, no
+    pivoting): the caller decides from ``d`` whether M was singular.  Floats raise ZeroDivisionError on a
+    zero pivot; arrays give inf/NaN there.
     """
     n = len(b)
     L = [[0.0] * n for _ in range(n)]
     d = [0.0] * n
+    for j in range(n):
+        Ld = [L[j][k] * d[k] for k in range(j)]
+        d[j] = M[j][j] - sum(L[j][k] * Ld[k] for k in range(j))
+        for i in range(j + 1, n):
+            L[i][j] = (M[i][j] - sum(L[i][k] * Ld[k] for k in range(j))) / d[j]
+    y = []
+    for i in range(n):
+        y.append(b[i] - sum(L[i][k] * y[k] for k in range(i)))
+    x = [0.0] * n
+    for i in range(n - 1, -1, -1):
+        x[i] = y[i] / d[i] - sum(L[k][i] * x[k] for k in range(i + 1, n))
+    return x, d
+
+
+def ldl_solve(M, b, tol: float):
+    """x = M⁻¹ b by M = L D Lᵀ (:func:`ldl_pivots_solve`); None where a pivot is ≤ tol · max pivot.
+
+    The pivots d_j equal the squared diagonal of the Cholesky factor, so the singularity test is the one of
+    the Cholesky route.
+    """
     try:
         with np.errstate(divide="ignore", invalid="ignore"):
-            for j in range(n):
-                Ld = [L[j][k] * d[k] for k in range(j)]
-                d[j] = M[j][j] - sum(L[j][k] * Ld[k] for k in range(j))
-                for i in range(j + 1, n):
-                    L[i][j] = (M[i][j] - sum(L[i][k] * Ld[k] for k in range(j))) / d[j]
-            y = []
-            for i in range(n):
-                y.append(b[i] - sum(L[i][k] * y[k] for k in range(i)))
-            x = [0.0] * n
-            for i in range(n - 1, -1, -1):
-                x[i] = y[i] / d[i] - sum(L[k][i] * x[k] for k in range(i + 1, n))
+            x, d = ldl_pivots_solve(M, b)
     except ZeroDivisionError:
         return None
     if all(isinstance(v, float) for v in d):
