@@ -148,3 +148,27 @@ def test_random_urdf_matches_pinocchio(seed, convention):
             M = pin.crba(model, data, q)
             M = np.triu(M) + np.triu(M, 1).T
             np.testing.assert_allclose(denavit.mass_matrix(robot, q), M, atol=1e-9 * max(1, np.abs(M).max()))
+
+
+# --- the command line ------------------------------------------------------------------------------------------
+
+def test_cli_import_urdf_writes_the_arm_and_reports(tmp_path, capsys):
+    import json
+
+    from denavit.cli import main
+
+    rng, links, joints, text = _chain(7, n=4)
+    (tmp_path / "arm.urdf").write_text(text)
+    out = tmp_path / "arm.yaml"
+    assert main(["import-urdf", str(tmp_path / "arm.urdf"), "--convention", "modified", "-o", str(out), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    robot = denavit.load_robot(out)
+    assert robot.convention.value == "modified" and robot.dof == 4
+    assert report["joints"] == [j.name for j in joints if j.kind != "fixed"]
+    assert len(report["cases"]) == 4 and report["cases"][-1] == "last"
+    assert report["self_check"]["position_error"] < ATOL
+    q = rng.uniform(-np.pi, np.pi, (5, 4))
+    np.testing.assert_allclose(denavit.forward_kinematics(robot, q), [chain_fk(joints, x) for x in q], atol=ATOL)
+    assert main(["import-urdf", str(tmp_path / "arm.urdf")]) == 0  # no -o: the robot file on stdout
+    shown = capsys.readouterr().out
+    assert "FK self-check" in shown and "joints:" in shown

@@ -6,6 +6,7 @@ Importing this package loads no XML library beyond the standard library's expat.
 
 from ._urdf_in import (
     CHECK_SAMPLES,
+    CHECK_TOL,
     INTERSECT_TOL,
     PARALLEL_TOL,
     ROW_CASES,
@@ -27,6 +28,7 @@ __all__ = [
     "PARALLEL_TOL",
     "INTERSECT_TOL",
     "CHECK_SAMPLES",
+    "CHECK_TOL",
     "ROW_CASES",
     "MAX_XML_BYTES",
     "MAX_XML_DEPTH",

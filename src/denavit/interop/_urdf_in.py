@@ -28,17 +28,18 @@ axis is the base link's z through its origin gets an identity base.  Fixed joint
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError, ParseError
+from ..errors import DenavitWarning, ModelError, ParseError
 from ..model import Convention, DHLink, DHRobot, JointType, LinkInertia
 from ..numeric import forward_kinematics, link_transforms
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
 
 __all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "PARALLEL_TOL", "INTERSECT_TOL",
-           "CHECK_SAMPLES", "ROW_CASES"]
+           "CHECK_SAMPLES", "CHECK_TOL", "ROW_CASES"]
 
 #: Two axes count as parallel when the sine of their angle is below this.
 PARALLEL_TOL = 1e-10
@@ -47,6 +48,8 @@ PARALLEL_TOL = 1e-10
 INTERSECT_TOL = 1e-10
 #: Random configurations of the import's FK self-check.
 CHECK_SAMPLES = 200
+#: Self-check errors (relative to the chain's size, at least 1 m) beyond which the import warns.
+CHECK_TOL = 1e-9
 #: The geometry of consecutive axes that decides each row (the last row's is ``last``).
 ROW_CASES = ("skew", "intersecting", "parallel", "anti-parallel", "coincident", "anti-coincident", "last")
 
@@ -65,8 +68,9 @@ class UrdfImport:
     cases : tuple of str
         Per row, the geometry of that joint's axis and the next one (see :data:`ROW_CASES`).
     position_error, rotation_error : float
-        Worst FK difference between the DH model and the URDF chain over :data:`CHECK_SAMPLES` random
-        configurations [m, rad].
+        Worst FK difference between the DH model and the URDF chain over ``samples`` random configurations
+        (largest entry difference of position [m] and of rotation matrix); a warning is raised beyond
+        :data:`CHECK_TOL`.
     notes : tuple of str
         What else the import did (fixed joints folded, branches locked, ...).
     """
@@ -79,6 +83,7 @@ class UrdfImport:
     position_error: float
     rotation_error: float
     notes: tuple[str, ...]
+    samples: int = CHECK_SAMPLES
 
 
 def _unit_perp(v: np.ndarray, z: np.ndarray) -> np.ndarray | None:
@@ -256,6 +261,10 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
     robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base)
     pos, rot = _self_check(robot, path, rng)
+    if pos > CHECK_TOL * scale or rot > CHECK_TOL:
+        warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
+                      f"{rot:.2g} in rotation at random configurations (nearly parallel axes?)", DenavitWarning,
+                      stacklevel=2)
     folded = sum(1 for j in path if not j.moving)
     if folded:
         notes = (f"{folded} fixed joint{'s' if folded > 1 else ''} folded into the geometry",) + notes

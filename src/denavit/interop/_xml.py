@@ -26,12 +26,13 @@ MAX_XML_ELEMENTS = 100_000
 
 
 class Element:
-    """One XML element: ``tag``, ``attrib`` (dict of str), ``children`` (list of Element), ``line`` (1-based)."""
+    """One XML element: ``tag``, ``attrib`` (dict of str), ``children`` (list of Element), ``line`` (1-based),
+    ``parent`` (Element or None)."""
 
-    __slots__ = ("tag", "attrib", "children", "line")
+    __slots__ = ("tag", "attrib", "children", "line", "parent")
 
-    def __init__(self, tag: str, attrib: dict[str, str], line: int) -> None:
-        self.tag, self.attrib, self.children, self.line = tag, attrib, [], line
+    def __init__(self, tag: str, attrib: dict[str, str], line: int, parent: "Element | None" = None) -> None:
+        self.tag, self.attrib, self.children, self.line, self.parent = tag, attrib, [], line, parent
 
     def iter(self, tag: str) -> Iterator["Element"]:
         """Direct children named ``tag``."""
@@ -42,10 +43,17 @@ class Element:
         return next(self.iter(tag), None)
 
     def describe(self) -> str:
-        """``<joint name='shoulder'> (line 12)``: how errors name the element."""
-        name = self.attrib.get("name")
-        shown = f" name={name[:40]!r}" if name is not None else ""
-        return f"<{self.tag}{shown}> (line {self.line})"
+        """``<joint name='shoulder'> <origin> (line 12)``: how errors name the element (with its nearest named
+        ancestor)."""
+        def tag(el: Element) -> str:
+            name = el.attrib.get("name")
+            return f"<{el.tag[:40]}" + (f" name={name[:40]!r}>" if name is not None else ">")
+
+        owner = self.parent
+        while owner is not None and "name" not in owner.attrib:
+            owner = owner.parent
+        prefix = f"{tag(owner)} " if owner is not None and owner.parent is not None and "name" not in self.attrib else ""
+        return f"{prefix}{tag(self)} (line {self.line})"
 
 
 def read_xml_source(source: str | os.PathLike[str], what: str = "URDF") -> tuple[str, bytes]:
@@ -110,7 +118,7 @@ def parse_xml(data: bytes, where: str) -> Element:
             raise _Refused(f"line {line()}: more than {MAX_XML_ELEMENTS} elements")
         if len(stack) >= MAX_XML_DEPTH:
             raise _Refused(f"line {line()}: <{tag[:40]}> nested more than {MAX_XML_DEPTH} levels deep")
-        el = Element(tag, dict(attrib), line())
+        el = Element(tag, dict(attrib), line(), stack[-1] if stack else None)
         if stack:
             stack[-1].children.append(el)
         else:
