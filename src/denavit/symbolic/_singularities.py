@@ -34,9 +34,10 @@ from ._jacobians import geometric_jacobian_sym, reduce_trig, simplify_kinematic
 from ._kinematics import link_transforms_sym
 from ._symbols import joint_symbols, parameter_symbols
 
-__all__ = ["SingularSolution", "SingularCondition", "SingularityAnalysis", "singularity_analysis"]
+__all__ = ["SingularSolution", "SingularCondition", "SingularityAnalysis", "singularity_analysis", "task_rows"]
 
 ZERO_TOL = 1e-9
+TASK_ROW_SAMPLES = 5  # random configurations that decide the task rows of an arm with fewer than 6 joints
 
 
 @dataclass(frozen=True)
@@ -88,81 +89,179 @@ class SingularityAnalysis:
         return singularities_markdown(self)
 
 
-# --- the matrix --------------------------------------------------------------------------------------
+# --- the matrix, in a polynomial ring ------------------------------------------------------------------
+#
+# Every entry of J is a polynomial in s_i = sin q_i, c_i = cos q_i and the named parameters. Determinants,
+# gcds and factorizations are done with sympy's sparse polynomial ring (sympy.polys.rings), which is two to
+# three orders of magnitude faster than the same algebra on expression trees; constants that are not
+# rational (√3/2, a float twist cos 0.7) are carried as extra generators and put back at the end, so
+# nothing is expanded through trigonometric identities. Reduction modulo s_i² + c_i² − 1 (a Gröbner basis
+# in lex order with s before c) gives the canonical form used for the zero test; factors are taken from
+# the determinant as multiplied, where the product structure of the arm is still visible.
 
 
-def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMatrix, str]:
-    """J in the axes of the frame of joint 3's axis, reference point on the last joint axis."""
-    Ts = link_transforms_sym(robot, simplify)
+class _Ring:
+    """QQ[parameters, constants, s_1…s_n, c_1…c_n] for expressions in q and the robot's parameters."""
+
+    def __init__(self, exprs: list[sp.Expr], q) -> None:
+        from sympy.polys.domains import QQ
+        from sympy.polys.rings import ring
+
+        n = len(q)
+        self.q = tuple(q)
+        self.s = sp.symbols(f"_s1:{n + 1}")
+        self.c = sp.symbols(f"_c1:{n + 1}")
+        xs = [self._trig_vars(e) for e in exprs]
+        consts: set[sp.Expr] = set()
+        params: set[sp.Symbol] = set()
+        for x in xs:
+            consts |= {a for a in x.atoms(sp.Float, sp.Pow, sp.sin, sp.cos, sp.NumberSymbol, sp.exp)
+                       if a.is_number and not a.is_Rational}
+            params |= {a for a in x.free_symbols if a not in self.s and a not in self.c}
+        consts = {a for a in consts if not any(a != b and a.has(b) for b in consts)}  # outermost only
+        self.konst = {a: sp.Dummy(f"k{i}") for i, a in enumerate(sorted(consts, key=sp.default_sort_key))}
+        self.back = {v: k for k, v in self.konst.items()}
+        gens = sorted(params, key=str) + list(self.konst.values()) + list(self.s) + list(self.c)
+        self.R, *self.gens = ring(gens, QQ)
+        # algebraic constants (√3) keep their minimal polynomial: r² − 3 restores RᵀR = I of a 60° twist
+        self.const_relations = [self.R(sp.minimal_polynomial(a, d)) for a, d in self.konst.items()
+                                if not a.has(sp.Float) and a.is_algebraic]
+        self.relations = self.const_relations + [self.R(si ** 2 + ci ** 2 - 1) for si, ci in zip(self.s, self.c)]
+        self._x = xs
+
+    def _trig_vars(self, e: sp.Expr) -> sp.Expr:
+        x = sp.expand(sp.expand_trig(sp.sympify(e)))
+        x = x.xreplace({sp.cos(qi): ci for qi, ci in zip(self.q, self.c)})
+        return x.xreplace({sp.sin(qi): si for qi, si in zip(self.q, self.s)})
+
+    def elements(self):
+        return [self.R(x.xreplace(self.konst)) for x in self._x]
+
+    def reduce(self, p):
+        return p.rem(self.relations)
+
+    def to_expr(self, p) -> sp.Expr:
+        e = p.as_expr().xreplace(self.back)
+        e = e.xreplace({ci: sp.cos(qi) for qi, ci in zip(self.q, self.c)})
+        return e.xreplace({si: sp.sin(qi) for qi, si in zip(self.q, self.s)})
+
+
+def _middle_frame(robot: DHRobot) -> int:
+    """Index (0-based, into the chain's axis frames) of the frame whose axes J is expressed in."""
+    return min(2, robot.dof - 1) if robot.dof <= 6 else robot.dof // 2
+
+
+def _ring_frames(rg: _Ring, A: list, k: int):
+    """T_k_i for every frame i = 0 … N as 4×4 lists of ring elements, from the link matrices A (4×4 lists)
+    (k: a DH frame index; frames before k through the inverses Rᵀ, −Rᵀp of the link matrices)."""
+    R = rg.R
+
+    def mul(X, Y):
+        return [[rg.reduce(sum((X[i][l] * Y[l][j] for l in range(4)), R.zero)) for j in range(4)] for i in range(4)]
+
+    def inv(X):
+        Rt = [[X[j][i] for j in range(3)] for i in range(3)]
+        p = [-sum((Rt[i][l] * X[l][3] for l in range(3)), R.zero) for i in range(3)]
+        return [Rt[i] + [p[i]] for i in range(3)] + [[R.zero, R.zero, R.zero, R.one]]
+
+    T = {k: [[R.one if i == j else R.zero for j in range(4)] for i in range(4)]}
+    for i in range(k + 1, len(A) + 1):
+        T[i] = mul(T[i - 1], A[i - 1])
+    for i in range(k - 1, -1, -1):
+        T[i] = mul(T[i + 1], inv(A[i]))
+    return [T[i] for i in range(len(A) + 1)]
+
+
+def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMatrix, str, _Ring, list]:
+    """J in the axes of a middle frame (joint 3's axis frame; joint 4's for 7 joints), reference point on the
+    last joint axis: (sympy matrix, note, ring, ring matrix as a list of rows)."""
+    from ._kinematics import link_matrices_sym
+
     axis = chain_of(robot).axis_frame
-    k, m = axis[min(2, robot.dof - 1)], axis[-1]
-    Rk, p = Ts[k][:3, :3], Ts[m][:3, 3]
+    k, m = axis[_middle_frame(robot)], axis[-1]
+    q = joint_symbols(robot.dof).q
+    mats = link_matrices_sym(robot)
+    rg = _Ring([e for A in mats for e in A], q)
+    vals = rg.elements()
+    T = _ring_frames(rg, [[vals[16 * j + 4 * i:16 * j + 4 * i + 4] for i in range(4)] for j in range(len(mats))], k)
+    p = [T[m][i][3] for i in range(3)]
     cols = []
     for a, jt in zip(axis, robot.joint_types):
-        z, o = Ts[a][:3, 2], Ts[a][:3, 3]
-        cols.append(sp.Matrix.vstack(z.cross(p - o), z) if jt is JointType.REVOLUTE
-                    else sp.Matrix.vstack(z, sp.zeros(3, 1)))
-    J = sp.Matrix.hstack(*cols)
-    J = sp.Matrix.vstack(Rk.T * J[:3, :], Rk.T * J[3:, :])
+        z, o = [T[a][i][2] for i in range(3)], [T[a][i][3] for i in range(3)]
+        d = [p[i] - o[i] for i in range(3)]
+        if jt is JointType.REVOLUTE:
+            v = [z[1] * d[2] - z[2] * d[1], z[2] * d[0] - z[0] * d[2], z[0] * d[1] - z[1] * d[0]]
+            cols.append([rg.reduce(x) for x in v] + z)
+        else:
+            cols.append(z + [rg.R.zero] * 3)
+    J = [[cols[j][i] for j in range(robot.dof)] for i in range(6)]
     note = (f"J in the axes of frame {{{k}}} with reference point o_{m} (on the axis of joint {robot.dof}); "
             "its rank, and for 6 joints its determinant, equal those of J0 and Je")
-    return simplify_kinematic(J, simplify, joint_symbols(robot.dof).q), note
+    M = sp.ImmutableMatrix(6, robot.dof, [_display(rg.to_expr(x), simplify, q) for row in J for x in row])
+    return M, note, rg, J
 
 
-def _measure(M: sp.MatrixBase, q) -> tuple[str, sp.Expr, list[sp.Expr]]:
-    """(name, expression, list of the minors whose common factor is solved)."""
-    m, k = M.shape
+def _display(e: sp.Expr, simplify: str, q) -> sp.Expr:
+    return reduce_trig(e, q) if simplify == "trig" else (sp.simplify(e) if simplify == "full" else e)
+
+
+def _minors(rg: _Ring, J: list, shape: tuple[int, int]) -> tuple[str, list]:
+    """(name of the measure, ring minors whose common factor is solved): det J, or the k×k minors."""
+    from sympy.polys.matrices import DomainMatrix
+
+    m, k = shape
+    dom = rg.R.to_domain()
+
+    def det(rows, cols):
+        return DomainMatrix([[J[i][j] for j in cols] for i in rows], (len(rows), len(cols)), dom).det()
+
     if m == k:
-        return "det J", M.det(method="berkowitz"), [M.det(method="berkowitz")]
+        return "det J", [det(range(m), range(k))]
     small = min(m, k)
-    minors = []
-    for rows in itertools.combinations(range(m), small) if m > k else [tuple(range(m))]:
-        for cols in itertools.combinations(range(k), small) if k > m else [tuple(range(k))]:
-            minors.append(reduce_trig(M.extract(list(rows), list(cols)).det(method="berkowitz"), q))
+    minors = [det(rows, cols)
+              for rows in (itertools.combinations(range(m), small) if m > k else [tuple(range(m))])
+              for cols in (itertools.combinations(range(k), small) if k > m else [tuple(range(k))])]
     name = ("common factor of the k×k minors (zeros of det(JᵀJ) = Σ minors²)" if m > k
             else "common factor of the k×k minors (zeros of det(J Jᵀ) = Σ minors²)").replace("k×k", f"{small}×{small}")
-    return name, sp.Add(*[x ** 2 for x in minors]), minors
+    return name, minors
 
 
 # --- factoring -------------------------------------------------------------------------------------
 
 
-def _poly_vars(q):
-    n = len(q)
-    return sp.symbols(f"_c1:{n + 1}"), sp.symbols(f"_s1:{n + 1}")
+def _factors(rg: _Ring, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
+    """Common factor of the ring minors, factorized: (constant part, [(factor in q, multiplicity)]).
 
-
-def _to_poly(e: sp.Expr, q) -> sp.Expr:
-    c, s = _poly_vars(q)
-    x = sp.expand(sp.expand_trig(e))
-    return x.xreplace({sp.cos(qi): ci for qi, ci in zip(q, c)}).xreplace({sp.sin(qi): si for qi, si in zip(q, s)})
-
-
-def _from_poly(e: sp.Expr, q) -> sp.Expr:
-    c, s = _poly_vars(q)
-    return e.xreplace({ci: sp.cos(qi) for qi, ci in zip(q, c)}).xreplace({si: sp.sin(qi) for qi, si in zip(q, s)})
-
-
-def _factors(exprs: list[sp.Expr], q) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
-    """Common factor of the expressions, factorized: (constant part, [(factor in q, multiplicity)])."""
-    polys = [_to_poly(e, q) for e in exprs]
-    g = polys[0]
-    for p in polys[1:]:
-        g = sp.gcd(g, p)
-    coeff, facs = sp.factor_list(g)
-    const, out = (coeff if isinstance(coeff, sp.Basic) else sp.Integer(coeff)), []  # may be √3/4, not an integer
+    The gcd of the minors as multiplied is tried first (it keeps the arm's product structure); when it is
+    a constant, the gcd of their canonical forms modulo s² + c² = 1."""
+    q = rg.q
+    g = minors[0]
+    for p in minors[1:]:
+        g = g.gcd(p)
+    if len(minors) > 1 and not any(g.degree(x) > 0 for x in rg.gens[-2 * len(q):]):
+        red = [rg.reduce(p) for p in minors]
+        g2 = red[0]
+        for p in red[1:]:
+            g2 = g2.gcd(p)
+        g = g * g2 if any(g2.degree(x) > 0 for x in rg.gens[-2 * len(q):]) else g
+    if rg.const_relations:
+        g = g.rem(rg.const_relations)
+    coeff, facs = g.factor_list()
+    const, out = sp.nsimplify(rg.R.domain.to_sympy(coeff)), []
     for f, mult in facs:
-        f = reduce_trig(_from_poly(f, q), q)
-        if not f.has(*q):
-            const *= f ** mult
+        fr = rg.reduce(f)
+        e = rg.to_expr(fr)
+        if not e.has(*q):
+            const *= e ** mult
             continue
+        e = reduce_trig(e, q)
         for i, (o, m) in enumerate(out):
-            if sp.expand(f - o) == 0 or sp.expand(f + o) == 0:
-                const *= (1 if sp.expand(f - o) == 0 else -1) ** mult
+            if sp.expand(e - o) == 0 or sp.expand(e + o) == 0:
+                const *= (1 if sp.expand(e - o) == 0 else -1) ** mult
                 out[i] = (o, m + mult)
                 break
         else:
-            out.append((f, mult))
+            out.append((e, mult))
     return const, out
 
 
@@ -318,17 +417,32 @@ def _aligned_pairs(robot: DHRobot, q: np.ndarray) -> list[tuple[int, int, str]]:
     return out
 
 
+def _common_point(z, o) -> np.ndarray | None:
+    """The point the lines (o_i, z_i) all pass through, or None."""
+    A = np.concatenate([np.eye(3) - np.outer(zz, zz) for zz in z])
+    b = np.concatenate([(np.eye(3) - np.outer(zz, zz)) @ oo for zz, oo in zip(z, o)])
+    c, *_ = np.linalg.lstsq(A, b, rcond=None)
+    return c if np.linalg.norm(A @ c - b) < 1e-9 * (1 + np.abs(b).max()) else None
+
+
 def _reference_point(robot: DHRobot, q: np.ndarray) -> tuple[np.ndarray, str]:
-    """The wrist centre when the last three axes meet in a point, else the end-effector origin."""
+    """The wrist centre when the last three axes meet in a point; else the point where the last two axes
+    meet (a UR-type wrist, Hawkins 2013); else the end-effector origin."""
     frames = link_transforms(robot, q)
-    if robot.dof >= 3 and all(t is JointType.REVOLUTE for t in robot.joint_types[-3:]):
-        z, o = joint_axes(robot, frames)
-        A = np.concatenate([np.eye(3) - np.outer(zz, zz) for zz in z[-3:]])
-        b = np.concatenate([(np.eye(3) - np.outer(zz, zz)) @ oo for zz, oo in zip(z[-3:], o[-3:])])
-        c, *_ = np.linalg.lstsq(A, b, rcond=None)
-        if np.linalg.norm(A @ c - b) < 1e-9 * (1 + np.abs(b).max()):
-            return c, "wrist centre"
+    z, o = joint_axes(robot, frames)
+    for k, name in ((3, "wrist centre"), (2, "point where the last two axes meet")):
+        if robot.dof >= k and all(t is JointType.REVOLUTE for t in robot.joint_types[-k:]):
+            c = _common_point(z[-k:], o[-k:])
+            if c is not None and (k == 3 or np.linalg.norm(np.cross(z[-1], z[-2])) > 1e-7):
+                return c, name
     return (frames[-1] @ robot.tool_matrix)[:3, 3], "end point"
+
+
+def _parallel_revolute_pairs(robot: DHRobot, q: np.ndarray) -> set[tuple[int, int]]:
+    """Pairs of revolute joints (0-based) whose axes are parallel (coaxial or not) at q."""
+    z, _ = joint_axes(robot, link_transforms(robot, q))
+    rev = [i for i, t in enumerate(robot.joint_types) if t is JointType.REVOLUTE]
+    return {(i, j) for i, j in itertools.combinations(rev, 2) if np.linalg.norm(np.cross(z[i], z[j])) < 1e-7}
 
 
 def _rho2(robot: DHRobot, q: np.ndarray) -> float:
@@ -368,6 +482,19 @@ def _classify(f, variables, sols, robot, q, params, rng) -> tuple[str, str]:
     if set(variables) <= last3 and in_wrist and samples and _reference_point(robot, samples[0])[1] == "wrist centre":
         i, j, kind = in_wrist[0]
         return "wrist", f"wrist: the axes of joints {i + 1} and {j + 1} are {kind}"
+    if set(variables) <= last3 and samples and robot.dof >= 5:
+        # a wrist without a centre (UR): two wrist axes turn parallel, and with them the arm's parallel axes
+        generic_par = _parallel_revolute_pairs(robot, _random_q(robot, rng))
+        new = None
+        for x in samples:
+            pairs = _parallel_revolute_pairs(robot, x) - generic_par
+            new = pairs if new is None else new & pairs
+        wrist_pairs = sorted(p for p in (new or ()) if p[0] in last3 and p[1] in last3)
+        if wrist_pairs:
+            i, j = wrist_pairs[0]
+            group = sorted({k for p in (new or ()) for k in p} | {k for p in generic_par if i in p or j in p for k in p})
+            also = f" (axes {', '.join(str(k + 1) for k in group)} all parallel)" if len(group) > 2 else ""
+            return "wrist", f"wrist: the axes of joints {i + 1} and {j + 1} are parallel{also}"
     first = [(i, j, kind) for i, j, kind in aligned if i == 0]
     if first:
         _, j, kind = first[0]
@@ -397,8 +524,36 @@ def _everywhere_reason(robot: DHRobot, rows: list[int], frame: Frame, rng) -> tu
     return max(ranks), "; ".join(text) or "the columns are dependent for every q"
 
 
+def task_rows(robot: DHRobot, frame: Frame | str = Frame.BASE, seed: int = 0) -> tuple[str, ...]:
+    """The task rows an arm of fewer than six joints is analysed on (all six for six or more joints).
+
+    The rows of J that are not zero for every q (a planar arm in the xy plane has wx = wy = 0, and vz = 0
+    unless it also moves along z); when there are as many of them as joints, those. Otherwise the position
+    rows (vx, vy, vz) that are not always zero, then the angular rows, whichever has generic rank equal to
+    the number of joints: a positioning arm is analysed on (x, y, z), a planar 2R on (x, y), a 3-axis wrist
+    on (wx, wy, wz). Decided numerically on :data:`TASK_ROW_SAMPLES` random configurations.
+    """
+    if robot.dof >= 6:
+        return TWIST_ROWS
+    frame = Frame(frame)
+    rng = np.random.default_rng(seed)
+    Js = [geometric_jacobian(robot, _random_q(robot, rng), frame) for _ in range(TASK_ROW_SAMPLES)]
+    scale = max(1.0, max(float(np.abs(J).max()) for J in Js))
+    live = [i for i in range(6) if max(float(np.abs(J[i]).max()) for J in Js) > 1e-9 * scale]
+
+    def rank(rows):
+        return max(int(jacobian_rank(J[rows, :], RANK_RTOL)) for J in Js) if rows else 0
+
+    candidates = [live] if len(live) == robot.dof else []
+    candidates += [[i for i in live if i < 3], [i for i in live if i >= 3]]
+    for rows in candidates:
+        if len(rows) >= robot.dof and rank(rows) == robot.dof:
+            return tuple(TWIST_ROWS[i] for i in rows)
+    return tuple(TWIST_ROWS[i] for i in live) or TWIST_ROWS
+
+
 @lru_cache(maxsize=32)
-def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame | str = Frame.BASE,
+def singularity_analysis(robot: DHRobot, rows: str | None = "auto", frame: Frame | str = Frame.BASE,
                          simplify: str = "trig", progress: Callable[[str], None] | None = None
                          ) -> SingularityAnalysis:
     """Singular configurations of an arm: the factorized determinant and each factor solved and classified.
@@ -406,47 +561,63 @@ def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame |
     Parameters
     ----------
     robot : DHRobot
-    rows : str, optional
-        Comma-separated task rows, e.g. ``"vx,vy,wz"`` (all six when omitted).
+    rows : str or None, optional
+        Comma-separated task rows, e.g. ``"vx,vy,wz"``; ``None`` for all six; ``"auto"`` (default): all six
+        for arms of six or more joints, the rows of :func:`task_rows` for fewer (a positioning arm on
+        vx, vy, vz, a planar arm on vx, vy, wz).
     frame : Frame or {"base", "tool"}
-        Axes of the Jacobian whose ``rows`` are taken (ignored without ``rows``: the rank does not depend on it).
+        Axes of the Jacobian whose ``rows`` are taken (ignored for all six rows: the rank does not depend on it).
     simplify : {"none", "trig", "full"}
+        Display form of the matrix entries and factors (the algebra is done on polynomials either way).
     progress : callable, optional
-        Called with a short message at each stage (Jacobian, minors, factors, each condition); a 6- or
-        7-joint arm takes seconds to minutes.
+        Called with a short message at each stage (Jacobian, minors, factors, each condition).
 
     Returns
     -------
     SingularityAnalysis
 
+    Notes
+    -----
+    With all six rows the Jacobian is taken in the axes of a middle frame with the reference point on the
+    last joint axis (its determinant, or the minors of a 7-joint arm, equal those of J0: Siciliano et al.
+    sec. 3.3); determinants and common factors are computed on polynomials in sin qᵢ, cos qᵢ (see the
+    module notes). A 7-joint arm's 6×6 minors usually share no factor: its singular configurations are then
+    where all seven vanish together, which is reported as such, not solved.
+
     Examples
     --------
     >>> import denavit, denavit.symbolic as S
-    >>> a = S.singularity_analysis(denavit.load_robot("report004-1-planar2r"), rows="vx,vy")
-    >>> [str(c.factor) for c in a.conditions], [s.values for s in a.conditions[0].solutions]
-    (['sin(q2)'], [(0.0,), (3.141592653589793,)])
+    >>> a = S.singularity_analysis(denavit.load_robot("report004-1-planar2r"))
+    >>> a.rows, [str(c.factor) for c in a.conditions], [s.values for s in a.conditions[0].solutions]
+    (('vx', 'vy'), ['sin(q2)'], [(0.0,), (3.141592653589793,)])
     """
     frame = Frame(frame)
     q = joint_symbols(robot.dof).q
+    if rows == "auto":
+        auto = task_rows(robot, frame)
+        rows = None if auto == TWIST_ROWS else ",".join(auto)
     idx = select_rows(rows)
     params = {parameter_symbols(robot)[k]: sp.Float(v) for k, v in robot.parameters}
     say = progress or (lambda msg: None)
     say("symbolic Jacobian")
     if rows is None:
-        M, note = _wrist_frame_jacobian(robot, simplify)
+        M, note, rg, J = _wrist_frame_jacobian(robot, simplify)
     else:
         M = sp.ImmutableMatrix(geometric_jacobian_sym(robot, frame, simplify).extract(idx, list(range(robot.dof))))
         note = f"rows {', '.join(TWIST_ROWS[i] for i in idx)} of J{'0' if frame is Frame.BASE else 'e'}"
+        rg = _Ring(list(M), q)
+        vals = rg.elements()
+        J = [vals[i * M.shape[1]:(i + 1) * M.shape[1]] for i in range(M.shape[0])]
     say(f"determinant / minors of the {M.shape[0]}x{M.shape[1]} matrix")
-    name, measure, minors = _measure(M, q)
+    name, minors = _minors(rg, J, M.shape)
     rng = np.random.default_rng(0)
     full = min(M.shape)
-    if all(reduce_trig(m, q) == 0 for m in minors):
+    if all(rg.reduce(m) == 0 for m in minors):
         rank, reason = _everywhere_reason(robot, idx, frame, rng)
         return SingularityAnalysis(robot.name, tuple(TWIST_ROWS[i] for i in idx), M, note, name, sp.Integer(0),
                                    (), (), True, rank, full, reason)
     say("factoring")
-    const, facs = _factors(minors, q)
+    const, facs = _factors(rg, minors)
     conds = []
     for k, (f, _) in enumerate(facs, start=1):
         say(f"solving and classifying factor {k}/{len(facs)}")
@@ -456,7 +627,7 @@ def singularity_analysis(robot: DHRobot, rows: str | None = None, frame: Frame |
         conds.append(SingularCondition(f, tuple(f"q{k + 1}" for k in variables), tuple(sols), kind, text))
     det = sp.Mul(const, *[f ** m for f, m in facs])  # for m ≠ k: the common factor of the minors
     everywhere = abs(complex(sp.N(const.subs(params)))) < ZERO_TOL
-    const_list = tuple(sp.Mul.make_args(const)) if const != 1 else ()
+    const_list = tuple(x for x in sp.Mul.make_args(const) if x not in (1, -1))
     reason = "a constant factor is zero at these parameter values" if everywhere else ""
     return SingularityAnalysis(robot.name, tuple(TWIST_ROWS[i] for i in idx), M, note, name, det, const_list,
                                tuple(conds), bool(everywhere), full - int(everywhere), full, reason)
