@@ -337,11 +337,12 @@ def cmd_singularities(args: argparse.Namespace):
         rows_idx = select_rows(args.rows)
     except ValueError as exc:
         raise ParseError(f"--rows: {exc}") from None
-    rows = None if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
+    rows = "auto" if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
     if args.q is not None:
         joint_values(args, robot, args.q)  # a bad -q fails now, not after minutes of symbolic work
     require_symbolic_size(robot, "singularities", MAX_SYMBOLIC_ANALYSIS_JOINTS)
     res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
+    rows_idx = [ROWS.index(r) for r in res.rows]  # the task rows analysed (an arm of < 6 joints: its own)
     fmt = _formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)
     lines = [f"{robot.name}: singularities", f"matrix: {res.matrix_note}", f"measure: {res.measure}"]
