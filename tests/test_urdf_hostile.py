@@ -71,9 +71,9 @@ CASES = {
                                 '<child link="b"/></joint><joint name="c2" type="fixed"><parent link="b"/>'
                                 '<child link="a"/></joint></robot>'), ["arm.urdf", "cycle"]),
     "two roots": (_swap("</robot>", '<link name="lonely"/></robot>'), ["arm.urdf", "lonely"]),
-    "branching without --tip": (_swap("</robot>", '<link name="cam"/><joint name="jc" type="fixed">'
+    "branching without --tip": (_swap("</robot>", '<link name="cam"/><joint name="jc" type="revolute">'
                                                   '<parent link="l1"/><child link="cam"/></joint></robot>'),
-                                ["arm.urdf", "--tip", "cam"]),
+                                ["arm.urdf", "--tip", "cam", "l2"]),
     "huge number": (_swap('xyz="0.2 0 0"', 'xyz="1e300 0 0"'), ["arm.urdf", "j2", "out of range"]),
     "overflow": (_swap('xyz="0.2 0 0"', 'xyz="1e999 0 0"'), ["arm.urdf", "j2", "out of range"]),
     "nan": (_swap('xyz="0.2 0 0"', 'xyz="nan 0 0"'), ["arm.urdf", "j2", "not a number"]),

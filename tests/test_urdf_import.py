@@ -172,3 +172,17 @@ def test_cli_import_urdf_writes_the_arm_and_reports(tmp_path, capsys):
     assert main(["import-urdf", str(tmp_path / "arm.urdf")]) == 0  # no -o: the robot file on stdout
     shown = capsys.readouterr().out
     assert "FK self-check" in shown and "joints:" in shown
+
+
+def test_default_tip_is_the_leaf_with_most_moving_joints():
+    """Frames hanging off by fixed joints (a camera, a 'base' marker) do not compete for the tip."""
+    text = """<robot name="t"><link name="w"/><link name="a"/><link name="b"/><link name="cam"/><link name="mark"/>
+      <joint name="j1" type="continuous"><parent link="w"/><child link="a"/><axis xyz="0 0 1"/></joint>
+      <joint name="j2" type="prismatic"><parent link="a"/><child link="b"/><origin xyz="0.1 0 0"/>
+        <axis xyz="1 0 0"/><limit lower="0" upper="0.5" effort="1" velocity="1"/></joint>
+      <joint name="fc" type="fixed"><parent link="a"/><child link="cam"/><origin xyz="0 0.1 0"/></joint>
+      <joint name="fm" type="fixed"><parent link="w"/><child link="mark"/></joint></robot>"""
+    result = import_urdf(text)
+    assert (result.base_link, result.tip_link) == ("w", "b")
+    assert [j.value for j in result.robot.joint_types] == ["revolute", "prismatic"]
+    assert result.robot.joints[0].q_limits is None and result.robot.joints[1].q_limits == (0.0, 0.5)

@@ -265,6 +265,11 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
                       f"{rot:.2g} in rotation at random configurations (nearly parallel axes?)", DenavitWarning,
                       stacklevel=2)
+    empty = [j.name for j in moving if j.limits is not None and j.limits[0] == j.limits[1]]
+    if empty:
+        notes = (f"limits with lower = upper read as no limits: {', '.join(empty)}",) + notes
+    if any(j.kind == "continuous" for j in moving):
+        notes = ("continuous joints have no limits",) + notes
     folded = sum(1 for j in path if not j.moving)
     if folded:
         notes = (f"{folded} fixed joint{'s' if folded > 1 else ''} folded into the geometry",) + notes
@@ -277,7 +282,8 @@ def _robot(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], theta, d
     for k, j in enumerate(moving):
         ak, alk = (a[k], alpha[k]) if conv is Convention.STANDARD else ((a[k - 1], alpha[k - 1]) if k else (0.0, 0.0))
         kind = JointType.PRISMATIC if j.kind == "prismatic" else JointType.REVOLUTE
-        links.append(DHLink(a=ak, alpha=alk, d=d[k], theta=theta[k], joint=kind, q_limits=j.limits))
+        limits = j.limits if j.limits is None or j.limits[0] < j.limits[1] else None  # [0, 0]: no range given
+        links.append(DHLink(a=ak, alpha=alk, d=d[k], theta=theta[k], joint=kind, q_limits=limits))
     names = ", ".join(j.name for j in moving)
     try:
         robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=F0,

@@ -253,11 +253,35 @@ def _leaves_below(model: UrdfModel, link: str) -> Iterator[str]:
         stack.extend(j.child for j in reversed(kids))
 
 
+def _moving_depth(model: UrdfModel, link: str, base: str) -> int:
+    count = 0
+    while link != base:
+        j = model.parent_joint[link]
+        count += j.moving
+        link = j.parent
+    return count
+
+
+def _default_tip(model: UrdfModel, base: str) -> str:
+    leaves = list(_leaves_below(model, base))
+    if len(leaves) == 1:
+        return leaves[0]
+    depth = {leaf: _moving_depth(model, leaf, base) for leaf in leaves}
+    best = max(depth.values())
+    top = [leaf for leaf in leaves if depth[leaf] == best]
+    if len(top) == 1:
+        return top[0]
+    shown = ", ".join(x[:40] for x in top[:12]) + (" ..." if len(top) > 12 else "")
+    raise model.error(f"the tree branches below link {base[:60]!r} into {len(top)} chains of {best} moving joints; "
+                      f"choose the end link with --tip (leaves: {shown})")
+
+
 def chain_path(model: UrdfModel, base: str | None = None, tip: str | None = None) -> tuple[str, str, list[UrdfJoint]]:
     """``(base, tip, joints)``: the joints from link ``base`` to link ``tip``, base first.
 
-    ``base`` defaults to the tree's root; ``tip`` to the one leaf below ``base`` (a tree that branches below
-    ``base`` needs ``tip``: the error lists the leaves).
+    ``base`` defaults to the tree's root; ``tip`` to the leaf below ``base`` reached through the most moving
+    joints (sensor and tool frames hanging off by fixed joints do not compete); when two leaves tie (a gripper's
+    two fingers) ``tip`` is needed, and the error lists the leaves.
     """
     for what, name in (("base", base), ("tip", tip)):
         if name is not None and name not in model.links:
@@ -270,12 +294,7 @@ def chain_path(model: UrdfModel, base: str | None = None, tip: str | None = None
                               "a URDF is one tree")
         base = roots[0]
     if tip is None:
-        leaves = list(_leaves_below(model, base))
-        if len(leaves) != 1:
-            shown = ", ".join(x[:40] for x in leaves[:12]) + (" ..." if len(leaves) > 12 else "")
-            raise model.error(f"the tree branches below link {base[:60]!r}; choose the end link with --tip "
-                              f"(leaves: {shown})")
-        tip = leaves[0]
+        tip = _default_tip(model, base)
     path: list[UrdfJoint] = []
     link = tip
     while link != base:
