@@ -49,7 +49,8 @@ class CheckResult:
 
     def to_json(self) -> dict[str, Any]:
         return {"robot": self.robot, "claims_file": self.source, "notes": list(self.notes),
-                "summary": {k: self.count(k) for k in ("correct", "incorrect", "unreadable")},
+                "summary": {k: self.count(k) for k in ("correct", "incorrect", "ambiguous", "unreadable")
+                            if k != "ambiguous" or self.count(k)},  # "ambiguous" only when some are
                 "claims": [v.to_json() for v in self.verdicts]}
 
 
@@ -130,7 +131,8 @@ def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResul
 def verdicts_text(result: CheckResult) -> str:
     """A readable summary, one block per claim."""
     lines = [f"{result.robot}: {result.count('correct')} correct, {result.count('incorrect')} incorrect, "
-             f"{result.count('unreadable')} unreadable ({result.source})"]
+             f"{result.count('unreadable')} unreadable"
+             + (f", {result.count('ambiguous')} ambiguous" if result.count("ambiguous") else "") + f" ({result.source})"]
     lines += [f"note: {n}" for n in result.notes]
     for v in result.verdicts:
         lines.append(f"\n[{v.verdict.upper()}] {v.id} ({v.quantity}): {v.message}")

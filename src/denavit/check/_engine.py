@@ -21,7 +21,7 @@ from ..errors import ParseError
 from ..io import with_parameters
 from ..model import DHRobot, JointType
 from ._hints import hints_for
-from ._latex import RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix
+from ._latex import RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix, split_list
 from ._text import split_top
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver
@@ -233,35 +233,85 @@ def _sample_q(robot: DHRobot, rng: np.random.Generator) -> np.ndarray:
     return rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi))
 
 
-def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, deg: bool) -> list[Point]:
+def _gravity_name(robot: DHRobot) -> list[str]:
+    """``g`` (the magnitude of the robot's gravity) is a known name unless the robot has a parameter g."""
+    return [] if "g" in robot.parameter_values else ["g"]
+
+
+#: Bases of the names a symbolic wrench may use (``f_x``, ``F_y``, ``n_z``, ``M_x``, ``N_z``, ``\\tau_x``).
+WRENCH_BASES = ("f", "F", "n", "N", "m", "M")
+
+
+def _wrench_nodes(raw: Any, robot: DHRobot) -> list[tuple]:
+    """A claim's 'wrench': 6 entries (f, n) or 3 (a pure force), numbers or symbols such as ``f_x``."""
+    known = robot_resolver(robot)
+
+    def resolve(ident):
+        if ident.dots == 0 and ident.base in WRENCH_BASES and ident.sub in ("x", "y", "z"):
+            return ("name", ident.base + ident.sub)
+        return known(ident)
+
+    if isinstance(raw, str):
+        text = raw.strip().strip("$").strip()
+        cells = split_list(text) if text[:1] in "([" else [[c] for c in split_top(text, (",", ";"))]
+        items: list[Any] = [c for row in cells or [[text]] for c in row if str(c).strip()]
+    elif isinstance(raw, list):
+        items = raw
+    else:
+        items = [raw]
+    if len(items) not in (3, 6):
+        raise ParseError(f"wrench: expected 6 values (f, n) or 3 (a force), got {len(items)}")
+    out = []
+    for i, v in enumerate(items, start=1):
+        try:
+            out.append(_expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), resolve, rhs=False))
+        except ParseError as exc:
+            raise ParseError(f"wrench: value {i} ({str(v)[:40]!r}): {exc}") from None
+    zero = ("num", "0")
+    return out + [zero] * (6 - len(out))
+
+
+def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, deg: bool, *,
+            wrench: list[tuple] | None = None, symbols: list[str] = ()) -> list[Point]:
     """Evaluation points: the claim's q (or random ones), its q̇/wrench (or random), robot parameter sets."""
     params = [k for k, _ in robot.parameters]
     robots = [robot]
-    if names & set(params):
+    varied = names & (set(params) | {"g"})
+    if varied:
         for _ in range(N_PARAM_SETS):
-            robots.append(with_parameters(robot, **{k: v * rng.uniform(0.6, 1.4) if v else rng.uniform(0.1, 1.0)
-                                                   for k, v in robot.parameters if k in names}))
+            r = with_parameters(robot, **{k: v * rng.uniform(0.6, 1.4) if v else rng.uniform(0.1, 1.0)
+                                          for k, v in robot.parameters if k in names})
+            if "g" in names and "g" not in params:  # the symbol g: the same direction, another magnitude
+                r = r.replace(gravity=tuple(float(x) * rng.uniform(0.6, 1.4) for x in r.gravity))
+            robots.append(r)
     fixed_q = _joint_values(spec["q"], robot, "q", deg) if "q" in spec else None
     fixed_qd = _joint_values(spec["qd"], robot, "qd", deg) if "qd" in spec else None
-    wrench = numbers(spec["wrench"], 6, "wrench") if "wrench" in spec else None
     if "wrench" in needs and wrench is None:
-        raise ParseError("a torques claim needs 'wrench' (6 numbers f, n)")
+        raise ParseError("this claim needs 'wrench' (6 numbers or symbols f, n; or 3 for a force)")
     uses_q = any(n.startswith("q") and n[1:].isdigit() for n in names)
     uses_qd = any(n.startswith("qd") and n[2:].isdigit() for n in names)
     if "qd" in needs and fixed_qd is None and not uses_qd:
         raise ParseError("this claim needs 'qd' (joint rates) or a formula in the rates")
-    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) else 1
+    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) or symbols else 1
     pts = []
     for r in robots:
         for _ in range(n_q):
             q = fixed_q if fixed_q is not None else _sample_q(robot, rng)
             qd = fixed_qd if fixed_qd is not None else rng.normal(size=robot.dof)
-            pts.append(Point(r, q, qd, wrench))
+            sym = tuple((s, float(rng.normal())) for s in symbols)
+            w = None
+            if wrench is not None:
+                env = {**r.parameter_values, **dict(sym)}
+                w = np.array([_expr.evaluate(nd, env) for nd in wrench], dtype=float)
+            pts.append(Point(r, q, qd, w, sym))
     return pts
 
 
 def _env(p: Point) -> dict[str, float]:
     env = dict(p.robot.parameters)
+    if "g" not in env:
+        env["g"] = float(np.linalg.norm(p.robot.gravity))
+    env.update(p.symbols)
     for k in range(p.robot.dof):
         env[f"q{k + 1}"] = float(p.q[k])
         if p.qd is not None:
@@ -294,12 +344,20 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         qty, extra = quantity(raw.get("quantity"))
         spec = {**extra, **{k: v for k, v in raw.items() if k not in ("id", "quantity", "value")}}
         deg = bool(spec.get("deg", deg))
-        cells = _values(raw["value"], robot_resolver(robot))
+        wrench = _wrench_nodes(spec["wrench"], robot) if "wrench" in spec else None
+        symbols = sorted({n for nd in wrench or () for n in _expr.names_in(nd)} - {k for k, _ in robot.parameters})
+        cells = _values(raw["value"], robot_resolver(robot, extra=symbols + _gravity_name(robot)))
+        if qty.name == "det_jacobian" and len(cells) * len(cells[0]) > 1 and 1 in (len(cells), len(cells[0])):
+            factors = [c for row in cells for c in row]  # det J written as a list of its factors
+            prod = factors[0]
+            for f in factors[1:]:
+                prod = ("bin", "*", prod, f)
+            cells = [[prod]]
         names: set[str] = set()
         for row in cells:
             for c in row:
                 names |= _expr.names_in(c)
-        points = _points(robot, spec, names, qty.needs, rng, deg)
+        points = _points(robot, spec, names, qty.needs, rng, deg, wrench=wrench, symbols=symbols)
         if "entry" in spec:  # one entry of the quantity: hints then compare that entry too
             qty = replace(qty, truth=_entry_of(qty.truth))
         truth = np.array([np.asarray(qty.truth(p, spec), dtype=float) for p in points])  # (P, *shape)
@@ -388,6 +446,10 @@ def _special(name: str):
         from ._singular import check_singularities
 
         return check_singularities
+    if name in ("dh_matrix", "general_dh", "dh"):
+        from ._dh_claims import check_dh_matrix
+
+        return check_dh_matrix
     if name in ("ik_formula", "ik_solutions"):
         from . import _ik_claims
 

@@ -115,11 +115,17 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
     joint = raw.get("joint")
     if joint is not None and (isinstance(joint, bool) or not isinstance(joint, int) or not 1 <= joint <= robot.dof):
         raise ParseError(f"'joint' must be an integer from 1 to {robot.dof}, got {str(joint)[:40]!r}")
+    inverse = None  # cos q_k = …: the formula gives cos q_k (both q_k = ±acos(…) are claimed)
     if "=" in value:
-        lhs, value = split_relation(value)
-        node = parse_math(lhs, robot_resolver(robot), rhs=False)
-        if node[0] != "name" or not node[1].startswith("q") or not node[1][1:].isdigit():
-            raise ParseError(f"the left side {lhs!r} must be one joint variable (q_k or \\theta_k)")
+        lhs, rhs = split_relation(value)
+        node, inverse = _joint_side(robot, lhs)
+        if node is None:  # written the other way round: atan2(…) = q_1
+            node, inverse = _joint_side(robot, rhs)
+            lhs, rhs = rhs, lhs
+        if node is None:
+            raise ParseError(f"one side of {value[:60]!r} must be one joint variable (q_k or \\theta_k), or its "
+                             "cos / sin / tan")
+        value = rhs
         j = int(node[1][1:])
         if joint is not None and joint != j:
             raise ParseError(f"'joint: {joint}' disagrees with the formula's left side (joint {j})")
@@ -141,7 +147,15 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
                 nodes.append(parse_math(text, resolve, rhs=False))
             except ParseError as exc:
                 raise ParseError(f"{'where ' + name if name != 'value' else 'formula'}: {exc}") from None
-        versions.append((nodes[:-1], nodes[-1]))
+        if inverse is None:
+            versions.append((nodes[:-1], nodes[-1]))
+        else:  # every angle with that cosine / sine / tangent
+            x = nodes[-1]
+            pi = ("name", "pi")
+            alts = {"cos": [("call", "acos", (x,)), ("neg", ("call", "acos", (x,)))],
+                    "sin": [("call", "asin", (x,)), ("bin", "-", pi, ("call", "asin", (x,)))],
+                    "tan": [("call", "atan", (x,)), ("bin", "+", ("call", "atan", (x,)), pi)]}[inverse]
+            versions += [(nodes[:-1], a) for a in alts]
     used: set[str] = set()
     for ws, v in versions:
         for nd in ws + [v]:
@@ -150,6 +164,20 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
     if len(versions) * 2 ** len(used_signs) > MAX_SIGN_COMBOS:
         raise ParseError("too many sign combinations")
     return joint - 1, names, versions, used_signs, used
+
+
+def _joint_side(robot: DHRobot, text: str) -> tuple[tuple | None, str | None]:
+    """(``("name", "qk")``, None) for ``q_k``; (…, "cos") for ``\\cos q_k`` (also sin, tan); else (None, None)."""
+    try:
+        node = parse_math(text, robot_resolver(robot), rhs=False)
+    except ParseError:
+        return None, None
+    fn = None
+    if node[0] == "call" and node[1] in ("cos", "sin", "tan") and len(node[2]) == 1:
+        fn, node = node[1], node[2][0]
+    if node[0] == "name" and node[1].startswith("q") and node[1][1:].isdigit():
+        return node, fn
+    return None, None
 
 
 def _formula_values(names, versions, used_signs, env: dict) -> np.ndarray:
@@ -214,8 +242,73 @@ def _formula_hint(robot: DHRobot, j: int, v: float, s_j: float) -> str | None:
     return None
 
 
+_POSITION_NAMES = {"px", "py", "pz", "Px", "Py", "Pz", "x", "y", "z"}
+
+
+def wrist_offset(robot: DHRobot) -> np.ndarray | None:
+    """The point where the last three joint axes meet, in the last DH frame (None if they do not meet there).
+
+    For an arm with a spherical wrist this is the wrist centre P of the kinematic decoupling; its position in
+    {0} is ``T_0_N @ [offset, 1]`` for every target.
+    """
+    if robot.dof < 3:
+        return None
+    q = np.linspace(0.3, 1.1, robot.dof)
+    F = N.link_transforms(robot, q)
+    z, o = N.joint_axes(robot, F)
+    z, o = z[-3:], o[-3:]
+    A = sum(np.eye(3) - np.outer(d, d) for d in z)
+    b = sum((np.eye(3) - np.outer(d, d)) @ c for d, c in zip(z, o))
+    if np.linalg.matrix_rank(A, tol=1e-9) < 3:
+        return None
+    c = np.linalg.solve(A, b)
+    if max(np.linalg.norm((np.eye(3) - np.outer(d, d)) @ (c - p)) for d, p in zip(z, o)) > 1e-9:
+        return None
+    T0N = np.linalg.solve(np.asarray(robot.base_matrix, dtype=float), F[-1])
+    local = np.linalg.solve(T0N, np.append(np.linalg.solve(np.asarray(robot.base_matrix, dtype=float),
+                                                           np.append(c, 1.0))[:3], 1.0))[:3]
+    return None if np.linalg.norm(local) < 1e-12 else local
+
+
 def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
-    """The verdict on a formula for one joint of the inverse kinematics (see the module notes)."""
+    """The verdict on a formula for one joint of the inverse kinematics (see the module notes).
+
+    ``p_x p_y p_z`` mean the origin of the last DH frame (the flange) unless the claim says ``point: wrist``
+    (the wrist centre).  A formula that is wrong with the flange but right with the wrist centre, written without
+    ``point``, gets the verdict "ambiguous" saying so: a question, not "incorrect".
+    """
+    from ._engine import Verdict
+
+    point = str(raw.get("point", "flange"))
+    if point not in ("flange", "wrist"):
+        raise ParseError(f"'point' must be flange (the last DH frame's origin, default) or wrist (the wrist "
+                         f"centre), got {point[:40]!r}")
+    offset = wrist_offset(robot)
+    if point == "wrist" and offset is None:
+        raise ParseError("'point: wrist': the last three joint axes of this arm do not meet in one point")
+    state = rng.bit_generator.state
+    verdict = _check_ik_formula(robot, raw, cid, rng, offset if point == "wrist" else None)
+    if verdict.verdict != "incorrect" or "point" in raw or offset is None:
+        return verdict
+    *_, used = _read_formula(robot, raw)
+    declared = {re.sub(r"[^A-Za-z0-9]", "", str(k)) for k in (raw.get("where") or {})}
+    if not (used & _POSITION_NAMES) - declared:
+        return verdict
+    again = np.random.default_rng()
+    again.bit_generator.state = state
+    alt = _check_ik_formula(robot, raw, cid, again, offset)
+    if alt.verdict != "correct":
+        return verdict
+    return Verdict(cid, "ik_formula", "ambiguous",
+                   "ambiguous: which point is P? With P = (p_x, p_y, p_z) the origin of the last DH frame (the "
+                   "default meaning) the formula is wrong; with P the wrist centre (where the last three axes meet) "
+                   "it is correct. Add 'point: wrist' to the claim if that is what you meant.",
+                   verdict.entries, verdict.counterexample, verdict.hints, None, alt.method,
+                   {**verdict.extra, "readings": {"flange": "incorrect", "wrist": "correct"}})
+
+
+def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator,
+                      wrist: np.ndarray | None):
     from ._engine import Verdict
 
     j, names, versions, used_signs, used = _read_formula(robot, raw)
@@ -241,6 +334,13 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
             continue
         checked += 1
         env0 = {**params, **target_env(robot, T, pose)}
+        if wrist is not None:  # P is the wrist centre: T_0_N applied to its fixed place in the last frame
+            T0N = np.linalg.solve(robot.base_matrix, T) @ np.linalg.inv(robot.tool_matrix)
+            P = T0N[:3, :3] @ wrist + T0N[:3, 3]
+            if pose == "world":
+                P = (np.asarray(robot.base_matrix) @ np.append(P, 1.0))[:3]
+            params_ = {k for k, _ in robot.parameters}
+            env0.update({k: P[i] for i, ax in enumerate("xyz") for k in (f"p{ax}", f"P{ax}", ax) if k not in params_})
         rows = _controlled_rows(res)
         hit = set()
         for s in ([S[k] for k in usable] if deps else [S[usable[0]]]):

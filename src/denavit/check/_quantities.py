@@ -27,6 +27,8 @@ class Point:
     q: np.ndarray
     qd: np.ndarray | None = None
     wrench: np.ndarray | None = None
+    #: Values of the other symbols a claim uses at this point (a symbolic wrench's f_x, …), as (name, value) pairs.
+    symbols: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -103,6 +105,82 @@ def _torques(p: Point, spec: dict[str, Any]) -> np.ndarray:
     return N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)).T @ p.wrench
 
 
+def _frame_index(p: Point, spec: dict[str, Any]) -> int:
+    """'index' of a propagation frame: 0 … N (DH frames) or N+1 / "e" (the end effector, after the tool)."""
+    n = p.robot.n_rows
+    v = spec.get("index")
+    if isinstance(v, str) and v.strip().lower() in ("e", "ee", "tool", "end_effector"):
+        return n + 1
+    return _index(spec, "index", 0, n + 1)
+
+
+def _omega(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    return N.velocity_propagation(p.robot, p.q, p.qd).omega[_frame_index(p, spec)]
+
+
+def _velocity(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    return N.velocity_propagation(p.robot, p.q, p.qd).v[_frame_index(p, spec)]
+
+
+def _wrench_frame(spec: dict[str, Any]) -> Frame:
+    try:
+        return Frame(spec.get("frame", "tool"))
+    except ValueError:
+        raise ParseError(f"'frame' must be base or tool, got {spec.get('frame')!r}") from None
+
+
+def _force(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).f[_frame_index(p, spec)]
+
+
+def _moment(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).n[_frame_index(p, spec)]
+
+
+def _com_row(p: Point, spec: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    """World pose (4×4) of the frame of DH row 'index' and that link's centre of mass in it."""
+    if not p.robot.has_dynamics:
+        raise ParseError("the robot has no inertial data, so centre-of-mass claims cannot be checked")
+    i = _index(spec, "index", 1, p.robot.n_rows)
+    link = p.robot.links[i - 1]
+    if link.inertia is None:
+        raise ParseError(f"DH row {i} has no inertial data (no centre of mass)")
+    return _frames(p)[i], np.asarray(link.inertia.com, dtype=float)
+
+
+def _com_position(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    F, c = _com_row(p, spec)
+    return F[:3, :3] @ c + F[:3, 3]
+
+
+def _com_velocity(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    F, c = _com_row(p, spec)
+    i = _index(spec, "index", 1, p.robot.n_rows)
+    prop = N.velocity_propagation(p.robot, p.q, p.qd)  # frame i's ω and origin velocity, in its own axes
+    return F[:3, :3] @ (prop.v[i] + np.cross(prop.omega[i], c))  # ṗ_c = R (v_i + ω_i × c), world axes
+
+
+def _energy(which: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
+    def truth(p: Point, spec: dict[str, Any]) -> np.ndarray:
+        if not p.robot.has_dynamics:
+            raise ParseError("the robot has no inertial data, so energy claims cannot be checked")
+        K = N.kinetic_energy(p.robot, p.q, p.qd) if which != "potential" else 0.0
+        V = N.potential_energy(p.robot, p.q) if which != "kinetic" else 0.0
+        return np.asarray(K - V if which == "lagrangian" else K + V, dtype=float)
+
+    return truth
+
+
+def _det(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    J = N.geometric_jacobian(p.robot, p.q, frame=_frame(spec))
+    if "rows" not in spec and p.robot.dof != 6:
+        raise ParseError(f"det J needs a square Jacobian: give 'rows' ({p.robot.dof} of vx,vy,vz,wx,wy,wz)")
+    J = J[_rows(spec)]
+    if J.shape[0] != J.shape[1]:
+        raise ParseError(f"det J needs a square Jacobian: 'rows' gives {J.shape[0]} rows for {J.shape[1]} joints")
+    return np.asarray(np.linalg.det(J))
+
+
 def _dynamics(name: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
     def truth(p: Point, spec: dict[str, Any]) -> np.ndarray:
         fn = getattr(N, name, None)
@@ -137,9 +215,25 @@ QUANTITIES: dict[str, Quantity] = {
                  about="velocity torques c(q, q̇) = C(q, q̇) q̇ (Coriolis and centrifugal)"),
         Quantity("coriolis_matrix", _dynamics("coriolis_matrix"), ("qd",),
                  about="C(q, q̇) from the Christoffel symbols of M (a whole C with C q̇ = c is accepted too)"),
+        Quantity("omega", _omega, ("qd",), about="ⁱωᵢ: angular velocity of frame 'index' in its own axes "
+                 "(velocity propagation; index 0 … N, or e)"),
+        Quantity("velocity", _velocity, ("qd",), about="ⁱvᵢ: velocity of the origin of frame 'index' in its own axes"),
+        Quantity("force", _force, ("wrench",), about="ⁱfᵢ: force across frame 'index' in its own axes (force "
+                 "propagation of the tip wrench; 'frame' tool (default) or base for the wrench's axes)"),
+        Quantity("moment", _moment, ("wrench",), about="ⁱnᵢ: moment across frame 'index' about its origin, in its axes"),
+        Quantity("com_position", _com_position, about="world position of the centre of mass of link 'index' (DH row)"),
+        Quantity("com_velocity", _com_velocity, ("qd",), about="world velocity of the centre of mass of link 'index'"),
+        Quantity("kinetic_energy", _energy("kinetic"), ("qd",), about="K = ½ q̇ᵀ M(q) q̇"),
+        Quantity("potential_energy", _energy("potential"), about="V = −Σ m gᵀ p_c (zero at the base origin)"),
+        Quantity("lagrangian", _energy("lagrangian"), ("qd",), about="L = K − V"),
+        Quantity("det_jacobian", _det, about="det J (square: 6 joints, or 'rows' naming as many rows as joints); "
+                 "a list of factors is read as their product"),
     )
 }
-_ALIASES = {"A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
+_ALIASES = {"w": "omega", "angular_velocity": "omega", "v": "velocity", "linear_velocity": "velocity", "f": "force",
+            "n": "moment", "com": "com_position", "p_c": "com_position", "v_c": "com_velocity", "K": "kinetic_energy",
+            "V": "potential_energy", "U": "potential_energy", "L": "lagrangian", "det": "det_jacobian",
+            "detJ": "det_jacobian", "A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
             "J": "jacobian", "J0": "jacobian", "Je": "jacobian", "tau": "torques", "M": "mass_matrix", "g": "gravity",
             "c": "coriolis", "C": "coriolis_matrix"}
 
