@@ -1,4 +1,4 @@
-"""Subcommands that draw: plot, animate, view, workspace."""
+"""Subcommands that draw: plot, animate, view (workspace and reachability: cli/_scale.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import ParseError
 from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
-                      joint_values, load, nonneg_int, number_text, numbers_text, output_file, require_finite)
+                      joint_values, load, numbers_text, output_file, require_finite)
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 PICTURES = (".png", ".svg", ".pdf")
@@ -20,9 +20,6 @@ DPI_RANGE = (10, 600)
 MAX_DURATION = 600.0
 MAX_FPS = 60.0
 MAX_FRAMES = 1000
-#: workspace: --samples range per run, and the --resolution range [m].
-SAMPLES_RANGE = (100, 2_000_000)
-RESOLUTION_RANGE = (1e-6, 1e6)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -62,17 +59,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="HTML file to write")
     add_force(p)
     p.set_defaults(handler=cmd_view)
-
-    p = sub.add_parser("workspace", help="reachable workspace by sampling: size, volume, picture")
-    add_common(p)
-    p.add_argument("-o", "--output", metavar="FILE", help="picture to write (.png, .svg, .pdf); numbers only if absent")
-    p.add_argument("--samples", type=bounded_int(*SAMPLES_RANGE), default=100_000,
-                   help=f"random configurations (default 100000; {SAMPLES_RANGE[0]} to {SAMPLES_RANGE[1]})")
-    p.add_argument("--resolution", type=bounded_float(*RESOLUTION_RANGE),
-                   help="voxel edge [m] (default: longest side / 40; 1e-6 to 1e6)")
-    p.add_argument("--seed", type=nonneg_int, help="random seed, for repeatable figures")
-    add_force(p)
-    p.set_defaults(handler=cmd_workspace)
 
 
 def _out_q(args, robot, q: np.ndarray) -> np.ndarray:
@@ -175,30 +161,3 @@ def cmd_view(args: argparse.Namespace):
             "output": str(path), "bytes": size}
     return data, f"wrote {path} ({size // 1024} KiB, self-contained: open it in any browser, no network needed)"
 
-
-def cmd_workspace(args: argparse.Namespace):
-    from ..viz import plot_workspace, workspace
-
-    check_output(args, args.output, PICTURES, kind="picture format")
-    robot = load(args)
-    rng = np.random.default_rng(args.seed)
-    ws = workspace(robot, args.samples, args.resolution, rng)
-    require_finite("workspace", ws.bounds_min, ws.bounds_max, ws.reach)
-    if args.output:
-        from ..viz import save_figure
-
-        with output_file(args.output) as tmp:
-            save_figure(plot_workspace(ws, robot.name), tmp)
-    data = {"robot": robot.name, "output": args.output, "seed": args.seed, **ws.summary()}
-    size = (f"area ≈ {ws.area:.4g} m² (planar arm; {ws.voxels} cells of {ws.resolution:.3g} m)" if ws.planar
-            else f"volume ≈ {ws.volume:.4g} m³ ({ws.voxels} voxels of {ws.resolution:.3g} m)")
-    big = float(max(np.abs(ws.bounds_min).max(), np.abs(ws.bounds_max).max()))
-    b = lambda x: number_text(x, 4, big)  # noqa: E731
-    lines = [f"{robot.name} workspace from {ws.samples} samples within the joint limits",
-             f"x: [{b(ws.bounds_min[0])}, {b(ws.bounds_max[0])}] m   y: [{b(ws.bounds_min[1])}, "
-             f"{b(ws.bounds_max[1])}] m   z: [{b(ws.bounds_min[2])}, {b(ws.bounds_max[2])}] m",
-             f"extent: {b(ws.extent[0])} × {b(ws.extent[1])} × {b(ws.extent[2])} m, reach from base origin "
-             f"{ws.reach:.4g} m", size]
-    if args.output:
-        lines.append(f"wrote {args.output}")
-    return data, "\n".join(lines)

@@ -9,7 +9,7 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import BLOCK, FINE_CELLS, MAX_CELLS, Grid, PositionFK, reach_bound, sampling_limits
 from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
-from ._volume import VolumeEstimate, estimate_volume
+from ._volume import VolumeEstimate, coarsen, estimate_volume
 from ._occupancy import (DEFAULT_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy, new_seed, occupancy,
                          sample_positions)
 
@@ -26,6 +26,7 @@ __all__ = [
     "PositionFK",
     "VolumeEstimate",
     "check_scheduler",
+    "coarsen",
     "estimate_volume",
     "load_occupancy",
     "new_seed",

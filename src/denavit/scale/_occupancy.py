@@ -85,7 +85,8 @@ class Occupancy:
     def save(self, path) -> None:
         """Write the counts and grid to a ``.npz`` file (read back with :func:`load_occupancy`)."""
         g, e = self.grid, self.estimate
-        np.savez_compressed(path, counts=self.counts, centre=g.centre, basis=g.basis,
+        with open(path, "wb") as fh:  # a file object: numpy adds no '.npz' to the name
+            np.savez_compressed(fh, counts=self.counts, centre=g.centre, basis=g.basis,
                             resolution=g.resolution, side=g.side, levels=g.levels, samples=self.samples,
                             seed=np.uint64(self.seed), bounds_min=self.bounds_min, bounds_max=self.bounds_max,
                             reach=self.reach, estimate=np.array([e.value, e.low, e.high, e.resolution]))

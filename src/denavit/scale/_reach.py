@@ -95,7 +95,8 @@ class ReachabilityMap:
     def save(self, path) -> None:
         """Write the maps and grid to ``.npz`` (plain arrays)."""
         g = self.grid
-        np.savez_compressed(path, fraction=self.fraction, manipulability=self.manipulability,
+        with open(path, "wb") as fh:  # a file object: numpy adds no '.npz' to the name
+            np.savez_compressed(fh, fraction=self.fraction, manipulability=self.manipulability,
                             orientations=self.orientations, centre=g.centre, resolution=g.resolution,
                             side=g.side)
 

@@ -14,7 +14,7 @@ from typing import Any
 
 from ..errors import MissingDependencyError
 from ._geometry import ArmGeometry, arm_geometry, default_configuration, robot_scale
-from ._workspace import Workspace, plot_workspace, sample_workspace, workspace
+from ._workspace import Workspace, plot_occupancy, plot_reachability, plot_workspace, sample_workspace, workspace
 from ._html import slider_limits, viewer_html, write_viewer
 
 __all__ = [
@@ -30,6 +30,8 @@ __all__ = [
     "write_viewer",
     "plot_robot",
     "plot_workspace",
+    "plot_occupancy",
+    "plot_reachability",
     "save_figure",
     "animate_robot",
     "require_matplotlib",

@@ -6,6 +6,10 @@ estimated.  The volume is the number of occupied cubic voxels of a stated edge l
 voxel volume (an occupancy estimate: it grows with the sample count and shrinks with finer voxels,
 so both are reported).  A planar arm's cloud has no thickness; its area is estimated the same way
 with square pixels in its plane.
+
+This module keeps every sample in memory (small runs, the point cloud itself); :mod:`denavit.scale` streams
+any number of samples into voxel counts with a volume interval, and :func:`plot_occupancy` /
+:func:`plot_reachability` draw its results.
 """
 
 from __future__ import annotations
@@ -15,10 +19,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..model import DHRobot, JointType
+from ..model import DHRobot
 from ..numeric import forward_kinematics
+from ..scale import sampling_limits
 
-__all__ = ["Workspace", "sample_workspace", "workspace", "plot_workspace", "sampling_limits"]
+__all__ = ["Workspace", "sample_workspace", "workspace", "plot_workspace", "sampling_limits", "plot_occupancy",
+           "plot_reachability"]
 
 DEFAULT_SAMPLES = 100_000
 DEFAULT_CELLS = 40  # voxels along the longest bounding-box side when no resolution is given
@@ -69,17 +75,6 @@ class Workspace:
         return {"samples": self.samples, "resolution": self.resolution, "bounds_min": self.bounds_min.tolist(),
                 "bounds_max": self.bounds_max.tolist(), "extent": self.extent.tolist(), "reach": self.reach,
                 "voxels": self.voxels, "volume": self.volume, "planar": self.planar, "area": self.area}
-
-
-def sampling_limits(robot: DHRobot) -> np.ndarray:
-    """Per-joint sampling ranges (n, 2): the limits, [−π, π] for an unlimited revolute joint."""
-    lim = robot.q_limits
-    for k, kind in enumerate(robot.joint_types):
-        if not np.all(np.isfinite(lim[k])):
-            if kind is JointType.PRISMATIC:
-                raise ModelError(f"joint {k + 1} is prismatic without limits: give it limits to sample a workspace")
-            lim[k] = np.clip(lim[k], -np.pi, np.pi)
-    return lim
 
 
 def sample_workspace(robot: DHRobot, samples: int = DEFAULT_SAMPLES, rng: np.random.Generator | None = None
@@ -182,4 +177,103 @@ def plot_workspace(ws: Workspace, title: str = "", max_points: int = 20_000, fig
         f" ({ws.resolution:.3g} m cells, {ws.samples} samples)"
     fig.suptitle(f"{title} workspace — extent {ws.extent[0]:.3g} × {ws.extent[1]:.3g} × {ws.extent[2]:.3g} m, "
                  f"reach {ws.reach:.3g} m, {size}", fontsize=10)
+    return fig
+
+
+# ---- pictures of the streamed results (denavit.scale) ------------------------------------------------------
+
+def _image(ax, img: np.ndarray, extent, label_x: str, label_y: str, cmap: str, title: str, vmax=None):
+    im = ax.imshow(img.T, origin="lower", extent=extent, cmap=cmap, vmin=0, vmax=vmax, interpolation="nearest")
+    ax.set_xlabel(label_x)
+    ax.set_ylabel(label_y)
+    ax.set_title(title, fontsize=9)
+    return im
+
+
+def _level_counts(occ) -> tuple[np.ndarray, float]:
+    """The counts summed to the cell edge of the reported estimate."""
+    from ..scale import coarsen
+
+    c, h = occ.counts, occ.grid.resolution
+    while h < occ.estimate.resolution * (1 - 1e-9):
+        c, h = coarsen(c), 2 * h
+    return c, h
+
+
+def _crop(ax, lo, hi, pad: float) -> None:
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+
+
+def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
+    """Pictures of a :class:`denavit.scale.Occupancy`: x–y projection, x–z and y–z sections through the base.
+
+    Cells (at the edge of the reported estimate) are shaded by the log of their sample count: the sampling
+    density, not a reachability measure.  A planar arm gets one picture of its plane.  Returns a Figure.
+    """
+    from ._plot import new_figure
+
+    g, e = occ.grid, occ.estimate
+    counts, h = _level_counts(occ)
+    n = counts.shape[0]
+    span = (g.lo, g.lo + n * h)
+    dens = np.log1p(counts.astype(float))
+    hit = np.argwhere(counts > 0)
+    lo_u, hi_u = g.lo + hit.min(axis=0) * h, g.lo + (hit.max(axis=0) + 1) * h  # occupied box, grid coordinates
+    fig = new_figure(figsize, dpi)
+    if occ.planar:
+        ax = fig.add_subplot(1, 1, 1)
+        _image(ax, dens, (*span, *span), "u [m] (in the arm's plane)", "v [m]", "viridis",
+               "sampled cells (log count)")
+        ax.set_aspect("equal")
+        _crop(ax, lo_u, hi_u, 2 * h)
+        size = f"area {e.value:.4g} m² ∈ [{e.low:.4g}, {e.high:.4g}]"
+    else:
+        i0 = n // 2  # the centre plane holds the base of joint 1
+        panels = [(dens.max(axis=2), (0, 1), "x–y projection (top view)"),
+                  (dens[:, i0, :], (0, 2), "x–z section through the base"),
+                  (dens[i0, :, :], (1, 2), "y–z section through the base")]
+        for k, (img, (a, b), name) in enumerate(panels):
+            ax = fig.add_subplot(1, 3, k + 1)
+            c = g.centre[[a, b]]
+            _image(ax, img, (c[0] + span[0], c[0] + span[1], c[1] + span[0], c[1] + span[1]), "xyz"[a] + " [m]",
+                   "xyz"[b] + " [m]", "viridis", name, vmax=float(dens.max()) or 1.0)
+            ax.set_aspect("equal")
+            _crop(ax, c + lo_u[[a, b]], c + hi_u[[a, b]], 2 * h)
+        size = f"volume {e.value:.4g} m³ ∈ [{e.low:.4g}, {e.high:.4g}]"
+    fig.suptitle(f"{title} workspace — {size} ({e.resolution:.3g} m cells, {occ.samples:,} samples), "
+                 f"reach {occ.reach:.3g} m", fontsize=10)
+    return fig
+
+
+def plot_reachability(rmap, title: str = "", slices: int = 4, figsize=(13.5, 7.0), dpi: int = 100):
+    """Horizontal slices of a :class:`denavit.scale.ReachabilityMap`: reachability (top), manipulability (bottom).
+
+    ``slices`` heights evenly spread over the reached cells.  Returns a Figure.
+    """
+    from ._plot import new_figure
+
+    g = rmap.grid
+    hit = np.argwhere(rmap.fraction > 0)
+    ks = np.linspace(hit[:, 2].min(), hit[:, 2].max(), slices + 2)[1:-1].round().astype(int) if len(hit) else \
+        np.full(slices, g.side // 2)
+    lo = g.centre + g.lo
+    ext = (lo[0], lo[0] + g.side * g.resolution, lo[1], lo[1] + g.side * g.resolution)
+    wmax = float(rmap.manipulability.max()) or 1.0
+    fig = new_figure(figsize, dpi)
+    for j, k in enumerate(ks):
+        z = lo[2] + (k + 0.5) * g.resolution
+        ax = fig.add_subplot(2, slices, j + 1)
+        im1 = _image(ax, rmap.fraction[:, :, k], ext, "x [m]", "y [m]", "magma", f"z = {z:.3g} m", vmax=1.0)
+        ax.set_aspect("equal")
+        ax = fig.add_subplot(2, slices, slices + j + 1)
+        im2 = _image(ax, rmap.manipulability[:, :, k], ext, "x [m]", "y [m]", "viridis", f"z = {z:.3g} m",
+                     vmax=wmax)
+        ax.set_aspect("equal")
+    fig.colorbar(im1, ax=fig.axes[0::2], label="share of orientations reached", shrink=0.8)
+    fig.colorbar(im2, ax=fig.axes[1::2], label="manipulability √det(J Jᵀ)", shrink=0.8)
+    s = rmap.summary()
+    fig.suptitle(f"{title} reachability — {s['orientations']} orientations per {g.resolution:.3g} m voxel "
+                 f"({rmap.method} IK); reachable {s['reachable_volume']:.3g} m³, ≥ 50 % of orientations "
+                 f"{s['dexterous_volume']:.3g} m³", fontsize=10)
     return fig
