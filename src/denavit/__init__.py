@@ -23,6 +23,7 @@ from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
+from .codegen import CompiledRobot, compile
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 
 __version__ = "0.1.0"
@@ -78,5 +79,7 @@ __all__ = [
     "IKResult",
     "analytic_ik",
     "solve_ik",
+    "compile",
+    "CompiledRobot",
     "__version__",
 ]

@@ -1,0 +1,15 @@
+"""Generated kernels: each arm's FK, Jacobians and dynamics as straight-line code (numba or numpy), and
+exported as standalone C99 or Python source.  DESIGN.md's one bridge between the engines.
+
+>>> import denavit
+>>> fast = denavit.compile(denavit.load_robot("planar2r"), backend="numpy")
+>>> fast.fk([0.0, 0.0])[:3, 3].tolist()
+[2.0, 0.0, 0.0]
+"""
+
+from ._compiled import CompiledRobot, cache_dir, compile, numba_available
+from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
+from ._trace import Sym, Tape
+
+__all__ = ["compile", "CompiledRobot", "cache_dir", "numba_available", "KERNEL_NAMES", "KernelSpec",
+           "trace_kernels", "Sym", "Tape"]

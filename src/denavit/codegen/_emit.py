@@ -1,0 +1,173 @@
+"""Source code from traced kernels: numba, numpy (vectorised), plain Python scalars, C99.
+
+Only two kinds of text reach the generated source: identifiers made here (``q_0``, ``v12``) and constants
+written by ``float.__repr__`` (digits, sign, point, exponent — checked finite).  Nothing a user typed, no
+name from a robot file, is ever pasted into code.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ._kernels import KernelSpec
+
+__all__ = ["python_module", "c_sources", "NUMBA", "NUMPY"]
+
+NUMBA, NUMPY = "numba", "numpy"
+
+
+def _const(v: float, lang: str) -> str:
+    if not math.isfinite(v):
+        raise ValueError(f"non-finite constant {v!r} in a kernel")  # the model refuses these: a bug if reached
+    text = repr(float(v))
+    return f"({text})" if text.startswith("-") else text
+
+
+class _Names:
+    def __init__(self, spec: KernelSpec, lang: str) -> None:
+        self.spec, self.lang, self.tape = spec, lang, spec.tape
+
+    def __call__(self, x) -> str:
+        if isinstance(x, float):
+            return _const(x, self.lang)
+        op, a, b = self.tape.ops[x]
+        if op == "input":
+            return f"{a}_{b}"
+        return f"v{x}"
+
+
+_PY_FUNCS = {  # op → (scalar/numba form, numpy vector form)
+    "sin": ("math.sin({a})", "np.sin({a})"),
+    "cos": ("math.cos({a})", "np.cos({a})"),
+    "sign": ("_sign({a})", "np.sign({a})"),
+    "min": ("min({a}, {b})", "np.minimum({a}, {b})"),
+    "max": ("max({a}, {b})", "np.maximum({a}, {b})"),
+}
+_C_FUNCS = {"sin": "sin({a})", "cos": "cos({a})", "sign": "(double)(({a} > 0.0) - ({a} < 0.0))",
+            "min": "fmin({a}, {b})", "max": "fmax({a}, {b})"}
+_INFIX = {"add": "+", "sub": "-", "mul": "*", "div": "/"}
+
+
+def _statements(spec: KernelSpec, lang: str, vector: bool = False) -> list[str]:
+    """One assignment per node of the kernel's program (inputs excluded)."""
+    name = _Names(spec, lang)
+    tape = spec.tape
+    lines = []
+    for i in tape.program(spec.outputs):
+        op, a, b = tape.ops[i]
+        if op == "input":
+            continue
+        A = name(a)
+        B = name(b) if b is not None else None
+        if op in _INFIX:
+            expr = f"{A} {_INFIX[op]} {B}"
+        elif op == "neg":
+            expr = f"-{A}"
+        elif lang == "c":
+            expr = _C_FUNCS[op].format(a=A, b=B)
+        else:
+            expr = _PY_FUNCS[op][1 if vector else 0].format(a=A, b=B)
+        lines.append(f"double v{i} = {expr};" if lang == "c" else f"v{i} = {expr}")
+    return lines
+
+
+def _used_inputs(spec: KernelSpec) -> list[tuple[str, int]]:
+    tape = spec.tape
+    return [(tape.ops[i][1], tape.ops[i][2]) for i in tape.program(spec.outputs) if tape.ops[i][0] == "input"]
+
+
+def _index(shape: tuple[int, ...], flat: int) -> tuple[int, ...]:
+    idx = []
+    for size in reversed(shape):
+        idx.append(flat % size)
+        flat //= size
+    return tuple(reversed(idx))
+
+
+def _python_kernel(spec: KernelSpec, backend: str) -> list[str]:
+    """``<name>_1(inputs..., out)`` (one configuration, inputs (k,)) and ``<name>_n(inputs..., out)`` (a batch, (B, k)
+    inputs, (B,) + shape output)."""
+    args = ", ".join(name for name, _ in spec.inputs)
+    used = _used_inputs(spec)
+    name = _Names(spec, backend)
+    shape = spec.shape
+    L: list[str] = []
+    deco = ["@njit(cache=True, nogil=True, error_model='numpy')"] if backend == NUMBA else []
+    # --- one configuration ---------------------------------------------------------------------------
+    L += deco + [f"def {spec.name}_1({args}, out):", f'    """{spec.doc}: one configuration, out {shape}."""']
+    if backend == NUMBA:
+        L += [f"    {a}_{k} = {a}[{k}]" for a, k in used]
+    else:
+        for a, size in spec.inputs:
+            names = [f"{a}_{k}" if (a, k) in used else "_" for k in range(size)]
+            if any(x != "_" for x in names):
+                L.append(f"    {', '.join(names)}, = {a}.tolist()")
+    L += ["    " + s for s in _statements(spec, backend)]
+    L += [f"    out[{', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}" for f, o in enumerate(spec.outputs)]
+    L += ["", ""]
+    # --- a batch ---------------------------------------------------------------------------------------
+    L += deco + [f"def {spec.name}_n({args}, out):", f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {shape}."""']
+    if backend == NUMBA:
+        L.append(f"    for b in range({spec.inputs[0][0]}.shape[0]):")
+        pad = "        "
+        L += [f"{pad}{a}_{k} = {a}[b, {k}]" for a, k in used]
+        L += [pad + s for s in _statements(spec, backend)]
+        L += [f"{pad}out[b, {', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}"
+              for f, o in enumerate(spec.outputs)]
+    else:
+        pad = "    "
+        L += [f"{pad}{a}_{k} = {a}[:, {k}]" for a, k in used]
+        L += [pad + s for s in _statements(spec, backend, vector=True)]
+        L += [f"{pad}out[:, {', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}"
+              for f, o in enumerate(spec.outputs)]
+    L += ["", ""]
+    return L
+
+
+def _ref(o):
+    """An output entry as a node index (int) or a constant (float)."""
+    return float(o) if isinstance(o, (int, float)) else o.i
+
+
+def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str:
+    """A Python module with ``<name>_1`` / ``<name>_n`` for every kernel (numba-jitted or numpy)."""
+    head = [f'"""{title}', "", "Generated by denavit.compile: straight-line code, do not edit.",
+            f"Backend: {backend}.  Each kernel has <name>_1(inputs..., out) for one configuration and <name>_n(inputs..., out) for",
+            'batches (inputs shaped (B, k), out (B,) + shape)."""', "", "import math", "", "import numpy as np"]
+    if backend == NUMBA:
+        head += ["from numba import njit", "", "",
+                 "@njit(cache=True, nogil=True)", "def _sign(x):",
+                 "    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)", "", ""]
+    else:
+        head += ["", "", "def _sign(x):", "    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)", "", ""]
+    body: list[str] = []
+    for spec in specs.values():
+        body += _python_kernel(spec, backend)
+    return "\n".join(head + body).rstrip() + "\n"
+
+
+def c_sources(specs: dict[str, KernelSpec], prefix: str, title: str) -> tuple[str, str]:
+    """(header, source) of C99 functions ``void <prefix>_<name>(const double *in..., double *out)``."""
+    protos, bodies = [], []
+    for spec in specs.values():
+        args = ", ".join(f"const double {a}[{k}]" for a, k in spec.inputs)
+        size = 1
+        for s in spec.shape:
+            size *= s
+        proto = f"void {prefix}_{spec.name}({args}, double out[{size}])"
+        shape = "x".join(map(str, spec.shape))
+        protos.append(f"/* {spec.doc}; out: {shape}, row-major. */\n{proto};")
+        name = _Names(spec, "c")
+        lines = [f"{proto}", "{"]
+        lines += [f"    const double {a}_{k} = {a}[{k}];" for a, k in _used_inputs(spec)]
+        lines += ["    " + s for s in _statements(spec, "c")]
+        lines += [f"    out[{f}] = {name(_ref(o))};" for f, o in enumerate(spec.outputs)]
+        lines += ["}", ""]
+        bodies.append("\n".join(lines))
+    guard = f"{prefix.upper()}_H"
+    header = "\n".join([f"/* {title}", " * Generated by denavit: C99, libm only, no allocation. */",
+                        f"#ifndef {guard}", f"#define {guard}", "", "#ifdef __cplusplus", 'extern "C" {', "#endif",
+                        "", "\n\n".join(protos), "", "#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""])
+    source = "\n".join([f"/* {title}", " * Generated by denavit: C99, libm only, no allocation. */",
+                        "#include <math.h>", f'#include "{prefix}.h"', "", *bodies])
+    return header, source

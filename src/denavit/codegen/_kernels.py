@@ -1,0 +1,175 @@
+"""The kernels of one arm, traced: each quantity as straight-line code over the joint inputs.
+
+Every kernel is the library's own algorithm run on traced values (:mod:`denavit.codegen._trace`):
+the chain walker of :mod:`denavit.chain` for poses and joint axes, and the RNEA / CRBA / LDLᵀ kernels of
+:mod:`denavit.numeric` for dynamics.  Nothing here re-derives kinematics or dynamics; it only says which
+outputs each kernel has.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..chain import COMPONENTS, chain_of, walk
+from ..model import DHRobot
+from ..errors import ModelError
+from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
+from ._trace import Tape, sym_max, sym_min, sym_sign
+
+__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES"]
+
+KERNEL_NAMES = ("fk", "frames", "jacobian0", "jacobiane", "rnea", "mass_matrix", "gravity", "coriolis",
+                "forward_dynamics")
+DYNAMICS = frozenset({"rnea", "mass_matrix", "gravity", "coriolis", "forward_dynamics"})
+
+
+@dataclass(frozen=True)
+class KernelSpec:
+    """One traced kernel: ``inputs`` (name, length) in call order, ``shape`` of the output, ``outputs`` its
+    entries in C order (traced values or constants), ``tape`` the recording they live on."""
+
+    name: str
+    doc: str
+    inputs: tuple[tuple[str, int], ...]
+    shape: tuple[int, ...]
+    outputs: tuple
+    tape: Tape
+
+
+def _columns_to_matrix(x, y, z, p):
+    """A pose as 16 entries of the 4×4 homogeneous matrix, row-major."""
+    return [x[0], y[0], z[0], p[0], x[1], y[1], z[1], p[1], x[2], y[2], z[2], p[2], 0.0, 0.0, 0.0, 1.0]
+
+
+def _with_tool(pose, T):
+    """pose · T for a constant 4×4 T (nested lists), on column tuples."""
+    x, y, z, p = pose
+
+    def apply(col, w):  # R · col + w·p, with col the constant column
+        out = []
+        for r in range(3):
+            s = w * p[r] if w else 0.0
+            for v, c in zip((x, y, z), col):
+                if c != 0.0:
+                    s = s + c * v[r]
+            out.append(s)
+        return tuple(out)
+
+    cols = [[T[r][j] for r in range(3)] for j in range(4)]
+    return apply(cols[0], 0.0), apply(cols[1], 0.0), apply(cols[2], 0.0), apply(cols[3], 1.0)
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def trace_kernels(robot: DHRobot, names=KERNEL_NAMES) -> dict[str, KernelSpec]:
+    """Trace the kernels ``names`` of ``robot`` (dynamics ones only when it carries inertial data)."""
+    chain = chain_of(robot)
+    n = chain.dof
+    out: dict[str, KernelSpec] = {}
+    tool = chain.tool.tolist()
+
+    def kinematics(name):
+        tape = Tape()
+        q = tape.inputs("q", n)
+        frames = walk(chain, q, COMPONENTS, frames=True)
+        end = _with_tool(frames[-1], tool) if not chain.tool_identity else frames[-1]
+        return tape, q, frames, end
+
+    if "fk" in names:
+        tape, q, frames, end = kinematics("fk")
+        out["fk"] = KernelSpec("fk", "T_w_e, the end-effector pose (tool applied)", (("q", n),), (4, 4),
+                               tuple(_columns_to_matrix(*end)), tape)
+    if "frames" in names:
+        tape, q, frames, end = kinematics("frames")
+        entries = [e for F in frames for e in _columns_to_matrix(*F)]
+        out["frames"] = KernelSpec("frames", "world poses of the DH frames {0} ... {N} (no tool)",
+                                   (("q", n),), (len(frames), 4, 4), tuple(entries), tape)
+    for name in ("jacobian0", "jacobiane"):
+        if name not in names:
+            continue
+        tape, q, frames, end = kinematics(name)
+        xe, ye, ze, pe = end
+        v_rows, w_rows = [], []
+        for k in range(n):
+            F = frames[chain.axis_frame[k]]
+            z, o = F[2], F[3]
+            if chain.revolute[k]:  # [z × (p_e − o); z]  (Siciliano et al. 2009, eq. 3.30)
+                v, w = _cross(z, tuple(pe[i] - o[i] for i in range(3))), z
+            else:  # [z; 0]
+                v, w = z, (0.0, 0.0, 0.0)
+            if name == "jacobiane":  # rows of R_eᵀ: components along the end-effector axes
+                v = tuple(sum((a[i] * v[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
+                w = tuple(sum((a[i] * w[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
+            v_rows.append(v)
+            w_rows.append(w)
+        entries = [v_rows[k][r] for r in range(3) for k in range(n)] + [w_rows[k][r] for r in range(3)
+                                                                         for k in range(n)]
+        frame = "base (J0)" if name == "jacobian0" else "tool (Je)"
+        out[name] = KernelSpec(name, f"geometric Jacobian, rows (v, w), in the {frame} frame", (("q", n),),
+                               (6, n), tuple(entries), tape)
+    if not DYNAMICS & set(names) or not _has_dynamics(robot):
+        return out
+
+    pl = dynamics_plan(robot)
+    g = [float(v) for v in robot.gravity]
+    fv = [link.inertia.viscous if link.inertia else 0.0 for link in robot.joints]
+    fc = [link.inertia.coulomb if link.inertia else 0.0 for link in robot.joints]
+
+    def friction(qd):
+        return [fv[k] * qd[k] + fc[k] * sym_sign(qd[k]) for k in range(n)]
+
+    if "rnea" in names:
+        tape = Tape()
+        q, qd, qdd = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("qdd", n)
+        tau = rnea_kernel(pl, q, qd, qdd, g)
+        tau = [t + f for t, f in zip(tau, friction(qd))]
+        out["rnea"] = KernelSpec("rnea", "tau = M(q) qdd + C(q, qd) qd + g(q) + tau_f (friction)",
+                                 (("q", n), ("qd", n), ("qdd", n)), (n,), tuple(tau), tape)
+    if "gravity" in names:
+        tape = Tape()
+        q = tape.inputs("q", n)
+        zero = [0.0] * n
+        out["gravity"] = KernelSpec("gravity", "g(q), the gravity torques", (("q", n),), (n,),
+                                    tuple(rnea_kernel(pl, q, zero, zero, g)), tape)
+    if "coriolis" in names:
+        tape = Tape()
+        q, qd = tape.inputs("q", n), tape.inputs("qd", n)
+        c = rnea_kernel(pl, q, qd, [0.0] * n, [0.0, 0.0, 0.0])
+        out["coriolis"] = KernelSpec("coriolis", "c(q, qd) = C(q, qd) qd, the velocity torques",
+                                     (("q", n), ("qd", n)), (n,), tuple(c), tape)
+    if "mass_matrix" in names:
+        tape = Tape()
+        q = tape.inputs("q", n)
+        M = mass_matrix_kernel(pl, q)
+        out["mass_matrix"] = KernelSpec("mass_matrix", "M(q), the joint-space inertia matrix", (("q", n),),
+                                        (n, n), tuple(e for row in M for e in row), tape)
+    if "forward_dynamics" in names:
+        tape = Tape()
+        q, qd, tau = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("tau", n)
+        frames = walk(chain, q, COMPONENTS, frames=True)
+        bias = rnea_kernel(pl, q, qd, [0.0] * n, g, frames)
+        M = mass_matrix_kernel(pl, q, frames)
+        rhs = [t - f - b for t, f, b in zip(tau, friction(qd), bias)]
+        try:
+            qdd, d = ldl_pivots_solve(M, rhs)
+        except ZeroDivisionError:  # a pivot that is 0 for every q: M singular everywhere
+            qdd, d = [0.0] * n, [-1.0]
+        lo, hi = d[0], d[0]
+        for v in d[1:]:
+            lo, hi = sym_min(lo, v), sym_max(hi, v)
+        ok = lo - SINGULAR_TOL * hi  # > 0 ⇔ M regular (the test of denavit.forward_dynamics)
+        out["forward_dynamics"] = KernelSpec(
+            "forward_dynamics", "qdd = M^-1 (tau - c - g - tau_f); last entry > 0 iff M is regular",
+            (("q", n), ("qd", n), ("tau", n)), (n + 1,), tuple(qdd) + (ok,), tape)
+    return out
+
+
+def _has_dynamics(robot: DHRobot) -> bool:
+    """The rule of :func:`denavit.numeric.require_dynamics` (inertial data on some moving row)."""
+    try:
+        require_dynamics(robot)
+    except ModelError:
+        return False
+    return True

@@ -1,0 +1,235 @@
+"""denavit.compile: generated kernels against independent routes and Pinocchio.
+
+Oracles: FK as a product of elementary 4×4 matrices (test_fk.elementary_fk), the Jacobian by central finite
+differences of that FK and by the differentiation route, dynamics by Pinocchio built independently from the
+DH frames (test_dynamics_numeric.pinocchio_model), plus identities (M symmetric positive definite,
+forward dynamics inverts inverse dynamics).  The numpy backend is checked on many random arms (it is quick to
+build); the numba backend on a few, against the numpy backend.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from _random_robots import random_robot as random_kinematic_robot
+from conftest import REDUCED
+from test_dynamics_numeric import pinocchio_model, random_robot as random_dynamic_robot, random_state
+from test_fk import elementary_fk
+
+import denavit
+from denavit.codegen import numba_available
+from denavit.errors import ModelError, ShapeError
+from denavit.numeric import differentiation_jacobian, friction_torques, transform_from_xyz_rpy
+
+N_KIN = 40 if REDUCED else 150
+N_DYN = 15 if REDUCED else 60
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "kernels"))
+
+
+def fd_jacobian(robot, q, h=1e-6):
+    """Base-frame geometric Jacobian by central differences of the elementary-product FK."""
+    n = robot.dof
+    J = np.zeros((6, n))
+    for k in range(n):
+        dq = np.zeros(n)
+        dq[k] = h
+        Tp, _ = elementary_fk(robot, q + dq)
+        Tm, _ = elementary_fk(robot, q - dq)
+        J[:3, k] = (Tp[:3, 3] - Tm[:3, 3]) / (2 * h)
+        dR = (Tp[:3, :3] - Tm[:3, :3]) / (2 * h)
+        W = dR @ elementary_fk(robot, q)[0][:3, :3].T  # skew(ω)
+        J[3:, k] = (W[2, 1], W[0, 2], W[1, 0])
+    return J
+
+
+@pytest.mark.parametrize("seed", range(N_KIN))
+def test_kinematics_kernels_on_random_arms(seed):
+    rng = np.random.default_rng(9100 + seed)
+    robot = random_kinematic_robot(rng)
+    fast = denavit.compile(robot, backend="numpy")
+    Q = rng.uniform(-np.pi, np.pi, (3, robot.dof))
+    for q in Q:
+        T, frames = elementary_fk(robot, q)
+        np.testing.assert_allclose(fast.fk(q), T, atol=1e-12)
+        np.testing.assert_allclose(fast.fk(q, frames=True), frames, atol=1e-12)
+        J0 = fast.jacobian(q)
+        np.testing.assert_allclose(J0, differentiation_jacobian(robot, q), atol=1e-10)
+        np.testing.assert_allclose(J0, fd_jacobian(robot, q), atol=1e-6)
+        R = T[:3, :3]
+        Je = fast.jacobian(q, "tool")
+        np.testing.assert_allclose(np.vstack([R @ Je[:3], R @ Je[3:]]), J0, atol=1e-12)
+    # a batch is the loop of single calls, whatever its shape
+    B = Q.reshape(3, 1, robot.dof)
+    np.testing.assert_allclose(fast.fk(B), np.stack([fast.fk(q) for q in Q]).reshape(3, 1, 4, 4), atol=1e-14)
+    np.testing.assert_allclose(fast.jacobian(B, "tool"),
+                               np.stack([fast.jacobian(q, "tool") for q in Q]).reshape(3, 1, 6, robot.dof),
+                               atol=1e-14)
+    assert fast.fk(np.zeros((0, robot.dof))).shape == (0, 4, 4)
+
+
+def _with_tool(robot, rng):
+    from dataclasses import replace
+
+    return replace(robot, tool=transform_from_xyz_rpy(rng.uniform(-0.5, 0.5, 3), rng.uniform(-np.pi, np.pi, 3)))
+
+
+@pytest.mark.peer
+@pytest.mark.parametrize("seed", range(N_DYN))
+def test_dynamics_kernels_equal_pinocchio_on_random_arms(seed):
+    pin = pytest.importorskip("pinocchio")
+    rng = np.random.default_rng(9300 + seed)
+    robot = _with_tool(random_dynamic_robot(rng, motor=True, friction=seed % 2 == 0), rng)
+    fast = denavit.compile(robot, backend="numpy")
+    model = pinocchio_model(robot)
+    data = model.createData()
+    for _ in range(3):
+        q, qd, qdd = random_state(rng, robot)
+        tf = friction_torques(robot, qd)
+        np.testing.assert_allclose(fast.rnea(q, qd, qdd) - tf, pin.rnea(model, data, q, qd, qdd), atol=1e-10)
+        Mp = pin.crba(model, data, q)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        M = fast.mass_matrix(q)
+        np.testing.assert_allclose(M, Mp, atol=1e-10)
+        np.testing.assert_array_equal(M, M.T)
+        assert np.linalg.eigvalsh(M).min() > 0
+        np.testing.assert_allclose(fast.gravity(q), pin.computeGeneralizedGravity(model, data, q), atol=1e-10)
+        np.testing.assert_allclose(fast.coriolis(q, qd),
+                                   pin.nonLinearEffects(model, data, q, qd) - pin.computeGeneralizedGravity(model, data, q),
+                                   atol=1e-10)
+        tau = rng.normal(size=robot.dof) * 5
+        np.testing.assert_allclose(fast.forward_dynamics(q, qd, tau + tf), pin.aba(model, data, q, qd, tau),
+                                   atol=1e-8)
+        # forward dynamics inverts inverse dynamics (friction included)
+        np.testing.assert_allclose(fast.forward_dynamics(q, qd, fast.rnea(q, qd, qdd)), qdd, atol=1e-8)
+
+
+def test_batches_broadcast_and_equal_single_calls():
+    rng = np.random.default_rng(5)
+    robot = denavit.load_robot("puma560")
+    fast = denavit.compile(robot, backend="numpy")
+    q, qd, qdd = random_state(rng, robot, (2, 3))
+    tau = fast.rnea(q, qd, qdd[0, 0])  # qdd broadcast over the batch
+    assert tau.shape == (2, 3, 6)
+    for i in range(2):
+        for j in range(3):
+            np.testing.assert_allclose(tau[i, j], fast.rnea(q[i, j], qd[i, j], qdd[0, 0]), atol=1e-12)
+            np.testing.assert_allclose(fast.mass_matrix(q)[i, j], fast.mass_matrix(q[i, j]), atol=1e-12)
+    np.testing.assert_allclose(fast.forward_dynamics(q, qd, tau), np.broadcast_to(qdd[0, 0], (2, 3, 6)),
+                               atol=1e-8)
+    assert fast.fk(q.tolist()[0][0]).shape == (4, 4)  # lists and integer arrays are converted
+    np.testing.assert_allclose(fast.fk(np.zeros(6, dtype=int)), fast.fk(np.zeros(6)))
+
+
+@pytest.mark.parametrize("name", ["puma560", "panda", "stanford", "ur5"])
+def test_singular_configurations(name):
+    """At a singular q the kernels still equal the independent routes (nothing divides by a Jacobian)."""
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot, backend="numpy")
+    q = np.zeros(robot.dof)  # stretched / aligned axes: singular for these arms
+    assert np.linalg.matrix_rank(fast.jacobian(q), tol=1e-9) < 6
+    np.testing.assert_allclose(fast.jacobian(q), differentiation_jacobian(robot, q), atol=1e-10)
+    np.testing.assert_allclose(fast.fk(q), elementary_fk(robot, q)[0], atol=1e-12)
+
+
+def test_singular_mass_matrix_and_missing_inertia_raise():
+    robot = random_kinematic_robot(np.random.default_rng(1))  # no inertial data
+    fast = denavit.compile(robot, backend="numpy")
+    assert "rnea" not in fast.kernels
+    with pytest.raises(ModelError, match="no inertial data"):
+        fast.rnea(*[np.zeros(robot.dof)] * 3)
+    rng = np.random.default_rng(3)
+    dyn = random_dynamic_robot(rng, n=3, fixed_rows=False, prismatic=False)
+    from dataclasses import replace
+
+    last = dyn.links[-1]
+    massless = replace(dyn, links=dyn.links[:-1] + (replace(last, inertia=None),))
+    fast = denavit.compile(massless, backend="numpy")
+    with pytest.raises(ModelError, match="singular"):
+        fast.forward_dynamics(np.zeros(3), np.zeros(3), np.ones(3))
+    with pytest.raises(ModelError):
+        denavit.forward_dynamics(massless, np.zeros(3), np.zeros(3), np.ones(3))  # the plain function agrees
+
+
+@pytest.mark.parametrize("bad", [np.zeros(5), np.zeros((2, 7)), 0.0, [[1, 2, 3, 4, 5, 6]] * 2 + [[1]]])
+def test_bad_shapes_raise_shape_error(bad):
+    fast = denavit.compile(denavit.load_robot("puma560"), backend="numpy")
+    with pytest.raises((ShapeError, ValueError)):
+        fast.fk(bad)
+    with pytest.raises(ShapeError):
+        fast.rnea(np.zeros((2, 6)), np.zeros((3, 6)), np.zeros(6))
+
+
+def test_bad_arguments():
+    robot = denavit.load_robot("puma560")
+    with pytest.raises(ValueError, match="backend"):
+        denavit.compile(robot, backend="fortran")
+    with pytest.raises(ValueError, match="unknown kernels"):
+        denavit.compile(robot, kernels=["fk", "ik"])
+    with pytest.raises(ValueError):
+        denavit.compile(robot, backend="numpy").jacobian(np.zeros(6), "elbow")
+    with pytest.raises(TypeError):
+        denavit.compile("puma560")
+
+
+def test_no_user_text_reaches_generated_code():
+    """A robot's name is never pasted into source (it could close a string and run code)."""
+    from dataclasses import replace
+
+    evil = '"""\nimport os; os.system("echo pwned")\n"""'
+    robot = replace(denavit.load_robot("planar2r"), name=evil)
+    fast = denavit.compile(robot, backend="numpy")
+    assert "pwned" not in fast.source
+    np.testing.assert_allclose(fast.fk([0.1, 0.2]), denavit.forward_kinematics(robot, [0.1, 0.2]), atol=1e-14)
+
+
+needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (the 'fast' extra) is not installed")
+
+
+@needs_numba
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["puma560", "panda"])
+def test_numba_backend_equals_numpy_backend(name):
+    rng = np.random.default_rng(11)
+    robot = denavit.load_robot(name)
+    jit = denavit.compile(robot, backend="numba")
+    ref = denavit.compile(robot, backend="numpy")
+    q, qd, qdd = random_state(rng, robot, (4,))
+    for method, args in [("fk", (q,)), ("jacobian", (q,)), ("rnea", (q, qd, qdd)), ("mass_matrix", (q,)),
+                         ("gravity", (q,)), ("coriolis", (q, qd)), ("forward_dynamics", (q, qd, qdd))]:
+        a, b = getattr(jit, method)(*args), getattr(ref, method)(*args)
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+        one = getattr(jit, method)(*(x[0] for x in args))
+        np.testing.assert_allclose(one, b[0], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(jit.jacobian(q[0], "tool"), ref.jacobian(q[0], "tool"), atol=1e-12)
+    np.testing.assert_allclose(jit.fk(q, frames=True), ref.fk(q, frames=True), atol=1e-12)
+
+
+@needs_numba
+@pytest.mark.slow
+def test_numba_kernels_are_cached_on_disk_for_the_next_process(tmp_path):
+    """The second process compiles nothing: numba reports cache hits and no misses."""
+    script = textwrap.dedent("""
+        import numpy as np, denavit
+        fast = denavit.compile(denavit.load_robot("planar3r"))
+        fast.fk(np.zeros(3)); fast.jacobian(np.zeros((2, 3)))
+        m = fast._m
+        hits = m.fk_1.stats.cache_hits.values() and sum(m.fk_1.stats.cache_hits.values())
+        misses = sum(m.fk_1.stats.cache_misses.values()) + sum(m.jacobian0_n.stats.cache_misses.values())
+        print(fast.backend, hits, misses)
+    """)
+    env = {**__import__("os").environ, "DENAVIT_CACHE_DIR": str(tmp_path)}
+    first = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    second = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
+    backend, _, misses1 = first.stdout.split()
+    _, hits2, misses2 = second.stdout.split()
+    assert backend == "numba" and int(misses1) > 0
+    assert int(hits2) > 0 and int(misses2) == 0
+    assert any(p.suffix == ".nbi" for p in tmp_path.rglob("*"))
