@@ -153,3 +153,29 @@ def chain_fk(joints: list[GenJoint], q) -> np.ndarray:
 
 def dof(joints: list[GenJoint]) -> int:
     return sum(j.kind != "fixed" for j in joints)
+
+
+def with_random_inertia(robot, rng: np.random.Generator, motor: bool = True):
+    """``robot`` with random inertial data on every row (fixed rows too), motor inertia and no friction."""
+    from denavit import DHLink, LinkInertia
+
+    links = []
+    for link in robot.links:
+        m, _, _, I = _inertial(rng)
+        li = LinkInertia(mass=m, com=tuple(rng.uniform(-0.3, 0.3, 3)), inertia=I,
+                         motor_inertia=float(rng.uniform(0, 0.05)) if motor and link.is_joint else 0.0)
+        links.append(DHLink(a=link.a, alpha=link.alpha, d=link.d, theta=link.theta, joint=link.joint,
+                            q_limits=link.q_limits, inertia=li))
+    return robot.replace(links=tuple(links))
+
+
+def without_motor_inertia(robot):
+    """``robot`` with every row's motor inertia set to 0 (URDF has no place for it)."""
+    from dataclasses import replace
+
+    from denavit import DHLink
+
+    links = [link if link.inertia is None else DHLink(
+        a=link.a, alpha=link.alpha, d=link.d, theta=link.theta, joint=link.joint, q_limits=link.q_limits,
+        inertia=replace(link.inertia, motor_inertia=0.0)) for link in robot.links]
+    return robot.replace(links=tuple(links))

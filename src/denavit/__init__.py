@@ -18,7 +18,7 @@ from .model import Convention, DHLink, DHRobot, Frame, JointType, LinkInertia
 from ._convert import convert_convention
 from .build import fixed, prismatic, revolute, robot
 from .display import dh_table
-from .interop import from_urdf
+from .interop import from_urdf, to_mjcf, to_urdf
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
@@ -50,6 +50,8 @@ __all__ = [
     "robot",
     "dh_table",
     "from_urdf",
+    "to_urdf",
+    "to_mjcf",
     "Convention",
     "Frame",
     "DHLink",

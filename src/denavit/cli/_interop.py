@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ._common import check_output, output_file
+from ._common import add_common, check_output, load, output_file
 
 #: File types ``import-urdf -o`` writes (a denavit robot file).
 ROBOT_SUFFIXES = (".yaml", ".yml", ".json")
@@ -22,6 +22,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
     p.set_defaults(handler=cmd_import_urdf)
+
+    for fmt, suffix, help_text in (("urdf", ".urdf", "the arm as URDF (links, joints, limits, inertials, visuals)"),
+                                   ("mjcf", ".xml", "the arm as MJCF for MuJoCo (bodies, joints, inertials, armature)")):
+        p = sub.add_parser(f"export-{fmt}", help=help_text)
+        add_common(p)
+        p.add_argument("-o", "--output", metavar="FILE", help=f"file to write ({suffix}); stdout if absent")
+        p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+        p.set_defaults(handler=cmd_export, fmt=fmt, suffixes=(suffix,) if fmt == "mjcf" else (".urdf", ".xml"))
 
 
 def cmd_import_urdf(args: argparse.Namespace):
@@ -55,3 +63,19 @@ def cmd_import_urdf(args: argparse.Namespace):
                            "rotation_error": result.rotation_error},
             "notes": list(result.notes), "output": args.output, "robot_file": robot_to_dict(robot)}
     return data, "\n".join(lines)
+
+
+def cmd_export(args: argparse.Namespace):
+    from ..interop import to_mjcf, to_urdf
+
+    check_output(args, args.output, args.suffixes)  # before any work
+    robot = load(args)
+    text = (to_urdf if args.fmt == "urdf" else to_mjcf)(robot)
+    data = {"robot": robot.name, "format": args.fmt, "output": args.output, "joints": [f"q{k + 1}" for k in range(robot.dof)],
+            "dynamics": robot.has_dynamics}
+    if args.output:
+        with output_file(args.output) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+        return data, f"wrote {args.output} ({args.fmt.upper()}, {robot.dof} joints q1 … q{robot.dof}, tool frame 'tool')"
+    data["text"] = text
+    return data, text

@@ -15,11 +15,17 @@ from ._urdf_in import (
     import_urdf,
     urdf_chain_fk,
 )
+from ._mjcf_out import MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
+from ._urdf_out import to_urdf
 from ._urdf_read import MAX_URDF_LINKS, chain_path, read_urdf
 from ._xml import MAX_XML_BYTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
 
 __all__ = [
     "from_urdf",
+    "to_urdf",
+    "to_mjcf",
+    "MJCF_MIN_MASS",
+    "MJCF_MIN_INERTIA",
     "import_urdf",
     "UrdfImport",
     "read_urdf",

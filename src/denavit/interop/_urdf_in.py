@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import DenavitWarning, ModelError, ParseError
 from ..model import Convention, DHLink, DHRobot, JointType, LinkInertia
 from ..numeric import forward_kinematics, link_transforms
+from ._export import combine_inertia
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
 
 __all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "PARALLEL_TOL", "INTERSECT_TOL",
@@ -170,17 +171,6 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
         cases.append(case)
         g, x_prev = g_next, x
     return theta, d, a, alpha, cases, F0
-
-
-def _combine(pieces: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
-    """Mass, COM and inertia about the COM of rigid pieces (mass, com, inertia about own COM; one frame)."""
-    m = sum(p[0] for p in pieces)
-    c = sum(p[0] * p[1] for p in pieces) / m if m > 0 else np.zeros(3)
-    I = np.zeros((3, 3))
-    for mi, ci, Ii in pieces:
-        r = ci - c
-        I += Ii + mi * ((r @ r) * np.eye(3) - np.outer(r, r))  # parallel-axis theorem
-    return float(m), c, 0.5 * (I + I.T)
 
 
 def urdf_chain_fk(path: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
@@ -332,7 +322,7 @@ def _with_inertia(robot: DHRobot, model: UrdfModel, path: list[UrdfJoint], link_
     links = list(robot.links)
     moving = [j for j in path if j.moving]
     for k in range(n):
-        m, c, I = _combine(pieces[k]) if pieces[k] else (0.0, np.zeros(3), np.zeros((3, 3)))
+        m, c, I = combine_inertia(pieces[k]) if pieces[k] else (0.0, np.zeros(3), np.zeros((3, 3)))
         try:
             li = LinkInertia(mass=m, com=tuple(c), inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
                              viscous=moving[k].damping, coulomb=moving[k].friction)
