@@ -19,9 +19,9 @@ from _hostile import assert_accepted_quietly, assert_refused, corpus, run_cli, r
 GOOD = """<?xml version="1.0"?>
 <robot name="arm">
   <link name="base"/>
-  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1"/></inertial></link>
+  <link name="l1"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="l2"><inertial><origin xyz="0.1 0 0"/><mass value="0.5"/>
-    <inertia ixx="0.01" iyy="0.02" izz="0.02"/></inertial></link>
+    <inertia ixx="0.01" iyy="0.02" izz="0.02" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3"/>
     <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
   <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.2 0 0" rpy="1.5707963 0 0"/>
@@ -80,6 +80,9 @@ CASES = {
     "inf": (_swap('<mass value="1"/>', '<mass value="inf"/>'), ["arm.urdf", "mass", "not a number"]),
     "underscore number": (_swap('<mass value="1"/>', '<mass value="1_0"/>'), ["arm.urdf", "not a number"]),
     "two numbers for three": (_swap('xyz="0.2 0 0"', 'xyz="0.2 0"'), ["arm.urdf", "expected 3"]),
+    "inertia entry missing": (_swap(' ixy="0" ixz="0" iyz="0"/></inertial></link>\n  <link name="l2">',
+                                    ' ixz="0" iyz="0"/></inertial></link>\n  <link name="l2">'),
+                              ["arm.urdf", "l1", "ixy"]),
     "negative mass": (_swap('<mass value="1"/>', '<mass value="-1"/>'), ["arm.urdf", "negative"]),
     "impossible inertia": (_swap('ixx="0.1" iyy="0.1" izz="0.1"', 'ixx="0.1" iyy="0.1" izz="5"'),
                            ["arm.urdf", "j1", "triangle"]),

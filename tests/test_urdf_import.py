@@ -8,6 +8,8 @@ with scipy, and Pinocchio's own URDF parser (``buildModelFromXML``) for FK, RNEA
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -186,3 +188,40 @@ def test_default_tip_is_the_leaf_with_most_moving_joints():
     assert (result.base_link, result.tip_link) == ("w", "b")
     assert [j.value for j in result.robot.joint_types] == ["revolute", "prismatic"]
     assert result.robot.joints[0].q_limits is None and result.robot.joints[1].q_limits == (0.0, 0.5)
+
+
+SMALL_ARM = Path(__file__).resolve().parents[1] / "examples" / "urdf" / "small_arm.urdf"
+
+
+def test_small_arm_fixture_by_hand():
+    """examples/urdf/small_arm.urdf worked by hand: a pedestal 0.05 + 0.3 + 0.1 = 0.45 m high, the shoulder-lift
+    axis (y) meeting the pan axis (z) there, the telescope (x) meeting both, the wrist roll on the telescope's
+    line 0.5 m out, the flange 0.05 m beyond; the camera (fixed to the shoulder) rides on body 1."""
+    result = import_urdf(SMALL_ARM)
+    robot = result.robot
+    assert (result.base_link, result.tip_link) == ("world", "flange")
+    assert result.cases == ("intersecting", "intersecting", "coincident", "last")
+    assert [t.value for t in robot.joint_types] == ["revolute", "revolute", "prismatic", "revolute"]
+    assert robot.joints[2].q_limits == (0.0, 0.2) and robot.joints[3].q_limits is None
+    for q, p in (([0, 0, 0, 0], [0.55, 0, 0.45]), ([np.pi / 2, 0, 0, 0], [0, 0.55, 0.45]),
+                 ([0, 0, 0.2, 1.0], [0.75, 0, 0.45]), ([0, -np.pi / 2, 0, 0], [0, 0, 1.0])):
+        np.testing.assert_allclose(denavit.forward_kinematics(robot, q)[:3, 3], p, atol=1e-12)
+    assert robot.joints[0].inertia.mass == pytest.approx(2.2)  # shoulder 2.0 + camera 0.2
+    assert robot.joints[0].inertia.viscous == 0.1 and robot.joints[0].inertia.coulomb == 0.05
+
+
+@pytest.mark.peer
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_small_arm_fixture_matches_pinocchio(convention, rng):
+    pin = pytest.importorskip("pinocchio")
+    robot = import_urdf(SMALL_ARM, convention=convention).robot
+    model = pin.buildModelFromUrdf(str(SMALL_ARM))
+    data = model.createData()
+    fid = model.getFrameId("flange")
+    for _ in range(10):
+        q, qd, qdd = (rng.uniform(-1, 1, 4) for _ in range(3))
+        x = np.concatenate([q[:3], [np.cos(q[3]), np.sin(q[3])]])  # the continuous wrist as (cos, sin)
+        pin.framesForwardKinematics(model, data, x)
+        np.testing.assert_allclose(denavit.forward_kinematics(robot, q), data.oMf[fid].homogeneous, atol=1e-12)
+        np.testing.assert_allclose(denavit.rnea(robot, q, qd, qdd, friction=False), pin.rnea(model, data, x, qd, qdd),
+                                   atol=1e-12)

@@ -8,8 +8,8 @@ direction x_k perpendicular to both, from a foot f_k on L_k to a foot g_{k+1} on
 and the twist α_k from z_k to z_{k+1} about x_k.  The cases (``ROW_CASES``):
 
 - ``skew``: N_k is unique;
-- ``intersecting``: a_k = 0, f_k = g_{k+1} the intersection, x_k = z_k × z_{k+1} / |z_k × z_{k+1}|
-  (so α_k ∈ (0, π));
+- ``intersecting``: a_k = 0, f_k = g_{k+1} the intersection, x_k = ±z_k × z_{k+1} / |z_k × z_{k+1}|, the
+  sign that keeps x_k within 90° of x_{k-1} (so |θ_k| ≤ π/2; + when perpendicular);
 - ``parallel`` / ``anti-parallel`` (distinct lines): x_k is unique, its foot is not; the normal is taken
   through the origin the URDF gives joint k+1 (so a pedestal's height stays in d_1, as textbooks write it);
 - ``coincident`` / ``anti-coincident`` (one line): a_k = 0, α_k ∈ {0, π}; f_k = g_{k+1} is the origin of
@@ -148,6 +148,8 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
                 dist = float(w @ x)  # signed length of the common normal
                 if abs(dist) < tol:
                     ak, case = 0.0, "intersecting"
+                    if float(x @ x_prev) < -1e-9:  # the sign keeping θ_k within ±π/2 (+ on a tie)
+                        x = -x
                 else:
                     x, ak, case = (x if dist > 0 else -x), abs(dist), "skew"
                 g_next = f + ak * x

@@ -140,7 +140,8 @@ def _inertial(where: str, el: Element) -> UrdfInertial:
     I = np.zeros((3, 3))
     if in_el is not None:
         names = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
-        ixx, iyy, izz, ixy, ixz, iyz = (_numbers(where, in_el, k, 1, (0.0,), MAX_MAGNITUDE, " kg m²")[0] for k in names)
+        # all six are required (the URDF specification; urdfdom drops a tensor that lacks one)
+        ixx, iyy, izz, ixy, ixz, iyz = (_numbers(where, in_el, k, 1, None, MAX_MAGNITUDE, " kg m²")[0] for k in names)
         I = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
     return UrdfInertial(mass, _origin(where, el.find("origin")), I)
 
