@@ -8,8 +8,10 @@ exported as standalone C99 or Python source.  DESIGN.md's one bridge between the
 """
 
 from ._compiled import CompiledRobot, cache_dir, compile, numba_available
+from ._export import LANGUAGES, PREFIX_PATTERN, default_prefix, export_sources
 from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
+from ._llvm import kernel_intrinsic
 from ._trace import Sym, Tape
 
-__all__ = ["compile", "CompiledRobot", "cache_dir", "numba_available", "KERNEL_NAMES", "KernelSpec",
-           "trace_kernels", "Sym", "Tape"]
+__all__ = ["compile", "CompiledRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir", "numba_available", "KERNEL_NAMES", "KernelSpec",
+           "trace_kernels", "Sym", "Tape", "kernel_intrinsic"]

@@ -91,7 +91,7 @@ def _as_batch(arrays, n: int, names):
     return flat, batch
 
 
-_ndarray, _F64, _empty = np.ndarray, np.dtype(np.float64), np.empty
+_ndarray, _F64, _empty, _SHAPE44, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (8,)
 
 
 class CompiledRobot:
@@ -108,10 +108,54 @@ class CompiledRobot:
                         "jacobiane": (6, n), "rnea": (n,), "gravity": (n,), "coriolis": (n,),
                         "mass_matrix": (n, n), "forward_dynamics": (n + 1,)}
         self._one = {name: (getattr(module, f"{name}_1"), self._shapes[name]) for name in names}
+        self._vec, self._jshape, self._mshape, self._fshape = (n,), (6, n), (n, n), (n + 1,)
+        for name in self._shapes:  # bound kernels for the hot paths; a missing one raises the clear error
+            if name not in self._one:
+                setattr(self, f"_{name}_1", self._missing(name))
+            else:
+                setattr(self, f"_{name}_1", self._first(name) if backend == NUMBA else self._one[name][0])
 
     def __repr__(self) -> str:
         return (f"<CompiledRobot {self.robot.name!r}: {self.dof} joints, {self.backend}, "
                 f"kernels {', '.join(self.kernels)}>")
+
+    def warm(self) -> dict[str, float]:
+        """Run every kernel once, single and batch (this compiles it, or loads it from the disk cache);
+        return the seconds each took."""
+        import time
+
+        out = {}
+        for name in self.kernels:
+            kernel, shape = self._one[name]
+            k = {"rnea": 3, "forward_dynamics": 3, "coriolis": 2}.get(name, 1)
+            t = time.perf_counter()
+            kernel(*[np.zeros(self.dof)] * k, _empty(shape))
+            getattr(self._m, f"{name}_n")(*[np.zeros((1, self.dof))] * k, _empty((1,) + shape))
+            out[name] = time.perf_counter() - t
+        return out
+
+    def _first(self, name: str):
+        """The kernel's first call: compile (or load) it, then bind its machine-code entry point.
+
+        A numba dispatcher spends a few hundred nanoseconds per call choosing the compiled version from the
+        argument types; the hot paths already know them (float64, C-contiguous, fresh output), so they call
+        the entry point of that version directly."""
+        dispatcher = self._one[name][0]
+
+        def first(*args):
+            dispatcher(*args)
+            for sig, result in dispatcher.overloads.items():
+                if all(getattr(t, "layout", "C") == "C" for t in sig):
+                    setattr(self, f"_{name}_1", result.entry_point)
+                    break
+
+        return first
+
+    def _missing(self, name: str):
+        def kernel(*args):
+            self._kernel(name)
+
+        return kernel
 
     # --- plumbing ---------------------------------------------------------------------------------------
     def _kernel(self, name: str):
@@ -135,7 +179,7 @@ class CompiledRobot:
             arrays.append(a)
         if all(a.ndim == 1 for a in arrays):
             out = _empty(shape)
-            kernel(*arrays, out)
+            getattr(self, f"_{name}_1")(*[np.ascontiguousarray(a) for a in arrays], out)
             return out
         flat, batch = _as_batch(arrays, n, labels)
         out = _empty((flat[0].shape[0],) + shape)
@@ -143,44 +187,56 @@ class CompiledRobot:
             getattr(self._m, f"{name}_n")(*flat, out)
         return out.reshape(batch + shape)
 
-    def _fast(self, name: str, q):
-        """One q: a float64 vector of the right length goes straight to the kernel."""
-        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == (self.dof,):
-            kernel, shape = self._kernel(name)
-            out = _empty(shape)
-            kernel(q, out)
-            return out
-        return self._call(name, (q,), ("q",))
-
     # --- kinematics ---------------------------------------------------------------------------------------
+    # Each method first tries the hot path: float64 ndarrays of shape (n,) go straight to the kernel with a
+    # fresh output; anything else (lists, other dtypes, batches, wrong shapes) takes :meth:`_call`.
     def fk(self, q, frames: bool = False) -> np.ndarray:
         """End-effector pose T_w_e, shape (..., 4, 4) (as :func:`denavit.forward_kinematics`); with
         ``frames=True`` the world poses of the DH frames {0} … {N}, shape (..., N+1, 4, 4) (as
         :func:`denavit.link_transforms`, tool not applied)."""
-        return self._fast("frames" if frames else "fk", q)
+        if not frames and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            out = _empty(_SHAPE44)
+            self._fk_1(q, out)
+            return out
+        return self._call("frames" if frames else "fk", (q,), ("q",))
 
     def jacobian(self, q, frame: Frame | str = "base") -> np.ndarray:
         """Geometric Jacobian, shape (..., 6, n), rows (v, ω): ``base`` J0 or ``tool`` Je (as
         :func:`denavit.geometric_jacobian`)."""
         if frame == "base" or frame is Frame.BASE:
-            return self._fast("jacobian0", q)
+            if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+                out = _empty(self._jshape)
+                self._jacobian0_1(q, out)
+                return out
+            return self._call("jacobian0", (q,), ("q",))
         if Frame(frame) is Frame.TOOL:
-            return self._fast("jacobiane", q)
+            return self._call("jacobiane", (q,), ("q",))
         raise ValueError(f"frame must be 'base' or 'tool', got {frame!r}")  # pragma: no cover (Frame raises)
 
     # --- dynamics -------------------------------------------------------------------------------------------
     def rnea(self, q, qd, qdd) -> np.ndarray:
         """Inverse dynamics τ = M q̈ + C q̇ + g + τ_f, shape (..., n) (as :func:`denavit.rnea` with the robot's
         gravity and friction)."""
+        if (q.__class__ is _ndarray and qd.__class__ is _ndarray and qdd.__class__ is _ndarray
+                and q.dtype is _F64 and qd.dtype is _F64 and qdd.dtype is _F64
+                and q.shape == self._vec and qd.shape == self._vec and qdd.shape == self._vec
+                and q.strides == qd.strides == qdd.strides == _STRIDE):
+            out = _empty(self._vec)
+            self._rnea_1(q, qd, qdd, out)
+            return out
         return self._call("rnea", (q, qd, qdd), ("q", "qd", "qdd"))
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), shape (..., n, n) (as :func:`denavit.mass_matrix`)."""
-        return self._fast("mass_matrix", q)
+        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            out = _empty(self._mshape)
+            self._mass_matrix_1(q, out)
+            return out
+        return self._call("mass_matrix", (q,), ("q",))
 
     def gravity(self, q) -> np.ndarray:
         """g(q), shape (..., n) (as :func:`denavit.gravity_torques` with the robot's gravity)."""
-        return self._fast("gravity", q)
+        return self._call("gravity", (q,), ("q",))
 
     def coriolis(self, q, qd) -> np.ndarray:
         """c(q, q̇) = C(q, q̇) q̇, shape (..., n) (as :func:`denavit.coriolis_vector`)."""
@@ -189,7 +245,14 @@ class CompiledRobot:
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """q̈ = M⁻¹ (τ − c − g − τ_f), shape (..., n) (as :func:`denavit.forward_dynamics`); ModelError where
         M is singular."""
-        r = self._call("forward_dynamics", (q, qd, tau), ("q", "qd", "tau"))
+        if (q.__class__ is _ndarray and qd.__class__ is _ndarray and tau.__class__ is _ndarray
+                and q.dtype is _F64 and qd.dtype is _F64 and tau.dtype is _F64
+                and q.shape == self._vec and qd.shape == self._vec and tau.shape == self._vec
+                and q.strides == qd.strides == tau.strides == _STRIDE):
+            r = _empty(self._fshape)
+            self._forward_dynamics_1(q, qd, tau, r)
+        else:
+            r = self._call("forward_dynamics", (q, qd, tau), ("q", "qd", "tau"))
         if r.ndim == 1:
             if not r[-1] > 0.0:
                 self._singular()

@@ -1,0 +1,79 @@
+"""``denavit compile`` (build and cache an arm's kernels) and ``denavit export`` (standalone C or Python)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from ..errors import ParseError
+from ._common import add_common, load, output_file
+
+__all__ = ["register"]
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("compile", help="generate and cache an arm's kernels (FK, Jacobians, dynamics); time them")
+    add_common(p)
+    p.add_argument("--backend", choices=["numba", "numpy"], help="default: numba when installed (the 'fast' extra)")
+    p.set_defaults(handler=cmd_compile)
+
+    p = sub.add_parser("export", help="write an arm's kernels as standalone C99 or numpy-only Python source")
+    add_common(p)
+    p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into (made if absent)")
+    p.add_argument("--prefix", help="C function / module name prefix (default: from the robot's name)")
+    p.add_argument("--force", action="store_true", help="replace files of the same names in DIR")
+    p.set_defaults(handler=cmd_export)
+
+
+def cmd_compile(args: argparse.Namespace):
+    from ..codegen import cache_dir, compile
+
+    robot = load(args)
+    t0 = time.perf_counter()
+    fast = compile(robot, backend=args.backend)
+    timings = fast.warm()
+    total = time.perf_counter() - t0
+    lines = [f"{robot.name}: {robot.dof} joints, backend {fast.backend}, {len(fast.kernels)} kernels in "
+             f"{total:.2f} s (cache: {cache_dir()})"]
+    lines += [f"  {name:<17} {dt * 1e3:8.1f} ms" for name, dt in timings.items()]
+    return {"robot": robot.name, "backend": fast.backend, "kernels": list(fast.kernels), "seconds": total,
+            "kernel_seconds": timings, "cache": str(cache_dir())}, "\n".join(lines)
+
+
+def cmd_export(args: argparse.Namespace):
+    from ..codegen import export_sources
+
+    if args.prefix is not None and not _valid_prefix(args.prefix):
+        raise ParseError(f"--prefix {args.prefix!r}: expected a C identifier (letters, digits, _; "
+                         "not a digit first; at most 40)")
+    folder = Path(args.output)
+    if folder.exists() and not folder.is_dir():
+        raise ParseError(f"-o {args.output!r} is not a folder")
+    if not folder.exists() and not folder.parent.is_dir():
+        raise ParseError(f"-o {args.output!r}: its parent folder does not exist")
+    robot = load(args)
+    files = export_sources(robot, args.lang, args.prefix)
+    clash = [name for name in files if os.path.lexists(folder / name)]
+    if clash and not args.force:
+        raise ParseError(f"{folder / clash[0]} exists; not overwriting it (choose another folder or pass --force)")
+    for name in clash:
+        if not (folder / name).is_file():
+            raise ParseError(f"{folder / name} exists and is not a regular file")
+    try:
+        folder.mkdir(exist_ok=True)
+    except OSError as exc:
+        raise ParseError(f"-o {args.output!r}: {exc.strerror}") from None
+    for name, text in files.items():
+        with output_file(str(folder / name)) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+    written = [str(folder / name) for name in files]
+    return {"robot": robot.name, "lang": args.lang, "files": written}, "wrote " + ", ".join(written)
+
+
+def _valid_prefix(text: str) -> bool:
+    from ..codegen import PREFIX_PATTERN
+
+    return PREFIX_PATTERN.fullmatch(text) is not None

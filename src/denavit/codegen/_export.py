@@ -1,0 +1,110 @@
+"""Standalone source of an arm's kernels: C99 (header + source, libm only) or a numpy-only Python module."""
+
+from __future__ import annotations
+
+import re
+
+from ..model import DHRobot
+from ._emit import NUMPY, c_sources, python_module
+from ._kernels import KERNEL_NAMES, trace_kernels
+
+__all__ = ["export_sources", "default_prefix", "PREFIX_PATTERN", "LANGUAGES"]
+
+LANGUAGES = ("c", "python")
+#: A prefix becomes C identifiers and file names: letters, digits, underscores, at most 40, not a digit first.
+PREFIX_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,39}")
+
+_PY_API = '''
+
+# --- convenience: (n,) or (..., n) in, arrays out -------------------------------------------------------
+N = {n}
+
+
+def _call(one, many, shape, *xs):
+    xs = np.broadcast_arrays(*[np.asarray(x, dtype=float) for x in xs])
+    for x in xs:
+        if x.ndim == 0 or x.shape[-1] != N:
+            raise ValueError(f"expected shape (..., {{N}}), got {{x.shape}}")
+    if xs[0].ndim == 1:
+        out = np.empty(shape)
+        one(*xs, out)
+        return out
+    batch = xs[0].shape[:-1]
+    flat = [np.ascontiguousarray(x.reshape(-1, N)) for x in xs]
+    out = np.empty((flat[0].shape[0],) + shape)
+    if out.shape[0]:
+        many(*flat, out)
+    return out.reshape(batch + shape)
+'''
+
+_PY_WRAPPERS = {
+    "fk": ("fk(q)", "T_w_e, shape (..., 4, 4)", "q"),
+    "frames": ("frames(q)", "world poses of the DH frames {{0}} ... {{N}}, shape (..., {rows}, 4, 4)", "q"),
+    "jacobian0": ("jacobian0(q)", "geometric Jacobian J0 (base frame), rows (v, w), shape (..., 6, n)", "q"),
+    "jacobiane": ("jacobiane(q)", "geometric Jacobian Je (tool frame), rows (v, w), shape (..., 6, n)", "q"),
+    "rnea": ("rnea(q, qd, qdd)", "inverse dynamics tau (gravity and friction of the model), shape (..., n)",
+             "q, qd, qdd"),
+    "mass_matrix": ("mass_matrix(q)", "M(q), shape (..., n, n)", "q"),
+    "gravity": ("gravity(q)", "g(q), shape (..., n)", "q"),
+    "coriolis": ("coriolis(q, qd)", "c(q, qd) = C(q, qd) qd, shape (..., n)", "q, qd"),
+}
+
+
+def default_prefix(robot: DHRobot) -> str:
+    """A C identifier from the robot's name (non-identifier characters become ``_``)."""
+    text = re.sub(r"[^A-Za-z0-9_]", "_", robot.name)[:40] or "robot"
+    return text if PREFIX_PATTERN.fullmatch(text) else ("r" + text)[:40]
+
+
+def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels=None) -> dict[str, str]:
+    """The files of a standalone export, ``{file name: text}``.
+
+    ``lang="c"``: ``<prefix>.h`` and ``<prefix>.c`` — functions ``void <prefix>_<kernel>(const double q[n],
+    ..., double out[k])`` writing row-major results, C99, libm only, no allocation.  ``lang="python"``:
+    ``<prefix>.py``, needing only numpy, with ``fk(q)``, ``jacobian0(q)``, … on ``(n,)`` or ``(..., n)``.
+    """
+    if lang not in LANGUAGES:
+        raise ValueError(f"lang must be one of {', '.join(LANGUAGES)}, got {lang!r}")
+    prefix = default_prefix(robot) if prefix is None else prefix
+    if not PREFIX_PATTERN.fullmatch(prefix):
+        raise ValueError(f"prefix {prefix!r}: expected a C identifier of at most 40 characters")
+    specs = trace_kernels(robot, KERNEL_NAMES if kernels is None else kernels)
+    n = robot.dof
+    title = f"Kernels of a {n}-joint arm ({robot.convention.value} DH), exported by denavit."
+    if lang == "c":
+        usage = _c_usage(prefix, n, "rnea" in specs)
+        header, source = c_sources(specs, prefix, title + usage)
+        return {f"{prefix}.h": header, f"{prefix}.c": source}
+    text = python_module(specs, NUMPY, title + _py_usage(prefix, n))
+    text += _PY_API.format(n=n)
+    rows = len(robot.links) + 1
+    for name, (sig, doc, args) in _PY_WRAPPERS.items():
+        if name in specs:
+            text += (f"\n\ndef {sig}:\n    \"\"\"{doc.format(rows=rows)}.\"\"\"\n"
+                     f"    return _call({name}_1, {name}_n, {specs[name].shape!r}, {args})\n")
+    if "forward_dynamics" in specs:
+        text += (f"\n\ndef forward_dynamics(q, qd, tau):\n"
+                 f"    \"\"\"qdd = M^-1 (tau - c - g - tau_f), shape (..., n); ValueError where M is singular.\"\"\"\n"
+                 f"    r = _call(forward_dynamics_1, forward_dynamics_n, {specs['forward_dynamics'].shape!r}, q, qd, tau)\n"
+                 f"    if not (r[..., -1] > 0.0).all():\n"
+                 f"        raise ValueError(\"the mass matrix is singular at this configuration\")\n"
+                 f"    return r[..., :-1]\n")
+    return {f"{prefix}.py": text}
+
+
+def _c_usage(prefix: str, n: int, dynamics: bool) -> str:
+    lines = ["", "", "Usage:", f'    #include "{prefix}.h"', f"    double q[{n}] = {{0}}, T[16], J[{6 * n}];",
+             f"    {prefix}_fk(q, T);          (T[4*i + j] = T_w_e(i, j))",
+             f"    {prefix}_jacobian0(q, J);   (J[{n}*r + k]: row r of (v, w), joint k)"]
+    if dynamics:
+        lines += [f"    double qd[{n}] = {{0}}, qdd[{n}] = {{0}}, tau[{n}], M[{n * n}], a[{n + 1}];",
+                  f"    {prefix}_rnea(q, qd, qdd, tau);",
+                  f"    {prefix}_mass_matrix(q, M);",
+                  f"    {prefix}_forward_dynamics(q, qd, tau, a);  (qdd in a[0..{n - 1}]; a[{n}] > 0 iff M is regular)"]
+    lines += [f"Build: cc -std=c99 -O2 -c {prefix}.c && link with -lm."]
+    return "\n".join(lines)
+
+
+def _py_usage(prefix: str, n: int) -> str:
+    return "\n".join(["", "", "Usage:", f"    import numpy as np, {prefix}", f"    T = {prefix}.fk(np.zeros({n}))",
+                      f"    J = {prefix}.jacobian0(np.random.rand(1000, {n}))  # a batch: (1000, 6, {n})"])
