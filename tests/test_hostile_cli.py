@@ -139,7 +139,7 @@ SCALAR_CASES = [
     (["plot", "planar2r", "-o", "p.png"], "--dpi", 10, 600, True),
     (["animate", "planar2r", "--from", "0,0", "--to", "1,1", "-o", "a.gif"], "--duration", 5e-324, 600, False),
     (["animate", "planar2r", "--from", "0,0", "--to", "1,1", "-o", "a.gif"], "--fps", 5e-324, 60, False),
-    (["workspace", "planar2r"], "--samples", 100, 2_000_000, True),
+    (["workspace", "planar2r"], "--samples", 100, 10**10, True),  # streamed (issue 17): denavit.scale.MAX_SAMPLES
     (["workspace", "planar2r"], "--resolution", 1e-6, 1e6, False),
     (["workspace", "planar2r"], "--seed", 0, 10**19, True),
     (["ik", "planar2r", "--method", "numeric", "--pose", "1,1,0,0,0,0"], "--restarts", 0, 1000, True),
@@ -156,9 +156,20 @@ def test_bad_scalars(folder, head, option, lo, hi, integer):
     def case(text):
         if option == "--seed" and text.strip().isdigit():
             return  # any whole number >= 0 is a seed
+        if option == "--samples" and _whole_count(text, lo, hi):
+            return  # a whole count may be written 1e9 or 1000.0 (issue 17)
         _check(folder, head + [f"{option}={text}"], mentions=[option.lstrip("-")])
 
     case()
+
+
+def _whole_count(text: str, lo: int, hi: int) -> bool:
+    from decimal import Decimal
+
+    t = text.strip()
+    if not re.fullmatch(r"\+?[0-9]{1,20}(\.[0-9]{0,20})?([eE]\+?[0-9]{1,3})?", t):
+        return False
+    return Decimal(t) == Decimal(t).to_integral_value() and lo <= Decimal(t) <= hi
 
 
 SIM = ["simulate", "planar2r", "--q0", "0,0"]
@@ -330,7 +341,7 @@ def test_full_disk_leaves_nothing(command, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("argv", [
-    ["workspace", "planar2r", "--samples", "20000000"],
+    ["workspace", "planar2r", "--samples", "100000000000"],  # streamed since issue 17: 2e7 is fine, 1e11 is not
     ["plot", "planar2r", "--dpi", "100000", "-o", "p.png"],
     ["animate", "planar2r", "--from", "0,0", "--to", "1,1", "--duration", "100000", "-o", "a.gif"],
     ["simulate", "planar2r", "--q0", "0,0", "--duration", "1000", "--dt", "1e-6"],

@@ -18,7 +18,7 @@ SAMPLES_MIN = 100
 RESOLUTION_RANGE = (1e-6, 1e6)
 #: reachability: --resolution range [m].
 REACH_RESOLUTION_RANGE = (1e-3, 1e3)
-_WHOLE = re.compile(r"\+?\d{1,20}(?:\.\d{0,20})?(?:[eE]\+?\d{1,3})?")
+_WHOLE = re.compile(r"\+?[0-9]{1,20}(?:\.[0-9]{0,20})?(?:[eE]\+?[0-9]{1,3})?")
 
 
 def sample_count(lo: int, hi: int):
