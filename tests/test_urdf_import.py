@@ -225,3 +225,29 @@ def test_small_arm_fixture_matches_pinocchio(convention, rng):
         np.testing.assert_allclose(denavit.forward_kinematics(robot, q), data.oMf[fid].homogeneous, atol=1e-12)
         np.testing.assert_allclose(denavit.rnea(robot, q, qd, qdd, friction=False), pin.rnea(model, data, x, qd, qdd),
                                    atol=1e-12)
+
+
+def _two_axes(eps: float) -> str:
+    """Joint 2's z axis turned by eps about x and y: skew to joint 1's, nearly parallel for small eps."""
+    return f"""<robot name="r"><link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+      <joint name="j2" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0.4 0.2 0.1"
+        rpy="{eps!r} {eps!r} 0"/><axis xyz="0 0 1"/></joint>
+      <joint name="j3" type="fixed"><parent link="c"/><child link="d"/><origin xyz="0.3 0 0"/></joint></robot>"""
+
+
+@pytest.mark.parametrize("eps", [1e-2, 1e-3, 1e-4])
+def test_nearly_parallel_skew_axes_stay_exact(eps):
+    """The common normal of nearly parallel axes is far away (about 0.1/eps² m) but the model stays exact."""
+    result = import_urdf(_two_axes(eps))
+    assert result.cases == ("skew", "last")
+    assert result.position_error < 1e-12 and result.rotation_error < 1e-12
+
+
+@pytest.mark.parametrize("eps", [1e-5, 1e-7])
+def test_almost_parallel_axes_taken_as_parallel_with_a_note_and_a_warning(eps):
+    with pytest.warns(denavit.DenavitWarning, match="differs from the URDF chain"):
+        result = import_urdf(_two_axes(eps))
+    assert result.cases == ("parallel", "last")
+    assert any("nearly parallel" in note for note in result.notes)
+    assert 0 < result.position_error < 10 * eps and result.rotation_error < 10 * eps

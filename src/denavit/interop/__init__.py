@@ -7,6 +7,7 @@ Importing this package loads no XML library beyond the standard library's expat.
 from ._urdf_in import (
     CHECK_SAMPLES,
     CHECK_TOL,
+    FAR_FOOT,
     INTERSECT_TOL,
     PARALLEL_TOL,
     ROW_CASES,
@@ -35,6 +36,7 @@ __all__ = [
     "INTERSECT_TOL",
     "CHECK_SAMPLES",
     "CHECK_TOL",
+    "FAR_FOOT",
     "ROW_CASES",
     "MAX_XML_BYTES",
     "MAX_XML_DEPTH",

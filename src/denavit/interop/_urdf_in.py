@@ -40,13 +40,16 @@ from ._export import combine_inertia
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
 
 __all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "PARALLEL_TOL", "INTERSECT_TOL",
-           "CHECK_SAMPLES", "CHECK_TOL", "ROW_CASES"]
+           "CHECK_SAMPLES", "CHECK_TOL", "FAR_FOOT", "ROW_CASES"]
 
 #: Two axes count as parallel when the sine of their angle is below this.
 PARALLEL_TOL = 1e-10
 #: Two axes count as meeting (and parallel axes as one line) when their distance is below this, relative to
 #: the chain's size (at least 1 m).
 INTERSECT_TOL = 1e-10
+#: Nearly parallel axes whose common normal meets the first axis farther than this (relative to the chain's size)
+#: are taken as parallel: the DH model then approximates the URDF, and the self-check reports by how much.
+FAR_FOOT = 1e3
 #: Random configurations of the import's FK self-check.
 CHECK_SAMPLES = 200
 #: Self-check errors (relative to the chain's size, at least 1 m) beyond which the import warns.
@@ -127,7 +130,7 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
     if x_prev is None:
         x_prev = _unit_perp(np.array([0.0, 1.0, 0.0]), Z[0])
     F0 = _frame(g, x_prev, Z[0])
-    theta, d, a, alpha, cases = [], [], [], [], []
+    theta, d, a, alpha, cases, approximated = [], [], [], [], [], []
     for k in range(n):
         z = Z[k]
         if k == n - 1:
@@ -139,12 +142,12 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
             zn, w = Z[k + 1], P[k + 1] - P[k]
             c = np.cross(z, zn)
             s = float(np.linalg.norm(c))
-            if s > PARALLEL_TOL:
-                b = float(z @ zn)
-                d1, d2 = float(w @ z), float(w @ zn)
-                t1 = (d1 - b * d2) / (s * s)
+            x = c / s if s > 0 else c
+            t1 = float(np.cross(w, zn) @ x) / s if s > 0 else math.inf
+            if s > PARALLEL_TOL and abs(t1) <= FAR_FOOT * scale:
+                # foot on L_k: t = det[w, z_{k+1}, c] / |c|², written so that its error is ~ eps/s, not eps/s²
+                # (nearly parallel axes): the foot on L_{k+1} then stays on it to rounding
                 f = P[k] + t1 * z
-                x = c / s
                 dist = float(w @ x)  # signed length of the common normal
                 if abs(dist) < tol:
                     ak, case = 0.0, "intersecting"
@@ -153,7 +156,9 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
                 else:
                     x, ak, case = (x if dist > 0 else -x), abs(dist), "skew"
                 g_next = f + ak * x
-            else:
+            else:  # parallel, or so nearly that the common normal is far away: taken as parallel
+                if s > PARALLEL_TOL:
+                    approximated.append(k)
                 f = P[k] + ((P[k + 1] - P[k]) @ z) * z  # the normal through the next joint's origin
                 v = P[k + 1] - f
                 v = v - (v @ z) * z  # from L_k to L_{k+1}, perpendicular to both
@@ -172,7 +177,7 @@ def _dh_geometry(P: np.ndarray, Z: np.ndarray, T_tip: np.ndarray, scale: float):
         alpha.append(_snap(alk))
         cases.append(case)
         g, x_prev = g_next, x
-    return theta, d, a, alpha, cases, F0
+    return theta, d, a, alpha, cases, F0, approximated
 
 
 def urdf_chain_fk(path: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
@@ -249,7 +254,7 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     P, Z = np.array(P), np.array(Z)
     Z /= np.linalg.norm(Z, axis=1, keepdims=True)
     scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
-    theta, d, a, alpha, cases, F0 = _dh_geometry(P, Z, T, scale)
+    theta, d, a, alpha, cases, F0, approximated = _dh_geometry(P, Z, T, scale)
     robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
     robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base)
     pos, rot = _self_check(robot, path, rng)
@@ -262,6 +267,10 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         notes = (f"limits with lower = upper read as no limits: {', '.join(empty)}",) + notes
     if any(j.kind == "continuous" for j in moving):
         notes = ("continuous joints have no limits",) + notes
+    if approximated:
+        rows = ", ".join(f"{k + 1} ({moving[k].name})" for k in approximated)
+        notes = (f"rows {rows}: nearly parallel axes (common normal farther than {FAR_FOOT:g} × the arm's size) "
+                 "taken as parallel; the self-check shows the error",) + notes
     folded = sum(1 for j in path if not j.moving)
     if folded:
         notes = (f"{folded} fixed joint{'s' if folded > 1 else ''} folded into the geometry",) + notes
@@ -269,6 +278,14 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
 
 
 def _robot(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], theta, d, a, alpha, F0, T_tip) -> DHRobot:
+    try:
+        return _robot_rows(model, conv, moving, theta, d, a, alpha, F0, T_tip)
+    except ModelError as exc:
+        raise model.error(f"the chain gives no valid DH model: {exc}") from None
+
+
+def _robot_rows(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], theta, d, a, alpha, F0,
+                T_tip) -> DHRobot:
     n = len(moving)
     links = []
     for k, j in enumerate(moving):
@@ -277,15 +294,12 @@ def _robot(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], theta, d
         limits = j.limits if j.limits is None or j.limits[0] < j.limits[1] else None  # [0, 0]: no range given
         links.append(DHLink(a=ak, alpha=alk, d=d[k], theta=theta[k], joint=kind, q_limits=limits))
     names = ", ".join(j.name for j in moving)
-    try:
-        robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=F0,
-                        description=f"imported from URDF; rows are the joints {names}"[:2000])
-        Fn = link_transforms(robot, np.zeros(n))[-1]
-        tool = np.linalg.solve(Fn, T_tip)
-        tool[3] = (0.0, 0.0, 0.0, 1.0)
-        return robot.replace(tool=tool)
-    except ModelError as exc:
-        raise model.error(f"the chain gives no valid DH model: {exc}") from None
+    robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=F0,
+                    description=f"imported from URDF; rows are the joints {names}"[:2000])
+    Fn = link_transforms(robot, np.zeros(n))[-1]
+    tool = np.linalg.solve(Fn, T_tip)
+    tool[3] = (0.0, 0.0, 0.0, 1.0)
+    return robot.replace(tool=tool)
 
 
 def _with_inertia(robot: DHRobot, model: UrdfModel, path: list[UrdfJoint], link_pose: dict, link_body: dict,
