@@ -32,6 +32,7 @@ from ..numeric import (RANK_RTOL, TWIST_ROWS, geometric_jacobian, jacobian_rank,
                        select_rows)
 from ._jacobians import geometric_jacobian_sym, reduce_trig, simplify_kinematic
 from ._kinematics import link_transforms_sym
+from ._rings import TrigRing
 from ._symbols import joint_symbols, parameter_symbols
 
 __all__ = ["SingularSolution", "SingularCondition", "SingularityAnalysis", "singularity_analysis", "task_rows"]
@@ -100,50 +101,9 @@ class SingularityAnalysis:
 # the determinant as multiplied, where the product structure of the arm is still visible.
 
 
-class _Ring:
-    """QQ[parameters, constants, s_1…s_n, c_1…c_n] for expressions in q and the robot's parameters."""
-
-    def __init__(self, exprs: list[sp.Expr], q) -> None:
-        from sympy.polys.domains import QQ
-        from sympy.polys.rings import ring
-
-        n = len(q)
-        self.q = tuple(q)
-        self.s = sp.symbols(f"_s1:{n + 1}")
-        self.c = sp.symbols(f"_c1:{n + 1}")
-        xs = [self._trig_vars(e) for e in exprs]
-        consts: set[sp.Expr] = set()
-        params: set[sp.Symbol] = set()
-        for x in xs:
-            consts |= {a for a in x.atoms(sp.Float, sp.Pow, sp.sin, sp.cos, sp.NumberSymbol, sp.exp)
-                       if a.is_number and not a.is_Rational}
-            params |= {a for a in x.free_symbols if a not in self.s and a not in self.c}
-        consts = {a for a in consts if not any(a != b and a.has(b) for b in consts)}  # outermost only
-        self.konst = {a: sp.Dummy(f"k{i}") for i, a in enumerate(sorted(consts, key=sp.default_sort_key))}
-        self.back = {v: k for k, v in self.konst.items()}
-        gens = sorted(params, key=str) + list(self.konst.values()) + list(self.s) + list(self.c)
-        self.R, *self.gens = ring(gens, QQ)
-        # algebraic constants (√3) keep their minimal polynomial: r² − 3 restores RᵀR = I of a 60° twist
-        self.const_relations = [self.R(sp.minimal_polynomial(a, d)) for a, d in self.konst.items()
-                                if not a.has(sp.Float) and a.is_algebraic]
-        self.relations = self.const_relations + [self.R(si ** 2 + ci ** 2 - 1) for si, ci in zip(self.s, self.c)]
-        self._x = xs
-
-    def _trig_vars(self, e: sp.Expr) -> sp.Expr:
-        x = sp.expand(sp.expand_trig(sp.sympify(e)))
-        x = x.xreplace({sp.cos(qi): ci for qi, ci in zip(self.q, self.c)})
-        return x.xreplace({sp.sin(qi): si for qi, si in zip(self.q, self.s)})
-
-    def elements(self):
-        return [self.R(x.xreplace(self.konst)) for x in self._x]
-
-    def reduce(self, p):
-        return p.rem(self.relations)
-
-    def to_expr(self, p) -> sp.Expr:
-        e = p.as_expr().xreplace(self.back)
-        e = e.xreplace({ci: sp.cos(qi) for qi, ci in zip(self.q, self.c)})
-        return e.xreplace({si: sp.sin(qi) for qi, si in zip(self.q, self.s)})
+def _Ring(exprs: list[sp.Expr], q, robot: DHRobot) -> TrigRing:
+    """The ring of the analysis: one angle per revolute joint, prismatic variables as generators."""
+    return TrigRing(exprs, q, revolute=[k for k, t in enumerate(robot.joint_types) if t is JointType.REVOLUTE])
 
 
 def _middle_frame(robot: DHRobot) -> int:
@@ -151,7 +111,7 @@ def _middle_frame(robot: DHRobot) -> int:
     return min(2, robot.dof - 1) if robot.dof <= 6 else robot.dof // 2
 
 
-def _ring_frames(rg: _Ring, A: list, k: int):
+def _ring_frames(rg: TrigRing, A: list, k: int):
     """T_k_i for every frame i = 0 … N as 4×4 lists of ring elements, from the link matrices A (4×4 lists)
     (k: a DH frame index; frames before k through the inverses Rᵀ, −Rᵀp of the link matrices)."""
     R = rg.R
@@ -172,7 +132,7 @@ def _ring_frames(rg: _Ring, A: list, k: int):
     return [T[i] for i in range(len(A) + 1)]
 
 
-def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMatrix, str, _Ring, list]:
+def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMatrix, str, TrigRing, list]:
     """J in the axes of a middle frame (joint 3's axis frame; joint 4's for 7 joints), reference point on the
     last joint axis: (sympy matrix, note, ring, ring matrix as a list of rows)."""
     from ._kinematics import link_matrices_sym
@@ -181,7 +141,7 @@ def _wrist_frame_jacobian(robot: DHRobot, simplify: str) -> tuple[sp.ImmutableMa
     k, m = axis[_middle_frame(robot)], axis[-1]
     q = joint_symbols(robot.dof).q
     mats = link_matrices_sym(robot)
-    rg = _Ring([e for A in mats for e in A], q)
+    rg = _Ring([e for A in mats for e in A], q, robot)
     vals = rg.elements()
     T = _ring_frames(rg, [[vals[16 * j + 4 * i:16 * j + 4 * i + 4] for i in range(4)] for j in range(len(mats))], k)
     p = [T[m][i][3] for i in range(3)]
@@ -205,7 +165,7 @@ def _display(e: sp.Expr, simplify: str, q) -> sp.Expr:
     return reduce_trig(e, q) if simplify == "trig" else (sp.simplify(e) if simplify == "full" else e)
 
 
-def _minors(rg: _Ring, J: list, shape: tuple[int, int]) -> tuple[str, list]:
+def _minors(rg: TrigRing, J: list, shape: tuple[int, int]) -> tuple[str, list]:
     """(name of the measure, ring minors whose common factor is solved): det J, or the k×k minors."""
     from sympy.polys.matrices import DomainMatrix
 
@@ -229,7 +189,7 @@ def _minors(rg: _Ring, J: list, shape: tuple[int, int]) -> tuple[str, list]:
 # --- factoring -------------------------------------------------------------------------------------
 
 
-def _factors(rg: _Ring, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
+def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
     """Common factor of the ring minors, factorized: (constant part, [(factor in q, multiplicity)]).
 
     The gcd of the minors as multiplied is tried first (it keeps the arm's product structure); when it is
@@ -238,12 +198,12 @@ def _factors(rg: _Ring, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]
     g = minors[0]
     for p in minors[1:]:
         g = g.gcd(p)
-    if len(minors) > 1 and not any(g.degree(x) > 0 for x in rg.gens[-2 * len(q):]):
+    if len(minors) > 1 and not rg.to_expr(g).has(*q):
         red = [rg.reduce(p) for p in minors]
         g2 = red[0]
         for p in red[1:]:
             g2 = g2.gcd(p)
-        g = g * g2 if any(g2.degree(x) > 0 for x in rg.gens[-2 * len(q):]) else g
+        g = g2 if rg.to_expr(g2).has(*q) else g
     if rg.const_relations:
         g = g.rem(rg.const_relations)
     coeff, facs = g.factor_list()
@@ -605,7 +565,7 @@ def singularity_analysis(robot: DHRobot, rows: str | None = "auto", frame: Frame
     else:
         M = sp.ImmutableMatrix(geometric_jacobian_sym(robot, frame, simplify).extract(idx, list(range(robot.dof))))
         note = f"rows {', '.join(TWIST_ROWS[i] for i in idx)} of J{'0' if frame is Frame.BASE else 'e'}"
-        rg = _Ring(list(M), q)
+        rg = _Ring(list(M), q, robot)
         vals = rg.elements()
         J = [vals[i * M.shape[1]:(i + 1) * M.shape[1]] for i in range(M.shape[0])]
     say(f"determinant / minors of the {M.shape[0]}x{M.shape[1]} matrix")
