@@ -1,4 +1,5 @@
-"""Workspace and reachability at scale: streamed sampling, voxel occupancy, volume with an interval.
+"""Workspace and reachability at scale: streamed sampling, voxel occupancy, volume with an interval,
+reachability and manipulability maps.
 
 The same task functions run in this process, in a thread or process pool, or on a ``dask.distributed``
 cluster given by address (the optional extra ``denavit[scale]``); results depend on the seed only, not on
@@ -10,11 +11,13 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 from ._sampler import BLOCK, FINE_CELLS, MAX_CELLS, Grid, PositionFK, reach_bound, sampling_limits
 from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
 from ._volume import VolumeEstimate, coarsen, estimate_volume
+from ._reach import DEFAULT_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
 from ._occupancy import (DEFAULT_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy, new_seed, occupancy,
                          sample_positions)
 
 __all__ = [
     "BLOCK",
+    "DEFAULT_ORIENTATIONS",
     "CONNECT_TIMEOUT",
     "DEFAULT_CHUNK",
     "FINE_CELLS",
@@ -24,6 +27,7 @@ __all__ = [
     "Grid",
     "Occupancy",
     "PositionFK",
+    "ReachabilityMap",
     "VolumeEstimate",
     "check_scheduler",
     "coarsen",
@@ -31,6 +35,8 @@ __all__ = [
     "load_occupancy",
     "new_seed",
     "occupancy",
+    "orientation_set",
+    "reachability",
     "reach_bound",
     "sample_positions",
     "sampling_limits",
