@@ -18,6 +18,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tip", metavar="LINK", help="last link of the chain (default: the one leaf; needed when the "
                                                   "tree branches)")
     p.add_argument("--convention", choices=["standard", "modified"], default="standard", help="DH convention")
+    p.add_argument("--xacro", action="store_true", help="expand a xacro file first (needs denavit[xacro]); xacro "
+                                                         "evaluates Python expressions: only for files you trust")
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
     p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
@@ -38,7 +40,7 @@ def cmd_import_urdf(args: argparse.Namespace):
     from ..io import dump_robot, robot_to_dict
 
     check_output(args, args.output, ROBOT_SUFFIXES)  # before any work
-    result = import_urdf(args.urdf, args.base, args.tip, args.convention)
+    result = import_urdf(args.urdf, args.base, args.tip, args.convention, xacro=args.xacro)
     robot = result.robot
     width = max([len("URDF joint")] + [len(n) for n in result.joint_names])
     lines = [f"{robot.name}: the chain {result.base_link} -> {result.tip_link} of {args.urdf} as {robot.dof} "

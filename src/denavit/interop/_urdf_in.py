@@ -200,7 +200,7 @@ def urdf_chain_fk(path: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
 
 
 def import_urdf(source, base: str | None = None, tip: str | None = None, convention: str = "standard", *,
-                rng: np.random.Generator | None = None) -> UrdfImport:
+                xacro: bool = False, rng: np.random.Generator | None = None) -> UrdfImport:
     """Extract the DH model of the serial chain from link ``base`` to link ``tip`` of a URDF, with its report.
 
     Parameters
@@ -211,6 +211,9 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     base, tip : str, optional
         Link names; default the URDF's root and its one leaf (a branching tree needs ``tip``).
     convention : {"standard", "modified"}
+    xacro : bool
+        Expand a xacro document first (needs the optional ``xacrodoc``).  Xacro evaluates Python expressions:
+        only for files you trust; a ``*.xacro`` path without it is refused.
     rng : numpy.random.Generator, optional
         For the self-check's random configurations (default: a fixed seed, so reports repeat).
 
@@ -228,7 +231,7 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     conv = Convention(convention) if convention in ("standard", "modified") else None
     if conv is None:
         raise ParseError(f"convention {str(convention)[:40]!r}: choose one of standard, modified")
-    model = read_urdf(source)
+    model = read_urdf(source, xacro=xacro)
     base, tip, path = chain_path(model, base, tip)
     moving = [j for j in path if j.moving]
     for j in path:
@@ -363,7 +366,8 @@ def _self_check(robot: DHRobot, path: list[UrdfJoint], rng: np.random.Generator 
     return pos, rot
 
 
-def from_urdf(source, base: str | None = None, tip: str | None = None, convention: str = "standard") -> DHRobot:
+def from_urdf(source, base: str | None = None, tip: str | None = None, convention: str = "standard", *,
+              xacro: bool = False) -> DHRobot:
     """The DH model of a URDF's serial chain from link ``base`` to link ``tip`` (see :func:`import_urdf`).
 
     Examples
@@ -376,4 +380,4 @@ def from_urdf(source, base: str | None = None, tip: str | None = None, conventio
     >>> robot.links[0].d, robot.links[0].q_limits
     (0.5, (-1.0, 1.0))
     """
-    return import_urdf(source, base, tip, convention).robot
+    return import_urdf(source, base, tip, convention, xacro=xacro).robot
