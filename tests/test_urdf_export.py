@@ -132,3 +132,14 @@ def test_cli_export_urdf(tmp_path, capsys):
     assert out.read_text() == "mine"
     assert main(["export-urdf", "stanford", "-o", str(tmp_path / "arm.png")]) == 2
     assert not (tmp_path / "arm.png").exists()
+
+
+@pytest.mark.parametrize("name", ["a\x01b <&> \"quoted\" 'x' -- end", "\ud800lone", "ünïcödé ✓", "x" * 5000])
+def test_any_robot_name_gives_well_formed_files(name):
+    """A robot's name is free text from a file: the URDF and MJCF written stay well-formed XML."""
+    robot = denavit.load_robot("planar2r").replace(name=name)
+    back = denavit.interop.read_urdf(denavit.to_urdf(robot))
+    assert back.name and "\x01" not in back.name and len(back.name) <= 200
+    import xml.etree.ElementTree as ET  # our own output: trusted
+
+    assert ET.fromstring(denavit.to_mjcf(robot)).tag == "mujoco"

@@ -9,6 +9,7 @@ mass, centre of mass and inertia tensor in the body's frame.  The tool is a fram
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,7 +17,7 @@ import numpy as np
 from ..chain import chain_of
 from ..model import DHRobot, inertial_rows
 
-__all__ = ["Body", "export_plan", "combine_inertia", "quaternion_wxyz", "num", "nums"]
+__all__ = ["Body", "export_plan", "combine_inertia", "quaternion_wxyz", "num", "nums", "xml_safe"]
 
 #: Joint glyph radius of the visuals, as a fraction of the arm's size (as in the plots).
 GLYPH_FRACTION = 0.035
@@ -105,3 +106,12 @@ def num(x: float) -> str:
 
 def nums(values) -> str:
     return " ".join(num(v) for v in values)
+
+
+_NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def xml_safe(text: str, limit: int = 200) -> str:
+    """Free text (a robot's name) without the characters XML 1.0 cannot hold (control characters, lone
+    surrogates), cut to ``limit`` characters; quoting is the caller's (``quoteattr``)."""
+    return _NOT_XML.sub("?", str(text))[:limit]

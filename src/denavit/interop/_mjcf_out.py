@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import DenavitWarning
 from ..model import DHRobot
-from ._export import GLYPH_FRACTION, export_plan, num, nums, quaternion_wxyz
+from ._export import GLYPH_FRACTION, export_plan, num, nums, quaternion_wxyz, xml_safe
 
 __all__ = ["to_mjcf", "MJCF_MIN_MASS", "MJCF_MIN_INERTIA"]
 
@@ -72,7 +72,7 @@ def to_mjcf(robot: DHRobot) -> str:
 
     bodies, tool = export_plan(robot)
     r = GLYPH_FRACTION * robot_scale(robot)
-    out = [f"<mujoco model={quoteattr(robot.name)}>",
+    out = [f"<mujoco model={quoteattr(xml_safe(robot.name))}>",
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
            f'  <option gravity="{nums(robot.gravity)}"/>',
            "  <worldbody>",

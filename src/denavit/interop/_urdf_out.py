@@ -15,7 +15,7 @@ import numpy as np
 
 from ..model import MAX_MAGNITUDE, DHRobot
 from ..numeric import rpy_from_rotation
-from ._export import GLYPH_FRACTION, export_plan, num, nums
+from ._export import GLYPH_FRACTION, export_plan, num, nums, xml_safe
 
 __all__ = ["to_urdf"]
 
@@ -62,8 +62,9 @@ def to_urdf(robot: DHRobot) -> str:
 
     bodies, tool = export_plan(robot)
     r = GLYPH_FRACTION * robot_scale(robot)
-    out = ['<?xml version="1.0"?>', f"<!-- {escape(robot.name)[:200].replace('--', '- -')}: written by denavit -->",
-           f"<robot name={quoteattr(robot.name)}>",
+    name = xml_safe(robot.name)
+    out = ['<?xml version="1.0"?>', f"<!-- {escape(name).replace('--', '- -')}: written by denavit -->",
+           f"<robot name={quoteattr(name)}>",
            '  <material name="link"><color rgba="0.55 0.55 0.55 1"/></material>',
            '  <material name="joint"><color rgba="0.25 0.45 0.75 1"/></material>',
            f'  <link name="base_link"><visual><geometry><box size="{nums([4 * r, 4 * r, r])}"/></geometry>'
