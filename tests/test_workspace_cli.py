@@ -1,0 +1,137 @@
+"""`denavit workspace` and `denavit reachability` on the command line: results, data files, hostile input."""
+
+from __future__ import annotations
+
+import json
+import socket
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from _hostile import assert_refused, run_cli
+
+TWO_R = """name: two-r
+convention: standard
+joints:
+  - {a: 1.0, alpha: 0, d: 0, theta: q, limits: [-pi, pi]}
+  - {a: 0.5, alpha: 0, d: 0, theta: q, limits: [-pi, pi]}
+"""
+
+
+def _ok(o):
+    assert o.code == 0 and not o.hung, o.describe()
+    assert "Traceback" not in o.err and o.err == "", o.describe()  # quiet: no progress when stderr is no tty
+    return json.loads(o.out) if o.out.lstrip().startswith("{") else o.out
+
+
+@pytest.mark.slow
+def test_workspace_json_interval_holds_the_annulus_and_data_loads(tmp_path):
+    pytest.importorskip("matplotlib")
+    o = run_cli(["workspace", "arm.yaml", "--samples", "4e5", "--seed", "3", "-o", "w.png", "--data", "w.npz",
+                 "--json"], tmp_path, files={"arm.yaml": TWO_R})
+    data = _ok(o)
+    exact = np.pi * (1.5**2 - 0.5**2)
+    lo, hi = data["interval"]
+    assert data["planar"] and data["volume"] == 0.0 and lo <= exact <= hi and lo <= data["area"] <= hi
+    assert data["samples"] == 400_000 and data["seed"] == 3
+    with np.load(tmp_path / "w.npz", allow_pickle=False) as z:
+        assert int(z["counts"].sum()) == 400_000 and z["counts"].ndim == 2
+        assert float(z["reach"]) == pytest.approx(data["reach"])
+    assert (tmp_path / "w.png").stat().st_size > 1000
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.yaml", "w.npz", "w.png"]
+
+
+@pytest.mark.slow
+def test_workspace_text_and_same_numbers_on_processes(tmp_path):
+    base = ["workspace", "puma560", "--samples", "150000", "--seed", "5", "--json"]
+    a = _ok(run_cli(base + ["--scheduler", "synchronous"], tmp_path))
+    b = _ok(run_cli(base + ["--scheduler", "processes", "--workers", "2"], tmp_path))
+    for key in ("voxels", "volume", "interval", "bounds_min", "bounds_max", "reach", "resolution"):
+        assert a[key] == b[key], key
+    text = _ok(run_cli(base[:-1], tmp_path))
+    assert "volume ≈" in text and "between" in text and "seed 5" in text
+
+
+@pytest.mark.slow
+def test_reachability_command(tmp_path):
+    pytest.importorskip("matplotlib")
+    data = _ok(run_cli(["reachability", "puma560", "--resolution", "0.3", "--orientations", "8", "-o", "r.png",
+                        "--data", "r.npz", "--json"], tmp_path))
+    assert data["orientations"] == 8 and data["method"] == "analytic" and data["voxels_reached"] > 0
+    with np.load(tmp_path / "r.npz", allow_pickle=False) as z:
+        f = z["fraction"]
+        assert f.min() >= 0 and f.max() <= 1 and int((f > 0).sum()) == data["voxels_reached"]
+        assert np.all(z["manipulability"][f == 0] == 0)
+    assert (tmp_path / "r.png").stat().st_size > 1000
+
+
+# ---- hostile ---------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("argv,mention", [
+    (["workspace", "planar2r", "--samples", "1e11"], "samples"),
+    (["workspace", "planar2r", "--samples", "0"], "samples"),
+    (["workspace", "planar2r", "--samples", "2.5e2.5"], "samples"),
+    (["workspace", "planar2r", "--samples", "nan"], "samples"),
+    (["workspace", "planar2r", "--samples", "1" + "0" * 400], "samples"),
+    (["workspace", "puma560", "--resolution", "1e-5"], "resolution"),
+    (["workspace", "planar2r", "--workers", "0"], "workers"),
+    (["workspace", "planar2r", "--workers", "100000"], "workers"),
+    (["workspace", "planar2r", "--data", "w.txt"], "--data"),
+    (["workspace", "planar2r", "--data", "nofolder/w.npz"], "nofolder"),
+    (["workspace", "planar2r", "--scheduler", "tcp://"], "scheduler"),
+    (["workspace", "planar2r", "--scheduler", "cluster"], "scheduler"),
+    (["reachability", "puma560", "--orientations", "0"], "orientations"),
+    (["reachability", "puma560", "--orientations", "99999999"], "orientations"),
+    (["reachability", "puma560", "--resolution", "0.001"], "resolution"),
+    (["reachability", "puma560", "--resolution", "0"], "resolution"),
+    (["reachability", "puma560", "--ik", "magic"], "ik"),
+    (["reachability", "puma560", "--scheduler", "host:99999"], "scheduler"),
+])
+def test_bad_sizes_and_schedulers_are_one_line(tmp_path, argv, mention):
+    assert_refused(run_cli(argv, tmp_path), mentions=[mention])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.text(min_size=0, max_size=80).filter(lambda s: s.strip() not in ("threads", "processes", "synchronous")
+                                               and not s.startswith("-")))
+def test_any_bad_scheduler_text_is_one_line(tmp_path_factory, text):
+    from denavit.scale import check_scheduler
+    from denavit.errors import ParseError
+
+    try:
+        check_scheduler(text)
+    except ParseError:
+        pass
+    else:
+        return  # a well-formed address: would try to connect (covered below)
+    assert_refused(run_cli(["workspace", "planar2r", "--scheduler", text], tmp_path_factory.mktemp("s")),
+                   mentions=["scheduler"])
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path, monkeypatch):
+    pytest.importorskip("distributed")
+    import denavit.scale._schedule as sched
+
+    monkeypatch.setattr(sched, "CONNECT_TIMEOUT", 1.0)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    o = run_cli(["workspace", "planar2r", "--scheduler", f"tcp://127.0.0.1:{port}", "--data", "w.npz"], tmp_path)
+    assert_refused(o, mentions=[f"127.0.0.1:{port}"])
+    assert o.seconds < 15
+
+
+def test_existing_data_file_is_kept_without_force(tmp_path):
+    (tmp_path / "w.npz").write_bytes(b"mine")
+    assert_refused(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz"], tmp_path),
+                   mentions=["w.npz"])
+    assert (tmp_path / "w.npz").read_bytes() == b"mine"
+    _ok(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz", "--force"], tmp_path))
+    assert (tmp_path / "w.npz").read_bytes()[:2] == b"PK"  # a zip (.npz), replaced
+
+
+def test_reachability_of_an_arm_without_full_pose_is_one_line(tmp_path):
+    o = run_cli(["reachability", "planar2r"], tmp_path)
+    assert o.code in (1, 2) and len(o.err.strip().splitlines()) == 1 and "6 or more joints" in o.err
+    assert o.out == "" and "Traceback" not in o.err
