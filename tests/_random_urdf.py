@@ -56,8 +56,10 @@ def _inertial(rng):
 
 
 def random_chain(rng: np.random.Generator, n: int | None = None, cases=CASES, fixed: float = 0.25,
-                 prismatic: float = 0.2, inertia: bool = True) -> tuple[list[GenLink], list[GenJoint]]:
-    """Links and joints of a random serial URDF (link i+1 child of joint i)."""
+                 prismatic: float = 0.2, inertia: bool = True,
+                 continuous: bool = True) -> tuple[list[GenLink], list[GenJoint]]:
+    """Links and joints of a random serial URDF (link i+1 child of joint i); some revolute joints without
+    limits are ``continuous``."""
     n = n or int(rng.integers(1, 8))
     joints: list[GenJoint] = []
     prev = None  # previous moving axis in the current link's frame: (point, direction)
@@ -98,6 +100,8 @@ def random_chain(rng: np.random.Generator, n: int | None = None, cases=CASES, fi
             limits = (float(rng.uniform(-1, 0)), float(rng.uniform(0, 1)))
         elif rng.random() < 0.7:
             limits = (float(rng.uniform(-3, 0)), float(rng.uniform(0, 3)))
+        elif continuous and rng.random() < 0.5:
+            kind = "continuous"
         joints.append(GenJoint(f"joint{k + 1}", kind, xyz, rpy, axis, limits, case))
         prev = (np.zeros(3), axis / np.linalg.norm(axis))
         k += 1
@@ -125,7 +129,7 @@ def urdf_text(links: list[GenLink], joints: list[GenJoint], name: str = "random"
                    f'ixz="{I[4]!r}" iyz="{I[5]!r}"/></inertial></link>')
     for i, j in enumerate(joints):
         limit = (f'<limit lower="{j.limits[0]!r}" upper="{j.limits[1]!r}" effort="10" velocity="1"/>'
-                 if j.limits else ('<limit effort="10" velocity="1"/>' if j.kind != "fixed" else ""))
+                 if j.limits else ('<limit effort="10" velocity="1"/>' if j.kind in ("revolute", "prismatic") else ""))
         out.append(f'  <joint name="{j.name}" type="{j.kind}"><parent link="{links[i].name}"/>'
                    f'<child link="{links[i + 1].name}"/><origin xyz="{_v(j.xyz)}" rpy="{_v(j.rpy)}"/>'
                    f'<axis xyz="{_v(j.axis)}"/>{limit}</joint>')

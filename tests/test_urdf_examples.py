@@ -27,6 +27,7 @@ ARMS = [  # (file under robots/, base link, tip link)
     ("z1_description/urdf/z1.urdf", None, None),
     ("so_arm_description/urdf/so100.urdf", None, None),
     ("double_pendulum_description/urdf/double_pendulum.urdf", None, None),
+    ("double_pendulum_description/urdf/double_pendulum_continuous.urdf", None, None),
 ]
 
 
