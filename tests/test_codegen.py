@@ -233,3 +233,37 @@ def test_numba_kernels_are_cached_on_disk_for_the_next_process(tmp_path):
     assert backend == "numba" and int(misses1) > 0
     assert int(hits2) > 0 and int(misses2) == 0
     assert any(p.suffix == ".nbi" for p in tmp_path.rglob("*"))
+
+
+def test_cache_key_follows_the_numbers_not_the_name(tmp_path, monkeypatch):
+    from dataclasses import replace
+
+    from denavit.codegen import robot_key
+
+    robot = denavit.load_robot("puma560")
+    key = robot_key(robot, "numpy", True, ("fk",))
+    assert robot_key(replace(robot, name="other"), "numpy", True, ("fk",)) == key
+    moved = replace(robot, gravity=(0.0, 0.0, -9.80665))
+    assert robot_key(moved, "numpy", True, ("fk",)) != key
+    link = robot.links[2]
+    heavier = replace(robot, links=robot.links[:2] + (replace(link, inertia=replace(link.inertia, mass=link.inertia.mass
+                                                                                     + 1e-9)),) + robot.links[3:])
+    assert robot_key(heavier, "numpy", True, ("fk",)) != key
+    assert robot_key(robot, "numpy", False, ("fk",)) != key
+    # the kernels of the changed robot are its own, not the cached ones of the first
+    q = np.full(6, 0.3)
+    a = denavit.compile(robot, backend="numpy").gravity(q)
+    b = denavit.compile(moved, backend="numpy").gravity(q)
+    np.testing.assert_allclose(b, denavit.gravity_torques(moved, q), atol=1e-10)
+    assert not np.allclose(a, b, atol=1e-6)
+
+
+def test_unwritable_cache_folder_falls_back_to_a_private_temporary_one(tmp_path, monkeypatch):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(blocker / "kernels"))
+    fast = denavit.compile(denavit.load_robot("planar3r"), backend="numpy", kernels=["fk"])
+    folder = fast.path.parent
+    assert folder.name.startswith("denavit-kernels-") and (folder.stat().st_mode & 0o077) == 0
+    assert blocker.read_text() == "not a folder"
+    np.testing.assert_allclose(fast.fk(np.zeros(3)), denavit.forward_kinematics(fast.robot, np.zeros(3)), atol=1e-14)

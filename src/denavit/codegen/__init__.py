@@ -7,7 +7,7 @@ exported as standalone C99 or Python source.  DESIGN.md's one bridge between the
 [2.0, 0.0, 0.0]
 """
 
-from ._compiled import CompiledRobot, cache_dir, compile, numba_available
+from ._compiled import CompiledRobot, cache_dir, compile, numba_available, robot_key
 from ._export import LANGUAGES, PREFIX_PATTERN, default_prefix, export_sources
 from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
 from ._llvm import kernel_intrinsic

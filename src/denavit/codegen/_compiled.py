@@ -15,9 +15,9 @@ import numpy as np
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from ._emit import NUMBA, NUMPY, python_module
-from ._kernels import DYNAMICS, KERNEL_NAMES, trace_kernels
+from ._kernels import DYNAMICS, KERNEL_NAMES, has_dynamics as _has_dynamics, trace_kernels
 
-__all__ = ["compile", "CompiledRobot", "cache_dir", "numba_available"]
+__all__ = ["compile", "CompiledRobot", "cache_dir", "numba_available", "robot_key", "GENERATOR_VERSION"]
 
 CACHE_ENV = "DENAVIT_CACHE_DIR"
 _LOCK = threading.Lock()
@@ -40,6 +40,11 @@ def cache_dir() -> Path:
 
 
 def _writable(path: Path) -> Path:
+    """``path`` when we can write there; otherwise a private temporary folder.
+
+    The folder's files are imported as code, so a fallback is never a shared, guessable path another user
+    could have prepared: it is made fresh by ``mkdtemp`` (mode 0700) once per process."""
+    global _FALLBACK
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / f".probe-{os.getpid()}"
@@ -47,25 +52,50 @@ def _writable(path: Path) -> Path:
         probe.unlink()
         return path
     except OSError:
-        fallback = Path(tempfile.gettempdir()) / f"denavit-kernels-{os.getuid() if hasattr(os, 'getuid') else 0}"
-        fallback.mkdir(parents=True, exist_ok=True)
-        return fallback
+        if _FALLBACK is None:
+            _FALLBACK = Path(tempfile.mkdtemp(prefix="denavit-kernels-"))
+        return _FALLBACK
 
 
-def _load(source: str, tag: str):
-    """Import the generated ``source`` from the cache (written once, atomically; named by its hash)."""
-    digest = hashlib.sha256(source.encode()).hexdigest()[:24]
-    modname = f"_denavit_kernels_{tag}_{digest}"
+_FALLBACK: Path | None = None
+
+
+#: Bumped whenever the generated code changes for the same robot (it is part of every cache key).
+GENERATOR_VERSION = "1"
+
+
+def robot_key(robot: DHRobot, backend: str, friction: bool, kernels) -> str:
+    """A digest of everything the kernels depend on: the DH rows, base, tool, gravity, inertial data, the
+    backend and options (exact float bits), and the generator's version.  Names and presentation are left out."""
+    def h(x) -> str:
+        return float(x).hex()
+
+    parts = [GENERATOR_VERSION, backend, str(bool(friction)), ",".join(kernels), robot.convention.value]
+    for link in robot.links:
+        parts.append(" ".join([link.joint.value, h(link.a), h(link.alpha), h(link.d), h(link.theta)]))
+        li = link.inertia
+        if li is not None:
+            parts.append(" ".join(h(v) for v in (li.mass, *li.com, *li.inertia, li.motor_inertia, li.viscous,
+                                                 li.coulomb)))
+    for M in (robot.base, robot.tool):
+        parts.append(" ".join(h(v) for row in M for v in row))
+    parts.append(" ".join(h(v) for v in robot.gravity))
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:24]
+
+
+def _load(key: str, tag: str, make_source):
+    """Import the generated module for ``key`` from the cache, writing it first (atomically) when absent."""
+    modname = f"_denavit_kernels_{tag}_{key}"
     with _LOCK:
         mod = _LOADED.get(modname)
         if mod is not None:
             return mod
         folder = _writable(cache_dir())
         path = folder / f"{modname}.py"
-        if not path.exists() or path.read_text() != source:
+        if not path.exists():
             fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
             with os.fdopen(fd, "w") as fh:
-                fh.write(source)
+                fh.write(make_source())
             os.replace(tmp, path)
         spec = importlib.util.spec_from_file_location(modname, path)
         mod = importlib.util.module_from_spec(spec)
@@ -97,11 +127,10 @@ _ndarray, _F64, _empty, _SHAPE44, _STRIDE = np.ndarray, np.dtype(np.float64), np
 class CompiledRobot:
     """The generated kernels of one arm.  Made by :func:`compile`; see there."""
 
-    def __init__(self, robot: DHRobot, module, backend: str, source: str, names) -> None:
+    def __init__(self, robot: DHRobot, module, backend: str, names) -> None:
         self.robot = robot
         self.dof = n = robot.dof
         self.backend = backend
-        self.source = source
         self.kernels = tuple(names)
         self._m = module
         self._shapes = {"fk": (4, 4), "frames": (len(robot.links) + 1, 4, 4), "jacobian0": (6, n),
@@ -114,6 +143,16 @@ class CompiledRobot:
                 setattr(self, f"_{name}_1", self._missing(name))
             else:
                 setattr(self, f"_{name}_1", self._first(name) if backend == NUMBA else self._one[name][0])
+
+    @property
+    def source(self) -> str:
+        """The generated module's source text (kept in :func:`cache_dir`)."""
+        return Path(self._m.__file__).read_text(encoding="utf-8")
+
+    @property
+    def path(self) -> Path:
+        """Where the generated module lives."""
+        return Path(self._m.__file__)
 
     def __repr__(self) -> str:
         return (f"<CompiledRobot {self.robot.name!r}: {self.dof} joints, {self.backend}, "
@@ -265,7 +304,8 @@ class CompiledRobot:
                          "(a joint whose subtree has no inertia about its axis)")
 
 
-def compile(robot: DHRobot, *, backend: str | None = None, kernels=None) -> CompiledRobot:  # noqa: A001
+def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa: A001
+            friction: bool = True) -> CompiledRobot:
     """Generated kernels of ``robot``: FK, Jacobians and dynamics as straight-line code for this arm.
 
     Parameters
@@ -276,6 +316,9 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None) -> Comp
         numba is installed, else ``numpy`` (the same code run by numpy: vectorised over batches).
     kernels : iterable of str, optional
         Which kernels to build (default all of ``KERNEL_NAMES`` the robot supports).
+    friction : bool
+        ``rnea`` and ``forward_dynamics`` include the joints' friction τ_f = viscous·q̇ + coulomb·sign(q̇), as the
+        plain functions do by default (``friction=False`` there ⇔ ``compile(robot, friction=False)`` here).
 
     Returns
     -------
@@ -304,7 +347,15 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None) -> Comp
     unknown = [k for k in wanted if k not in KERNEL_NAMES]
     if unknown:
         raise ValueError(f"unknown kernels {unknown}; choose from {', '.join(KERNEL_NAMES)}")
-    specs = trace_kernels(robot, wanted)
-    source = python_module(specs, backend, f"Kernels of a {robot.dof}-joint arm.")  # no user text in code
-    module = _load(source, backend)
-    return CompiledRobot(robot, module, backend, source, specs.keys())
+    if not _has_dynamics(robot):
+        wanted = tuple(k for k in wanted if k not in DYNAMICS)
+    key = robot_key(robot, backend, friction, wanted)
+
+    def make_source() -> str:
+        specs = trace_kernels(robot, wanted, friction)
+        return python_module(specs, backend, f"Kernels of a {robot.dof}-joint arm.")  # no user text in code
+
+    module = _load(key, backend, make_source)
+    fast = CompiledRobot(robot, module, backend, wanted)
+    fast.friction = bool(friction)
+    return fast

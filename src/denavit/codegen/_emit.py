@@ -117,44 +117,87 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
             f"    for b in range({first}.shape[0]):", f"        _{k}({rows}, out[b])", "", ""])
 
 
-def _python_kernel(spec: KernelSpec, backend: str) -> list[str]:
+def _python_kernel(spec: KernelSpec) -> list[str]:
     """``<name>_1(inputs..., out)`` (one configuration, inputs (k,)) and ``<name>_n(inputs..., out)`` (a batch, (B, k)
     inputs, (B,) + shape output)."""
     args = ", ".join(name for name, _ in spec.inputs)
     used = _used_inputs(spec)
-    name = _Names(spec, backend)
+    name = _Names(spec, NUMPY)
     shape = spec.shape
     L: list[str] = []
-    deco = ["@njit(cache=True, nogil=True, error_model='numpy')"] if backend == NUMBA else []
     # --- one configuration ---------------------------------------------------------------------------
-    L += deco + [f"def {spec.name}_1({args}, out):", f'    """{spec.doc}: one configuration, out {shape}."""']
-    if backend == NUMBA:
-        L += [f"    {a}_{k} = {a}[{k}]" for a, k in used]
-    else:
-        for a, size in spec.inputs:
-            names = [f"{a}_{k}" if (a, k) in used else "_" for k in range(size)]
-            if any(x != "_" for x in names):
-                L.append(f"    {', '.join(names)}, = {a}.tolist()")
-    L += ["    " + s for s in _statements(spec, backend)]
+    L += [f"def {spec.name}_1({args}, out):", f'    """{spec.doc}: one configuration, out {shape}."""']
+    for a, size in spec.inputs:
+        names = [f"{a}_{k}" if (a, k) in used else "_" for k in range(size)]
+        if any(x != "_" for x in names):
+            L.append(f"    {', '.join(names)}, = {a}.tolist()")
+    L += ["    " + s for s in _statements(spec, NUMPY)]
     L += [f"    out[{', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}" for f, o in enumerate(spec.outputs)]
     L += ["", ""]
-    # --- a batch ---------------------------------------------------------------------------------------
-    L += deco + [f"def {spec.name}_n({args}, out):", f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {shape}."""']
-    if backend == NUMBA:
-        L.append(f"    for b in range({spec.inputs[0][0]}.shape[0]):")
-        pad = "        "
-        L += [f"{pad}{a}_{k} = {a}[b, {k}]" for a, k in used]
-        L += [pad + s for s in _statements(spec, backend)]
-        L += [f"{pad}out[b, {', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}"
-              for f, o in enumerate(spec.outputs)]
-    else:
-        pad = "    "
-        L += [f"{pad}{a}_{k} = {a}[:, {k}]" for a, k in used]
-        L += [pad + s for s in _statements(spec, backend, vector=True)]
-        L += [f"{pad}out[:, {', '.join(map(str, _index(shape, f)))}] = {name(_ref(o))}"
-              for f, o in enumerate(spec.outputs)]
+    # --- a batch: numpy on chunks of CHUNK configurations, values kept in as few arrays as live at once ----
+    L += [f"def {spec.name}_n({args}, out):", f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {shape}."""',
+          f"    for s in range(0, {spec.inputs[0][0]}.shape[0], CHUNK):", "        e = s + CHUNK"]
+    pad = "        "
+    for a, _ in spec.inputs:
+        if any(x == a for x, _ in used):
+            L.append(f"{pad}{a}T = np.ascontiguousarray({a}[s:e].T)")
+    L += [f"{pad}{a}_{k} = {a}T[{k}]" for a, k in used]
+    body, reg = _vector_statements(spec)
+    L += [pad + x for x in body]
+    for f, o in enumerate(spec.outputs):
+        value = name(o) if isinstance(o, (int, float)) else reg[o.i]
+        L.append(f"{pad}out[s:e, {', '.join(map(str, _index(shape, f)))}] = {value}")
     L += ["", ""]
     return L
+
+
+def _vector_statements(spec: KernelSpec) -> tuple[list[str], dict[int, str]]:
+    """The program on arrays, each result in a register ``r<k>`` reused once its value is dead (a linear
+    scan over the straight-line code): a batch keeps tens of arrays alive, not one per operation."""
+    tape = spec.tape
+    prog = tape.program(spec.outputs)
+    last: dict[int, float] = {}
+    for pos, i in enumerate(prog):
+        op, a, b = tape.ops[i]
+        if op != "input":
+            for x in (a, b):
+                if isinstance(x, int):
+                    last[x] = pos
+    for o in spec.outputs:
+        if not isinstance(o, (int, float)):
+            last[o.i] = float("inf")
+    reg: dict[int, str] = {}
+    free: list[str] = []
+    count = 0
+    lines = []
+    for pos, i in enumerate(prog):
+        op, a, b = tape.ops[i]
+        if op == "input":
+            reg[i] = f"{a}_{b}"
+            continue
+
+        def ref(x):
+            return _const(x, "py") if isinstance(x, float) else reg[x]
+
+        A = ref(a)
+        B = ref(b) if b is not None else None
+        if op in _INFIX:
+            expr = f"{A} {_INFIX[op]} {B}"
+        elif op == "neg":
+            expr = f"-{A}"
+        else:
+            expr = _PY_FUNCS[op][1].format(a=A, b=B)
+        for x in {a, b}:
+            if isinstance(x, int) and last.get(x) == pos and tape.ops[x][0] != "input":
+                free.append(reg[x])
+        if free:
+            target = free.pop()
+        else:
+            target = f"r{count}"
+            count += 1
+        reg[i] = target
+        lines.append(f"{target} = {expr}")
+    return lines, reg
 
 
 def _ref(o):
@@ -170,10 +213,11 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     if backend == NUMBA:
         head += ["from numba import njit", "", "from denavit.codegen import kernel_intrinsic", "", ""]
     else:
-        head += ["", "", "def _sign(x):", "    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)", "", ""]
+        head += ["", "CHUNK = 8192  # configurations per pass: the live arrays stay in cache", "", "",
+                 "def _sign(x):", "    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)", "", ""]
     body: list[str] = []
     for spec in specs.values():
-        body += _numba_kernel(spec) if backend == NUMBA else _python_kernel(spec, backend)
+        body += _numba_kernel(spec) if backend == NUMBA else _python_kernel(spec)
     return "\n".join(head + body).rstrip() + "\n"
 
 

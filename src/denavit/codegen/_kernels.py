@@ -16,7 +16,7 @@ from ..errors import ModelError
 from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
 from ._trace import Tape, sym_max, sym_min, sym_sign
 
-__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES"]
+__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics"]
 
 KERNEL_NAMES = ("fk", "frames", "jacobian0", "jacobiane", "rnea", "mass_matrix", "gravity", "coriolis",
                 "forward_dynamics")
@@ -63,8 +63,9 @@ def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-def trace_kernels(robot: DHRobot, names=KERNEL_NAMES) -> dict[str, KernelSpec]:
-    """Trace the kernels ``names`` of ``robot`` (dynamics ones only when it carries inertial data)."""
+def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> dict[str, KernelSpec]:
+    """Trace the kernels ``names`` of ``robot`` (dynamics ones only when it carries inertial data);
+    ``friction``: rnea and forward_dynamics include the joints' viscous and Coulomb friction."""
     chain = chain_of(robot)
     n = chain.dof
     out: dict[str, KernelSpec] = {}
@@ -109,13 +110,13 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES) -> dict[str, KernelSpec]:
         frame = "base (J0)" if name == "jacobian0" else "tool (Je)"
         out[name] = KernelSpec(name, f"geometric Jacobian, rows (v, w), in the {frame} frame", (("q", n),),
                                (6, n), tuple(entries), tape)
-    if not DYNAMICS & set(names) or not _has_dynamics(robot):
+    if not DYNAMICS & set(names) or not has_dynamics(robot):
         return out
 
     pl = dynamics_plan(robot)
     g = [float(v) for v in robot.gravity]
-    fv = [link.inertia.viscous if link.inertia else 0.0 for link in robot.joints]
-    fc = [link.inertia.coulomb if link.inertia else 0.0 for link in robot.joints]
+    fv = [link.inertia.viscous if link.inertia and friction else 0.0 for link in robot.joints]
+    fc = [link.inertia.coulomb if link.inertia and friction else 0.0 for link in robot.joints]
 
     def friction(qd):
         return [fv[k] * qd[k] + fc[k] * sym_sign(qd[k]) for k in range(n)]
@@ -166,7 +167,7 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES) -> dict[str, KernelSpec]:
     return out
 
 
-def _has_dynamics(robot: DHRobot) -> bool:
+def has_dynamics(robot: DHRobot) -> bool:
     """The rule of :func:`denavit.numeric.require_dynamics` (inertial data on some moving row)."""
     try:
         require_dynamics(robot)
