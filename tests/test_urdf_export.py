@@ -1,5 +1,5 @@
-"""denavit → URDF: the file loads in Pinocchio and gives denavit's FK, RNEA and mass matrix; and URDF → DH → URDF
-round trips keep the arm.  Catalogue arms and random arms (both conventions, prismatic joints, fixed rows with
+"""denavit → URDF: the file loads in Pinocchio (and yourdfpy) and gives denavit's FK, RNEA and mass matrix; and
+URDF → DH → URDF round trips keep the arm.  Catalogue arms and random arms (both conventions, prismatic joints, fixed rows with
 inertia, base and tool).  URDF has no place for motor inertia or gravity: the comparisons use the arm without
 motor inertia, and set Pinocchio's gravity to the arm's.
 """
@@ -143,3 +143,20 @@ def test_any_robot_name_gives_well_formed_files(name):
     import xml.etree.ElementTree as ET  # our own output: trusted
 
     assert ET.fromstring(denavit.to_mjcf(robot)).tag == "mujoco"
+
+
+@pytest.mark.parametrize("name", denavit.catalogue_names())
+def test_catalogue_urdf_valid_in_yourdfpy_with_same_fk(name, rng):
+    """A second URDF reader (yourdfpy, its own parser and FK): the file validates and gives denavit's FK."""
+    import io
+
+    yourdfpy = pytest.importorskip("yourdfpy")
+    robot = denavit.load_robot(name)
+    urdf = yourdfpy.URDF.load(io.StringIO(denavit.to_urdf(robot)), load_meshes=False,
+                              build_collision_scene_graph=False)
+    assert urdf.validate()
+    assert urdf.actuated_joint_names == [f"q{k + 1}" for k in range(robot.dof)]
+    for q in rng.uniform(-1, 1, (3, robot.dof)):
+        urdf.update_cfg(q)
+        np.testing.assert_allclose(urdf.get_transform("tool", "base_link"), denavit.forward_kinematics(robot, q),
+                                   atol=1e-12)
