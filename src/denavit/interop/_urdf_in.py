@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DenavitWarning, ModelError, ParseError
-from ..model import Convention, DHLink, DHRobot, JointType, LinkInertia
+from ..model import MAX_JOINTS, Convention, DHLink, DHRobot, JointType, LinkInertia
 from ..numeric import forward_kinematics, link_transforms
 from ._export import combine_inertia
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
@@ -233,7 +233,23 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         raise ParseError(f"convention {str(convention)[:40]!r}: choose one of standard, modified")
     model = read_urdf(source, xacro=xacro)
     base, tip, path = chain_path(model, base, tip)
-    moving = [j for j in path if j.moving]
+    moving = _moving_joints(model, path, base, tip)
+    P, Z, T, link_pose, link_body = _chain_at_zero(path, base)
+    scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
+    theta, d, a, alpha, cases, F0, approximated = _dh_geometry(P, Z, T, scale)
+    robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
+    robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base)
+    pos, rot = _self_check(robot, path, rng)
+    if pos > CHECK_TOL * scale or rot > CHECK_TOL:
+        warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
+                      f"{rot:.2g} in rotation at random configurations (nearly parallel axes?)", DenavitWarning,
+                      stacklevel=2)
+    notes = _notes(path, moving, approximated) + notes
+    return UrdfImport(robot, base, tip, tuple(j.name for j in moving), tuple(cases), pos, rot, notes)
+
+
+def _moving_joints(model: UrdfModel, path: list[UrdfJoint], base: str, tip: str) -> list[UrdfJoint]:
+    """The chain's moving joints; floating, planar and mimic joints on it refused."""
     for j in path:
         if j.kind in ("floating", "planar"):
             raise model.error(f"<joint name={j.name[:40]!r}> (line {j.line}): a {j.kind} joint has no DH row; "
@@ -241,11 +257,17 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         if j.mimic and j.moving:
             raise model.error(f"<joint name={j.name[:40]!r}> (line {j.line}): a mimic joint (coupled to another "
                               "joint) has no independent DH row")
+    moving = [j for j in path if j.moving]
     if not moving:
         raise model.error(f"no revolute, continuous or prismatic joint between links {base[:40]!r} and {tip[:40]!r}")
-    if len(moving) > 32:
-        raise model.error(f"the chain has {len(moving)} moving joints (at most 32)")
-    # the chain at q = 0: axis lines and link poses in the base link's frame
+    if len(moving) > MAX_JOINTS:
+        raise model.error(f"the chain has {len(moving)} moving joints (at most {MAX_JOINTS})")
+    return moving
+
+
+def _chain_at_zero(path: list[UrdfJoint], base: str):
+    """At q = 0, in the base link's frame: axis points P (n, 3) and unit directions Z (n, 3), the tip pose T,
+    and every chain link's pose and body (the 0-based moving joint carrying it; -1 for the fixed base)."""
     T = np.eye(4)
     P, Z, link_pose, link_body = [], [], {base: np.eye(4)}, {base: -1}
     for j in path:
@@ -256,28 +278,24 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         link_pose[j.child], link_body[j.child] = T.copy(), len(P) - 1
     P, Z = np.array(P), np.array(Z)
     Z /= np.linalg.norm(Z, axis=1, keepdims=True)
-    scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
-    theta, d, a, alpha, cases, F0, approximated = _dh_geometry(P, Z, T, scale)
-    robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
-    robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base)
-    pos, rot = _self_check(robot, path, rng)
-    if pos > CHECK_TOL * scale or rot > CHECK_TOL:
-        warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
-                      f"{rot:.2g} in rotation at random configurations (nearly parallel axes?)", DenavitWarning,
-                      stacklevel=2)
-    empty = [j.name for j in moving if j.limits is not None and j.limits[0] == j.limits[1]]
-    if empty:
-        notes = (f"limits with lower = upper read as no limits: {', '.join(empty)}",) + notes
-    if any(j.kind == "continuous" for j in moving):
-        notes = ("continuous joints have no limits",) + notes
-    if approximated:
-        rows = ", ".join(f"{k + 1} ({moving[k].name})" for k in approximated)
-        notes = (f"rows {rows}: nearly parallel axes (common normal farther than {FAR_FOOT:g} × the arm's size) "
-                 "taken as parallel; the self-check shows the error",) + notes
+    return P, Z, T, link_pose, link_body
+
+
+def _notes(path: list[UrdfJoint], moving: list[UrdfJoint], approximated: list[int]) -> tuple[str, ...]:
+    notes = []
     folded = sum(1 for j in path if not j.moving)
     if folded:
-        notes = (f"{folded} fixed joint{'s' if folded > 1 else ''} folded into the geometry",) + notes
-    return UrdfImport(robot, base, tip, tuple(j.name for j in moving), tuple(cases), pos, rot, notes)
+        notes.append(f"{folded} fixed joint{'s' if folded > 1 else ''} folded into the geometry")
+    if approximated:
+        rows = ", ".join(f"{k + 1} ({moving[k].name})" for k in approximated)
+        notes.append(f"rows {rows}: nearly parallel axes (common normal farther than {FAR_FOOT:g} × the arm's "
+                     "size) taken as parallel; the self-check shows the error")
+    if any(j.kind == "continuous" for j in moving):
+        notes.append("continuous joints have no limits")
+    empty = [j.name for j in moving if j.limits is not None and j.limits[0] == j.limits[1]]
+    if empty:
+        notes.append(f"limits with lower = upper read as no limits: {', '.join(empty)}")
+    return tuple(notes)
 
 
 def _robot(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], theta, d, a, alpha, F0, T_tip) -> DHRobot:
