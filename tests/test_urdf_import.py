@@ -254,3 +254,28 @@ def test_almost_parallel_axes_taken_as_parallel_with_a_note_and_a_warning(eps):
     assert result.cases == ("parallel", "last")
     assert any("nearly parallel" in note for note in result.notes)
     assert 0 < result.position_error < 10 * eps and result.rotation_error < 10 * eps
+
+
+@settings(max_examples=EXAMPLES, deadline=None)
+@given(seed=seeds, exponent=st.integers(-3, 5))
+def test_arms_of_any_size_import_exactly_or_are_refused_cleanly(seed, exponent):
+    """Every length scaled by 10^exponent (millimetre arms to 100 km ones): the import is exact relative to the
+    arm's size, or (beyond the magnitude bounds of denavit.model) a ParseError naming the file; nothing else."""
+    import re
+    import warnings
+
+    rng, links, joints, text = _chain(seed)
+    factor = 10.0 ** exponent
+    text = re.sub(r'<origin xyz="([^"]*)"',
+                  lambda m: '<origin xyz="' + " ".join(repr(float(v) * factor) for v in m.group(1).split()) + '"',
+                  text)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", denavit.DenavitWarning)  # a failed self-check would be an error here
+            result = import_urdf(text)
+    except denavit.ParseError as exc:
+        # only arms whose lengths or (mass times length squared) inertias pass the 1e6 bounds may be refused
+        assert exponent >= 3 and "<URDF text>" in str(exc)
+        return
+    size = max(1.0, factor)
+    assert result.position_error < 1e-9 * size and result.rotation_error < 1e-9
