@@ -158,7 +158,7 @@ def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, 
     cell = np.floor((u - g.lo) / g.resolution).astype(np.int64)  # (m, dim)
     if cell.min() < 0 or cell.max() >= g.side:
         raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
-    flat = np.ravel_multi_index(tuple(cell.T), g.shape)
+    flat = np.ravel_multi_index(tuple(cell.T), g.shape).astype(np.int32)  # < MAX_CELLS = 2^24: sorts faster
     idx, cnt = np.unique(flat, return_counts=True)
     reach = float(np.sqrt(((p - job.base_origin) ** 2).sum(axis=1).max()))
     return idx, cnt.astype(np.uint32), p.min(axis=0), p.max(axis=0), reach, len(p)
