@@ -129,7 +129,8 @@ def _symbolic(robot, args):
     else:
         terms = S.lagrangian_dynamics(robot, coriolis=args.coriolis, **kw)
     include = ("M", "C", "c", "g", "friction") if args.coriolis else ("M", "c", "g", "friction")
-    text = S.format_dynamics(terms, args.format, cse=False if args.no_cse else None, include=include)
+    text = S.format_dynamics(terms, args.format, cse=False if args.no_cse else None, include=include,
+                             gravity_symbol=True)
     elapsed = time.perf_counter() - t0
     data = {"M_symbolic": terms.M, "c_symbolic": terms.c, "g_symbolic": terms.g,
             "friction_symbolic": terms.friction, "symbolic_text": text, "format": args.format,

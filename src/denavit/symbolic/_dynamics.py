@@ -15,6 +15,7 @@ carried by the preceding moving link).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -55,6 +56,12 @@ class DynamicsTerms:
     q: tuple[sp.Symbol, ...]
     qd: tuple[sp.Symbol, ...]
     qdd: tuple[sp.Symbol, ...]
+    form: str = "expanded"
+    """"hand": each entry a sum of parameter groups times sines and cosines (``simplify="trig"``)."""
+    gravity: sp.Expr | None = None
+    """|g₀| [m/s²] when ``g_unit`` is given."""
+    g_unit: sp.ImmutableMatrix | None = None
+    """g(q) per unit of gravitational acceleration (g = |g₀| · g_unit): presenters write g as a symbol."""
 
     def _repr_latex_(self) -> str:
         from ..display import dynamics_latex
@@ -197,9 +204,9 @@ def lagrangian_dynamics(robot: DHRobot, simplify: str = "trig", numeric: bool = 
     if simplify == "trig":  # the same formulas on polynomials, in hand form (C23 …): _dynamics_ring
         from ._dynamics_ring import ring_dynamics
 
-        M, C, c, g = ring_dynamics(robot, numeric, coriolis, progress)
+        M, C, c, g, size, g_unit = ring_dynamics(robot, numeric, coriolis, progress)
         _report(progress, "done", 1, 1)
-        return DynamicsTerms(M, C, c, g, friction_vector(robot, qd, numeric), q, qd, qdd)
+        return DynamicsTerms(M, C, c, g, friction_vector(robot, qd, numeric), q, qd, qdd, "hand", size, g_unit)
     n = robot.dof
     pieces = inertial_pieces(robot, numeric)
     armature, _, _ = joint_parameters(robot, numeric)
@@ -337,24 +344,96 @@ def terms_from_tau(tau: sp.MatrixBase, q, qd, qdd, friction: sp.MatrixBase,
 # presentation: text, LaTeX, Markdown, with common subexpressions pulled out
 
 
-def _display(e: sp.Expr, q, digits: int | None, short: bool) -> sp.Expr:
+def _display(e: sp.Expr, q, digits: int | None, short: bool, collapse: bool = True) -> sp.Expr:
     if digits is not None:
         e = e.xreplace({r: sp.Float(r, digits) for r in e.atoms(sp.Rational) if r.q != 1 and r.q > 12})
-    return shorthand(e, q) if short else e
+    return shorthand(e, q, collapse=collapse) if short else e
+
+
+_TRAILING = re.compile(r"(?<![\w.])(\d+\.\d*?[1-9])0+(?![\d])|(?<![\w.])(\d+)\.0+(?![\d.e])")
+
+
+def _trim(text: str) -> str:
+    """0.00576000 → 0.00576, 2.00000 → 2 (plain-text output only)."""
+    return _TRAILING.sub(lambda m: m.group(1) or m.group(2), text)
+
+
+def _is_group(a: sp.Expr, rates) -> bool:
+    return isinstance(a, sp.Add) and len(a.args) > 1 and not a.has(sp.sin, sp.cos, *rates)
+
+
+def _group_key(a: sp.Add) -> tuple[sp.Expr, int]:
+    """The group with a canonical sign (its first term, in sympy's order, positive) and that sign."""
+    first = sp.Add.make_args(a)[0]
+    return (a, 1) if not first.could_extract_minus_sign() else (-a, -1)
+
+
+def _walk_groups(e: sp.Expr, rates, visit) -> sp.Expr:
+    """Rebuild e with every parameter group (a sum of parameter terms, no sines, cosines or rates) passed
+    through visit(group) -> replacement; sums containing sines or rates are walked into."""
+    if isinstance(e, sp.Add):
+        if _is_group(e, rates):
+            return visit(e)
+        return sp.Add(*[_walk_groups(t, rates, visit) for t in e.args])
+    if isinstance(e, sp.Mul):
+        return sp.Mul(*[_walk_groups(f, rates, visit) for f in e.args])
+    return e
+
+
+GROUP_NAME_CHARS = 40  # a parameter group longer than this, or occurring twice, is named P1, P2 … by format_dynamics
+
+
+def _name_groups(exprs: list[sp.Expr], rates) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """Parameter groups that recur or are long get names P1, P2 … (in order of first use)."""
+    count: dict[sp.Expr, int] = {}
+
+    def tally(a):
+        key, _ = _group_key(a)
+        count[key] = count.get(key, 0) + 1
+        return a
+
+    for e in exprs:
+        _walk_groups(e, rates, tally)
+    names: dict[sp.Expr, sp.Symbol] = {}
+
+    def name(a):
+        key, sign = _group_key(a)
+        if count[key] < 2 and len(str(key)) <= GROUP_NAME_CHARS:
+            return a
+        if key not in names:
+            names[key] = sp.Symbol(f"P{len(names) + 1}", real=True)
+        return sign * names[key]
+
+    out = [_walk_groups(e, rates, name) for e in exprs]
+    return [(v, k) for k, v in names.items()], out
 
 
 def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None = None, short: bool = True,
-                    digits: int | None = 6, include: tuple[str, ...] = ("M", "c", "g", "friction")) -> str:
+                    digits: int | None = 6, include: tuple[str, ...] = ("M", "c", "g", "friction"),
+                    gravity_symbol: bool = False) -> str:
     """The equations of motion as text, LaTeX or Markdown.
 
-    ``cse`` pulls repeated subexpressions out as x0, x1, … (``sympy.cse``; ``None``: only when the entries
-    are long, over ``CSE_AUTO_CHARS`` characters in all); ``short`` writes cos(q1 + q2)
-    as C12; ``digits`` prints long exact fractions as decimals.
+    Entries in hand form (``lagrangian_dynamics(simplify="trig")``) are written entry by entry, each a sum
+    of parameter groups times sines and cosines; when the entries are long (over ``CSE_AUTO_CHARS``
+    characters in all, and ``cse`` is not False) a group that recurs or is longer than ``GROUP_NAME_CHARS``
+    is named P1, P2 … (π₁, π₂ … in LaTeX) and defined first. With ``gravity_symbol`` gravity is the symbol
+    g (its value in the header; g = |g₀| · g_unit). Other forms: ``cse`` pulls repeated subexpressions out as
+    x0, x1, … (``sympy.cse``; ``None``: only when the entries are long). ``short`` writes cos(q1 + q2) as C12
+    (LaTeX C_{12}; the Coriolis matrix's entries are \mathcal{C}_{12}); ``digits``: fractions with
+    denominators above 12 are printed as decimals of that many significant digits (trailing zeros dropped
+    in text).
     """
     if style not in ("text", "latex", "markdown"):
         raise ValueError(f"unknown style {style!r}; choose one of text, latex, markdown")
     n = len(terms.q)
+    hand = terms.form == "hand"
     blocks = {"M": terms.M, "C": terms.C, "c": terms.c, "g": terms.g, "friction": terms.friction}
+    notes = []
+    G = sp.Symbol("g", positive=True)
+    taken = {str(s) for m in (terms.M, terms.g) for s in m.free_symbols}
+    if gravity_symbol and terms.g_unit is not None and "g" not in taken and "g" in include:
+        blocks["g"] = sp.ImmutableMatrix([G * e for e in terms.g_unit])
+        notes.append(f"g = {_trim(sp.sstr(sp.Float(terms.gravity, 6)))} m/s^2 (gravitational acceleration)")
     entries: list[tuple[str, sp.Expr]] = []
     for name in include:
         mat = blocks[name]
@@ -363,18 +442,29 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
         for i in range(mat.shape[0]):
             for j in range(mat.shape[1]):
                 label = f"{name}[{i + 1},{j + 1}]" if mat.shape[1] > 1 else f"{name}[{i + 1}]"
-                entries.append((label, _display(mat[i, j], terms.q, digits, short)))
+                entries.append((label, mat[i, j]))
     exprs = [e for _, e in entries]
     repl: list[tuple[sp.Symbol, sp.Expr]] = []
-    if cse is None:
-        cse = sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS
-    if cse:
-        repl, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("x"), optimizations="basic")
+    long = sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS
+    grouped = hand and cse is not False and long
+    if grouped:
+        repl, exprs = _name_groups(exprs, terms.qd)
+    show = lambda e: _display(e, terms.q, digits, short, collapse=not hand)  # noqa: E731
+    repl, exprs = [(s, show(e)) for s, e in repl], [show(e) for e in exprs]
+    if not hand:
+        if cse is None:
+            cse = long
+        if cse:
+            repl, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("x"), optimizations="basic")
     pairs = [(str(s), e) for s, e in repl] + [(label, e) for (label, _), e in zip(entries, exprs)]
     head = f"M(q) q'' + c(q, q') + g(q) + tau_f(q') = tau   ({n} joints)"
+    if short:
+        notes.append("Ci = cos(qi), Sij = sin(qi + qj), …")
     if style == "text":
-        return "\n".join([head, ""] + [f"{k} = {sp.sstr(e)}" for k, e in pairs])
-    tex = [(_tex_label(k), sp.latex(e)) for k, e in pairs]
+        return "\n".join([head] + [f"  {x}" for x in notes] + [""] +
+                         [f"{k} = {_trim(sp.sstr(e))}" for k, e in pairs])
+    names = _latex_names([e for _, e in pairs])
+    tex = [(_tex_label(k), sp.latex(e, symbol_names=names)) for k, e in pairs]
     if style == "latex":
         rows = " \\\\\n".join(f"{k} &= {v}" for k, v in tex)
         return "\\begin{aligned}\n" + rows + "\n\\end{aligned}"
@@ -382,11 +472,20 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
     return "\n\n".join(lines)
 
 
+def _latex_names(exprs: list[sp.Expr]) -> dict[sp.Symbol, str]:
+    """Parameter groups P1 as \\pi_{1}."""
+    return {s: f"\\pi_{{{s.name[1:]}}}" for e in exprs for s in e.free_symbols
+            if s.name[:1] == "P" and s.name[1:].isdigit()}
+
+
 def _tex_label(label: str) -> str:
     if "[" not in label:
+        if label.startswith("P") and label[1:].isdigit():
+            return f"\\pi_{{{label[1:]}}}"
         return label.replace("x", "x_{", 1) + "}" if label.startswith("x") else label
     name, idx = label[:-1].split("[")
     if name == "friction":  # one subscript: \tau_{f}_{1} is a LaTeX error
         return f"\\tau_{{f,{idx.replace(',', '')}}}"
-    name = {"friction": "\\tau_{f}", "M": "M", "c": "c", "g": "g", "C": "C"}[name]
+    if name == "C":  # C_{12} is the shorthand of cos(q1 + q2)
+        return f"\\mathcal{{C}}_{{{idx.replace(',', '')}}}"
     return f"{name}_{{{idx.replace(',', '')}}}"

@@ -149,10 +149,11 @@ class RingDynamics:
             e += rg.element(self.armature[j])
         return rg.reduce(e)
 
-    def gravity(self):
-        """g_j = −Σ m (z_j × (c − o_j))·g₀ in base axes, in the absolute angles."""
+    def gravity(self, unit: bool = False):
+        """g_j = −Σ m (z_j × (c − o_j))·g₀ in base axes, in the absolute angles (per unit of |g₀| if ``unit``)."""
         rg, T = self.ring(-1)
-        g0 = [rg.element(x) for x in self.g0]
+        size = sp.sqrt(sum(x ** 2 for x in self.g0))
+        g0 = [rg.element(x / size if unit and size != 0 else x) for x in self.g0]
         out = []
         for j in range(self.n):
             e = rg.R.zero
@@ -177,7 +178,7 @@ def _report(progress, stage, done, total):
 
 @lru_cache(maxsize=16)
 def ring_dynamics(robot: DHRobot, numeric: bool = False, coriolis: bool = True, progress: Progress | None = None):
-    """(M, C or None, c, g) as sympy matrices in hand form (see module notes and :func:`hand_terms`)."""
+    """(M, C or None, c, g, |g₀|, g per unit |g₀|) as sympy in hand form (module notes, :func:`hand_terms`)."""
     D = RingDynamics(robot, numeric)
     n = D.n
     qd = joint_symbols(n).qd
@@ -193,9 +194,11 @@ def ring_dynamics(robot: DHRobot, numeric: bool = False, coriolis: bool = True, 
     # c and C from the Christoffel symbols of M, all in the ring of angles after joint 1
     rg0, _ = D.ring(0)
     M0 = {}
+    done = 0
     for j in range(n):
         for k in range(j, n):
-            _report(progress, "mass matrix (for c)", j * n + k, n * n)
+            _report(progress, "mass matrix in the angles after joint 1 (for c)", done, total)
+            done += 1
             M0[j, k] = M0[k, j] = D.mass_entry(j, k, 0)
     dM = {(i, j, k): D.diff(rg0, M0[j, k], i) for i in range(n) for j in range(n) for k in range(j, n)}
     for (i, j, k), v in list(dM.items()):
@@ -218,12 +221,65 @@ def ring_dynamics(robot: DHRobot, numeric: bool = False, coriolis: bool = True, 
                                       for k in range(n) for j in range(n)])
     rgg, gs = D.gravity()
     g = sp.ImmutableMatrix([hand_terms(rgg, x) for x in gs])
-    return sp.ImmutableMatrix(M), C, sp.ImmutableMatrix(c), g
+    size = sp.sqrt(sum(x ** 2 for x in D.g0))
+    rgg, gs = D.gravity(unit=True)
+    g_unit = sp.ImmutableMatrix([hand_terms(rgg, x) for x in gs]) if size != 0 else None
+    return sp.ImmutableMatrix(M), C, sp.ImmutableMatrix(c), g, (size if size != 0 else None), g_unit
+
+
+def _pair_angles(rg: TrigRing, terms: dict) -> dict:
+    """Collapse pairs of terms into the sine or cosine of an angle difference, within a group of parallel axes:
+    X (c_a c_b + s_a s_b) → X cos(φ_b − φ_a) (C₂C₂₃ + S₂S₂₃ → C₃), X (s_a c_b − c_a s_b) → X sin(φ_a − φ_b).
+
+    ``terms`` maps (parameter exponents, trig exponents, extra atoms) to coefficients; extra atoms are the
+    new sines and cosines (sympy)."""
+    m = len(rg.sums)
+    S, C = (lambda a: a), (lambda a: m + a)
+    pairs = [(a, b) for a in range(m) for b in range(m) if a != b and rg.sums[a][0] == rg.sums[b][0]]
+    if not pairs:
+        return terms
+
+    def moved(t, minus, plus):
+        t = list(t)
+        for i in minus:
+            t[i] -= 1
+        for i in plus:
+            t[i] += 1
+        return tuple(t)
+
+    changed = True
+    while changed:
+        changed = False
+        for (pm, tm, extra), coeff in list(terms.items()):
+            if (pm, tm, extra) not in terms:
+                continue
+            for a, b in pairs:
+                patterns = []
+                if a < b and tm[C(a)] and tm[C(b)]:  # c_a c_b + s_a s_b
+                    patterns.append(((C(a), C(b)), (S(a), S(b)), 1, sp.cos(rg.angles[b] - rg.angles[a])))
+                if tm[S(a)] and tm[C(b)]:  # s_a c_b − c_a s_b
+                    patterns.append(((S(a), C(b)), (C(a), S(b)), -1, sp.sin(rg.angles[a] - rg.angles[b])))
+                for minus, plus, sign, atom in patterns:
+                    partner = (pm, moved(tm, minus, plus), extra)
+                    if terms.get(partner) == sign * coeff:
+                        del terms[pm, tm, extra], terms[partner]
+                        key = (pm, moved(tm, minus, ()), tuple(sorted(extra + (atom,), key=sp.default_sort_key)))
+                        terms[key] = terms.get(key, 0) + coeff
+                        if not terms[key]:
+                            del terms[key]
+                        changed = True
+                        break
+                if changed:
+                    break
+            if changed:
+                break
+    return terms
 
 
 def hand_terms(rg: TrigRing, poly) -> sp.Expr:
-    """A ring element as Σ (parameter group) × (sines and cosines): terms collected on the trigonometric
-    monomial (constant first), each group with its rational content and common parameter monomial taken out."""
+    """A ring element as Σ (parameter group) × (sines and cosines): angle differences within a group of
+    parallel axes collapsed (:func:`_pair_angles`), terms collected on the trigonometric part (constant
+    first), each group with its rational content and common parameter monomial taken out."""
     if not poly:
         return sp.Integer(0)
     ntrig = len(rg.trig_gens)
@@ -231,20 +287,24 @@ def hand_terms(rg: TrigRing, poly) -> sp.Expr:
     syms = [s.xreplace(rg.back) for s in rg.R.symbols[:k0]]
     trig_atoms = [rg.trig_of(g) for g in rg.trig_gens]
     to_sympy = rg.R.domain.to_sympy
-    groups: dict[tuple[int, ...], list] = {}
-    for monom, coeff in poly.terms():
-        groups.setdefault(monom[k0:], []).append((monom[:k0], coeff))
+    terms = _pair_angles(rg, {(monom[:k0], monom[k0:], ()): to_sympy(coeff) for monom, coeff in poly.terms()})
+    groups: dict[tuple, list] = {}
+    for (pm, tm, extra), coeff in terms.items():
+        groups.setdefault((tm, extra), []).append((pm, coeff))
     out = []
-    for key in sorted(groups, key=lambda m: (sum(m), m)):
+    for key in sorted(groups, key=lambda k: (sum(k[0]) + len(k[1]), k[0], [str(x) for x in k[1]])):
         items = groups[key]
         low = [min(m[i] for m, _ in items) for i in range(k0)]
-        nums = [to_sympy(cf) for _, cf in items]
+        nums = [cf for _, cf in items]
         content = sp.gcd_list(nums) if len(nums) > 1 else nums[0]
+        if len(nums) > 1 and (content.q > 4 or content.p > 1000) and not all(x.is_Integer for x in nums):
+            content = sp.Integer(1)  # decimal data: 0.1465 a2 + 0.0791, not 8.0e-9 (18312500 a2 + 9887500)
         if len(nums) > 1 and all(x < 0 for x in nums):
             content = -content
         common = content * sp.Mul(*[x ** e for x, e in zip(syms, low) if e])
         rest = sp.Add(*[(x / content) * sp.Mul(*[v ** (e - l) for v, e, l in zip(syms, m, low) if e - l])
                         for (m, _), x in zip(items, nums)])
-        trig = sp.Mul(*[a ** e for a, e in zip(trig_atoms, key) if e])
+        tm, extra = key
+        trig = sp.Mul(*[a ** e for a, e in zip(trig_atoms, tm) if e], *extra)
         out.append(sp.Mul(common, rest, trig))
     return sp.Add(*out)

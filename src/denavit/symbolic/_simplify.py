@@ -70,12 +70,13 @@ def _joint_variables(q) -> tuple[sp.Symbol, ...]:
     return qs
 
 
-def shorthand(e: sp.Expr, q, style: str = "C") -> sp.Expr:
+def shorthand(e: sp.Expr, q, style: str = "C", collapse: bool = True) -> sp.Expr:
     """Replace cos(q1 + q2) by the symbol C12, sin(q3) by S3 (``style="c"`` gives c12, s3).
 
     ``q`` is the joint variables: a :class:`JointSymbols` object (``joint_symbols(n)``) or a sequence of
     symbols. Products that are angle sums (cos q2 cos q3 − sin q2 sin q3) are collapsed first (Fu's TR10i),
-    so the result reads C23, not C2*C3 - S2*S3. For display only: the result uses plain symbols and is not
+    so the result reads C23, not C2*C3 - S2*S3 (``collapse=False``: atoms replaced only, for entries already
+    written in angle sums). For display only: the result uses plain symbols and is not
     meant to be computed with.
 
     Examples
@@ -87,7 +88,7 @@ def shorthand(e: sp.Expr, q, style: str = "C") -> sp.Expr:
     C12 + S2
     """
     qs = {s: i + 1 for i, s in enumerate(_joint_variables(q))}
-    if isinstance(e, sp.Basic) and e.has(sp.sin, sp.cos):
+    if collapse and isinstance(e, sp.Basic) and e.has(sp.sin, sp.cos):
         terms = sp.Add.make_args(sp.expand(e))
         if any(isinstance(t, sp.Mul) and len(t.atoms(sp.sin, sp.cos)) > 1 for t in terms) and not (
             e.has(sp.Float) and len(terms) > 24  # same bound as the "trig" policy: float geometry stays as is
