@@ -25,7 +25,8 @@ def peak_mb() -> float:
 
 
 def run_samples(robot, counts, scheduler, workers) -> list[str]:
-    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] | cell edge [m] | coverage | volume [m³] | interval [m³] |",
+    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] | cell edge [m] | coverage | volume [m³] "
+            "| interval [m³] |",
             "|---:|---:|---:|---:|---:|---:|---:|---|"]
     for n in counts:
         t0 = time.perf_counter()

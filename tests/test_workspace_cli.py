@@ -135,3 +135,26 @@ def test_reachability_of_an_arm_without_full_pose_is_one_line(tmp_path):
     o = run_cli(["reachability", "planar2r"], tmp_path)
     assert o.code in (1, 2) and len(o.err.strip().splitlines()) == 1 and "6 or more joints" in o.err
     assert o.out == "" and "Traceback" not in o.err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scheduler", ["threads", "processes"])
+def test_ctrl_c_stops_cleanly(tmp_path, scheduler):
+    """SIGINT mid-run: exit 130 within seconds, one line on stderr, no traceback, no partial --data file."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "denavit", "workspace", "puma560", "--samples", "1e9",
+                             "--scheduler", scheduler, "--workers", "2", "--data", "w.npz"], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(4)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.perf_counter()
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert time.perf_counter() - t0 < 30
+    assert out == "" and "Traceback" not in err and err.strip().splitlines() == ["denavit: interrupted"], err
+    assert os.listdir(tmp_path) == []

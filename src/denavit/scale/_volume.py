@@ -13,9 +13,10 @@ is flat at the scale of 3h has a whole neighbour outside W, so it is not interio
 W only move cells from I to the boundary (the lower bound stays a lower bound).  The estimate is the interval's
 midpoint.  Counts are kept at the finest edge and added up 2×2×2 for each coarser level; among the levels
 whose Good–Turing sample coverage 1 − f1/N is at least MIN_COVERAGE (Chao1 is only trusted there: at low
-coverage it under-counts the unseen cells badly) the one with the narrowest interval is reported, so the interval shrinks as samples fill finer levels (width ≈ boundary area ×
-3h).  Assumptions (stated in docs/workspace.md): a boundary smooth at the scale of 3h (thin slivers and holes
-narrower than a cell are not resolved) and the Chao1 model for the unseen cells.
+coverage it under-counts the unseen cells badly) the one with the narrowest interval is reported, so the
+interval shrinks as samples fill finer levels (width ≈ boundary area × 3h).  Assumptions (stated in
+docs/workspace.md): a boundary smooth at the scale of 3h (thin slivers and holes narrower than a cell are not
+resolved) and the Chao1 model for the unseen cells.
 """
 
 from __future__ import annotations
