@@ -140,8 +140,11 @@ def verdicts_text(result: CheckResult) -> str:
             lines.append(f"  entry {tuple(e['entry'])}: claimed {e['claimed']:.6g}, expected {e['expected']:.6g}")
         if v.counterexample:
             cx = v.counterexample
-            lines.append("  counterexample: q = [" + ", ".join(f"{x:.6g}" for x in cx["q"]) + "]"
-                         + (f", parameters {cx['parameters']}" if "parameters" in cx else ""))
+            head = ("q = [" + ", ".join(f"{x:.6g}" for x in cx["q"]) + "]" if "q" in cx else
+                    ", ".join(f"{k} = {x:.6g}" for k, x in cx.items() if isinstance(x, float)))
+            lines.append("  counterexample: " + head
+                         + (f", parameters {cx['parameters']}" if "parameters" in cx else "")
+                         + "".join(f", {k} = {x:.6g}" for k, x in cx.get("symbols", {}).items()))
         lines += [f"  hint: {h}" for h in v.hints]
         if v.extra.get("expected_latex"):
             lines.append(f"  correct formula (LaTeX): {v.extra['expected_latex']}")

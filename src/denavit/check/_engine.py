@@ -290,9 +290,10 @@ def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, d
         raise ParseError("this claim needs 'wrench' (6 numbers or symbols f, n; or 3 for a force)")
     uses_q = any(n.startswith("q") and n[1:].isdigit() for n in names)
     uses_qd = any(n.startswith("qd") and n[2:].isdigit() for n in names)
-    if "qd" in needs and fixed_qd is None and not uses_qd:
-        raise ParseError("this claim needs 'qd' (joint rates) or a formula in the rates")
-    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) or symbols else 1
+    # a quantity of the rates claimed without 'qd' and without rates (ⁱvᵢ = 0, a constant): it must hold at any
+    # rates, so it is checked at random ones
+    const_qd = "qd" in needs and fixed_qd is None and not uses_qd
+    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) or symbols or const_qd else 1
     pts = []
     for r in robots:
         for _ in range(n_q):
@@ -465,8 +466,9 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
     own = np.array([p.robot is robot for p in points])
     k = int(np.argmax(np.where(own, err, -1.0))) if (own & (err > 1)).any() else int(np.argmax(err))
     p = points[k]
-    if truth.ndim == 1:  # one entry per point ('entry' claims)
-        e = spec["entry"] if isinstance(spec["entry"], list) else [spec["entry"]]
+    if truth.ndim == 1:  # one entry per point ('entry' claims, scalar quantities)
+        e = spec.get("entry", 1)
+        e = e if isinstance(e, list) else [e]
         idx = [tuple(e)]
         entries = ({"entry": list(e), "claimed": float(claimed[k]), "expected": float(truth[k])},)
     else:
@@ -477,6 +479,8 @@ def _incorrect(robot, cid, qty, spec, cells, points, claimed, truth, ok, tol, me
         cex["qd"] = p.qd.tolist()
     if p.robot is not robot:
         cex["parameters"] = dict(p.robot.parameters)
+    if p.symbols:  # a symbolic wrench's f_x, …: the values used at this point
+        cex["symbols"] = dict(p.symbols)
     hints = hints_for(robot, qty, spec, cells, points, claimed, truth, ok, tol, rng) if detail else ()
     extra = {}
     if detail and len(points) > 1 and "q" not in spec:  # a formula: give the correct formula too
