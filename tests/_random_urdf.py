@@ -55,6 +55,14 @@ def _inertial(rng):
             tuple(float(x) for x in (J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2])))
 
 
+def _skew(prev, point, direction) -> bool:
+    """True when the line (point, direction) is clearly skew to ``prev`` (neither parallel nor meeting)."""
+    p, u = prev
+    c = np.cross(u, direction / np.linalg.norm(direction))
+    s = float(np.linalg.norm(c))
+    return s > 1e-3 and abs(float((point - p) @ c)) / s > 1e-3
+
+
 def random_chain(rng: np.random.Generator, n: int | None = None, cases=CASES, fixed: float = 0.25,
                  prismatic: float = 0.2, inertia: bool = True,
                  continuous: bool = True) -> tuple[list[GenLink], list[GenJoint]]:
@@ -80,6 +88,8 @@ def random_chain(rng: np.random.Generator, n: int | None = None, cases=CASES, fi
         case = "" if prev is None else str(rng.choice(cases))
         if case in ("", "skew"):
             axis = np.eye(3)[rng.integers(3)] * rng.choice([-1, 1]) if rng.random() < 0.5 else _unit(rng)
+            if case == "skew" and not _skew(prev, xyz, R @ axis):
+                continue  # quarter turns can make it parallel or meeting by chance: draw again
         else:
             p, u = prev
             if case in ("parallel", "anti-parallel", "coincident", "anti-coincident"):
