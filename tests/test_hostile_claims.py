@@ -19,6 +19,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import denavit as dn
+from denavit.check import MAX_CLAIMS
+
 from _hostile import TIME_LIMIT, assert_refused, run_cli, run_cli_limited, corpus
 
 ROBOT = "planar2r"
@@ -81,6 +83,26 @@ LONG_PRODUCT = "*".join(["1"] * 3000)
     ({"quantity": "ik_formula", "joint": [1], "value": "atan2(p_y, p_x)"}, ["'joint'"]),
     ({"quantity": "ik_formula", "where": {f"w{k}": "1" for k in range(50)}, "value": "q_1 = w1"}, ["'where'"]),
     ({"quantity": "position", "value": "1.2.3"}, ["malformed number"]),
+    # the claim kinds of issue 13: bad keys and names are that claim's "unreadable", with the reason
+    ({"quantity": "omega", "index": "x", "value": [0, 0, 0]}, ["'index'"]),
+    ({"quantity": "omega", "index": 10**30, "value": [0, 0, 0]}, ["'index'"]),
+    ({"quantity": "force", "index": 1, "value": [0, 0, 0]}, ["wrench"]),
+    ({"quantity": "force", "index": 1, "wrench": "[f_x]", "value": [0, 0, 0]}, ["wrench", "got 1"]),
+    ({"quantity": "force", "index": 1, "wrench": "f_q, 0, 0", "value": [0, 0, 0]}, ["wrench", "unknown symbol"]),
+    ({"quantity": "moment", "index": 1, "wrench": "0," * 5000, "value": [0, 0, 0]}, ["wrench"]),
+    ({"quantity": "force", "index": 1, "wrench": "f_x, 0, 0", "value": "[F_y, 0, 0]"}, ["unknown symbol"]),
+    ({"quantity": "dh_matrix", "convention": "weird", "value": "1"}, ["'convention'"]),
+    ({"quantity": "dh_matrix", "value": "\\input{/etc/passwd}"}, ["unsupported latex command"]),
+    ({"quantity": "dh_matrix", "value": "\\begin{bmatrix} L_1 \\end{bmatrix}"}, ["unknown symbol"]),
+    ({"quantity": "ik_formula", "point": "elbow", "value": "q_1 = atan2(p_y, p_x)"}, ["'point'"]),
+    ({"quantity": "ik_formula", "point": "wrist", "value": "q_1 = atan2(p_y, p_x)"}, ["wrist"]),
+    ({"quantity": "ik_formula", "value": "\\cos(q_1 + 1) = 0.5"}, ["joint variable"]),
+    ({"quantity": "det_jacobian", "value": "1"}, ["square"]),
+    ({"quantity": "det_jacobian", "rows": "vx", "value": "1"}, ["square"]),
+    ({"quantity": "com_position", "index": 9, "value": [0, 0, 0]}, ["'index'"]),
+    ({"quantity": "jacobian", "rows": "vx,vq", "value": [[1, 2]]}, ["'rows'"]),
+    ({"quantity": "position", "q": "(" * 100 + "0, 0" + ")" * 100, "value": [1, 2, 0]}, ["q"]),
+    ({"quantity": "position", "q": "0^{\\circ\\circ}, 0", "value": [1, 2, 0]}, ["q"]),
 ])
 def test_trigger_is_one_unreadable_claim(tmp_path, claim, words):
     good = {"id": "good", "quantity": "position", "value": ["L_1 C_1 + L_2 C_{12}", "L_1 S_1 + L_2 S_{12}", 0]}
@@ -176,7 +198,8 @@ BAD_FILES = {
     "huge int": ("claims:\n- quantity: position\n  entry: 1\n  value: " + "9" * 5000 + "\n", ["digits"]),
     "huge int 400": ("claims:\n- quantity: position\n  entry: " + "9" * 400 + "\n  value: 1\n", ["digits"]),
     "not utf-8": (b"claims:\n- quantity: \xff\xfe\n  value: 1\n", ["utf-8"]),
-    "too many claims": (yaml.safe_dump({"claims": [{"quantity": "position", "value": [1, 2, 3]}] * 101}), ["101"]),
+    "too many claims": (yaml.safe_dump({"claims": [{"quantity": "position", "value": [1, 2, 3]}] * (MAX_CLAIMS + 1)}),
+                        [str(MAX_CLAIMS + 1)]),
     "too many costly claims": (yaml.safe_dump({"claims": [{"quantity": "singularities", "value": "none"}] * 21}),
                                ["21"]),
 }
@@ -204,6 +227,21 @@ def test_many_incorrect_claims_in_bounded_time(tmp_path):
     assert any("first 8 incorrect" in n for n in json.loads(o.out)["notes"])
 
 
+@pytest.mark.slow
+def test_a_file_of_the_most_claims_is_judged_in_bounded_time(tmp_path):
+    """MAX_CLAIMS (500) claims of every plain kind, right and wrong, each judged, well inside a minute."""
+    kinds = [{"quantity": "position", "value": ["L_1 C_1 + L_2 C_{12}", "L_1 S_1 + L_2 S_{12}", 0]},
+             {"quantity": "jacobian", "value": [[1, 2], [3, 4], [0, 0], [0, 0], [0, 0], [1, 2]]},
+             {"quantity": "omega", "index": 2, "value": [0, 0, "\\dot\\theta_1 + \\dot\\theta_2"]},
+             {"quantity": "torques", "wrench": "F_x, F_y, 0", "value": ["F_x", "F_y"]},
+             {"quantity": "K", "value": "\\dot q_1^2"}]
+    o = _check(tmp_path, _file(*[kinds[k % len(kinds)] for k in range(MAX_CLAIMS)]))
+    vs = _verdicts(o)
+    assert len(vs) == MAX_CLAIMS
+    assert [v["verdict"] for v in vs[:5]] == ["correct", "incorrect", "correct", "incorrect", "incorrect"]
+    assert o.seconds < 60, o.describe()
+
+
 def test_repeated_singularity_claims_share_the_analysis(tmp_path):
     claims = [{"quantity": "singularities", "rows": "vx,vy", "value": "\\sin\\theta_2 = 0"}] * 20  # the cap
     o = _check(tmp_path, _file(*claims))
@@ -229,6 +267,17 @@ CORRECT = [  # a planar 2R with a1 = 1, a2 = 0.5 and no parameters (standard DH)
                                                          [0, 0, 1, 0], [0, 0, 0, 1]]},
     {"quantity": "twist", "entry": 6, "value": "\\dot\\theta_1 + \\dot\\theta_2"},
     {"quantity": "singularities", "rows": "vx,vy", "value": "q_2 = 0, \\pi"},
+    {"quantity": "omega", "index": 2, "value": [0, 0, "\\dot\\theta_1 + \\dot\\theta_2"]},
+    {"quantity": "velocity", "index": 1, "value": ["0", "\\dot\\theta_1", "0"]},
+    {"quantity": "force", "index": 1, "wrench": "[f_x, f_y, 0]", "value": ["c_2 f_x - s_2 f_y", "s_2 f_x + c_2 f_y", 0]},
+    {"quantity": "moment", "index": 1, "wrench": "[f_x, f_y, 0]", "value": [0, 0, "0.5 f_y"]},
+    {"quantity": "torques", "wrench": "F_x, F_y, 0, 0, 0, 0",
+     "value": ["-(S_1 + 0.5 S_{12}) F_x + (C_1 + 0.5 C_{12}) F_y", "-0.5 S_{12} F_x + 0.5 C_{12} F_y"]},
+    {"quantity": "det_jacobian", "rows": "vx,vy", "value": "\\frac{1}{2} \\sin\\theta_2"},
+    {"quantity": "dh_matrix", "value": "\\begin{bmatrix} c\\theta & -s\\theta c\\alpha & s\\theta s\\alpha & a c\\theta \\\\ "
+                                       "s\\theta & c\\theta c\\alpha & -c\\theta s\\alpha & a s\\theta \\\\ "
+                                       "0 & s\\alpha & c\\alpha & d \\\\ 0 & 0 & 0 & 1 \\end{bmatrix}"},
+    {"quantity": "jacobian", "q": "(90^\\circ, -90°)", "value": "[-1, 0; 0.5, 0.5; 1, 1]"},
 ]
 
 
@@ -258,10 +307,11 @@ ANY_VALUE = st.recursive(
     max_leaves=12,
 )
 KEYS = ["quantity", "value", "entry", "index", "column", "rows", "frame", "q", "qd", "wrench", "joint", "where",
-        "pose", "T", "from", "to", "deg", "id"]
+        "pose", "T", "from", "to", "deg", "id", "point", "convention"]
 QUANTITY_NAMES = ["position", "rotation", "end_effector", "transform", "link_transform", "jacobian", "J0", "Je",
                   "twist", "torques", "mass_matrix", "gravity", "coriolis", "C", "singularities", "ik_formula",
-                  "ik_solutions", "bogus", "", "__class__"]
+                  "ik_solutions", "bogus", "", "__class__", "omega", "velocity", "force", "moment", "com_position",
+                  "com_velocity", "K", "V", "L", "det_jacobian", "dh_matrix"]
 
 
 @st.composite

@@ -24,8 +24,8 @@ __all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_tex
            "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_COSTLY_CLAIMS", "MAX_DETAILED",
            "MAX_FILE_BYTES"]
 
-#: Most claims in one file (a file is one person's derivation; split a longer one).
-MAX_CLAIMS = 100
+#: Most claims in one file (a whole course report is a few hundred; 500 are judged in well under a minute).
+MAX_CLAIMS = 500
 #: Most claims of the kinds that search or solve (singularities, ik_formula, ik_solutions) in one file.
 MAX_COSTLY_CLAIMS = 20
 #: Incorrect claims that get the full explanation (tested hints, the correct formula); later ones get the verdict,
