@@ -103,3 +103,30 @@ def test_cli_export_mjcf(tmp_path, capsys):
     assert model.nq == 6
     assert main(["export-mjcf", "ur5", "-o", str(tmp_path / "arm.urdf")]) == 2
     assert not (tmp_path / "arm.urdf").exists()
+
+
+@pytest.mark.parametrize("name", denavit.catalogue_names())
+def test_visual_rods_follow_the_plotted_centre_line(name, rng):
+    """The capsules MuJoCo places at q are segments of the plots' link centre line (viz.arm_geometry) at q.
+    Prismatic joints are held at 0 (the plot's segment along a prismatic axis stretches; a rigid capsule cannot)."""
+    from denavit.viz import arm_geometry
+
+    robot = denavit.load_robot(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DenavitWarning)
+        model = mujoco.MjModel.from_xml_string(denavit.to_mjcf(robot))
+    data = mujoco.MjData(model)
+    capsules = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE]
+    if not capsules:  # only an arm whose centre line at q = 0 is a point has none
+        assert np.ptp(arm_geometry(robot, np.zeros(robot.dof)).skeleton, axis=0).max() < 1e-9
+    prismatic = np.array([t is denavit.JointType.PRISMATIC for t in robot.joint_types])
+    for q in rng.uniform(-1, 1, (3, robot.dof)):
+        q[prismatic] = 0.0
+        data.qpos[:] = q
+        mujoco.mj_forward(model, data)
+        skeleton = arm_geometry(robot, q).skeleton  # (2N+2, 3)
+        for g in capsules:
+            half = model.geom_size[g, 1] * data.geom_xmat[g].reshape(3, 3)[:, 2]
+            for end in (data.geom_xpos[g] - half, data.geom_xpos[g] + half):
+                gap = np.linalg.norm(skeleton - end, axis=1).min()
+                assert gap < 1e-9

@@ -39,7 +39,7 @@ class Body:
     motor_inertia: float
     viscous: float
     coulomb: float
-    next_origin: np.ndarray  # (3,) the next joint's (or the tool's) origin in this body's frame, for visuals
+    rods: tuple  # ((start, end), ...) the plots' link centre line carried by this body, in its frame [m]
 
 
 def combine_inertia(pieces) -> tuple[float, np.ndarray, np.ndarray]:
@@ -54,8 +54,35 @@ def combine_inertia(pieces) -> tuple[float, np.ndarray, np.ndarray]:
     return m, np.asarray(c, dtype=float), 0.5 * (I + I.T)
 
 
-def export_plan(robot: DHRobot) -> tuple[list[Body], np.ndarray]:
-    """``(bodies, tool)``: the bodies of the arm, base to tip, and the tool frame C_n in the last body."""
+def _rods(robot: DHRobot, chain) -> list[list[tuple[np.ndarray, np.ndarray]]]:
+    """The plots' link centre line (``denavit.viz.arm_geometry`` skeleton at q = 0: o_{i-1}, knee k_i, o_i, …,
+    the tool) cut into segments, each in the frame of the body that carries it; index 0 is the fixed base."""
+    from ..viz import arm_geometry
+
+    skel = arm_geometry(robot, np.zeros(robot.dof)).skeleton  # (2N+2, 3) world, q = 0
+    body_after = np.cumsum([link.is_joint for link in robot.links]) - 1  # body carrying frame {i+1}
+    L = [np.eye(4)]  # world pose of body k's frame at q = 0 (index 0: the base)
+    for C in chain.constants[:-1]:
+        L.append(L[-1] @ C)
+    out: list[list] = [[] for _ in range(robot.dof + 1)]
+
+    def add(body: int, a: np.ndarray, b: np.ndarray) -> None:
+        if np.linalg.norm(b - a) > 1e-9:
+            Li = np.linalg.inv(L[body + 1])
+            out[body + 1].append((Li[:3, :3] @ a + Li[:3, 3], Li[:3, :3] @ b + Li[:3, 3]))
+
+    for i in range(robot.n_rows):
+        before = int(body_after[i - 1]) if i else -1
+        first = before if not chain.standard else int(body_after[i])  # standard: along z_{i-1}, row i's axis
+        add(first, skel[2 * i], skel[2 * i + 1])
+        add(int(body_after[i]), skel[2 * i + 1], skel[2 * i + 2])
+    add(robot.dof - 1, skel[-2], skel[-1])
+    return out
+
+
+def export_plan(robot: DHRobot) -> tuple[list[Body], np.ndarray, tuple]:
+    """``(bodies, tool, base_rods)``: the bodies of the arm, base to tip, the tool frame C_n in the last body,
+    and the centre-line segments of the fixed base (world frame)."""
     chain = chain_of(robot)
     C = chain.constants
     pieces: list[list] = [[] for _ in range(robot.dof)]
@@ -65,6 +92,7 @@ def export_plan(robot: DHRobot) -> tuple[list[Body], np.ndarray]:
             X = X @ chain.row_constant(i)
         R = X[:3, :3]
         pieces[body].append((li.mass, X[:3, :3] @ np.array(li.com) + X[:3, 3], R @ li.inertia_matrix @ R.T))
+    rods = _rods(robot, chain)
     bodies = []
     for k, r in enumerate(chain.joint_rows):
         link = robot.links[r]
@@ -74,9 +102,9 @@ def export_plan(robot: DHRobot) -> tuple[list[Body], np.ndarray]:
             name=f"link{k + 1}", joint=f"q{k + 1}", placement=np.array(C[k]), prismatic=chain.prismatic[k],
             limits=link.q_limits, mass=m, com=c, inertia=I, has_inertia=bool(pieces[k]),
             motor_inertia=li.motor_inertia if li else 0.0, viscous=li.viscous if li else 0.0,
-            coulomb=li.coulomb if li else 0.0, next_origin=np.array(C[k + 1][:3, 3]),
+            coulomb=li.coulomb if li else 0.0, rods=tuple(rods[k + 1]),
         ))
-    return bodies, np.array(C[-1])
+    return bodies, np.array(C[-1]), tuple(rods[0])
 
 
 def quaternion_wxyz(R: np.ndarray) -> np.ndarray:

@@ -51,11 +51,10 @@ def _mujoco_inertia(I: np.ndarray, body: str) -> np.ndarray:
     return (V * w) @ V.T
 
 
-def _rod(p: np.ndarray, radius: float) -> str:
-    if float(np.linalg.norm(p)) < 1e-9:
-        return ""
-    return (f'<geom type="capsule" fromto="0 0 0 {nums(p)}" size="{num(radius * 0.5)}" rgba="0.55 0.55 0.55 1" '
-            'contype="0" conaffinity="0" group="1"/>')
+def _rods(rods, radius: float) -> str:
+    """Capsules along the link centre line segments (in the body's frame), visual only."""
+    return "".join(f'<geom type="capsule" fromto="{nums(a)} {nums(b)}" size="{num(radius * 0.5)}" '
+                   'rgba="0.55 0.55 0.55 1" contype="0" conaffinity="0" group="1"/>' for a, b in rods)
 
 
 def to_mjcf(robot: DHRobot) -> str:
@@ -70,14 +69,14 @@ def to_mjcf(robot: DHRobot) -> str:
     """
     from ..viz import robot_scale
 
-    bodies, tool = export_plan(robot)
+    bodies, tool, base_rods = export_plan(robot)
     r = GLYPH_FRACTION * robot_scale(robot)
     out = [f"<mujoco model={quoteattr(xml_safe(robot.name))}>",
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
            f'  <option gravity="{nums(robot.gravity)}"/>',
            "  <worldbody>",
            f'    <geom type="box" size="{nums([2 * r, 2 * r, r / 2])}" rgba="0.55 0.55 0.55 1" contype="0" '
-           f'conaffinity="0" group="1"/>{_rod(bodies[0].placement[:3, 3], r)}']
+           f'conaffinity="0" group="1"/>{_rods(base_rods, r)}']
     indent = "    "
     for b in bodies:
         out.append(f'{indent}<body name="{b.name}" {_pose(b.placement)}>')
@@ -100,7 +99,7 @@ def to_mjcf(robot: DHRobot) -> str:
         glyph = (f'type="box" size="{nums([r, r, 1.5 * r])}"' if b.prismatic
                  else f'type="cylinder" size="{nums([r, 1.5 * r])}"')
         out.append(f'{indent}<geom {glyph} rgba="0.25 0.45 0.75 1" contype="0" conaffinity="0" group="1"/>'
-                   f"{_rod(b.next_origin, r)}")
+                   f"{_rods(b.rods, r)}")
     out.append(f'{indent}<site name="tool" {_pose(tool)} size="{num(r / 2)}"/>')
     for _ in bodies:
         indent = indent[:-2]

@@ -24,14 +24,12 @@ def _origin(T: np.ndarray) -> str:
     return f'<origin xyz="{nums(T[:3, 3])}" rpy="{nums(rpy_from_rotation(T[:3, :3]))}"/>'
 
 
-def _rod(p: np.ndarray, radius: float) -> str:
-    """A cylinder visual from this link's origin to ``p`` (the next joint's origin)."""
-    length = float(np.linalg.norm(p))
-    if length < 1e-9:
-        return ""
-    z = p / length
-    # a rotation taking z to the rod's direction: about z × u by the angle between them
-    axis = np.cross([0.0, 0.0, 1.0], z)
+def _rod(a: np.ndarray, b: np.ndarray, radius: float) -> str:
+    """A cylinder visual from ``a`` to ``b`` (a segment of the link centre line, in the link's frame)."""
+    v = b - a
+    length = float(np.linalg.norm(v))
+    z = v / length
+    axis = np.cross([0.0, 0.0, 1.0], z)  # turn z onto the segment: about z × u by the angle between them
     s, c = float(np.linalg.norm(axis)), float(z[2])
     if s < 1e-12:
         R = np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
@@ -40,9 +38,13 @@ def _rod(p: np.ndarray, radius: float) -> str:
         K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
         R = np.eye(3) + s * K + (1 - c) * K @ K
     T = np.eye(4)
-    T[:3, :3], T[:3, 3] = R, p / 2
+    T[:3, :3], T[:3, 3] = R, (a + b) / 2
     return (f'<visual>{_origin(T)}<geometry><cylinder radius="{num(radius * 0.5)}" length="{num(length)}"/>'
             f'</geometry><material name="link"/></visual>')
+
+
+def _rods(rods, radius: float) -> str:
+    return "".join(_rod(a, b, radius) for a, b in rods)
 
 
 def to_urdf(robot: DHRobot) -> str:
@@ -60,7 +62,7 @@ def to_urdf(robot: DHRobot) -> str:
     """
     from ..viz import robot_scale
 
-    bodies, tool = export_plan(robot)
+    bodies, tool, base_rods = export_plan(robot)
     r = GLYPH_FRACTION * robot_scale(robot)
     name = xml_safe(robot.name)
     out = ['<?xml version="1.0"?>', f"<!-- {escape(name).replace('--', '- -')}: written by denavit -->",
@@ -68,7 +70,7 @@ def to_urdf(robot: DHRobot) -> str:
            '  <material name="link"><color rgba="0.55 0.55 0.55 1"/></material>',
            '  <material name="joint"><color rgba="0.25 0.45 0.75 1"/></material>',
            f'  <link name="base_link"><visual><geometry><box size="{nums([4 * r, 4 * r, r])}"/></geometry>'
-           f'<material name="link"/></visual>{_rod(bodies[0].placement[:3, 3], r)}</link>']
+           f'<material name="link"/></visual>{_rods(base_rods, r)}</link>']
     parent = "base_link"
     for b in bodies:
         glyph = (f'<box size="{nums([2 * r, 2 * r, 3 * r])}"/>' if b.prismatic
@@ -80,7 +82,7 @@ def to_urdf(robot: DHRobot) -> str:
                         f'<inertia ixx="{num(I[0, 0])}" iyy="{num(I[1, 1])}" izz="{num(I[2, 2])}" '
                         f'ixy="{num(I[0, 1])}" ixz="{num(I[0, 2])}" iyz="{num(I[1, 2])}"/></inertial>')
         out.append(f'  <link name="{b.name}">{inertial}<visual><geometry>{glyph}</geometry>'
-                   f'<material name="joint"/></visual>{_rod(b.next_origin, r)}</link>')
+                   f'<material name="joint"/></visual>{_rods(b.rods, r)}</link>')
         if b.prismatic:
             kind = "prismatic"
             lo, hi = b.limits if b.limits is not None else (-MAX_MAGNITUDE, MAX_MAGNITUDE)
