@@ -267,3 +267,54 @@ def test_unwritable_cache_folder_falls_back_to_a_private_temporary_one(tmp_path,
     assert folder.name.startswith("denavit-kernels-") and (folder.stat().st_mode & 0o077) == 0
     assert blocker.read_text() == "not a folder"
     np.testing.assert_allclose(fast.fk(np.zeros(3)), denavit.forward_kinematics(fast.robot, np.zeros(3)), atol=1e-14)
+
+
+@needs_numba
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["puma560", "panda"])
+def test_compiled_numeric_ik_solves_reachable_targets_within_limits(name):
+    """Targets made by FK of random q inside the limits: every one solved, judged by the plain FK."""
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot)
+    rng = np.random.default_rng(21)
+    lim = robot.q_limits
+    n_targets = 60 if REDUCED else 300
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (n_targets, robot.dof))
+    T = denavit.forward_kinematics(robot, Q)
+    for i in range(n_targets):  # one call per target, cold (no seed)
+        res = fast.solve_ik(T[i], rng=rng)
+        assert res.success and res.reason == ""
+        assert np.all(res.q >= lim[:, 0] - 1e-12) and np.all(res.q <= lim[:, 1] + 1e-12)
+        Tq = denavit.forward_kinematics(robot, res.q)
+        assert np.abs(Tq[:3, 3] - T[i, :3, 3]).max() <= 1e-9
+        assert np.abs(Tq[:3, :3] - T[i, :3, :3]).max() <= 1e-8
+    seeded = fast.solve_ik(T[:10], Q[:10] + rng.normal(0, 0.05, (10, robot.dof)), rng=rng)  # a batch, seeded
+    assert seeded.success.all() and seeded.q.shape == (10, robot.dof)
+    np.testing.assert_allclose(denavit.forward_kinematics(robot, seeded.q), T[:10], atol=1e-8)
+    assert np.median(seeded.iterations) <= 10  # near seeds converge in a few LM steps
+
+
+@needs_numba
+@pytest.mark.slow
+def test_compiled_numeric_ik_failures_and_bad_input():
+    robot = denavit.load_robot("puma560")
+    fast = denavit.compile(robot)
+    far = np.eye(4)
+    far[:3, 3] = (5.0, 0.0, 0.0)  # 5 m away: outside the workspace
+    res = fast.solve_ik(far, restarts=2, rng=np.random.default_rng(0))
+    assert not res.success and res.reason == "unreachable"
+    bad = np.eye(4)
+    bad[0, 0] = 2.0
+    with pytest.raises(ShapeError, match="orthonormal"):
+        fast.solve_ik(bad)
+    with pytest.raises(ShapeError, match="non-finite"):
+        fast.solve_ik(np.full((4, 4), np.nan))
+    with pytest.raises(ShapeError):
+        fast.solve_ik(np.eye(4), np.array([np.nan] * 6))
+    with pytest.raises(ShapeError):
+        fast.solve_ik(np.eye(3))
+    # the numpy backend answers with the plain solver
+    slow = denavit.compile(robot, backend="numpy")
+    T = denavit.forward_kinematics(robot, np.full(6, 0.2))
+    res = slow.solve_ik(T, rng=np.random.default_rng(1))
+    assert res.success and np.allclose(denavit.forward_kinematics(robot, res.q), T, atol=1e-8)

@@ -13,5 +13,5 @@ from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
 from ._llvm import kernel_intrinsic
 from ._trace import Sym, Tape
 
-__all__ = ["compile", "CompiledRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir", "numba_available", "KERNEL_NAMES", "KernelSpec",
+__all__ = ["compile", "CompiledRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir", "numba_available", "robot_key", "KERNEL_NAMES", "KernelSpec",
            "trace_kernels", "Sym", "Tape", "kernel_intrinsic"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import random as _random
 import importlib.util
 import os
 import sys
@@ -12,6 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .._validate import as_joint_array
+from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, IKResult, JointLimits, characteristic_length,
+                       row_mask, solve_ik)
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from ._emit import NUMBA, NUMPY, python_module
@@ -60,8 +64,22 @@ def _writable(path: Path) -> Path:
 _FALLBACK: Path | None = None
 
 
-#: Bumped whenever the generated code changes for the same robot (it is part of every cache key).
+#: Part of every cache key, with a digest of the sources that shape the generated code (the generator, the
+#: chain walker, the dynamics kernels): a changed generator never reads a stale module.
 GENERATOR_VERSION = "1"
+_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
+            "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py")
+_DIGEST: list[str] = []
+
+
+def _generator_digest() -> str:
+    if not _DIGEST:
+        root = Path(__file__).resolve().parent.parent
+        h = hashlib.sha256(GENERATOR_VERSION.encode())
+        for rel in _SOURCES:
+            h.update((root / rel).read_bytes())
+        _DIGEST.append(h.hexdigest()[:16])
+    return _DIGEST[0]
 
 
 def robot_key(robot: DHRobot, backend: str, friction: bool, kernels) -> str:
@@ -70,7 +88,7 @@ def robot_key(robot: DHRobot, backend: str, friction: bool, kernels) -> str:
     def h(x) -> str:
         return float(x).hex()
 
-    parts = [GENERATOR_VERSION, backend, str(bool(friction)), ",".join(kernels), robot.convention.value]
+    parts = [_generator_digest(), backend, str(bool(friction)), ",".join(kernels), robot.convention.value]
     for link in robot.links:
         parts.append(" ".join([link.joint.value, h(link.a), h(link.alpha), h(link.d), h(link.theta)]))
         li = link.inertia
@@ -134,10 +152,11 @@ class CompiledRobot:
         self.kernels = tuple(names)
         self._m = module
         self._shapes = {"fk": (4, 4), "frames": (len(robot.links) + 1, 4, 4), "jacobian0": (6, n),
-                        "jacobiane": (6, n), "rnea": (n,), "gravity": (n,), "coriolis": (n,),
+                        "jacobiane": (6, n), "fk_jacobian0": (16 + 6 * n,), "rnea": (n,), "gravity": (n,), "coriolis": (n,),
                         "mass_matrix": (n, n), "forward_dynamics": (n + 1,)}
         self._one = {name: (getattr(module, f"{name}_1"), self._shapes[name]) for name in names}
         self._vec, self._jshape, self._mshape, self._fshape = (n,), (6, n), (n, n), (n + 1,)
+        self._ik_constants = None
         for name in self._shapes:  # bound kernels for the hot paths; a missing one raises the clear error
             if name not in self._one:
                 setattr(self, f"_{name}_1", self._missing(name))
@@ -298,6 +317,81 @@ class CompiledRobot:
         elif not (r[..., -1] > 0.0).all():
             self._singular()
         return r[..., :-1]
+
+    # --- inverse kinematics ------------------------------------------------------------------------------------
+    def solve_ik(self, T, q0=None, *, mask="pose", tol: float | None = None, max_iterations: int | None = None,
+                 restarts: int | None = None, respect_limits: bool = True, rng: np.random.Generator | None = None):
+        """Numeric IK by Levenberg–Marquardt on the compiled FK and Jacobian: as :func:`denavit.solve_ik`
+        (same arguments, same :class:`~denavit.IKResult`), each iteration in machine code.
+
+        Targets the compiled search does not solve are handed to :func:`denavit.solve_ik` with the same
+        arguments (its closed-form and bank rescues, and its diagnosis of *why* a target fails), so the
+        answers are never worse than the plain function's.  The numpy backend always uses the plain function.
+        """
+        tol = IK_TOL if tol is None else float(tol)
+        max_iterations = IK_MAX_ITERATIONS if max_iterations is None else int(max_iterations)
+        restarts = IK_RESTARTS if restarts is None else int(restarts)
+        plain = dict(mask=mask, tol=tol, max_iterations=max_iterations, restarts=restarts,
+                     respect_limits=respect_limits, rng=rng)
+        if self.backend != NUMBA or not {"fk", "fk_jacobian0"} <= set(self.kernels):
+            return solve_ik(self.robot, T, q0, **plain)
+        c = self._ik_constants
+        if c is None or c[0] != (mask if isinstance(mask, str) else tuple(mask), respect_limits):
+            L = characteristic_length(self.robot)
+            w = np.where(row_mask(mask), 1.0, 0.0) * np.array([1.0, 1.0, 1.0, L, L, L])
+            lim = JointLimits(self.robot, not respect_limits)
+            slo, shi = lim.sample_bounds(L)
+            mid = np.where(np.isfinite(lim.lo) & np.isfinite(lim.hi), 0.5 * (np.nan_to_num(lim.lo) + np.nan_to_num(lim.hi)),
+                           0.0)
+            c = self._ik_constants = ((mask if isinstance(mask, str) else tuple(mask), respect_limits), w, L, lim,
+                                      slo, shi, lim.revolute.astype(np.bool_), mid)
+        _, w, L, lim, slo, shi, revolute, mid = c
+        n = self.dof
+        Ta = np.asarray(T, dtype=np.float64)
+        if Ta.ndim < 2 or Ta.shape[-2:] != (4, 4):
+            raise ShapeError(f"T: expected shape (..., 4, 4), got {Ta.shape}")
+        batch = Ta.shape[:-2]
+        Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))
+        B = Tf.shape[0]
+        err = self._m.ik_check(Tf)
+        if err > 1e-6:
+            raise ShapeError("T has non-finite values" if err == np.inf else
+                             f"T: rotation part is not orthonormal (error {err:.2g})")
+        if q0 is None:
+            Q0 = np.ascontiguousarray(np.broadcast_to(mid, (B, n)))
+        elif B == 1 and q0.__class__ is _ndarray and q0.dtype is _F64 and q0.shape == self._vec:
+            Q0 = q0.reshape(1, n)  # one target, one seed: checked for NaN by the solver's own test below
+            if not self._m.ik_finite(Q0):
+                raise ShapeError("q0 has non-finite values (NaN or inf)")
+        else:
+            Q0 = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n)
+            Q0 = np.ascontiguousarray(Q0, dtype=np.float64)
+        seed = _random.getrandbits(31) if rng is None else int(rng.bit_generator.random_raw() & 0x7FFFFFFF)
+        q_out = np.empty((B, n))
+        info = np.empty((B, 5))
+        self._m.ik_lm(Tf, Q0, lim.lo, lim.hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed,
+                      q_out, info)
+        if batch == () and info[0, 0] > 0.0:  # one target, solved: the lean path
+            return IKResult(q_out[0], True, float(info[0, 1]), float(info[0, 2]), int(info[0, 3]), int(info[0, 4]),
+                            "")
+        success = info[:, 0] > 0.0
+        reason = np.full(B, "", dtype=object)
+        iters, used = info[:, 3].astype(int), info[:, 4].astype(int)
+        pe, re = info[:, 1].copy(), info[:, 2].copy()
+        if not success.all():  # the plain solver: rescues, and the reason of each failure
+            fail = np.flatnonzero(~success)
+            again = solve_ik(self.robot, Tf[fail], Q0[fail], **plain)
+            q_out[fail] = again.q
+            success[fail] = again.success
+            pe[fail], re[fail] = again.position_error, again.orientation_error
+            iters[fail] += again.iterations
+            used[fail] += again.restarts
+            reason[fail] = again.reason
+        if batch == ():
+            return IKResult(q_out[0], bool(success[0]), float(pe[0]), float(re[0]), int(iters[0]), int(used[0]),
+                            str(reason[0]))
+        return IKResult(q_out.reshape(batch + (n,)), success.reshape(batch), pe.reshape(batch), re.reshape(batch),
+                        iters.reshape(batch), used.reshape(batch), reason.reshape(batch))
 
     def _singular(self):
         raise ModelError(f"robot {self.robot.name!r}: the mass matrix is singular at this configuration "

@@ -18,8 +18,8 @@ from ._trace import Tape, sym_max, sym_min, sym_sign
 
 __all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics"]
 
-KERNEL_NAMES = ("fk", "frames", "jacobian0", "jacobiane", "rnea", "mass_matrix", "gravity", "coriolis",
-                "forward_dynamics")
+KERNEL_NAMES = ("fk", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix", "gravity",
+                "coriolis", "forward_dynamics")
 DYNAMICS = frozenset({"rnea", "mass_matrix", "gravity", "coriolis", "forward_dynamics"})
 
 
@@ -87,7 +87,7 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
         entries = [e for F in frames for e in _columns_to_matrix(*F)]
         out["frames"] = KernelSpec("frames", "world poses of the DH frames {0} ... {N} (no tool)",
                                    (("q", n),), (len(frames), 4, 4), tuple(entries), tape)
-    for name in ("jacobian0", "jacobiane"):
+    for name in ("jacobian0", "jacobiane", "fk_jacobian0"):
         if name not in names:
             continue
         tape, q, frames, end = kinematics(name)
@@ -107,6 +107,10 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
             w_rows.append(w)
         entries = [v_rows[k][r] for r in range(3) for k in range(n)] + [w_rows[k][r] for r in range(3)
                                                                          for k in range(n)]
+        if name == "fk_jacobian0":  # the pose and J0 in one pass (what each IK iteration needs)
+            out[name] = KernelSpec(name, "T_w_e (16 entries, row-major) then J0 (6 x n, row-major)", (("q", n),),
+                                   (16 + 6 * n,), tuple(_columns_to_matrix(*end)) + tuple(entries), tape)
+            continue
         frame = "base (J0)" if name == "jacobian0" else "tool (Je)"
         out[name] = KernelSpec(name, f"geometric Jacobian, rows (v, w), in the {frame} frame", (("q", n),),
                                (6, n), tuple(entries), tape)

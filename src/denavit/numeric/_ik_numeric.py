@@ -23,7 +23,8 @@ from ._ik_seeds import rescue
 from ._ik_single import solve_single
 from ._kinematics import forward_kinematics
 
-__all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask"]
+__all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask", "JointLimits", "characteristic_length",
+           "TOL", "MAX_ITERATIONS", "RESTARTS"]
 
 TOL = 1e-9  # default position [m] and orientation [rad] tolerance
 MAX_ITERATIONS = 100
@@ -151,10 +152,19 @@ class _Limits:
     def inside(self, q: np.ndarray, tol: float = 1e-12) -> np.ndarray:
         return np.all((q >= self.lo - tol) & (q <= self.hi + tol), axis=-1)
 
-    def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
+    def sample_bounds(self, scale: float) -> tuple[np.ndarray, np.ndarray]:
+        """Where random restarts are drawn: the limits, or ±π (revolute) / ±scale (prismatic) where infinite."""
         lo = np.where(np.isfinite(self.lo), self.lo, np.where(self.revolute, -np.pi, -scale))
         hi = np.where(np.isfinite(self.hi), self.hi, np.where(self.revolute, np.pi, scale))
+        return lo, hi
+
+    def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
+        lo, hi = self.sample_bounds(scale)
         return rng.uniform(lo, hi, size=shape + (len(lo),))
+
+
+JointLimits = _Limits  # public name: the compiled solver (denavit.codegen) uses the same rule
+characteristic_length = _char_length
 
 
 @lru_cache(maxsize=128)
