@@ -20,6 +20,7 @@ from denavit import symbolic as S
 from denavit.check import check_claims
 
 from conftest import REDUCED
+from test_check_shapes import _dh
 
 ARMS = ["planar3r", "report000-planar3r", "scara", "stanford", "report000-6r", "puma560", "report004-4-rrp"]
 
@@ -318,3 +319,73 @@ def test_text_output_of_new_kinds_does_not_fail():
                                                    "value": "[F_x, 0, 0]"}])
     text = verdicts_text(res)
     assert "counterexample: a = " in text and "Fx = " in text
+
+
+# --- property: numeric claims at random q from an independent numeric route ------------------------------
+
+
+def _poses(robot, q):
+    """World poses of frames 0 … N by the test's own product of DH matrices (test_check_shapes._dh)."""
+    T, k, out = np.asarray(robot.base_matrix, dtype=float), 0, []
+    out.append(T)
+    for link in robot.links:
+        th, d = link.theta, link.d
+        if link.is_joint:
+            if link.joint is dn.JointType.REVOLUTE:
+                th += q[k]
+            else:
+                d += q[k]
+            k += 1
+        T = T @ _dh(robot.convention.value, th, d, link.a, link.alpha)
+        out.append(T)
+    return out
+
+
+@settings(max_examples=10 if REDUCED else 40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(name=st.sampled_from(ARMS), seed=st.integers(0, 2**31 - 1), kind=st.sampled_from(["omega", "velocity",
+       "force", "moment"]), broken=st.booleans())
+def test_propagation_claims_at_random_q_never_rejected_and_slips_named(name, seed, kind, broken):
+    robot = dn.load_robot(name)
+    rng = np.random.default_rng(seed)
+    q, qd = rng.uniform(-2, 2, robot.dof), rng.normal(size=robot.dof)
+    F = rng.normal(size=6)
+    i = int(rng.integers(0, robot.n_rows + 1))
+    P = _poses(robot, q)
+    B = np.linalg.inv(P[0])  # frame {0} at rest: everything relative to it
+    if kind in ("omega", "velocity"):
+        h = 1e-5
+        Pp, Pm = _poses(robot, q + h * qd), _poses(robot, q - h * qd)
+        R, Rd = (B @ P[i])[:3, :3], ((B @ Pp[i]) - (B @ Pm[i]))[:3, :3] / (2 * h)
+        pd = ((B @ Pp[i]) - (B @ Pm[i]))[:3, 3] / (2 * h)
+        W = R.T @ Rd
+        value = np.array([W[2, 1], W[0, 2], W[1, 0]]) if kind == "omega" else R.T @ pd
+    else:
+        Te = P[-1] @ np.asarray(robot.tool_matrix, dtype=float)
+        R_ie = P[i][:3, :3].T @ Te[:3, :3]
+        f = R_ie @ F[:3]
+        value = f if kind == "force" else R_ie @ F[3:] + np.cross(P[i][:3, :3].T @ (Te[:3, 3] - P[i][:3, 3]), f)
+    value = np.round(value, 6) + 0.0
+    j = int(rng.integers(0, 3))
+    if broken:
+        value[j] += 0.01
+    claim = {"quantity": kind, "index": i, "q": ", ".join(repr(float(x)) for x in q),
+             "value": [f"{x:.6f}" for x in value]}
+    claim["qd" if kind in ("omega", "velocity") else "wrench"] = ", ".join(
+        repr(float(x)) for x in (qd if kind in ("omega", "velocity") else F))
+    (v,) = _v(robot, [claim])
+    if broken:
+        assert v.verdict == "incorrect" and f"({j + 1})" in v.message, v.message
+    else:
+        assert v.verdict == "correct", v.message
+
+
+def test_potential_energy_up_to_a_constant_and_rotation_blocks():
+    robot = dn.load_robot(P3)
+    (v,) = _v(robot, [{"quantity": "V", "value": _V + " + 3 m_1 g"}])
+    assert v.verdict == "correct" and "constant" in v.message
+    (v,) = _v(robot, [{"quantity": "V", "value": _V + r" + m_1 g \cos\theta_1"}])
+    assert v.verdict == "incorrect"
+    q = np.array([0.3, -0.2, 0.9])
+    R = _poses(robot, q)[3][:3, :3]
+    (v,) = _v(robot, [{"quantity": "T", "q": "0.3, -0.2, 0.9", "value": R.tolist()}])
+    assert v.verdict == "correct" and "rotation block" in v.message
