@@ -209,3 +209,22 @@ def test_planar_jacobian_correct_accepted_perturbed_named(q, style, rows, flip, 
         assert f"({i + 1}, {j + 1})" in v.message
     else:
         assert v.verdict == "correct", v.message
+
+
+def test_seed_report_layouts_are_read():
+    """The layouts of the seed reports (values from the textbook DH matrix, not from the reports): equation numbers
+    ``\\quad (2)``, ``\\theta_i(t)`` with ``*``, ``T_0^1 = …``, a Bmatrix τ = Jᵀ F with F_1 … F_3."""
+    robot = dn.load_robot(P3)
+    a1 = (r"T_0^1 = \begin{bmatrix} \cos \theta_1 & -\sin \theta_1 & 0 & L_1 \cos \theta_1 \\ \sin \theta_1 & "
+          r"\cos \theta_1 & 0 & L_1 \sin \theta_1 \\ 0 & 0 & 1 & 0 \\ 0 & 0 & 0 & 1 \end{bmatrix} \quad (2)")
+    px = (r"p_x = L_1 * \cos(\theta_1(t)) + L_2 * \cos(\theta_1(t) + \theta_2(t)) + L_3 * \cos(\theta_1(t) + "
+          r"\theta_2(t) + \theta_3(t)) \quad (11)")
+    tau = (r"\begin{Bmatrix} \tau_1 \\ \tau_2 \\ \tau_3 \end{Bmatrix} = J^T \begin{Bmatrix} F_1 \\ F_2 \\ F_3 "
+           r"\end{Bmatrix} = \begin{Bmatrix} -(L_1 S_1 + L_2 S_{12} + L_3 S_{123}) F_1 + (L_1 C_1 + L_2 C_{12} + "
+           r"L_3 C_{123}) F_2 \\ -(L_2 S_{12} + L_3 S_{123}) F_1 + (L_2 C_{12} + L_3 C_{123}) F_2 \\ -L_3 S_{123} F_1 "
+           r"+ L_3 C_{123} F_2 \end{Bmatrix} \tag{13}")
+    v = _v([{"quantity": "A", "index": 1, "value": a1}, {"quantity": "position", "entry": 1, "value": px},
+            {"quantity": "tau", "wrench": "F_1, F_2, F_3", "value": tau}])
+    assert [x.verdict for x in v] == ["correct"] * 3, [x.message for x in v]
+    (w,) = _v([{"quantity": "position", "entry": 1, "value": px.replace(r"\quad (11)", "(11)")}])
+    assert w.verdict == "incorrect"  # without \quad, "(11)" is a factor: never silently dropped

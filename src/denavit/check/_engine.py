@@ -240,7 +240,7 @@ def _gravity_name(robot: DHRobot) -> list[str]:
     return [] if "g" in robot.parameter_values else ["g"]
 
 
-#: Bases of the names a symbolic wrench may use (``f_x``, ``F_y``, ``n_z``, ``M_x``, ``N_z``, ``\\tau_x``).
+#: Bases of the names a symbolic wrench may use, with subscript x, y, z or 1 … 6 (``f_x``, ``F_y``, ``n_z``, ``F_1``).
 WRENCH_BASES = ("f", "F", "n", "N", "m", "M")
 
 
@@ -249,7 +249,7 @@ def _wrench_nodes(raw: Any, robot: DHRobot) -> list[tuple]:
     known = robot_resolver(robot)
 
     def resolve(ident):
-        if ident.dots == 0 and ident.base in WRENCH_BASES and ident.sub in ("x", "y", "z"):
+        if ident.dots == 0 and ident.base in WRENCH_BASES and ident.sub in ("x", "y", "z", "1", "2", "3", "4", "5", "6"):
             return ("name", ident.base + ident.sub)
         return known(ident)
 

@@ -429,11 +429,19 @@ def _strip_rhs(text: str) -> str:
     return text[cut + 1:] if cut >= 0 else text
 
 
+_EQ_NUMBER = re.compile(r"(?:\\q?quad\s*\(\s*\d{1,6}[a-z]?\s*\)|\\tag\*?\{[^{}]{0,40}\})\s*$")
+
+
+def strip_equation_number(text: str) -> str:
+    """``… \\quad (11)`` or ``… \\tag{11}`` at the end: the report's equation number, not a factor 11."""
+    return _EQ_NUMBER.sub("", text.strip().strip("$").strip())
+
+
 def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
     """One scalar expression (LaTeX or plain) → an :mod:`denavit._expr` tree."""
     if not isinstance(text, str):
         text = str(text)
-    text = text.strip().strip("$").strip()
+    text = strip_equation_number(text).strip()
     if rhs:
         text = _strip_rhs(text)
     if not text.strip():
@@ -552,7 +560,7 @@ def parse_matrix(text: str, resolve: Resolver) -> list[list[tuple]]:
     """
     if len(text) > MAX_CHARS:
         raise ParseError(f"expression longer than {MAX_CHARS} characters")
-    text = after_last_equals(text.strip().strip("$"))
+    text = after_last_equals(strip_equation_number(text))
     cells = split_matrix(text)
     if cells is None:
         cells = split_list(_normalize(text))
