@@ -106,15 +106,14 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
     outs = [f"    ({_index(spec.shape, f)!r}, {ref(_ref(o))})," for f, o in enumerate(spec.outputs)]
     args = ", ".join(name for name, _ in spec.inputs)
     first = spec.inputs[0][0]
-    rows = ", ".join(f"{name}[b]" for name, _ in spec.inputs)
     k = spec.name
     return ([f"_{k}_steps = ("] + steps + [")", f"_{k}_outputs = ("] + outs + [")",
-            f"_{k} = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
+            f"_{k}, _{k}_row = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_1({args}, out):",
             f'    """{spec.doc}: one configuration, out {spec.shape}."""', f"    _{k}({args}, out)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",
             f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {spec.shape}."""',
-            f"    for b in range({first}.shape[0]):", f"        _{k}({rows}, out[b])", "", ""])
+            f"    for b in range({first}.shape[0]):", f"        _{k}_row({args}, out, b)", "", ""])
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:

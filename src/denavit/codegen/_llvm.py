@@ -22,7 +22,11 @@ __all__ = ["kernel_intrinsic"]
 
 
 def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
-    """A numba intrinsic ``f(in_0, …, in_{k-1}, out) -> None`` evaluating the program into ``out``."""
+    """Two numba intrinsics, ``f(in_0, …, in_{k-1}, out)`` and ``f(in_0, …, in_{k-1}, out, b)`` (-> None), evaluating the program into ``out``.
+
+    Without ``b`` the inputs are vectors and ``out`` has the kernel's shape; with an integer ``b`` the inputs are
+    (B, k) arrays and ``out`` (B,) + shape, and row ``b`` is computed — no array views per row, so a batch loop
+    does no reference counting.  sin and cos of one argument are one ``sincos`` call (glibc, libm)."""
     from llvmlite import ir
     from numba.core import cgutils, types
     from numba.extending import intrinsic
@@ -31,9 +35,15 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
     i64 = ir.IntType(64)
 
     def codegen(context, builder, sig, args):
-        arrays = [context.make_array(ty)(context, builder, val) for ty, val in zip(sig.args, args)]
+        batched = isinstance(sig.args[-1], types.Integer)
+        arrays = [context.make_array(ty)(context, builder, val)
+                  for ty, val in zip(sig.args[:n_inputs + 1], args[:n_inputs + 1])]
+        row = [args[-1]] if batched else []
         module = builder.module
         fns = {name: module.declare_intrinsic(f"llvm.{name}", [dbl]) for name in ("sin", "cos")}
+        sincos = cgutils.get_or_insert_function(
+            module, ir.FunctionType(ir.VoidType(), [dbl, dbl.as_pointer(), dbl.as_pointer()]), "sincos")
+        both: dict = {}
         for name in ("minnum", "maxnum"):
             fns[name] = module.declare_intrinsic(f"llvm.{name}", [dbl], ir.FunctionType(dbl, [dbl, dbl]))
         inputs: dict = {}
@@ -50,7 +60,7 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             if v is None:
                 arg = ref[1]
                 ptr = cgutils.get_item_pointer(context, builder, sig.args[arg], arrays[arg],
-                                               [ir.Constant(i64, ref[2])])
+                                               row + [ir.Constant(i64, ref[2])])
                 v = inputs[key] = builder.load(ptr)
             return v
 
@@ -68,7 +78,12 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             elif op == "neg":
                 v = builder.fneg(A)
             elif op in ("sin", "cos"):
-                v = builder.call(fns[op], [A])
+                pair = both.get(repr(a))
+                if pair is None:
+                    s_ptr, c_ptr = cgutils.alloca_once(builder, dbl), cgutils.alloca_once(builder, dbl)
+                    builder.call(sincos, [A, s_ptr, c_ptr])
+                    pair = both[repr(a)] = (builder.load(s_ptr), builder.load(c_ptr))
+                v = pair[0] if op == "sin" else pair[1]
             elif op == "sign":  # 1, −1 or 0 (NaN stays NaN through the multiplications it feeds)
                 v = builder.select(builder.fcmp_ordered(">", A, zero), one,
                                    builder.select(builder.fcmp_ordered("<", A, zero), minus, zero))
@@ -79,25 +94,28 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             else:  # pragma: no cover - the tape has no other operations
                 raise ValueError(f"unknown operation {op!r}")
             values.append(v)
-        out_ty, out = sig.args[-1], arrays[-1]
+        out_ty, out = sig.args[n_inputs], arrays[n_inputs]
         for index, ref in outputs:
-            ptr = cgutils.get_item_pointer(context, builder, out_ty, out, [ir.Constant(i64, i) for i in index])
+            ptr = cgutils.get_item_pointer(context, builder, out_ty, out, row + [ir.Constant(i64, i) for i in index])
             builder.store(operand(ref), ptr)
         return context.get_dummy_value()
 
     def typer(typingctx, *args):
         return types.void(*args), codegen
 
-    # numba's @intrinsic needs a fixed signature: inputs + out
-    if n_inputs == 1:
-        def kernel(typingctx, a0, a1):
-            return typer(typingctx, a0, a1)
-    elif n_inputs == 2:
-        def kernel(typingctx, a0, a1, a2):
-            return typer(typingctx, a0, a1, a2)
-    elif n_inputs == 3:
-        def kernel(typingctx, a0, a1, a2, a3):
-            return typer(typingctx, a0, a1, a2, a3)
-    else:  # pragma: no cover - kernels have one to three inputs
-        raise ValueError(f"kernels take 1 to 3 inputs, not {n_inputs}")
-    return intrinsic(kernel)
+    # numba's @intrinsic needs a fixed signature: inputs + out (+ row)
+    def kernel2(typingctx, a0, a1):
+        return typer(typingctx, a0, a1)
+
+    def kernel3(typingctx, a0, a1, a2):
+        return typer(typingctx, a0, a1, a2)
+
+    def kernel4(typingctx, a0, a1, a2, a3):
+        return typer(typingctx, a0, a1, a2, a3)
+
+    def kernel5(typingctx, a0, a1, a2, a3, a4):
+        return typer(typingctx, a0, a1, a2, a3, a4)
+
+    single = {2: kernel2, 3: kernel3, 4: kernel4}[n_inputs + 1]
+    batch = {3: kernel3, 4: kernel4, 5: kernel5}[n_inputs + 2]
+    return intrinsic(single), intrinsic(batch)
