@@ -228,3 +228,14 @@ def test_seed_report_layouts_are_read():
     assert [x.verdict for x in v] == ["correct"] * 3, [x.message for x in v]
     (w,) = _v([{"quantity": "position", "entry": 1, "value": px.replace(r"\quad (11)", "(11)")}])
     assert w.verdict == "incorrect"  # without \quad, "(11)" is a factor: never silently dropped
+
+
+def test_where_declares_the_names_a_derivation_introduces():
+    x2 = "L_1 c_1 + L_2 c_{12}"  # the elbow's x, from the textbook
+    v = _v([{"quantity": "position", "entry": 1, "where": {"x_2": x2}, "value": r"x_2 + L_3 c_{123}"},
+            {"quantity": "position", "entry": 1, "where": {"k": "L_3", "x_2": x2}, "value": r"x_2 + k\cos(q_1+q_2+q_3)"},
+            {"quantity": "position", "entry": 1, "where": {"x_2": x2}, "value": r"x_2 - L_3 c_{123}"},
+            {"quantity": "position", "entry": 1, "value": r"x_2 + L_3 c_{123}"},
+            {"quantity": "position", "entry": 1, "where": {"k": "L_2"}, "value": r"L_1 c_1 + k c_{12} + k c_{123}"}])
+    assert [x.verdict for x in v] == ["correct", "correct", "incorrect", "unreadable", "incorrect"], [x.message for x in v]
+    assert "where" in v[3].message

@@ -10,6 +10,7 @@ one unit of the last decimal written for claims written with rounded decimals.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Any
@@ -33,6 +34,8 @@ N_POINTS = 6
 MAX_ENTRIES = 4096
 N_PARAM_SETS = 2
 EXACT_RTOL = 1e-9
+#: Longest name a claim's 'where' may define.
+MAX_NAME = 40
 
 
 @dataclass(frozen=True)
@@ -322,8 +325,35 @@ def _env(p: Point) -> dict[str, float]:
     return env
 
 
-def _evaluate(cells: list[list[tuple]], p: Point) -> np.ndarray:
+def _where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, tuple]]:
+    """A claim's 'where': names a derivation introduces (``k: a_2``, ``x_c: p_x - d_6 a_x``…), each a formula in
+    the robot's names and the names defined before it, in order."""
+    from ._ik_claims import MAX_WHERE
+
+    if raw is None:
+        return []
+    if not isinstance(raw, dict):
+        raise ParseError("'where' must be a mapping of names to formulas, in evaluation order")
+    if len(raw) > MAX_WHERE:
+        raise ParseError(f"'where' has {len(raw)} definitions; at most {MAX_WHERE}")
+    out: list[tuple[str, tuple]] = []
+    for key, text in raw.items():
+        name = re.sub(r"[^A-Za-z0-9]", "", str(key))[:MAX_NAME]
+        if not name or name[0].isdigit():
+            raise ParseError(f"'where' names must start with a letter, got {str(key)[:40]!r}")
+        try:
+            node = (_expr.parse(text) if isinstance(text, (int, float)) and not isinstance(text, bool)
+                    else parse_math(str(text), robot_resolver(robot, extra=extra + [n for n, _ in out]), rhs=False))
+        except ParseError as exc:
+            raise ParseError(f"where {name}: {exc}") from None
+        out.append((name, node))
+    return out
+
+
+def _evaluate(cells: list[list[tuple]], p: Point, where: list[tuple[str, tuple]] = ()) -> np.ndarray:
     env = _env(p)
+    for name, node in where:
+        env[name] = _expr.evaluate(node, env)
     return np.array([[_expr.evaluate(c, env) for c in row] for row in cells], dtype=float)
 
 
@@ -349,7 +379,10 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         deg = bool(spec.get("deg", deg))
         wrench = _wrench_nodes(spec["wrench"], robot) if "wrench" in spec else None
         symbols = sorted({n for nd in wrench or () for n in _expr.names_in(nd)} - {k for k, _ in robot.parameters})
-        cells = _values(raw["value"], robot_resolver(robot, extra=symbols + _gravity_name(robot)))
+        where = _where_nodes(spec.get("where"), robot, symbols + _gravity_name(robot))
+        spec["_where"] = where
+        cells = _values(raw["value"], robot_resolver(robot, extra=symbols + _gravity_name(robot)
+                                                     + [n for n, _ in where]))
         if qty.name == "det_jacobian" and len(cells) * len(cells[0]) > 1 and 1 in (len(cells), len(cells[0])):
             factors = [c for row in cells for c in row]  # det J written as a list of its factors
             prod = factors[0]
@@ -360,6 +393,12 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         for row in cells:
             for c in row:
                 names |= _expr.names_in(c)
+        if where:  # the names the definitions use count as used (random q, parameter sets)
+            used = {n for n, _ in where} & names
+            for n, nd in reversed(where):
+                if n in used:
+                    used |= _expr.names_in(nd)
+            names = (names | used) - {n for n, _ in where}
         points = _points(robot, spec, names, qty.needs, rng, deg, wrench=wrench, symbols=symbols)
         if "entry" in spec:  # one entry of the quantity: hints then compare that entry too
             qty = replace(qty, truth=_entry_of(qty.truth))
@@ -394,7 +433,7 @@ def _compare(robot, cid, qty, spec, cells, points, truth, rng, detail) -> Verdic
     """The verdict on claimed cells (already of the truth's shape) against the truth at the points."""
     try:
         cells = _shape_to(cells, truth.shape[1:])
-        claimed = np.array([_evaluate(cells, p).reshape(truth.shape[1:]) for p in points])
+        claimed = np.array([_evaluate(cells, p, spec.get("_where", ())).reshape(truth.shape[1:]) for p in points])
     except ParseError as exc:
         return Verdict(cid, qty.name, "unreadable", str(exc))
     dec = np.array([[_decimals(c) for c in row] for row in cells]).reshape(truth.shape[1:])

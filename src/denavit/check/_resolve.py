@@ -71,6 +71,7 @@ def robot_resolver(robot: DHRobot, extra: Iterable[str] = ()):
                 return ("call", _SHORT[base], (node,))
         sub = sub if len(sub) <= 40 else sub[:20] + "…"
         written = base + (f"_{{{sub}}}" if sub else "") if not ident.dots else f"\\dot{{{base}}}_{sub}"
-        raise ParseError(f"unknown symbol {written!r}; known: {known()}")
+        raise ParseError(f"unknown symbol {written!r}; known: {known()} (a name the derivation introduces is "
+                         f"declared with where: {{name: formula}})")
 
     return resolve
