@@ -318,3 +318,42 @@ def test_compiled_numeric_ik_failures_and_bad_input():
     T = denavit.forward_kinematics(robot, np.full(6, 0.2))
     res = slow.solve_ik(T, rng=np.random.default_rng(1))
     assert res.success and np.allclose(denavit.forward_kinematics(robot, res.q), T, atol=1e-8)
+
+
+@needs_numba
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(2 if REDUCED else 4))
+def test_numba_backend_on_random_arms_equals_pinocchio(seed):
+    """Random arms (both conventions, prismatic joints, fixed rows, motor inertia, friction, base and tool)."""
+    pin = pytest.importorskip("pinocchio")
+    rng = np.random.default_rng(9500 + seed)
+    robot = _with_tool(random_dynamic_robot(rng, motor=True, friction=True), rng)
+    fast = denavit.compile(robot, backend="numba", kernels=["fk", "jacobian0", "rnea", "mass_matrix"])
+    model = pinocchio_model(robot)
+    data = model.createData()
+    q, qd, qdd = random_state(rng, robot, (5,))
+    tau = fast.rnea(q, qd, qdd) - friction_torques(robot, qd)
+    for i in range(5):
+        np.testing.assert_allclose(tau[i], pin.rnea(model, data, q[i], qd[i], qdd[i]), atol=1e-10)
+        Mp = pin.crba(model, data, q[i])
+        np.testing.assert_allclose(fast.mass_matrix(q[i]), np.triu(Mp) + np.triu(Mp, 1).T, atol=1e-10)
+        np.testing.assert_allclose(fast.fk(q[i]), elementary_fk(robot, q[i])[0], atol=1e-12)
+        np.testing.assert_allclose(fast.jacobian(q[i]), differentiation_jacobian(robot, q[i]), atol=1e-10)
+    # the numba and numpy backends agree to rounding
+    ref = denavit.compile(robot, backend="numpy")
+    np.testing.assert_allclose(fast.mass_matrix(q), ref.mass_matrix(q), rtol=1e-13, atol=1e-13)
+    with pytest.raises(ModelError, match="not compiled"):
+        fast.gravity(q[0])
+
+
+def test_without_numba_compile_falls_back_to_numpy(monkeypatch):
+    from denavit.codegen import _compiled
+    from denavit.errors import MissingDependencyError
+
+    monkeypatch.setattr(_compiled, "numba_available", lambda: False)
+    robot = denavit.load_robot("planar3r")
+    fast = denavit.compile(robot)
+    assert fast.backend == "numpy"
+    np.testing.assert_allclose(fast.fk(np.ones(3)), denavit.forward_kinematics(robot, np.ones(3)), atol=1e-14)
+    with pytest.raises(MissingDependencyError, match="fast"):
+        denavit.compile(robot, backend="numba")

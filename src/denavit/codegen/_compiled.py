@@ -219,7 +219,7 @@ class CompiledRobot:
     def _kernel(self, name: str):
         hit = self._one.get(name)
         if hit is None:
-            if name in DYNAMICS:
+            if name in DYNAMICS and not _has_dynamics(self.robot):
                 raise ModelError(f"robot {self.robot.name!r} has no inertial data: compiled dynamics need "
                                  "'inertia: {mass, com, inertia}' on its joint rows")
             raise ModelError(f"kernel {name!r} was not compiled (compile(robot, kernels=...) left it out)")
