@@ -389,3 +389,13 @@ def test_potential_energy_up_to_a_constant_and_rotation_blocks():
     R = _poses(robot, q)[3][:3, :3]
     (v,) = _v(robot, [{"quantity": "T", "q": "0.3, -0.2, 0.9", "value": R.tolist()}])
     assert v.verdict == "correct" and "rotation block" in v.message
+
+
+def test_propagation_slips_are_named():
+    """ⁱvᵢ written in base axes, or the vector of the neighbouring frame: incorrect, with the slip as a hint."""
+    robot = dn.load_robot(P3)
+    v2_base = _VX[1].replace("Lc_2", "L_2"), _VY[1].replace("Lc_2", "L_2")  # ṗ of frame 2's origin, world axes
+    v = _v(robot, [{"quantity": "velocity", "index": 2, "value": f"[{v2_base[0]}, {v2_base[1]}, 0]"},
+                   {"quantity": "omega", "index": 2, "value": r"[0, 0, \dot\theta_1]"}])
+    assert v[0].verdict == "incorrect" and any("base axes" in h for h in v[0].hints), v[0].hints
+    assert v[1].verdict == "incorrect" and any("frame {1}" in h for h in v[1].hints), v[1].hints

@@ -96,6 +96,8 @@ def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
                 hints.append(f"this is the pose of frame {{{j}}} in {{0}} (T_0_{j})"
                              + (" - a fixed row or the tool is missing" if j < n else ""))
                 break
+    if qty.name in ("omega", "velocity", "force", "moment") and truth.ndim == 2:
+        hints += _propagation(qty, spec, points, claimed, tol)
     if qty.name in ("jacobian", "twist", "torques"):
         other = "tool" if Frame(spec.get("frame", "base")) is Frame.BASE else "base"
         alt = _alt(qty, spec, points, spec_change={"frame": other})
@@ -107,6 +109,32 @@ def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
             if _close(claimed, truth[:, perm], tol[perm]):
                 hints.append("the rows are in (ω, v) order; denavit's twists and Jacobians are (v, ω)")
     return hints
+
+
+def _propagation(qty, spec, points, claimed, tol) -> list[str]:
+    """ⁱωᵢ … written in base axes ({0}) instead of frame i's own, or the vector of a neighbouring frame."""
+    from .. import numeric as N
+    from ._quantities import frame_index
+
+    out = []
+    try:
+        i = frame_index(points[0], spec)
+        in_base = []
+        for p in points:
+            F = N.link_transforms(p.robot, p.q)
+            R0i = np.linalg.solve(F[0][:3, :3], F[min(i, len(F) - 1)][:3, :3])
+            if i == len(F):  # "e": the tool frame
+                R0i = R0i @ np.asarray(p.robot.tool_matrix, dtype=float)[:3, :3]
+            in_base.append(R0i @ np.asarray(qty.truth(p, spec), dtype=float))
+        if _close(claimed, np.array(in_base), tol):
+            out.append(f"it is expressed in base axes ({{0}}); propagation gives each vector in its own frame {{{i}}}'s axes")
+    except Exception:  # noqa: BLE001 - no hint when the frames cannot be computed
+        pass
+    for j in (i - 1, i + 1):
+        alt = _alt(qty, spec, points, spec_change={"index": j}) if j >= 0 else None
+        if alt is not None and _close(claimed, alt, tol):
+            out.append(f"it is the vector of frame {{{j}}}, not {{{i}}}")
+    return out
 
 
 def _parameter(robot, qty, spec, claimed, truth, tol) -> list[str]:

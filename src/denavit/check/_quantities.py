@@ -16,7 +16,7 @@ from .. import numeric as N
 from ..errors import ParseError
 from ..model import DHRobot, Frame
 
-__all__ = ["Quantity", "QUANTITIES", "quantity", "Point"]
+__all__ = ["Quantity", "QUANTITIES", "quantity", "Point", "frame_index"]
 
 
 @dataclass(frozen=True)
@@ -105,7 +105,7 @@ def _torques(p: Point, spec: dict[str, Any]) -> np.ndarray:
     return N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)).T @ p.wrench
 
 
-def _frame_index(p: Point, spec: dict[str, Any]) -> int:
+def frame_index(p: Point, spec: dict[str, Any]) -> int:
     """'index' of a propagation frame: 0 … N (DH frames) or N+1 / "e" (the end effector, after the tool)."""
     n = p.robot.n_rows
     v = spec.get("index")
@@ -115,11 +115,11 @@ def _frame_index(p: Point, spec: dict[str, Any]) -> int:
 
 
 def _omega(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.velocity_propagation(p.robot, p.q, p.qd).omega[_frame_index(p, spec)]
+    return N.velocity_propagation(p.robot, p.q, p.qd).omega[frame_index(p, spec)]
 
 
 def _velocity(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.velocity_propagation(p.robot, p.q, p.qd).v[_frame_index(p, spec)]
+    return N.velocity_propagation(p.robot, p.q, p.qd).v[frame_index(p, spec)]
 
 
 def _wrench_frame(spec: dict[str, Any]) -> Frame:
@@ -130,11 +130,11 @@ def _wrench_frame(spec: dict[str, Any]) -> Frame:
 
 
 def _force(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).f[_frame_index(p, spec)]
+    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).f[frame_index(p, spec)]
 
 
 def _moment(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).n[_frame_index(p, spec)]
+    return N.force_propagation(p.robot, p.q, p.wrench, frame=_wrench_frame(spec)).n[frame_index(p, spec)]
 
 
 def _com_row(p: Point, spec: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
