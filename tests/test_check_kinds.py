@@ -399,3 +399,18 @@ def test_propagation_slips_are_named():
                    {"quantity": "omega", "index": 2, "value": r"[0, 0, \dot\theta_1]"}])
     assert v[0].verdict == "incorrect" and any("base axes" in h for h in v[0].hints), v[0].hints
     assert v[1].verdict == "incorrect" and any("frame {1}" in h for h in v[1].hints), v[1].hints
+
+
+def test_jacobian_ingredients_axes_and_origins():
+    """z and p of J_i = [z_{i-1} × (p − p_{i-1}); z_{i-1}] from the test's own DH product (puma560, standard DH)."""
+    robot = dn.load_robot("puma560")
+    q = np.array([0.3, -0.8, 1.1, 0.4, -0.6, 0.2])
+    P = _poses(robot, q)
+    claims = [{"quantity": "z", "index": k + 1, "q": ", ".join(repr(float(x)) for x in q), "value": P[k][:3, 2].tolist()}
+              for k in range(6)]
+    claims += [{"quantity": "p", "index": k, "q": ", ".join(repr(float(x)) for x in q), "value": P[k][:3, 3].tolist()}
+               for k in range(7)]
+    assert [v.verdict for v in _v(robot, claims)] == ["correct"] * 13
+    bad = dict(claims[2], value=P[3][:3, 2].tolist())  # z_3 given for joint 3 (standard DH: it is z_2)
+    (v,) = _v(robot, [bad])
+    assert v.verdict == "incorrect"

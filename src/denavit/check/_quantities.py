@@ -160,6 +160,15 @@ def _com_velocity(p: Point, spec: dict[str, Any]) -> np.ndarray:
     return F[:3, :3] @ (prop.v[i] + np.cross(prop.omega[i], c))  # ṗ_c = R (v_i + ω_i × c), world axes
 
 
+def _joint_axis(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    z, _ = N.joint_axes(p.robot, _frames(p))
+    return z[_index(spec, "index", 1, p.robot.dof) - 1]
+
+
+def _origin(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    return _frames(p)[_index(spec, "index", 0, p.robot.n_rows)][:3, 3]
+
+
 def _energy(which: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
     def truth(p: Point, spec: dict[str, Any]) -> np.ndarray:
         if not p.robot.has_dynamics:
@@ -221,6 +230,9 @@ QUANTITIES: dict[str, Quantity] = {
         Quantity("force", _force, ("wrench",), about="ⁱfᵢ: force across frame 'index' in its own axes (force "
                  "propagation of the tip wrench; 'frame' tool (default) or base for the wrench's axes)"),
         Quantity("moment", _moment, ("wrench",), about="ⁱnᵢ: moment across frame 'index' about its origin, in its axes"),
+        Quantity("joint_axis", _joint_axis, about="z of joint 'index' (1 … n) in world axes: the z_{i-1} (standard DH) "
+                 "or z_i (modified) of J_i = [z × (p − p_i); z]"),
+        Quantity("origin", _origin, about="world position of the origin of DH frame 'index' (0 … N): the p_i of J_i"),
         Quantity("com_position", _com_position, about="world position of the centre of mass of link 'index' (DH row)"),
         Quantity("com_velocity", _com_velocity, ("qd",), about="world velocity of the centre of mass of link 'index'"),
         Quantity("kinetic_energy", _energy("kinetic"), ("qd",), about="K = ½ q̇ᵀ M(q) q̇"),
@@ -230,7 +242,7 @@ QUANTITIES: dict[str, Quantity] = {
                  "a list of factors is read as their product"),
     )
 }
-_ALIASES = {"w": "omega", "angular_velocity": "omega", "v": "velocity", "linear_velocity": "velocity", "f": "force",
+_ALIASES = {"z": "joint_axis", "axis": "joint_axis", "p": "origin", "frame_origin": "origin", "w": "omega", "angular_velocity": "omega", "v": "velocity", "linear_velocity": "velocity", "f": "force",
             "n": "moment", "com": "com_position", "p_c": "com_position", "v_c": "com_velocity", "K": "kinetic_energy",
             "V": "potential_energy", "U": "potential_energy", "L": "lagrangian", "det": "det_jacobian",
             "detJ": "det_jacobian", "A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
