@@ -107,6 +107,56 @@ def batch_rows(name: str, batch: int, repeat: int):
     return rows
 
 
+def ik_rows(name: str, n_targets: int):
+    """Numeric IK, one call per target, 1e-9 within limits: compiled LM against roboticstoolbox's C++ ik_LM.
+    Cold: no seed (denavit: mid-limits then random restarts; rtb: random); seeded: q0 = the generating q plus
+    N(0, 0.1 rad) noise.  Success re-checked here with denavit's plain FK for both libraries."""
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot)
+    rng = np.random.default_rng(2)
+    lim = robot.q_limits
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (n_targets, robot.dof))
+    T = denavit.forward_kinematics(robot, Q)
+    seeds = Q + rng.normal(0, 0.1, Q.shape)
+    fast.solve_ik(T[0], rng=rng)  # compile / load the solver (both paths)
+    fast.solve_ik(T[0], seeds[0], rng=rng)
+
+    def ok(q, Tk):
+        if q is None or not (np.all(q >= lim[:, 0] - 1e-12) and np.all(q <= lim[:, 1] + 1e-12)):
+            return False
+        Tq = denavit.forward_kinematics(robot, q)
+        return np.abs(Tq[:3, 3] - Tk[:3, 3]).max() <= 1e-8 and np.abs(Tq[:3, :3] - Tk[:3, :3]).max() <= 1e-8
+
+    def run(solve):
+        times, good = [], 0
+        for i in range(n_targets):
+            t0 = time.perf_counter()
+            q = solve(i)
+            times.append(time.perf_counter() - t0)
+            good += ok(q, T[i])
+        return float(np.median(times)) * 1e6, float(np.mean(times)) * 1e6, good / n_targets
+
+    rows = [(name, "denavit.compile solve_ik, cold", *run(lambda i: fast.solve_ik(T[i], rng=rng).q)),
+            (name, "denavit.compile solve_ik, seeded", *run(lambda i: fast.solve_ik(T[i], seeds[i], rng=rng).q))]
+    try:
+        from bench_ik import _fold_limits, rtb_ets
+
+        ets = rtb_ets(robot, name)
+    except ImportError:
+        ets = None
+    if ets is not None:
+        def rtb(i, q0=None):
+            sol = ets.ik_LM(T[i], q0=q0, tol=RTB_TOL, joint_limits=True, ilimit=100, slimit=100)
+            return _fold_limits(robot, sol.q) if sol.success else None
+
+        rows += [(name, "roboticstoolbox ets().ik_LM, cold", *run(rtb)),
+                 (name, "roboticstoolbox ets().ik_LM, seeded", *run(lambda i: rtb(i, seeds[i])))]
+    return rows
+
+
+#: roboticstoolbox stops when E = ½ eᵀ W e < tol: 5e-19 asks for |e| ≤ 1e-9, the precision denavit is timed at.
+RTB_TOL = 5e-19
+
 COLD = """
 import time, numpy as np
 t0 = time.perf_counter()
@@ -136,6 +186,7 @@ def main() -> None:
     ap.add_argument("--batch", type=int, default=200_000)
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--number", type=int, default=5000)
+    ap.add_argument("--targets", type=int, default=1000, help="IK targets per arm")
     args = ap.parse_args()
     import numba
     import pinocchio as pin
@@ -153,6 +204,11 @@ def main() -> None:
         for r in batch_rows(name, args.batch, max(3, args.repeat // 2)):
             peer = f"{r[4] / 1e6:.2f} M" if r[4] else "—"
             print(f"| {r[0]} | {r[1]} | {r[2] / 1e6:.2f} M | {r[3] / 1e6:.2f} M | {peer} |")
+    print("\n| robot | IK solver | median / solve [µs] | mean / solve [µs] | success (1e-8, in limits) |")
+    print("|---|---|---:|---:|---:|")
+    for name in ("puma560", "ur5", "panda"):
+        for r in ik_rows(name, args.targets):
+            print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {100 * r[4]:.1f} % |")
     print("\n| robot | compile, empty cache [s] | compile, from the cache [s] | numba + denavit import [s] |")
     print("|---|---:|---:|---:|")
     for name in ROBOTS:

@@ -114,11 +114,10 @@ def bench_denavit_general(robot, q_true, T):
     return _time_all_solutions(robot, q_true, T, lambda Tb: _solve(robot, Tb, plan))
 
 
-def bench_rtb(robot, name, T):
-    try:
-        import roboticstoolbox as rtb
-    except ImportError:
-        return None
+def rtb_ets(robot, name):
+    """roboticstoolbox's ETS of the very same DH table (standard DH, no fixed rows; else None)."""
+    import roboticstoolbox as rtb
+
     if robot.convention.value != "standard" or any(not l.is_joint for l in robot.links):
         return None
     links = []
@@ -128,7 +127,17 @@ def bench_rtb(robot, name, T):
             links.append(rtb.RevoluteDH(d=link.d, offset=link.theta, **kw))
         else:
             links.append(rtb.PrismaticDH(theta=link.theta, offset=link.d, **kw))
-    ets = rtb.DHRobot(links, name=name).ets()
+    return rtb.DHRobot(links, name=name).ets()
+
+
+def bench_rtb(robot, name, T):
+    try:
+        import roboticstoolbox as rtb
+    except ImportError:
+        return None
+    ets = rtb_ets(robot, name)
+    if ets is None:
+        return None
     times, ok = [], []
     for Tk in T:
         t0 = time.perf_counter()

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validate import as_joint_array
 from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, IKResult, JointLimits, characteristic_length,
                        row_mask, solve_ik)
 from ..errors import MissingDependencyError, ModelError, ShapeError
@@ -353,19 +352,23 @@ class CompiledRobot:
         batch = Ta.shape[:-2]
         Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))
         B = Tf.shape[0]
-        err = self._m.ik_check(Tf)
-        if err > 1e-6:
-            raise ShapeError("T has non-finite values" if err == np.inf else
-                             f"T: rotation part is not orthonormal (error {err:.2g})")
         if q0 is None:
             Q0 = np.ascontiguousarray(np.broadcast_to(mid, (B, n)))
         elif B == 1 and q0.__class__ is _ndarray and q0.dtype is _F64 and q0.shape == self._vec:
-            Q0 = q0.reshape(1, n)  # one target, one seed: checked for NaN by the solver's own test below
-            if not self._m.ik_finite(Q0):
-                raise ShapeError("q0 has non-finite values (NaN or inf)")
+            Q0 = np.ascontiguousarray(q0).reshape(1, n)
         else:
-            Q0 = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n)
-            Q0 = np.ascontiguousarray(Q0, dtype=np.float64)
+            try:
+                Q0 = np.broadcast_to(np.asarray(q0, dtype=np.float64), batch + (n,)).reshape(B, n)
+            except (ValueError, TypeError):
+                raise ShapeError(f"q0: expected shape (..., {n}) matching the targets {batch}, got "
+                                 f"{np.shape(q0)}") from None
+            Q0 = np.ascontiguousarray(Q0)
+        err = self._m.ik_check(Tf, Q0)  # NaN, inf and orthonormality in one pass
+        if err < 0.0:
+            raise ShapeError("q0 has non-finite values (NaN or inf)")
+        if err > 1e-6:
+            raise ShapeError("T has non-finite values" if err == np.inf else
+                             f"T: rotation part is not orthonormal (error {err:.2g})")
         seed = _random.getrandbits(31) if rng is None else int(rng.bit_generator.random_raw() & 0x7FFFFFFF)
         q_out = np.empty((B, n))
         info = np.empty((B, 5))

@@ -68,9 +68,13 @@ def _ik_residual(T, P, w, e):
 
 
 @njit(cache=True, nogil=True)
-def ik_check(T):
-    """The largest |R^T R - I| entry over the targets (the test of denavit's as_transform); inf if one holds a
-    NaN or an infinity."""
+def ik_check(T, Q):
+    """The largest |R^T R - I| entry over the targets (the test of denavit's as_transform); inf if a target
+    holds a NaN or an infinity, -1 if a seed does."""
+    for b in range(Q.shape[0]):
+        for k in range(Q.shape[1]):
+            if not math.isfinite(Q[b, k]):
+                return -1.0
     worst = 0.0
     for b in range(T.shape[0]):
         for i in range(4):
@@ -84,15 +88,6 @@ def ik_check(T):
                 if d > worst:
                     worst = d
     return worst
-
-
-@njit(cache=True, nogil=True)
-def ik_finite(Q):
-    for b in range(Q.shape[0]):
-        for k in range(Q.shape[1]):
-            if not math.isfinite(Q[b, k]):
-                return False
-    return True
 
 
 @njit(cache=True, nogil=True)
