@@ -103,6 +103,14 @@ LONG_PRODUCT = "*".join(["1"] * 3000)
     ({"quantity": "jacobian", "rows": "vx,vq", "value": [[1, 2]]}, ["'rows'"]),
     ({"quantity": "position", "q": "(" * 100 + "0, 0" + ")" * 100, "value": [1, 2, 0]}, ["q"]),
     ({"quantity": "position", "q": "0^{\\circ\\circ}, 0", "value": [1, 2, 0]}, ["q"]),
+    ({"quantity": "position", "entry": 1, "where": "x", "value": "1"}, ["'where'"]),
+    ({"quantity": "position", "entry": 1, "where": {"a": "a"}, "value": "a"}, ["where a", "unknown symbol"]),
+    ({"quantity": "position", "entry": 1, "where": {"x" * 5000: "1"}, "value": "1"}, ["'where' name"]),
+    ({"quantity": "position", "entry": 1, "where": {f"w{k}": "1" for k in range(50)}, "value": "1"}, ["'where'"]),
+    ({"quantity": "position", "entry": 1, "where": {f"w{k}": (f"w{k - 1}*w{k - 1}" if k else "9") for k in range(20)},
+      "value": "w19"}, ["not finite"]),
+    ({"quantity": "position", "entry": 1, "where": {"q_1": "3"}, "value": "q_1"}, ["cannot redefine"]),
+    ({"quantity": "position", "entry": 1, "where": {"L_1": "3"}, "value": "L_1"}, ["cannot redefine"]),
 ])
 def test_trigger_is_one_unreadable_claim(tmp_path, claim, words):
     good = {"id": "good", "quantity": "position", "value": ["L_1 C_1 + L_2 C_{12}", "L_1 S_1 + L_2 S_{12}", 0]}

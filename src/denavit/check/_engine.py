@@ -22,7 +22,7 @@ from ..errors import ParseError
 from ..io import with_parameters
 from ..model import DHRobot, JointType
 from ._hints import hints_for
-from ._latex import RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix, split_list
+from ._latex import Ident, RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix, split_list
 from ._text import split_top
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver
@@ -338,9 +338,18 @@ def _where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, 
         raise ParseError(f"'where' has {len(raw)} definitions; at most {MAX_WHERE}")
     out: list[tuple[str, tuple]] = []
     for key, text in raw.items():
-        name = re.sub(r"[^A-Za-z0-9]", "", str(key))[:MAX_NAME]
+        name = re.sub(r"[^A-Za-z0-9]", "", str(key)[:10 * MAX_NAME])
+        if len(name) > MAX_NAME:
+            raise ParseError(f"'where' name longer than {MAX_NAME} characters")
         if not name or name[0].isdigit():
             raise ParseError(f"'where' names must start with a letter, got {str(key)[:40]!r}")
+        m = re.fullmatch(r"([A-Za-z]+?)(\d*)", name)
+        try:  # a name that already means something (q1, L1, C12, pi, g) cannot be redefined
+            meaning = robot_resolver(robot, extra=extra)(Ident(m.group(1), m.group(2))) if m else None
+        except ParseError:
+            meaning = None
+        if meaning is not None or name in ("pi", "e"):
+            raise ParseError(f"'where' cannot redefine {name!r}: it already means {_expr.to_text(meaning) if meaning else name}")
         try:
             node = (_expr.parse(text) if isinstance(text, (int, float)) and not isinstance(text, bool)
                     else parse_math(str(text), robot_resolver(robot, extra=extra + [n for n, _ in out]), rhs=False))
