@@ -7,6 +7,7 @@ exported as standalone C99 or Python source.  DESIGN.md's one bridge between the
 [2.0, 0.0, 0.0]
 """
 
+from ._bridge import numeric_function
 from ._compiled import CompiledRobot, cache_dir, compile, numba_available, robot_key
 from ._export import LANGUAGES, PREFIX_PATTERN, default_prefix, export_sources
 from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
@@ -14,4 +15,4 @@ from ._llvm import kernel_intrinsic
 from ._trace import Sym, Tape
 
 __all__ = ["compile", "CompiledRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir", "numba_available", "robot_key", "KERNEL_NAMES", "KernelSpec",
-           "trace_kernels", "Sym", "Tape", "kernel_intrinsic"]
+           "trace_kernels", "Sym", "Tape", "kernel_intrinsic", "numeric_function"]

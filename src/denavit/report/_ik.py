@@ -22,6 +22,7 @@ import numpy as np
 import sympy as sp
 
 from .. import numeric as N
+from ..codegen import numeric_function
 from ..model import JointType
 from . import _capabilities
 from ._context import Context
@@ -59,7 +60,7 @@ def derived_branches(derivation: Any, T_0N: np.ndarray) -> tuple[np.ndarray, np.
     """Evaluate the derivation's assignments in order at one pose, for every sign combination.
 
     Returns ``(signs, q)``: signs (K, b) of ±1 and q (K, n), NaN where a branch has no real value.
-    The formulas are the library's own sympy expressions, compiled with ``lambdify`` (never user text).
+    The formulas are the library's own sympy expressions, made numeric by :func:`denavit.codegen.numeric_function` (never user text).
     """
     combos = np.array(list(itertools.product((1.0, -1.0), repeat=len(derivation.branches))), dtype=float)
     K = len(combos)
@@ -72,7 +73,7 @@ def derived_branches(derivation: Any, T_0N: np.ndarray) -> tuple[np.ndarray, np.
         for sym, expr in pairs:
             args = sorted(expr.free_symbols, key=str)
             with np.errstate(invalid="ignore", divide="ignore"):
-                val = sp.lambdify(args, expr, "numpy")(*(env[a] for a in args))
+                val = numeric_function(expr, args)(*(env[a] for a in args))
             val = np.asarray(val, dtype=complex if np.iscomplexobj(val) else float)
             if np.iscomplexobj(val):
                 val = np.where(np.abs(val.imag) < 1e-12, val.real, np.nan)

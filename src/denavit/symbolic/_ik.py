@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from ..codegen import numeric_function
 from ..chain import chain_of
 from ..errors import UnsupportedRobotError
 from ..model import Convention, DHRobot, JointType
@@ -193,7 +194,7 @@ def _param_values(robot: DHRobot) -> dict:
 
 def _numeric_zero(expr, robot: DHRobot, qs, rng: np.random.Generator, tol: float = 1e-9) -> bool:
     """Is ``expr`` zero for the robot's parameter values at random joint values (a cheap identity test)?"""
-    f = sp.lambdify(list(qs), sp.sympify(expr).subs(_param_values(robot)), "numpy")  # safe: expr is built by this module, never user text
+    f = numeric_function(sp.sympify(expr).subs(_param_values(robot)), list(qs))  # expr: built here, not user text
     for _ in range(4):
         if np.max(np.abs(np.asarray(f(*rng.uniform(-3, 3, len(qs))), dtype=complex))) > tol:
             return False
