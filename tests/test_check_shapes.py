@@ -239,3 +239,17 @@ def test_where_declares_the_names_a_derivation_introduces():
             {"quantity": "position", "entry": 1, "where": {"k": "L_2"}, "value": r"L_1 c_1 + k c_{12} + k c_{123}"}])
     assert [x.verdict for x in v] == ["correct", "correct", "incorrect", "unreadable", "incorrect"], [x.message for x in v]
     assert "where" in v[3].message
+
+
+@pytest.mark.parametrize("q_text", [
+    r"\theta_1 = -60^\circ, \theta_2 = 0^\circ, \theta_3 = 90^\circ",
+    r"q_3 = \pi/2, q_1 = -\pi/3, q_2 = 0",
+    "θ1 = -60°; θ2 = 0°; θ3 = 90°",
+])
+def test_q_written_as_assignments(q_text):
+    q = np.radians([-60.0, 0.0, 90.0])
+    x = math.cos(q[0]) + 0.8 * math.cos(q[0] + q[1]) + 0.6 * math.cos(q.sum())
+    (v,) = _v([{"quantity": "position", "q": q_text, "entry": 1, "value": x}])
+    assert v.verdict == "correct", v.message
+    (v,) = _v([{"quantity": "position", "q": q_text.replace("_2", "_1").replace("θ2", "θ1"), "entry": 1, "value": x}])
+    assert v.verdict == "unreadable"  # a joint given twice is not guessed

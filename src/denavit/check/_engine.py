@@ -186,6 +186,9 @@ def numbers(raw: Any, n: int, what: str, *, marked: list[bool] | None = None) ->
     """
     if isinstance(raw, str):
         text = raw.strip().strip("$").strip()
+        assigned = _assignments(text, n)
+        if assigned is not None:  # θ_1 = 0°, θ_2 = 90°, … (in any order)
+            text = ", ".join(assigned)
         text = after_last_equals(text)
         for a, b in (("\\left(", "\\right)"), ("\\left[", "\\right]")):
             if text.startswith(a) and text.endswith(b):
@@ -210,6 +213,25 @@ def numbers(raw: Any, n: int, what: str, *, marked: list[bool] | None = None) ->
         if marked is not None:
             marked.append(_has_degrees(node))
     return np.array(out, dtype=float)
+
+
+_ASSIGNED = re.compile(r"\s*(?:\\(?:var)?theta|θ|q|Q|d)\s*_?\s*\{?\s*(\d{1,3})\s*\}?\s*=(.*)", re.S)
+
+
+def _assignments(text: str, n: int) -> list[str] | None:
+    """``θ_1 = 0, θ_2 = \\pi/2`` (each joint once, any order) → the values in joint order; None otherwise."""
+    parts = [p for p in split_top(text, (",", ";")) if p.strip()]
+    if len(parts) != n:
+        return None
+    found: dict[int, str] = {}
+    for p in parts:
+        m = _ASSIGNED.fullmatch(p)
+        if m is None or "=" in m.group(2):
+            return None
+        found[int(m.group(1))] = m.group(2)
+    if sorted(found) != list(range(1, n + 1)):
+        return None
+    return [found[k] for k in range(1, n + 1)]
 
 
 def _has_degrees(node: tuple) -> bool:
