@@ -90,14 +90,28 @@ class AnalyticIKResult:
         return np.asarray(self.free, dtype=object) != ""
 
 
-@lru_cache(maxsize=64)
 def _plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Plan:
+    """The plan of ``robot``: kept with its chain (found by identity, no hashing per call), built once per
+    distinct robot value (an equal robot loaded anew shares it through :func:`_plan_of_value`)."""
+    memo = dh_chain.chain_of(robot).memo
+    key = ("ik_plan", closed_form, general)
+    plan = memo.get(key)
+    if plan is None:
+        plan = memo[key] = _plan_of_value(robot, closed_form, general)
+    return plan
+
+
+@lru_cache(maxsize=64)
+def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
     return make_plan(robot, closed_form, general)
 
 
-@lru_cache(maxsize=64)
 def _chain(robot: DHRobot):
-    return chain_of(robot)  # read-only use below (labels)
+    """The joint-screw arrays of ``robot`` (read-only use below: labels), kept with its chain."""
+    memo = dh_chain.chain_of(robot).memo
+    if "ik_screws" not in memo:
+        memo["ik_screws"] = chain_of(robot)
+    return memo["ik_screws"]
 
 
 def ik_structure(robot: DHRobot) -> str:
@@ -480,6 +494,8 @@ def _label_table(names: tuple) -> np.ndarray:
                     dtype=object)
 
 
-@lru_cache(maxsize=64)
 def _thetas(robot: DHRobot) -> np.ndarray:
-    return np.array([l.theta for l in robot.joints])  # read-only use
+    memo = dh_chain.chain_of(robot).memo
+    if "ik_thetas" not in memo:
+        memo["ik_thetas"] = np.array([l.theta for l in robot.joints])  # read-only use
+    return memo["ik_thetas"]

@@ -10,12 +10,12 @@ the returned joint values, never taken from the iteration's own bookkeeping.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any, Sequence
 
 import numpy as np
 
 from .._validate import as_joint_array, as_transform
+from ..chain import chain_of
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
 from ._ik_kernel import kernel_of, targets_soa
@@ -125,11 +125,13 @@ def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
     return np.concatenate([dp, dw], axis=-1)
 
 
-@lru_cache(maxsize=64)
 def _char_length(robot: DHRobot) -> float:
     """A length scale of the arm [m]: sum of |a| and |d| over the rows and the tool offset (≥ 1 mm)."""
-    s = sum(abs(l.a) + abs(l.d) for l in robot.links) + float(np.linalg.norm(robot.tool_matrix[:3, 3]))
-    return max(s, 1e-3)
+    memo = chain_of(robot).memo
+    if "ik_length" not in memo:
+        s = sum(abs(l.a) + abs(l.d) for l in robot.links) + float(np.linalg.norm(robot.tool_matrix[:3, 3]))
+        memo["ik_length"] = max(s, 1e-3)
+    return memo["ik_length"]
 
 
 class _Limits:
@@ -167,9 +169,12 @@ JointLimits = _Limits  # public name: the compiled solver (denavit.codegen) uses
 characteristic_length = _char_length
 
 
-@lru_cache(maxsize=128)
 def _limits_of(robot: DHRobot, ignore: bool) -> _Limits:
-    return _Limits(robot, ignore)  # read-only after construction: shared between calls
+    memo = chain_of(robot).memo  # by identity: no hashing of the robot per call
+    key = ("ik_limits", ignore)
+    if key not in memo:
+        memo[key] = _Limits(robot, ignore)  # read-only after construction: shared between calls
+    return memo[key]
 
 
 class _Slots:
