@@ -266,7 +266,11 @@ class CompiledRobot:
                 self._jacobian0_1(q, out)
                 return out
             return self._call("jacobian0", (q,), ("q",))
-        if Frame(frame) is Frame.TOOL:
+        if frame == "tool" or Frame(frame) is Frame.TOOL:
+            if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+                out = _empty(self._jshape)
+                self._jacobiane_1(q, out)
+                return out
             return self._call("jacobiane", (q,), ("q",))
         raise ValueError(f"frame must be 'base' or 'tool', got {frame!r}")  # pragma: no cover (Frame raises)
 
@@ -293,6 +297,10 @@ class CompiledRobot:
 
     def gravity(self, q) -> np.ndarray:
         """g(q), shape (..., n) (as :func:`denavit.gravity_torques` with the robot's gravity)."""
+        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            out = _empty(self._vec)
+            self._gravity_1(q, out)
+            return out
         return self._call("gravity", (q,), ("q",))
 
     def coriolis(self, q, qd) -> np.ndarray:
