@@ -414,3 +414,55 @@ def test_jacobian_ingredients_axes_and_origins():
     bad = dict(claims[2], value=P[3][:3, 2].tolist())  # z_3 given for joint 3 (standard DH: it is z_2)
     (v,) = _v(robot, [bad])
     assert v.verdict == "incorrect"
+
+
+_CRAIG_EOM = [  # Craig, Introduction to Robotics, eq. 6.60: point masses at the distal ends, gravity −g ŷ0
+    r"\tau_1 = m_2 L_2^2 (\ddot\theta_1 + \ddot\theta_2) + m_2 L_1 L_2 c_2 (2 \ddot\theta_1 + \ddot\theta_2)"
+    r" + (m_1 + m_2) L_1^2 \ddot\theta_1 - m_2 L_1 L_2 s_2 \dot\theta_2^2 - 2 m_2 L_1 L_2 s_2 \dot\theta_1"
+    r" \dot\theta_2 + m_2 L_2 g c_{12} + (m_1 + m_2) L_1 g c_1",
+    r"\tau_2 = m_2 L_1 L_2 c_2 \ddot\theta_1 + m_2 L_1 L_2 s_2 \dot\theta_1^2 + m_2 L_2 g c_{12}"
+    r" + m_2 L_2^2 (\ddot\theta_1 + \ddot\theta_2)",
+]
+
+
+def test_equations_of_motion_of_craigs_two_link_arm():
+    robot = dn.load_robot("planar2r")
+    (v,) = _v(robot, [{"quantity": "equations_of_motion", "value": _CRAIG_EOM}])
+    assert v.verdict == "correct", v.message
+    (v,) = _v(robot, [{"quantity": "eom", "q": "0.3, -0.4", "qd": "0, 0", "qdd": "0, 0", "value": [
+        f"(m_1 + m_2) L_1 g \\cos(0.3) + m_2 L_2 g \\cos(-0.1)", "m_2 L_2 g \\cos(-0.1)"]}])
+    assert v.verdict == "correct", v.message
+    slip = [_CRAIG_EOM[0], _CRAIG_EOM[1].replace(r"+ m_2 L_1 L_2 s_2 \dot\theta_1^2", r"- m_2 L_1 L_2 s_2 \dot\theta_1^2")]
+    (v,) = _v(robot, [{"quantity": "eom", "value": slip}])
+    assert v.verdict == "incorrect" and "(2)" in v.message
+
+
+@pytest.mark.slow
+def test_equations_of_motion_of_the_planar_3r_by_lagrange():
+    """Report 000's planar 3R: d/dt ∂L/∂q̇ − ∂L/∂q by sympy from the textbook L = K − V (COM at Lc_i, I_i)."""
+    robot = dn.load_robot(P3)
+    t = sp.Symbol("t")
+    th = [sp.Function(f"th{k}")(t) for k in range(1, 4)]
+    m, L, Lc, I, g = sp.symbols("m1:4"), sp.symbols("L1:4"), sp.symbols("Lc1:4"), sp.symbols("I1:4"), sp.Symbol("g")
+    a = [th[0], th[0] + th[1], th[0] + th[1] + th[2]]
+    x = [Lc[0] * sp.cos(a[0]), L[0] * sp.cos(a[0]) + Lc[1] * sp.cos(a[1]),
+         L[0] * sp.cos(a[0]) + L[1] * sp.cos(a[1]) + Lc[2] * sp.cos(a[2])]
+    y = [Lc[0] * sp.sin(a[0]), L[0] * sp.sin(a[0]) + Lc[1] * sp.sin(a[1]),
+         L[0] * sp.sin(a[0]) + L[1] * sp.sin(a[1]) + Lc[2] * sp.sin(a[2])]
+    K = sum(m[i] * (x[i].diff(t) ** 2 + y[i].diff(t) ** 2) / 2 + I[i] * a[i].diff(t) ** 2 / 2 for i in range(3))
+    V = sum(m[i] * g * y[i] for i in range(3))
+    Lag = K - V
+    eqs = [(Lag.diff(th[k].diff(t)).diff(t) - Lag.diff(th[k])) for k in range(3)]
+    q, qd, qdd = sp.symbols("q1:4"), sp.symbols("qd1:4"), sp.symbols("qdd1:4")
+    subs = {}
+    for k in range(3):
+        subs[th[k].diff(t, 2)] = qdd[k]
+    eqs = [e.subs(subs) for e in eqs]
+    eqs = [e.subs({th[k].diff(t): qd[k] for k in range(3)}) for e in eqs]
+    eqs = [e.subs({th[k]: q[k] for k in range(3)}) for e in eqs]
+    value = [sp.latex(e) for e in eqs]
+    (v,) = _v(robot, [{"quantity": "eom", "value": value}])
+    assert v.verdict == "correct", v.message
+    value[2] = sp.latex(eqs[2] - I[2] * qdd[0])
+    (v,) = _v(robot, [{"quantity": "eom", "value": value}])
+    assert v.verdict == "incorrect" and "(3)" in v.message

@@ -82,7 +82,7 @@ def _values(raw: Any, resolve) -> list[list[tuple]]:
             cells = []
             for j, v in enumerate(row, start=1):
                 try:
-                    cells.append(_expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), resolve, rhs=False))
+                    cells.append(_expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), resolve))
                 except ParseError as exc:
                     raise ParseError(f"entry ({i}, {j}) {str(v)[:40]!r}: {exc}") from None
             out.append(cells)
@@ -313,6 +313,8 @@ def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, d
             robots.append(r)
     fixed_q = _joint_values(spec["q"], robot, "q", deg) if "q" in spec else None
     fixed_qd = _joint_values(spec["qd"], robot, "qd", deg) if "qd" in spec else None
+    fixed_qdd = _joint_values(spec["qdd"], robot, "qdd", deg) if "qdd" in spec else None
+    uses_qdd = any(n.startswith("qdd") and n[3:].isdigit() for n in names)
     if "wrench" in needs and wrench is None:
         raise ParseError("this claim needs 'wrench' (6 numbers or symbols f, n; or 3 for a force)")
     uses_q = any(n.startswith("q") and n[1:].isdigit() for n in names)
@@ -320,18 +322,21 @@ def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, d
     # a quantity of the rates claimed without 'qd' and without rates (ⁱvᵢ = 0, a constant): it must hold at any
     # rates, so it is checked at random ones
     const_qd = "qd" in needs and fixed_qd is None and not uses_qd
-    n_q = N_POINTS if (uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) or symbols or const_qd else 1
+    const_qd = const_qd or ("qdd" in needs and fixed_qdd is None and not uses_qdd)
+    n_q = N_POINTS if ((uses_q and fixed_q is None) or (uses_qd and fixed_qd is None) or symbols or const_qd
+                       or (uses_qdd and fixed_qdd is None)) else 1
     pts = []
     for r in robots:
         for _ in range(n_q):
             q = fixed_q if fixed_q is not None else _sample_q(robot, rng)
             qd = fixed_qd if fixed_qd is not None else rng.normal(size=robot.dof)
+            qdd = fixed_qdd if fixed_qdd is not None else rng.normal(size=robot.dof)
             sym = tuple((s, float(rng.normal())) for s in symbols)
             w = None
             if wrench is not None:
                 env = {**r.parameter_values, **dict(sym)}
                 w = np.array([_expr.evaluate(nd, env) for nd in wrench], dtype=float)
-            pts.append(Point(r, q, qd, w, sym))
+            pts.append(Point(r, q, qd, w, sym, qdd))
     return pts
 
 
@@ -344,6 +349,8 @@ def _env(p: Point) -> dict[str, float]:
         env[f"q{k + 1}"] = float(p.q[k])
         if p.qd is not None:
             env[f"qd{k + 1}"] = float(p.qd[k])
+        if p.qdd is not None:
+            env[f"qdd{k + 1}"] = float(p.qdd[k])
     return env
 
 

@@ -7,6 +7,7 @@ parameter value, a joint angle's sign), at the same evaluation points.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -39,7 +40,7 @@ def _alt(qty, spec, points, robot_map=None, spec_change=None) -> np.ndarray | No
 
     try:
         s = {**spec, **(spec_change or {})}
-        return np.array([np.asarray(qty.truth(Point(robot_of(p.robot), p.q, p.qd, p.wrench), s), dtype=float)
+        return np.array([np.asarray(qty.truth(replace(p, robot=robot_of(p.robot)), s), dtype=float)
                          for p in points])
     except Exception:  # e.g. an index out of range for the changed spec: no hint
         return None
@@ -184,7 +185,7 @@ def _joint_sign(robot, qty, spec, claimed, truth, tol) -> list[str]:
         return []
     points = spec["_points"]
     for k in range(robot.dof):
-        flipped = [Point(p.robot, p.q * np.where(np.arange(robot.dof) == k, -1, 1), p.qd, p.wrench) for p in points]
+        flipped = [replace(p, q=p.q * np.where(np.arange(robot.dof) == k, -1, 1)) for p in points]
         alt = _alt(qty, spec, flipped)
         if alt is not None and _close(claimed, alt, tol):
             return [f"it is right for the opposite sign of joint {k + 1} (q{k + 1} = {-points[0].q[k]:.6g})"]

@@ -29,6 +29,7 @@ class Point:
     wrench: np.ndarray | None = None
     #: Values of the other symbols a claim uses at this point (a symbolic wrench's f_x, …), as (name, value) pairs.
     symbols: tuple[tuple[str, float], ...] = ()
+    qdd: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -180,6 +181,12 @@ def _energy(which: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
     return truth
 
 
+def _equations_of_motion(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    if not p.robot.has_dynamics:
+        raise ParseError("the robot has no inertial data, so equations of motion cannot be checked")
+    return np.asarray(N.rnea(p.robot, p.q, p.qd, p.qdd), dtype=float)
+
+
 def _det(p: Point, spec: dict[str, Any]) -> np.ndarray:
     J = N.geometric_jacobian(p.robot, p.q, frame=_frame(spec))
     if "rows" not in spec and p.robot.dof != 6:
@@ -238,11 +245,13 @@ QUANTITIES: dict[str, Quantity] = {
         Quantity("kinetic_energy", _energy("kinetic"), ("qd",), about="K = ½ q̇ᵀ M(q) q̇"),
         Quantity("potential_energy", _energy("potential"), about="V = −Σ m gᵀ p_c (zero at the base origin)"),
         Quantity("lagrangian", _energy("lagrangian"), ("qd",), about="L = K − V"),
+        Quantity("equations_of_motion", _equations_of_motion, ("qd", "qdd"), about="τ = M(q) q̈ + C(q, q̇) q̇ + g(q) "
+                 "(+ the robot's friction): the Lagrange or Newton–Euler equations of motion"),
         Quantity("det_jacobian", _det, about="det J (square: 6 joints, or 'rows' naming as many rows as joints); "
                  "a list of factors is read as their product"),
     )
 }
-_ALIASES = {"z": "joint_axis", "axis": "joint_axis", "p": "origin", "frame_origin": "origin", "w": "omega", "angular_velocity": "omega", "v": "velocity", "linear_velocity": "velocity", "f": "force",
+_ALIASES = {"eom": "equations_of_motion", "dynamics": "equations_of_motion", "z": "joint_axis", "axis": "joint_axis", "p": "origin", "frame_origin": "origin", "w": "omega", "angular_velocity": "omega", "v": "velocity", "linear_velocity": "velocity", "f": "force",
             "n": "moment", "com": "com_position", "p_c": "com_position", "v_c": "com_velocity", "K": "kinetic_energy",
             "V": "potential_energy", "U": "potential_energy", "L": "lagrangian", "det": "det_jacobian",
             "detJ": "det_jacobian", "A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
