@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import hashlib
 import random as _random
+import importlib.machinery
 import importlib.util
+import py_compile
 import os
 import sys
 import tempfile
@@ -114,8 +116,19 @@ def _load(key: str, tag: str, make_source):
             with os.fdopen(fd, "w") as fh:
                 fh.write(make_source())
             os.replace(tmp, path)
-        spec = importlib.util.spec_from_file_location(modname, path)
+        # the bytecode is kept beside the source by us (PYTHONDONTWRITEBYTECODE would otherwise make every
+        # process parse the module again: ~0.3 s for a 7-joint arm); numba's own cache keys on the source file
+        pyc = folder / f"{modname}.pyc"
+        if not pyc.exists():
+            fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+            os.close(fd)
+            py_compile.compile(str(path), cfile=tmp, dfile=str(path), doraise=True,
+                               invalidation_mode=py_compile.PycInvalidationMode.UNCHECKED_HASH)
+            os.replace(tmp, pyc)
+        loader = importlib.machinery.SourcelessFileLoader(modname, str(pyc))
+        spec = importlib.util.spec_from_loader(modname, loader, origin=str(path))
         mod = importlib.util.module_from_spec(spec)
+        mod.__file__ = str(path)
         sys.modules[modname] = mod
         try:
             spec.loader.exec_module(mod)
