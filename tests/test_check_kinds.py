@@ -466,3 +466,14 @@ def test_equations_of_motion_of_the_planar_3r_by_lagrange():
     value[2] = sp.latex(eqs[2] - I[2] * qdd[0])
     (v,) = _v(robot, [{"quantity": "eom", "value": value}])
     assert v.verdict == "incorrect" and "(3)" in v.message
+
+
+def test_energy_slips_are_named():
+    robot = dn.load_robot(P3)
+    no_rot = " + ".join(_K_TERMS[:3])
+    v = _v(robot, [{"quantity": "K", "value": no_rot}, {"quantity": "K", "value": f"2 ({_K})"},
+                   {"quantity": "L", "value": f"{_K} + {_V}"}])
+    assert [x.verdict for x in v] == ["incorrect"] * 3
+    assert any("rotational" in h for h in v[0].hints), v[0].hints
+    assert any("½ is missing" in h for h in v[1].hints), v[1].hints
+    assert any("K + V" in h for h in v[2].hints), v[2].hints

@@ -315,11 +315,11 @@ ANY_VALUE = st.recursive(
     max_leaves=12,
 )
 KEYS = ["quantity", "value", "entry", "index", "column", "rows", "frame", "q", "qd", "wrench", "joint", "where",
-        "pose", "T", "from", "to", "deg", "id", "point", "convention"]
+        "pose", "T", "from", "to", "deg", "id", "point", "convention", "qdd"]
 QUANTITY_NAMES = ["position", "rotation", "end_effector", "transform", "link_transform", "jacobian", "J0", "Je",
                   "twist", "torques", "mass_matrix", "gravity", "coriolis", "C", "singularities", "ik_formula",
                   "ik_solutions", "bogus", "", "__class__", "omega", "velocity", "force", "moment", "com_position",
-                  "com_velocity", "K", "V", "L", "det_jacobian", "dh_matrix"]
+                  "com_velocity", "K", "V", "L", "det_jacobian", "dh_matrix", "eom", "z", "p"]
 
 
 @st.composite

@@ -99,6 +99,8 @@ def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
                 break
     if qty.name in ("omega", "velocity", "force", "moment") and truth.ndim == 2:
         hints += _propagation(qty, spec, points, claimed, tol)
+    if qty.name in ("kinetic_energy", "lagrangian", "equations_of_motion", "mass_matrix") and truth.ndim >= 1:
+        hints += _dynamics_slips(qty, spec, points, claimed, truth, tol)
     if qty.name in ("jacobian", "twist", "torques"):
         other = "tool" if Frame(spec.get("frame", "base")) is Frame.BASE else "base"
         alt = _alt(qty, spec, points, spec_change={"frame": other})
@@ -135,6 +137,31 @@ def _propagation(qty, spec, points, claimed, tol) -> list[str]:
         alt = _alt(qty, spec, points, spec_change={"index": j}) if j >= 0 else None
         if alt is not None and _close(claimed, alt, tol):
             out.append(f"it is the vector of frame {{{j}}}, not {{{i}}}")
+    return out
+
+
+def _no_rotational_inertia(r):
+    from dataclasses import replace as dc_replace
+
+    links = tuple(dc_replace(lk, inertia=dc_replace(lk.inertia, inertia=(0.0,) * 6)) if lk.inertia is not None else lk
+                  for lk in r.links)
+    return r.replace(links=links)
+
+
+def _dynamics_slips(qty, spec, points, claimed, truth, tol) -> list[str]:
+    """The rotational term ½ ωᵀ I ω missing; the factor ½ of K missing; L written K + V."""
+    out = []
+    alt = _alt(qty, spec, points, robot_map=_no_rotational_inertia)
+    if alt is not None and not _close(alt, truth, 0.0) and _close(claimed, alt, tol):
+        out.append("it leaves out the rotational energy ½ ωᵀ I ω of the links (their inertia about the centre of mass)")
+    if qty.name == "kinetic_energy" and _close(claimed, 2 * truth, tol):
+        out.append("it is 2K: the factor ½ is missing")
+    if qty.name == "lagrangian":
+        from ._quantities import QUANTITIES
+
+        K = _alt(QUANTITIES["kinetic_energy"], spec, points)
+        if K is not None and _close(claimed, 2 * K - truth, tol):
+            out.append("it is K + V; the Lagrangian is L = K − V")
     return out
 
 
