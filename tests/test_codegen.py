@@ -59,6 +59,7 @@ def test_kinematics_kernels_on_random_arms(seed):
     for q in Q:
         T, frames = elementary_fk(robot, q)
         np.testing.assert_allclose(fast.fk(q), T, atol=1e-12)
+        np.testing.assert_allclose(fast.position(q), T[:3, 3], atol=1e-12)
         np.testing.assert_allclose(fast.fk(q, frames=True), frames, atol=1e-12)
         J0 = fast.jacobian(q)
         np.testing.assert_allclose(J0, differentiation_jacobian(robot, q), atol=1e-10)
@@ -202,7 +203,7 @@ def test_numba_backend_equals_numpy_backend(name):
     jit = denavit.compile(robot, backend="numba")
     ref = denavit.compile(robot, backend="numpy")
     q, qd, qdd = random_state(rng, robot, (4,))
-    for method, args in [("fk", (q,)), ("jacobian", (q,)), ("rnea", (q, qd, qdd)), ("mass_matrix", (q,)),
+    for method, args in [("fk", (q,)), ("position", (q,)), ("jacobian", (q,)), ("rnea", (q, qd, qdd)), ("mass_matrix", (q,)),
                          ("gravity", (q,)), ("coriolis", (q, qd)), ("forward_dynamics", (q, qd, qdd))]:
         a, b = getattr(jit, method)(*args), getattr(ref, method)(*args)
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)

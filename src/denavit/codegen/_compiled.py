@@ -151,7 +151,7 @@ def _as_batch(arrays, n: int, names):
     return flat, batch
 
 
-_ndarray, _F64, _empty, _SHAPE44, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (8,)
+_ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
 
 class CompiledRobot:
@@ -163,7 +163,7 @@ class CompiledRobot:
         self.backend = backend
         self.kernels = tuple(names)
         self._m = module
-        self._shapes = {"fk": (4, 4), "frames": (len(robot.links) + 1, 4, 4), "jacobian0": (6, n),
+        self._shapes = {"fk": (4, 4), "position": (3,), "frames": (len(robot.links) + 1, 4, 4), "jacobian0": (6, n),
                         "jacobiane": (6, n), "fk_jacobian0": (16 + 6 * n,), "rnea": (n,), "gravity": (n,), "coriolis": (n,),
                         "mass_matrix": (n, n), "forward_dynamics": (n + 1,)}
         self._one = {name: (getattr(module, f"{name}_1"), self._shapes[name]) for name in names}
@@ -269,6 +269,15 @@ class CompiledRobot:
             self._fk_1(q, out)
             return out
         return self._call("frames" if frames else "fk", (q,), ("q",))
+
+    def position(self, q) -> np.ndarray:
+        """End-effector origin p_w_e, shape (..., 3): ``fk(q)[..., :3, 3]`` from a kernel that computes only
+        what the origin needs (for workspace sampling)."""
+        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            out = _empty(_SHAPE3)
+            self._position_1(q, out)
+            return out
+        return self._call("position", (q,), ("q",))
 
     def jacobian(self, q, frame: Frame | str = "base") -> np.ndarray:
         """Geometric Jacobian, shape (..., 6, n), rows (v, ω): ``base`` J0 or ``tool`` Je (as

@@ -39,6 +39,7 @@ def _call(one, many, shape, *xs):
 
 _PY_WRAPPERS = {
     "fk": ("fk(q)", "T_w_e, shape (..., 4, 4)", "q"),
+    "position": ("position(q)", "p_w_e, the end-effector origin, shape (..., 3)", "q"),
     "frames": ("frames(q)", "world poses of the DH frames {{0}} ... {{N}}, shape (..., {rows}, 4, 4)", "q"),
     "jacobian0": ("jacobian0(q)", "geometric Jacobian J0 (base frame), rows (v, w), shape (..., 6, n)", "q"),
     "jacobiane": ("jacobiane(q)", "geometric Jacobian Je (tool frame), rows (v, w), shape (..., 6, n)", "q"),

@@ -18,8 +18,8 @@ from ._trace import Tape, sym_max, sym_min, sym_sign
 
 __all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics"]
 
-KERNEL_NAMES = ("fk", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix", "gravity",
-                "coriolis", "forward_dynamics")
+KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
+                "gravity", "coriolis", "forward_dynamics")
 DYNAMICS = frozenset({"rnea", "mass_matrix", "gravity", "coriolis", "forward_dynamics"})
 
 
@@ -82,6 +82,10 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
         tape, q, frames, end = kinematics("fk")
         out["fk"] = KernelSpec("fk", "T_w_e, the end-effector pose (tool applied)", (("q", n),), (4, 4),
                                tuple(_columns_to_matrix(*end)), tape)
+    if "position" in names:  # the origin alone: the rotation's arithmetic not needed for it is dropped
+        tape, q, frames, end = kinematics("position")
+        out["position"] = KernelSpec("position", "p_w_e, the end-effector origin (tool applied)", (("q", n),),
+                                     (3,), tuple(end[3]), tape)
     if "frames" in names:
         tape, q, frames, end = kinematics("frames")
         entries = [e for F in frames for e in _columns_to_matrix(*F)]
