@@ -477,3 +477,29 @@ def test_energy_slips_are_named():
     assert any("rotational" in h for h in v[0].hints), v[0].hints
     assert any("½ is missing" in h for h in v[1].hints), v[1].hints
     assert any("K + V" in h for h in v[2].hints), v[2].hints
+
+
+ARM_WITH_G = """name: two-link-g
+convention: standard
+parameters: {L1: 0.7, L2: 0.5, m1: 1.5, m2: 0.8, g: 9.81}
+joints:
+  - {a: L1, alpha: 0, d: 0, theta: q, inertia: {mass: m1, com: [0, 0, 0], inertia: [0, 0, 0, 0, 0, 0]}}
+  - {a: L2, alpha: 0, d: 0, theta: q, inertia: {mass: m2, com: [0, 0, 0], inertia: [0, 0, 0, 0, 0, 0]}}
+gravity: [0, -g, 0]
+"""
+
+
+def test_gravity_as_a_parameter_g_of_the_robot_file(tmp_path):
+    """gravity: [0, -g, 0] with a parameter g: a claim in g is checked at other values of g too (Craig eq. 6.60's
+    gravity terms, point masses at the link ends)."""
+    path = tmp_path / "arm.yaml"
+    path.write_text(ARM_WITH_G)
+    robot = dn.load_robot(str(path))
+    assert robot.has_dynamics, "the test arm must carry masses"
+    good = [r"(m_1 + m_2) L_1 g c_1 + m_2 L_2 g c_{12}", r"m_2 L_2 g c_{12}"]
+    (v,) = _v(robot, [{"quantity": "gravity", "value": good}])
+    assert v.verdict == "correct", v.message
+    (v,) = _v(robot, [{"quantity": "gravity", "value": [t.replace("g", "2 g") for t in good]}])
+    assert v.verdict == "incorrect"
+    (v,) = _v(robot, [{"quantity": "gravity", "value": [good[0], "m_2 L_2 9.81 c_{12} + 0 g"]}])
+    assert v.verdict == "incorrect" and any("parameter" in h for h in v.hints), v.hints
