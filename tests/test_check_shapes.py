@@ -253,3 +253,22 @@ def test_q_written_as_assignments(q_text):
     assert v.verdict == "correct", v.message
     (v,) = _v([{"quantity": "position", "q": q_text.replace("_2", "_1").replace("θ2", "θ1"), "entry": 1, "value": x}])
     assert v.verdict == "unreadable"  # a joint given twice is not guessed
+
+
+def test_transposed_jacobians_and_unit_headers():
+    rng = np.random.default_rng(9)
+    q = rng.uniform(-2, 2, 3)
+    J = _planar3r_j(q)  # rows (x, y, α): square
+    M = np.zeros((6, 3))
+    M[[0, 1, 5]] = J
+    tex = lambda A: r"\begin{bmatrix}" + r" \\ ".join(" & ".join(repr(float(x)) for x in r) for r in A) + r"\end{bmatrix}"  # noqa: E731
+    v = _v([{"quantity": "J", "q": _q(q), "value": M.T.tolist()},
+            {"quantity": "J", "q": _q(q), "rows": "planar", "value": r"\begin{split} & J^T \\ & = " + tex(J.T) + r"\end{split}"},
+            {"quantity": "J", "q": _q(q), "rows": "planar", "transpose": True, "value": J.T.tolist()},
+            {"quantity": "J", "q": _q(q), "rows": "planar", "value": "J = " + tex(J.T)}])
+    assert [x.verdict for x in v] == ["correct", "correct", "correct", "incorrect"], [x.message for x in v]
+    assert "transpose" in v[0].message and "transposed" in " ".join(v[3].hints)
+    x = math.cos(0.5) + 0.8 * math.cos(0.5 + math.pi / 4) + 0.6 * math.cos(0.5 + math.pi / 4 - math.pi / 2)
+    (w,) = _v([{"quantity": "position", "entry": 1, "value": x,
+                "q": r"(\theta_1, \theta_2, \theta_3)[deg] = (" + f"{math.degrees(0.5)!r}, 45, -90)"}])
+    assert w.verdict == "correct", w.message

@@ -152,6 +152,8 @@ def _readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: list[lis
     out = []
     if qty.fk_like and shape == (4, 4) and (r, c) == (3, 4):
         out.append(("the top 3 rows [R | p] of the 4×4 transform", lambda t: t[:3]))
+    if qty.name == "jacobian" and len(shape) == 2 and shape[0] != shape[1] and (r, c) == (shape[1], shape[0]):
+        out.append(("the transpose Jᵀ (as in τ = Jᵀ F)", lambda t: t.T))
     if qty.fk_like and shape == (4, 4) and (r, c) == (3, 3):  # R_3_6 of a wrist derivation
         out.append(("the rotation block R of the 4×4 transform", lambda t: t[:3, :3]))
     six = (len(shape) >= 1 and shape[0] == 6 and qty.name in ("jacobian", "twist") and "rows" not in spec
@@ -189,7 +191,7 @@ def numbers(raw: Any, n: int, what: str, *, marked: list[bool] | None = None) ->
         assigned = _assignments(text, n)
         if assigned is not None:  # θ_1 = 0°, θ_2 = 90°, … (in any order)
             text = ", ".join(assigned)
-        text = after_last_equals(text)
+        text = after_last_equals(text).strip()
         for a, b in (("\\left(", "\\right)"), ("\\left[", "\\right]")):
             if text.startswith(a) and text.endswith(b):
                 text = text[len(a) - 1:len(text) - len(b)] + b[-1]
@@ -244,7 +246,12 @@ def _has_degrees(node: tuple) -> bool:
     return False
 
 
+_DEG_HEADER = re.compile(r"\[\s*deg\s*\]|\(\s*deg\s*\)|\[\s*°\s*\]|\\text\{\s*deg\s*\}")
+
+
 def _joint_values(raw: Any, robot: DHRobot, what: str, deg: bool) -> np.ndarray:
+    if isinstance(raw, str) and "=" in raw and _DEG_HEADER.search(raw[:raw.rindex("=")]):
+        deg = True  # (θ_1, …, θ_6)[deg] = (0, 45, …): the unit is written before the values
     marked: list[bool] = []
     vals = numbers(raw, robot.dof, what, marked=marked)
     if deg:  # angle_unit: deg - except entries that carry their own degree mark (already in radians)
@@ -452,7 +459,11 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
     except ParseError as exc:
         return Verdict(cid, qname, "unreadable", str(exc))
     if len(readings) == 1 and readings[0][0] is None:
-        return _compare(robot, cid, qty, spec, cells, points, truth, rng, detail)
+        if qty.name == "jacobian" and len(truth.shape) == 3 and truth.shape[1] == truth.shape[2] and (
+                spec.get("transpose") is True or (isinstance(raw["value"], str) and _says_transpose(raw["value"]))):
+            readings = [("the transpose Jᵀ (as the claim writes it)", lambda t: t.T)]
+        else:
+            return _compare(robot, cid, qty, spec, cells, points, truth, rng, detail)
     verdicts = []
     for label, fn in readings:
         q2 = replace(qty, truth=lambda p, s, f=fn, t=qty.truth: f(np.asarray(t(p, s), dtype=float)))
@@ -465,6 +476,15 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
     v = _compare(robot, cid, q2, spec, _shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
     others = "; ".join(lb for _, lb, _, _ in verdicts if lb != label)
     return replace(v, message=f"{v.message}, read as {label}" + (f" (also wrong read as {others})" if others else ""))
+
+
+_TRANSPOSED = re.compile(r"\^\s*(?:T|\{\s*T\s*\}|\\top|\{\s*\\top\s*\})(?![A-Za-z])")
+
+
+def _says_transpose(text: str) -> bool:
+    """``J^T = …`` / ``J_\\theta^{T} = …``: the left side names a transposed matrix."""
+    head = text[:len(text) - len(after_last_equals(text))]
+    return bool(_TRANSPOSED.search(head))
 
 
 def _compare(robot, cid, qty, spec, cells, points, truth, rng, detail) -> Verdict:

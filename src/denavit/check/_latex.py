@@ -495,7 +495,7 @@ def split_matrix(text: str) -> list[list[str]] | None:
     return [[c.strip() for c in r.split("&")] for r in rows]
 
 
-_ENV = re.compile(r"\\(begin|end)\{[A-Za-z*]+\}")
+_ENV = re.compile(r"\\(begin|end)\{(?:[bBpvV]?matrix|array|smallmatrix)\*?\}")  # not split/aligned: an = there counts
 
 
 def after_last_equals(text: str) -> str:
