@@ -503,3 +503,15 @@ def test_gravity_as_a_parameter_g_of_the_robot_file(tmp_path):
     assert v.verdict == "incorrect"
     (v,) = _v(robot, [{"quantity": "gravity", "value": [good[0], "m_2 L_2 9.81 c_{12} + 0 g"]}])
     assert v.verdict == "incorrect" and any("parameter" in h for h in v.hints), v.hints
+
+
+def test_det_written_as_the_determinant_of_a_matrix():
+    """Report 004's layout: det J = |J_v| written as a vmatrix of ³J's rows (x, y) (textbook planar 3R, tool axes)."""
+    robot = dn.load_robot(P3)
+    a = [r"L_1 s_{23} + L_2 s_3", r"L_2 s_3", "0", r"L_1 c_{23} + L_2 c_3 + L_3", r"L_2 c_3 + L_3", "L_3", "1", "1", "1"]
+    vm = (r"\begin{vmatrix} " + " & ".join(a[0:3]) + r" \\ " + " & ".join(a[3:6]) + r" \\ " + " & ".join(a[6:9])
+          + r" \end{vmatrix}")
+    v = _v(robot, [{"quantity": "det", "rows": "planar", "frame": "tool", "value": vm},
+                   {"quantity": "det", "rows": "planar", "value": vm},  # det is the same in base axes (a rotation)
+                   {"quantity": "det", "rows": "planar", "value": vm.replace("L_2 s_3 &", "-L_2 s_3 &", 1)}])
+    assert [x.verdict for x in v] == ["correct", "correct", "incorrect"], [x.message for x in v]

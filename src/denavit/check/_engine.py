@@ -361,6 +361,29 @@ def _env(p: Point) -> dict[str, float]:
     return env
 
 
+#: Largest matrix whose determinant a det_jacobian claim may write out (``\\begin{vmatrix} … \\end{vmatrix}``).
+MAX_DET_SIZE = 6
+
+
+def _determinant(cells: list[list[tuple]]) -> tuple:
+    """det of a square matrix of trees, by Laplace expansion (sums balanced, so the tree stays shallow)."""
+    import itertools
+
+    n = len(cells)
+    terms = []
+    for perm in itertools.permutations(range(n)):
+        inversions = sum(perm[a] > perm[b] for a in range(n) for b in range(a + 1, n))
+        term = _balanced("*", [cells[i][perm[i]] for i in range(n)])
+        terms.append(("neg", term) if inversions % 2 else term)
+    return _balanced("+", terms)
+
+
+def _balanced(op: str, nodes: list[tuple]) -> tuple:
+    while len(nodes) > 1:
+        nodes = [("bin", op, nodes[k], nodes[k + 1]) if k + 1 < len(nodes) else nodes[k] for k in range(0, len(nodes), 2)]
+    return nodes[0]
+
+
 def _where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, tuple]]:
     """A claim's 'where': names a derivation introduces (``k: a_2``, ``x_c: p_x - d_6 a_x``…), each a formula in
     the robot's names and the names defined before it, in order."""
@@ -434,6 +457,8 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
             for f in factors[1:]:
                 prod = ("bin", "*", prod, f)
             cells = [[prod]]
+        elif qty.name == "det_jacobian" and 1 < len(cells) == len(cells[0]) <= MAX_DET_SIZE:
+            cells = [[_determinant(cells)]]  # |a b; c d| (a vmatrix): the determinant of the matrix written
         names: set[str] = set()
         for row in cells:
             for c in row:
