@@ -111,6 +111,7 @@ LONG_PRODUCT = "*".join(["1"] * 3000)
       "value": "w19"}, ["not finite"]),
     ({"quantity": "position", "entry": 1, "where": {"q_1": "3"}, "value": "q_1"}, ["cannot redefine"]),
     ({"quantity": "position", "entry": 1, "where": {"L_1": "3"}, "value": "L_1"}, ["cannot redefine"]),
+    ({"quantity": "det_jacobian", "rows": "vx,vy", "value": [["+".join(["q_1"] * 390)] * 6] * 6}, ["too large"]),
 ])
 def test_trigger_is_one_unreadable_claim(tmp_path, claim, words):
     good = {"id": "good", "quantity": "position", "value": ["L_1 C_1 + L_2 C_{12}", "L_1 S_1 + L_2 S_{12}", 0]}

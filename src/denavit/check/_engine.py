@@ -10,6 +10,7 @@ one unit of the last decimal written for claims written with rounded decimals.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
@@ -363,6 +364,8 @@ def _env(p: Point) -> dict[str, float]:
 
 #: Largest matrix whose determinant a det_jacobian claim may write out (``\\begin{vmatrix} … \\end{vmatrix}``).
 MAX_DET_SIZE = 6
+#: Bound on the work of expanding such a determinant (tree nodes of the entries × (n − 1)!).
+MAX_DET_WORK = 200_000
 
 
 def _determinant(cells: list[list[tuple]]) -> tuple:
@@ -370,12 +373,30 @@ def _determinant(cells: list[list[tuple]]) -> tuple:
     import itertools
 
     n = len(cells)
+    work = sum(_tree_size(c) for row in cells for c in row) * math.factorial(n - 1)
+    if work > MAX_DET_WORK:
+        raise ParseError(f"the determinant written out is too large to expand ({n}×{n} with long entries); "
+                         "give its value instead")
     terms = []
     for perm in itertools.permutations(range(n)):
         inversions = sum(perm[a] > perm[b] for a in range(n) for b in range(a + 1, n))
         term = _balanced("*", [cells[i][perm[i]] for i in range(n)])
         terms.append(("neg", term) if inversions % 2 else term)
     return _balanced("+", terms)
+
+
+def _tree_size(node: tuple) -> int:
+    size, stack = 0, [node]
+    while stack:
+        nd = stack.pop()
+        size += 1
+        if nd[0] == "neg":
+            stack.append(nd[1])
+        elif nd[0] == "bin":
+            stack += [nd[2], nd[3]]
+        elif nd[0] == "call":
+            stack += list(nd[2])
+    return size
 
 
 def _balanced(op: str, nodes: list[tuple]) -> tuple:
