@@ -100,7 +100,8 @@ def _tip_statics(robot, i, wrench):
     return f, n
 
 
-@pytest.mark.parametrize("name", ["planar3r", "report000-planar3r", "scara", "report004-4-rrp", "report000-6r"])
+@pytest.mark.parametrize("name", ["planar3r", "report000-planar3r", "scara", "report004-4-rrp",
+                                  pytest.param("report000-6r", marks=pytest.mark.slow)])
 def test_force_propagation_vectors_with_a_symbolic_tip_wrench(name):
     robot = dn.load_robot(name)
     fx, fy, fz, nz = sp.symbols("f_x f_y f_z n_z")
@@ -161,6 +162,7 @@ _K = " + ".join(_K_TERMS)
 _V = " + ".join(rf"m_{i + 1} g ({_YC[i]})" for i in range(3))
 
 
+@pytest.mark.slow
 def test_planar3r_centres_of_mass_and_energies_from_the_textbook():
     robot = dn.load_robot(P3)
     claims = [{"id": f"pc{i + 1}", "quantity": "com_position", "index": i + 1, "value": f"[{_XC[i]}, {_YC[i]}, 0]"}
