@@ -284,7 +284,9 @@ def hand_terms(rg: TrigRing, poly) -> sp.Expr:
         return sp.Integer(0)
     ntrig = len(rg.trig_gens)
     k0 = len(rg.gens) - ntrig
+    # constants: algebraic ones (√3) stay exact, transcendental ones (cos 0.7) become numbers
     syms = [s.xreplace(rg.back) for s in rg.R.symbols[:k0]]
+    syms = [x.evalf(15) if x.is_number and not x.is_algebraic else x for x in syms]
     trig_atoms = [rg.trig_of(g) for g in rg.trig_gens]
     to_sympy = rg.R.domain.to_sympy
     terms = _pair_angles(rg, {(monom[:k0], monom[k0:], ()): to_sympy(coeff) for monom, coeff in poly.terms()})

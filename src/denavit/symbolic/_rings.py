@@ -21,7 +21,9 @@ from typing import Iterable, Sequence
 
 import sympy as sp
 
-__all__ = ["TrigRing"]
+__all__ = ["TrigRing", "FLOAT_PAIR_TOL"]
+
+FLOAT_PAIR_TOL = 1e-12  # two floats x, y with |x² + y² − 1| below this are taken as cos and sin of one angle
 
 
 class TrigRing:
@@ -50,6 +52,7 @@ class TrigRing:
         self.angles = [sp.Add(*[self.q[i] for i in s]) for s in self.sums]
         self._subs = self._joint_trig()
         exprs = list(exprs)
+        self._floats = self._float_map(exprs)
         consts: set[sp.Expr] = set()
         params: set[sp.Symbol] = set()
         for e in exprs:
@@ -64,6 +67,11 @@ class TrigRing:
         self.R, *self.gens = ring(gens, QQ)
         self.const_relations = [self.R(sp.minimal_polynomial(a, d)) for a, d in self.konst.items()
                                 if not a.has(sp.Float) and a.is_algebraic]
+        self.const_relations += [self.R(self.konst[x] ** 2 + self.konst[y] ** 2 - 1) for x, y in self._pairs
+                                 if x in self.konst and y in self.konst]
+        # cos r and sin r of one constant angle (a twist of 0.7 rad written exactly as 7/10): r² + s² = 1
+        self.const_relations += [self.R(self.konst[a] ** 2 + self.konst[sp.sin(a.args[0])] ** 2 - 1)
+                                 for a in self.konst if isinstance(a, sp.cos) and sp.sin(a.args[0]) in self.konst]
         self.relations = self.const_relations + [self.R(si ** 2 + ci ** 2 - 1) for si, ci in zip(self.s, self.c)]
         self._exprs = exprs
         self.trig_gens = self.gens[len(self.gens) - 2 * m:]
@@ -86,8 +94,29 @@ class TrigRing:
                 out[sp.sin(self.q[i])] = self.s[a] * self.c[b] - self.c[a] * self.s[b]
         return out
 
+    def _float_map(self, exprs) -> dict[sp.Float, sp.Expr]:
+        """Floats (a generic twist's cos 0.7 = 0.7648…): pairs x, y with x² + y² = 1 (to 1e-12) become the
+        cosine and sine of one constant angle, generators with the relation x² + y² − 1 (so RᵀR = I holds
+        exactly and terms cancel); other floats become exact rationals of their decimal text."""
+        floats = sorted({abs(f) for e in exprs for f in sp.sympify(e).atoms(sp.Float)}, key=float)
+        paired: dict[sp.Float, sp.Float] = {}
+        for i, x in enumerate(floats):
+            for y in floats[i:]:
+                if x not in paired and y not in paired and abs(float(x) ** 2 + float(y) ** 2 - 1) < FLOAT_PAIR_TOL:
+                    paired[x], paired[y] = y, x
+        self._pairs = list({tuple(sorted((x, y), key=float)) for x, y in paired.items()})
+        out: dict[sp.Float, sp.Expr] = {}
+        for e in exprs:
+            for f in sp.sympify(e).atoms(sp.Float):
+                a = abs(f)
+                val = a if a in paired else sp.Rational(repr(float(a)))
+                out[f] = val if f >= 0 else -val
+        return out
+
     def _trig_vars(self, e: sp.Expr, strict: bool = True) -> sp.Expr:
         x = sp.expand(sp.expand_trig(sp.sympify(e)))
+        if self._floats:
+            x = sp.expand(x.xreplace({f: self._floats.get(f, f) for f in x.atoms(sp.Float)}))
         x = x.xreplace(self._subs)
         left = [f for f in x.atoms(sp.sin, sp.cos) if f.has(*self.q)]
         if left and not strict:  # scanning for parameters and constants only

@@ -189,6 +189,22 @@ def _minors(rg: TrigRing, J: list, shape: tuple[int, int]) -> tuple[str, list]:
 # --- factoring -------------------------------------------------------------------------------------
 
 
+BIG_RATIONAL = 10 ** 6  # a factor with a coefficient whose numerator or denominator exceeds this is shown in floats
+
+
+def _tidy(e: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """(e / scale, scale): a factor of a float arm (cos 0.7, 17-digit decimals) written with floats of order
+    one, its largest coefficient ±1; exact factors are returned as they are (scale 1)."""
+    trans = {a: a.evalf(15) for a in e.atoms(sp.sin, sp.cos) if a.is_number and not a.is_algebraic}
+    big = any(abs(r.p) > BIG_RATIONAL or r.q > BIG_RATIONAL for r in e.atoms(sp.Rational))
+    if not trans and not big:
+        return e, sp.Integer(1)
+    x = sp.expand(e.xreplace(trans))
+    coeffs = [abs(float(t.as_coeff_Mul()[0])) for t in sp.Add.make_args(x)]
+    scale = sp.Float(max(coeffs), 15) if coeffs and max(coeffs) > 0 else sp.Integer(1)
+    return sp.expand(sp.N(x / scale, 15)), scale
+
+
 def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
     """Common factor of the ring minors, factorized: (constant part, [(factor in q, multiplicity)]).
 
@@ -207,13 +223,15 @@ def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, i
     if rg.const_relations:
         g = g.rem(rg.const_relations)
     coeff, facs = g.factor_list()
-    const, out = sp.nsimplify(rg.R.domain.to_sympy(coeff)), []
+    const, out = rg.R.domain.to_sympy(coeff), []
     for f, mult in facs:
         fr = rg.reduce(f)
         e = rg.to_expr(fr)
         if not e.has(*q):
             const *= e ** mult
             continue
+        e, scale = _tidy(e)
+        const *= scale ** mult
         e = reduce_trig(e, q)
         for i, (o, m) in enumerate(out):
             if sp.expand(e - o) == 0 or sp.expand(e + o) == 0:
@@ -586,7 +604,10 @@ def singularity_analysis(robot: DHRobot, rows: str | None = "auto", frame: Frame
         kind, text = _classify(f, variables, sols, robot, q, params, rng)
         conds.append(SingularCondition(f, tuple(f"q{k + 1}" for k in variables), tuple(sols), kind, text))
     det = sp.Mul(const, *[f ** m for f, m in facs])  # for m ≠ k: the common factor of the minors
-    everywhere = abs(complex(sp.N(const.subs(params)))) < ZERO_TOL
+    # a numeric factor is zero only when it is 0 (a generic float arm's content can be 1e-37); a factor in
+    # the parameters is zero when it vanishes at their values (a2 = 0)
+    everywhere = any(f == 0 or (f.free_symbols and abs(complex(sp.N(f.subs(params)))) < ZERO_TOL)
+                     for f in sp.Mul.make_args(const))
     const_list = tuple(x for x in sp.Mul.make_args(const) if x not in (1, -1))
     reason = "a constant factor is zero at these parameter values" if everywhere else ""
     return SingularityAnalysis(robot.name, tuple(TWIST_ROWS[i] for i in idx), M, note, name, det, const_list,
