@@ -517,3 +517,19 @@ def test_det_written_as_the_determinant_of_a_matrix():
                    {"quantity": "det", "rows": "planar", "value": vm},  # det is the same in base axes (a rotation)
                    {"quantity": "det", "rows": "planar", "value": vm.replace("L_2 s_3 &", "-L_2 s_3 &", 1)}])
     assert [x.verdict for x in v] == ["correct", "correct", "incorrect"], [x.message for x in v]
+
+
+@pytest.mark.parametrize("name", ["planar2r-mdh", pytest.param("report000-planar3r", marks=pytest.mark.slow),
+                                  pytest.param("scara", marks=pytest.mark.slow)])
+def test_the_correct_formula_given_for_a_wrong_propagation_claim_is_itself_correct(name):
+    robot = dn.load_robot(name)
+    wrong = [{"quantity": "velocity", "index": 2, "value": r"[\dot\theta_1, 0, 0]"},
+             {"quantity": "omega", "index": robot.n_rows, "value": r"[0, \dot\theta_2, 0]"},
+             {"quantity": "moment", "index": 1, "wrench": "[f_x, f_y, 0, 0, 0, n_z]", "value": "[0, 0, f_x]"},
+             {"quantity": "force", "index": 0, "wrench": "[F_1, 0, F_3]", "value": "[F_3, 0, 0]"}]
+    for claim, v in zip(wrong, _v(robot, wrong)):
+        assert v.verdict == "incorrect", v.message
+        formula = v.extra.get("expected_latex")
+        assert formula, (claim, "no correct formula given")
+        (again,) = _v(robot, [{**claim, "value": formula}])
+        assert again.verdict == "correct", (claim, formula, again.message)
