@@ -12,17 +12,19 @@ from ._sampler import BLOCK, FINE_CELLS, MAX_CELLS, Grid, PositionFK, reach_boun
 from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
 from ._volume import VolumeEstimate, coarsen, estimate_volume
 from ._reach import DEFAULT_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
-from ._occupancy import (DEFAULT_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy, new_seed, occupancy,
-                         sample_positions)
+from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy,
+                         new_seed, occupancy, sample_positions)
 
 __all__ = [
     "BLOCK",
+    "CLUSTER_CHUNK",
     "DEFAULT_ORIENTATIONS",
     "CONNECT_TIMEOUT",
     "DEFAULT_CHUNK",
     "FINE_CELLS",
     "LOCAL_SCHEDULERS",
     "MAX_CELLS",
+    "MAX_CHUNK",
     "MAX_SAMPLES",
     "Grid",
     "Occupancy",

@@ -10,16 +10,18 @@ import numpy as np
 from ..errors import ModelError
 from ..model import DHRobot
 from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
-from ._schedule import Progress, run
+from ._schedule import LOCAL_SCHEDULERS, Progress, run
 from ._volume import VolumeEstimate, estimate_volume
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
-           "new_seed"]
+           "CLUSTER_CHUNK", "MAX_CHUNK", "new_seed"]
 
 #: Most samples in one run (10¹⁰ ≈ 1 h here with the default FK; bounded time).
 MAX_SAMPLES = 10**10
 #: Default samples per task (4 random blocks; about 60 MB of scratch per worker with the default FK).
 DEFAULT_CHUNK = 4 * BLOCK
+#: Default samples per task on a dask.distributed cluster (fewer, larger tasks: less scheduling per sample).
+CLUSTER_CHUNK = 16 * BLOCK
 #: Most samples per task.
 MAX_CHUNK = 64 * BLOCK
 
@@ -117,7 +119,7 @@ def _check_sizes(samples: int, chunk: int) -> None:
 
 
 def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None = None, seed: int | None = None,
-              *, scheduler: Any = "threads", workers: int | None = None, chunk: int = DEFAULT_CHUNK,
+              *, scheduler: Any = "threads", workers: int | None = None, chunk: int | None = None,
               fk: Callable | None = None, progress: bool | None = False) -> Occupancy:
     """Stream ``samples`` uniform joint configurations through FK into voxel counts; volume with an interval.
 
@@ -135,8 +137,9 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         Where the tasks run; ``"tcp://host:8786"`` connects to a dask.distributed scheduler.
     workers : int, optional
         Local pool size (default: the CPU count).
-    chunk : int
-        Samples per task (rounded down to whole blocks of 65 536).  Results do not depend on it.
+    chunk : int, optional
+        Samples per task (rounded down to whole blocks of 65 536); default DEFAULT_CHUNK on this machine,
+        CLUSTER_CHUNK on a cluster.  Results do not depend on it.
     fk : callable, optional
         Joint values (m, n) → end-effector origins (m, 3) or poses (m, 4, 4); default
         :class:`PositionFK` (``denavit.forward_kinematics``).
@@ -155,6 +158,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     >>> ws.planar, ws.estimate.low <= 3.1416 * 2.0**2 <= ws.estimate.high
     (True, True)
     """
+    if chunk is None:
+        chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS else CLUSTER_CHUNK
     _check_sizes(samples, chunk)
     seed = new_seed() if seed is None else int(seed)
     if seed < 0:
