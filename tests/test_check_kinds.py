@@ -533,3 +533,42 @@ def test_the_correct_formula_given_for_a_wrong_propagation_claim_is_itself_corre
         assert formula, (claim, "no correct formula given")
         (again,) = _v(robot, [{**claim, "value": formula}])
         assert again.verdict == "correct", (claim, formula, again.message)
+
+
+# --- relations: textbook identities of the Jacobian and statics ------------------------------------------
+
+_STD_COLUMN = r"J_i = \begin{bmatrix} z_{i-1} \times (p - p_{i-1}) \\ z_{i-1} \end{bmatrix}"  # Siciliano eq. 3.30
+_MDH_COLUMN = r"J_i = \begin{bmatrix} z_{i} \times (p_e - p_{i}) \\ z_{i} \end{bmatrix}"  # Craig's frames: axis z_i
+
+
+@pytest.mark.parametrize("name", ["puma560", "stanford", "report000-6r", "report004-4-rrp", "scara"])
+def test_relations_of_the_textbook(name):
+    robot = dn.load_robot(name)
+    std = robot.convention is dn.Convention.STANDARD
+    right, wrong = (_STD_COLUMN, _MDH_COLUMN) if std else (_MDH_COLUMN, _STD_COLUMN)
+    prism = (r"J_i = [z_{i-1}; 0]" if std else r"J_i = [z_{i}; 0]")
+    claims = [{"id": "column rule", "quantity": "relation", "value": right},
+              {"id": "statics", "quantity": "relation", "value": r"\boldsymbol\tau = \mathbf{J}^T \mathbf{F}"},
+              {"id": "twist", "quantity": "relation", "value": r"\begin{bmatrix} v \\ \omega \end{bmatrix} = J \dot q"},
+              {"id": "rows", "quantity": "relation", "value": r"\omega = J_\omega \dot\theta"},
+              {"id": "wrong frames", "quantity": "relation", "value": wrong},
+              {"id": "no transpose", "quantity": "relation", "value": r"\tau = J F"},
+              {"id": "v from all of J", "quantity": "relation", "value": r"v = J \dot q"}]
+    if any(t is dn.JointType.PRISMATIC for t in robot.joint_types):
+        claims.append({"id": "prismatic rule", "quantity": "relation", "joints": "prismatic", "value": prism})
+    v = {x.id: x for x in _v(robot, claims)}
+    for k in ("column rule", "statics", "twist", "rows", "prismatic rule"):
+        if k in v:
+            assert v[k].verdict == "correct", (k, v[k].message)
+    assert v["wrong frames"].verdict == "incorrect", v["wrong frames"].message
+    assert v["no transpose"].verdict == "incorrect"
+    assert v["v from all of J"].verdict == "incorrect" and "shape" in v["v from all of J"].message
+
+
+def test_relation_readers_refuse_what_they_cannot_read():
+    robot = dn.load_robot("puma560")
+    bad = [r"\tau", r"\tau = K F", r"J_x = 1", r"{}^3 J = J", "(" * 60 + "J" + ")" * 60 + " = J", r"\tau = J^{2} F"]
+    for verdict in _v(robot, [{"quantity": "relation", "value": b} for b in bad]):
+        assert verdict.verdict == "unreadable", verdict.message
+    (v,) = _v(robot, [{"quantity": "relation", "joints": "prismatic", "value": "J_i = [z_{i-1}; 0]"}])
+    assert v.verdict == "unreadable" and "no prismatic" in v.message

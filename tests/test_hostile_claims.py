@@ -112,6 +112,13 @@ LONG_PRODUCT = "*".join(["1"] * 3000)
     ({"quantity": "position", "entry": 1, "where": {"q_1": "3"}, "value": "q_1"}, ["cannot redefine"]),
     ({"quantity": "position", "entry": 1, "where": {"L_1": "3"}, "value": "L_1"}, ["cannot redefine"]),
     ({"quantity": "det_jacobian", "rows": "vx,vy", "value": [["+".join(["q_1"] * 390)] * 6] * 6}, ["too large"]),
+    ({"quantity": "relation", "value": "(" * 100 + "J" + ")" * 100 + " = J"}, ["nested too deeply"]),
+    ({"quantity": "relation", "value": "J = " + "J + " * 6000 + "J"}, ["longer than"]),
+    ({"quantity": "relation", "value": "\\tau = \\frac{1}{0} F"}, ["division by zero"]),
+    ({"quantity": "relation", "value": "\\tau = 1e300 1e300 F"}, ["not finite"]),
+    ({"quantity": "relation", "value": "\\input{/etc/passwd} = J"}, ["unsupported"]),
+    ({"quantity": "relation", "value": "J_{" + "1" * 500 + "} = J"}, ["digits"]),
+    ({"quantity": "relation", "joints": "x", "value": "J_i = J_i"}, ["'joints'"]),
 ])
 def test_trigger_is_one_unreadable_claim(tmp_path, claim, words):
     good = {"id": "good", "quantity": "position", "value": ["L_1 C_1 + L_2 C_{12}", "L_1 S_1 + L_2 S_{12}", 0]}
@@ -316,11 +323,11 @@ ANY_VALUE = st.recursive(
     max_leaves=12,
 )
 KEYS = ["quantity", "value", "entry", "index", "column", "rows", "frame", "q", "qd", "wrench", "joint", "where",
-        "pose", "T", "from", "to", "deg", "id", "point", "convention", "qdd"]
+        "pose", "T", "from", "to", "deg", "id", "point", "convention", "qdd", "joints"]
 QUANTITY_NAMES = ["position", "rotation", "end_effector", "transform", "link_transform", "jacobian", "J0", "Je",
                   "twist", "torques", "mass_matrix", "gravity", "coriolis", "C", "singularities", "ik_formula",
                   "ik_solutions", "bogus", "", "__class__", "omega", "velocity", "force", "moment", "com_position",
-                  "com_velocity", "K", "V", "L", "det_jacobian", "dh_matrix", "eom", "z", "p"]
+                  "com_velocity", "K", "V", "L", "det_jacobian", "dh_matrix", "eom", "z", "p", "relation"]
 
 
 @st.composite

@@ -606,6 +606,10 @@ def _special(name: str):
         from ._singular import check_singularities
 
         return check_singularities
+    if name in ("relation", "rule"):
+        from ._relations import check_relation
+
+        return check_relation
     if name in ("dh_matrix", "general_dh", "dh"):
         from ._dh_claims import check_dh_matrix
 

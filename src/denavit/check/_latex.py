@@ -23,7 +23,7 @@ from typing import Callable
 from .. import _expr
 from ..errors import ParseError
 
-__all__ = ["Ident", "RaggedMatrix", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
+__all__ = ["Ident", "RaggedMatrix", "tokenize", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
            "MAX_DIGITS", "Resolver"]
 
 MAX_CHARS = 20_000
@@ -89,6 +89,11 @@ def _normalize(text: str) -> str:
         text = text.replace(k, v)
     text = _JOINT_SPACE.sub(lambda m: f"{m.group(1)}_{{{m.group(2)}}}", text)  # \\theta 2 → \\theta_{2}
     return _OF_TIME.sub("", text)  # \\theta_1(t) → \\theta_1
+
+
+def tokenize(text: str) -> list[tuple[str, str]]:
+    """The tokens ``(kind, text)`` of a formula (kinds num, cmd, word, op), spacing commands dropped; capped."""
+    return _tokens(text)
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
