@@ -419,7 +419,7 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
     is named P1, P2 … (π₁, π₂ … in LaTeX) and defined first. With ``gravity_symbol`` gravity is the symbol
     g (its value in the header; g = |g₀| · g_unit). Other forms: ``cse`` pulls repeated subexpressions out as
     x0, x1, … (``sympy.cse``; ``None``: only when the entries are long). ``short`` writes cos(q1 + q2) as C12
-    (LaTeX C_{12}; the Coriolis matrix's entries are \mathcal{C}_{12}); ``digits``: fractions with
+    (LaTeX C_{12}; the Coriolis matrix's entries are \\mathcal{C}_{12}); ``digits``: fractions with
     denominators above 12 are printed as decimals of that many significant digits (trailing zeros dropped
     in text).
     """

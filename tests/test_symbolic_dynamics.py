@@ -1,0 +1,166 @@
+"""Symbolic M, C, c, g in hand form (lagrangian_dynamics(simplify="trig"), computed on polynomials) against the
+numeric engine (CRBA, Christoffel C, RNEA, gravity — itself checked against Pinocchio in test_dynamics_numeric)
+at random configurations, Ṁ − 2C skew by sympy's own differentiation, a textbook closed form, and the printed
+form (angle sums, no decimals for symbolic data, gravity as g, LaTeX that compiles)."""
+
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import denavit
+from denavit import DHLink, DHRobot, JointType
+from denavit import numeric as N
+from denavit.model import LinkInertia
+from denavit.symbolic import format_dynamics, joint_symbols, lagrangian_dynamics, parameter_symbols
+
+from test_jacobians import make_robot
+
+ARMS = ["planar2r", "planar3r", "planar3r-lagrange"] + [pytest.param(n, marks=pytest.mark.slow)
+                                                        for n in ("puma560", "puma560-mdh", "ur5")]
+
+
+def _functions(robot, t):
+    js = joint_symbols(robot.dof)
+    syms = list(js.q) + list(js.qd) + list(parameter_symbols(robot).values())
+    mats = [t.M, t.c, t.g] + ([t.C] if t.C is not None else [])
+    f = sp.lambdify(syms, mats, "numpy")
+    values = list(robot.parameter_values.values())
+    return lambda q, qd: [np.array(x, dtype=float) for x in f(*q, *qd, *values)]
+
+
+def _check_against_numeric(robot, t, rng, count=4):
+    f = _functions(robot, t)
+    for _ in range(count):
+        q, qd, qdd = rng.uniform(-np.pi, np.pi, robot.dof), rng.uniform(-2, 2, robot.dof), rng.uniform(-2, 2, robot.dof)
+        for k, jt in enumerate(robot.joint_types):
+            if jt is JointType.PRISMATIC:
+                q[k] = rng.uniform(-0.5, 0.5)
+        M, c, g, *C = f(q, qd)
+        scale = 1 + np.abs(N.mass_matrix(robot, q)).max()
+        np.testing.assert_allclose(M, N.mass_matrix(robot, q), atol=1e-11 * scale)
+        np.testing.assert_allclose(g.ravel(), N.gravity_torques(robot, q), atol=1e-10 * (1 + np.abs(g).max()))
+        np.testing.assert_allclose(c.ravel(), N.coriolis_vector(robot, q, qd), atol=1e-10 * scale)
+        if C:
+            np.testing.assert_allclose(C[0], N.coriolis_matrix(robot, q, qd), atol=1e-10 * scale)
+        tau = M @ qdd + c.ravel() + g.ravel()
+        np.testing.assert_allclose(tau, N.rnea(robot, q, qd, qdd, friction=False), atol=1e-9 * scale)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_catalogue_arms_match_the_numeric_engine(name):
+    robot = denavit.load_robot(name)
+    t = lagrangian_dynamics(robot)
+    assert t.form == "hand"
+    _check_against_numeric(robot, t, np.random.default_rng(80))
+
+
+@pytest.mark.slow
+def test_panda_matches_the_numeric_engine():
+    robot = denavit.load_robot("panda")
+    t = lagrangian_dynamics(robot, coriolis=False)
+    _check_against_numeric(robot, t, np.random.default_rng(81), count=2)
+
+
+def _random_inertial_arm(rng, n_rows):
+    rough = make_robot(rng, n_rows=n_rows)
+    links = []
+    for link in rough.links:
+        I = np.concatenate([rng.uniform(0.05, 0.1, 3), rng.uniform(-0.002, 0.002, 3)])  # a body: triangle inequality
+        links.append(DHLink(a=link.a, alpha=link.alpha, d=link.d, theta=link.theta, joint=link.joint,
+                            inertia=LinkInertia(mass=float(rng.uniform(0.5, 3)), com=tuple(rng.uniform(-0.3, 0.3, 3)),
+                                                inertia=tuple(float(x) for x in I),
+                                                motor_inertia=float(rng.choice([0.0, 0.2])))))
+    return rough.replace(links=tuple(links))
+
+
+@pytest.mark.parametrize("seed", [0, 1] + [pytest.param(s, marks=pytest.mark.slow) for s in range(2, 8)])
+def test_random_arms_with_generic_twists_match_the_numeric_engine(seed):
+    """Random rows (generic float twists, prismatic joints, fixed rows with inertia, base and tool, both
+    conventions) with random inertia: the polynomial route stays exact enough and quick."""
+    rng = np.random.default_rng(300 + seed)
+    robot = _random_inertial_arm(rng, int(rng.integers(2, 4)))
+    if not any(l.inertia is not None and l.inertia.mass > 0 for l in robot.joints):
+        pytest.skip("no moving mass")
+    _check_against_numeric(robot, lagrangian_dynamics(robot), rng, count=3)
+
+
+@pytest.mark.slow
+def test_mdot_minus_2c_is_skew_by_sympy_differentiation():
+    robot = denavit.load_robot("puma560")
+    t = lagrangian_dynamics(robot)
+    js = joint_symbols(6)
+    params = {parameter_symbols(robot)[k]: v for k, v in robot.parameters}
+    rng = np.random.default_rng(82)
+    q, qd = rng.uniform(-np.pi, np.pi, 6), rng.uniform(-1, 1, 6)
+    point = {**dict(zip(js.q, q)), **dict(zip(js.qd, qd)), **params}
+    Mdot = sum((t.M.diff(js.q[i]) * js.qd[i] for i in range(6)), sp.zeros(6, 6))
+    Nn = np.array((Mdot - 2 * t.C).subs(point).evalf(), dtype=float)
+    np.testing.assert_allclose(Nn + Nn.T, 0, atol=1e-12)
+
+
+def test_planar_3r_is_the_textbook_closed_form_in_relative_angles():
+    """M of the planar 3R (point masses at Lc, rotational inertias I) written by hand, e.g. Spong sec. 7.4."""
+    robot = denavit.load_robot("planar3r-lagrange")
+    t = lagrangian_dynamics(robot)
+    q1, q2, q3 = joint_symbols(3).q
+    L1, L2, Lc1, Lc2, Lc3, m1, m2, m3, I1, I2, I3 = sp.symbols("L1 L2 Lc1 Lc2 Lc3 m1 m2 m3 I1 I2 I3", real=True)
+    c2, c3, c23 = sp.cos(q2), sp.cos(q3), sp.cos(q2 + q3)
+    M33 = I3 + m3 * Lc3 ** 2
+    M23 = M33 + m3 * L2 * Lc3 * c3
+    M22 = I2 + I3 + m2 * Lc2 ** 2 + m3 * (L2 ** 2 + Lc3 ** 2 + 2 * L2 * Lc3 * c3)
+    M13 = M23 + m3 * L1 * Lc3 * c23
+    M12 = M22 + m2 * L1 * Lc2 * c2 + m3 * (L1 * L2 * c2 + L1 * Lc3 * c23)
+    M11 = (I1 + I2 + I3 + m1 * Lc1 ** 2 + m2 * (L1 ** 2 + Lc2 ** 2 + 2 * L1 * Lc2 * c2)
+           + m3 * (L1 ** 2 + L2 ** 2 + Lc3 ** 2 + 2 * L1 * L2 * c2 + 2 * L1 * Lc3 * c23 + 2 * L2 * Lc3 * c3))
+    expected = sp.Matrix([[M11, M12, M13], [M12, M22, M23], [M13, M23, M33]])
+    names = {s.name: s for s in t.M.free_symbols}
+    got = t.M.xreplace({names[k]: v for k, v in zip("L1 L2 Lc1 Lc2 Lc3 m1 m2 m3 I1 I2 I3".split(),
+                                                     (L1, L2, Lc1, Lc2, Lc3, m1, m2, m3, I1, I2, I3)) if k in names})
+    assert sp.expand(got - expected) == sp.zeros(3, 3)  # equal term by term, no trigonometric rewriting
+    assert not t.M.has(sp.Float) and not t.c.has(sp.Float)
+
+
+def test_printed_form_uses_angle_sums_gravity_symbol_and_no_decimals():
+    robot = denavit.load_robot("planar3r-lagrange")  # every inertial value a named parameter
+    text = format_dynamics(lagrangian_dynamics(robot), "text", gravity_symbol=True)
+    body = [line for line in text.splitlines() if "] = " in line]
+    assert body and not any("." in line for line in body)  # 9.81 only in the header, as g
+    assert "g = 9.81 m/s^2" in text and any(line.startswith("g[1] = ") and "g*" in line for line in body)
+    m22 = next(line for line in body if line.startswith("M[2,2] = "))
+    assert "C3" in m22 and "C2" not in m22.replace("C23", "")  # row 2 in the angles after joint 2
+    assert "S23" in text and not any("sin(" in line or "cos(" in line for line in body)
+
+
+@pytest.mark.slow
+def test_long_results_name_their_parameter_groups_and_stay_short():
+    robot = denavit.load_robot("puma560")
+    t = lagrangian_dynamics(robot)
+    text = format_dynamics(t, "text", gravity_symbol=True)
+    assert "P1 = " in text and "x0 = " not in text
+    defs, entries = {}, {}
+    for line in text.splitlines():
+        if " = " in line and not line.startswith(" "):
+            k, v = line.split(" = ", 1)
+            (defs if k.startswith("P") else entries)[k] = v
+    used = " ".join(entries.values())
+    assert defs and all(any(f"{k}{e}" in used + " " for e in "* )+-") for k in defs)  # every group is used
+    assert not any("P" in v for v in defs.values())  # groups are sums of parameters, not of other groups
+    assert len(text) < 20_000
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("pdflatex") is None, reason="no LaTeX engine")
+def test_latex_output_compiles(tmp_path):
+    for name in ("planar3r-lagrange", "puma560"):
+        t = lagrangian_dynamics(denavit.load_robot(name))
+        tex = format_dynamics(t, "latex", include=("M", "C", "c", "g", "friction"), gravity_symbol=True)
+        assert "\\tau_{f,1}" in tex and "\\mathcal{C}_{12}" in tex and "}_{" not in tex.replace("\\mathcal{C}_{", "")
+        doc = ("\\documentclass{article}\\usepackage{amsmath}\\usepackage[paperwidth=200in,paperheight=200in]"
+               "{geometry}\\begin{document}\\[" + tex + "\\]\\end{document}\n")
+        (tmp_path / f"{name}.tex").write_text(doc)
+        run = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", f"{name}.tex"],
+                             cwd=tmp_path, capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0, run.stdout[-2000:]
