@@ -216,11 +216,17 @@ def test_unreachable_scheduler_is_refused_in_bounded_time(monkeypatch):
 
 
 @pytest.mark.parametrize("kw", [{"samples": 0}, {"samples": 10**11}, {"samples": 2.5}, {"chunk": 10},
-                                {"resolution": 1e-6}, {"resolution": -1.0}, {"seed": -3}])
+                                {"resolution": 1e-6}, {"resolution": -1.0}, {"resolution": 1.0}, {"seed": -3}])
 def test_absurd_sizes_are_refused(kw):
     args = {"samples": 1000, "seed": 0, **kw}
     with pytest.raises(ModelError):
         occupancy(denavit.load_robot("puma560"), args.pop("samples"), scheduler="synchronous", **args)
+
+
+def test_progress_line_has_rate_and_eta(capsys):
+    occupancy(denavit.load_robot("planar2r"), 3 * BLOCK, seed=0, scheduler="synchronous", chunk=BLOCK, progress=True)
+    err = capsys.readouterr().err
+    assert "100.0%" in err and "ETA" in err and "samples/s" in err and err.endswith("\n")
 
 
 def test_unlimited_prismatic_joint_is_refused():

@@ -75,6 +75,7 @@ def test_reachability_command(tmp_path):
     (["workspace", "planar2r", "--samples", "nan"], "samples"),
     (["workspace", "planar2r", "--samples", "1" + "0" * 400], "samples"),
     (["workspace", "puma560", "--resolution", "1e-5"], "resolution"),
+    (["workspace", "puma560", "--resolution", "1e6"], "resolution"),
     (["workspace", "planar2r", "--workers", "0"], "workers"),
     (["workspace", "planar2r", "--workers", "100000"], "workers"),
     (["workspace", "planar2r", "--data", "w.txt"], "--data"),

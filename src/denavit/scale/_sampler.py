@@ -207,5 +207,8 @@ def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, 
             raise ModelError(f"resolution {h:g} m gives {cells:.3g} cells along the {2 * R:.4g} m reach box "
                              f"(at most {cap} per side, {MAX_CELLS} in all): use a resolution of at least "
                              f"{2 * R / cap:.3g} m")
-        side, levels = max(1, math.ceil(cells)), 1
+        if cells < MIN_CELLS:
+            raise ModelError(f"resolution {h:g} m leaves {cells:.3g} cells along the {2 * R:.4g} m reach box (at "
+                             f"least {MIN_CELLS}): use a resolution of at most {2 * R / MIN_CELLS:.3g} m")
+        side, levels = math.ceil(cells), 1
     return Job(fk, limits, seed, samples, Grid(centre, basis, h, side, levels), base_origin)
