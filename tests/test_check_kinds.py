@@ -432,7 +432,7 @@ def test_equations_of_motion_of_craigs_two_link_arm():
     (v,) = _v(robot, [{"quantity": "equations_of_motion", "value": _CRAIG_EOM}])
     assert v.verdict == "correct", v.message
     (v,) = _v(robot, [{"quantity": "eom", "q": "0.3, -0.4", "qd": "0, 0", "qdd": "0, 0", "value": [
-        f"(m_1 + m_2) L_1 g \\cos(0.3) + m_2 L_2 g \\cos(-0.1)", "m_2 L_2 g \\cos(-0.1)"]}])
+        "(m_1 + m_2) L_1 g \\cos(0.3) + m_2 L_2 g \\cos(-0.1)", "m_2 L_2 g \\cos(-0.1)"]}])
     assert v.verdict == "correct", v.message
     slip = [_CRAIG_EOM[0], _CRAIG_EOM[1].replace(r"+ m_2 L_1 L_2 s_2 \dot\theta_1^2", r"- m_2 L_1 L_2 s_2 \dot\theta_1^2")]
     (v,) = _v(robot, [{"quantity": "eom", "value": slip}])

@@ -214,7 +214,6 @@ def test_planar_jacobian_correct_accepted_perturbed_named(q, style, rows, flip, 
 def test_seed_report_layouts_are_read():
     """The layouts of the seed reports (values from the textbook DH matrix, not from the reports): equation numbers
     ``\\quad (2)``, ``\\theta_i(t)`` with ``*``, ``T_0^1 = …``, a Bmatrix τ = Jᵀ F with F_1 … F_3."""
-    robot = dn.load_robot(P3)
     a1 = (r"T_0^1 = \begin{bmatrix} \cos \theta_1 & -\sin \theta_1 & 0 & L_1 \cos \theta_1 \\ \sin \theta_1 & "
           r"\cos \theta_1 & 0 & L_1 \sin \theta_1 \\ 0 & 0 & 1 & 0 \\ 0 & 0 & 0 & 1 \end{bmatrix} \quad (2)")
     px = (r"p_x = L_1 * \cos(\theta_1(t)) + L_2 * \cos(\theta_1(t) + \theta_2(t)) + L_3 * \cos(\theta_1(t) + "

@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 
 from ..model import Convention, Frame
-from ._quantities import Point
 
 __all__ = ["hints_for", "MAX_PARAMETER_HINTS"]
 
