@@ -55,8 +55,9 @@ def run_cluster(robot, n, trim: bool) -> str:
         ws = occupancy(robot, n, seed=1, scheduler=client)
         dt = time.perf_counter() - t0
     same = np.array_equal(ws.counts, ref.counts)
-    return (f"LocalCluster(2 processes{', MALLOC_TRIM_THRESHOLD_=1 GiB' if trim else ''}): {n:.0e} samples in {dt:.1f} s ({n / dt:.3g}/s); local process pool "
-            f"(2): {t_ref:.1f} s ({n / t_ref:.3g}/s); identical counts: {same}")
+    note = ", MALLOC_TRIM_THRESHOLD_=1 GiB" if trim else ""
+    return (f"LocalCluster(2 processes{note}): {n:.0e} samples in {dt:.1f} s ({n / dt:.3g}/s); local process "
+            f"pool (2): {t_ref:.1f} s ({n / t_ref:.3g}/s); identical counts: {same}")
 
 
 def run_reach(robot, spec: str, scheduler, workers) -> str:
