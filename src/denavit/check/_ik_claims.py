@@ -303,8 +303,9 @@ def check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.rand
                    "ambiguous: which point is P? With P = (p_x, p_y, p_z) the origin of the last DH frame (the "
                    "default meaning) the formula is wrong; with P the wrist centre (where the last three axes meet) "
                    "it is correct. Add 'point: wrist' to the claim if that is what you meant.",
-                   verdict.entries, verdict.counterexample, verdict.hints, None, alt.method,
-                   {**verdict.extra, "readings": {"flange": "incorrect", "wrist": "correct"}})
+                   (), None, (), None, alt.method,
+                   {**verdict.extra, "readings": {"flange": verdict.message, "wrist": alt.message},
+                    "flange_entries": list(verdict.entries)})
 
 
 def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator,
