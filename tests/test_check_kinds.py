@@ -572,3 +572,18 @@ def test_relation_readers_refuse_what_they_cannot_read():
         assert verdict.verdict == "unreadable", verdict.message
     (v,) = _v(robot, [{"quantity": "relation", "joints": "prismatic", "value": "J_i = [z_{i-1}; 0]"}])
     assert v.verdict == "unreadable" and "no prismatic" in v.message
+
+
+def test_example_ik_file_of_report_003(capsys):
+    """examples/claims/report003-ik.yaml (Spong's decoupling): all correct but the undeclared P, which is ambiguous."""
+    import json
+    from pathlib import Path
+
+    from denavit.cli import main
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "claims" / "report003-ik.yaml"
+    assert main(["check", "elbow-6r-deg", str(path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    verdicts = {c["id"]: c["verdict"] for c in data["claims"]}
+    assert verdicts.pop("q1 written as in the report (P undeclared)") == "ambiguous"
+    assert set(verdicts.values()) == {"correct"}, verdicts

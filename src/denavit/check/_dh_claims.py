@@ -1,8 +1,8 @@
 """``dh_matrix`` claims: the general DH link matrix with symbolic a, α, d, θ.
 
 The person's 4×4 matrix is read with a resolver that knows only the four DH symbols (any subscript: ``a_{i-1}``,
-``\\alpha_{i-1}``, ``d_i``, ``\\theta_i``; shorthand ``c_i``/``s_i``/``c\\theta_i`` for the cosine and sine of θ,
-``c\\alpha``/``s\\alpha`` for α) and compared, at random values of the four, with the numeric engine's
+``\\alpha_{i-1}``, ``d_i``, ``\\theta_i`` or ``q_i``, ``Q_i``; shorthand ``c_i``/``s_i``/``c\\theta_i`` for the
+cosine and sine of θ, ``c\\alpha``/``s\\alpha`` for α) and compared, at random values of the four, with the numeric engine's
 :func:`denavit.numeric.dh_transform` for the convention named in the claim (default: the robot's).
 """
 
@@ -22,7 +22,7 @@ __all__ = ["check_dh_matrix", "N_DH_POINTS"]
 
 #: Random (a, α, d, θ) at which a claimed general DH matrix is compared.
 N_DH_POINTS = 8
-_BASES = {"a": "a", "alpha": "alpha", "d": "d", "theta": "theta", "vartheta": "theta", "r": "a"}
+_BASES = {"a": "a", "alpha": "alpha", "d": "d", "theta": "theta", "vartheta": "theta", "q": "theta", "Q": "theta", "r": "a"}
 _SHORT = {"c": "cos", "C": "cos", "s": "sin", "S": "sin"}
 
 
