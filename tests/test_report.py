@@ -293,12 +293,27 @@ def test_report_dynamics_printed_formulas_equal_the_numeric_library(name):
 
 
 def test_report_dynamics_of_a_long_arm_is_numeric_only():
-    robot = dn.load_robot("puma560")
-    sec = derive(robot, qd=[1] * 6, topics=["dynamics"]).section("dynamics")
+    robot = dn.load_robot("panda")  # 7 joints: more than HAND_FORM_MAX_DOF
+    q = np.array([0, -0.3, 0, -2.2, 0, 2, 0.8])
+    sec = derive(robot, q=list(q), qd=[1] * 7, topics=["dynamics"]).section("dynamics")
     assert not any(isinstance(s, Equation) for s in sec.steps)
-    q = np.array([float(sp.pi / 6)] * 6)
     np.testing.assert_allclose(_numbers(sec, "M(q)")[0].values, N.mass_matrix(robot, q), atol=1e-12)
     assert "DISAGREE" not in " ".join(s.text for s in sec.steps if isinstance(s, Text))
+
+
+def test_report_dynamics_of_a_six_joint_arm_is_in_closed_form_entry_by_entry():
+    """Puma 560: M_jk (j <= k), c_k, g_k as equations (hand form, C_{23}), checked at the case against the
+    numeric engine in the report's own text, without the step-by-step Lagrange derivation."""
+    robot = dn.load_robot("puma560")
+    sec = derive(robot, qd=[1] * 6, topics=["dynamics"]).section("dynamics")
+    lhs = [s.lhs for s in sec.steps if isinstance(s, Equation)]
+    assert lhs[:2] == ["M_{11}", "M_{12}"] and "M_{66}" in lhs and "c_{6}" in lhs and "g_{2}" in lhs
+    assert not any(x.startswith("\\frac{d}{dt}") for x in lhs)
+    assert any("C_{23}" in str(s.expr) for s in sec.steps if isinstance(s, Equation))
+    texts = " ".join(s.text for s in sec.steps if isinstance(s, Text))
+    assert texts.count("agree") >= 4 and "DISAGREE" not in texts
+    q = np.array([float(sp.pi / 6)] * 6)
+    np.testing.assert_allclose(_numbers(sec, "M(q)")[0].values, N.mass_matrix(robot, q), atol=1e-12)
 
 
 CHROMIUM = os.environ.get("DENAVIT_CHROMIUM", "/usr/bin/chromium")

@@ -3,8 +3,9 @@
 For a small arm (at most :data:`SYMBOLIC_MAX_DOF` joints) the Euler–Lagrange derivation is printed step by step
 as a person writes it (Spong, Hutchinson & Vidyasagar 2006, sec. 7.1–7.4): the centre of mass p_c of each
 link and its velocity, ω, the kinetic and potential energies, L = K − P, ∂L/∂q̇_k, d/dt ∂L/∂q̇_k, ∂L/∂q_k and
-τ_k, then the split τ = M(q) q̈ + c(q, q̇) + g(q) (+ friction).  Longer arms get M, c, g at the numeric case
-only (a symbolic 7-joint derivation takes minutes).  The numbers at the case come from the numeric engine
+τ_k, then the split τ = M(q) q̈ + c(q, q̇) + g(q) (+ friction).  Arms of up to :data:`HAND_FORM_MAX_DOF`
+joints get M, c, g in closed form entry by entry (``lagrangian_dynamics``, hand form); longer ones (7 joints:
+entries of pages) M, c, g at the numeric case only.  The numbers at the case come from the numeric engine
 (CRBA mass matrix, Christoffel c, gravity torques); the symbolic results evaluated at the same point are
 compared with them, and c + g is compared with the recursive Newton–Euler torques at q̈ = 0 (Craig 2005,
 sec. 6.5): independent routes.
@@ -21,9 +22,10 @@ from . import _capabilities
 from ._context import Context
 from ._derivation import Equation, Numbers, Section, Text
 
-__all__ = ["section_dynamics", "SYMBOLIC_MAX_DOF", "symbolic_terms_at"]
+__all__ = ["section_dynamics", "SYMBOLIC_MAX_DOF", "HAND_FORM_MAX_DOF", "symbolic_terms_at"]
 
 SYMBOLIC_MAX_DOF = 3
+HAND_FORM_MAX_DOF = 6  # M, c, g in closed form (lagrangian_dynamics, ~1 s for a 6-joint arm) up to this many joints
 AGREE_TOL = 1e-9
 
 
@@ -103,11 +105,15 @@ def _symbolic(ctx: Context, steps: list) -> Any:
         steps.append(Text("The symbolic Lagrange derivation is not available in this installation."))
         return None
     if robot.dof > SYMBOLIC_MAX_DOF:
-        steps.append(Text(f"The symbolic Lagrange derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints; "
-                          f"for {robot.dof} joints it runs to pages and takes minutes (the function "
-                          "lagrangian_dynamics of denavit.symbolic derives it). Shown instead: the same quantities "
-                          "at the numeric case, from the numeric engine: the energies $K$ and $P$, then $M$, $C$, "
-                          "$c$ and $g$, with $c + g$ checked against the recursive Newton-Euler torques."))
+        hand = _capabilities.capability("denavit.symbolic", "lagrangian_dynamics")
+        if hand is not None and robot.dof <= HAND_FORM_MAX_DOF:
+            return _hand_form(ctx, steps, hand)
+        steps.append(Text(f"The symbolic Lagrange derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints, "
+                          f"and M, c, g in closed form for at most {HAND_FORM_MAX_DOF}; for {robot.dof} joints the "
+                          "entries run to pages (the function lagrangian_dynamics of denavit.symbolic derives them, "
+                          "in under a minute). Shown instead: the same quantities at the numeric case, from the "
+                          "numeric engine: the energies $K$ and $P$, then $M$, $C$, $c$ and $g$, with $c + g$ "
+                          "checked against the recursive Newton-Euler torques."))
         return None
     try:
         st = found[1](robot, ctx.simplify)
@@ -125,6 +131,44 @@ def _symbolic(ctx: Context, steps: list) -> Any:
         steps.append(_eq(ctx, "C(q, \\dot q)", t.C))
     steps.append(_eq(ctx, "c(q, \\dot q)", t.c))
     steps.append(_eq(ctx, "g(q)", t.g))
+    if any(e != 0 for e in t.friction):
+        steps.append(_eq(ctx, "\\tau_f(\\dot q)", t.friction))
+    return t
+
+
+def _hand_form(ctx: Context, steps: list, found) -> Any:
+    """M, c, g of a longer arm in closed form, entry by entry (no step-by-step Lagrange derivation)."""
+    from ..symbolic import shorthand
+
+    robot = ctx.robot
+    try:
+        t = found[1](robot, "trig", coriolis=False)
+    except Exception as exc:  # another area's function: report, do not crash the report
+        steps.append(Text(f"The symbolic dynamics ({found[0]}) failed: {type(exc).__name__}: {exc}."))
+        return None
+    steps.append(Text(f"For {robot.dof} joints the step-by-step Lagrange derivation runs to pages; M, c and g are "
+                      "given in closed form instead, entry by entry (the same Lagrange equations written with "
+                      "Jacobians, $M = \\sum m J_v^T J_v + J_\\omega^T I J_\\omega$, $g = -\\sum m J_v^T g_0$, "
+                      "$c$ from the Christoffel symbols of $M$; Spong et al. 2006, sec. 7.3). Consecutive joints "
+                      "with parallel axes use angle sums ($C_{23} = \\cos(q_2 + q_3)$); row $j$ of $M$ is written in "
+                      "the angles after joint $j$, on which it alone depends. $M$ is symmetric: $M_{kj} = M_{jk}$."))
+
+    def entry(lhs: str, e: Any) -> None:
+        if ctx.too_long(e):
+            steps.append(Text(f"(${lhs}$ is too long to print usefully.)"))
+            return
+        e = e.xreplace({r: sp.Float(r, 6) for r in e.atoms(sp.Rational) if r.q > 12})  # 0.0202, not 2527/125000
+        e = shorthand(e, ctx.syms.q, collapse=False)
+        steps.append(Equation(lhs, sp.latex(e, symbol_names=_dot_names(e, robot.dof)), shorthand=True))
+
+    n = robot.dof
+    for j in range(n):
+        for k in range(j, n):
+            entry(f"M_{{{j + 1}{k + 1}}}", t.M[j, k])
+    for k in range(n):
+        entry(f"c_{{{k + 1}}}", t.c[k])
+    for k in range(n):
+        entry(f"g_{{{k + 1}}}", t.g[k])
     if any(e != 0 for e in t.friction):
         steps.append(_eq(ctx, "\\tau_f(\\dot q)", t.friction))
     return t
