@@ -358,3 +358,65 @@ def test_without_numba_compile_falls_back_to_numpy(monkeypatch):
     np.testing.assert_allclose(fast.fk(np.ones(3)), denavit.forward_kinematics(robot, np.ones(3)), atol=1e-14)
     with pytest.raises(MissingDependencyError, match="fast"):
         denavit.compile(robot, backend="numba")
+
+
+def _same_analytic(a, b):
+    assert a.solutions.shape == b.solutions.shape
+    np.testing.assert_allclose(a.solutions, b.solutions, atol=1e-9)
+    assert np.array_equal(np.asarray(a.branches, dtype=object), np.asarray(b.branches, dtype=object))
+    assert np.array_equal(np.asarray(a.free, dtype=object), np.asarray(b.free, dtype=object))
+    np.testing.assert_allclose(np.asarray(a.outside_limits), np.asarray(b.outside_limits), atol=1e-9)
+    assert a.method == b.method and a.controlled == b.controlled
+
+
+@needs_numba
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["puma560", "puma560-mdh"])
+def test_compiled_analytic_ik_equals_the_plain_solver(name):
+    """Every solution, label and out-of-limits solution of denavit.analytic_ik, pose by pose: at random poses
+    (the compiled closed form answers) and at singular ones (it hands them to the plain solver)."""
+    from denavit.numeric import ik_plan
+
+    robot = denavit.load_robot(name)
+    assert ik_plan(robot).closed is not None  # the elbow + spherical-wrist class
+    fast = denavit.compile(robot)
+    rng = np.random.default_rng(31)
+    lim = robot.q_limits
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (150 if REDUCED else 600, robot.dof))
+    singular = Q[:40].copy()
+    singular[:10, 4] = 0.0  # wrist: axes 4 and 6 aligned
+    singular[10:20, 2] = np.arctan2(robot.links[3].d, robot.links[2].a) if name == "puma560" else 0.0  # stretched
+    singular[20:40] = np.round(singular[20:40], 1)
+    for k, q in enumerate(np.concatenate([Q, singular])):
+        T = denavit.forward_kinematics(robot, q)
+        a, b = fast.analytic_ik(T), denavit.analytic_ik(robot, T)
+        _same_analytic(a, b)
+        if k < len(Q):
+            assert a.count >= 1  # q itself is a solution (inside the limits)
+    batch = denavit.forward_kinematics(robot, Q[:5])
+    _same_analytic(fast.analytic_ik(batch), denavit.analytic_ik(robot, batch))  # a batch: the plain path
+
+
+@needs_numba
+@pytest.mark.slow
+def test_compiled_analytic_ik_other_arms_and_bad_input():
+    from denavit.errors import UnsupportedRobotError
+
+    for name in ("stanford", "ur5"):  # closed forms of other classes: answered by the plain solver
+        robot = denavit.load_robot(name)
+        fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+        T = denavit.forward_kinematics(robot, np.full(robot.dof, 0.3))
+        _same_analytic(fast.analytic_ik(T), denavit.analytic_ik(robot, T))
+    panda = denavit.compile(denavit.load_robot("panda"), kernels=["fk", "fk_jacobian0"])
+    with pytest.raises(UnsupportedRobotError):
+        panda.analytic_ik(np.eye(4))
+    fast = denavit.compile(denavit.load_robot("puma560"))
+    bad = np.eye(4)
+    bad[0, 1] = 0.5
+    with pytest.raises(ShapeError, match="orthonormal"):
+        fast.analytic_ik(bad)
+    with pytest.raises(ShapeError, match="non-finite"):
+        fast.analytic_ik(np.full((4, 4), np.inf))
+    far = np.eye(4)
+    far[:3, 3] = (9.0, 0.0, 0.0)
+    assert fast.analytic_ik(far).count == 0

@@ -15,11 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, IKResult, JointLimits, characteristic_length,
-                       row_mask, solve_ik)
+from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, AnalyticIKResult, IKResult, JointLimits,
+                       analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik)
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from ._emit import NUMBA, NUMPY, python_module
+from ._ik_elbow import ELBOW_LAYOUT
 from ._kernels import DYNAMICS, KERNEL_NAMES, has_dynamics as _has_dynamics, trace_kernels
 
 __all__ = ["compile", "CompiledRobot", "cache_dir", "numba_available", "robot_key", "GENERATOR_VERSION"]
@@ -68,7 +69,7 @@ _FALLBACK: Path | None = None
 #: Part of every cache key, with a digest of the sources that shape the generated code (the generator, the
 #: chain walker, the dynamics kernels): a changed generator never reads a stale module.
 GENERATOR_VERSION = "1"
-_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
+_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_ik_elbow.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
             "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py")
 _DIGEST: list[str] = []
 
@@ -152,6 +153,7 @@ def _as_batch(arrays, n: int, names):
 
 
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
+_NO_SEEDS = np.zeros((0, 1))
 
 
 class CompiledRobot:
@@ -169,6 +171,7 @@ class CompiledRobot:
         self._one = {name: (getattr(module, f"{name}_1"), self._shapes[name]) for name in names}
         self._vec, self._jshape, self._mshape, self._fshape = (n,), (6, n), (n, n), (n + 1,)
         self._ik_constants = None
+        self._elbow = None
         for name in self._shapes:  # bound kernels for the hot paths; a missing one raises the clear error
             if name not in self._one:
                 setattr(self, f"_{name}_1", self._missing(name))
@@ -425,6 +428,49 @@ class CompiledRobot:
                             str(reason[0]))
         return IKResult(q_out.reshape(batch + (n,)), success.reshape(batch), pe.reshape(batch), re.reshape(batch),
                         iters.reshape(batch), used.reshape(batch), reason.reshape(batch))
+
+    def analytic_ik(self, T) -> AnalyticIKResult:
+        """Every closed-form solution of one pose: as :func:`denavit.analytic_ik` (same result), in machine code
+        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms).
+
+        Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
+        polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
+        (its batched path is already the fast one) and arms of other classes.
+        """
+        c = self._elbow
+        if c is None:
+            plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
+            if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
+                c = self._elbow = False
+            else:
+                k = dict(plan.closed)
+                lim = self.robot.q_limits
+                k.update(lo=lim[:, 0], hi=lim[:, 1],
+                         revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
+                K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
+                assert K.size == sum(size for _, size in ELBOW_LAYOUT)
+                c = self._elbow = [K, k["labels"], plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
+        Ta = np.asarray(T, dtype=np.float64)
+        if c is False or Ta.shape != (4, 4):
+            return analytic_ik(self.robot, T)
+        K, labels, kind, check, solve, first = c
+        Tf = np.ascontiguousarray(Ta).reshape(1, 4, 4)
+        err = check(Tf, _NO_SEEDS)
+        if err > 1e-6:
+            raise ShapeError("T has non-finite values" if err == np.inf else
+                             f"T: rotation part is not orthonormal (error {err:.2g})")
+        f = np.empty((1, 8, 14))  # solutions (6), residuals (2), outside-limits solutions (6)
+        i = np.empty((1, 11), dtype=np.int64)  # label codes (8), then kept, outside, status
+        solve(Tf, K, f, i)
+        if first:  # numba compiled (or loaded) them on this first call: call their machine code from now on
+            c[3] = next(iter(self._m.ik_check.overloads.values())).entry_point
+            c[4] = next(iter(self._m.ik_elbow_packed.overloads.values())).entry_point
+            c[5] = False
+        if i[0, 10]:
+            return analytic_ik(self.robot, T)
+        k, j = int(i[0, 8]), int(i[0, 9])
+        return AnalyticIKResult(f[0, :k, :6], tuple(labels[i[0, :k]]), ("",) * k, f[0, :k, 6], f[0, :k, 7],
+                                f[0, :j, 8:], kind, "pose", np.ones(k, dtype=bool))
 
     def _singular(self):
         raise ModelError(f"robot {self.robot.name!r}: the mass matrix is singular at this configuration "

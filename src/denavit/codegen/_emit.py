@@ -218,9 +218,11 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     for spec in specs.values():
         body += _numba_kernel(spec) if backend == NUMBA else _python_kernel(spec)
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
+        from ._ik_elbow import IK_ELBOW_SOURCE
         from ._ik_lm import IK_LM_SOURCE
 
         body.append(IK_LM_SOURCE)
+        body.append(IK_ELBOW_SOURCE)
     return "\n".join(head + body).rstrip() + "\n"
 
 

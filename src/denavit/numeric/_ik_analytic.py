@@ -24,8 +24,9 @@ from ._ik_plans import Plan, make_plan
 from ._ik_kernel import kernel_of, targets_soa
 from ._kinematics import forward_kinematics
 
-__all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure"]
+__all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure", "ik_plan"]
 
+SHOULDER, ELBOW, WRIST = ("shoulder right", "shoulder left"), ("elbow up", "elbow down"), ("wrist noflip", "wrist flip")
 VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
 POLISH_STEPS = 30
 DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
@@ -103,7 +104,21 @@ def _plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Pl
 
 @lru_cache(maxsize=64)
 def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
-    return make_plan(robot, closed_form, general)
+    plan = make_plan(robot, closed_form, general)
+    if plan.closed is not None:  # what the compiled solver needs besides the geometry (denavit.codegen)
+        from ._ik_closed import FREE_TOL, RATIO_TOL
+        from ._ik_subproblems import AXES_ALIGNED_TOL
+
+        plan.closed.update(labels=_label_table((SHOULDER, ELBOW, WRIST)),
+                           theta=np.array([l.theta for l in robot.joints], float),
+                           tols=np.array([FREE_TOL, RATIO_TOL, VERIFY_TOL, POLISH_ABOVE, DUPLICATE_TOL, MERGE_RADIUS,
+                                          AXES_ALIGNED_TOL, _reach(robot)], float))
+    return plan
+
+
+def ik_plan(robot: DHRobot) -> Plan:
+    """The closed-form plan of ``robot`` (kind, route, solver; raises UnsupportedRobotError if none)."""
+    return _plan(robot, True)
 
 
 def _chain(robot: DHRobot):
@@ -462,7 +477,7 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
         x1, _, _, S = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
         if rev[0]:  # measured from axis 1 (not from S, which a shoulder offset a1 moves along x1)
             O1 = chain.consts[0][:3, 3][:, None, None]  # a point of axis 1
-            parts.append((np.sum(x1 * (X - O1), axis=0) >= 0, "shoulder right", "shoulder left"))
+            parts.append((np.sum(x1 * (X - O1), axis=0) >= 0, *SHOULDER))
         if n >= 3 and rev[1] and rev[2]:
             # in the plane normal to axis 2 the two elbows are mirror images across the line from the shoulder S
             # to the point W the joints 2-3 place (the wrist centre; UR: a point of axis 4, parallel to axis 2):
@@ -473,9 +488,9 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
             up = chain.consts[0][:3, 2][:, None, None]
             nrm = np.cross(a2, W - S, axis=0)
             towards = np.where(np.sum(up * nrm, axis=0) >= 0, 1.0, -1.0)
-            parts.append((np.sum((E - S) * nrm, axis=0) * towards >= 0, "elbow up", "elbow down"))
+            parts.append((np.sum((E - S) * nrm, axis=0) * towards >= 0, *ELBOW))
         if n == 6 and rev[4] and plan.kind.startswith(("pieper", "parallel")):
-            parts.append((np.sin(qq[..., 4] + theta[4]) >= 0, "wrist noflip", "wrist flip"))
+            parts.append((np.sin(qq[..., 4] + theta[4]) >= 0, *WRIST))
     elif plan.kind == "planar":
         r = np.flatnonzero(rev)
         parts.append((np.sin(qq[..., r[1]] + theta[r[1]]) >= 0, "elbow up", "elbow down"))

@@ -33,7 +33,7 @@ from ._ik_subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_a
                               trig_coefficients)
 from ._transforms import inverse_transform
 
-__all__ = ["Plan", "make_plan"]
+__all__ = ["Plan", "make_plan", "elbow_constants"]
 
 GEOM_TOL = 1e-9  # relative tolerance of the structural tests (axes parallel / through one point)
 
@@ -48,6 +48,8 @@ class Plan:
     point_e: np.ndarray | None = None  # wrist / reference point in the end-effector frame, for labels
     notes: list[str] = field(default_factory=list)
     route: str = ""  # how joints 1-3 of a Pieper arm are found: "closed form (elbow|stanford)" or "resultant"
+    closed: dict | None = None  # the constants of a direct (unmirrored, unmerged) elbow Pieper arm: the compiled
+    # solver of denavit.codegen reads them (see elbow_constants)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -189,7 +191,22 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
         B = len(T)
         return q.reshape(B, -1, 6), free.reshape(B, -1)
 
+    solve.closed = None
+    if fast is not None and fast.kind == "elbow":
+        solve.closed = elbow_constants(chain, fast, X_e, C0i, R4, R5, R6)
     return solve, X_e, (f"closed form ({fast.kind})" if fast is not None else "resultant")
+
+
+def elbow_constants(chain: Chain, pos, X_e, C0i, R4, R5, R6) -> dict:
+    """Everything the elbow + spherical-wrist closed form needs, as float arrays (for the compiled solver)."""
+    r, u = R4[2, :], R5[:, 2]
+    a, b, _ = rz_bilinear(r, u)
+    br, bu = np.arctan2(np.hypot(r[0], r[1]), r[2]), np.arctan2(np.hypot(u[0], u[1]), u[2])
+    scalars = [pos.h, pos.na, pos.nb, pos.base, pos.L, float(np.hypot(a, b)), float(np.arctan2(b, a)), br, bu]
+    return dict(X_e=np.array(X_e, float), C0i=np.array(C0i, float), R6=np.array(R6, float), R1=pos.R1.copy(),
+                p1=pos.p1.copy(), a=pos.a.copy(), R2=pos.R2.copy(), p2=pos.p2.copy(), P=pos.P.copy(),
+                consts=np.array(chain.consts[:4], float), R4=np.array(R4, float), R5=np.array(R5, float),
+                scalars=np.array(scalars, float))
 
 
 def _free_q3(chain: Chain, q123: np.ndarray, Y: np.ndarray, R4: np.ndarray, R5: np.ndarray, samples: int = 24):
@@ -521,6 +538,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
     eye = np.eye(6)
     all_rev = not chain.prismatic.any()
     solve, point, kind, P, route = None, None, "", eye, ""
+    closed = None
     if general:
         if m != 6 or not all_rev:
             raise UnsupportedRobotError(f"{robot.name}: the general solver takes 6 revolute joints")
@@ -533,6 +551,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
         if not chain.prismatic[3:].any() and _intersect(chain, (3, 4, 5), rng):
             solve, point, route = _pieper(chain, rng, names, tuple(lim[reps[2]]), closed_form)
             kind = "pieper"
+            closed = solve.closed if not groups else None
         elif not chain.prismatic[:3].any() and _intersect(chain, (0, 1, 2), rng):
             s, _, route = _pieper(rev, rng, rnames, tuple(-lim[reps[3]][::-1]), closed_form)
             solve, kind = _mirrored(s), "pieper (mirrored: spherical joint at the base)"
@@ -590,4 +609,4 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
             free = _free_text(~named_free, text, free)
         return expand(q), free
 
-    return Plan(kind, P, run, point, [coaxial] if coaxial else [], route)
+    return Plan(kind, P, run, point, [coaxial] if coaxial else [], route, closed)

@@ -1,0 +1,305 @@
+"""Analytic IK on the generated kernels: the elbow + spherical-wrist closed form in numba.
+
+The same formulas as :class:`denavit.numeric._ik_closed.ElbowPosition` and ``wrist_angles`` (Craig 3rd ed.
+Sec. 4.7; Paden–Kahan subproblems 1 and 2; the digit-keeping half-angle forms of those modules), for the eight
+candidates of one pose at a time, each verified by the arm's compiled FK, folded into the joint limits, merged
+when equal and labelled (shoulder, elbow, wrist: the tests of docs/ik.md).
+
+Every case the plain solver treats specially is handed back to it (``status`` 1): a joint left free by the
+pose (wrist centre on axis 1 or 2, wrist axes aligned), a root next to a double root (|ratio| near 1), a
+candidate that would need polishing, or two solutions closer than the merge radius.  The compiled path answers
+only where its answer is the plain solver's.  The text below is appended to each generated numba module of an
+arm whose IK plan is this closed form; it calls that module's ``fk_1``; nothing of the robot or the user is
+pasted into it.
+"""
+
+from __future__ import annotations
+
+__all__ = ["IK_ELBOW_SOURCE", "ELBOW_LAYOUT"]
+
+#: The constants of ``ik_elbow_packed``'s vector K, in order, with their sizes (181 numbers for a 6R arm).
+ELBOW_LAYOUT = (("X_e", 3), ("C0i", 16), ("R6", 9), ("R1", 9), ("p1", 3), ("a", 3), ("R2", 9), ("p2", 3), ("P", 3),
+                ("consts", 64), ("R4", 9), ("R5", 9), ("scalars", 9), ("lo", 6), ("hi", 6), ("revolute", 6),
+                ("theta", 6), ("tols", 8))
+
+IK_ELBOW_SOURCE = '''
+
+@njit(cache=True, nogil=True)
+def _elbow_half_angle(lo, hi, tol):
+    """x with (1 - cos x)/2 = lo, (1 + cos x)/2 = hi, from the smaller one; NaN when out of range."""
+    if lo < -0.5 * tol or hi < -0.5 * tol:
+        return np.nan
+    if lo <= hi:
+        return 2.0 * math.asin(math.sqrt(min(1.0, max(0.0, lo))))
+    return math.pi - 2.0 * math.asin(math.sqrt(min(1.0, max(0.0, hi))))
+
+
+@njit(cache=True, nogil=True)
+def ik_elbow_packed(T, K, f, i):
+    """:func:`ik_elbow` with the constants packed in one vector K (ELBOW_LAYOUT order) and the outputs in two
+    arrays (f: solutions, residuals, outside-limits solutions; i: label codes, then k, j, status): four
+    arguments instead of twenty-three to unbox per call."""
+    X_e, C0i, R6 = K[0:3], K[3:19].reshape((4, 4)), K[19:28].reshape((3, 3))
+    R1, p1, a = K[28:37].reshape((3, 3)), K[37:40], K[40:43]
+    R2, p2, P = K[43:52].reshape((3, 3)), K[52:55], K[55:58]
+    consts = K[58:122].reshape((4, 4, 4))
+    R4, R5, sc = K[122:131].reshape((3, 3)), K[131:140].reshape((3, 3)), K[140:149]
+    lo_lim, hi_lim, rev, theta, tols = K[149:155], K[155:161], K[161:167], K[167:173], K[173:181]
+    ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, rev, theta, tols,
+             f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:])
+
+
+@njit(cache=True, nogil=True)
+def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, revolute, theta, tols,
+             out_q, out_err, out_label, out_outq, out_status):
+    """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
+    residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
+    solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide)."""
+    h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
+    free_tol, ratio_tol, verify_tol, polish_above, dup_tol, merge_r, aligned_tol = (
+        tols[0], tols[1], tols[2], tols[3], tols[4], tols[5], tols[6])
+    tiny = free_tol * L
+    reach = tols[7]
+    F = np.empty((4, 4))
+    q = np.empty(6)
+    cand = np.empty((8, 6))
+    cerr = np.empty((8, 2))
+    ok = np.zeros(8, dtype=np.bool_)
+    inside = np.zeros(8, dtype=np.bool_)
+    used = np.zeros(8, dtype=np.bool_)
+    Xw, W, Y, M = np.empty(3), np.empty(3), np.empty((3, 3)), np.empty((3, 3))
+    cx, cy, cz = np.empty(3), np.empty(3), np.empty(3)
+    x1, y1c, z1, S, E, dW = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    for b in range(T.shape[0]):
+        status = 0
+        # wrist centre and the target rotation without the last constant
+        for i in range(3):
+            Xw[i] = T[b, i, 0] * X_e[0] + T[b, i, 1] * X_e[1] + T[b, i, 2] * X_e[2] + T[b, i, 3]
+        for i in range(3):
+            W[i] = C0i[i, 0] * Xw[0] + C0i[i, 1] * Xw[1] + C0i[i, 2] * Xw[2] + C0i[i, 3]
+        for i in range(3):
+            for j in range(3):
+                Y[i, j] = T[b, i, 0] * R6[j, 0] + T[b, i, 1] * R6[j, 1] + T[b, i, 2] * R6[j, 2]
+        # shoulder: (Rz(q1) a).W = h
+        c = h - a[2] * W[2]
+        A = a[0] * W[0] + a[1] * W[1]
+        Bq = a[0] * W[1] - a[1] * W[0]
+        rho = math.hypot(A, Bq)
+        if (math.hypot(W[0], W[1]) < tiny and abs(c) < tiny) or rho <= 1e-12:
+            status = 1
+        ratio = c / rho if rho > 1e-12 else 2.0
+        if abs(abs(ratio) - 1.0) < 1e-6:
+            status = 1  # next to a double root: the plain solver polishes and looks for partners
+        ncand = 0
+        for k in range(8):
+            ok[k] = False
+        if status == 0 and abs(ratio) <= 1.0 + ratio_tol:
+            base1 = math.atan2(Bq, A)
+            delta = math.acos(min(1.0, max(-1.0, ratio)))
+            for s1 in range(2):
+                q1 = base1 + delta if s1 == 0 else base1 - delta
+                c1, s1v = math.cos(q1), math.sin(q1)
+                d0 = c1 * W[0] + s1v * W[1] - p1[0]
+                d1 = -s1v * W[0] + c1 * W[1] - p1[1]
+                d2 = W[2] - p1[2]
+                g0 = d0 * R1[0, 0] + d1 * R1[1, 0] + d2 * R1[2, 0]
+                g1 = d0 * R1[0, 1] + d1 * R1[1, 1] + d2 * R1[2, 1]
+                G = math.hypot(g0, g1)
+                den = 4.0 * na * nb
+                sm, df = na + nb, abs(na - nb)
+                x = _elbow_half_angle((sm - G) * (sm + G) / den, (G - df) * (G + df) / den, ratio_tol)
+                if x != x:
+                    continue
+                if x < 1e-6 or math.pi - x < 1e-6:
+                    status = 1  # folded or stretched elbow: a double root
+                for s3 in range(2):
+                    q3 = base3 + x if s3 == 0 else base3 - x
+                    c3, s3v = math.cos(q3), math.sin(q3)
+                    u0, u1 = c3 * P[0] - s3v * P[1], s3v * P[0] + c3 * P[1]
+                    vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
+                    vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
+                    if math.hypot(vx, vy) < tiny:
+                        status = 1
+                    q2 = math.atan2(g1, g0) - math.atan2(vy, vx)
+                    # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
+                    for i in range(3):
+                        cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
+                    for kk in range(3):
+                        qk = q1 if kk == 0 else (q2 if kk == 1 else q3)
+                        ck, sk = math.cos(qk), math.sin(qk)
+                        for i in range(3):
+                            xi, yi = cx[i], cy[i]
+                            cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
+                        C = consts[kk + 1]
+                        for i in range(3):
+                            xi, yi, zi = cx[i], cy[i], cz[i]
+                            cx[i] = xi * C[0, 0] + yi * C[1, 0] + zi * C[2, 0]
+                            cy[i] = xi * C[0, 1] + yi * C[1, 1] + zi * C[2, 1]
+                            cz[i] = xi * C[0, 2] + yi * C[1, 2] + zi * C[2, 2]
+                    for j in range(3):
+                        M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
+                        M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
+                        M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
+                    # wrist: r^T Rz(qb) u = M_zz (half-angle form), qa onto M e_z, qc from the x-row
+                    if rho_w < 1e-12:
+                        status = 1
+                        continue
+                    phi = math.atan2(math.hypot(M[0, 2], M[1, 2]), M[2, 2])
+                    dm, smw = br - bu, br + bu
+                    xw = _elbow_half_angle(math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w,
+                                           math.sin((smw + phi) / 2) * math.sin((smw - phi) / 2) / rho_w, ratio_tol)
+                    if xw != xw:
+                        continue
+                    for s5 in range(2):
+                        qb = base_w + xw if s5 == 0 else base_w - xw
+                        cb, sb = math.cos(qb), math.sin(qb)
+                        # v = Ra Rz(qb) u, u = Rb e_z
+                        ux, uy, uz = R5[0, 2], R5[1, 2], R5[2, 2]
+                        rx, ry = cb * ux - sb * uy, sb * ux + cb * uy
+                        v0 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * uz
+                        v1 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * uz
+                        if math.hypot(v0, v1) < aligned_tol:
+                            status = 1  # wrist singular: a continuum
+                        qa = math.atan2(M[1, 2], M[0, 2]) - math.atan2(v1, v0)
+                        ca, sa = math.cos(qa), math.sin(qa)
+                        y0 = ca * M[0, 0] + sa * M[1, 0]
+                        y1 = -sa * M[0, 0] + ca * M[1, 0]
+                        n2 = M[2, 0]
+                        ex, ey, ez = R5[0, 0], R5[1, 0], R5[2, 0]
+                        rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
+                        x00 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * ez
+                        x01 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * ez
+                        x02 = R4[2, 0] * rx + R4[2, 1] * ry + R4[2, 2] * ez
+                        ex, ey, ez = R5[0, 1], R5[1, 1], R5[2, 1]
+                        rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
+                        x10 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * ez
+                        x11 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * ez
+                        x12 = R4[2, 0] * rx + R4[2, 1] * ry + R4[2, 2] * ez
+                        N00 = x00 * y0 + x01 * y1 + x02 * n2
+                        N10 = x10 * y0 + x11 * y1 + x12 * n2
+                        qc = math.atan2(N10, N00)
+                        cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
+                        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
+                        ncand += 1
+        # verify each candidate by the FK
+        for k in range(ncand):
+            for j in range(6):
+                q[j] = cand[k, j]
+            fk_1(q, F)
+            pe = math.sqrt((F[0, 3] - T[b, 0, 3]) ** 2 + (F[1, 3] - T[b, 1, 3]) ** 2 + (F[2, 3] - T[b, 2, 3]) ** 2)
+            # rotation error: angle of R_t R^T
+            tr = 0.0
+            for i in range(3):
+                for j in range(3):
+                    tr += T[b, i, j] * F[i, j]
+            v0 = 0.0
+            v1 = 0.0
+            v2 = 0.0
+            for j in range(3):
+                v0 += T[b, 2, j] * F[1, j] - T[b, 1, j] * F[2, j]
+                v1 += T[b, 0, j] * F[2, j] - T[b, 2, j] * F[0, j]
+                v2 += T[b, 1, j] * F[0, j] - T[b, 0, j] * F[1, j]
+            re = math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0))
+            cerr[k, 0], cerr[k, 1] = pe, re
+            size = pe + reach * re
+            if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
+                status = 1  # would be polished by the plain solver
+            ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
+        # fold into the limits; duplicates (and near-duplicates) decided as the plain solver does
+        for k in range(ncand):
+            if not ok[k]:
+                continue
+            ins = True
+            for j in range(6):
+                x = cand[k, j]
+                if revolute[j] != 0.0:
+                    x = math.pi - ((math.pi - x) % (2.0 * math.pi))
+                    if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
+                        x += 2.0 * math.pi
+                    if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
+                        x -= 2.0 * math.pi
+                cand[k, j] = x
+                ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
+            inside[k] = ins
+            for m in range(k):
+                if not ok[m]:
+                    continue
+                dmax = 0.0
+                for j in range(6):
+                    d = abs(cand[k, j] - cand[m, j])
+                    if revolute[j] != 0.0:
+                        d = abs(d - 2.0 * math.pi * np.rint(d / (2.0 * math.pi)))
+                    dmax = max(dmax, d)
+                if dmax < dup_tol:
+                    ok[k] = False
+                    break
+                if dmax < merge_r:
+                    status = 1  # the plain solver merges such a pair by the FK of its midpoint
+        kept = 0
+        n_out = 0
+        for k in range(ncand):
+            if ok[k] and not inside[k]:
+                for j in range(6):
+                    out_outq[b, n_out, j] = cand[k, j]
+                n_out += 1
+                ok[k] = False
+            elif ok[k]:
+                kept += 1
+        # sorted lexicographically (as the plain solver returns one pose), with labels
+        for k in range(8):
+            used[k] = False
+        for slot in range(kept):
+            best = -1
+            for k in range(ncand):
+                if ok[k] and not used[k]:
+                    if best < 0:
+                        best = k
+                    else:
+                        for j in range(6):
+                            if cand[k, j] != cand[best, j]:
+                                if cand[k, j] < cand[best, j]:
+                                    best = k
+                                break
+            used[best] = True
+            for j in range(6):
+                out_q[b, slot, j] = cand[best, j]
+            out_err[b, slot, 0], out_err[b, slot, 1] = cerr[best, 0], cerr[best, 1]
+            # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5))
+            q1 = cand[best, 0]
+            c1, s1v = math.cos(q1), math.sin(q1)
+            code = 0
+            # frame after joint 1: columns of C0 Rz(q1) C1
+            for i in range(3):
+                xi, yi = consts[0, i, 0], consts[0, i, 1]
+                rx, ry, rz = c1 * xi + s1v * yi, c1 * yi - s1v * xi, consts[0, i, 2]
+                x1[i] = rx * consts[1, 0, 0] + ry * consts[1, 1, 0] + rz * consts[1, 2, 0]
+                y1c[i] = rx * consts[1, 0, 1] + ry * consts[1, 1, 1] + rz * consts[1, 2, 1]
+                z1[i] = rx * consts[1, 0, 2] + ry * consts[1, 1, 2] + rz * consts[1, 2, 2]
+                S[i] = consts[0, i, 3] + rx * consts[1, 0, 3] + ry * consts[1, 1, 3] + rz * consts[1, 2, 3]
+            s_right = 0.0
+            for i in range(3):
+                s_right += x1[i] * (Xw[i] - consts[0, i, 3])
+            if s_right < 0.0:
+                code |= 1
+            # a point of axis 3: origin of C0 Rz(q1) C1 Rz(q2) C2
+            q2 = cand[best, 1]
+            c2, s2v = math.cos(q2), math.sin(q2)
+            for i in range(3):
+                rx, ry = c2 * x1[i] + s2v * y1c[i], c2 * y1c[i] - s2v * x1[i]
+                E[i] = S[i] + rx * consts[2, 0, 3] + ry * consts[2, 1, 3] + z1[i] * consts[2, 2, 3]
+            for i in range(3):
+                dW[i] = Xw[i] - S[i]
+            nrm0 = z1[1] * dW[2] - z1[2] * dW[1]
+            nrm1 = z1[2] * dW[0] - z1[0] * dW[2]
+            nrm2 = z1[0] * dW[1] - z1[1] * dW[0]
+            towards = 1.0 if consts[0, 0, 2] * nrm0 + consts[0, 1, 2] * nrm1 + consts[0, 2, 2] * nrm2 >= 0.0 else -1.0
+            side = (E[0] - S[0]) * nrm0 + (E[1] - S[1]) * nrm1 + (E[2] - S[2]) * nrm2
+            if side * towards < 0.0:
+                code |= 2
+            if math.sin(cand[best, 4] + theta[4]) < 0.0:
+                code |= 4
+            out_label[b, slot] = code
+        out_status[b, 0] = kept
+        out_status[b, 1] = n_out
+        out_status[b, 2] = status
+'''
