@@ -154,6 +154,32 @@ def ik_rows(name: str, n_targets: int):
     return rows
 
 
+def analytic_rows(name: str, n_targets: int):
+    """All analytic solutions of one pose per call: compiled, plain, and ik-geo (Rust) when installed."""
+    from bench_ik import _stats, bench_ikgeo
+
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot)
+    rng = np.random.default_rng(3)
+    lim = robot.q_limits
+    T = denavit.forward_kinematics(robot, rng.uniform(lim[:, 0], lim[:, 1], (n_targets, robot.dof)))
+    fast.analytic_ik(T[0])
+    rows = []
+    for label, solve in (("denavit.compile analytic_ik", fast.analytic_ik),
+                         ("denavit.analytic_ik (plain)", lambda Tk: denavit.analytic_ik(robot, Tk))):
+        times, count = [], []
+        for Tk in T:
+            t0 = time.perf_counter()
+            res = solve(Tk)
+            times.append(time.perf_counter() - t0)
+            count.append(res.count)
+        rows.append((name, label, *_stats(times), float(np.mean(count))))
+    geo = bench_ikgeo(robot, T)
+    if geo is not None:
+        rows.append((name, "ik-geo get_ik (Rust)", geo[1], geo[2], geo[3]))
+    return rows
+
+
 #: roboticstoolbox stops when E = ½ eᵀ W e < tol: 5e-19 asks for |e| ≤ 1e-9, the precision denavit is timed at.
 RTB_TOL = 5e-19
 
@@ -209,6 +235,10 @@ def main() -> None:
     for name in ("puma560", "ur5", "panda"):
         for r in ik_rows(name, args.targets):
             print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {100 * r[4]:.1f} % |")
+    print("\n| robot | analytic IK, one pose per call | median [µs] | p95 [µs] | solutions / pose |")
+    print("|---|---|---:|---:|---:|")
+    for r in analytic_rows("puma560", args.targets):
+        print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {r[4]:.2f} |")
     print("\n| robot | compile, empty cache [s] | compile, from the cache [s] | numba + denavit import [s] |")
     print("|---|---:|---:|---:|")
     for name in ROBOTS:
