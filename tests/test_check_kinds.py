@@ -23,6 +23,7 @@ from conftest import REDUCED
 from test_check_shapes import _dh
 
 ARMS = ["planar3r", "report000-planar3r", "scara", "stanford", "report000-6r", "puma560", "report004-4-rrp"]
+_ARMS_SLOW_6R = [pytest.param(a, marks=pytest.mark.slow) if a == "puma560" else a for a in ARMS]
 
 
 def _tex(M) -> str:
@@ -69,7 +70,7 @@ def _v(robot, claims, seed=0):
     return check_claims(robot, claims, seed=seed).verdicts
 
 
-@pytest.mark.parametrize("name", ARMS)
+@pytest.mark.parametrize("name", _ARMS_SLOW_6R)
 def test_velocity_propagation_vectors_against_differentiation(name):
     robot = dn.load_robot(name)
     claims = []
