@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import ModelError, UnsupportedRobotError
 from ..model import DHRobot
-from ._sampler import Grid, reach_bound, sampling_limits
+from ._sampler import MAX_CELLS, MIN_CELLS, Grid, reach_bound, sampling_limits
 from ._schedule import Progress, run
 
 __all__ = ["ReachabilityMap", "reachability", "orientation_set", "DEFAULT_ORIENTATIONS", "MAX_ORIENTATIONS",
@@ -145,9 +145,15 @@ def _near_samples(robot, grid: Grid, seed: int, scheduler, workers) -> np.ndarra
     from ._occupancy import occupancy
     from ._volume import interior
 
-    occ = occupancy(robot, SCREEN_SAMPLES, grid.resolution, seed, scheduler=scheduler, workers=workers)
+    everything = np.ones(grid.shape, dtype=bool)
+    if grid.side <= MIN_CELLS:  # too coarse a grid to screen: test every cell
+        return everything
+    try:
+        occ = occupancy(robot, SCREEN_SAMPLES, grid.resolution, seed, scheduler=scheduler, workers=workers)
+    except ModelError:  # a grid finer than occupancy's MAX_CELLS: test every cell
+        return everything
     if occ.planar or occ.grid.side != grid.side or not np.allclose(occ.grid.centre, grid.centre):
-        return np.ones(grid.shape, dtype=bool)
+        return everything
     near = occ.counts > 0
     for _ in range(SCREEN_MARGIN):  # dilation = complement of the erosion of the complement
         near = ~interior(~near)
@@ -215,18 +221,28 @@ def reachability(robot: DHRobot, resolution: float = 0.05, orientations: int = D
     if not (h > 0 and np.isfinite(h)):
         raise ModelError(f"resolution must be a positive length in metres, got {resolution}")
     centre, R = reach_bound(robot)
-    side = int(np.ceil(2 * R / h)) if 2 * R / h < 1e4 else 10**4
-    grid = Grid(centre, np.eye(3), h, max(side, 1), 1)
+    cells_per_side = 2 * R / h
+    cap = round(MAX_CELLS ** (1 / 3))
+    if cells_per_side > cap:
+        raise ModelError(f"resolution {h:g} m gives {cells_per_side:.3g} cells along the {2 * R:.4g} m reach box "
+                         f"(at most {cap}): use a resolution of at least {2 * R / cap:.3g} m")
+    side = max(1, int(np.ceil(cells_per_side)))
+    grid = Grid(centre, np.eye(3), h, side, 1)
     ball = 4 / 3 * np.pi * (R + h) ** 3 / h**3  # cells to test, about
     limit = MAX_POSES if method == "analytic" else MAX_NUMERIC_POSES
     if ball * k > limit:
         raise ModelError(f"resolution {h:g} m and {k} orientations make about {ball * k:.3g} IK problems "
                          f"(at most {limit:.3g} with {method} IK): use a coarser resolution or fewer orientations")
-    idx = np.indices(grid.shape).reshape(3, -1).T  # (side³, 3)
-    inside = np.linalg.norm(grid.cell_centres(idx) - centre, axis=1) <= R + 0.5 * np.sqrt(3) * h
-    if screen:
-        inside &= _near_samples(robot, grid, seed, scheduler, workers).reshape(-1)
-    cells = idx[inside]
+    near = _near_samples(robot, grid, seed, scheduler, workers) if screen else None
+    jk = np.indices((side, side), dtype=np.int32).reshape(2, -1).T  # (side², 2)
+    parts = []
+    for i in range(side):  # one x-slice at a time: memory ∝ side², not side³
+        idx = np.column_stack([np.full(len(jk), i, dtype=np.int32), jk])  # (side², 3)
+        inside = np.linalg.norm(grid.cell_centres(idx) - centre, axis=1) <= R + 0.5 * np.sqrt(3) * h
+        if near is not None:
+            inside &= near[i].reshape(-1)
+        parts.append(idx[inside])
+    cells = np.concatenate(parts)
     rot = orientation_set(k)
     if method == "analytic":
         tasks = ((robot, grid, cells[i:i + VOXELS_PER_TASK], rot) for i in range(0, len(cells), VOXELS_PER_TASK))
