@@ -271,7 +271,7 @@ def plot_reachability(rmap, title: str = "", slices: int = 4, figsize=(13.5, 7.0
                      vmax=wmax)
         ax.set_aspect("equal")
     fig.colorbar(im1, ax=fig.axes[0::2], label="share of orientations reached", shrink=0.8)
-    fig.colorbar(im2, ax=fig.axes[1::2], label="manipulability √det(J Jᵀ)", shrink=0.8)
+    fig.colorbar(im2, ax=fig.axes[1::2], label="manipulability √det(J J$^T$)", shrink=0.8)
     s = rmap.summary()
     fig.suptitle(f"{title} reachability — {s['orientations']} orientations per {g.resolution:.3g} m voxel "
                  f"({rmap.method} IK); reachable {s['reachable_volume']:.3g} m³, ≥ 50 % of orientations "
