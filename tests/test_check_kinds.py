@@ -588,3 +588,15 @@ def test_example_ik_file_of_report_003(capsys):
     verdicts = {c["id"]: c["verdict"] for c in data["claims"]}
     assert verdicts.pop("q1 written as in the report (P undeclared)") == "ambiguous"
     assert set(verdicts.values()) == {"correct"}, verdicts
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("quantity", ["gravity", "M"])
+def test_the_correct_dynamics_formula_given_is_itself_correct_and_keeps_g(quantity):
+    robot = dn.load_robot(P3)
+    (v,) = _v(robot, [{"quantity": quantity, "value": [["m_1 g c_1"] * (3 if quantity == "M" else 1)] * 3}])
+    assert v.verdict == "incorrect"
+    formula = v.extra.get("expected_latex")
+    assert formula and ("981" not in formula) and (quantity == "M" or "g" in formula), formula
+    (again,) = _v(robot, [{"quantity": quantity, "value": formula}])
+    assert again.verdict == "correct", (formula, again.message)

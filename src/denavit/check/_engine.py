@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .. import _expr
-from ..errors import ParseError
+from ..errors import DenavitError, ParseError
 from ..io import with_parameters
 from ..model import DHRobot, JointType
 from ._hints import hints_for
@@ -669,6 +669,8 @@ def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | N
     return _expected_formula(robot, name, *keys)
 
 
+#: Most joints for which an incorrect M or g(q) claim is given the correct formula (symbolic Lagrangian dynamics).
+MAX_FORMULA_DOF_DYNAMICS = 4
 #: Most joints for which an incorrect ⁱfᵢ / ⁱnᵢ claim is given the correct formula (symbolic force propagation of a
 #: 6-joint arm takes seconds).
 MAX_FORMULA_DOF_STATICS = 4
@@ -725,13 +727,23 @@ def _expected_formula(robot: DHRobot, name: str, index: int | None, frm: int | N
         elif name in ("end_effector", "position", "rotation"):
             T = S.forward_kinematics_sym(robot)
             M = T if name == "end_effector" else T[:3, 3] if name == "position" else T[:3, :3]
+        elif name in ("gravity", "mass_matrix"):
+            if robot.dof > MAX_FORMULA_DOF_DYNAMICS or not robot.has_dynamics:
+                return None
+            terms = S.lagrangian_dynamics(robot, coriolis=False)
+            if name == "mass_matrix":
+                M = terms.M
+            elif terms.g_unit is not None and "g" not in robot.parameter_values:
+                M = sp.Symbol("g") * terms.g_unit  # the symbol g, not 981/100
+            else:
+                M = terms.g
         elif name in ("omega", "velocity"):
             steps = {st.label: st for st in S.velocity_propagation_sym(robot).steps}
             step = steps[str(spec["index"])]
             M = step.omega if name == "omega" else step.v
         else:
             return None
-    except (KeyError, ValueError, IndexError, TypeError):
+    except (KeyError, ValueError, IndexError, TypeError, DenavitError):
         return None
     if len(str(M)) > 20_000:
         return None
