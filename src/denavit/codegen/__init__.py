@@ -8,7 +8,8 @@ exported as standalone C99 or Python source.  DESIGN.md's one bridge between the
 """
 
 from ._bridge import numeric_function
-from ._compiled import CompiledRobot, cache_dir, compile, numba_available, robot_key
+from ._cache import cache_dir, numba_available, robot_key
+from ._compiled import CompiledRobot, compile
 from ._export import LANGUAGES, PREFIX_PATTERN, default_prefix, export_sources
 from ._kernels import KERNEL_NAMES, KernelSpec, trace_kernels
 from ._llvm import kernel_intrinsic

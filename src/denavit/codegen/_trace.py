@@ -23,7 +23,7 @@ straight-line program.
 >>> q = tape.inputs("q", 2)
 >>> e = q[0] * 2.0 + 0.0 * q[1] + q[0] * 2.0
 >>> [tape.ops[i] for i in tape.program([e])]
-[('mul', 0, 2.0), ('add', 2, 2)]
+[('input', 'q', 0), ('mul', 0, 2.0), ('add', 2, 2)]
 """
 
 from __future__ import annotations

@@ -1,0 +1,144 @@
+"""The IK half of :class:`denavit.codegen.CompiledRobot`: numeric (LM) and analytic IK on the compiled kernels."""
+
+from __future__ import annotations
+
+import random as _random
+
+import numpy as np
+
+from ..errors import ShapeError
+from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, AnalyticIKResult, IKResult, JointLimits,
+                       analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik)
+from ._emit import NUMBA
+from ._ik_elbow import ELBOW_LAYOUT
+
+__all__ = ["IKMethods"]
+
+_ndarray, _F64 = np.ndarray, np.dtype(np.float64)
+_NO_SEEDS = np.zeros((0, 1))
+
+
+class IKMethods:
+    """``solve_ik`` and ``analytic_ik`` of a compiled arm (mixed into CompiledRobot, whose kernels they call)."""
+
+    # --- inverse kinematics ------------------------------------------------------------------------------------
+    def solve_ik(self, T, q0=None, *, mask="pose", tol: float | None = None, max_iterations: int | None = None,
+                 restarts: int | None = None, respect_limits: bool = True, rng: np.random.Generator | None = None):
+        """Numeric IK by Levenberg–Marquardt on the compiled FK and Jacobian: as :func:`denavit.solve_ik`
+        (same arguments, same :class:`~denavit.IKResult`), each iteration in machine code.
+
+        Targets the compiled search does not solve are handed to :func:`denavit.solve_ik` with the same
+        arguments (its closed-form and bank rescues, and its diagnosis of *why* a target fails), so the
+        answers are never worse than the plain function's.  The numpy backend always uses the plain function.
+        """
+        tol = IK_TOL if tol is None else float(tol)
+        max_iterations = IK_MAX_ITERATIONS if max_iterations is None else int(max_iterations)
+        restarts = IK_RESTARTS if restarts is None else int(restarts)
+        plain = dict(mask=mask, tol=tol, max_iterations=max_iterations, restarts=restarts,
+                     respect_limits=respect_limits, rng=rng)
+        if self.backend != NUMBA or not {"fk", "fk_jacobian0"} <= set(self.kernels):
+            return solve_ik(self.robot, T, q0, **plain)
+        c = self._ik_constants
+        if c is None or c[0] != (mask if isinstance(mask, str) else tuple(mask), respect_limits):
+            L = characteristic_length(self.robot)
+            w = np.where(row_mask(mask), 1.0, 0.0) * np.array([1.0, 1.0, 1.0, L, L, L])
+            lim = JointLimits(self.robot, not respect_limits)
+            slo, shi = lim.sample_bounds(L)
+            mid = np.where(np.isfinite(lim.lo) & np.isfinite(lim.hi), 0.5 * (np.nan_to_num(lim.lo) + np.nan_to_num(lim.hi)),
+                           0.0)
+            c = self._ik_constants = ((mask if isinstance(mask, str) else tuple(mask), respect_limits), w, L, lim,
+                                      slo, shi, lim.revolute.astype(np.bool_), mid)
+        _, w, L, lim, slo, shi, revolute, mid = c
+        n = self.dof
+        Ta = np.asarray(T, dtype=np.float64)
+        if Ta.ndim < 2 or Ta.shape[-2:] != (4, 4):
+            raise ShapeError(f"T: expected shape (..., 4, 4), got {Ta.shape}")
+        batch = Ta.shape[:-2]
+        Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))
+        B = Tf.shape[0]
+        if q0 is None:
+            Q0 = np.ascontiguousarray(np.broadcast_to(mid, (B, n)))
+        elif B == 1 and q0.__class__ is _ndarray and q0.dtype is _F64 and q0.shape == self._vec:
+            Q0 = np.ascontiguousarray(q0).reshape(1, n)
+        else:
+            try:
+                Q0 = np.broadcast_to(np.asarray(q0, dtype=np.float64), batch + (n,)).reshape(B, n)
+            except (ValueError, TypeError):
+                raise ShapeError(f"q0: expected shape (..., {n}) matching the targets {batch}, got "
+                                 f"{np.shape(q0)}") from None
+            Q0 = np.ascontiguousarray(Q0)
+        err = self._m.ik_check(Tf, Q0)  # NaN, inf and orthonormality in one pass
+        if err < 0.0:
+            raise ShapeError("q0 has non-finite values (NaN or inf)")
+        if err > 1e-6:
+            raise ShapeError("T has non-finite values" if err == np.inf else
+                             f"T: rotation part is not orthonormal (error {err:.2g})")
+        seed = _random.getrandbits(31) if rng is None else int(rng.bit_generator.random_raw() & 0x7FFFFFFF)
+        q_out = np.empty((B, n))
+        info = np.empty((B, 5))
+        self._m.ik_lm(Tf, Q0, lim.lo, lim.hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed,
+                      q_out, info)
+        if batch == () and info[0, 0] > 0.0:  # one target, solved: the lean path
+            return IKResult(q_out[0], True, float(info[0, 1]), float(info[0, 2]), int(info[0, 3]), int(info[0, 4]),
+                            "")
+        success = info[:, 0] > 0.0
+        reason = np.full(B, "", dtype=object)
+        iters, used = info[:, 3].astype(int), info[:, 4].astype(int)
+        pe, re = info[:, 1].copy(), info[:, 2].copy()
+        if not success.all():  # the plain solver: rescues, and the reason of each failure
+            fail = np.flatnonzero(~success)
+            again = solve_ik(self.robot, Tf[fail], Q0[fail], **plain)
+            q_out[fail] = again.q
+            success[fail] = again.success
+            pe[fail], re[fail] = again.position_error, again.orientation_error
+            iters[fail] += again.iterations
+            used[fail] += again.restarts
+            reason[fail] = again.reason
+        if batch == ():
+            return IKResult(q_out[0], bool(success[0]), float(pe[0]), float(re[0]), int(iters[0]), int(used[0]),
+                            str(reason[0]))
+        return IKResult(q_out.reshape(batch + (n,)), success.reshape(batch), pe.reshape(batch), re.reshape(batch),
+                        iters.reshape(batch), used.reshape(batch), reason.reshape(batch))
+
+    def analytic_ik(self, T) -> AnalyticIKResult:
+        """Every closed-form solution of one pose: as :func:`denavit.analytic_ik` (same result), in machine code
+        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms).
+
+        Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
+        polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
+        (its batched path is already the fast one) and arms of other classes.
+        """
+        c = self._elbow
+        if c is None:
+            plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
+            if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
+                c = self._elbow = False
+            else:
+                k = dict(plan.closed)
+                lim = self.robot.q_limits
+                k.update(lo=lim[:, 0], hi=lim[:, 1],
+                         revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
+                K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
+                assert K.size == sum(size for _, size in ELBOW_LAYOUT)
+                c = self._elbow = [K, k["labels"], plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
+        Ta = np.asarray(T, dtype=np.float64)
+        if c is False or Ta.shape != (4, 4):
+            return analytic_ik(self.robot, T)
+        K, labels, kind, check, solve, first = c
+        Tf = np.ascontiguousarray(Ta).reshape(1, 4, 4)
+        err = check(Tf, _NO_SEEDS)
+        if err > 1e-6:
+            raise ShapeError("T has non-finite values" if err == np.inf else
+                             f"T: rotation part is not orthonormal (error {err:.2g})")
+        f = np.empty((1, 8, 14))  # solutions (6), residuals (2), outside-limits solutions (6)
+        i = np.empty((1, 11), dtype=np.int64)  # label codes (8), then kept, outside, status
+        solve(Tf, K, f, i)
+        if first:  # numba compiled (or loaded) them on this first call: call their machine code from now on
+            c[3] = next(iter(self._m.ik_check.overloads.values())).entry_point
+            c[4] = next(iter(self._m.ik_elbow_packed.overloads.values())).entry_point
+            c[5] = False
+        if i[0, 10]:
+            return analytic_ik(self.robot, T)
+        k, j = int(i[0, 8]), int(i[0, 9])
+        return AnalyticIKResult(f[0, :k, :6], tuple(labels[i[0, :k]]), ("",) * k, f[0, :k, 6], f[0, :k, 7],
+                                f[0, :j, 8:], kind, "pose", np.ones(k, dtype=bool))
