@@ -50,6 +50,7 @@ def section_singularities(ctx: Context) -> Section:
                         "in some direction.")]
     sym = capability("denavit.symbolic", "singularity_analysis", "singularities_sym", "singular_conditions")
     heavy = robot.dof > 6 or not ctx.symbolic_jacobian_ok
+    rows = list(range(6))
     if sym is not None and heavy:
         steps.append(Text("The symbolic analysis is left out for this arm (more than six joints or a long pose "
                           "formula: it would take minutes); numeric measures at the numeric case follow."))
@@ -60,9 +61,12 @@ def section_singularities(ctx: Context) -> Section:
             steps.append(Text(f"The symbolic analysis ({sym[0]}) failed: {type(exc).__name__}: {exc}."))
         else:
             steps += _singular_result_steps(result)
-    J = N.geometric_jacobian(robot, ctx.q)
+            names = ("vx", "vy", "vz", "wx", "wy", "wz")
+            rows = [names.index(r) for r in getattr(result, "rows", names) if r in names] or rows
+    J = N.geometric_jacobian(robot, ctx.q)[rows, :]  # the task rows analysed (an arm of < 6 joints: its own)
     sv = np.linalg.svd(J, compute_uv=False)
-    steps.append(Numbers("\\sigma(J_0(q))", sv, note="singular values at the numeric case"))
+    which = "" if len(rows) == 6 else " (rows " + ", ".join(("vx", "vy", "vz", "wx", "wy", "wz")[i] for i in rows) + ")"
+    steps.append(Numbers("\\sigma(J_0(q))", sv, note="singular values at the numeric case" + which))
     manip = capability("denavit.numeric", "manipulability")
     if manip is not None:
         steps.append(Numbers("w(q)", np.atleast_1d(manip[1](J)),
