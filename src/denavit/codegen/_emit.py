@@ -48,6 +48,17 @@ _C_FUNCS = {"sin": "sin({a})", "cos": "cos({a})", "sign": "(double)(({a} > 0.0) 
 _INFIX = {"add": "+", "sub": "-", "mul": "*", "div": "/"}
 
 
+def _expression(op: str, A: str, B: str | None, lang: str, vector: bool) -> str:
+    """The right-hand side of one operation on the operands' texts, in C or Python (scalar or numpy)."""
+    if op in _INFIX:
+        return f"{A} {_INFIX[op]} {B}"
+    if op == "neg":
+        return f"-{A}"
+    if lang == "c":
+        return _C_FUNCS[op].format(a=A, b=B)
+    return _PY_FUNCS[op][1 if vector else 0].format(a=A, b=B)
+
+
 def _statements(spec: KernelSpec, lang: str, vector: bool = False) -> list[str]:
     """One assignment per node of the kernel's program (inputs excluded)."""
     name = _Names(spec, lang)
@@ -57,16 +68,7 @@ def _statements(spec: KernelSpec, lang: str, vector: bool = False) -> list[str]:
         op, a, b = tape.ops[i]
         if op == "input":
             continue
-        A = name(a)
-        B = name(b) if b is not None else None
-        if op in _INFIX:
-            expr = f"{A} {_INFIX[op]} {B}"
-        elif op == "neg":
-            expr = f"-{A}"
-        elif lang == "c":
-            expr = _C_FUNCS[op].format(a=A, b=B)
-        else:
-            expr = _PY_FUNCS[op][1 if vector else 0].format(a=A, b=B)
+        expr = _expression(op, name(a), name(b) if b is not None else None, lang, vector)
         lines.append(f"double v{i} = {expr};" if lang == "c" else f"v{i} = {expr}")
     return lines
 
@@ -178,14 +180,7 @@ def _vector_statements(spec: KernelSpec) -> tuple[list[str], dict[int, str]]:
         def ref(x):
             return _const(x, "py") if isinstance(x, float) else reg[x]
 
-        A = ref(a)
-        B = ref(b) if b is not None else None
-        if op in _INFIX:
-            expr = f"{A} {_INFIX[op]} {B}"
-        elif op == "neg":
-            expr = f"-{A}"
-        else:
-            expr = _PY_FUNCS[op][1].format(a=A, b=B)
+        expr = _expression(op, ref(a), ref(b) if b is not None else None, "py", True)
         for x in {a, b}:
             if isinstance(x, int) and last.get(x) == pos and tape.ops[x][0] != "input":
                 free.append(reg[x])
