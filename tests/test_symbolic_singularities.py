@@ -149,3 +149,16 @@ def test_singularities_cli_measures_the_planar_rows_of_a_planar_arm(capsys):
     np.testing.assert_allclose(data["measures"]["manipulability"], abs(np.linalg.det(J)), rtol=1e-12)
     assert data["measures"]["manipulability"] > 0.1
     assert [c["kind"] for c in data["conditions"]] == ["elbow"]
+
+
+def test_report_measures_a_short_arm_on_its_task_rows():
+    from denavit.report import derive
+    from denavit.report._derivation import Numbers
+
+    robot = load_robot("planar3r")
+    q = np.array([0.3, 0.5, 0.2])
+    sec = derive(robot, q=list(q), topics=["singularities"]).section("singularities")
+    w = [s for s in sec.steps if isinstance(s, Numbers) and s.lhs == "w(q)"][0]
+    J = N.geometric_jacobian(robot, q)[[0, 1, 5], :]
+    np.testing.assert_allclose(float(np.ravel(w.values)[0]), abs(np.linalg.det(J)), rtol=1e-10)
+    assert float(np.ravel(w.values)[0]) > 0.1
