@@ -54,9 +54,10 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
     from ..scale import LOCAL_SCHEDULERS
     from ..scale._schedule import MAX_WORKERS
 
-    p.add_argument("--scheduler", type=scheduler_name, default="threads", metavar="WHERE",
-                   help=f"{', '.join(LOCAL_SCHEDULERS)} (default threads) or a dask.distributed scheduler "
-                        "address such as tcp://10.0.0.5:8786 (needs denavit[scale])")
+    p.add_argument("--scheduler", type=scheduler_name, default="auto", metavar="WHERE",
+                   help=f"{', '.join(LOCAL_SCHEDULERS)} (default auto: processes for 1e7 samples or more, threads "
+                        "below) or a dask.distributed scheduler address such as tcp://10.0.0.5:8786 "
+                        "(needs denavit[scale])")
     p.add_argument("--workers", type=bounded_int(1, MAX_WORKERS), metavar="N",
                    help=f"local threads or processes (default: the CPU count; at most {MAX_WORKERS})")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

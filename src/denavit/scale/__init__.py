@@ -8,7 +8,8 @@ the number of workers or the chunk size.  See ``docs/workspace.md``.
 Importing this package needs numpy only; dask is imported when a cluster or a dask array is asked for.
 """
 
-from ._sampler import BLOCK, FINE_CELLS, MAX_CELLS, Grid, PositionFK, reach_bound, sampling_limits
+from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
+                       reach_bound, sampling_limits)
 from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
 from ._volume import VolumeEstimate, coarsen, estimate_volume
 from ._reach import DEFAULT_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
@@ -18,6 +19,8 @@ from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, O
 __all__ = [
     "BLOCK",
     "CLUSTER_CHUNK",
+    "COMPILED_FROM",
+    "CompiledPositionFK",
     "DEFAULT_ORIENTATIONS",
     "CONNECT_TIMEOUT",
     "DEFAULT_CHUNK",
@@ -32,6 +35,7 @@ __all__ = [
     "ReachabilityMap",
     "VolumeEstimate",
     "check_scheduler",
+    "default_fk",
     "coarsen",
     "estimate_volume",
     "load_occupancy",

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model import DHRobot
 from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
-from ._schedule import LOCAL_SCHEDULERS, Progress, run
+from ._schedule import LOCAL_SCHEDULERS, Progress, resolve_auto, run
 from ._volume import VolumeEstimate, estimate_volume
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
@@ -119,7 +119,7 @@ def _check_sizes(samples: int, chunk: int) -> None:
 
 
 def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None = None, seed: int | None = None,
-              *, scheduler: Any = "threads", workers: int | None = None, chunk: int | None = None,
+              *, scheduler: Any = "auto", workers: int | None = None, chunk: int | None = None,
               fk: Callable | None = None, progress: bool | None = False) -> Occupancy:
     """Stream ``samples`` uniform joint configurations through FK into voxel counts; volume with an interval.
 
@@ -133,8 +133,9 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         from which the narrowest volume interval is reported.  Given: that edge only.
     seed : int, optional
         Seed of the counter-based random stream; ``None`` draws one (returned in the result).
-    scheduler : {"threads", "processes", "synchronous"}, str address or distributed.Client
-        Where the tasks run; ``"tcp://host:8786"`` connects to a dask.distributed scheduler.
+    scheduler : {"auto", "threads", "processes", "synchronous"}, str address or distributed.Client
+        Where the tasks run; ``"auto"``: processes from AUTO_PROCESSES_FROM samples on, threads below;
+        ``"tcp://host:8786"`` connects to a dask.distributed scheduler.
     workers : int, optional
         Local pool size (default: the CPU count).
     chunk : int, optional
@@ -142,7 +143,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         CLUSTER_CHUNK on a cluster.  Results do not depend on it.
     fk : callable, optional
         Joint values (m, n) → end-effector origins (m, 3) or poses (m, 4, 4); default
-        :class:`PositionFK` (``denavit.forward_kinematics``).
+        :func:`default_fk`: the compiled position kernel (``denavit.compile``) for runs of at least
+        COMPILED_FROM samples when numba is installed, else :class:`PositionFK` (``denavit.forward_kinematics``).
     progress : bool or None
         Progress line with ETA on stderr (``None``: when stderr is a terminal).
 
@@ -158,6 +160,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     >>> ws.planar, ws.estimate.low <= 3.1416 * 2.0**2 <= ws.estimate.high
     (True, True)
     """
+    scheduler = resolve_auto(scheduler, samples)
     if chunk is None:
         chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS else CLUSTER_CHUNK
     _check_sizes(samples, chunk)
@@ -214,7 +217,7 @@ def _span_positions(job: Job, first: int, count: int) -> np.ndarray:
 
 
 def _job_args(robot, samples, seed, fk):
-    from ._sampler import PositionFK, sampling_limits
+    from ._sampler import default_fk, sampling_limits
 
-    return (PositionFK(robot) if fk is None else fk, sampling_limits(robot), seed, samples,
+    return (default_fk(robot, samples) if fk is None else fk, sampling_limits(robot), seed, samples,
             Grid(np.zeros(3), np.eye(3), 1.0, 1, 1), np.array(robot.base_matrix[:3, 3], dtype=float))

@@ -18,8 +18,9 @@ import numpy as np
 from ..errors import DenavitError, ModelError
 from ..model import DHRobot, JointType
 
-__all__ = ["BLOCK", "Grid", "Job", "PositionFK", "make_job", "reach_bound", "sampling_limits", "positions_block",
-           "run_task", "FINE_CELLS", "MAX_CELLS", "FLAT_TOLERANCE", "PILOT"]
+__all__ = ["BLOCK", "Grid", "Job", "PositionFK", "CompiledPositionFK", "default_fk", "COMPILED_FROM", "make_job",
+           "reach_bound", "sampling_limits", "positions_block", "run_task", "FINE_CELLS", "MAX_CELLS",
+           "FLAT_TOLERANCE", "PILOT"]
 
 #: Samples per random block: the unit of randomness (fixed, independent of chunking and workers).
 BLOCK = 65_536
@@ -33,6 +34,8 @@ FINE_CELLS = {3: 256, 2: 2048}
 MAX_CELLS = 2**24
 #: Coarsest level kept: at least this many cells along a side.
 MIN_CELLS = 8
+#: Runs of at least this many samples use the compiled position kernel by default (when numba is installed).
+COMPILED_FROM = 2_000_000
 
 
 def sampling_limits(robot: DHRobot) -> np.ndarray:
@@ -82,6 +85,39 @@ class PositionFK:
         from ..numeric import forward_kinematics
 
         return forward_kinematics(self.robot, q)[:, :3, 3]
+
+
+class CompiledPositionFK:
+    """FK callable from the generated position kernel (``denavit.compile(robot).position``), built lazily.
+
+    Pickles as the robot alone: each worker process compiles (or loads from the on-disk cache) on first use.
+    """
+
+    def __init__(self, robot: DHRobot) -> None:
+        self.robot = robot
+        self._kernel = None
+
+    def __getstate__(self):
+        return {"robot": self.robot, "_kernel": None}
+
+    def __call__(self, q: np.ndarray) -> np.ndarray:
+        if self._kernel is None:
+            from ..codegen import compile as compile_robot
+
+            self._kernel = compile_robot(self.robot, kernels=["position"]).position
+        return self._kernel(np.ascontiguousarray(q, dtype=float))
+
+
+def default_fk(robot: DHRobot, samples: int) -> Callable:
+    """The FK callable a run uses when none is given: the compiled position kernel when numba is installed
+    and the run has at least COMPILED_FROM samples (its first compile of an arm costs seconds), else
+    :class:`PositionFK`."""
+    if samples >= COMPILED_FROM:
+        import importlib.util
+
+        if importlib.util.find_spec("numba") is not None:
+            return CompiledPositionFK(robot)
+    return PositionFK(robot)
 
 
 @dataclass(frozen=True)
@@ -134,7 +170,9 @@ def positions_block(job: Job, block: int, rows: int | None = None) -> np.ndarray
     m = min(BLOCK, job.samples - block * BLOCK) if rows is None else rows
     rng = np.random.Generator(np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))))
     lo, hi = job.limits[:, 0], job.limits[:, 1]
-    q = lo + rng.random((m, len(lo))) * (hi - lo)  # (m, n); a prefix of the block's stream
+    q = rng.random((m, len(lo)))  # (m, n); a prefix of the block's stream
+    q *= hi - lo
+    q += lo  # = lo + r·(hi − lo), in place
     return _positions(job.fk(q))
 
 
@@ -150,18 +188,23 @@ def _positions(out) -> np.ndarray:
 def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples."""
     g = job.grid
-    parts = [positions_block(job, b) for b in range(first, first + count)]
-    p = np.concatenate(parts) if len(parts) > 1 else parts[0]  # (m, 3)
-    if not np.all(np.isfinite(p)):
+    P = np.concatenate([positions_block(job, b).T for b in range(first, first + count)], axis=1)  # (3, m)
+    lo, hi = P.min(axis=1), P.max(axis=1)  # NaN and inf reach these
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
-    u = (p - g.centre) @ g.basis.T  # (m, dim)
-    cell = np.floor((u - g.lo) / g.resolution).astype(np.int64)  # (m, dim)
-    if cell.min() < 0 or cell.max() >= g.side:
-        raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
-    flat = np.ravel_multi_index(tuple(cell.T), g.shape).astype(np.int32)  # < MAX_CELLS = 2^24: sorts faster
+    d = P - job.base_origin[:, None]
+    reach = float(np.sqrt(np.einsum("im,im->m", d, d).max()))
+    D = P - g.centre[:, None]  # (3, m)
+    U = D if g.dim == 3 and np.array_equal(g.basis, np.eye(3)) else g.basis @ D  # (dim, m)
+    flat = np.zeros(P.shape[1], dtype=np.int32)  # < MAX_CELLS = 2^24: sorts faster than int64
+    for row in U:
+        c = np.floor((row - g.lo) / g.resolution)
+        if c.min() < 0 or c.max() >= g.side:
+            raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
+        flat *= g.side
+        flat += c.astype(np.int32)  # row-major cell index, as numpy.ravel_multi_index
     idx, cnt = np.unique(flat, return_counts=True)
-    reach = float(np.sqrt(((p - job.base_origin) ** 2).sum(axis=1).max()))
-    return idx, cnt.astype(np.uint32), p.min(axis=0), p.max(axis=0), reach, len(p)
+    return idx, cnt.astype(np.uint32), lo, hi, reach, P.shape[1]
 
 
 def _plane(points: np.ndarray) -> np.ndarray | None:
@@ -181,7 +224,7 @@ def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, 
     """Sampler, grid (finest resolution, levels) and FK callable for one run."""
     limits = sampling_limits(robot)
     centre, R = reach_bound(robot)
-    fk = PositionFK(robot) if fk is None else fk
+    fk = default_fk(robot, samples) if fk is None else fk
     base_origin = np.array(robot.base_matrix[:3, 3], dtype=float)
     probe = Job(fk, limits, seed, max(samples, PILOT), Grid(centre, np.eye(3), 1.0, 1, 1), base_origin)
     pilot = positions_block(probe, 0, rows=PILOT)

@@ -17,10 +17,12 @@ from typing import Any, Callable, Iterable, Iterator
 
 from ..errors import MissingDependencyError, ParseError
 
-__all__ = ["LOCAL_SCHEDULERS", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
+__all__ = ["LOCAL_SCHEDULERS", "AUTO_PROCESSES_FROM", "resolve_auto", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
 
 #: Schedulers that need no cluster: in this process, a thread pool, a process pool.
-LOCAL_SCHEDULERS = ("synchronous", "threads", "processes")
+LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes")
+#: "auto" runs on processes from this many samples on (FK threads contend for the GIL), on threads below.
+AUTO_PROCESSES_FROM = 10_000_000
 #: Seconds to wait for a dask.distributed scheduler to answer.
 CONNECT_TIMEOUT = 10.0
 #: Tasks submitted ahead per worker (bounds the results held at once).
@@ -44,6 +46,13 @@ def check_scheduler(scheduler: Any) -> None:
         shown = scheduler if len(scheduler) <= 60 else scheduler[:57] + "..."
         raise ParseError(f"scheduler {shown!r}: expected one of {', '.join(LOCAL_SCHEDULERS)} or a dask "
                          "scheduler address such as tcp://127.0.0.1:8786")
+
+
+def resolve_auto(scheduler: Any, samples: int) -> Any:
+    """``"auto"`` → ``"processes"`` for runs of at least AUTO_PROCESSES_FROM samples, else ``"threads"``."""
+    if isinstance(scheduler, str) and scheduler == "auto":
+        return "processes" if samples >= AUTO_PROCESSES_FROM else "threads"
+    return scheduler
 
 
 def _quiet_worker() -> None:  # process-pool workers leave Ctrl-C to the driver
@@ -87,8 +96,9 @@ def _wait(client, pending: set):
 
 def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
         ) -> Iterator[Any]:
-    """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler."""
+    """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler ("auto": threads)."""
     check_scheduler(scheduler)
+    scheduler = resolve_auto(scheduler, 0)
     client, own, pool = None, False, None
     if not isinstance(scheduler, str):
         client = scheduler
