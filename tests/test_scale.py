@@ -203,6 +203,22 @@ def test_local_dask_cluster_gives_the_same_counts():
         _same(ref, occupancy(robot, n, seed=9, scheduler=cluster.scheduler_address, chunk=2 * BLOCK))
 
 
+@pytest.mark.slow
+def test_compiled_position_kernel_agrees_and_travels():
+    pytest.importorskip("numba")
+    from denavit.scale import CompiledPositionFK, PositionFK, default_fk
+    from denavit.scale._sampler import COMPILED_FROM
+
+    robot = denavit.load_robot("ur5")
+    q = np.random.default_rng(2).uniform(-3, 3, (5000, 6))
+    np.testing.assert_allclose(CompiledPositionFK(robot)(q), PositionFK(robot)(q), rtol=0, atol=1e-12)
+    assert isinstance(default_fk(robot, COMPILED_FROM), CompiledPositionFK)
+    assert isinstance(default_fk(robot, COMPILED_FROM - 1), PositionFK)
+    fk = CompiledPositionFK(robot)
+    ref = occupancy(robot, 2 * BLOCK, seed=4, scheduler="synchronous", fk=fk)
+    _same(ref, occupancy(robot, 2 * BLOCK, seed=4, scheduler="processes", workers=2, chunk=BLOCK, fk=fk))
+
+
 def test_dask_array_of_positions():
     pytest.importorskip("dask.array")
     robot = denavit.load_robot("scara")
