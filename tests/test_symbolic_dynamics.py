@@ -164,3 +164,15 @@ def test_latex_output_compiles(tmp_path):
         run = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", f"{name}.tex"],
                              cwd=tmp_path, capture_output=True, text=True, timeout=120)
         assert run.returncode == 0, run.stdout[-2000:]
+
+
+@pytest.mark.slow
+def test_a_generic_twist_stays_exact():
+    """Puma 560 with α₂ = 0.7 rad instead of 0 (axes 2, 3 no longer parallel): M, c, g against the numeric engine."""
+    import dataclasses
+
+    robot = denavit.load_robot("puma560")
+    links = list(robot.links)
+    links[1] = dataclasses.replace(links[1], alpha=0.7, symbols=tuple(s for s in links[1].symbols if s[0] != "alpha"))
+    robot = robot.replace(links=tuple(links))
+    _check_against_numeric(robot, lagrangian_dynamics(robot, coriolis=False), np.random.default_rng(83), count=2)

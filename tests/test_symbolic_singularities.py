@@ -162,3 +162,32 @@ def test_report_measures_a_short_arm_on_its_task_rows():
     J = N.geometric_jacobian(robot, q)[[0, 1, 5], :]
     np.testing.assert_allclose(float(np.ravel(w.values)[0]), abs(np.linalg.det(J)), rtol=1e-10)
     assert float(np.ravel(w.values)[0]) > 0.1
+
+
+def _puma_with_twist(row, alpha=0.7):
+    import dataclasses
+
+    robot = load_robot("puma560")
+    links = list(robot.links)
+    links[row] = dataclasses.replace(links[row], alpha=alpha,
+                                     symbols=tuple(s for s in links[row].symbols if s[0] != "alpha"))
+    return robot.replace(links=tuple(links))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("row", [0, 1])
+def test_generic_twist_conditions_lose_rank(row):
+    """A Puma with a 0.7 rad twist (cos 0.7 and sin 0.7 carried as a pair, never expanded) keeps its wrist and
+    elbow conditions; every reported condition is singular and 1e-3 away is not."""
+    from denavit.symbolic import singularity_analysis
+
+    robot = _puma_with_twist(row)
+    res = singularity_analysis(robot)
+    assert not res.everywhere and {"wrist", "elbow"} <= {c.kind for c in res.conditions}
+    rng = np.random.default_rng(73)
+    for cond in res.conditions:
+        for q, k in _points(robot, cond, rng, count=2):
+            assert _ratio(_J(robot, q, res.rows)) < 1e-9, (cond.factor, q)
+            near = q.copy()
+            near[k] += 1e-3
+            assert not N.is_singular(_J(robot, near, res.rows))

@@ -205,6 +205,11 @@ def _tidy(e: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
     return sp.expand(sp.N(x / scale, 15)), scale
 
 
+def _unit_floats(e: sp.Expr) -> sp.Expr:
+    """1.0·x → x (a float coefficient within 1e-12 of ±1)."""
+    return e.xreplace({f: sp.Integer(round(float(f))) for f in e.atoms(sp.Float) if abs(abs(float(f)) - 1) < 1e-12})
+
+
 def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, int]]]:
     """Common factor of the ring minors, factorized: (constant part, [(factor in q, multiplicity)]).
 
@@ -233,6 +238,8 @@ def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, i
         e, scale = _tidy(e)
         const *= scale ** mult
         e = reduce_trig(e, q)
+        if scale != 1:
+            e = _unit_floats(e)
         for i, (o, m) in enumerate(out):
             if sp.expand(e - o) == 0 or sp.expand(e + o) == 0:
                 const *= (1 if sp.expand(e - o) == 0 else -1) ** mult
