@@ -408,6 +408,49 @@ def _name_groups(exprs: list[sp.Expr], rates) -> tuple[list[tuple[sp.Symbol, sp.
     return [(v, k) for k, v in names.items()], out
 
 
+def _name_rate_coefficients(exprs: list[sp.Expr], rates) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """Coefficients of q̇ᵢq̇ⱼ that recur (up to a rational factor, e.g. 2Γ in one row and Γ in another) are named
+    B1, B2 … and defined once."""
+    def split(e):
+        out = []
+        for t in sp.Add.make_args(e):
+            coeff, mono = t.as_independent(*rates, as_Add=False)
+            out.append((coeff, mono))
+        return out
+
+    def key(coeff):
+        x = sp.expand(coeff)
+        lead = sp.Add.make_args(x)[0].as_coeff_Mul()[0]
+        return sp.expand(x / lead), lead
+
+    count: dict[sp.Expr, int] = {}
+    for e in exprs:
+        if e.has(*rates):
+            for coeff, mono in split(e):
+                if mono != 1 and isinstance(coeff, (sp.Add, sp.Mul)) and coeff.has(sp.sin, sp.cos):
+                    k, _ = key(coeff)
+                    count[k] = count.get(k, 0) + 1
+    names: dict[sp.Expr, tuple[sp.Symbol, sp.Expr]] = {}
+    out = []
+    for e in exprs:
+        if not e.has(*rates):
+            out.append(e)
+            continue
+        terms = []
+        for coeff, mono in split(e):
+            if mono != 1 and isinstance(coeff, (sp.Add, sp.Mul)) and coeff.has(sp.sin, sp.cos):
+                k, lead = key(coeff)
+                if count[k] > 1:
+                    if k not in names:  # defined as it first occurs; later ones are a multiple (2, −1, ½ …)
+                        names[k] = (sp.Symbol(f"B{len(names) + 1}", real=True), coeff, lead)
+                    sym, _, first = names[k]
+                    terms.append(sp.nsimplify(lead / first) * sym * mono)
+                    continue
+            terms.append(coeff * mono)
+        out.append(sp.Add(*terms))
+    return [(sym, e) for sym, e, _ in names.values()], out
+
+
 def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None = None, short: bool = True,
                     digits: int | None = 6, include: tuple[str, ...] = ("M", "c", "g", "friction"),
                     gravity_symbol: bool = False) -> str:
@@ -448,7 +491,10 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
     long = sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS
     grouped = hand and cse is not False and long
     if grouped:
-        repl, exprs = _name_groups(exprs, terms.qd)
+        rates, exprs = _name_rate_coefficients(exprs, terms.qd)
+        repl, named = _name_groups([e for _, e in rates] + exprs, terms.qd)
+        repl += [(s, e) for (s, _), e in zip(rates, named[:len(rates)])]
+        exprs = named[len(rates):]
     show = lambda e: _display(e, terms.q, digits, short, collapse=not hand)  # noqa: E731
     repl, exprs = [(s, show(e)) for s, e in repl], [show(e) for e in exprs]
     if not hand:
@@ -473,15 +519,16 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
 
 
 def _latex_names(exprs: list[sp.Expr]) -> dict[sp.Symbol, str]:
-    """Parameter groups P1 as \\pi_{1}."""
-    return {s: f"\\pi_{{{s.name[1:]}}}" for e in exprs for s in e.free_symbols
-            if s.name[:1] == "P" and s.name[1:].isdigit()}
+    """Parameter groups P1 as \\pi_{1}, rate coefficients B1 as \\beta_{1}."""
+    greek = {"P": "pi", "B": "beta"}
+    return {s: f"\\{greek[s.name[0]]}_{{{s.name[1:]}}}" for e in exprs for s in e.free_symbols
+            if s.name[:1] in greek and s.name[1:].isdigit()}
 
 
 def _tex_label(label: str) -> str:
     if "[" not in label:
-        if label.startswith("P") and label[1:].isdigit():
-            return f"\\pi_{{{label[1:]}}}"
+        if label[:1] in "PB" and label[1:].isdigit():
+            return f"\\{'pi' if label[0] == 'P' else 'beta'}_{{{label[1:]}}}"
         return label.replace("x", "x_{", 1) + "}" if label.startswith("x") else label
     name, idx = label[:-1].split("[")
     if name == "friction":  # one subscript: \tau_{f}_{1} is a LaTeX error

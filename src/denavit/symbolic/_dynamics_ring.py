@@ -100,7 +100,9 @@ class RingDynamics:
         self.axis = list(chain_of(robot).axis_frame)
         self.revolute = [k for k, t in enumerate(robot.joint_types) if t is JointType.REVOLUTE]
         self.start = parallel_groups(robot)
+        size = sp.sqrt(sum(x ** 2 for x in self.g0))
         self._exprs = [e for A in self.mats for e in A] + list(self.g0) + list(self.armature)
+        self._exprs += [x / size for x in self.g0] if size != 0 else []  # the unit gravity vector's constants
         for p in self.pieces:
             self._exprs += [p.mass, *p.com, *p.inertia]
         self._rings: dict[int, tuple[TrigRing, _Frames]] = {}
