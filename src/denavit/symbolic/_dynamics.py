@@ -358,6 +358,14 @@ def _trim(text: str) -> str:
     return _TRAILING.sub(lambda m: m.group(1) or m.group(2), text)
 
 
+LONG_NODES = 200_000  # expression nodes above which format_dynamics prints terms in sympy's internal order
+
+
+def _size(e: sp.Expr) -> int:
+    """Number of nodes of an expression tree (cheap; printing pages of output to measure them is not)."""
+    return sum(1 for _ in sp.preorder_traversal(e))
+
+
 def _is_group(a: sp.Expr, rates) -> bool:
     return isinstance(a, sp.Add) and len(a.args) > 1 and not a.has(sp.sin, sp.cos, *rates)
 
@@ -488,7 +496,8 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
                 entries.append((label, mat[i, j]))
     exprs = [e for _, e in entries]
     repl: list[tuple[sp.Symbol, sp.Expr]] = []
-    long = sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS
+    nodes = sum(_size(e) for e in exprs)
+    long = nodes > CSE_AUTO_CHARS or sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS  # printing only short ones
     grouped = hand and cse is not False and long
     if grouped:
         rates, exprs = _name_rate_coefficients(exprs, terms.qd)
@@ -506,11 +515,12 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
     head = f"M(q) q'' + c(q, q') + g(q) + tau_f(q') = tau   ({n} joints)"
     if short:
         notes.append("Ci = cos(qi), Sij = sin(qi + qj), …")
+    order = "none" if nodes > LONG_NODES else None  # sorting the terms of pages of output costs minutes
     if style == "text":
         return "\n".join([head] + [f"  {x}" for x in notes] + [""] +
-                         [f"{k} = {_trim(sp.sstr(e))}" for k, e in pairs])
+                         [f"{k} = {_trim(sp.sstr(e, order=order))}" for k, e in pairs])
     names = _latex_names([e for _, e in pairs])
-    tex = [(_tex_label(k), sp.latex(e, symbol_names=names)) for k, e in pairs]
+    tex = [(_tex_label(k), sp.latex(e, symbol_names=names, order=order)) for k, e in pairs]
     if style == "latex":
         rows = " \\\\\n".join(f"{k} &= {v}" for k, v in tex)
         return "\\begin{aligned}\n" + rows + "\n\\end{aligned}"
