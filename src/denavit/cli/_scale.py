@@ -51,8 +51,7 @@ def scheduler_name(text: str) -> str:
 
 
 def _add_run_options(p: argparse.ArgumentParser) -> None:
-    from ..scale import LOCAL_SCHEDULERS
-    from ..scale._schedule import MAX_WORKERS
+    from ..scale import LOCAL_SCHEDULERS, MAX_WORKERS
 
     p.add_argument("--scheduler", type=scheduler_name, default="auto", metavar="WHERE",
                    help=f"{', '.join(LOCAL_SCHEDULERS)} (default auto: processes for 1e7 samples or more, threads "
@@ -66,8 +65,7 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from ..scale import MAX_SAMPLES
-    from ..scale._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS
+    from ..scale import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, MAX_SAMPLES
 
     p = sub.add_parser("workspace", help="reachable workspace by streamed sampling: bounds, volume with an interval")
     add_common(p)
@@ -104,7 +102,7 @@ def _write_data(args, result) -> None:
 
 
 def cmd_workspace(args: argparse.Namespace):
-    from ..scale import occupancy
+    from ..scale import MIN_COVERAGE, occupancy
 
     check_output(args, args.output, PICTURES, kind="picture format")
     check_output(args, args.data, DATA, what="--data")
@@ -133,6 +131,8 @@ def cmd_workspace(args: argparse.Namespace):
              f"{what} ≈ {e.value:.4g} {unit}, between {e.low:.4g} and {e.high:.4g} {unit}"
              + (" (planar arm)" if ws.planar else "")
              + f" ({e.occupied} cells of {e.resolution:.3g} m, sample coverage {e.coverage:.4f})"]
+    if e.coverage < MIN_COVERAGE:
+        lines.append(f"too few samples for a trusted interval (coverage below {MIN_COVERAGE}): use more samples")
     lines += [f"wrote {p}" for p in (args.output, args.data) if p]
     return data, "\n".join(lines)
 

@@ -10,9 +10,9 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
                        reach_bound, sampling_limits)
-from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, check_scheduler
-from ._volume import VolumeEstimate, coarsen, estimate_volume
-from ._reach import DEFAULT_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
+from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
+from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
+from ._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
 from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy,
                          new_seed, occupancy, sample_positions)
 
@@ -28,7 +28,10 @@ __all__ = [
     "LOCAL_SCHEDULERS",
     "MAX_CELLS",
     "MAX_CHUNK",
+    "MAX_ORIENTATIONS",
     "MAX_SAMPLES",
+    "MAX_WORKERS",
+    "MIN_COVERAGE",
     "Grid",
     "Occupancy",
     "PositionFK",

@@ -82,7 +82,7 @@ class Occupancy:
                 "bounds_min": self.bounds_min.tolist(), "bounds_max": self.bounds_max.tolist(),
                 "extent": self.extent.tolist(), "reach": self.reach, "voxels": e.occupied,
                 "planar": self.planar, **size, "interval": [e.low, e.high], "interior_voxels": e.interior,
-                "unseen_voxels": e.unseen, "finest_resolution": self.grid.resolution}
+                "unseen_voxels": e.unseen, "coverage": e.coverage, "finest_resolution": self.grid.resolution}
 
     def save(self, path) -> None:
         """Write the counts and grid to a ``.npz`` file (read back with :func:`load_occupancy`)."""
@@ -90,7 +90,7 @@ class Occupancy:
         with open(path, "wb") as fh:  # a file object: numpy adds no '.npz' to the name
             np.savez_compressed(fh, counts=self.counts, centre=g.centre, basis=g.basis,
                             resolution=g.resolution, side=g.side, levels=g.levels, samples=self.samples,
-                            seed=np.uint64(self.seed), bounds_min=self.bounds_min, bounds_max=self.bounds_max,
+                            seed=np.array(str(self.seed)), bounds_min=self.bounds_min, bounds_max=self.bounds_max,
                             reach=self.reach, estimate=np.array([e.value, e.low, e.high, e.resolution]))
 
 
@@ -100,7 +100,7 @@ def load_occupancy(path) -> Occupancy:
         grid = Grid(z["centre"], z["basis"], float(z["resolution"]), int(z["side"]), int(z["levels"]))
         counts = z["counts"]
         best, levels = estimate_volume(counts, grid.resolution, grid.levels)
-        return Occupancy(counts, grid, int(z["samples"]), int(z["seed"]), z["bounds_min"], z["bounds_max"],
+        return Occupancy(counts, grid, int(z["samples"]), int(str(z["seed"])), z["bounds_min"], z["bounds_max"],
                          float(z["reach"]), best, levels)
 
 
@@ -160,10 +160,10 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     >>> ws.planar, ws.estimate.low <= 3.1416 * 2.0**2 <= ws.estimate.high
     (True, True)
     """
+    _check_sizes(samples, DEFAULT_CHUNK if chunk is None else chunk)
     scheduler = resolve_auto(scheduler, samples)
     if chunk is None:
         chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS else CLUSTER_CHUNK
-    _check_sizes(samples, chunk)
     seed = new_seed() if seed is None else int(seed)
     if seed < 0:
         raise ModelError(f"seed must be a whole number >= 0, got {seed}")
