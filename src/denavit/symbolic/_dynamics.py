@@ -426,10 +426,10 @@ def _name_rate_coefficients(exprs: list[sp.Expr], rates) -> tuple[list[tuple[sp.
             out.append((coeff, mono))
         return out
 
-    def key(coeff):
-        x = sp.expand(coeff)
+    def key(coeff):  # expanded (canonical) when small; long ones compared as built (expanding them costs minutes)
+        x = sp.expand(coeff) if _size(coeff) < 3000 else coeff
         lead = sp.Add.make_args(x)[0].as_coeff_Mul()[0]
-        return sp.expand(x / lead), lead
+        return (sp.expand(x / lead) if x is not coeff else x / lead), lead
 
     count: dict[sp.Expr, int] = {}
     for e in exprs:
@@ -500,7 +500,7 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
     long = nodes > CSE_AUTO_CHARS or sum(len(str(e)) for e in exprs) > CSE_AUTO_CHARS  # printing only short ones
     grouped = hand and cse is not False and long
     if grouped:
-        rates, exprs = _name_rate_coefficients(exprs, terms.qd)
+        rates, exprs = _name_rate_coefficients(exprs, terms.qd) if nodes <= LONG_NODES else ([], exprs)
         repl, named = _name_groups([e for _, e in rates] + exprs, terms.qd)
         repl += [(s, e) for (s, _), e in zip(rates, named[:len(rates)])]
         exprs = named[len(rates):]
