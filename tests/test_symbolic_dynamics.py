@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 import denavit
-from denavit import DHLink, DHRobot, JointType
+from denavit import DHLink, JointType
 from denavit import numeric as N
 from denavit.model import LinkInertia
 from denavit.symbolic import format_dynamics, joint_symbols, lagrangian_dynamics, parameter_symbols

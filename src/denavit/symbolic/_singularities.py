@@ -6,7 +6,9 @@ the reference point is moved (both are block-triangular maps with determinant 1,
 so it is computed in the axes of a middle frame with the reference point on the last joint axis, where the
 entries are shortest (Craig sec. 5.9 does the same with ³J). For a non-square m×k matrix the measure is the
 Gram determinant det(JᵀJ) (m > k) or det(J Jᵀ) (m < k), a sum of squared k×k minors (Cauchy–Binet); their
-common factor is what is factorized and solved.
+common factor is what is factorized and solved. The algebra (frames, determinants, gcds, factorization) is done
+on polynomials in sin qᵢ, cos qᵢ (:class:`~denavit.symbolic._rings.TrigRing`): a Panda's seven 6×6 minors take
+seconds. Arms of fewer than six joints are analysed on their task rows (:func:`task_rows`).
 
 Each factor becomes a :class:`SingularCondition`: closed-form solutions when it involves one joint variable
 (a cos q + b sin q + c = 0, or a polynomial in a prismatic d), the equation itself otherwise, plus a
@@ -30,8 +32,7 @@ from ..chain import chain_of
 from ..model import DHRobot, Frame, JointType
 from ..numeric import (RANK_RTOL, TWIST_ROWS, geometric_jacobian, jacobian_rank, joint_axes, link_transforms,
                        select_rows)
-from ._jacobians import geometric_jacobian_sym, reduce_trig, simplify_kinematic
-from ._kinematics import link_transforms_sym
+from ._jacobians import geometric_jacobian_sym, reduce_trig
 from ._rings import TrigRing
 from ._symbols import joint_symbols, parameter_symbols
 
