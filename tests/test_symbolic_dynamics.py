@@ -176,3 +176,26 @@ def test_a_generic_twist_stays_exact():
     links[1] = dataclasses.replace(links[1], alpha=0.7, symbols=tuple(s for s in links[1].symbols if s[0] != "alpha"))
     robot = robot.replace(links=tuple(links))
     _check_against_numeric(robot, lagrangian_dynamics(robot, coriolis=False), np.random.default_rng(83), count=2)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["puma560", "ur5", "panda"])
+def test_symbolic_terms_match_pinocchio(name):
+    """M (crba, armature included), g (computeGeneralizedGravity) and c = C q̇ (computeCoriolisMatrix) of
+    Pinocchio, the model built by denavit.peers.to_pinocchio."""
+    pin = pytest.importorskip("pinocchio")
+    from denavit.peers import to_pinocchio
+
+    robot = denavit.load_robot(name)
+    t = lagrangian_dynamics(robot, coriolis=False)
+    f = _functions(robot, t)
+    model, data, _ = to_pinocchio(robot)
+    rng = np.random.default_rng(84)
+    for _ in range(2):
+        q, qd = rng.uniform(-np.pi, np.pi, robot.dof), rng.uniform(-2, 2, robot.dof)
+        M, c, g = f(q, qd)
+        Mp = pin.crba(model, data, q)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        np.testing.assert_allclose(M, Mp, atol=1e-10)
+        np.testing.assert_allclose(g.ravel(), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
+        np.testing.assert_allclose(c.ravel(), pin.computeCoriolisMatrix(model, data, q, qd) @ qd, atol=1e-9)
