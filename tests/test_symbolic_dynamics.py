@@ -199,3 +199,46 @@ def test_symbolic_terms_match_pinocchio(name):
         np.testing.assert_allclose(M, Mp, atol=1e-10)
         np.testing.assert_allclose(g.ravel(), pin.computeGeneralizedGravity(model, data, q), atol=1e-9)
         np.testing.assert_allclose(c.ravel(), pin.computeCoriolisMatrix(model, data, q, qd) @ qd, atol=1e-9)
+
+
+def _standard_parameters(robot):
+    """π of every inertial piece from the robot's data, by the parallel axis theorem written here:
+    (m, m c, I_c + m(|c|² 1 − c cᵀ)), then the motor inertias."""
+    from denavit.model import inertial_rows
+
+    vals = []
+    for _row, _body, li in inertial_rows(robot):
+        m, c = li.mass, np.array(li.com)
+        I = np.array([[li.inertia[0], li.inertia[3], li.inertia[4]], [li.inertia[3], li.inertia[1], li.inertia[5]],
+                      [li.inertia[4], li.inertia[5], li.inertia[2]]])
+        J = I + m * (c @ c * np.eye(3) - np.outer(c, c))
+        vals += [m, *(m * c), J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]]
+    return np.array(vals + [link.inertia.motor_inertia if link.inertia is not None else 0.0 for link in robot.joints])
+
+
+def _check_regressor(robot, rng, count=3):
+    from denavit.symbolic import regressor_sym
+
+    Y, pi = regressor_sym(robot)
+    js = joint_symbols(robot.dof)
+    assert Y.shape == (robot.dof, len(pi)) and not (Y.free_symbols & set(pi))  # linear: π is not left in Y
+    f = sp.lambdify(list(js.q) + list(js.qd) + list(js.qdd) + list(parameter_symbols(robot).values()), Y, "numpy")
+    p = _standard_parameters(robot)
+    for _ in range(count):
+        q, qd, qdd = (rng.uniform(-2, 2, robot.dof) for _ in range(3))
+        Yv = np.array(f(*q, *qd, *qdd, *robot.parameter_values.values()), dtype=float)
+        np.testing.assert_allclose(Yv @ p, N.rnea(robot, q, qd, qdd, friction=False), atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["planar2r", "planar3r-lagrange", pytest.param("puma560", marks=pytest.mark.slow),
+                                  pytest.param("ur5", marks=pytest.mark.slow)])
+def test_regressor_times_standard_parameters_is_the_rnea_torque(name):
+    _check_regressor(denavit.load_robot(name), np.random.default_rng(85))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(3))
+def test_regressor_of_random_arms(seed):
+    rng = np.random.default_rng(400 + seed)
+    robot = _random_inertial_arm(rng, int(rng.integers(2, 4)))
+    _check_regressor(robot, rng)

@@ -13,6 +13,7 @@ from ._dynamics import (
     lagrangian_dynamics,
 )
 from ._dynamics_trig import fourier_form
+from ._dynamics_ring import PARAMETER_NAMES, regressor_sym
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
 from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
@@ -53,6 +54,8 @@ __all__ = [
     "inertial_pieces",
     "lagrangian_dynamics",
     "fourier_form",
+    "PARAMETER_NAMES",
+    "regressor_sym",
     "LagrangeSteps",
     "lagrange_steps",
     "time_derivative",
