@@ -28,6 +28,7 @@ import numpy as np
 
 from .. import _expr
 from .. import numeric as N
+from ..codegen import numeric_function
 from ..errors import ParseError
 from ..model import DHRobot, Frame, JointType
 from ._latex import MAX_CHARS, parse_math
@@ -368,7 +369,7 @@ def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarra
                         q[j] = v
                         points.append((f"{s.variable} = {v:.6g} (from {factor})", q))
             continue
-        fn0 = sp.lambdify(qs, sp.sympify(c.factor).xreplace(psub), "numpy")  # safe: c.factor is the library's own sympy expression, never user text
+        fn0 = numeric_function(c.factor.xreplace(psub), list(qs))  # c.factor: the library's own sympy expression
         fn = lambda Q, f=fn0: np.broadcast_to(np.asarray(f(*Q.T), dtype=float), Q.shape[:1])  # noqa: E731
         for q in zero_set_points(fn, [int(v[1:]) - 1 for v in c.variables], arm, _scale(fn, arm), 3):
             points.append((factor, q))
