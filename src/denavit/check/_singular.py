@@ -281,7 +281,19 @@ def _cond_points(c: Cond, arm: _Arm) -> list[np.ndarray]:
     c.scale = _scale(fn, arm)
     if c.scale == 0.0:  # identically zero: the whole configuration space
         return list(arm.random_q(4))
-    return zero_set_points(fn, _variables(c.node), arm, c.scale)
+    variables = _variables(c.node)
+    pts = zero_set_points(fn, variables, arm, c.scale)
+    if not pts and len(variables) == 1:
+        # no root inside the limits: judged where it is, as ``q3 = 0`` written as a value is (a condition the
+        # library lists outside the limits, e.g. a prismatic joint at zero extension, is still a true one)
+        j = variables[0]
+        span = arm.hi[j] - arm.lo[j]
+        lo, hi = (-np.pi, np.pi) if arm.rev[j] else (arm.lo[j] - span - abs(arm.lo[j]), arm.hi[j] + span + abs(arm.hi[j]))
+        for r in roots_along(fn, arm.random_q()[0], j, lo, hi, c.scale)[:12]:
+            for q in arm.random_q(2):
+                q[j] = r
+                pts.append(q)
+    return pts
 
 
 def _ratio_near(c: Cond, q: np.ndarray, arm: _Arm) -> float:
