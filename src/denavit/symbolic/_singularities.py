@@ -28,6 +28,7 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
+from ..codegen import numeric_function
 from ..chain import chain_of
 from ..model import DHRobot, Frame, JointType
 from ..numeric import (RANK_RTOL, TWIST_ROWS, geometric_jacobian, jacobian_rank, joint_axes, link_transforms,
@@ -337,7 +338,7 @@ def _solutions(f: sp.Expr, var: int, robot: DHRobot, q, params: dict) -> list[Si
                         chosen.append(e)
                         break
             return [SingularSolution(str(qk), e, (v,), (_in_limits(v, lo, hi, True),)) for e, v in zip(chosen, vals)]
-        fn = sp.lambdify(qk, f.subs(params), "math")
+        fn = numeric_function(f.subs(params), [qk], "math")
         vals = [_wrap(v) for v in _scan_roots(fn, -math.pi, math.pi)]
         vals = sorted({round(v, 12) for v in vals})
         return [SingularSolution(str(qk), None, (v,), (_in_limits(v, lo, hi, True),)) for v in vals]
@@ -368,7 +369,7 @@ def _zero_set_samples(f, variables: list[int], sols, robot, q, params, rng, coun
                     x[variables[0]] = v
                     out.append(x)
         return out
-    fn = sp.lambdify(q, f.subs(params), "math")
+    fn = numeric_function(f.subs(params), list(q), "math")
     k = variables[-1]
     for _ in range(20 * count):
         x = _random_q(robot, rng)
