@@ -194,7 +194,7 @@ def _param_values(robot: DHRobot) -> dict:
 
 def _numeric_zero(expr, robot: DHRobot, qs, rng: np.random.Generator, tol: float = 1e-9) -> bool:
     """Is ``expr`` zero for the robot's parameter values at random joint values (a cheap identity test)?"""
-    f = numeric_function(sp.sympify(expr).subs(_param_values(robot)), list(qs))  # expr: built here, not user text
+    f = numeric_function(sp.sympify(expr).subs(_param_values(robot)), list(qs))  # safe: expr is built by this module, never user text
     for _ in range(4):
         if np.max(np.abs(np.asarray(f(*rng.uniform(-3, 3, len(qs))), dtype=complex))) > tol:
             return False

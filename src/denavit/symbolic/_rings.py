@@ -98,7 +98,7 @@ class TrigRing:
         """Floats (a generic twist's cos 0.7 = 0.7648…): pairs x, y with x² + y² = 1 (to 1e-12) become the
         cosine and sine of one constant angle, generators with the relation x² + y² − 1 (so RᵀR = I holds
         exactly and terms cancel); other floats become exact rationals of their decimal text."""
-        floats = sorted({abs(f) for e in exprs for f in sp.sympify(e).atoms(sp.Float)}, key=float)
+        floats = sorted({abs(f) for e in exprs for f in sp.sympify(e).atoms(sp.Float)}, key=float)  # safe: the engine's own expressions (ints → Integer), never text
         paired: dict[sp.Float, sp.Float] = {}
         for i, x in enumerate(floats):
             for y in floats[i:]:
@@ -107,14 +107,14 @@ class TrigRing:
         self._pairs = list({tuple(sorted((x, y), key=float)) for x, y in paired.items()})
         out: dict[sp.Float, sp.Expr] = {}
         for e in exprs:
-            for f in sp.sympify(e).atoms(sp.Float):
+            for f in sp.sympify(e).atoms(sp.Float):  # safe: the engine's own expressions, never text
                 a = abs(f)
                 val = a if a in paired else sp.Rational(repr(float(a)))
                 out[f] = val if f >= 0 else -val
         return out
 
     def _trig_vars(self, e: sp.Expr, strict: bool = True) -> sp.Expr:
-        x = sp.expand(sp.expand_trig(sp.sympify(e)))
+        x = sp.expand(sp.expand_trig(sp.sympify(e)))  # safe: the engine's own expressions, never text
         if self._floats:
             x = sp.expand(x.xreplace({f: self._floats.get(f, f) for f in x.atoms(sp.Float)}))
         x = x.xreplace(self._subs)
