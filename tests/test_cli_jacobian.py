@@ -148,3 +148,65 @@ def test_singularities_of_a_non_square_jacobian_without_common_factor_are_not_ca
     main(["singularities", "report004-1-planar2r", "--rows", "vx,vy", "--json"])
     data = json.loads(capsys.readouterr().out)
     assert data["conditions"] and data["conditions_complete"] is True
+
+
+def _evaluate(texts, robot, q, qd=None, wrench=None):
+    """Formulas printed by the CLI (our own output, read back here with sympy) at numbers."""
+    import sympy as sp
+
+    from denavit import symbolic as S
+
+    js = S.joint_symbols(robot.dof)
+    subs = {**dict(zip(js.q, q)), **{S.parameter_symbols(robot)[k]: v for k, v in robot.parameters}}
+    if qd is not None:
+        subs.update(zip(js.qd, qd))
+    if wrench is not None:
+        subs.update(zip(S.wrench_symbols(), wrench))
+    names = {str(s): s for s in subs}
+    return np.array([float(sp.sympify(t, locals=names).subs(subs)) for t in texts])
+
+
+@pytest.mark.parametrize("name", ["report004-1-planar2r", "planar3r", "scara", "stanford"])
+@pytest.mark.parametrize("frame", ["base", "tool"])
+def test_velocity_symbolic_formulas_equal_the_numeric_twist_and_propagation(capsys, name, frame):
+    robot = load_robot(name)
+    data = run_json(capsys, "velocity", name, "--symbolic", "--steps", "--frame", frame)
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q, qd = rng.uniform(-2, 2, robot.dof), rng.uniform(-2, 2, robot.dof)
+        twist = N.end_effector_twist(robot, q, qd, frame)
+        np.testing.assert_allclose(_evaluate(data["v_symbolic"], robot, q, qd), twist[:3], atol=1e-9)
+        np.testing.assert_allclose(_evaluate(data["omega_symbolic"], robot, q, qd), twist[3:], atol=1e-9)
+        prop = N.velocity_propagation(robot, q, qd)  # the numeric route, frame by frame
+        for step in data["steps"]:
+            k = list(prop.labels).index(step["frame"])
+            np.testing.assert_allclose(_evaluate(step["omega"], robot, q, qd), prop.omega[k], atol=1e-9)
+            np.testing.assert_allclose(_evaluate(step["v"], robot, q, qd), prop.v[k], atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["report004-1-planar2r", "planar3r", "stanford"])
+@pytest.mark.parametrize("method, frame", [("jacobian", "base"), ("jacobian", "tool"), ("propagation", "tool")])
+def test_statics_symbolic_tau_equals_the_numeric_torques(capsys, name, method, frame):
+    robot = load_robot(name)
+    argv = ["statics", name, "--symbolic", "--method", method, "--frame", frame]
+    data = run_json(capsys, *argv + (["--steps"] if method == "propagation" else []))
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        q, W = rng.uniform(-2, 2, robot.dof), rng.normal(size=6)
+        tau = N.joint_torques(robot, q, W, frame)  # τ = Jᵀ F, numerically
+        np.testing.assert_allclose(_evaluate(data["tau_symbolic"], robot, q, wrench=W), tau, atol=1e-9)
+        if method == "propagation":
+            prop = N.force_propagation(robot, q, W, frame)
+            for step in data["steps"]:
+                k = list(prop.labels).index(step["frame"])
+                np.testing.assert_allclose(_evaluate(step["f"], robot, q, wrench=W), prop.f[k], atol=1e-9)
+                np.testing.assert_allclose(_evaluate(step["n"], robot, q, wrench=W), prop.n[k], atol=1e-9)
+
+
+def test_symbolic_velocity_and_statics_defaults_and_refusals(capsys):
+    data = run_json(capsys, "statics", "planar2r", "--method", "propagation")  # no -q: formulas, tool axes
+    assert data["frame"] == "tool" and len(data["tau_symbolic"]) == 2
+    assert "propagation" in run_error(capsys, "statics", "planar2r", "--method", "propagation", "--frame", "base")
+    assert "--qd" in run_error(capsys, "velocity", "planar2r", "-q", "0, 1")
+    assert "--wrench" in run_error(capsys, "statics", "planar2r", "-q", "0, 1")
+    assert "--steps" in run_error(capsys, "statics", "planar2r", "--symbolic", "--steps")

@@ -32,23 +32,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     _sym_format(p)
     p.set_defaults(handler=cmd_jacobian)
 
-    p = sub.add_parser("velocity", help="end-effector twist (v, w) from joint rates")
+    p = sub.add_parser("velocity", help="end-effector twist (v, w) from joint rates, numeric or symbolic")
     add_common(p)
-    add_q(p)
-    p.add_argument("--qd", required=True, metavar="QD", help="joint rates [rad/s or m/s; deg/s with --deg]")
+    add_q(p, required=False)
+    p.add_argument("--qd", metavar="QD", help="joint rates [rad/s or m/s; deg/s with --deg] (numeric route)")
     _frame(p)
     p.add_argument("--steps", action="store_true", help="omega_i and v_i of every frame (outward propagation)")
+    p.add_argument("--symbolic", action="store_true",
+                   help="the formulas in q and qd (the default when -q is not given)")
+    _sym_format(p)
     p.set_defaults(handler=cmd_velocity)
 
-    p = sub.add_parser("statics", help="joint torques balancing an end-effector wrench (f, n)")
+    p = sub.add_parser("statics", help="joint torques balancing an end-effector wrench (f, n), numeric or symbolic")
     add_common(p)
-    add_q(p)
-    p.add_argument("--wrench", required=True, metavar="W",
-                   help="fx, fy, fz[, nx, ny, nz] [N, N m] exerted by the end effector, at its origin")
-    _frame(p, what="axes of the wrench")
+    add_q(p, required=False)
+    p.add_argument("--wrench", metavar="W",
+                   help="fx, fy, fz[, nx, ny, nz] [N, N m] exerted by the end effector, at its origin (numeric route)")
+    p.add_argument("--frame", choices=["base", "tool"], default=None,
+                   help="axes of the wrench: base/world or tool (default base; tool for --symbolic --method "
+                        "propagation, whose wrench starts in tool axes)")
     p.add_argument("--method", choices=["jacobian", "propagation"], default="jacobian",
                    help="tau = J^T F, or Craig's inward force propagation")
     p.add_argument("--steps", action="store_true", help="f_i and n_i of every frame (inward propagation)")
+    p.add_argument("--symbolic", action="store_true",
+                   help="tau as formulas of q and the wrench symbols f_x ... n_z (the default when -q is not given)")
+    _sym_format(p)
     p.set_defaults(handler=cmd_statics)
 
     p = sub.add_parser("singularities", help="singular configurations: factored determinant, conditions, kinds")
@@ -191,10 +199,55 @@ def cmd_jacobian(args: argparse.Namespace):
 # --- velocity ------------------------------------------------------------------------------------------
 
 
+def _symbolic_velocity(robot, args) -> tuple[dict, list[str]]:
+    """v and ω of the end effector as formulas of q and q̇ (J q̇), and with --steps every ω_i, v_i."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    require_symbolic_size(robot, "velocity --symbolic")
+    js = S.joint_symbols(robot.dof)
+    fmt = _formatter(args, js.q)
+    J = S.jacobian_sym(robot, "geometric", args.frame, args.simplify)
+    twist = S.simplify_matrix(J * sp.Matrix(js.qd), args.simplify)
+    v, w = sp.ImmutableMatrix(twist[:3, :]), sp.ImmutableMatrix(twist[3:, :])
+    lines = [f"{robot.name}: symbolic end-effector twist = J q̇", _header(args.frame, "twist (v, w)"),
+             "v =", fmt(v), "w =", fmt(w)]
+    data = {"v_symbolic": [str(e) for e in v], "omega_symbolic": [str(e) for e in w],
+            "v_latex": sp.latex(v), "omega_latex": sp.latex(w)}
+    if args.steps:
+        prop = S.velocity_propagation_sym(robot, args.simplify)
+        lines += ["", "outward velocity propagation (omega_i, v_i of frame {i} in its own axes; Craig 5.45-5.47):"]
+        steps = []
+        for st in prop.steps[1:]:
+            lines += [f"omega_{st.label} =", fmt(st.omega), f"v_{st.label} =", fmt(st.v)]
+            steps.append({"frame": st.label, "joint": st.joint, "omega": [str(e) for e in st.omega],
+                          "v": [str(e) for e in st.v]})
+        data["steps"] = steps
+    return data, lines
+
+
 def cmd_velocity(args: argparse.Namespace):
+    robot = load(args)
+    if args.q is not None and args.qd is None:
+        raise ParseError("--qd is required with -q (the joint rates); for formulas leave out -q or add --symbolic")
+    if args.symbolic or args.q is None:
+        if args.q is not None:  # a bad -q fails now, not after the symbolic work
+            joint_values(args, robot, args.q)
+            joint_values(args, robot, args.qd, what="qd", rates=True)
+        data, lines = _symbolic_velocity(robot, args)
+        data.update({"robot": robot.name, "frame": args.frame, "reference_point": REFERENCE})
+        if args.q is None:
+            return data, "\n".join(lines)
+        numeric, text = cmd_velocity_numeric(args, robot)
+        data.update(numeric)
+        return data, "\n".join(lines + ["", text])
+    return cmd_velocity_numeric(args, robot)
+
+
+def cmd_velocity_numeric(args: argparse.Namespace, robot):
     from .. import numeric as N
 
-    robot = load(args)
     q = joint_values(args, robot, args.q)
     qd = joint_values(args, robot, args.qd, what="qd", rates=True)
     twist = N.end_effector_twist(robot, q, qd, args.frame)
@@ -231,11 +284,73 @@ def _wrench(text: str) -> np.ndarray:
     return W
 
 
+def _symbolic_statics(robot, args) -> tuple[dict, list[str]]:
+    """τ as formulas of q and the wrench symbols: J^T F, or Craig's inward propagation (with every f_i, n_i)."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    require_symbolic_size(robot, "statics --symbolic")
+    q = S.joint_symbols(robot.dof).q
+    fmt = _formatter(args, q)
+    W = sp.Matrix(S.wrench_symbols())
+    axes = "base/world" if args.frame == "base" else "tool"
+    lines = [f"{robot.name}: symbolic joint torques", f"wrench (f_x, f_y, f_z, n_x, n_y, n_z) exerted by the end "
+             f"effector, in {axes} axes, at the {REFERENCE}"]
+    data: dict = {"wrench_symbols": [str(x) for x in W]}
+    if args.method == "propagation":
+        if args.frame == "base":
+            raise ParseError("--symbolic --method propagation starts from the wrench in tool axes (Craig 5.80-5.81): "
+                             "use --frame tool, or --method jacobian for a wrench in base axes")
+        prop = S.force_propagation_sym(robot, args.simplify)
+        tau = sp.ImmutableMatrix(prop.tau)
+        lines.append("method: inward force propagation (Craig 5.80-5.81): tau_i = n_i . z_i (revolute), f_i . z_i "
+                     "(prismatic)")
+        if args.steps:
+            lines += ["", "inward propagation (f_i, n_i at the origin of {i}, in its axes):"]
+            steps = []
+            for st in prop.steps:
+                lines += [f"f_{st.label} =", fmt(st.f), f"n_{st.label} =", fmt(st.n)]
+                steps.append({"frame": st.label, "f": [str(e) for e in st.f], "n": [str(e) for e in st.n],
+                              "joint": None if st.joint is None else st.joint + 1,
+                              "tau": None if st.tau is None else str(st.tau)})
+            data["steps"] = steps
+            lines.append("")
+    else:
+        if args.steps:
+            raise ParseError("--steps goes with --method propagation")
+        J = S.jacobian_sym(robot, "geometric", args.frame, args.simplify)
+        tau = S.simplify_matrix(J.T * W, args.simplify)
+        lines.append("method: tau = J^T F")
+    lines += ["tau =", fmt(tau)]
+    data.update({"tau_symbolic": [str(e) for e in tau], "tau_latex": sp.latex(tau)})
+    return data, lines
+
+
 def cmd_statics(args: argparse.Namespace):
+    robot = load(args)
+    if args.frame is None:
+        args.frame = "tool" if (args.symbolic or args.q is None) and args.method == "propagation" else "base"
+    if args.q is not None and args.wrench is None:
+        raise ParseError("--wrench is required with -q; for formulas leave out -q or add --symbolic")
+    if args.symbolic or args.q is None:
+        if args.q is not None:  # a bad -q or --wrench fails now, not after the symbolic work
+            joint_values(args, robot, args.q)
+            _wrench(args.wrench)
+        data, lines = _symbolic_statics(robot, args)
+        data.update({"robot": robot.name, "frame": args.frame, "method": args.method, "reference_point": REFERENCE})
+        if args.q is None:
+            return data, "\n".join(lines)
+        numeric, text = cmd_statics_numeric(args, robot)
+        data.update(numeric)
+        return data, "\n".join(lines + ["", text])
+    return cmd_statics_numeric(args, robot)
+
+
+def cmd_statics_numeric(args: argparse.Namespace, robot):
     from .. import numeric as N
     from ..model import JointType
 
-    robot = load(args)
     q = joint_values(args, robot, args.q)
     W = _wrench(args.wrench)
     prop = N.force_propagation(robot, q, W, args.frame)
