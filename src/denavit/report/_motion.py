@@ -16,9 +16,9 @@ from .. import numeric as N
 from .. import symbolic as S
 from ..chain import chain_of
 from ..model import JointType
-from ._context import EXACT_TOL, Context
+from ._context import Context
 from ._derivation import Equation, Numbers, Section, Table, Text
-from ._sections import MAX_EXACT_CHARS, latex
+from ._sections import MAX_EXACT_CHARS
 
 __all__ = ["section_jacobian", "section_velocity", "section_statics", "jacobian_sym", "jacobian_case"]
 
@@ -155,7 +155,31 @@ def section_velocity(ctx: Context) -> Section:
                           "$\\omega$ and $v$ in its own axes:"))
         steps.append(Table(("\\text{frame } k", "{}^k\\omega_k", "{}^k v_k"), rows))
         steps.append(Text(f"Propagated twist in base axes vs $J_0 \\dot q$: {_agree(_max_diff(vp.twist('base'), tw))}."))
+        if ctx.symbolic_jacobian_ok:
+            steps += _velocity_steps_sym(ctx, vp)
     return Section("velocity", "Velocity", tuple(steps))
+
+
+def _velocity_steps_sym(ctx: Context, vp) -> list:
+    """The propagation written out: ω_k, v_k of every frame as formulas of q, q̇, checked at the case."""
+    prop = S.velocity_propagation_sym(ctx.robot, ctx.simplify)
+    if ctx.robot.convention.value == "standard":
+        rule = ("standard DH: ${}^{i}\\omega_{i} = {}^{i}R_{i-1}({}^{i-1}\\omega_{i-1} + \\dot q_i \\hat z)$, "
+                "${}^{i}v_{i} = {}^{i}R_{i-1}({}^{i-1}v_{i-1} + {}^{i-1}\\omega_{i} \\times {}^{i-1}P_{i})$ (revolute)")
+    else:
+        rule = ("modified DH: ${}^{i+1}\\omega_{i+1} = {}^{i+1}R_{i}\\,{}^{i}\\omega_{i} + \\dot q_{i+1} \\hat z$, "
+                "${}^{i+1}v_{i+1} = {}^{i+1}R_{i}({}^{i}v_{i} + {}^{i}\\omega_{i} \\times {}^{i}P_{i+1})$ (revolute)")
+    out: list = [Text(f"The same propagation as formulas (Craig 2005, eq. 5.45-5.47; {rule}):")]
+    worst = 0.0
+    subs = {**ctx.param_subs, **dict(zip(prop.q, ctx.q)), **dict(zip(prop.qd, ctx.qd))}
+    for st in prop.steps[1:]:
+        out.append(Equation(f"{{}}^{{{st.label}}}\\omega_{{{st.label}}}", ctx.short(st.omega), shorthand=True))
+        out.append(Equation(f"{{}}^{{{st.label}}}v_{{{st.label}}}", ctx.short(st.v), shorthand=True))
+        k = list(vp.labels).index(st.label)
+        at = [float(e) for e in st.omega.xreplace(subs).evalf()] + [float(e) for e in st.v.xreplace(subs).evalf()]
+        worst = max(worst, _max_diff(at, np.concatenate([vp.omega[k], vp.v[k]])))
+    out.append(Text(f"Check, the formulas at the numeric case vs the table above: {_agree(worst)}."))
+    return out
 
 
 def _vec(x, digits: int = 4) -> str:
@@ -197,4 +221,26 @@ def section_statics(ctx: Context) -> Section:
         steps.append(Table(("\\text{frame } k", "{}^k f_k", "{}^k n_k"), rows))
         steps.append(Numbers("\\tau", fp.tau, note="route 2"))
         steps.append(Text(f"The two routes {_agree(_max_diff(fp.tau, tau))}."))
+        if ctx.symbolic_jacobian_ok:
+            steps += _force_steps_sym(ctx)
     return Section("statics", "Statics", tuple(steps))
+
+
+def _force_steps_sym(ctx: Context) -> list:
+    """The inward propagation as formulas of q and a wrench (f_x, …, n_z) in tool axes, checked at the case."""
+    prop = S.force_propagation_sym(ctx.robot, ctx.simplify)
+    out: list = [Text("The same propagation as formulas, for a wrench $(f_x, f_y, f_z, n_x, n_y, n_z)$ given in "
+                      "tool axes (Craig's setting):")]
+    for st in prop.steps:
+        out.append(Equation(f"{{}}^{{{st.label}}}f_{{{st.label}}}", ctx.short(st.f), shorthand=True))
+        out.append(Equation(f"{{}}^{{{st.label}}}n_{{{st.label}}}", ctx.short(st.n), shorthand=True))
+    out.append(Equation("\\tau", ctx.short(sp.ImmutableMatrix(prop.tau)), shorthand=True))
+    R = N.forward_kinematics(ctx.robot, ctx.q)[:3, :3]
+    W_tool = np.concatenate([R.T @ ctx.wrench[:3], R.T @ ctx.wrench[3:6]]) if len(ctx.wrench) == 6 else \
+        np.concatenate([R.T @ ctx.wrench[:3], np.zeros(3)])
+    subs = {**ctx.param_subs, **dict(zip(ctx.q_syms, ctx.q)), **dict(zip(prop.wrench, W_tool))}
+    at = [float(e) for e in sp.ImmutableMatrix(prop.tau).xreplace(subs).evalf()]
+    tau = N.joint_torques(ctx.robot, ctx.q, ctx.wrench)
+    out.append(Text("Check, $\\tau$ from these formulas at the numeric case (the wrench turned into tool axes) vs "
+                    f"route 1: {_agree(_max_diff(at, tau))}."))
+    return out
