@@ -138,15 +138,22 @@ def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
     if args.steps:
         if args.method != "propagation":
             raise ParseError("--steps goes with --method propagation")
-        prop = S.velocity_propagation_sym(robot, args.simplify)
         lines += ["", "outward velocity propagation (each vector in its own frame's axes):"]
-        steps = []
-        for st in prop.steps[1:]:
-            lines += [f"omega_{st.label} =", fmt(st.omega), f"v_{st.label} =", fmt(st.v)]
-            steps.append({"frame": st.label, "joint": st.joint, "omega": [str(e) for e in st.omega],
-                          "v": [str(e) for e in st.v]})
-        data["steps"] = steps
+        data["steps"] = _velocity_steps_sym(robot, args, fmt, lines)
     return data, lines
+
+
+def _velocity_steps_sym(robot, args, fmt, lines: list[str]) -> list[dict]:
+    """ω_i and v_i of every frame as formulas (symbolic outward propagation): printed lines appended to
+    ``lines``, the JSON records returned."""
+    from .. import symbolic as S
+
+    steps = []
+    for st in S.velocity_propagation_sym(robot, args.simplify).steps[1:]:
+        lines += [f"omega_{st.label} =", fmt(st.omega), f"v_{st.label} =", fmt(st.v)]
+        steps.append({"frame": st.label, "joint": st.joint, "omega": [str(e) for e in st.omega],
+                      "v": [str(e) for e in st.v]})
+    return steps
 
 
 def cmd_jacobian(args: argparse.Namespace):
@@ -216,14 +223,8 @@ def _symbolic_velocity(robot, args) -> tuple[dict, list[str]]:
     data = {"v_symbolic": [str(e) for e in v], "omega_symbolic": [str(e) for e in w],
             "v_latex": sp.latex(v), "omega_latex": sp.latex(w)}
     if args.steps:
-        prop = S.velocity_propagation_sym(robot, args.simplify)
         lines += ["", "outward velocity propagation (omega_i, v_i of frame {i} in its own axes; Craig 5.45-5.47):"]
-        steps = []
-        for st in prop.steps[1:]:
-            lines += [f"omega_{st.label} =", fmt(st.omega), f"v_{st.label} =", fmt(st.v)]
-            steps.append({"frame": st.label, "joint": st.joint, "omega": [str(e) for e in st.omega],
-                          "v": [str(e) for e in st.v]})
-        data["steps"] = steps
+        data["steps"] = _velocity_steps_sym(robot, args, fmt, lines)
     return data, lines
 
 
