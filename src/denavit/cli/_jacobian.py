@@ -1,4 +1,4 @@
-"""Subcommands on Jacobians: jacobian, velocity, statics, singularities.
+"""Subcommands on Jacobians: jacobian, velocity, statics (singularities: :mod:`._singularities`).
 
 Each handler parses, calls the library, and formats; results carry their frame, reference point and row order.
 """
@@ -6,16 +6,15 @@ Each handler parses, calls the library, and formats; results carry their frame, 
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 
 from ..errors import ParseError
-from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_q, check_values, joint_values, load, matrix_text, number_text, numbers_text,
-                      require_finite,
-                      require_symbolic_size, stage_printer)
+from ..numeric import TWIST_ROWS as ROWS
+from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
+                      require_symbolic_size)
+from ._shared import add_frame, add_sym_format, q_out, q_text, sym_formatter
 
-ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 REFERENCE = "end-effector origin (after the tool transform)"
 
 
@@ -23,24 +22,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("jacobian", help="Jacobian J0 (base axes) or Je (tool axes), numeric or symbolic")
     add_common(p)
     add_q(p, required=False)
-    _frame(p)
+    add_frame(p)
     p.add_argument("--method", choices=["geometric", "differentiation", "propagation"], default="geometric",
                    help="route: joint axes of the frames, differentiation of FK, or Craig's velocity propagation")
     p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
     p.add_argument("--analytic", choices=["rpy", "zyz"], help="analytic Jacobian: rows (xdot, ydot, zdot, angle rates); numeric with -q, symbolic without")
     p.add_argument("--steps", action="store_true", help="with --method propagation: every omega_i and v_i (symbolic)")
-    _sym_format(p)
+    add_sym_format(p)
     p.set_defaults(handler=cmd_jacobian)
 
     p = sub.add_parser("velocity", help="end-effector twist (v, w) from joint rates, numeric or symbolic")
     add_common(p)
     add_q(p, required=False)
     p.add_argument("--qd", metavar="QD", help="joint rates [rad/s or m/s; deg/s with --deg] (numeric route)")
-    _frame(p)
+    add_frame(p)
     p.add_argument("--steps", action="store_true", help="omega_i and v_i of every frame (outward propagation)")
     p.add_argument("--symbolic", action="store_true",
                    help="the formulas in q and qd (the default when -q is not given)")
-    _sym_format(p)
+    add_sym_format(p)
     p.set_defaults(handler=cmd_velocity)
 
     p = sub.add_parser("statics", help="joint torques balancing an end-effector wrench (f, n), numeric or symbolic")
@@ -56,43 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--steps", action="store_true", help="f_i and n_i of every frame (inward propagation)")
     p.add_argument("--symbolic", action="store_true",
                    help="tau as formulas of q and the wrench symbols f_x ... n_z (the default when -q is not given)")
-    _sym_format(p)
+    add_sym_format(p)
     p.set_defaults(handler=cmd_statics)
 
-    p = sub.add_parser("singularities", help="singular configurations: factored determinant, conditions, kinds")
-    add_common(p)
-    add_q(p, required=False)
-    p.add_argument("--rows", metavar="ROWS", help="task rows of the Jacobian, e.g. vx,vy,wz (default: all six)")
-    _frame(p, what="axes of the Jacobian whose rows are taken")
-    _sym_format(p, simplify=False)
-    p.set_defaults(handler=cmd_singularities)
-
-
-def _frame(p, what: str = "axes of the result") -> None:
-    p.add_argument("--frame", choices=["base", "tool"], default="base", help=f"{what}: base/world (J0) or tool (Je)")
-
-
-def _sym_format(p, simplify: bool = True) -> None:
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--latex", action="store_true", help="symbolic output as LaTeX")
-    g.add_argument("--markdown", action="store_true", help="symbolic output as Markdown with $$ math $$ blocks")
-    p.add_argument("--shorthand", action="store_true", help="write cos(q1+q2) as C12, sin(q3) as S3")
-    if simplify:
-        p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
-
-
-def _formatter(args, q):
-    import sympy as sp
-
-    from .. import symbolic as S
-
-    show = (lambda M: S.shorthand(M, q) if not hasattr(M, "shape") else S.shorthand_matrix(M, q)) \
-        if args.shorthand else (lambda M: M)
-    if getattr(args, "markdown", False):
-        return lambda M: "$$\n" + sp.latex(show(M)) + "\n$$"
-    if getattr(args, "latex", False):
-        return lambda M: sp.latex(show(M))
-    return lambda M: sp.pretty(show(M), use_unicode=True, wrap_line=False)
 
 
 def _header(frame: str, what: str = "J") -> str:
@@ -106,20 +71,6 @@ def _labelled(M: np.ndarray, labels=ROWS) -> str:
     return "\n".join(f"{lab:>{width}} {row}" for lab, row in zip(labels, body))
 
 
-def _q_out(args, robot, q):
-    from ..model import JointType
-
-    if not args.deg:
-        return q
-    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-    return np.where(rev, np.degrees(q), q)
-
-
-def _q_text(args, robot, q) -> str:
-    unit = "deg for revolute joints" if args.deg else "rad"
-    return f"q = [{numbers_text(_q_out(args, robot, q))}] ({unit})"
-
-
 # --- jacobian ------------------------------------------------------------------------------------------
 
 
@@ -130,7 +81,7 @@ def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
 
     require_symbolic_size(robot, "jacobian --symbolic")
     q = S.joint_symbols(robot.dof).q
-    fmt = _formatter(args, q)
+    fmt = sym_formatter(args, q)
     J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
     name = "J0" if args.frame == "base" else "Je"
     lines = [f"{robot.name}: symbolic Jacobian by {args.method}", _header(args.frame), f"{name} =", fmt(J)]
@@ -176,18 +127,18 @@ def cmd_jacobian(args: argparse.Namespace):
             angles = ", ".join(str(a) for a in S.angle_symbols(args.analytic))
             lines += ["", f"analytic Jacobian Ja ({args.analytic}): rows (xdot, ydot, zdot, rates of {angles}), "
                       f"in terms of q and the current angles {angles}", "Ja =",
-                      _formatter(args, S.joint_symbols(robot.dof).q)(Ja)]
+                      sym_formatter(args, S.joint_symbols(robot.dof).q)(Ja)]
             data.update({"Ja_symbolic": Ja, "Ja_latex": sp.latex(Ja), "representation": args.analytic})
     if args.q is not None:
         q = joint_values(args, robot, args.q)
-        data["q"] = _q_out(args, robot, q)
+        data["q"] = q_out(args, robot, q)
         if args.analytic:
             Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
             require_finite("jacobian", phi)  # rate rows are NaN at a representation singularity (warned)
             names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
             conv = np.degrees(phi) if args.deg else phi
             data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
-            lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {_q_text(args, robot, q)}",
+            lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {q_text(args, robot, q)}",
                       f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
                       f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
                       f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
@@ -198,7 +149,7 @@ def cmd_jacobian(args: argparse.Namespace):
             data["J"] = J
             if lines:
                 lines.append("")
-            lines += [f"{robot.name}: Jacobian by {args.method} at {_q_text(args, robot, q)}", _header(args.frame),
+            lines += [f"{robot.name}: Jacobian by {args.method} at {q_text(args, robot, q)}", _header(args.frame),
                       "(columns: per rad for revolute joints, per m for prismatic ones)", _labelled(J)]
     return data, "\n".join(line for line in lines if line is not None)
 
@@ -214,7 +165,7 @@ def _symbolic_velocity(robot, args) -> tuple[dict, list[str]]:
 
     require_symbolic_size(robot, "velocity --symbolic")
     js = S.joint_symbols(robot.dof)
-    fmt = _formatter(args, js.q)
+    fmt = sym_formatter(args, js.q)
     J = S.jacobian_sym(robot, "geometric", args.frame, args.simplify)
     twist = S.simplify_matrix(J * sp.Matrix(js.qd), args.simplify)
     v, w = sp.ImmutableMatrix(twist[:3, :]), sp.ImmutableMatrix(twist[3:, :])
@@ -255,10 +206,10 @@ def cmd_velocity_numeric(args: argparse.Namespace, robot):
     require_finite("velocity", twist)
     ang = np.degrees if args.deg else (lambda x: x)
     aunit = "deg/s" if args.deg else "rad/s"
-    data = {"robot": robot.name, "q": _q_out(args, robot, q), "qd": _q_out(args, robot, qd), "frame": args.frame,
+    data = {"robot": robot.name, "q": q_out(args, robot, q), "qd": q_out(args, robot, qd), "frame": args.frame,
             "reference_point": REFERENCE, "twist": np.concatenate([twist[:3], ang(twist[3:])]),
             "v": twist[:3], "omega": ang(twist[3:]), "angle_unit": "deg" if args.deg else "rad"}
-    lines = [f"{robot.name}: end-effector twist at {_q_text(args, robot, q)}", _header(args.frame, "twist (v, w)"),
+    lines = [f"{robot.name}: end-effector twist at {q_text(args, robot, q)}", _header(args.frame, "twist (v, w)"),
              f"v = [{numbers_text(twist[:3])}] m/s",
              f"w = [{numbers_text(ang(twist[3:]))}] {aunit}"]
     if args.steps:
@@ -293,7 +244,7 @@ def _symbolic_statics(robot, args) -> tuple[dict, list[str]]:
 
     require_symbolic_size(robot, "statics --symbolic")
     q = S.joint_symbols(robot.dof).q
-    fmt = _formatter(args, q)
+    fmt = sym_formatter(args, q)
     W = sp.Matrix(S.wrench_symbols())
     axes = "base/world" if args.frame == "base" else "tool"
     lines = [f"{robot.name}: symbolic joint torques", f"wrench (f_x, f_y, f_z, n_x, n_y, n_z) exerted by the end "
@@ -359,10 +310,10 @@ def cmd_statics_numeric(args: argparse.Namespace, robot):
     require_finite("statics", tau, prop.f, prop.n)
     units = ["N m" if t is JointType.REVOLUTE else "N" for t in robot.joint_types]
     F6 = N.as_wrench(W)
-    data = {"robot": robot.name, "q": _q_out(args, robot, q), "wrench": F6, "frame": args.frame,
+    data = {"robot": robot.name, "q": q_out(args, robot, q), "wrench": F6, "frame": args.frame,
             "method": args.method, "reference_point": REFERENCE, "tau": tau, "units": units}
     axes = "base/world" if args.frame == "base" else "tool"
-    lines = [f"{robot.name}: joint torques at {_q_text(args, robot, q)}",
+    lines = [f"{robot.name}: joint torques at {q_text(args, robot, q)}",
              f"wrench (f, n) = [{numbers_text(F6)}] N, N m exerted by the end effector, "
              f"in {axes} axes, at the {REFERENCE}",
              f"method: {'tau = J^T F' if args.method == 'jacobian' else 'inward force propagation (Craig 5.80-5.81)'}"]
@@ -374,137 +325,3 @@ def cmd_statics_numeric(args: argparse.Namespace, robot):
             lines.append(f"  {{{lab}}}: f = [{numbers_text(f)}] N, n = [{numbers_text(n)}] N m")
         data["steps"] = [{"frame": lab, "f": f, "n": n} for lab, f, n in zip(prop.labels, prop.f, prop.n)]
     return data, "\n".join(lines)
-
-
-# --- singularities -------------------------------------------------------------------------------------
-
-
-def _value_text(v: float, revolute: bool, deg: bool) -> str:
-    if not revolute:
-        return f"{number_text(v)} m"
-    if deg:
-        return f"{number_text(math.degrees(v))}°"
-    return f"{number_text(v)} rad ({number_text(math.degrees(v))}°)"
-
-
-def _condition_lines(cond, robot, args, fmt) -> list[str]:
-    import sympy as sp
-
-    from ..model import JointType
-
-    eq = fmt(sp.Eq(cond.factor, 0, evaluate=False)) if (args.latex or args.markdown) else f"{cond.factor} = 0"
-    if args.shorthand and not (args.latex or args.markdown):
-        eq = f"{fmt(cond.factor)} = 0" if "\n" not in fmt(cond.factor) else eq
-    lines = [f"- {eq}"]
-    if cond.solutions:
-        parts: dict[str, list[str]] = {}
-        for s in cond.solutions:
-            k = int(s.variable[1:]) - 1
-            rev = robot.joint_types[k] is JointType.REVOLUTE
-            vals = ", ".join(_value_text(v, rev, args.deg) + ("" if ok else " (outside limits)")
-                             for v, ok in zip(s.values, s.in_limits))
-            expr = f"{s.expression} = " if s.expression is not None and not s.expression.is_number else ""
-            parts.setdefault(s.variable, []).append(expr + vals)
-        lines.append("    → " + "; ".join(f"{var} = {', '.join(vals)}" for var, vals in parts.items()))
-    else:
-        lines.append("    (kept as an equation: no closed form in one variable)")
-    lines.append(f"    kind: {cond.kind} — {cond.explanation}")
-    return lines
-
-
-def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
-    from .. import numeric as N
-
-    q = joint_values(args, robot, args.q)
-    J = N.geometric_jacobian(robot, q, args.frame)[rows_idx, :]
-    require_finite("singularities", J)
-    s = N.singular_values(J)
-    lin = [i for i, r in enumerate(rows_idx) if r < 3] or list(range(len(rows_idx)))
-    vel, frc = N.velocity_ellipsoid(J[lin]), N.force_ellipsoid(J[lin])
-    which = ", ".join(ROWS[rows_idx[i]] for i in lin)
-    data = {"q": _q_out(args, robot, q), "J": J, "singular_values": s, "manipulability": float(N.manipulability(J)),
-            "condition_number": float(N.condition_number(J)), "smallest_singular_value": float(s[-1]),
-            "rank": int(N.jacobian_rank(J)), "singular": bool(N.is_singular(J)),
-            "ellipsoid_rows": [ROWS[rows_idx[i]] for i in lin],
-            "velocity_ellipsoid": {"axes": vel.axes, "radii": vel.radii},
-            "force_ellipsoid": {"axes": frc.axes, "radii": frc.radii}}
-    lines = ["", f"numeric measures at {_q_text(args, robot, q)} (rows {', '.join(ROWS[i] for i in rows_idx)}):",
-             f"  singular values: {numbers_text(s)}",
-             f"  rank {data['rank']} of {min(J.shape)} (threshold 1e-9 · largest singular value)"
-             + ("  → SINGULAR" if data["singular"] else ""),
-             f"  manipulability (Yoshikawa) sqrt(det J J^T) = "
-             f"{number_text(data['manipulability'], scale=float(np.prod(s[:-1])) if len(s) > 1 else 1.0)}",
-             f"  condition number = {number_text(data['condition_number'])}, smallest singular value = "
-             f"{number_text(s[-1], scale=s[0])}",
-             f"  velocity ellipsoid (rows {which}, |qd| <= 1): radii {numbers_text(vel.radii)}",
-             f"  force ellipsoid (rows {which}, |tau| <= 1): radii {numbers_text(frc.radii)}",
-             "  axes (columns, same for both):", matrix_text(vel.axes, indent="    ")]
-    return data, lines
-
-
-def cmd_singularities(args: argparse.Namespace):
-    import sympy as sp
-
-    from .. import symbolic as S
-    from ..numeric import select_rows
-
-    robot = load(args)
-    try:
-        rows_idx = select_rows(args.rows)
-    except ValueError as exc:
-        raise ParseError(f"--rows: {exc}") from None
-    rows = "auto" if args.rows is None else ",".join(ROWS[i] for i in rows_idx)
-    if args.q is not None:
-        joint_values(args, robot, args.q)  # a bad -q fails now, not after minutes of symbolic work
-    require_symbolic_size(robot, "singularities", MAX_SYMBOLIC_ANALYSIS_JOINTS)
-    res = S.singularity_analysis(robot, rows, args.frame, progress=stage_printer(args, "singularities"))
-    rows_idx = [ROWS.index(r) for r in res.rows]  # the task rows analysed (an arm of < 6 joints: its own)
-    fmt = _formatter(args, S.joint_symbols(robot.dof).q)
-    det_text = fmt(res.determinant)
-    lines = [f"{robot.name}: singularities", f"matrix: {res.matrix_note}", f"measure: {res.measure}"]
-    if args.markdown:
-        lines = [f"## {robot.name}: singularities", "", f"matrix: {res.matrix_note}", "", f"measure: {res.measure}", ""]
-    lines += ["matrix =", fmt(res.matrix), f"{res.measure} =", det_text]
-    if res.constant_factors:
-        lines.append("constant factors (assumed non-zero): " + ", ".join(str(c) for c in res.constant_factors))
-    if res.everywhere:
-        lines += ["", f"SINGULAR EVERYWHERE: rank {res.generic_rank} of {res.full_rank} for every q ({res.reason})"]
-    elif res.conditions:
-        lines += ["", "singular when:"]
-        for cond in res.conditions:
-            lines += _condition_lines(cond, robot, args, fmt)
-    elif "minors" in res.measure:
-        # Non-square J: a common factor of all minors is sufficient for a rank loss, not necessary. Without
-        # one, singular configurations (if any) are where all minors vanish together: not solved here.
-        lines += ["", "no common factor of the minors: any singular configuration lies where ALL the minors vanish "
-                  "together, which is not solved symbolically here (redundant arms, e.g. 7 joints, do have such "
-                  "configurations); check a configuration with -q (rank, smallest singular value), or pick a "
-                  "square sub-Jacobian with --rows"]
-    else:
-        lines += ["", "no singular configuration: the determinant never vanishes"]
-    data = {"robot": robot.name, "rows": list(res.rows), "frame": args.frame, "matrix_note": res.matrix_note,
-            "measure": res.measure, "matrix": res.matrix, "determinant": str(res.determinant),
-            "determinant_latex": sp.latex(res.determinant), "constant_factors": [str(c) for c in res.constant_factors],
-            "everywhere": res.everywhere, "generic_rank": res.generic_rank, "full_rank": res.full_rank,
-            "reason": res.reason, "angle_unit": "deg" if args.deg else "rad",
-            # False when J is not square and its minors share no factor: the singular set is not solved then
-            "conditions_complete": not ("minors" in res.measure and not res.conditions and not res.everywhere),
-            "conditions": [{"equation": f"{c.factor} = 0", "latex": sp.latex(c.factor) + " = 0",
-                            "variables": list(c.variables), "kind": c.kind, "explanation": c.explanation,
-                            "solutions": [{"variable": s.variable,
-                                           "expression": None if s.expression is None else str(s.expression),
-                                           "values": [math.degrees(v) if args.deg and _is_rev(robot, s.variable) else v
-                                                      for v in s.values],
-                                           "in_limits": list(s.in_limits)} for s in c.solutions]}
-                           for c in res.conditions]}
-    if args.q is not None:
-        mdata, mlines = _measures(robot, args, rows_idx)
-        data["measures"] = mdata
-        lines += mlines
-    return data, "\n".join(lines)
-
-
-def _is_rev(robot, var: str) -> bool:
-    from ..model import JointType
-
-    return robot.joint_types[int(var[1:]) - 1] is JointType.REVOLUTE
