@@ -224,7 +224,7 @@ def _free_joints(text: str) -> set[int]:
 
 
 def _decimals_of(nodes) -> int:
-    from ._engine import _decimals
+    from ._values import _decimals
 
     return max((_decimals(nd) for nd in nodes), default=0)
 
@@ -391,7 +391,7 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
 
 def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.ndarray, np.ndarray]]:
     """The claimed q vectors, each with the rounding unit of every entry (0 for exact entries)."""
-    from ._engine import _decimals, _no_names
+    from ._values import _decimals, _no_names
 
     if isinstance(raw, str) and "\\begin" in raw:
         rows = parse_matrix(raw, _no_names)
@@ -426,7 +426,8 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
 
 def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
     """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
-    from ._engine import Verdict, _joint_values, _no_names, _values
+    from ._engine import Verdict
+    from ._values import _joint_values, _no_names, _values
 
     if "q" in raw:
         T = N.forward_kinematics(robot, _joint_values(raw["q"], robot, "q", deg))

@@ -65,7 +65,7 @@ class Cond:
 
 
 def _decimals(node: tuple) -> int:
-    from ._engine import _decimals as dec
+    from ._values import _decimals as dec
 
     return dec(node)
 

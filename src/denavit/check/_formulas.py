@@ -1,0 +1,115 @@
+"""The correct formula of an incorrect claim, in LaTeX, from the symbolic engine (when it is cheap).
+
+Moved unchanged from ``_engine.py``.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import Any
+
+from .. import _expr
+from ..errors import DenavitError, ParseError
+from ..model import DHRobot
+from ._points import _wrench_nodes
+
+__all__ = ["expected_formula", "MAX_FORMULA_DOF_DYNAMICS", "MAX_FORMULA_DOF_STATICS"]
+
+
+def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | None:
+    """The correct formula in LaTeX (C_12/S_3 shorthand) from the symbolic engine, when it is cheap."""
+    keys = tuple(spec.get(k) for k in ("index", "from", "to"))
+    if not all(k is None or (isinstance(k, int) and not isinstance(k, bool)) for k in keys):
+        return None
+    if name in ("force", "moment"):
+        return _expected_statics(robot, name, spec)
+    return _expected_formula(robot, name, *keys)
+
+
+#: Most joints for which an incorrect M or g(q) claim is given the correct formula (symbolic Lagrangian dynamics).
+MAX_FORMULA_DOF_DYNAMICS = 4
+#: Most joints for which an incorrect ⁱfᵢ / ⁱnᵢ claim is given the correct formula (symbolic force propagation of a
+#: 6-joint arm takes seconds).
+MAX_FORMULA_DOF_STATICS = 4
+
+
+def _expected_statics(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | None:
+    """ⁱfᵢ / ⁱnᵢ from the symbolic force propagation, with the claim's wrench (tool axes) put in."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    if robot.dof > MAX_FORMULA_DOF_STATICS or str(spec.get("frame", "tool")) != "tool" or "wrench" not in spec:
+        return None
+    try:
+        nodes = _wrench_nodes(spec["wrench"], robot)
+        syms = {n: sp.Symbol(n[0] + "_" + n[1:]) for nd in nodes for n in _expr.names_in(nd)}
+        params = {k: sp.Symbol(k) for k, _ in robot.parameters}
+        values = [_expr.to_sympy(nd, {**params, **syms}) for nd in nodes]
+        prop = _statics_sym(robot)
+    except (ParseError, KeyError, ValueError, TypeError):
+        return None
+    steps = {st.label: st for st in prop.steps}
+    step = steps.get(str(spec.get("index")))
+    if step is None:
+        return None
+    M = (step.f if name == "force" else step.n).xreplace(dict(zip(S.wrench_symbols(), values)))
+    M = sp.ImmutableMatrix(M.applyfunc(sp.expand))
+    if len(str(M)) > 20_000:
+        return None
+    return sp.latex(S.shorthand_matrix(M, S.joint_symbols(robot.dof).q), mat_str="bmatrix", mat_delim="")
+
+
+@lru_cache(maxsize=8)
+def _statics_sym(robot: DHRobot):
+    from .. import symbolic as S
+
+    return S.force_propagation_sym(robot)
+
+
+@lru_cache(maxsize=64)
+def _expected_formula(robot: DHRobot, name: str, index: int | None, frm: int | None, to: int | None) -> str | None:
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    spec = {k: v for k, v in (("index", index), ("from", frm), ("to", to)) if v is not None}
+    try:
+        if name == "link_transform":
+            M = S.simplify_matrix(S.link_matrices_sym(robot)[int(spec["index"]) - 1])
+        elif name == "transform":
+            F = S.link_transforms_sym(robot)
+            i, j = int(spec.get("from", 0)), int(spec.get("to", robot.n_rows))
+            M = S.simplify_matrix(_inverse(F[i]) * F[j])
+        elif name in ("end_effector", "position", "rotation"):
+            T = S.forward_kinematics_sym(robot)
+            M = T if name == "end_effector" else T[:3, 3] if name == "position" else T[:3, :3]
+        elif name in ("gravity", "mass_matrix"):
+            if robot.dof > MAX_FORMULA_DOF_DYNAMICS or not robot.has_dynamics:
+                return None
+            terms = S.lagrangian_dynamics(robot, coriolis=False)
+            if name == "mass_matrix":
+                M = terms.M
+            elif terms.g_unit is not None and "g" not in robot.parameter_values:
+                M = sp.Symbol("g") * terms.g_unit  # the symbol g, not 981/100
+            else:
+                M = terms.g
+        elif name in ("omega", "velocity"):
+            steps = {st.label: st for st in S.velocity_propagation_sym(robot).steps}
+            step = steps[str(spec["index"])]
+            M = step.omega if name == "omega" else step.v
+        else:
+            return None
+    except (KeyError, ValueError, IndexError, TypeError, DenavitError):
+        return None
+    if len(str(M)) > 20_000:
+        return None
+    M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
+    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+
+
+def _inverse(T):
+    import sympy as sp
+
+    R, p = T[:3, :3], T[:3, 3]
+    return sp.ImmutableMatrix(sp.BlockMatrix([[R.T, -R.T * p], [sp.zeros(1, 3), sp.ones(1, 1)]]).as_explicit())
