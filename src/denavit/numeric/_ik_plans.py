@@ -151,7 +151,8 @@ def _free_text(mask: np.ndarray, text: str, out: np.ndarray) -> np.ndarray:
     return np.where(mask, add, out)
 
 
-def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tuple[Callable, np.ndarray, str]:
+def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True,
+            limits2=(-np.inf, np.inf)) -> tuple[Callable, np.ndarray, str]:
     L = _scale(chain)
     pts, dirs = axis_lines(chain, np.zeros(6))
     X = _common_point(pts[3:], dirs[3:])[0]
@@ -159,7 +160,7 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True) -> tupl
     P = (chain.consts[3] @ inverse_transform(F3) @ np.append(X, 1))[:3]
     X_e = (inverse_transform(chain_fk(chain, np.zeros(6))) @ np.append(X, 1))[:3]
     fast = closed_position(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L) if closed_form else None
-    pos = fast or Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng)
+    pos = fast or Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng, limits2)
     C0i, R4, R5, R6 = inverse_transform(chain.consts[0]), chain.consts[4][:3, :3], chain.consts[5][:3, :3], \
         chain.consts[6][:3, :3]
 
@@ -444,13 +445,13 @@ def _position_rank(chain: Chain, rng) -> int:
     return best
 
 
-def _position_plan(chain: Chain, rng, names, limits3) -> Callable:
+def _position_plan(chain: Chain, rng, names, limits3, limits2=(-np.inf, np.inf)) -> Callable:
     C = chain.consts
     # the direct closed forms where the class allows (articulated RRR with axes 2 ∥ 3, spherical RRP), as for the
     # wrist centre of a Pieper arm: the resultant has multiple roots on some of these (spherical-rrp: a 6-fold one
     # next to q3 = 0, whose roots came out 1e-2 apart), else the resultant route
     pos = closed_position(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain)) or \
-        Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng)
+        Position3(C[1], C[2], C[3][:3, 3], chain.prismatic, _scale(chain), limits3, rng, limits2)
     if _position_rank(chain, rng) < 3 - getattr(pos, "free3", False):  # e.g. two prismatic joints along one direction
         raise UnsupportedRobotError(
             "the joints of this 3-joint arm cannot place its end point in 3-D (the position rows of its Jacobian "
@@ -549,7 +550,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
         kind = "general"
     if m == 6 and solve is None:
         if not chain.prismatic[3:].any() and _intersect(chain, (3, 4, 5), rng):
-            solve, point, route = _pieper(chain, rng, names, tuple(lim[reps[2]]), closed_form)
+            solve, point, route = _pieper(chain, rng, names, tuple(lim[reps[2]]), closed_form, tuple(lim[reps[1]]))
             kind = "pieper"
             closed = solve.closed if not groups else None
         elif not chain.prismatic[:3].any() and _intersect(chain, (0, 1, 2), rng):
@@ -577,7 +578,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
             P = np.zeros((6, 6))
             P[3:, 3:] = np.eye(3)
         else:
-            solve, kind = _position_plan(chain, rng, names, tuple(lim[reps[2]])), "position"
+            solve, kind = _position_plan(chain, rng, names, tuple(lim[reps[2]]), tuple(lim[reps[1]])), "position"
             P = np.zeros((6, 6))
             P[:3, :3] = np.eye(3)
     if solve is None and m == 6 and all_rev:

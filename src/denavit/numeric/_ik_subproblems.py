@@ -22,6 +22,9 @@ FREE_AXIS = 1e-10  # distance to axis 1 or 2, relative to the arm's size, under 
 # FREE_TOL of the closed forms)
 REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
 REFINE_STEPS = 4
+CLUSTER_RADIUS = 1e-2  # relative distance of two roots of the resultant under which the other elimination order
+# is solved too (a multiple root split by rounding: a k-fold root comes out ~ε^(1/k) apart)
+_ALT_SEED = 20240602  # the other order's structural tests draw from their own fixed stream
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
 # parallel axes of a UR-type arm) under which a solution is reported as the continuum of the aligned axes
 
@@ -136,13 +139,17 @@ class Position3:
     """
 
     def __init__(self, C1: np.ndarray, C2: np.ndarray, P: np.ndarray, prismatic: np.ndarray, scale: float,
-                 limits3: tuple[float, float], rng: np.random.Generator) -> None:
+                 limits3: tuple[float, float], rng: np.random.Generator,
+                 limits2: tuple[float, float] = (-np.inf, np.inf), swap: bool = False) -> None:
         self.C1, self.C2, self.P = C1, C2, np.append(P, 1.0)
         self.pr1, self.pr2, self.pr3 = (bool(x) for x in prismatic)
+        # the joint eliminated (u) and the joint whose polynomial is solved (v): q2 and q3, or q3 and q2 (swap)
+        self.swap = swap
+        self.pu, self.pv = (self.pr3, self.pr2) if swap else (self.pr2, self.pr3)
         self.L = scale
         self.c = self._axis_foot() if not self.pr1 else np.zeros(3)
-        if self.pr3:
-            lo, hi = limits3
+        if self.pv:
+            lo, hi = limits2 if swap else limits3
             lo, hi = (lo if np.isfinite(lo) else -2 * scale), (hi if np.isfinite(hi) else 2 * scale)
             self.mid, self.half = 0.5 * (lo + hi), max(0.5 * (hi - lo), 1e-3 * scale)
             nodes = np.cos(np.pi * (np.arange(_PMAX + 1) + 0.5) / (_PMAX + 1))  # Chebyshev nodes
@@ -153,7 +160,16 @@ class Position3:
         self.coef = self._coefficients(self.nodes)  # (2, 3, N): rows k, (A, B, C)
         self.degree = self._effective_degree(rng)
         # the point on axis 3 (revolute): q3 does not move it, q1 and q2 place it, q3 is free (a continuum)
-        self.free3 = self.degree <= 0 and not self.pr3 and self._on_axis3(rng)  # (≡ 0, or constant in q3)
+        self.free3 = self.degree <= 0 and not self.pr3 and not swap and self._on_axis3(rng)  # (≡ 0, or const in q3)
+        self.alt = None  # the other elimination order, for poses whose roots cluster (see solve)
+        if swap:
+            return
+        if self.degree > 0 and not self.free3:
+            try:
+                alt = Position3(C1, C2, P, prismatic, scale, limits3, np.random.default_rng(_ALT_SEED), limits2, True)
+                self.alt = alt if alt.degree > 0 else None
+            except Exception:  # noqa: BLE001 — no second order for this arm: the first one is used alone
+                self.alt = None
         if self.degree < 0 and not self.free3:
             from ..errors import UnsupportedRobotError
 
@@ -177,6 +193,10 @@ class Position3:
         t = (o[2] - d[2] * np.dot(d, o)) / s  # closest point z·t on the z axis
         return np.array([0.0, 0.0, t])
 
+    def _guv(self, u, v) -> np.ndarray:
+        """g with the eliminated joint u and the solved joint v in their places."""
+        return self.g(v, u) if self.swap else self.g(u, v)
+
     def g(self, q2, q3) -> np.ndarray:
         """C1 J2(q2) C2 J3(q3) P, shape broadcast(q2, q3) + (3,)."""
         q2, q3 = np.broadcast_arrays(np.asarray(q2, float), np.asarray(q3, float))
@@ -190,26 +210,27 @@ class Position3:
         return np.stack([g[..., 2], np.sum((g - self.c) ** 2, axis=-1)], axis=-1)
 
     def _coefficients(self, q3) -> np.ndarray:
-        """(A, B, C) of both invariants in q2 at the given q3, shape (2, 3) + q3.shape."""
-        if self.pr2:
+        """(A, B, C) of both invariants in the eliminated joint (q2) at the given solved joint (q3), shape (2, 3) +
+        q3.shape."""
+        if self.pu:
             s = self.L
-            G = [self.invariants(self.g(v, q3)) for v in (-s, 0.0, s)]
+            G = [self.invariants(self._guv(v, q3)) for v in (-s, 0.0, s)]
             C = G[1]
             A = (G[0] + G[2] - 2 * C) / (2 * s * s)
             B = (G[2] - G[0]) / (2 * s)
         else:
-            A, B, C = trig_coefficients(*(self.invariants(self.g(v, q3)) for v in (0.0, np.pi / 2, np.pi)))
+            A, B, C = trig_coefficients(*(self.invariants(self._guv(v, q3)) for v in (0.0, np.pi / 2, np.pi)))
         return np.moveaxis(np.stack([A, B, C], axis=0), -1, 0)  # (2, 3, ...)
 
     def _effective_degree(self, rng) -> int:
         """Degree of the resultant for this arm (found on random reachable points; −1: identically zero)."""
-        q3 = rng.uniform(self.nodes.min(), self.nodes.max(), 16) if self.pr3 else rng.uniform(-3, 3, 16)
-        c = np.abs(self._poly(self.invariants(self.g(rng.uniform(-3, 3, 16), q3))))  # (16, m+1)
+        q3 = rng.uniform(self.nodes.min(), self.nodes.max(), 16) if self.pv else rng.uniform(-3, 3, 16)
+        c = np.abs(self._poly(self.invariants(self._guv(rng.uniform(-3, 3, 16), q3))))  # (16, m+1)
         rel = c.max(axis=0) / max(c.max(), 1e-300)
         nz = np.flatnonzero(rel > 1e-9)
         if nz.size == 0 or c.max() < 1e-12 * self.L ** 8:
             return -1
-        if self.pr3:
+        if self.pv:
             return c.shape[1] - 1 - int(nz[0])
         return int(np.max(np.abs(_KMAX - nz)))
 
@@ -217,7 +238,7 @@ class Position3:
     def _resultant_samples(self, w: np.ndarray) -> np.ndarray:
         A, B, C = self.coef[:, 0], self.coef[:, 1], self.coef[:, 2] - w[..., :, None]  # (..., 2, N)
         A1, B1, C1, A2, B2, C2 = A[0], B[0], C[..., 0, :], A[1], B[1], C[..., 1, :]
-        if not self.pr2:
+        if not self.pu:
             D = A1 * B2 - A2 * B1
             return (B1 * C2 - B2 * C1) ** 2 + (A2 * C1 - A1 * C2) ** 2 - D**2
         if np.max(np.abs(A1)) + np.max(np.abs(A2)) < FREE_EPS:
@@ -227,25 +248,33 @@ class Position3:
     def _poly(self, w: np.ndarray) -> np.ndarray:
         """Coefficients (highest first) of the resultant in z = e^{iq3} (revolute) or in x (prismatic)."""
         R = self._resultant_samples(w)  # (..., N)
-        if self.pr3:
+        if self.pv:
             return R @ self.fit.T
         N = R.shape[-1]
         k = np.arange(_KMAX, -_KMAX - 1, -1)
         return (R @ np.exp(-1j * np.outer(self.nodes, k))) / N  # c_K … c_{-K}
 
-    def _q3_candidates(self, w: np.ndarray) -> np.ndarray:
+    def _q3_candidates(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Real roots of the resultant in the solved joint (B, m), and which poses have roots that cluster (B,):
+        two roots, real or not, closer than CLUSTER_RADIUS (in e^{iq} or in the scaled length), where a multiple
+        root of the resultant was split by rounding into roots ~ε^(1/k) apart (some of them complex)."""
         p = self._poly(w)  # (B, 2K+1) or (B, P+1)
-        if self.pr3:
+        if self.pv:
             top = p.shape[-1] - 1 - self.degree
             p = p[:, top:]
         else:
             p = p[:, _KMAX - self.degree: _KMAX + self.degree + 1]
         roots = _batched_roots(p)
-        if self.pr3:
+        near = np.abs(roots.imag) < 0.1 * (1 + np.abs(roots.real)) if self.pv else np.abs(np.abs(roots) - 1.0) < 0.1
+        gap = np.abs(roots[:, :, None] - roots[:, None, :]) / (1 + np.abs(roots[:, :, None]))
+        gap[:, np.arange(roots.shape[1]), np.arange(roots.shape[1])] = np.inf
+        clustered = np.any((gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :], axis=(1, 2))
+        clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
+        if self.pv:
             ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
-            return np.where(ok, self.mid + self.half * roots.real, np.nan)
+            return np.where(ok, self.mid + self.half * roots.real, np.nan), clustered
         ok = np.abs(np.abs(roots) - 1.0) < 1e-3
-        return np.where(ok, np.angle(roots), np.nan)
+        return np.where(ok, np.angle(roots), np.nan), clustered
 
     def solve(self, W: np.ndarray):
         """All (q1, q2, q3) placing the point at W (B, 3).
@@ -255,12 +284,17 @@ class Position3:
         axis 3: 0 is returned).
         """
         w = self.invariants(W)
+        clustered = np.zeros(len(W), dtype=bool)
         if self.free3:
             q3 = np.zeros((len(W), 1))
+        elif self.degree > 0:
+            q3, clustered = self._q3_candidates(w)
         else:
-            q3 = self._q3_candidates(w) if self.degree > 0 else np.full((len(W), 1), np.nan)
+            q3 = np.full((len(W), 1), np.nan)
         q2, free2 = self._q2_candidates(q3, w)  # (B, M, 2)
         q3 = np.broadcast_to(q3[..., None], q2.shape)
+        if self.swap:  # solved q2, eliminated q3 (a q3 without effect is no continuum here: the point on axis 3)
+            q2, q3, free2 = q3, q2, np.zeros_like(free2)
         g = self.g(np.nan_to_num(q2), np.nan_to_num(q3))  # (B, M, 2, 3)
         Wb = W[:, None, None, :]
         if self.pr1:
@@ -276,8 +310,18 @@ class Position3:
         q[bad] = np.nan
         free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
         q = self._refine(q, W, free)
-        free = self._free_after(q, W, free)
-        return q, np.where(bad, 0, free)
+        free = np.where(bad, 0, self._free_after(q, W, free))
+        if self.alt is not None and clustered.any():
+            # a multiple root of this order's resultant (the point crossing axis 2, say): its roots came out
+            # ~ε^(1/k) apart or complex and the generating branch could be lost; the other order's resultant has
+            # simple roots there (q2 and q3 swap roles); the copies are merged by FK later
+            qa, fa = self.alt.solve(W[clustered])
+            extra = np.full((len(W),) + qa.shape[1:], np.nan)
+            extra[clustered] = qa
+            fe = np.zeros(extra.shape[:2], dtype=free.dtype)
+            fe[clustered] = fa
+            q, free = np.concatenate([q, extra], 1), np.concatenate([free, fe], 1)
+        return q, free
 
     def _free_after(self, q: np.ndarray, W: np.ndarray, free: np.ndarray) -> np.ndarray:
         """The free flags again from the refined joints: the point within FREE_AXIS · L of axis 2 (q2 revolute)
@@ -320,7 +364,7 @@ class Position3:
                 break
             J = np.stack([(self.point(x + h * d) - self.point(x - h * d)) / (2 * h) for d in np.eye(3)], -1)
             Jt = np.swapaxes(J, -1, -2)
-            dx = np.linalg.solve(Jt @ J + 1e-14 * self.L**2 * np.eye(3), (Jt @ e[..., None]))[..., 0]
+            dx = (np.linalg.pinv(Jt @ J, rcond=1e-15) @ (Jt @ e[..., None]))[..., 0]  # (a zero column: J singular)
             x = x - dx
         out = q.copy()
         out[todo] = np.where(np.linalg.norm(self.point(x) - w, axis=-1)[:, None]
@@ -337,7 +381,7 @@ class Position3:
         Ao, Bo, Co = pick(A, 1 - k), pick(B, 1 - k), pick(C, 1 - k)
         scale = self.L ** np.array([1.0, 2.0])[1 - k] if not self.pr1 else self.L
         free = pick(size, k) < FREE_EPS * np.maximum(scale, 1e-12)
-        if self.pr2:
+        if self.pu:
             lin = np.abs(Ak) < FREE_EPS * np.abs(Bk)
             disc = Bk**2 - 4 * Ak * Ck
             # a double root (the point at the turning height of q2) leaves disc ≈ 0 up to the error of Ck, which
@@ -355,13 +399,13 @@ class Position3:
         q2 = np.where(free[..., None], np.stack([np.zeros(Ck.shape), np.full(Ck.shape, np.nan)], -1), q2)
         # the other invariant must hold too (loose test: the candidates are polished and re-checked later)
         with np.errstate(invalid="ignore"):
-            if self.pr2:
+            if self.pu:
                 other = Ao[..., None] * q2**2 + Bo[..., None] * q2 + Co[..., None]
             else:
                 other = Ao[..., None] * np.cos(q2) + Bo[..., None] * np.sin(q2) + Co[..., None]
             ok = np.abs(other) <= 1e-2 * (np.abs(Ao) + np.abs(Bo) + np.abs(Co) + scale)[..., None]
         q2 = np.where(ok | free[..., None], q2, np.nan)
-        if not self.pr2:  # a q3 next to a multiple root with q2 nearly free (the point ~1e-6 from axis 2): no root
+        if not self.pu:  # a q3 next to a multiple root with q2 nearly free (the point ~1e-6 from axis 2): no root
             # of a slightly wrong equation; 0 and π are tried instead, refined with q1-q3 and checked by FK later
             weak = ~np.isfinite(q2).any(-1) & np.isfinite(q3) & (pick(size, k) < WEAK_Q2 * np.maximum(scale, 1e-12))
             q2 = np.where(weak[..., None], np.array([0.0, np.pi]), q2)
@@ -374,6 +418,12 @@ def _batched_roots(p: np.ndarray) -> np.ndarray:
     m = m1 - 1
     if m <= 0:
         return np.full((B, 0), np.nan + 0j)
+    bad = ~np.all(np.isfinite(p), axis=1) | ~np.any(p != 0, axis=1)
+    if bad.any():  # no roots for a pose whose coefficients overflowed or all vanish (the resultant ≡ 0 there)
+        out = np.full((B, m), np.nan + 0j)
+        if (~bad).any():
+            out[~bad] = _batched_roots(p[~bad])
+        return out
     lead = p[:, :1]
     tiny = np.abs(lead) < 1e-13 * np.max(np.abs(p), axis=1, keepdims=True)
     lead = np.where(tiny, 1e-13 * np.max(np.abs(p), axis=1, keepdims=True) + 1e-300, lead)
