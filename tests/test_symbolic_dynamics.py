@@ -3,6 +3,7 @@ numeric engine (CRBA, Christoffel C, RNEA, gravity — itself checked against Pi
 at random configurations, Ṁ − 2C skew by sympy's own differentiation, a textbook closed form, and the printed
 form (angle sums, no decimals for symbolic data, gravity as g, LaTeX that compiles)."""
 
+import re
 import shutil
 import subprocess
 
@@ -242,3 +243,64 @@ def test_regressor_of_random_arms(seed):
     rng = np.random.default_rng(400 + seed)
     robot = _random_inertial_arm(rng, int(rng.integers(2, 4)))
     _check_regressor(robot, rng)
+
+
+_NAME = re.compile(r"[A-Za-z_]\w*")
+_LABEL = re.compile(r"^(M|c|g)\[(\d+)(?:,(\d+))?\]$")
+
+
+def _printed_values(text, robot, q, qd):
+    """Evaluate the lines 'name = formula' of format_dynamics' text one after the other at (q, q̇) and the
+    robot's parameter values: Ci, Sij are cos, sin of q_i + q_j (one digit per joint), g = |g₀|, names
+    defined earlier in the text are their values. Returns the printed M (both triangles from the upper one),
+    c and g."""
+    n = robot.dof
+    env = {**{s: v for s, v in robot.parameters}, **{f"qd{k + 1}": qd[k] for k in range(n)},
+           "g": float(np.linalg.norm(robot.gravity))}
+    M, c, g = np.full((n, n), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    for line in text.splitlines():
+        name, _, formula = line.partition(" = ")
+        if not re.fullmatch(r"\w+(\[\d+(,\d+)?\])?", name):  # the header and its notes
+            continue
+        local = {}
+        for word in set(_NAME.findall(formula)):
+            if word in ("cos", "sin"):
+                continue
+            local[word] = sp.Symbol(word)
+            if word not in env and re.fullmatch(r"[CS]\d+", word):
+                angle = sum(q[int(d) - 1] for d in word[1:])
+                env[word] = np.cos(angle) if word[0] == "C" else np.sin(angle)
+        e = sp.sympify(formula, locals=local)  # our own printed output, in a test
+        q_subs = {sp.Symbol(f"q{k + 1}"): q[k] for k in range(n)}
+        value = float(e.xreplace({**q_subs, **{local[w]: env[w] for w in local if w in env}}))
+        m = _LABEL.match(name)
+        if m is None:
+            env[name] = value
+        elif m.group(1) == "M":
+            M[int(m.group(2)) - 1, int(m.group(3)) - 1] = M[int(m.group(3)) - 1, int(m.group(2)) - 1] = value
+        else:
+            (c if m.group(1) == "c" else g)[int(m.group(2)) - 1] = value
+    return M, c, g
+
+
+def _check_printed(robot, text, rng, count=2):
+    for _ in range(count):
+        q, qd = rng.uniform(-np.pi, np.pi, robot.dof), rng.uniform(-2, 2, robot.dof)
+        M, c, g = _printed_values(text, robot, q, qd)
+        scale = 1 + np.abs(N.mass_matrix(robot, q)).max()
+        np.testing.assert_allclose(M, N.mass_matrix(robot, q), atol=1e-5 * scale)  # 6 printed digits
+        np.testing.assert_allclose(c, N.coriolis_vector(robot, q, qd), atol=1e-5 * scale)
+        np.testing.assert_allclose(g, N.gravity_torques(robot, q), atol=1e-5 * (1 + np.abs(g).max()))
+
+
+@pytest.mark.parametrize("name", ["planar3r-lagrange", pytest.param("puma560", marks=pytest.mark.slow)])
+def test_printed_text_evaluates_to_the_numeric_m_c_g(name):
+    """The text a user reads (upper triangle of M, named groups P and rate coefficients B, g as a symbol),
+    evaluated line by line, is the numeric CRBA, Christoffel c and gravity; the Puma's is under 10 k characters."""
+    robot = denavit.load_robot(name)
+    text = format_dynamics(lagrangian_dynamics(robot, coriolis=False), "text", gravity_symbol=True,
+                           include=("M", "c", "g"))
+    assert "M is symmetric" in text and "M[2,1] = " not in text
+    _check_printed(robot, text, np.random.default_rng(86))
+    if name == "puma560":
+        assert len(text) <= 10_000

@@ -464,6 +464,7 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
                     gravity_symbol: bool = False) -> str:
     """The equations of motion as text, LaTeX or Markdown.
 
+    M is written by its upper triangle (M[j,k], j ≤ k; it is symmetric, as the header says).
     Entries in hand form (``lagrangian_dynamics(simplify="trig")``) are written entry by entry, each a sum
     of parameter groups times sines and cosines; when the entries are long (over ``CSE_AUTO_CHARS``
     characters in all, and ``cse`` is not False) a group that recurs or is longer than ``GROUP_NAME_CHARS``
@@ -491,7 +492,7 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
         if mat is None:
             continue
         for i in range(mat.shape[0]):
-            for j in range(mat.shape[1]):
+            for j in range(i if name == "M" else 0, mat.shape[1]):  # M is symmetric: its upper triangle
                 label = f"{name}[{i + 1},{j + 1}]" if mat.shape[1] > 1 else f"{name}[{i + 1}]"
                 entries.append((label, mat[i, j]))
     exprs = [e for _, e in entries]
@@ -513,6 +514,8 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
             repl, exprs = sp.cse(exprs, symbols=sp.numbered_symbols("x"), optimizations="basic")
     pairs = [(str(s), e) for s, e in repl] + [(label, e) for (label, _), e in zip(entries, exprs)]
     head = f"M(q) q'' + c(q, q') + g(q) + tau_f(q') = tau   ({n} joints)"
+    if "M" in include and n > 1:
+        notes.append("M is symmetric: M[k,j] = M[j,k]")
     if short:
         notes.append("Ci = cos(qi), Sij = sin(qi + qj), …")
     order = "none" if nodes > LONG_NODES else None  # sorting the terms of pages of output costs minutes
@@ -521,6 +524,8 @@ def format_dynamics(terms: DynamicsTerms, style: str = "text", cse: bool | None 
                          [f"{k} = {_trim(sp.sstr(e, order=order))}" for k, e in pairs])
     names = _latex_names([e for _, e in pairs])
     tex = [(_tex_label(k), sp.latex(e, symbol_names=names, order=order)) for k, e in pairs]
+    if "M" in include and n > 1:  # the upper triangle is written
+        tex.append(("M_{kj}", "M_{jk} \\quad (j < k)"))
     if style == "latex":
         rows = " \\\\\n".join(f"{k} &= {v}" for k, v in tex)
         return "\\begin{aligned}\n" + rows + "\n\\end{aligned}"
