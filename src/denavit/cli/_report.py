@@ -9,8 +9,7 @@ from typing import Any
 
 from ..errors import ParseError
 from ..io import parse_values, resolve_pose, split_values
-from ._common import (add_common, add_force, check_output, nonneg_int, add_q, joint_values, load, output_file,
-                      stage_printer)
+from ._common import add_common, add_force, check_output, joint_values, load, nonneg_int, output_file, stage_printer
 
 #: Suffixes of a report file (the format follows the suffix).
 REPORT_SUFFIXES = (".md", ".markdown", ".tex", ".html", ".htm", ".pdf")
@@ -23,9 +22,14 @@ MAX_TABLE_FILE_BYTES = 1_000_000
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("report", help="the whole derivation as a document (.md, .tex, .html or .pdf)")
     add_common(p)
-    add_q(p, required=False)
-    p.add_argument("--qd", metavar="QD", help="joint rates for the velocity section")
-    p.add_argument("--wrench", metavar="W", help="end-effector wrench fx,fy,fz,nx,ny,nz (base axes) for statics")
+    p.add_argument("-q", "--q", dest="q", action="append", metavar="Q",
+                   help='joint values of the numeric case, e.g. "0, pi/4, 90deg", or a named pose; repeat -q for '
+                        "several cases (each numeric section then shows every case)")
+    p.add_argument("--ignore-limits", action="store_true", help="compute even if q is outside the joint limits")
+    p.add_argument("--qd", metavar="QD", action="append",
+                   help="joint rates for the velocity section: once for every case, or once per -q in order")
+    p.add_argument("--wrench", metavar="W", action="append",
+                   help="end-effector wrench fx,fy,fz,nx,ny,nz (base axes) for statics: once, or once per -q")
     p.add_argument("-o", "--output", metavar="FILE", help="report file: .md, .tex, .html or .pdf (Markdown on stdout if absent)")
     p.add_argument("--topics", metavar="LIST", help="comma-separated sections to include (default: all)")
     p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
@@ -86,19 +90,11 @@ def cmd_report(args: argparse.Namespace):
 
         if latex_engine() is None:
             pdf_from_latex("", {})  # raises MissingDependencyError naming the engines looked for
-    q = qd = wrench = None
-    if args.q is not None:
-        joint_values(args, robot, args.q)  # validates count, syntax and limits (or a named pose: qr, ...)
-        q = args.q.strip() if resolve_pose(robot, args.q) is not None else split_values(args.q, "q")
-    if args.qd is not None:
-        joint_values(args, robot, args.qd, what="qd", rates=True)
-        qd = split_values(args.qd, "qd")
-    if args.wrench is not None:
-        parse_values(args.wrench, 6, what="wrench")
-        wrench = split_values(args.wrench, "wrench")
+    cases = _cases(args, robot)
     topics = [t.strip() for t in args.topics.split(",") if t.strip()] if args.topics else None
-    d = derive(robot, q, qd, wrench, topics=topics, simplify=args.simplify, deg=args.deg,
-               progress=stage_printer(args, "report"))
+    one = cases[0] if len(cases) == 1 else {"q": None, "qd": None, "wrench": None}
+    d = derive(robot, one["q"], one["qd"], one["wrench"], cases=cases if len(cases) > 1 else None, topics=topics,
+               simplify=args.simplify, deg=args.deg, progress=stage_printer(args, "report"))
     data = derivation_json(d)
     if args.output:
         prefix = Path(args.output).stem + "-"
@@ -125,9 +121,43 @@ def cmd_report(args: argparse.Namespace):
     return data, render_markdown(d)[0]
 
 
+def _cases(args: argparse.Namespace, robot) -> list[dict[str, Any]]:
+    """The numeric cases of -q/--qd/--wrench (each validated: count, syntax, limits), as text values."""
+    from ..report import MAX_CASES
+
+    qs = args.q or [None]
+    if len(qs) > MAX_CASES:
+        raise ParseError(f"-q given {len(qs)} times; a report takes at most {MAX_CASES} numeric cases")
+    for flag, given in (("--qd", args.qd), ("--wrench", args.wrench)):
+        if given and len(given) not in (1, len(qs)):
+            raise ParseError(f"{flag} given {len(given)} times for {len(qs)} case(s) (-q): give it once (used for "
+                             "every case) or once per -q, in the same order")
+    out = []
+    for k, q_text in enumerate(qs):
+        where = f"case {k + 1}: " if len(qs) > 1 else ""
+        qd_text = args.qd[k if len(args.qd) > 1 else 0] if args.qd else None
+        w_text = args.wrench[k if len(args.wrench) > 1 else 0] if args.wrench else None
+        case: dict[str, Any] = {"q": None, "qd": None, "wrench": None}
+        try:
+            if q_text is not None:
+                joint_values(args, robot, q_text)  # validates count, syntax and limits (or a named pose: qr, ...)
+                pose = resolve_pose(robot, q_text) is not None
+                case["q"] = q_text.strip() if pose else split_values(q_text, "q")
+            if qd_text is not None:
+                joint_values(args, robot, qd_text, what="qd", rates=True)
+                case["qd"] = split_values(qd_text, "qd")
+            if w_text is not None:
+                parse_values(w_text, 6, what="wrench")
+                case["wrench"] = split_values(w_text, "wrench")
+        except ParseError as exc:
+            raise ParseError(where + str(exc)) from None
+        out.append(case)
+    return out
+
+
 def derivation_json(d) -> dict[str, Any]:
     """The derivation as plain data: sections of steps with their LaTeX and values."""
-    from ..report import Equation, Figure, Numbers, Table, Text, math_of
+    from ..report import Equation, Figure, Heading, Numbers, Table, Text, math_of
 
     sections = []
     for s in d.sections:
@@ -135,6 +165,8 @@ def derivation_json(d) -> dict[str, Any]:
         for st in s.steps:
             if isinstance(st, Text):
                 steps.append({"type": "text", "text": st.text})
+            elif isinstance(st, Heading):
+                steps.append({"type": "heading", "text": st.text})
             elif isinstance(st, Equation):
                 steps.append({"type": "equation", "lhs": st.lhs, "latex": math_of(st), "note": st.note})
             elif isinstance(st, Numbers):

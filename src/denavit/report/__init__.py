@@ -8,15 +8,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Sequence
 
-from ._derivation import TOPICS, Derivation, Equation, Figure, Numbers, Section, Table, Text, derive
+from ._derivation import MAX_CASES, TOPICS, Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text, derive
 from ._pdf import latex_engine, pdf_from_latex
 from ._render import FORMATS, math_of, number_text, render, render_html, render_latex, render_markdown
 
 __all__ = [
     "TOPICS",
+    "MAX_CASES",
     "Derivation",
     "Section",
     "Text",
+    "Heading",
     "Equation",
     "Numbers",
     "Table",

@@ -133,6 +133,18 @@ class Context:
             "simplify": self.simplify,
         }
 
+    #: Cached results that do not depend on the numeric case (shared between the cases of one report).
+    SHARED = ("param_subs", "symbolic_jacobian_ok", "base_exact", "tool_exact", "links_sym", "frames_sym", "fk_sym",
+              "has_base_or_tool", "joint_frames_sym", "_J_sym", "_dT_sym")
+
+    def share_symbolic(self, other: "Context") -> None:
+        """Take ``other``'s case-independent results computed so far (same robot and simplification policy)."""
+        if other is self or other.robot is not self.robot or other.simplify != self.simplify:
+            return
+        for key in self.SHARED:
+            if key in other.__dict__ and key not in self.__dict__:
+                self.__dict__[key] = other.__dict__[key]
+
     # --- symbols and substitutions ---------------------------------------------------------------
     @property
     def q_syms(self) -> tuple:

@@ -21,6 +21,7 @@ from ..model import DHRobot
 
 __all__ = [
     "Text",
+    "Heading",
     "Equation",
     "Numbers",
     "Table",
@@ -30,12 +31,23 @@ __all__ = [
     "Step",
     "derive",
     "TOPICS",
+    "MAX_CASES",
 ]
+
+#: Most numeric cases in one report (each numeric section is written once per case).
+MAX_CASES = 8
 
 
 @dataclass(frozen=True)
 class Text:
     """A paragraph; ``$...$`` spans are inline mathematics (LaTeX)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class Heading:
+    """A sub-heading inside a section (``$...$`` spans are inline mathematics): one numeric case of several."""
 
     text: str
 
@@ -83,7 +95,7 @@ class Figure:
     name: str
 
 
-Step = Text | Equation | Numbers | Table | Figure
+Step = Text | Heading | Equation | Numbers | Table | Figure
 
 
 @dataclass(frozen=True)
@@ -149,6 +161,7 @@ def derive(
     qd: Sequence[Any] | None = None,
     wrench: Sequence[Any] | None = None,
     *,
+    cases: Sequence[dict[str, Any]] | None = None,
     topics: Sequence[str] | None = None,
     simplify: str = "trig",
     deg: bool = False,
@@ -168,6 +181,11 @@ def derive(
         Joint rates for the velocity section [rad/s or m/s].
     wrench : sequence, shape (6,), optional
         End-effector wrench (f, n) in base axes [N, N·m] for the statics section.
+    cases : sequence of dict, optional
+        Several numeric cases instead of ``q``/``qd``/``wrench``: mappings with ``"q"`` and optionally
+        ``"qd"``, ``"wrench"`` (read as above), at most :data:`MAX_CASES`.  The derivation (symbolic
+        steps) is written once; every numeric section shows each case under its label ("Case 1", …),
+        each checked as a single case is.  The figures show the first case.
     topics : sequence of str, optional
         Sections to build, from :data:`TOPICS` (all by default).
     simplify : {"none", "trig", "full"}
@@ -190,14 +208,27 @@ def derive(
         from ..errors import ParseError
 
         raise ParseError(f"unknown report topic {bad[0]!r}; choose from {', '.join(TOPICS)}")
-    ctx = Context.build(robot, q, qd, wrench, simplify=simplify, deg=deg)
+    from ._cases import CASE_TOPICS, case_list, merge_cases
+
+    ctxs = [Context.build(robot, c["q"], c["qd"], c["wrench"], simplify=simplify, deg=deg)
+            for c in case_list(q, qd, wrench, cases)]
     builders = _builders()
     chosen = [t for t in TOPICS if t in topics]
     sections = []
     for k, t in enumerate(chosen, start=1):
         if progress is not None:
             progress(f"section {k}/{len(chosen)}: {t}")
-        sections.append(builders[t](ctx))
+        if len(ctxs) == 1 or t not in CASE_TOPICS:
+            sections.append(builders[t](ctxs[0]))
+            continue
+        built = []
+        for c in ctxs:
+            c.share_symbolic(ctxs[0])  # the symbolic results are the same for every case: computed once
+            built.append(builders[t](c))
+        sections.append(merge_cases(built, ctxs))
     sections = tuple(sections)
     title = f"Kinematics and dynamics of {robot.name}"
-    return Derivation(robot=robot, title=title, inputs=ctx.inputs(), sections=sections)
+    inputs = ctxs[0].inputs()
+    if len(ctxs) > 1:
+        inputs["cases"] = [c.inputs() for c in ctxs]
+    return Derivation(robot=robot, title=title, inputs=inputs, sections=sections)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ._derivation import Derivation, Equation, Figure, Numbers, Section, Table, Text
+from ._derivation import Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text
 
 __all__ = ["render", "render_markdown", "render_latex", "render_html", "math_of", "number_text", "FORMATS"]
 
@@ -75,6 +75,9 @@ def _status_line(sec: Section) -> str:
 def _inputs_line(d: Derivation) -> str:
     inp = d.inputs
     parts = [f"robot {inp['robot']} ({inp['convention']} DH)"]
+    if len(inp.get("cases") or ()) > 1:
+        parts.append(f"{len(inp['cases'])} numeric cases")
+        return "; ".join(parts)
     parts.append("q = (" + ", ".join(inp["q_exact"]) + ")" + ("" if inp["q_given"] else " (default)"))
     if inp.get("qd") is not None:
         parts.append("qd = (" + ", ".join(f"{v:g}" for v in inp["qd"]) + ")")
@@ -98,6 +101,8 @@ def render_markdown(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[s
         for step in sec.steps:
             if isinstance(step, Text):
                 out += [step.text, ""]
+            elif isinstance(step, Heading):
+                out += [f"### {step.text}", ""]
             elif isinstance(step, (Equation, Numbers)):
                 out += ["$$", math_of(step), "$$", ""]
             elif isinstance(step, Table):
@@ -159,6 +164,8 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
         for step in sec.steps:
             if isinstance(step, Text):
                 out += [_tex_text(step.text), ""]
+            elif isinstance(step, Heading):
+                out += [rf"\subsection*{{{_tex_text(step.text)}}}", ""]
             elif isinstance(step, (Equation, Numbers)):
                 out += [r"\begin{center}\begin{adjustbox}{max width=\linewidth}$\displaystyle "
                         + math_of(step) + r"$\end{adjustbox}\end{center}", ""]
@@ -238,6 +245,8 @@ def _html_text(s: str) -> str:
 def _html_step(step: Any) -> str:
     if isinstance(step, Text):
         return f"<p>{_html_text(step.text)}</p>"
+    if isinstance(step, Heading):
+        return f"<h3>{_html_text(step.text)}</h3>"
     if isinstance(step, (Equation, Numbers)):
         return f'<div class="math-display">{html.escape(_STRETCH + math_of(step))}</div>'
     if isinstance(step, Table):
