@@ -311,8 +311,10 @@ def test_dynamics_terms_latex_is_sympy_latex_of_each_entry():
     assert tex.startswith("$$\\begin{aligned}") and tex.endswith("\\end{aligned}$$")
     n = robot.dof
     for i in range(n):
-        for j in range(n):
+        for j in range(i, n):  # M by its upper triangle, and the line saying it is symmetric
             assert f"M_{{{i + 1}{j + 1}}} &= {sp.latex(S.shorthand(terms.M[i, j], terms.q))}" in tex
+    assert "M_{kj} &= M_{jk}" in tex
+    for i in range(n):
         # format_dynamics prints fractions with denominators above 12 (981/100) as 6-digit decimals
         g = terms.g[i].xreplace({r: sp.Float(r, 6) for r in terms.g[i].atoms(sp.Rational) if r.q > 12})
         assert f"g_{{{i + 1}}} &= {sp.latex(S.shorthand(g, terms.q))}" in tex

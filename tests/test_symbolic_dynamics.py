@@ -3,6 +3,7 @@ numeric engine (CRBA, Christoffel C, RNEA, gravity — itself checked against Pi
 at random configurations, Ṁ − 2C skew by sympy's own differentiation, a textbook closed form, and the printed
 form (angle sums, no decimals for symbolic data, gravity as g, LaTeX that compiles)."""
 
+import functools
 import re
 import shutil
 import subprocess
@@ -23,6 +24,7 @@ ARMS = ["planar2r", "planar3r", "planar3r-lagrange"] + [pytest.param(n, marks=py
                                                         for n in ("puma560", "puma560-mdh", "ur5")]
 
 
+@functools.lru_cache(maxsize=2)  # the Panda's two tests share one lambdify of its ~1 MB of formulas
 def _functions(robot, t):
     js = joint_symbols(robot.dof)
     syms = list(js.q) + list(js.qd) + list(parameter_symbols(robot).values())
@@ -249,29 +251,33 @@ _NAME = re.compile(r"[A-Za-z_]\w*")
 _LABEL = re.compile(r"^(M|c|g)\[(\d+)(?:,(\d+))?\]$")
 
 
-def _printed_values(text, robot, q, qd):
-    """Evaluate the lines 'name = formula' of format_dynamics' text one after the other at (q, q̇) and the
-    robot's parameter values: Ci, Sij are cos, sin of q_i + q_j (one digit per joint), g = |g₀|, names
-    defined earlier in the text are their values. Returns the printed M (both triangles from the upper one),
-    c and g."""
-    n = robot.dof
-    env = {**{s: v for s, v in robot.parameters}, **{f"qd{k + 1}": qd[k] for k in range(n)},
-           "g": float(np.linalg.norm(robot.gravity))}
-    M, c, g = np.full((n, n), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+def _parse_printed(text):
+    """The lines 'name = formula' of a printed text, as (name, sympy expression, {word: symbol}), in order."""
+    out = []
     for line in text.splitlines():
         name, _, formula = line.partition(" = ")
         if not re.fullmatch(r"\w+(\[\d+(,\d+)?\])?", name):  # the header and its notes
             continue
-        local = {}
-        for word in set(_NAME.findall(formula)):
-            if word in ("cos", "sin"):
-                continue
-            local[word] = sp.Symbol(word)
+        local = {w: sp.Symbol(w) for w in set(_NAME.findall(formula)) if w not in ("cos", "sin")}
+        out.append((name, sp.sympify(formula, locals=local), local))  # our own printed output, in a test
+    return out
+
+
+def _printed_values(text, robot, q, qd, parsed=None):
+    """Evaluate the lines 'name = formula' of format_dynamics' (or format_recursive's) text one after the other
+    at (q, q̇) and the robot's parameter values: Ci, Sij are cos, sin of q_i + q_j (one digit per joint),
+    g = |g₀|, names defined earlier in the text are their values. Returns the printed M (both triangles from
+    the upper one), c and g."""
+    n = robot.dof
+    env = {**{s: v for s, v in robot.parameters}, **{f"qd{k + 1}": qd[k] for k in range(n)},
+           "g": float(np.linalg.norm(robot.gravity))}
+    M, c, g = np.full((n, n), np.nan), np.full(n, np.nan), np.full(n, np.nan)
+    q_subs = {sp.Symbol(f"q{k + 1}"): q[k] for k in range(n)}
+    for name, e, local in parsed or _parse_printed(text):
+        for word in local:
             if word not in env and re.fullmatch(r"[CS]\d+", word):
                 angle = sum(q[int(d) - 1] for d in word[1:])
                 env[word] = np.cos(angle) if word[0] == "C" else np.sin(angle)
-        e = sp.sympify(formula, locals=local)  # our own printed output, in a test
-        q_subs = {sp.Symbol(f"q{k + 1}"): q[k] for k in range(n)}
         value = float(e.xreplace({**q_subs, **{local[w]: env[w] for w in local if w in env}}))
         m = _LABEL.match(name)
         if m is None:
@@ -284,9 +290,13 @@ def _printed_values(text, robot, q, qd):
 
 
 def _check_printed(robot, text, rng, count=2):
+    parsed = _parse_printed(text)
     for _ in range(count):
         q, qd = rng.uniform(-np.pi, np.pi, robot.dof), rng.uniform(-2, 2, robot.dof)
-        M, c, g = _printed_values(text, robot, q, qd)
+        for k, jt in enumerate(robot.joint_types):
+            if jt is JointType.PRISMATIC:
+                q[k] = rng.uniform(-0.5, 0.5)
+        M, c, g = _printed_values(text, robot, q, qd, parsed)
         scale = 1 + np.abs(N.mass_matrix(robot, q)).max()
         np.testing.assert_allclose(M, N.mass_matrix(robot, q), atol=1e-5 * scale)  # 6 printed digits
         np.testing.assert_allclose(c, N.coriolis_vector(robot, q, qd), atol=1e-5 * scale)
@@ -304,3 +314,78 @@ def test_printed_text_evaluates_to_the_numeric_m_c_g(name):
     _check_printed(robot, text, np.random.default_rng(86))
     if name == "puma560":
         assert len(text) <= 10_000
+
+
+# --- the recursive form (arms whose expanded entries are unreadable: Panda, generic twists) -------------------
+
+def _recursive_text(robot, style="text"):
+    from denavit.symbolic import format_recursive, recursive_dynamics
+
+    return format_recursive(recursive_dynamics(robot), style)
+
+
+def test_recursive_form_of_the_panda_evaluates_to_the_numeric_m_c_g():
+    """Panda: the printed recursions (body and composite parameters, momenta carried inward, Newton-Euler),
+    evaluated line by line, are the numeric CRBA, Christoffel c and gravity; every line is short."""
+    robot = denavit.load_robot("panda")
+    text = _recursive_text(robot)
+    _check_printed(robot, text, np.random.default_rng(87), count=3)
+    lines = text.splitlines()
+    assert "recursive form" in lines[0] and len(lines) < 500 and max(map(len, lines)) < 300
+    assert "M[1,1] = " in text and "c[7] = " in text and "g[7] = " in text and "friction[7] = " in text
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_recursive_form_of_random_arms(seed):
+    """Random rows (generic float twists, prismatic joints, fixed rows with inertia, base and tool, both
+    conventions): the printed recursive form equals the numeric M, c, g."""
+    rng = np.random.default_rng(500 + seed)
+    robot = _random_inertial_arm(rng, int(rng.integers(2, 5)))
+    if not any(l.inertia is not None and l.inertia.mass > 0 for l in robot.joints):
+        pytest.skip("no moving mass")
+    _check_printed(robot, _recursive_text(robot), rng, count=2)
+
+
+@pytest.mark.slow
+def test_generic_twist_6r_recursive_form_is_quick_and_right():
+    """Six revolute rows with every twist, length and offset a random float (no right angles) and full inertia:
+    the recursive form in seconds (the expanded route takes more than ten minutes), equal to the numeric engine."""
+    import time
+
+    rng = np.random.default_rng(88)
+    links = tuple(DHLink(a=float(rng.uniform(0.05, 0.4)), alpha=float(rng.choice([-1, 1]) * rng.uniform(0.3, 1.3)),
+                         d=float(rng.uniform(0.05, 0.3)),
+                         inertia=LinkInertia(mass=float(rng.uniform(0.5, 3)), com=tuple(rng.uniform(-0.1, 0.1, 3)),
+                                             inertia=tuple(np.r_[rng.uniform(0.05, 0.1, 3), rng.uniform(-2e-3, 2e-3, 3)]),
+                                             motor_inertia=0.1)) for _ in range(6))
+    robot = denavit.DHRobot(name="generic6r", links=links)
+    from denavit.symbolic import dynamics_form
+
+    assert dynamics_form(robot) == "recursive" and dynamics_form(denavit.load_robot("puma560")) == "hand"
+    t0 = time.perf_counter()
+    text = _recursive_text(robot)
+    assert time.perf_counter() - t0 < 120  # a generous bound (seconds on an idle machine), not a benchmark
+    _check_printed(robot, text, rng, count=2)
+
+
+@pytest.mark.skipif(shutil.which("pdflatex") is None, reason="no LaTeX engine")
+def test_recursive_form_latex_compiles(tmp_path):
+    tex = _recursive_text(denavit.load_robot("panda"), "latex")
+    assert "J^{b}_{2xy}" in tex and "\\omega_{2x}" in tex and "L^{3}_{2x}" in tex and "\\dot{q}_{1}" in tex
+    doc = ("\\documentclass{article}\\usepackage{amsmath}\\usepackage[paperwidth=40in,paperheight=200in]"
+           "{geometry}\\begin{document}\\[" + tex + "\\]\\end{document}\n")
+    (tmp_path / "panda.tex").write_text(doc)
+    run = subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "panda.tex"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout[-2000:]
+
+
+def test_cli_writes_the_recursive_form_for_the_panda(capsys):
+    from denavit.cli import main
+
+    assert main(["dynamics", "panda", "--symbolic"]) == 0
+    out = capsys.readouterr().out
+    assert "recursive form" in out and "M[1,7] = " in out
+    assert main(["dynamics", "panda", "--symbolic", "--coriolis"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1 and "--form hand" in captured.err

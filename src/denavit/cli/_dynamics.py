@@ -33,6 +33,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--numeric-params", action="store_true", help="substitute the parameter values symbolically")
     p.add_argument("--no-cse", action="store_true", help="never pull out common subexpressions (default: only for long results)")
     p.add_argument("--coriolis", action="store_true", help="also print the matrix C (symbolic)")
+    p.add_argument("--form", choices=["auto", "hand", "recursive"], default="auto",
+                   help="symbolic M, c, g (lagrange): entry by entry ('hand'), or as recursions in named link "
+                        "quantities ('recursive'); 'auto': hand for arms whose entries stay short (up to 6 joints, "
+                        "twists multiples of 90 deg), recursive otherwise")
     p.set_defaults(handler=cmd_dynamics)
 
     p = sub.add_parser("simulate", help="simulate the arm's motion from an initial state")
@@ -121,6 +125,16 @@ def _symbolic(robot, args):
     from .. import symbolic as S
 
     t0 = time.perf_counter()
+    if args.method == "lagrange" and S.dynamics_form(robot, args.form) == "recursive":
+        if args.coriolis:
+            raise ParseError("--coriolis: the matrix C is written in the hand form only (add --form hand)")
+        rd = S.recursive_dynamics(robot, numeric=args.numeric_params)
+        text = S.format_recursive(rd, args.format)
+        elapsed = time.perf_counter() - t0
+        data = {"form": "recursive", "definitions": {str(k): v for k, v, _ in rd.definitions},
+                "M_symbolic": rd.M, "c_symbolic": rd.c, "g_symbolic": rd.g, "symbolic_text": text,
+                "format": args.format, "method": args.method, "seconds": round(elapsed, 3)}
+        return data, [f"{robot.name}: equations of motion ({args.method}, recursive form, {elapsed:.2f} s)", text]
     kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=None if args.json else _progress)
     if args.method == "newton-euler":
         terms = S.newton_euler_dynamics(robot, **kw).terms
@@ -132,7 +146,7 @@ def _symbolic(robot, args):
     text = S.format_dynamics(terms, args.format, cse=False if args.no_cse else None, include=include,
                              gravity_symbol=True)
     elapsed = time.perf_counter() - t0
-    data = {"M_symbolic": terms.M, "c_symbolic": terms.c, "g_symbolic": terms.g,
+    data = {"form": terms.form, "M_symbolic": terms.M, "c_symbolic": terms.c, "g_symbolic": terms.g,
             "friction_symbolic": terms.friction, "symbolic_text": text, "format": args.format,
             "method": args.method, "seconds": round(elapsed, 3)}
     if args.coriolis and terms.C is not None:

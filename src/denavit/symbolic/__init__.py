@@ -14,6 +14,7 @@ from ._dynamics import (
 )
 from ._dynamics_trig import fourier_form
 from ._dynamics_ring import PARAMETER_NAMES, regressor_sym
+from ._recursive import RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
 from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
@@ -56,6 +57,10 @@ __all__ = [
     "fourier_form",
     "PARAMETER_NAMES",
     "regressor_sym",
+    "RecursiveDynamics",
+    "format_recursive",
+    "dynamics_form",
+    "recursive_dynamics",
     "LagrangeSteps",
     "lagrange_steps",
     "time_derivative",
