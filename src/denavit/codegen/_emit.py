@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from ._kernels import KernelSpec
+from ._llvm import LANES
 
 __all__ = ["python_module", "c_sources", "NUMBA", "NUMPY"]
 
@@ -110,12 +111,14 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
     first = spec.inputs[0][0]
     k = spec.name
     return ([f"_{k}_steps = ("] + steps + [")", f"_{k}_outputs = ("] + outs + [")",
-            f"_{k}, _{k}_row = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
+            f"_{k}, _{k}_row, _{k}_rows = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_1({args}, out):",
             f'    """{spec.doc}: one configuration, out {spec.shape}."""', f"    _{k}({args}, out)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",
             f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {spec.shape}."""',
-            f"    for b in range({first}.shape[0]):", f"        _{k}_row({args}, out, b)", "", ""])
+            f"    n = {first}.shape[0]", f"    simd = n - n % {LANES}",
+            f"    for b in range(0, simd, {LANES}):", f"        _{k}_rows({args}, out, b)",
+            f"    for b in range(simd, n):", f"        _{k}_row({args}, out, b)", "", ""])
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:
