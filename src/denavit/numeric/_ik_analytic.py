@@ -377,7 +377,11 @@ def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
             q[rough] = _polish(robot, cand[rough], Tk[rough], plan.projector)
             fine = np.all(np.isfinite(q), axis=-1) & rough
             e = pose_error(Tk[fine], forward_kinematics(robot, q[fine])) @ plan.projector.T
+            pe0, re0 = pe.copy(), re.copy()
             pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
+            # next to a singular set (J's σ_min ~1e-9) a step can run off: the polish never makes a candidate worse
+            worse = rough & ~(pe + L * re <= pe0 + L * re0)
+            q[worse], pe[worse], re[worse] = cand[worse], pe0[worse], re0[worse]
     else:
         lost = np.zeros_like(ok)
     ok &= np.all(np.isfinite(q), axis=-1)

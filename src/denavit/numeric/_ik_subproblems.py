@@ -22,8 +22,10 @@ FREE_AXIS = 1e-10  # distance to axis 1 or 2, relative to the arm's size, under 
 # FREE_TOL of the closed forms)
 REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
 REFINE_STEPS = 4
-CLUSTER_RADIUS = 1e-2  # relative distance of two roots of the resultant under which the other elimination order
+CLUSTER_RADIUS = 1e-3  # relative distance of two roots of the resultant under which the other elimination order
 # is solved too (a multiple root split by rounding: a k-fold root comes out ~ε^(1/k) apart)
+CLUSTER_SIZE = 3  # roots that close together (a double root is split ~√ε only and handled by the refinement)
+SAME_ROOT = 1e-6  # joint-space distance [rad, m per L] under which a root of the other order is one already found
 _ALT_SEED = 20240602  # the other order's structural tests draw from their own fixed stream
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
 # parallel axes of a UR-type arm) under which a solution is reported as the continuum of the aligned axes
@@ -268,7 +270,8 @@ class Position3:
         near = np.abs(roots.imag) < 0.1 * (1 + np.abs(roots.real)) if self.pv else np.abs(np.abs(roots) - 1.0) < 0.1
         gap = np.abs(roots[:, :, None] - roots[:, None, :]) / (1 + np.abs(roots[:, :, None]))
         gap[:, np.arange(roots.shape[1]), np.arange(roots.shape[1])] = np.inf
-        clustered = np.any((gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :], axis=(1, 2))
+        close = (gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :]
+        clustered = np.any(close.sum(axis=2) >= CLUSTER_SIZE - 1, axis=1)
         clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
         if self.pv:
             ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
@@ -316,11 +319,31 @@ class Position3:
             # ~ε^(1/k) apart or complex and the generating branch could be lost; the other order's resultant has
             # simple roots there (q2 and q3 swap roles); the copies are merged by FK later
             qa, fa = self.alt.solve(W[clustered])
+            # a root both orders found is kept once, the copy that reproduces the point better (the copies would
+            # only cost downstream: every pose of the batch gets as many slots as the pose with most candidates)
+            rev = ~np.array([self.pr1, self.pr2, self.pr3])
+            qc = q[clustered]
+            d = qa[:, :, None] - qc[:, None]  # (b, Ma, M, 3)
+            d = np.nan_to_num(np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), np.abs(d)).max(-1),
+                              nan=np.inf)
+            near = np.argmin(d, axis=-1)  # (b, Ma)
+            same = np.take_along_axis(d, near[..., None], -1)[..., 0] < SAME_ROOT * max(self.L, 1.0)
+            Wc = W[clustered][:, None]
+            ra = np.linalg.norm(self.point(np.nan_to_num(qa)) - Wc, axis=-1)
+            rm = np.take_along_axis(np.linalg.norm(self.point(np.nan_to_num(qc)) - Wc, axis=-1), near, -1)
+            bi, ai = np.nonzero(same & (ra < rm))
+            qc[bi, near[bi, ai]] = qa[bi, ai]
+            q[clustered] = qc
+            qa = np.where(same[..., None], np.nan, qa)
             extra = np.full((len(W),) + qa.shape[1:], np.nan)
             extra[clustered] = qa
             fe = np.zeros(extra.shape[:2], dtype=free.dtype)
             fe[clustered] = fa
             q, free = np.concatenate([q, extra], 1), np.concatenate([free, fe], 1)
+            # the slots some pose uses, found ones first (the other poses' empty slots would cost downstream)
+            found = np.all(np.isfinite(q), -1)
+            order = np.argsort(~found, axis=1, kind="stable")[:, : max(int(found.sum(1).max()), 1)]
+            q, free = np.take_along_axis(q, order[..., None], 1), np.take_along_axis(free, order, 1)
         return q, free
 
     def _free_after(self, q: np.ndarray, W: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -364,8 +387,12 @@ class Position3:
                 break
             J = np.stack([(self.point(x + h * d) - self.point(x - h * d)) / (2 * h) for d in np.eye(3)], -1)
             Jt = np.swapaxes(J, -1, -2)
-            dx = (np.linalg.pinv(Jt @ J, rcond=1e-15) @ (Jt @ e[..., None]))[..., 0]  # (a zero column: J singular)
-            x = x - dx
+            JtJ = Jt @ J
+            # damping relative to the row's own scale: a zero column (the point on axis 1, say) stays solvable
+            damp = 1e-14 * np.maximum(np.trace(JtJ, axis1=-2, axis2=-1), self.L**2)[:, None, None] * np.eye(3)
+            dx = np.linalg.solve(JtJ + damp, Jt @ e[..., None])[..., 0]
+            x = np.where(np.isfinite(dx), x - dx, x)
+            continue
         out = q.copy()
         out[todo] = np.where(np.linalg.norm(self.point(x) - w, axis=-1)[:, None]
                              <= np.linalg.norm(self.point(q[todo]) - w, axis=-1)[:, None], x, q[todo])
