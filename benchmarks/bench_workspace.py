@@ -1,10 +1,11 @@
 """Workspace and reachability at scale (denavit.scale): throughput, memory and the volume interval vs samples.
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
-              [--workers 2] [--reach 0.05x100] [--markdown FILE]
+              [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--markdown FILE]
 Each row is one run in this process: wall time, samples/s, peak resident memory of the process so far
 (ru_maxrss, grows only), and the reported volume with its interval.  ``--cluster`` also runs the largest
-sample count on a local dask.distributed cluster (2 worker processes) and checks the counts are identical.
+sample count on a local process pool and on two local dask.distributed clusters (2 worker processes; Dask's
+defaults, and scale.LOCAL_CLUSTER_CONFIG), ``--repeat`` times each, and checks the counts are identical.
 """
 
 from __future__ import annotations
@@ -39,25 +40,67 @@ def run_samples(robot, counts, scheduler, workers) -> list[str]:
     return rows
 
 
-def run_cluster(robot, n, trim: bool) -> str:
+def _cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run_cluster(robot, n, repeat: int = 1) -> list[str]:
+    """Local process pool of 2 against LocalClusters of 2 single-threaded worker processes — one with Dask's
+    default settings, one with ``scale.LOCAL_CLUSTER_CONFIG`` (what ``scheduler="dask"`` starts) — alternating,
+    ``repeat`` times each, same seed; medians of wall time and of CPU time (all processes of the setup: the
+    driver, which also hosts the Dask scheduler, and the workers).  The clusters are started once, before the
+    timings; each local run starts its pool (spawn and kernel load included: about a second)."""
     import dask
     from distributed import Client, LocalCluster
 
-    if trim:  # dask's nanny sets 64 kB by default: FK's large temporaries are then returned and re-faulted
-        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 2**30})
+    from denavit.scale import LOCAL_CLUSTER_CONFIG
 
-    t0 = time.perf_counter()
-    ref = occupancy(robot, n, seed=1, scheduler="processes", workers=2)
-    t_ref = time.perf_counter() - t0
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
-        t0 = time.perf_counter()
-        ws = occupancy(robot, n, seed=1, scheduler=client)
-        dt = time.perf_counter() - t0
-    same = np.array_equal(ws.counts, ref.counts)
-    note = ", MALLOC_TRIM_THRESHOLD_=1 GiB" if trim else ""
-    return (f"LocalCluster(2 processes{note}): {n:.0e} samples in {dt:.1f} s ({n / dt:.3g}/s); local process "
-            f"pool (2): {t_ref:.1f} s ({n / t_ref:.3g}/s); identical counts: {same}")
+    wall = {"local": [], "dask": [], "tuned": []}
+    cpu = {k: [] for k in wall}
+    same, load = True, [os.getloadavg()[0]]
+
+    def worker_cpu(client):
+        return sum(client.run(_cpu).values())
+
+    kw = dict(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    with LocalCluster(**kw) as c1, Client(c1) as default_client:
+        with dask.config.set(LOCAL_CLUSTER_CONFIG):
+            c2 = LocalCluster(**kw)
+        with c2, Client(c2) as tuned_client:
+            for client in (default_client, tuned_client):  # warm the workers (kernel load)
+                occupancy(robot, 4 * 65536, seed=1, scheduler=client)
+            for _ in range(repeat):
+                m0, k0, t0 = _cpu(), _children_cpu(), time.perf_counter()
+                ref = occupancy(robot, n, seed=1, scheduler="processes", workers=2)
+                wall["local"].append(time.perf_counter() - t0)
+                cpu["local"].append(_cpu() - m0 + _children_cpu() - k0)
+                for key, client in (("dask", default_client), ("tuned", tuned_client)):
+                    w0, m0, t0 = worker_cpu(client), _cpu(), time.perf_counter()
+                    ws = occupancy(robot, n, seed=1, scheduler=client)
+                    wall[key].append(time.perf_counter() - t0)
+                    cpu[key].append(_cpu() - m0 + worker_cpu(client) - w0)
+                    same &= bool(np.array_equal(ws.counts, ref.counts))
+                load.append(os.getloadavg()[0])
+    med = {k: float(np.median(v)) for k, v in wall.items()}
+    cmed = {k: float(np.median(v)) for k, v in cpu.items()}
+    lines = [f"2 workers, {n:.0e} samples, medians of {repeat} alternating runs, load average "
+             f"{min(load):.1f}–{max(load):.1f}; identical counts: {same}", "",
+             "| setup | wall [s] | samples/s | wall ratio to the pool | CPU [s] | CPU ns/sample | CPU ratio |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    names = {"local": "local process pool", "dask": "LocalCluster, Dask defaults",
+             "tuned": "LocalCluster, LOCAL_CLUSTER_CONFIG (scheduler='dask')"}
+    for k in wall:
+        lines.append(f"| {names[k]} | {med[k]:.1f} | {n / med[k]:.3g} | {med['local'] / med[k]:.2f} | {cmed[k]:.1f} "
+                     f"| {cmed[k] / n * 1e9:.0f} | {cmed['local'] / cmed[k]:.2f} |")
+    lines.append("")
+    lines.append("each run [s]: " + "; ".join(f"{k} {', '.join(f'{t:.1f}' for t in v)}" for k, v in wall.items()))
+    return lines
 
 
 def run_reach(robot, spec: str, scheduler, workers) -> str:
@@ -78,7 +121,7 @@ def main() -> None:
     ap.add_argument("--scheduler", default="threads")
     ap.add_argument("--workers", type=int)
     ap.add_argument("--cluster", action="store_true")
-    ap.add_argument("--trim", action="store_true", help="raise the workers' MALLOC_TRIM_THRESHOLD_ to 1 GiB")
+    ap.add_argument("--repeat", type=int, default=1, help="cluster comparison: runs of each, alternating (medians)")
     ap.add_argument("--reach", help="e.g. 0.05x100: resolution [m] x orientations")
     ap.add_argument("--markdown")
     a = ap.parse_args()
@@ -87,8 +130,9 @@ def main() -> None:
              f"load average {os.getloadavg()[0]:.2f}", ""]
     lines += run_samples(robot, [int(float(x)) for x in a.samples.split(",")], a.scheduler, a.workers)
     if a.cluster:
-        lines.append(run_cluster(robot, int(float(a.samples.split(",")[-1])), a.trim))
-        print(lines[-1], flush=True)
+        more = run_cluster(robot, int(float(a.samples.split(",")[-1])), a.repeat)
+        print("\n".join(more), flush=True)
+        lines += more
     if a.reach:
         lines.append(run_reach(robot, a.reach, a.scheduler, a.workers))
         print(lines[-1], flush=True)

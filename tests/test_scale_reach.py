@@ -51,9 +51,14 @@ def test_analytic_reachability_agrees_with_numeric_ik():
     rmap = reachability(robot, 0.25, 6, scheduler="synchronous", screen=False)
     g = rmap.grid
     rng = np.random.default_rng(0)
-    cells = np.argwhere(rmap.fraction >= 0)[rng.choice(rmap.fraction.size, 25, replace=False)]
-    T = _poses(g, cells, rmap.orientations)  # (25, 6, 4, 4)
-    agree = total = 0
+    reached, missed = np.argwhere(rmap.fraction > 0), np.argwhere(rmap.fraction == 0)
+    assert len(reached) >= 6 and len(missed) >= 3
+    # reached cells (a random draw of all cells was ~95 % outside the workspace: nothing checked the reached
+    # ones) and a few missed ones (each failing numeric solve costs ~0.3 s of restarts)
+    cells = np.concatenate([reached[rng.choice(len(reached), 6, replace=False)],
+                            missed[rng.choice(len(missed), 3, replace=False)]])
+    T = _poses(g, cells, rmap.orientations)  # (9, 6, 4, 4)
+    agree = total = solved = 0
     for i, c in enumerate(cells):
         for k in range(len(rmap.orientations)):
             num = denavit.solve_ik(robot, T[i, k], restarts=6, rng=np.random.default_rng(k)).success
@@ -61,12 +66,13 @@ def test_analytic_reachability_agrees_with_numeric_ik():
             ana = res.solutions.shape[0] > 0
             if num:
                 assert ana, (c, k)  # numeric success proves the pose reachable within the limits
+            solved += num
             agree += num == ana
             total += 1
         f_direct = np.mean([denavit.analytic_ik(robot, T[i, k]).solutions.shape[0] > 0
                             for k in range(len(rmap.orientations))])
         assert rmap.fraction[tuple(c)] == pytest.approx(f_direct)
-    assert agree >= 0.9 * total
+    assert agree >= 0.9 * total and solved >= 6
 
 
 def test_manipulability_is_the_best_solution_averaged():

@@ -55,8 +55,9 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("--scheduler", type=scheduler_name, default="auto", metavar="WHERE",
                    help=f"{', '.join(LOCAL_SCHEDULERS)} (default auto: processes for 1e7 samples or more, threads "
-                        "below) or a dask.distributed scheduler address such as tcp://10.0.0.5:8786 "
-                        "(needs denavit[scale])")
+                        "below; dask: a dask.distributed LocalCluster of --workers processes, started for the run) "
+                        "or a dask.distributed scheduler address such as tcp://10.0.0.5:8786 (dask and addresses "
+                        "need denavit[scale])")
     p.add_argument("--workers", type=bounded_int(1, MAX_WORKERS), metavar="N",
                    help=f"local threads or processes (default: the CPU count; at most {MAX_WORKERS})")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

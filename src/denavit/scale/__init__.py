@@ -10,7 +10,7 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
                        reach_bound, sampling_limits)
-from ._schedule import CONNECT_TIMEOUT, LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
+from ._schedule import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
 from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
 from ._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
 from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy,
@@ -25,6 +25,7 @@ __all__ = [
     "CONNECT_TIMEOUT",
     "DEFAULT_CHUNK",
     "FINE_CELLS",
+    "LOCAL_CLUSTER_CONFIG",
     "LOCAL_SCHEDULERS",
     "MAX_CELLS",
     "MAX_CHUNK",

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model import DHRobot
 from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
-from ._schedule import LOCAL_SCHEDULERS, Progress, resolve_auto, run
+from ._schedule import POOLS, Progress, resolve_auto, run
 from ._volume import VolumeEstimate, estimate_volume
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
@@ -163,7 +163,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     _check_sizes(samples, DEFAULT_CHUNK if chunk is None else chunk)
     scheduler = resolve_auto(scheduler, samples)
     if chunk is None:
-        chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in LOCAL_SCHEDULERS else CLUSTER_CHUNK
+        chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in POOLS else CLUSTER_CHUNK
     seed = new_seed() if seed is None else int(seed)
     if seed < 0:
         raise ModelError(f"seed must be a whole number >= 0, got {seed}")

@@ -10,6 +10,7 @@ counts, bounds and reach are bit-identical for any number of workers and any chu
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 from typing import Callable
 
@@ -165,15 +166,20 @@ class Job:
     base_origin: np.ndarray  # (3,)
 
 
+def _draw(job: Job, block: int, q: np.ndarray) -> np.ndarray:
+    """Fill q (m, n) with the joint values of random block ``block`` (its first m samples); return q."""
+    rng = np.random.Generator(np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))))
+    lo, hi = job.limits[:, 0], job.limits[:, 1]
+    rng.random(out=q)  # a prefix of the block's stream
+    q *= hi - lo
+    q += lo  # = lo + r·(hi − lo), in place
+    return q
+
+
 def positions_block(job: Job, block: int, rows: int | None = None) -> np.ndarray:
     """End-effector origins (m, 3) of random block ``block`` (its first ``rows`` samples)."""
     m = min(BLOCK, job.samples - block * BLOCK) if rows is None else rows
-    rng = np.random.Generator(np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))))
-    lo, hi = job.limits[:, 0], job.limits[:, 1]
-    q = rng.random((m, len(lo)))  # (m, n); a prefix of the block's stream
-    q *= hi - lo
-    q += lo  # = lo + r·(hi − lo), in place
-    return _positions(job.fk(q))
+    return _positions(job.fk(_draw(job, block, np.empty((m, len(job.limits))))))
 
 
 def _positions(out) -> np.ndarray:
@@ -185,26 +191,87 @@ def _positions(out) -> np.ndarray:
     return p
 
 
+class _Scratch(threading.local):
+    """Per-thread work arrays, kept from task to task.
+
+    A task allocates nothing of the size of its samples beyond what the FK callable returns: fresh large
+    arrays cost page faults on every task wherever the allocator hands them back to the system at once (the
+    C library does so for every block above 64 kB under ``MALLOC_TRIM_THRESHOLD_=65536``, which Dask's
+    nanny sets in its workers), and that made a Dask worker ~40 % slower than a plain process."""
+
+    def get(self, name: str, shape: tuple, dtype) -> np.ndarray:
+        a = self.__dict__.get(name)
+        size = math.prod(shape)
+        if a is None or a.size < size or a.dtype != dtype:
+            a = np.empty(max(size, 0 if a is None else a.size), dtype=dtype)
+            self.__dict__[name] = a
+        return a[:size].reshape(shape)
+
+
+_scratch = _Scratch()
+
+
+def _cells(job: Job, P: np.ndarray, flat: np.ndarray) -> None:
+    """Row-major flat cell indices (as numpy.ravel_multi_index) of the positions P (m, 3), into ``flat``."""
+    g = job.grid
+    m = P.shape[0]
+    D = _scratch.get("D", (m, 3), np.float64)
+    np.subtract(P, g.centre, out=D)
+    if g.dim == 3 and np.array_equal(g.basis, np.eye(3)):
+        U = D  # (m, dim)
+    else:
+        U = np.matmul(D, g.basis.T, out=_scratch.get("U", (m, g.dim), np.float64))
+    t = _scratch.get("t", (m,), np.float64)
+    c = _scratch.get("c", (m,), np.int32)
+    flat[:] = 0
+    for a in range(g.dim):
+        np.subtract(U[:, a], g.lo, out=t)
+        t /= g.resolution
+        np.floor(t, out=t)
+        if t.min() < 0 or t.max() >= g.side:
+            raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
+        c[:] = t  # < MAX_CELLS = 2^24: int32 sorts faster than int64
+        flat *= g.side
+        flat += c
+
+
+def _distance_max(P: np.ndarray, origin: np.ndarray) -> float:
+    D = _scratch.get("D", P.shape, np.float64)
+    np.subtract(P, origin, out=D)
+    D *= D
+    return float(np.sqrt(D.sum(axis=1, out=_scratch.get("t", (P.shape[0],), np.float64)).max()))
+
+
 def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, int]:
     """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples."""
-    g = job.grid
-    P = np.concatenate([positions_block(job, b).T for b in range(first, first + count)], axis=1)  # (3, m)
-    lo, hi = P.min(axis=1), P.max(axis=1)  # NaN and inf reach these
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
-        raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
-    d = P - job.base_origin[:, None]
-    reach = float(np.sqrt(np.einsum("im,im->m", d, d).max()))
-    D = P - g.centre[:, None]  # (3, m)
-    U = D if g.dim == 3 and np.array_equal(g.basis, np.eye(3)) else g.basis @ D  # (dim, m)
-    flat = np.zeros(P.shape[1], dtype=np.int32)  # < MAX_CELLS = 2^24: sorts faster than int64
-    for row in U:
-        c = np.floor((row - g.lo) / g.resolution)
-        if c.min() < 0 or c.max() >= g.side:
-            raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
-        flat *= g.side
-        flat += c.astype(np.int32)  # row-major cell index, as numpy.ravel_multi_index
-    idx, cnt = np.unique(flat, return_counts=True)
-    return idx, cnt.astype(np.uint32), lo, hi, reach, P.shape[1]
+    total = min((first + count) * BLOCK, job.samples) - first * BLOCK
+    flat = _scratch.get("flat", (total,), np.int32)
+    lo, hi, reach, done = np.full(3, np.inf), np.full(3, -np.inf), 0.0, 0
+    for b in range(first, first + count):
+        m = min(BLOCK, job.samples - b * BLOCK)
+        P = _positions(job.fk(_draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64))))
+        lo, hi = np.minimum(lo, P.min(axis=0)), np.maximum(hi, P.max(axis=0))  # NaN and inf reach these
+        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+            raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
+        reach = max(reach, _distance_max(P, job.base_origin))
+        _cells(job, P, flat[done:done + m])
+        done += m
+    idx, cnt = _runs(flat)
+    return idx, cnt, lo, hi, reach, total
+
+
+def _runs(flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sorted distinct values of ``flat`` and how often each occurs (as numpy.unique; sorts ``flat`` in place)."""
+    flat.sort()
+    m = flat.shape[0]
+    step = _scratch.get("step", (m,), np.bool_)
+    step[0] = True
+    np.not_equal(flat[1:], flat[:-1], out=step[1:])
+    starts = np.flatnonzero(step)
+    cnt = np.empty(starts.shape[0], dtype=np.uint32)
+    np.subtract(starts[1:], starts[:-1], out=cnt[:-1], casting="unsafe")
+    cnt[-1] = m - starts[-1]
+    return flat[starts], cnt
 
 
 def _plane(points: np.ndarray) -> np.ndarray | None:

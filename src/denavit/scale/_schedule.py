@@ -1,4 +1,5 @@
-"""Where tasks run: in this process, a thread or process pool, or a ``dask.distributed`` cluster.
+"""Where tasks run: in this process, a thread or process pool, or a ``dask.distributed`` cluster (given, or a
+LocalCluster started here for the run).
 
 Every scheduler runs the same task functions and the driver merges results as they arrive; at most
 ``IN_FLIGHT`` tasks per worker are submitted at a time, so memory stays bounded whatever the task count.
@@ -17,10 +18,21 @@ from typing import Any, Callable, Iterable, Iterator
 
 from ..errors import MissingDependencyError, ParseError
 
-__all__ = ["LOCAL_SCHEDULERS", "AUTO_PROCESSES_FROM", "resolve_auto", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
+__all__ = ["LOCAL_SCHEDULERS", "POOLS", "LOCAL_CLUSTER_CONFIG", "AUTO_PROCESSES_FROM", "resolve_auto", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
 
-#: Schedulers that need no cluster: in this process, a thread pool, a process pool.
-LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes")
+#: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
+LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
+#: The local schedulers that run without Dask.
+POOLS = ("auto", "synchronous", "threads", "processes")
+#: Dask settings of the LocalCluster that ``scheduler="dask"`` starts (single-threaded worker processes): the
+#: workers' statistical profiler (a stack sample every 10 ms) and 0.1–0.5 s monitors cost an idle worker ~4 % of
+#: a core; the C library's trim threshold is raised from the nanny's 64 kB for FK callables with large temporaries.
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 2**30,
+}
 #: "auto" runs on processes from this many samples on (FK threads contend for the GIL), on threads below.
 AUTO_PROCESSES_FROM = 10_000_000
 #: Seconds to wait for a dask.distributed scheduler to answer.
@@ -86,12 +98,31 @@ def _client(address: str):
                          f"({type(exc).__name__})") from None
 
 
-def _wait(client, pending: set):
-    if client is None:
-        return cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-    from distributed import wait
+def _local_cluster(workers: int):
+    """A LocalCluster of ``workers`` single-threaded processes and its Client."""
+    try:
+        import dask
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise MissingDependencyError("scheduler 'dask' needs dask.distributed: pip install 'denavit[scale]'") \
+            from None
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    try:
+        client = Client(cluster, set_as_default=False)
+    except BaseException:
+        cluster.close()
+        raise
+    return client, cluster
 
-    return wait(list(pending), return_when="FIRST_COMPLETED")
+
+def _wait(done_order, pending: set):
+    """(done, not done) once at least one pending future is done; ``done_order`` is a dask ``as_completed``
+    for a cluster (``distributed.wait`` needs a default client, and ours is not made the default)."""
+    if done_order is None:
+        return cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+    done = {next(done_order)}
+    return done, pending - done
 
 
 def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
@@ -99,14 +130,24 @@ def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", worker
     """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler ("auto": threads)."""
     check_scheduler(scheduler)
     scheduler = resolve_auto(scheduler, 0)
-    client, own, pool = None, False, None
+    client, own, pool, cluster = None, False, None, None
     if not isinstance(scheduler, str):
         client = scheduler
+    elif scheduler == "dask":
+        (client, cluster), own = _local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS)), True
     elif scheduler not in LOCAL_SCHEDULERS:
         client, own = _client(scheduler), True
+    done_order = None
     if client is not None:
+        from distributed import as_completed
+
         width = max(1, sum(client.nthreads().values()))
-        submit = lambda *a: client.submit(*a, pure=False)  # noqa: E731
+        done_order = as_completed(loop=client.loop)
+
+        def submit(*a):
+            future = client.submit(*a, pure=False)
+            done_order.add(future)
+            return future
     else:
         width = workers or os.cpu_count() or 1
         if scheduler == "synchronous":
@@ -121,12 +162,12 @@ def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", worker
         for task in it:
             pending.add(submit(fn, *task))
             while len(pending) >= IN_FLIGHT * width:
-                done, pending = _wait(client, pending)
+                done, pending = _wait(done_order, pending)
                 pending = set(pending)
                 for f in done:
                     yield f.result()
         while pending:
-            done, pending = _wait(client, pending)
+            done, pending = _wait(done_order, pending)
             pending = set(pending)
             for f in done:
                 yield f.result()
@@ -137,6 +178,8 @@ def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", worker
             pool.shutdown(wait=True, cancel_futures=True)
         if own:
             client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 class Progress:
