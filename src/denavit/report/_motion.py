@@ -91,6 +91,57 @@ def _symbolic_columns(ctx: Context) -> list:
     return steps
 
 
+def _position_derivatives(ctx: Context) -> tuple:
+    """∂p_e/∂q_i of the end-effector position (world axes), one 3-vector per joint, and ∂T/∂q_i unsimplified."""
+    cached = getattr(ctx, "_dT_sym", None)
+    if cached is not None:
+        return cached
+    T = ctx.fk_sym
+    dT = tuple(sp.ImmutableMatrix(T.diff(qi)) for qi in ctx.q_syms)
+    dp = tuple(S.simplify_matrix(sp.ImmutableMatrix(d[:3, 3]), ctx.simplify) for d in dT)
+    ctx._dT_sym = (dp, dT)  # type: ignore[attr-defined]
+    return ctx._dT_sym
+
+
+def _differentiation_steps(ctx: Context) -> list:
+    """The Jacobian by differentiating T(q): ∂p_e/∂q_i (linear rows) and vee(∂R/∂q_i Rᵀ) (angular rows)."""
+    dp, _ = _position_derivatives(ctx)
+    steps: list = [Text(
+        "Second route, by differentiation (Spong et al. 2006, sec. 4.6; Siciliano et al. 2009, sec. 3.1): the "
+        "linear rows are the partial derivatives of the end-effector position, $J_{v,i} = \\partial p_e/\\partial "
+        "q_i$; the angular rows come from the rotation, $S(\\omega) = \\dot R R^T$, so $J_{\\omega,i} = "
+        "\\mathrm{vee}(\\partial R/\\partial q_i\\,R^T)$.  Writing $R = R_a\\,R_z(q_i)\\,R_b$ with $R_a$ the "
+        "rotation of the frame whose $z$ is joint $i$'s axis, $\\partial R/\\partial q_i\\,R^T = R_a S(\\hat z) "
+        "R_a^T = S(R_a \\hat z)$: the axis $z_i$ for a revolute joint, $0$ for a prismatic one.")]
+    for k, ((z, _), jt) in enumerate(zip(ctx.joint_frames_sym, ctx.robot.joint_types), start=1):
+        steps.append(Equation(f"\\frac{{\\partial p_e}}{{\\partial q_{{{k}}}}}", ctx.short(dp[k - 1]),
+                              shorthand=True))
+        w = z if jt is JointType.REVOLUTE else sp.ImmutableMatrix([0, 0, 0])
+        steps.append(Equation(f"J_{{\\omega,{k}}} = \\mathrm{{vee}}\\left(\\frac{{\\partial R}}{{\\partial q_{{{k}}}}}"
+                              "R^T\\right)", ctx.short(w), shorthand=True))
+    return steps
+
+
+def _differentiation_check(ctx: Context, J_num: np.ndarray) -> float:
+    """Largest difference, at the case, between J_num and (a) ∂p/∂q_i, vee(∂R/∂q_i Rᵀ) of the unsimplified
+    derivatives of T(q) evaluated directly, (b) the formulas the report prints."""
+    dp, dT = _position_derivatives(ctx)
+    subs = {**ctx.param_subs, **dict(zip(ctx.q_syms, ctx.q))}
+
+    def num(M) -> np.ndarray:
+        return np.array(sp.ImmutableMatrix(M).xreplace(ctx.param_subs).xreplace(subs).evalf(), dtype=float)
+
+    R = num(ctx.fk_sym)[:3, :3]
+    worst = 0.0
+    for k, ((z, _), jt) in enumerate(zip(ctx.joint_frames_sym, ctx.robot.joint_types)):
+        D = num(dT[k])
+        W = D[:3, :3] @ R.T
+        raw = np.concatenate([D[:3, 3], [W[2, 1], W[0, 2], W[1, 0]]])
+        shown = np.concatenate([num(dp[k]).ravel(), num(z).ravel() if jt is JointType.REVOLUTE else np.zeros(3)])
+        worst = max(worst, _max_diff(raw, J_num[:, k]), _max_diff(shown, J_num[:, k]))
+    return worst
+
+
 def section_jacobian(ctx: Context) -> Section:
     """The geometric Jacobian: z_i and p_i per column, J0 symbolic, J0 and Je at the numeric case."""
     robot = ctx.robot
@@ -104,9 +155,13 @@ def section_jacobian(ctx: Context) -> Section:
     J_num = N.geometric_jacobian(robot, ctx.q)
     if ctx.symbolic_jacobian_ok:
         steps += _symbolic_columns(ctx)
+        steps += _differentiation_steps(ctx)
         J_at_q = jacobian_sym(ctx).xreplace(ctx.param_subs).xreplace(dict(zip(ctx.q_syms, ctx.q)))
         steps.append(Text("Check: the symbolic $J_0$ at the numeric case against the numeric engine's "
                           f"geometric_jacobian: {_agree(_max_diff(J_at_q.evalf(), J_num))}."))
+        steps.append(Text("Check, the differentiation route at the numeric case ($\\partial p_e/\\partial q_i$ and "
+                          "$\\mathrm{vee}(\\partial R/\\partial q_i\\,R^T)$ of $T(q)$ evaluated directly, and the "
+                          f"formulas above) against geometric_jacobian: {_agree(_differentiation_check(ctx, J_num))}."))
     else:
         steps.append(Text("The symbolic Jacobian of this arm is too long to read usefully; it is shown at the "
                           "numeric case."))
