@@ -101,11 +101,15 @@ def _structural(robot, qty, spec, claimed, truth, tol) -> list[str]:
     if qty.name in ("kinetic_energy", "lagrangian", "equations_of_motion", "mass_matrix") and truth.ndim >= 1:
         hints += _dynamics_slips(qty, spec, points, claimed, truth, tol)
     if qty.name in ("jacobian", "twist", "torques"):
-        other = "tool" if Frame(spec.get("frame", "base")) is Frame.BASE else "base"
-        alt = _alt(qty, spec, points, spec_change={"frame": other})
-        if alt is not None and _close(claimed, alt, tol):
-            hints.append(f"it is expressed in {other} axes (J{'e' if other == 'tool' else '0'}), not "
-                         f"{spec.get('frame', 'base')} axes")
+        from ._quantities import axes_frame
+
+        f = axes_frame(spec)
+        written = f"frame {{{f}}}'s" if isinstance(f, int) else f.value
+        for other in ("base", "tool") if isinstance(f, int) else ("tool" if f is Frame.BASE else "base",):
+            alt = _alt(qty, spec, points, spec_change={"frame": other})
+            if alt is not None and _close(claimed, alt, tol):
+                hints.append(f"it is expressed in {other} axes (J{'e' if other == 'tool' else '0'}), not "
+                             f"{written} axes")
         if truth.ndim >= 2 and truth.shape[1] == 6:  # not for one entry (truth is 1-D then)
             perm = [3, 4, 5, 0, 1, 2]
             if _close(claimed, truth[:, perm], tol[perm]):

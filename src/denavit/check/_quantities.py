@@ -16,7 +16,7 @@ from .. import numeric as N
 from ..errors import ParseError
 from ..model import DHRobot, Frame
 
-__all__ = ["Quantity", "QUANTITIES", "quantity", "Point", "frame_index"]
+__all__ = ["Quantity", "QUANTITIES", "quantity", "Point", "frame_index", "axes_frame", "jacobian_in"]
 
 
 @dataclass(frozen=True)
@@ -72,15 +72,34 @@ def _end_effector(p: Point, spec: dict[str, Any]) -> np.ndarray:
     return N.forward_kinematics(p.robot, p.q)
 
 
-def _frame(spec: dict[str, Any]) -> Frame:
+def axes_frame(spec: dict[str, Any]) -> Frame | int:
+    """The axes a Jacobian claim is written in: base (J0), tool (Je) or DH frame i (``frame: 3``: ⁱJ)."""
+    f = spec.get("frame", "base")
+    if isinstance(f, str) and f.strip().isdigit() and len(f.strip()) <= 3:
+        f = int(f.strip())
+    if isinstance(f, int) and not isinstance(f, bool):
+        return f
     try:
-        return Frame(spec.get("frame", "base"))
+        return Frame(f)
     except ValueError:
-        raise ParseError(f"'frame' must be base or tool, got {spec.get('frame')!r}") from None
+        raise ParseError(f"'frame' must be base, tool or the index of a DH frame (0 … N), got {str(f)[:40]!r}") from None
+
+
+def jacobian_in(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    """J0, Je, or ⁱJ = blockdiag(R_0_iᵀ, R_0_iᵀ) J0 with R_0_i the world orientation of DH frame i (reference point
+    the end-effector origin in every case)."""
+    f = axes_frame(spec)
+    if isinstance(f, Frame):
+        return N.geometric_jacobian(p.robot, p.q, frame=f)
+    if not 0 <= f <= p.robot.n_rows:
+        raise ParseError(f"'frame' {f} is not a DH frame of this robot (0 … {p.robot.n_rows})")
+    J0 = N.geometric_jacobian(p.robot, p.q, frame=Frame.BASE)
+    R = _frames(p)[f][:3, :3]
+    return np.vstack([R.T @ J0[:3], R.T @ J0[3:]])
 
 
 def _jacobian(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    J = N.geometric_jacobian(p.robot, p.q, frame=_frame(spec))
+    J = jacobian_in(p, spec)
     J = J[_rows(spec)]
     if "column" in spec:
         return J[:, _index(spec, "column", 1, p.robot.dof) - 1]
@@ -99,11 +118,11 @@ def _rows(spec: dict[str, Any]) -> list[int]:
 
 
 def _twist(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return (N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)) @ p.qd)[_rows(spec)]
+    return (jacobian_in(p, spec) @ p.qd)[_rows(spec)]
 
 
 def _torques(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    return N.geometric_jacobian(p.robot, p.q, frame=_frame(spec)).T @ p.wrench
+    return jacobian_in(p, spec).T @ p.wrench
 
 
 def frame_index(p: Point, spec: dict[str, Any]) -> int:
@@ -188,7 +207,7 @@ def _equations_of_motion(p: Point, spec: dict[str, Any]) -> np.ndarray:
 
 
 def _det(p: Point, spec: dict[str, Any]) -> np.ndarray:
-    J = N.geometric_jacobian(p.robot, p.q, frame=_frame(spec))
+    J = jacobian_in(p, spec)
     if "rows" not in spec and p.robot.dof != 6:
         raise ParseError(f"det J needs a square Jacobian: give 'rows' ({p.robot.dof} of vx,vy,vz,wx,wy,wz)")
     J = J[_rows(spec)]
@@ -221,8 +240,8 @@ QUANTITIES: dict[str, Quantity] = {
                  fk_like=True),
         Quantity("rotation", lambda p, s: _end_effector(p, s)[:3, :3], about="end-effector orientation (world)",
                  fk_like=True),
-        Quantity("jacobian", _jacobian, about="geometric Jacobian J0 (frame: base) or Je (frame: tool), rows "
-                 "(v, ω); optional 'column' (1-based) and 'rows' (linear/angular)"),
+        Quantity("jacobian", _jacobian, about="geometric Jacobian J0 (frame: base), Je (frame: tool) or ⁱJ in the axes "
+                 "of DH frame i (frame: i), rows (v, ω); optional 'column' (1-based) and 'rows' (linear/angular)"),
         Quantity("twist", _twist, ("qd",), about="end-effector twist (v, ω) = J q̇"),
         Quantity("torques", _torques, ("wrench",), about="joint torques τ = Jᵀ F balancing wrench (f, n)"),
         Quantity("mass_matrix", _dynamics("mass_matrix"), about="joint-space inertia matrix M(q)"),
