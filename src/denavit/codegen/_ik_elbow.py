@@ -60,16 +60,14 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         tols[0], tols[1], tols[2], tols[3], tols[4], tols[5], tols[6])
     tiny = free_tol * L
     reach = tols[7]
-    F = np.empty((4, 4))
-    q = np.empty(6)
-    cand = np.empty((8, 6))
-    cerr = np.empty((8, 2))
-    ok = np.zeros(8, dtype=np.bool_)
-    inside = np.zeros(8, dtype=np.bool_)
-    used = np.zeros(8, dtype=np.bool_)
-    Xw, W, Y, M = np.empty(3), np.empty(3), np.empty((3, 3)), np.empty((3, 3))
-    cx, cy, cz = np.empty(3), np.empty(3), np.empty(3)
-    x1, y1c, z1, S, E, dW = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
+    ws = np.empty(137)
+    F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
+    Xw, W, Y, M = ws[86:89], ws[89:92], ws[92:101].reshape((3, 3)), ws[101:110].reshape((3, 3))
+    cx, cy, cz = ws[110:113], ws[113:116], ws[116:119]
+    x1, y1c, z1, S, E, dW = ws[119:122], ws[122:125], ws[125:128], ws[128:131], ws[131:134], ws[134:137]
+    flags = np.zeros(24, dtype=np.bool_)
+    ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     for b in range(T.shape[0]):
         status = 0
         # wrist centre and the target rotation without the last constant

@@ -16,6 +16,11 @@ __all__ = ["IKMethods"]
 
 _ndarray, _F64 = np.ndarray, np.dtype(np.float64)
 _NO_SEEDS = np.zeros((0, 1))
+_NO_FREE = ("",) * 8
+#: ``valid`` of a one-pose result with k solutions (all True), shared read-only arrays
+_ALL_VALID = tuple(np.ones(k, dtype=bool) for k in range(9))
+for _a in _ALL_VALID:
+    _a.flags.writeable = False
 
 
 class IKMethods:
@@ -120,7 +125,7 @@ class IKMethods:
                          revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
                 K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
                 assert K.size == sum(size for _, size in ELBOW_LAYOUT)
-                c = self._elbow = [K, k["labels"], plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
+                c = self._elbow = [K, list(k["labels"]), plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
         Ta = np.asarray(T, dtype=np.float64)
         if c is False or Ta.shape != (4, 4):
             return analytic_ik(self.robot, T)
@@ -140,5 +145,6 @@ class IKMethods:
         if i[0, 10]:
             return analytic_ik(self.robot, T)
         k, j = int(i[0, 8]), int(i[0, 9])
-        return AnalyticIKResult(f[0, :k, :6], tuple(labels[i[0, :k]]), ("",) * k, f[0, :k, 6], f[0, :k, 7],
-                                f[0, :j, 8:], kind, "pose", np.ones(k, dtype=bool))
+        g = f[0]
+        return AnalyticIKResult(g[:k, :6], tuple([labels[code] for code in i[0, :k].tolist()]), _NO_FREE[:k],
+                                g[:k, 6], g[:k, 7], g[:j, 8:], kind, "pose", _ALL_VALID[k])
