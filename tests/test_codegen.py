@@ -9,6 +9,7 @@ build); the numba backend on a few, against the numpy backend.
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import textwrap
@@ -31,7 +32,12 @@ N_DYN = 15 if REDUCED else 60
 
 @pytest.fixture(autouse=True)
 def _cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "kernels"))
+    """One kernel folder for the run, shared by pytest-xdist's workers (each worker's basetemp is a subfolder of
+    the run's): a robot's kernels are compiled once, not once per worker."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(base / "kernels"))
 
 
 def fd_jacobian(robot, q, h=1e-6):
@@ -250,7 +256,7 @@ def test_numba_kernels_are_cached_on_disk_for_the_next_process(tmp_path):
         misses = sum(m.fk_1.stats.cache_misses.values()) + sum(m.jacobian0_n.stats.cache_misses.values())
         print(fast.backend, hits, misses)
     """)
-    env = {**__import__("os").environ, "DENAVIT_CACHE_DIR": str(tmp_path)}
+    env = {**os.environ, "DENAVIT_CACHE_DIR": str(tmp_path)}
     first = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
     second = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, check=True)
     backend, _, misses1 = first.stdout.split()
