@@ -578,3 +578,82 @@ def test_skewed_prismatic_arms_at_and_near_the_point_crossing_axis_2(kinds, conv
         Q = np.concatenate([_crossing_configs(robot, rng, 6), _degenerate_configs(robot, rng, 6)])
         _check(robot, Q, (kinds, convention, robot.links))
     assert solved >= (4 if REDUCED else 20)
+
+
+@pytest.mark.parametrize("kinds,convention", [("RRP", "standard"), ("PRP", "modified"), ("RPP", "standard")])
+def test_skewed_prismatic_arms_near_the_crossing_miss_nothing_a_dense_search_finds(kinds, convention):
+    """Every distinct solution Newton finds from many random seeds (solve_ik on the position rows, independent
+    code) is one the analytic solver returns, ±1e-4 from the point crossing axis 2."""
+    rng = np.random.default_rng([1818, len(kinds), kinds.index("P"), convention == "standard"])
+    robot = _crossing_arm(rng, kinds, convention)
+    Q = _crossing_configs(robot, rng, 1)
+    Q = Q[1:3]  # ±1e-4 from the crossing (at 1e-8 Newton stalls at ~1e-9: σ_min of J is ~1e-8 there)
+    seeds = 100 if REDUCED else 400
+    for q in Q:
+        T = forward_kinematics(robot, q)
+        an = analytic_ik(robot, T)
+        num = denavit.solve_ik(robot, np.broadcast_to(T, (seeds, 4, 4)), _uniform(robot, rng, seeds), restarts=0,
+                               rng=rng, tol=1e-12, mask="position")
+        found = _distinct(robot, num.q[num.success])
+        assert found, (kinds, q)
+        for f in found:
+            assert _same_blob(robot, an.solutions, f, T, "position") or \
+                any(_member(robot, s, fr, f) for s, fr in zip(an.solutions, an.free)), (kinds, q, f, an.solutions)
+
+
+# --------------------------------------------------------------------------------------------------------------
+# no bare Python exception from any public IK function: random arms, random targets (reachable or not, extreme
+# but finite), degenerate rotations
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from conftest import robots  # noqa: E402
+
+_EXTREME = (0.0, 1e-300, 1e-12, 1.0, 1e6, 1e12, 1e150, 1e300)
+
+
+def _targets(robot, seed, k=6):
+    """Poses of the arm (reachable), the same moved far away or scaled down to ~0, random rotations with
+    translations of every magnitude in _EXTREME, a rotation that is not one (a reflection), all finite."""
+    rng = np.random.default_rng(seed)
+    T = forward_kinematics(robot, _uniform(robot, rng, k))
+    far = T.copy()
+    far[:, :3, 3] *= rng.choice(_EXTREME, (k, 1))
+    Rq, _ = np.linalg.qr(rng.normal(size=(k, 3, 3)))
+    rand = np.tile(np.eye(4), (k, 1, 1))
+    rand[:, :3, :3] = Rq
+    rand[:, :3, 3] = rng.normal(size=(k, 3)) * rng.choice(_EXTREME, (k, 1))
+    return np.concatenate([T, far, rand])
+
+
+@settings(max_examples=25 if REDUCED else 150)
+@given(robots(), st.integers(0, 2**32 - 1))
+def test_no_bare_exception_escapes_the_public_ik_functions(robot, seed):
+    """analytic_ik, ik_structure, ik_plan and solve_ik either answer (every analytic solution reproduces its target
+    to 1e-9 on the controlled rows; solve_ik's success is decided by FK) or raise a denavit error."""
+    from denavit.errors import DenavitError
+    from denavit.numeric import ik_plan, ik_structure
+
+    T = _targets(robot, seed)
+    try:
+        kind = ik_structure(robot)
+        assert ik_plan(robot).kind == kind
+        res = analytic_ik(robot, T)
+    except UnsupportedRobotError:
+        res = None
+    if res is not None:
+        for b in range(len(T)):
+            sols = res.solutions[b][res.valid[b]]
+            if len(sols):
+                r = _fk_residual(robot, sols, np.broadcast_to(T[b], (len(sols), 4, 4)), res.controlled)
+                assert np.all(r < 2 * FK_TOL * max(1.0, _reach(robot))), (b, T[b], r)
+        one = analytic_ik(robot, T[-1])  # a single pose (no batch axis) too
+        assert one.solutions.shape[-1] == robot.dof
+    try:
+        num = denavit.solve_ik(robot, T[: len(T) // 3 + 2], max_iterations=30, restarts=1,
+                               rng=np.random.default_rng(seed), mask="position" if robot.dof < 6 else "pose")
+    except DenavitError:
+        return
+    assert np.all(np.isfinite(num.q)) and num.success.shape == (len(T) // 3 + 2,)

@@ -18,7 +18,7 @@ import numpy as np
 from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
-from ._ik_chain import chain_columns, chain_of, wrap_angle
+from ._ik_chain import chain_columns, chain_of, damped_solve, wrap_angle
 from ._ik_numeric import pose_error
 from ._ik_plans import Plan, make_plan
 from ._ik_kernel import kernel_of, targets_soa
@@ -162,7 +162,7 @@ def _polish(robot: DHRobot, q: np.ndarray, T: np.ndarray, P: np.ndarray) -> np.n
             break
         Jt = np.swapaxes(J, -1, -2)
         A = Jt @ J + 1e-14 * np.eye(n)
-        q[act] += np.linalg.solve(A, np.einsum("bij,bj->bi", Jt, e)[..., None])[..., 0]
+        q[act] += damped_solve(A, np.einsum("bij,bj->bi", Jt, e)[..., None])[..., 0]
     return q
 
 
@@ -256,9 +256,13 @@ def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> An
     (True, True)
     """
     T = as_transform(T, "T")
-    if locked:
-        return _solve_locked(robot, T, locked)
-    return _solve(robot, T, _plan(robot, True))
+    plan = None if locked else _plan(robot, True)
+    # targets far beyond the reach (1e300 m, say) overflow on the way to "no solution"; every candidate is
+    # verified by FK, so those intermediate infinities are no news to the caller
+    with np.errstate(over="ignore", invalid="ignore"):
+        if locked:
+            return _solve_locked(robot, T, locked)
+        return _solve(robot, T, plan)
 
 
 def _lock(robot: DHRobot, locked: dict[str, float]) -> tuple[DHRobot, list[int], np.ndarray]:
@@ -318,7 +322,11 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
                                 np.zeros(batch + (0,), dtype=object), np.zeros(batch + (0,)), np.zeros(batch + (0,)),
                                 np.zeros(batch, dtype=int), plan.kind, _controlled(plan.projector),
                                 np.zeros(batch + (0,), dtype=bool))
-    cand, free = plan.solve(Tf)  # (B, K, n)
+    # a target beyond every reachable point (|p| above the bound below) has no solution: the plan is given a
+    # reachable stand-in instead (its candidates then fail the FK check against the real target), so that
+    # targets like 1e300 m never reach the root finders, whose intermediate quantities would overflow
+    far = np.linalg.norm(Tf[:, :3, 3], axis=-1) > 2 * _bound(robot) + 1.0
+    cand, free = plan.solve(np.where(far[:, None, None], _stand_in(robot), Tf) if far.any() else Tf)  # (B, K, n)
     q, ok, pe, re, lost = _verify(robot, plan, Tf, cand)
     fold = ok & lost & (free == "")
     if fold.any():  # roots near a double root that needed polishing: look for the partner of the pair
@@ -380,7 +388,8 @@ def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
             pe0, re0 = pe.copy(), re.copy()
             pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
             # next to a singular set (J's σ_min ~1e-9) a step can run off: the polish never makes a candidate worse
-            worse = rough & ~(pe + L * re <= pe0 + L * re0)
+            with np.errstate(invalid="ignore"):
+                worse = rough & ~(pe + L * re <= pe0 + L * re0)
             q[worse], pe[worse], re[worse] = cand[worse], pe0[worse], re0[worse]
     else:
         lost = np.zeros_like(ok)
@@ -440,6 +449,20 @@ def _null_text(v: np.ndarray) -> str:
     terms = [(c, k) for k, c in enumerate(v) if abs(c) > 0.05]
     text = " ".join(f"{'-' if c < 0 else '+'} {abs(c):.2f} q{k + 1}" for c, k in terms).lstrip("+ ")
     return f"{text} free (J singular: its null direction)"
+
+
+def _bound(robot: DHRobot) -> float:
+    """An upper bound of |p| over every configuration within the limits (inf with an unbounded prismatic joint):
+    the base and tool offsets plus every |a|, |d| and prismatic travel."""
+    lim = robot.q_limits
+    pr = np.array([t is JointType.PRISMATIC for t in robot.joint_types], dtype=bool)
+    travel = float(np.sum(np.max(np.abs(lim[pr]), axis=-1))) if pr.any() else 0.0
+    return (float(np.linalg.norm(np.asarray(robot.base, float)[:3, 3])) + _reach(robot) + travel
+            + float(np.linalg.norm(np.asarray(robot.tool, float)[:3, 3])))
+
+
+def _stand_in(robot: DHRobot) -> np.ndarray:
+    return forward_kinematics(robot, np.zeros(robot.dof))
 
 
 def _reach(robot: DHRobot) -> float:

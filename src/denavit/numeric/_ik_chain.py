@@ -19,7 +19,7 @@ from ..chain import chain_of as _chain_of
 from ..model import DHRobot
 from ._transforms import inverse_transform
 
-__all__ = ["Chain", "chain_of", "chain_fk", "chain_columns", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
+__all__ = ["Chain", "damped_solve", "chain_of", "chain_fk", "chain_columns", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
            "wrap_angle", "axis_lines"]
 
 
@@ -137,3 +137,15 @@ def solve_trig(a, b, c, tol: float = 1e-9) -> np.ndarray:
 def angle_about_z(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """θ with Rz(θ) u ≈ v in the xy-plane (Paden–Kahan subproblem 2 about z), shape (...)."""
     return np.arctan2(v[..., 1], v[..., 0]) - np.arctan2(u[..., 1], u[..., 0])
+
+
+def damped_solve(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve(A, b)`` for a batch of damped normal matrices A = JᵀJ + λI (..., n, n), b (..., n, k).
+
+    The damping can vanish against JᵀJ (a target 1e6 m away makes JᵀJ ~1e12 and λ lost to rounding on an arm
+    whose J lacks rank): such an A is exactly singular in floating point and LAPACK raises; those systems get
+    the least-squares step of their pseudo-inverse instead (no bare LinAlgError from the IK functions)."""
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        return np.linalg.pinv(np.nan_to_num(A, nan=0.0, posinf=0.0, neginf=0.0)) @ b

@@ -18,6 +18,7 @@ from .._validate import as_joint_array, as_transform
 from ..chain import chain_of
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
+from ._ik_chain import damped_solve
 from ._ik_kernel import kernel_of, targets_soa
 from ._ik_seeds import rescue
 from ._ik_single import solve_single
@@ -234,7 +235,7 @@ def _search(robot, q0, Tf, w, limits, max_iter, restarts, tol, L, rng, clip0=Non
     eye = np.eye(n)
     while S.tgt.size:
         Jt = np.swapaxes(S.J, -1, -2)
-        dq = np.linalg.solve(Jt @ S.J + S.lam[:, None, None] * eye, np.einsum("bij,bj->bi", Jt, S.e)[..., None])[..., 0]
+        dq = damped_solve(Jt @ S.J + S.lam[:, None, None] * eye, np.einsum("bij,bj->bi", Jt, S.e)[..., None])[..., 0]
         q_new = _wrap(S.q + dq, rev)
         # clipped attempts: folded by whole turns first, so a limit beyond ±π (Panda joint 6) stays reachable
         q_new = np.where(S.clip[:, None], np.clip(_fold(q_new, lo, hi, rev), lo, hi), q_new)

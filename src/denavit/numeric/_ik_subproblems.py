@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._ik_chain import angle_about_z, joint_motion, solve_trig
+from ._ik_chain import angle_about_z, damped_solve, joint_motion, solve_trig
 
 __all__ = ["Position3", "rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "split_aligned",
            "AXES_ALIGNED_TOL", "ALIGNED_EXACT"]
@@ -271,7 +271,16 @@ class Position3:
         gap = np.abs(roots[:, :, None] - roots[:, None, :]) / (1 + np.abs(roots[:, :, None]))
         gap[:, np.arange(roots.shape[1]), np.arange(roots.shape[1])] = np.inf
         close = (gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :]
-        clustered = np.any(close.sum(axis=2) >= CLUSTER_SIZE - 1, axis=1)
+        size = close.sum(axis=2)  # (B, m): other roots next to each root
+        clustered = np.any(size >= CLUSTER_SIZE - 1, axis=1)
+        if clustered.any():  # the centroid of the largest cluster is one more candidate: the mean of the k roots a
+            # k-fold root split into is exact to rounding (their sum is a coefficient's); where the point lies on
+            # axis 2 exactly, the other order's resultant vanishes and this is the root of the continuum
+            big = np.argmax(size, axis=1)
+            member = np.take_along_axis(close, big[:, None, None], 1)[:, 0]
+            member[np.arange(len(big)), big] = True
+            centre = np.sum(np.where(member, np.nan_to_num(roots), 0), axis=1) / member.sum(axis=1)
+            roots = np.concatenate([roots, np.where(clustered, centre, np.nan)[:, None]], axis=1)
         clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
         if self.pv:
             ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
@@ -390,7 +399,7 @@ class Position3:
             JtJ = Jt @ J
             # damping relative to the row's own scale: a zero column (the point on axis 1, say) stays solvable
             damp = 1e-14 * np.maximum(np.trace(JtJ, axis1=-2, axis2=-1), self.L**2)[:, None, None] * np.eye(3)
-            dx = np.linalg.solve(JtJ + damp, Jt @ e[..., None])[..., 0]
+            dx = damped_solve(JtJ + damp, Jt @ e[..., None])[..., 0]
             x = np.where(np.isfinite(dx), x - dx, x)
             continue
         out = q.copy()
