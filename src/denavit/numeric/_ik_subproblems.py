@@ -256,10 +256,12 @@ class Position3:
         k = np.arange(_KMAX, -_KMAX - 1, -1)
         return (R @ np.exp(-1j * np.outer(self.nodes, k))) / N  # c_K … c_{-K}
 
-    def _q3_candidates(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Real roots of the resultant in the solved joint (B, m), and which poses have roots that cluster (B,):
-        two roots, real or not, closer than CLUSTER_RADIUS (in e^{iq} or in the scaled length), where a multiple
-        root of the resultant was split by rounding into roots ~ε^(1/k) apart (some of them complex)."""
+    def _q3_candidates(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Real roots of the resultant in the solved joint (B, m); which poses have roots that cluster (B,):
+        CLUSTER_SIZE roots, real or not, within CLUSTER_RADIUS (in e^{iq} or in the scaled length), where a
+        multiple root of the resultant was split by rounding into roots ~ε^(1/k) apart (some of them complex);
+        and the centroid of the largest cluster (B,) (NaN where none): the mean of the k roots a k-fold root split
+        into is exact to rounding (their sum is a coefficient's)."""
         p = self._poly(w)  # (B, 2K+1) or (B, P+1)
         if self.pv:
             top = p.shape[-1] - 1 - self.degree
@@ -273,20 +275,17 @@ class Position3:
         close = (gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :]
         size = close.sum(axis=2)  # (B, m): other roots next to each root
         clustered = np.any(size >= CLUSTER_SIZE - 1, axis=1)
-        if clustered.any():  # the centroid of the largest cluster is one more candidate: the mean of the k roots a
-            # k-fold root split into is exact to rounding (their sum is a coefficient's); where the point lies on
-            # axis 2 exactly, the other order's resultant vanishes and this is the root of the continuum
-            big = np.argmax(size, axis=1)
-            member = np.take_along_axis(close, big[:, None, None], 1)[:, 0]
-            member[np.arange(len(big)), big] = True
-            centre = np.sum(np.where(member, np.nan_to_num(roots), 0), axis=1) / member.sum(axis=1)
-            roots = np.concatenate([roots, np.where(clustered, centre, np.nan)[:, None]], axis=1)
+        big = np.argmax(size, axis=1)
+        member = np.take_along_axis(close, big[:, None, None], 1)[:, 0]
+        member[np.arange(len(big)), big] = True
+        centre = np.sum(np.where(member, np.nan_to_num(roots), 0), axis=1) / member.sum(axis=1)
         clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
         if self.pv:
             ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
-            return np.where(ok, self.mid + self.half * roots.real, np.nan), clustered
+            centre = np.where(clustered, self.mid + self.half * centre.real, np.nan)
+            return np.where(ok, self.mid + self.half * roots.real, np.nan), clustered, centre
         ok = np.abs(np.abs(roots) - 1.0) < 1e-3
-        return np.where(ok, np.angle(roots), np.nan), clustered
+        return np.where(ok, np.angle(roots), np.nan), clustered, np.where(clustered, np.angle(centre), np.nan)
 
     def solve(self, W: np.ndarray):
         """All (q1, q2, q3) placing the point at W (B, 3).
@@ -300,9 +299,16 @@ class Position3:
         if self.free3:
             q3 = np.zeros((len(W), 1))
         elif self.degree > 0:
-            q3, clustered = self._q3_candidates(w)
+            q3, clustered, centre = self._q3_candidates(w)
         else:
             q3 = np.full((len(W), 1), np.nan)
+        q, free = self._from_q3(q3, w, W)
+        if clustered.any():
+            q, free = self._clustered(q, free, W, w, clustered, centre)
+        return q, free
+
+    def _from_q3(self, q3: np.ndarray, w: np.ndarray, W: np.ndarray):
+        """Candidates (B, M, 3) and free flags from the roots q3 (B, m) of the solved joint."""
         q2, free2 = self._q2_candidates(q3, w)  # (B, M, 2)
         q3 = np.broadcast_to(q3[..., None], q2.shape)
         if self.swap:  # solved q2, eliminated q3 (a q3 without effect is no continuum here: the point on axis 3)
@@ -322,37 +328,50 @@ class Position3:
         q[bad] = np.nan
         free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
         q = self._refine(q, W, free)
-        free = np.where(bad, 0, self._free_after(q, W, free))
-        if self.alt is not None and clustered.any():
-            # a multiple root of this order's resultant (the point crossing axis 2, say): its roots came out
-            # ~ε^(1/k) apart or complex and the generating branch could be lost; the other order's resultant has
-            # simple roots there (q2 and q3 swap roles); the copies are merged by FK later
-            qa, fa = self.alt.solve(W[clustered])
-            # a root both orders found is kept once, the copy that reproduces the point better (the copies would
-            # only cost downstream: every pose of the batch gets as many slots as the pose with most candidates)
-            rev = ~np.array([self.pr1, self.pr2, self.pr3])
-            qc = q[clustered]
-            d = qa[:, :, None] - qc[:, None]  # (b, Ma, M, 3)
-            d = np.nan_to_num(np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), np.abs(d)).max(-1),
-                              nan=np.inf)
-            near = np.argmin(d, axis=-1)  # (b, Ma)
-            same = np.take_along_axis(d, near[..., None], -1)[..., 0] < SAME_ROOT * max(self.L, 1.0)
-            Wc = W[clustered][:, None]
-            ra = np.linalg.norm(self.point(np.nan_to_num(qa)) - Wc, axis=-1)
-            rm = np.take_along_axis(np.linalg.norm(self.point(np.nan_to_num(qc)) - Wc, axis=-1), near, -1)
-            bi, ai = np.nonzero(same & (ra < rm))
-            qc[bi, near[bi, ai]] = qa[bi, ai]
-            q[clustered] = qc
-            qa = np.where(same[..., None], np.nan, qa)
-            extra = np.full((len(W),) + qa.shape[1:], np.nan)
-            extra[clustered] = qa
-            fe = np.zeros(extra.shape[:2], dtype=free.dtype)
-            fe[clustered] = fa
-            q, free = np.concatenate([q, extra], 1), np.concatenate([free, fe], 1)
-            # the slots some pose uses, found ones first (the other poses' empty slots would cost downstream)
-            found = np.all(np.isfinite(q), -1)
-            order = np.argsort(~found, axis=1, kind="stable")[:, : max(int(found.sum(1).max()), 1)]
-            q, free = np.take_along_axis(q, order[..., None], 1), np.take_along_axis(free, order, 1)
+        return q, np.where(bad, 0, self._free_after(q, W, free))
+
+    def _clustered(self, q, free, W, w, clustered, centre):
+        """More candidates for the poses whose resultant roots cluster: a multiple root of this order's resultant
+        (the point crossing axis 2, say) came out as roots ~ε^(1/k) apart or complex, and the generating branch
+        could be lost.  The other order's resultant (q2 and q3 swap roles) has simple roots there; where it has
+        none (it vanishes: the point exactly on axis 2, q2 free) the centroid of the cluster is the root."""
+        sub = np.flatnonzero(clustered)
+        if self.alt is not None:
+            qa, fa = self.alt.solve(W[sub])
+        else:
+            qa, fa = np.full((len(sub), 0, 3), np.nan), np.zeros((len(sub), 0), dtype=free.dtype)
+        none = ~np.all(np.isfinite(qa), -1).any(-1)
+        if none.any():
+            qn, fn = self._from_q3(centre[sub[none], None], w[sub[none]], W[sub[none]])
+            width = max(qa.shape[1], qn.shape[1])
+            pad = lambda a, v: np.concatenate([a, np.full((len(a), width - a.shape[1]) + a.shape[2:], v)], 1)  # noqa
+            qa, fa = pad(qa, np.nan), pad(fa, 0)
+            qa[none], fa[none] = pad(qn, np.nan), pad(fn, 0)
+        # a root both orders found is kept once, the copy that reproduces the point better (the copies would
+        # only cost downstream: every pose of the batch gets as many slots as the pose with most candidates)
+        rev = ~np.array([self.pr1, self.pr2, self.pr3])
+        qc = q[sub]
+        d = qa[:, :, None] - qc[:, None]  # (b, Ma, M, 3)
+        d = np.nan_to_num(np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), np.abs(d)).max(-1),
+                          nan=np.inf)
+        near = np.argmin(d, axis=-1)  # (b, Ma)
+        same = np.take_along_axis(d, near[..., None], -1)[..., 0] < SAME_ROOT * max(self.L, 1.0)
+        Wc = W[sub][:, None]
+        ra = np.linalg.norm(self.point(np.nan_to_num(qa)) - Wc, axis=-1)
+        rm = np.take_along_axis(np.linalg.norm(self.point(np.nan_to_num(qc)) - Wc, axis=-1), near, -1)
+        bi, ai = np.nonzero(same & (ra < rm))
+        qc[bi, near[bi, ai]] = qa[bi, ai]
+        q[sub] = qc
+        qa = np.where(same[..., None], np.nan, qa)
+        extra = np.full((len(W),) + qa.shape[1:], np.nan)
+        extra[sub] = qa
+        fe = np.zeros(extra.shape[:2], dtype=free.dtype)
+        fe[sub] = fa
+        q, free = np.concatenate([q, extra], 1), np.concatenate([free, fe], 1)
+        # the slots some pose uses, found ones first (the other poses' empty slots would cost downstream)
+        found = np.all(np.isfinite(q), -1)
+        order = np.argsort(~found, axis=1, kind="stable")[:, : max(int(found.sum(1).max()), 1)]
+        q, free = np.take_along_axis(q, order[..., None], 1), np.take_along_axis(free, order, 1)
         return q, free
 
     def _free_after(self, q: np.ndarray, W: np.ndarray, free: np.ndarray) -> np.ndarray:
