@@ -116,9 +116,8 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
             f'    """{spec.doc}: one configuration, out {spec.shape}."""', f"    _{k}({args}, out)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",
             f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {spec.shape}."""',
-            f"    n = {first}.shape[0]", f"    simd = n - n % {LANES}",
-            f"    for b in range(0, simd, {LANES}):", f"        _{k}_rows({args}, out, b)",
-            f"    for b in range(simd, n):", f"        _{k}_row({args}, out, b)", "", ""])
+            # LANES rows per call (the last call masks the lanes past the end)
+            f"    for b in range(0, {first}.shape[0], {LANES}):", f"        _{k}_rows({args}, out, b)", "", ""])
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:

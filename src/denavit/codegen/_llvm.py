@@ -15,7 +15,8 @@ Batches also get a third, SIMD form: the same program on ``<LANES x double>`` ve
 AVX2 register).  libm has no vector sine, so there sin and cos come from :func:`_vector_sincos` — Cody–Waite
 reduction by π/2 in three parts (exact for |x| < 2**19·π/2) and Taylor polynomials on [−π/4, π/4] truncated
 below 1e-19 — within an ulp or two of libm; lanes with |x| beyond the reduction's range (or ±inf) take libm's
-``sincos``, one lane at a time.  The rows left over (B mod LANES) use the scalar form.
+``sincos``, one lane at a time.  At the end of a batch the lanes past the last row are masked (they store
+nothing), so a batch kernel holds only the vector form.
 
 Program format (what the generated module embeds as literals): ``steps`` is a tuple of ``(op, a, b)`` in
 evaluation order, each operand either ``("n", j)`` (the value of step j), ``("c", x)`` (a double constant) or
@@ -50,7 +51,8 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
     ``f_row(in_0, …, out, b)``: the inputs are (B, k) arrays and ``out`` (B,) + shape; row ``b`` is computed — no
     array views per row, so a batch loop does no reference counting.  sin and cos of one argument are one
     ``sincos`` call (glibc, libm).
-    ``f_rows(in_0, …, out, b)``: rows ``b … b + LANES − 1`` at once, in SIMD (the caller keeps b + LANES ≤ B)."""
+    ``f_rows(in_0, …, out, b)``: rows ``b … b + LANES − 1`` at once, in SIMD; lanes past the last row (B mod
+    LANES at the end of a batch) compute a copy of the last row and store nothing."""
     from llvmlite import ir
     from numba.core import cgutils, types
     from numba.extending import intrinsic
@@ -62,7 +64,13 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
         batched = isinstance(sig.args[-1], types.Integer)
         arrays = [context.make_array(ty)(context, builder, val)
                   for ty, val in zip(sig.args[:n_inputs + 1], args[:n_inputs + 1])]
-        rows = [args[-1]] if not lanes else [builder.add(args[-1], ir.Constant(i64, j)) for j in range(lanes)]
+        rows = [args[-1]]
+        if lanes:  # rows b … b + lanes − 1; past the batch's end a lane reads the last row and stores nothing
+            n_rows = cgutils.unpack_tuple(builder, arrays[0].shape)[0]
+            last = builder.sub(n_rows, ir.Constant(i64, 1))
+            inside = [builder.icmp_signed("<", builder.add(args[-1], ir.Constant(i64, j)), n_rows)
+                      for j in range(lanes)]
+            rows = [builder.select(inside[j], builder.add(args[-1], ir.Constant(i64, j)), last) for j in range(lanes)]
         module = builder.module
         vty = ir.VectorType(dbl, lanes) if lanes else dbl
         sincos = cgutils.get_or_insert_function(
@@ -72,12 +80,42 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
         inputs: dict = {}
         values: list = []
 
+        constants: dict = {}
+
         def const(x: float):
-            return ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
+            c = constants.get(x)
+            if c is None:
+                c = constants[x] = ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
+            return c
+
+        # each array's data pointer (as bytes) and strides, read once here (before any conditional block):
+        # an element's address is data + Σ index·stride; numba's get_item_pointer would re-read them per element
+        i8p = ir.IntType(8).as_pointer()
+        layout = [(builder.bitcast(arr.data, i8p), cgutils.unpack_tuple(builder, arr.strides)) for arr in arrays]
+
+        def inner(arg, index):
+            """Σ index_k·stride_k over an element's own dimensions (not the batch row), or None for 0."""
+            offset = None
+            for i, stride in zip(index, layout[arg][1][1:] if batched else layout[arg][1]):
+                if i:
+                    term = builder.mul(ir.Constant(i64, i), stride)
+                    offset = term if offset is None else builder.add(offset, term)
+            return offset
+
+        def base(arg, row):
+            data, strides = layout[arg]
+            return builder.gep(data, [builder.mul(row, strides[0])]) if batched else data
+
+        def at(base_ptr, offset):
+            return builder.bitcast(base_ptr if offset is None else builder.gep(base_ptr, [offset]), dbl.as_pointer())
+
+        bases: dict = {}  # (input, row) -> the row's address: inputs are read in the main flow only
 
         def item(arg, index, row):
-            ty, arr = sig.args[arg], arrays[arg]
-            return cgutils.get_item_pointer(context, builder, ty, arr, ([row] if batched else []) + index)
+            b = bases.get((arg, id(row)))
+            if b is None:
+                b = bases[(arg, id(row))] = base(arg, row)
+            return at(b, inner(arg, index))
 
         def operand(ref):
             kind = ref[0]
@@ -88,7 +126,7 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             key = (ref[1], ref[2])
             v = inputs.get(key)
             if v is None:
-                k = [ir.Constant(i64, ref[2])]
+                k = [ref[2]]
                 if lanes:
                     v = ir.Constant(vty, ir.Undefined)
                     for j, row in enumerate(rows):
@@ -132,14 +170,17 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             else:  # pragma: no cover - the tape has no other operations
                 raise ValueError(f"unknown operation {op!r}")
             values.append(v)
-        for index, ref in outputs:
-            k = [ir.Constant(i64, i) for i in index]
-            v = operand(ref)
-            if lanes:
-                for j, row in enumerate(rows):
-                    builder.store(builder.extract_element(v, ir.Constant(i64, j)), item(n_inputs, k, row))
-            else:
-                builder.store(v, item(n_inputs, k, rows[0] if batched else None))
+        if not lanes:
+            row_base = base(n_inputs, rows[0])
+            for index, ref in outputs:
+                builder.store(operand(ref), at(row_base, inner(n_inputs, index)))
+            return context.get_dummy_value()
+        results = [(inner(n_inputs, index), operand(ref)) for index, ref in outputs]
+        for j, row in enumerate(rows):
+            with cgutils.if_likely(builder, inside[j]):
+                row_base = base(n_inputs, row)
+                for offset, v in results:
+                    builder.store(builder.extract_element(v, ir.Constant(i64, j)), at(row_base, offset))
         return context.get_dummy_value()
 
     def typer(lanes):
