@@ -216,8 +216,12 @@ BAD_FILES = {
     "not utf-8": (b"claims:\n- quantity: \xff\xfe\n  value: 1\n", ["utf-8"]),
     "too many claims": (yaml.safe_dump({"claims": [{"quantity": "position", "value": [1, 2, 3]}] * (MAX_CLAIMS + 1)}),
                         [str(MAX_CLAIMS + 1)]),
-    "too many costly claims": (yaml.safe_dump({"claims": [{"quantity": "singularities", "value": "none"}] * 21}),
-                               ["21"]),
+    # the 20-claim cap on costly kinds is gone (issue 13: 500 claims of any kind); its bounds are these two
+    "too many sign choices": (yaml.safe_dump({"claims": [{"quantity": "ik_formula", "value": "q_1 = atan2(y, x)"
+                                                          + " \\pm 0" * 6}] * 17}), ["1088", "sign choices"]),
+    "too many singular row sets": (yaml.safe_dump({"claims": [{"quantity": "singularities", "rows": r, "value": "none"}
+                                                              for r in ("vx,vy", "vx,wz", "vy,wz", "vx,vz")]}),
+                                   ["4 different rows/frame"]),
 }
 
 

@@ -21,18 +21,31 @@ from ._quantities import QUANTITIES
 from ._resolve import robot_resolver
 
 __all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_text", "parse_math", "parse_matrix",
-           "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_COSTLY_CLAIMS", "MAX_DETAILED",
+           "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_SIGN_CHOICES", "MAX_SINGULAR_SETS", "MAX_DETAILED",
            "MAX_FILE_BYTES"]
 
 #: Most claims in one file (a whole course report is a few hundred; 500 are judged in well under a minute).
 MAX_CLAIMS = 500
-#: Most claims of the kinds that search or solve (singularities, ik_formula, ik_solutions) in one file.
-MAX_COSTLY_CLAIMS = 20
+#: Most ± sign choices in one file, over its ik_formula and singularities claims (a claim without ± is one choice;
+#: each claim has at most 64).  Each choice is one evaluation of the claim (~7 ms on a 6-joint arm).
+MAX_SIGN_CHOICES = 1024
+#: Most different (rows, frame) of the singularities claims of one file: each is one symbolic singularity analysis
+#: (up to check._singular.MAX_ANALYSIS_CPU_SECONDS of CPU each).
+MAX_SINGULAR_SETS = 3
 #: Incorrect claims that get the full explanation (tested hints, the correct formula); later ones get the verdict,
 #: the differing entries and a counterexample only, so the work per file stays bounded.
 MAX_DETAILED = 8
 MAX_FILE_BYTES = 1_000_000
-_COSTLY = ("singularities", "singular_configurations", "singular", "ik_formula", "ik_solutions")
+_SINGULAR = ("singularities", "singular_configurations", "singular")
+_COSTLY = _SINGULAR + ("ik_formula", "ik_solutions")
+_SIGNS = ("\\pm", "\\mp", "±", "∓")
+
+
+def _sign_choices(claim: dict[str, Any]) -> int:
+    """The ± choices of one claim as written (2 per sign, at most 64: a claim with more is refused by itself)."""
+    text = str(claim.get("value", ""))[:100_000] + str(claim.get("where", ""))[:100_000]
+    n = sum(text.count(s) for s in _SIGNS)
+    return 2 ** n if n <= 6 else 1
 
 
 @dataclass(frozen=True)
@@ -61,10 +74,15 @@ def check_claims(robot: DHRobot, claims: list[Any], *, seed: int = 0, deg: bool 
         raise ParseError("'claims' must be a list of claims", where=source)
     if len(claims) > MAX_CLAIMS:
         raise ParseError(f"too many claims ({len(claims)}; at most {MAX_CLAIMS}: split the file)", where=source)
-    costly = sum(isinstance(c, dict) and str(c.get("quantity")) in _COSTLY for c in claims)
-    if costly > MAX_COSTLY_CLAIMS:
-        raise ParseError(f"too many singularities/IK claims ({costly}; at most {MAX_COSTLY_CLAIMS}: split the file)",
-                         where=source)
+    choices = sum(_sign_choices(c) for c in claims if isinstance(c, dict) and str(c.get("quantity")) in _COSTLY)
+    if choices > MAX_SIGN_CHOICES:
+        raise ParseError(f"the ik_formula/singularities claims have {choices} ± sign choices together (at most "
+                         f"{MAX_SIGN_CHOICES} in one file: split the file)", where=source)
+    sets = {(str(c.get("rows", "all")), str(c.get("frame", "base"))) for c in claims
+            if isinstance(c, dict) and str(c.get("quantity")) in _SINGULAR}
+    if len(sets) > MAX_SINGULAR_SETS:
+        raise ParseError(f"the singularities claims use {len(sets)} different rows/frame (at most {MAX_SINGULAR_SETS} "
+                         "in one file, each is one symbolic analysis: split the file)", where=source)
     rng = np.random.default_rng(seed)
     verdicts, detailed, notes = [], 0, []
     for k, c in enumerate(claims, start=1):

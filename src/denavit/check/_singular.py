@@ -19,6 +19,7 @@ searches one unit of the last written decimal around the point.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -36,7 +37,8 @@ from ._resolve import robot_resolver
 from ._text import expand_pm, split_relation, split_top
 from ._vectorized import vec_eval
 
-__all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_KPI_DIVISOR", "MAX_VALUES", "MAX_CONDITIONS"]
+__all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_KPI_DIVISOR", "MAX_VALUES", "MAX_CONDITIONS",
+           "MAX_ANALYSIS_CPU_SECONDS"]
 
 SINGULAR_RTOL = 1e-7
 #: Largest n in ``q_j = k\pi/n`` (each of its 2n values is tested).
@@ -46,6 +48,12 @@ MAX_VALUES = 64
 #: Most conditions (values of a joint, or equations) in one claim.
 MAX_CONDITIONS = 16
 TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
+#: CPU seconds the library's symbolic singularity analysis may take for one set of rows of one arm (it runs in a
+#: child process with this CPU limit; the Panda's 6 rows take ~4 s, but some row subsets of 6- and 7-joint arms do
+#: not finish in minutes).  Past it, a claim is judged on its own conditions only (never "correct").
+MAX_ANALYSIS_CPU_SECONDS = 10
+#: Arms with at most this many joints are analysed in the process itself (always fast).
+_SMALL_DOF = 3
 _NONE = {"none", "never", "nowhere", "no singularities", "\\emptyset", "∅", "{}"}
 _ALL = {"all", "always", "everywhere", "every configuration", "all q", "any q"}
 _SEPS = (";", "\n", " or ", "\\lor", "\\vee", "\\text{or}", "\\text{ or }", "\\quad", "\\qquad")
@@ -346,17 +354,68 @@ def _member(q: np.ndarray, conds: list[Cond], arm: _Arm) -> bool:
     return False
 
 
-@lru_cache(maxsize=8)
-def _analysis(robot: DHRobot, rows: str | None, frame: Frame):
-    """The library's singularity analysis, once per robot, rows and frame (claims of one file share it)."""
+def _analyse(robot: DHRobot, rows: str | None, frame: Frame):
     from .. import symbolic as S
 
     return S.singularity_analysis(robot, rows=rows, frame=frame)
 
 
-def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str]]:
+@lru_cache(maxsize=8)
+def _analysis(robot: DHRobot, rows: str | None, frame: Frame):
+    """The library's singularity analysis, once per robot, rows and frame (claims of one file share it); None when
+    it needs more than MAX_ANALYSIS_CPU_SECONDS of CPU."""
+    if robot.dof <= _SMALL_DOF:
+        return _analyse(robot, rows, frame)
+    return _cpu_bounded(_analyse, (robot, rows, frame), MAX_ANALYSIS_CPU_SECONDS)
+
+
+def _cpu_bounded(fn, args: tuple, seconds: float):
+    """``fn(*args)`` in a forked child whose CPU time is limited (RLIMIT_CPU, so the bound does not depend on the
+    machine's load); None when it runs out.  Without fork (Windows) it runs here, unbounded."""
+    import multiprocessing as mp
+
+    try:
+        ctx = mp.get_context("fork")
+    except ValueError:
+        return fn(*args)
+    recv, send = ctx.Pipe(duplex=False)
+    child = ctx.Process(target=_child, args=(send, fn, args, seconds), daemon=True)
+    child.start()
+    send.close()
+    ok, value = False, None
+    try:
+        if recv.poll(seconds * 40 + 60):  # a wall-clock safety net only: the CPU limit ends the child first
+            ok, value = recv.recv()
+    except (EOFError, OSError):  # the child was stopped by its CPU limit
+        pass
+    finally:
+        if child.is_alive():
+            child.kill()
+        child.join()
+        recv.close()
+    if not ok and isinstance(value, Exception):
+        raise value
+    return value if ok else None
+
+
+def _child(conn, fn, args: tuple, seconds: float) -> None:  # pragma: no cover - runs in the child process
+    import os
+    import resource
+
+    try:
+        limit = max(1, int(math.ceil(seconds)))
+        resource.setrlimit(resource.RLIMIT_CPU, (limit, limit + 1))
+        try:
+            conn.send((True, fn(*args)))
+        except Exception as exc:  # noqa: BLE001 - handed to the parent, which raises it
+            conn.send((False, exc))
+    finally:
+        os._exit(0)
+
+
+def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str] | None]:
     """Points of the library's singular set, each confirmed by the rank test: (description, q) pairs;
-    whether J is singular everywhere; the library's conditions as text."""
+    whether J is singular everywhere; the library's conditions as text (None: the analysis ran out of time)."""
     import sympy as sp
 
     from .. import symbolic as S
@@ -364,6 +423,10 @@ def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarra
     robot = arm.robot
     rows = None if arm.rows == list(range(6)) else ",".join(TWIST_ROWS[i] for i in arm.rows)
     a = _analysis(robot, rows, arm.frame)
+    if a is None:
+        if np.all(arm.ratio(arm.random_q(8)) < SINGULAR_RTOL):
+            return [], True, ["every configuration (J never has full rank at random q)"]
+        return [], False, None
     if a.everywhere or np.all(arm.ratio(arm.random_q(8)) < SINGULAR_RTOL):
         return [], True, [f"every configuration ({a.reason or 'J never has full rank'})"]
     qs = S.joint_symbols(robot.dof).q
@@ -448,6 +511,19 @@ def check_singularities(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.r
                 missing.append((d, q))
     method = (f"rank of J ({','.join(TWIST_ROWS[i] for i in arm.rows)} rows, {arm.frame.value} axes) at points on "
               "each claimed set and on the library's singular set (singularity_analysis)")
+    if described is None:  # the library's set is unknown: only the claimed conditions are judged
+        method = method.split(" and on ")[0]
+        why = (f"the library's singular set of this Jacobian ({len(arm.rows)} rows, {robot.dof} joints) was not "
+               f"computed within {MAX_ANALYSIS_CPU_SECONDS} s of CPU, so whether a singular configuration is missing "
+               "was not checked")
+        if bad:
+            return Verdict(cid, "singularities", "incorrect", "incorrect: " + "; ".join(bad[:8]) + f" ({why})",
+                           tuple(entries), {"q": entries[0]["q"]} if "q" in entries[0] else None, tuple(hints[:3]),
+                           None, method, {"missing": [], "library": None})
+        said = ("J has full rank at random configurations" if special == "none" else
+                f"each of the {len(conds)} claimed condition(s) makes J lose rank")
+        return Verdict(cid, "singularities", "ambiguous", f"ambiguous: {said}, but {why}", method=method,
+                       extra={"missing": [], "library": None})
     extra = {"missing": [d for d, _ in missing], "library": described}
     if not bad and not missing:
         return Verdict(cid, "singularities", "correct",
