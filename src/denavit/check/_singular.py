@@ -404,7 +404,9 @@ def _child(conn, fn, args: tuple, seconds: float) -> None:  # pragma: no cover -
 
     try:
         limit = max(1, int(math.ceil(seconds)))
-        resource.setrlimit(resource.RLIMIT_CPU, (limit, limit + 1))
+        _, hard = resource.getrlimit(resource.RLIMIT_CPU)
+        hard = limit + 1 if hard == resource.RLIM_INFINITY else min(hard, limit + 1)
+        resource.setrlimit(resource.RLIMIT_CPU, (min(limit, hard), hard))
         try:
             conn.send((True, fn(*args)))
         except Exception as exc:  # noqa: BLE001 - handed to the parent, which raises it
