@@ -73,7 +73,8 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def _is_formula(step: Any) -> bool:
-    return isinstance(step, Equation) and not isinstance(step.expr, str) and bool(getattr(step.expr, "free_symbols", ()))
+    """An equation in symbols (q, q̇, parameters …), or one given as LaTeX text (the IK derivation's)."""
+    return isinstance(step, Equation) and (isinstance(step.expr, str) or bool(getattr(step.expr, "free_symbols", ())))
 
 
 def _drop_repeated_formulas(tail: Sequence[Any], first_tail: Sequence[Any]) -> list:
@@ -81,8 +82,8 @@ def _drop_repeated_formulas(tail: Sequence[Any], first_tail: Sequence[Any]) -> l
     the sentence introducing them; one line says so.  Numbers and checks stay."""
     same = [k < len(first_tail) and _same(st, first_tail[k]) for k, st in enumerate(tail)]
     drop = [same[k] and _is_formula(st) for k, st in enumerate(tail)]
-    for k, st in enumerate(tail):  # a shared sentence that only introduces dropped formulas goes too
-        if same[k] and isinstance(st, Text) and k + 1 < len(tail) and drop[k + 1]:
+    for k in range(len(tail) - 2, -1, -1):  # shared sentences that only introduce dropped formulas go too
+        if same[k] and isinstance(tail[k], Text) and drop[k + 1]:
             drop[k] = True
     out: list = []
     for k, st in enumerate(tail):
