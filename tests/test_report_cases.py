@@ -138,3 +138,22 @@ def test_derive_refuses_bad_case_lists():
         derive(robot, cases=[])
     with pytest.raises(ParseError, match="case 2"):
         derive(robot, cases=[{"q": [0, 0]}, "0, 0"])
+
+
+def test_the_ik_derivation_is_written_once_and_evaluated_per_case():
+    robot = dn.load_robot("planar2r")
+    d = derive(robot, cases=[{"q": ["pi/6", "pi/3"]}, {"q": ["-pi/4", "pi/2"]}], topics=["ik"])
+    steps = d.section("ik").steps
+    heads = [k for k, s in enumerate(steps) if isinstance(s, Heading)]
+    assert len(heads) == 2
+    one, two = steps[heads[0]:heads[1]], steps[heads[1]:]
+    eq = [s for s in one if type(s).__name__ == "Equation"]
+    assert eq and not [s for s in two if type(s).__name__ == "Equation"]  # the derivation: once
+    tables = [[s for s in part if type(s).__name__ == "Table"] for part in (one, two)]
+    assert all(tables) and tables[0] != tables[1]  # evaluated at each case's own target
+    for q, part in zip(([np.pi / 6, np.pi / 3], [-np.pi / 4, np.pi / 2]), (one, two)):
+        (T,) = [s.values for s in part if type(s).__name__ == "Numbers" and s.lhs == "T_{\\text{target}}"]
+        c1, c12 = np.cos(q[0]), np.cos(q[0] + q[1])
+        s1, s12 = np.sin(q[0]), np.sin(q[0] + q[1])
+        L1, L2 = dict(robot.parameters)["L1"], dict(robot.parameters)["L2"]
+        np.testing.assert_allclose(T[:2, 3], [L1 * c1 + L2 * c12, L1 * s1 + L2 * s12], atol=1e-12)
