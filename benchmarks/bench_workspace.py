@@ -2,8 +2,9 @@
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
               [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--markdown FILE]
-Each row is one run in this process: wall time, samples/s, peak resident memory of the process so far
-(ru_maxrss, grows only), and the reported volume with its interval.  ``--cluster`` also runs the largest
+Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows only)
+of this process and of the largest finished worker process, the 1-minute load average at the end of the run,
+the refinement (cells refined × sub-cells per side) and the reported volume with its interval.  ``--cluster`` also runs the largest
 sample count on a local process pool and on two local dask.distributed clusters (2 worker processes; Dask's
 defaults, and scale.LOCAL_CLUSTER_CONFIG), ``--repeat`` times each, and checks the counts are identical.
 """
@@ -26,16 +27,19 @@ def peak_mb() -> float:
 
 
 def run_samples(robot, counts, scheduler, workers) -> list[str]:
-    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] | cell edge [m] | coverage | volume [m³] "
-            "| interval [m³] |",
-            "|---:|---:|---:|---:|---:|---:|---:|---|"]
+    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] driver / largest worker | load | refined cells × k "
+            "| cell edge [m] | coverage | volume [m³] | interval [m³] | width [m³] |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
     for n in counts:
         t0 = time.perf_counter()
         ws = occupancy(robot, n, seed=1, scheduler=scheduler, workers=workers, progress=None)
         dt = time.perf_counter() - t0
-        e = ws.estimate
-        rows.append(f"| {n:.0e} | {dt:.1f} | {n / dt:.3g} | {peak_mb():.0f} | {e.resolution:.3g} | "
-                    f"{e.coverage:.4f} | {e.value:.4g} | [{e.low:.4g}, {e.high:.4g}] |")
+        e, r = ws.estimate, ws.refinement
+        kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+        ref = "–" if r is None else f"{r.cells.size} × {r.factor}"
+        rows.append(f"| {n:.0e} | {dt:.1f} | {n / dt:.3g} | {peak_mb():.0f} / {kids:.0f} | {os.getloadavg()[0]:.1f} | "
+                    f"{ref} | {e.resolution:.3g} | {e.coverage:.4f} | {e.value:.4g} | [{e.low:.4g}, {e.high:.4g}] | "
+                    f"{e.high - e.low:.3g} |")
         print(rows[-1], flush=True)
     return rows
 

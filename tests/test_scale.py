@@ -68,6 +68,88 @@ def test_more_samples_narrow_the_interval():
     assert w[1] < 0.7 * w[0]
 
 
+# ---- boundary refinement: sub-cells of the boundary cells only ----------------------------------------------
+
+@settings(max_examples=3, deadline=None, derandomize=True)
+@given(st.floats(0.3, 1.5), st.floats(0.1, 1.5), st.integers(0, 2**40))
+def test_refined_annulus_area_in_the_interval_and_narrower_with_4x_samples(L1, L2, seed):
+    robot, exact = planar_2r(L1, L2), np.pi * ((L1 + L2) ** 2 - (L1 - L2) ** 2)
+    h = (L1 + L2) / 8  # a coarse grid: 16 cells across the reach box
+    runs = [occupancy(robot, n, h, seed=seed, scheduler="synchronous", refine=8) for n in (2 * BLOCK, 8 * BLOCK)]
+    plain = occupancy(robot, 8 * BLOCK, h, seed=seed, scheduler="synchronous", refine=0)
+    for ws in runs:
+        e = ws.estimate
+        assert ws.refinement.factor == 8 and e.low <= exact <= e.high and e.resolution < h, (e, exact)
+    w = [ws.estimate.high - ws.estimate.low for ws in runs]
+    assert w[1] < w[0] < 0.5 * (plain.estimate.high - plain.estimate.low)  # narrower with 4× samples, and
+    assert np.array_equal(runs[1].counts, plain.counts)  # far narrower than the same counts without sub-cells
+
+
+@pytest.mark.slow
+def test_refined_shell_volume_in_the_interval_and_narrower_with_4x_samples():
+    r0, r1 = 0.3, 0.8
+    exact = 4 / 3 * np.pi * (r1**3 - r0**3)
+    w = []
+    for n in (4 * BLOCK, 16 * BLOCK):
+        e = occupancy(spherical_rrp(r0, r1), n, r1 / 5, seed=5, scheduler="synchronous", refine=4).estimate
+        assert e.low <= exact <= e.high and e.resolution < r1 / 5, (n, e, exact)
+        w.append(e.high - e.low)
+    assert w[1] < 0.8 * w[0]
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([2, 3]), st.sampled_from([2, 4]))
+def test_refined_levels_are_the_dense_computation(seed, d, k):
+    """Sub-cell interior, occupied cells and bounds against the same sets built on a dense grid k× finer."""
+    from denavit.scale._refine import refined_levels, refinement
+    from denavit.scale._volume import chao1
+
+    rng = np.random.default_rng(seed)
+    side = 5
+    counts = ((rng.random((side,) * d) < 0.75) * rng.integers(1, 4, (side,) * d)).astype(np.uint64)
+    cells = np.flatnonzero(rng.random(side**d) < 0.6)
+    fine = ((rng.random((cells.size, k**d)) < 0.8) * rng.integers(1, 4, (cells.size, k**d))).astype(np.uint64)
+    fine[counts.reshape(-1)[cells] == 0] = 0  # a sample in a sub-cell is in its cell too
+    e = refined_levels(counts, 1.0, refinement(cells, k, 1), fine)[0]
+    occ = counts > 0
+    inner = interior(occ)
+    dense = np.zeros((side * k,) * d, dtype=bool)
+    slot = {c: i for i, c in enumerate(cells)}
+    for c in range(side**d):
+        at = np.unravel_index(c, occ.shape)
+        block = tuple(slice(i * k, (i + 1) * k) for i in at)
+        if inner[at]:
+            dense[block] = True
+        elif c in slot:
+            dense[block] = fine[slot[c]].reshape((k,) * d) > 0
+    dense_in = interior(dense)
+    boundary = [c for c in cells if occ.reshape(-1)[c] and not inner.reshape(-1)[c]]
+    sub_in = sum(int(dense_in[tuple(slice(i * k, (i + 1) * k) for i in np.unravel_index(c, occ.shape))].sum())
+                 for c in boundary)
+    sub_occ = sum(int((fine[slot[c]] > 0).sum()) for c in boundary)
+    unrefined = int(occ.sum() - inner.sum()) - len(boundary)
+    K = k**d
+    assert e.interior == int(inner.sum()) * K + sub_in
+    assert e.occupied == (int(inner.sum()) + unrefined) * K + sub_occ
+    assert e.low == pytest.approx(e.interior / K)
+    sub = np.concatenate([fine[slot[c]] for c in boundary]) if boundary else np.zeros(0)
+    m, sd = chao1(int((sub == 1).sum()), int((sub == 2).sum()))
+    mh, sdh = chao1(int((counts == 1).sum()), int((counts == 2).sum()))
+    assert e.high == pytest.approx((e.occupied + m + 2 * sd) / K + mh + 2 * sdh)
+    assert e.resolution == pytest.approx(1 / k)
+
+
+def test_refinement_is_identical_for_workers_and_chunks_and_saved(tmp_path):
+    robot = denavit.load_robot("stanford")
+    n = 5 * BLOCK + 999
+    ref = occupancy(robot, n, 0.1, seed=42, scheduler="synchronous", chunk=BLOCK, refine=4)
+    assert ref.refinement is not None and ref.refinement.pilot_blocks == 1 and ref.fine.sum() > 0
+    assert ref.fine.sum() <= ref.counts.sum() - BLOCK  # only the samples after the pilot
+    _same(ref, occupancy(robot, n, 0.1, seed=42, scheduler="threads", workers=2, chunk=2 * BLOCK, refine=4))
+    ref.save(tmp_path / "r.npz")
+    _same(ref, load_occupancy(tmp_path / "r.npz"))
+
+
 def test_given_resolution_is_the_only_level():
     ws = occupancy(spherical_rrp(0.3, 0.8), 100_000, resolution=0.1, seed=1, scheduler="synchronous")
     assert ws.estimate.resolution == pytest.approx(0.1) and len(ws.levels) == 1
@@ -170,6 +252,10 @@ def _same(a, b):
     assert np.array_equal(a.counts, b.counts)
     assert np.array_equal(a.bounds_min, b.bounds_min) and np.array_equal(a.bounds_max, b.bounds_max)
     assert a.reach == b.reach and a.estimate == b.estimate
+    assert (a.refinement is None) == (b.refinement is None)
+    if a.refinement is not None:
+        assert np.array_equal(a.refinement.cells, b.refinement.cells) and a.refinement.factor == b.refinement.factor
+        assert np.array_equal(a.fine, b.fine) and a.levels == b.levels
 
 
 def test_identical_for_workers_and_chunks():
@@ -280,7 +366,8 @@ def test_unreachable_scheduler_is_refused_in_bounded_time(monkeypatch):
 
 
 @pytest.mark.parametrize("kw", [{"samples": 0}, {"samples": 10**11}, {"samples": 2.5}, {"chunk": 10},
-                                {"resolution": 1e-6}, {"resolution": -1.0}, {"resolution": 1.0}, {"seed": -3}])
+                                {"resolution": 1e-6}, {"resolution": -1.0}, {"resolution": 1.0}, {"seed": -3},
+                                {"refine": 3}, {"refine": 16}, {"refine": True}, {"refine": 4.0}, {"refine": -2}])
 def test_absurd_sizes_are_refused(kw):
     args = {"samples": 1000, "seed": 0, **kw}
     with pytest.raises(ModelError):

@@ -25,6 +25,20 @@ def _ok(o):
     return json.loads(o.out) if o.out.lstrip().startswith("{") else o.out
 
 
+def test_workspace_refine_narrows_the_annulus_interval_and_saves_the_sub_cells(tmp_path):
+    from denavit.scale import load_occupancy
+
+    argv = ["workspace", "arm.yaml", "--samples", "2.5e5", "--seed", "3", "--resolution", "0.2", "--json"]
+    plain = _ok(run_cli(argv + ["--refine", "0"], tmp_path, files={"arm.yaml": TWO_R}))
+    data = _ok(run_cli(argv + ["--refine", "8", "--data", "w.npz"], tmp_path, files={"arm.yaml": TWO_R}))
+    exact = np.pi * (1.5**2 - 0.5**2)
+    (lo, hi), (plo, phi) = data["interval"], plain["interval"]
+    assert lo <= exact <= hi and plo <= exact <= phi and hi - lo < 0.5 * (phi - plo)
+    assert data["refine"] == 8 and data["refined_cells"] > 0 and data["resolution"] < 0.2 and plain["refine"] == 0
+    ws = load_occupancy(tmp_path / "w.npz")
+    assert ws.refinement.factor == 8 and [ws.estimate.low, ws.estimate.high] == data["interval"]
+
+
 @pytest.mark.slow
 def test_workspace_json_interval_holds_the_annulus_and_data_loads(tmp_path):
     pytest.importorskip("matplotlib")
@@ -82,6 +96,8 @@ def test_reachability_command(tmp_path):
     (["workspace", "planar2r", "--data", "nofolder/w.npz"], "nofolder"),
     (["workspace", "planar2r", "--scheduler", "tcp://"], "scheduler"),
     (["workspace", "planar2r", "--scheduler", "cluster"], "scheduler"),
+    (["workspace", "planar2r", "--refine", "3"], "refine"),
+    (["workspace", "planar2r", "--refine", "16"], "refine"),
     (["reachability", "puma560", "--orientations", "0"], "orientations"),
     (["reachability", "puma560", "--orientations", "99999999"], "orientations"),
     (["reachability", "puma560", "--resolution", "0.001"], "resolution"),
@@ -94,7 +110,8 @@ def test_bad_sizes_and_schedulers_are_one_line(tmp_path, argv, mention):
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.text(min_size=0, max_size=80).filter(lambda s: s.strip() not in ("threads", "processes", "synchronous")
+@given(st.text(min_size=0, max_size=80).filter(lambda s: s.strip() not in ("threads", "processes", "synchronous",
+                                                                          "auto", "dask")
                                                and not s.startswith("-")))
 def test_any_bad_scheduler_text_is_one_line(tmp_path_factory, text):
     from denavit.scale import check_scheduler

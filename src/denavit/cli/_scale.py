@@ -76,6 +76,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resolution", type=bounded_float(*RESOLUTION_RANGE),
                    help="voxel edge [m] (default: chosen from the sample count; 1e-6 to 1e6)")
     p.add_argument("--seed", type=nonneg_int, help="random seed (default: a fresh one, reported)")
+    p.add_argument("--refine", choices=("auto", "0", "2", "4", "8"), default="auto",
+                   help="sub-cells per side of the boundary cells, counted after a pilot of 1/8 of the samples "
+                        "(default auto: when the pilot fills the finest grid and no --resolution is given; 0: off)")
     _add_run_options(p)
     add_force(p)
     p.set_defaults(handler=cmd_workspace)
@@ -109,7 +112,8 @@ def cmd_workspace(args: argparse.Namespace):
     check_output(args, args.data, DATA, what="--data")
     robot = load(args)
     ws = occupancy(robot, args.samples, args.resolution, args.seed, scheduler=args.scheduler,
-                   workers=args.workers, progress=args.progress)
+                   workers=args.workers, progress=args.progress,
+                   refine=None if args.refine == "auto" else int(args.refine))
     require_finite("workspace", ws.bounds_min, ws.bounds_max, ws.reach)
     if args.output:
         from ..viz import plot_occupancy, save_figure
@@ -132,6 +136,10 @@ def cmd_workspace(args: argparse.Namespace):
              f"{what} ≈ {e.value:.4g} {unit}, between {e.low:.4g} and {e.high:.4g} {unit}"
              + (" (planar arm)" if ws.planar else "")
              + f" ({e.occupied} cells of {e.resolution:.3g} m, sample coverage {e.coverage:.4f})"]
+    if ws.refinement is not None:
+        r = ws.refinement
+        lines.append(f"boundary refined: {r.cells.size} cells of {ws.grid.resolution:.3g} m split {r.factor} per "
+                     f"side, counted after a pilot of {r.pilot_blocks} blocks")
     if e.coverage < MIN_COVERAGE:
         lines.append(f"too few samples for a trusted interval (coverage below {MIN_COVERAGE}): use more samples")
     lines += [f"wrote {p}" for p in (args.output, args.data) if p]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -9,9 +10,10 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model import DHRobot
+from ._refine import Refinement, check_factor, pilot_blocks, plan_refinement, refined_levels, refinement
 from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
 from ._schedule import POOLS, Progress, resolve_auto, run
-from ._volume import VolumeEstimate, estimate_volume
+from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
            "CLUSTER_CHUNK", "MAX_CHUNK", "new_seed"]
@@ -47,9 +49,14 @@ class Occupancy:
     reach : float
         Largest distance of a sample from the base origin [m].
     estimate : VolumeEstimate
-        Narrowest-interval volume (area when ``planar``) over the grid levels.
+        Narrowest-interval volume (area when ``planar``) over the grid levels and the refined levels.
     levels : list of VolumeEstimate
-        The estimate at each level (finest first).
+        The estimate at each level (finest first; refined levels, whose cells are finer than ``counts``'s,
+        come first).
+    refinement : Refinement or None
+        The cells of ``counts`` that also carry sub-cell counts (see :mod:`denavit.scale._refine`).
+    fine : ndarray of uint32 (uint64 past 2³² samples after the pilot), shape (len(refinement.cells), factor**dim), or None
+        Sub-cell counts of the refined cells (row-major sub-cells; from the samples after the pilot).
     """
 
     counts: np.ndarray
@@ -61,6 +68,8 @@ class Occupancy:
     reach: float
     estimate: VolumeEstimate
     levels: list = field(default_factory=list)
+    refinement: Refinement | None = None
+    fine: np.ndarray | None = None
 
     @property
     def planar(self) -> bool:
@@ -82,7 +91,9 @@ class Occupancy:
                 "bounds_min": self.bounds_min.tolist(), "bounds_max": self.bounds_max.tolist(),
                 "extent": self.extent.tolist(), "reach": self.reach, "voxels": e.occupied,
                 "planar": self.planar, **size, "interval": [e.low, e.high], "interior_voxels": e.interior,
-                "unseen_voxels": e.unseen, "coverage": e.coverage, "finest_resolution": self.grid.resolution}
+                "unseen_voxels": e.unseen, "coverage": e.coverage, "finest_resolution": self.grid.resolution,
+                "refine": 0 if self.refinement is None else self.refinement.factor,
+                "refined_cells": 0 if self.refinement is None else int(self.refinement.cells.size)}
 
     def save(self, path) -> None:
         """Write the counts and grid to a ``.npz`` file (read back with :func:`load_occupancy`)."""
@@ -91,7 +102,15 @@ class Occupancy:
             np.savez_compressed(fh, counts=self.counts, centre=g.centre, basis=g.basis,
                             resolution=g.resolution, side=g.side, levels=g.levels, samples=self.samples,
                             seed=np.array(str(self.seed)), bounds_min=self.bounds_min, bounds_max=self.bounds_max,
-                            reach=self.reach, estimate=np.array([e.value, e.low, e.high, e.resolution]))
+                            reach=self.reach, estimate=np.array([e.value, e.low, e.high, e.resolution]),
+                            **self._refined_arrays())
+
+    def _refined_arrays(self) -> dict:
+        r = self.refinement
+        if r is None:
+            return {}
+        return {"refined_cells": r.cells, "refine_factor": r.factor, "pilot_blocks": r.pilot_blocks,
+                "fine_counts": self.fine}
 
 
 def load_occupancy(path) -> Occupancy:
@@ -99,15 +118,30 @@ def load_occupancy(path) -> Occupancy:
     with np.load(path, allow_pickle=False) as z:
         grid = Grid(z["centre"], z["basis"], float(z["resolution"]), int(z["side"]), int(z["levels"]))
         counts = z["counts"]
-        best, levels = estimate_volume(counts, grid.resolution, grid.levels)
+        ref = fine = None
+        if "refined_cells" in z.files:
+            cells = z["refined_cells"].astype(np.int64)
+            ref = refinement(cells, int(z["refine_factor"]), int(z["pilot_blocks"]))
+            fine = z["fine_counts"]
+        best, levels = _estimate(counts, grid, ref, fine)
         return Occupancy(counts, grid, int(z["samples"]), int(str(z["seed"])), z["bounds_min"], z["bounds_max"],
-                         float(z["reach"]), best, levels)
+                         float(z["reach"]), best, levels, ref, fine)
 
 
-def _tasks(samples: int, chunk: int):
-    blocks = -(-samples // BLOCK)
+def _estimate(counts: np.ndarray, grid: Grid, ref: Refinement | None, fine) -> tuple[VolumeEstimate, list]:
+    """The narrowest trusted interval over the grid's levels and, with a refinement, its finer levels."""
+    best, levels = estimate_volume(counts, grid.resolution, grid.levels)
+    if ref is None:
+        return best, levels
+    levels = refined_levels(counts, grid.resolution, ref, fine) + levels
+    trusted = [e for e in levels if e.coverage >= MIN_COVERAGE] or [best]
+    return min(trusted, key=lambda e: (e.high - e.low, -e.resolution)), levels
+
+
+def _tasks(samples: int, chunk: int, start: int = 0, stop: int | None = None):
+    blocks = -(-samples // BLOCK) if stop is None else stop
     per = max(1, chunk // BLOCK)
-    for first in range(0, blocks, per):
+    for first in range(start, blocks, per):
         yield first, min(per, blocks - first)
 
 
@@ -120,7 +154,7 @@ def _check_sizes(samples: int, chunk: int) -> None:
 
 def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None = None, seed: int | None = None,
               *, scheduler: Any = "auto", workers: int | None = None, chunk: int | None = None,
-              fk: Callable | None = None, progress: bool | None = False) -> Occupancy:
+              fk: Callable | None = None, progress: bool | None = False, refine: int | None = None) -> Occupancy:
     """Stream ``samples`` uniform joint configurations through FK into voxel counts; volume with an interval.
 
     Parameters
@@ -161,6 +195,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     (True, True)
     """
     _check_sizes(samples, DEFAULT_CHUNK if chunk is None else chunk)
+    refine = check_factor(refine)
     scheduler = resolve_auto(scheduler, samples)
     if chunk is None:
         chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in POOLS else CLUSTER_CHUNK
@@ -172,17 +207,37 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     counts = np.zeros(g.shape, dtype=np.uint64)
     flat = counts.reshape(-1)
     lo, hi, reach = np.full(3, np.inf), np.full(3, -np.inf), 0.0
+    blocks = -(-job.samples // BLOCK)
+    pilot = pilot_blocks(blocks) if refine != 0 and (refine is not None or resolution is None) else 0
+    state = {"job": job, "fine": None}
+
+    def tasks():
+        if not pilot:
+            yield from ((job, f, c) for f, c in _tasks(job.samples, chunk))
+            return
+        yield from ((job, f, c) for f, c in _tasks(job.samples, chunk, 0, pilot))
+        yield None  # barrier: every pilot result is merged into counts before the plan is made
+        ref = plan_refinement(counts, refine, pilot)
+        if ref is not None:
+            state["job"] = dataclasses.replace(job, refine=ref)
+            small = job.samples - pilot * BLOCK < 2**32  # no sub-cell count can overflow uint32
+            state["fine"] = np.zeros(ref.cells.size * ref.factor**g.dim, dtype=np.uint32 if small else np.uint64)
+        yield from ((state["job"], f, c) for f, c in _tasks(job.samples, chunk, pilot, blocks))
+
     bar = Progress(int(samples), "samples", progress)
     try:
-        for idx, cnt, bmin, bmax, r, m in run(run_task, ((job, f, c) for f, c in _tasks(job.samples, chunk)),
-                                              scheduler, workers):
+        for idx, cnt, bmin, bmax, r, m, fidx, fcnt in run(run_task, tasks(), scheduler, workers):
             flat[idx] += cnt  # idx is unique within a task
+            if fidx.size:
+                state["fine"][fidx] += fcnt
             lo, hi, reach = np.minimum(lo, bmin), np.maximum(hi, bmax), max(reach, r)
             bar.update(m)
     finally:
         bar.close()
-    best, levels = estimate_volume(counts, g.resolution, g.levels)
-    return Occupancy(counts, g, int(samples), seed, lo, hi, reach, best, levels)
+    ref = state["job"].refine
+    fine = None if ref is None else state["fine"].reshape(ref.cells.size, -1)
+    best, levels = _estimate(counts, g, ref, fine)
+    return Occupancy(counts, g, int(samples), seed, lo, hi, reach, best, levels, ref, fine)
 
 
 def sample_positions(robot: DHRobot, samples: int, seed: int = 0, *, fk: Callable | None = None,

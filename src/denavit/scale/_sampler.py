@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import DenavitError, ModelError
 from ..model import DHRobot, JointType
+from ._refine import Refinement, popcount, slot_map
 
 __all__ = ["BLOCK", "Grid", "Job", "PositionFK", "CompiledPositionFK", "default_fk", "COMPILED_FROM", "make_job",
            "reach_bound", "sampling_limits", "positions_block", "run_task", "FINE_CELLS", "MAX_CELLS",
@@ -164,6 +165,7 @@ class Job:
     samples: int
     grid: Grid
     base_origin: np.ndarray  # (3,)
+    refine: Refinement | None = None  # sub-cell counts in these cells (blocks after the pilot)
 
 
 def _draw(job: Job, block: int, q: np.ndarray) -> np.ndarray:
@@ -211,8 +213,9 @@ class _Scratch(threading.local):
 _scratch = _Scratch()
 
 
-def _cells(job: Job, P: np.ndarray, flat: np.ndarray) -> None:
-    """Row-major flat cell indices (as numpy.ravel_multi_index) of the positions P (m, 3), into ``flat``."""
+def _cells(job: Job, P: np.ndarray, flat: np.ndarray, T: np.ndarray | None = None) -> None:
+    """Row-major flat cell indices (as numpy.ravel_multi_index) of the positions P (m, 3), into ``flat``;
+    with T (dim, m), also the coordinates in cell edges from the grid's corner (before flooring)."""
     g = job.grid
     m = P.shape[0]
     D = _scratch.get("D", (m, 3), np.float64)
@@ -221,18 +224,45 @@ def _cells(job: Job, P: np.ndarray, flat: np.ndarray) -> None:
         U = D  # (m, dim)
     else:
         U = np.matmul(D, g.basis.T, out=_scratch.get("U", (m, g.dim), np.float64))
-    t = _scratch.get("t", (m,), np.float64)
     c = _scratch.get("c", (m,), np.int32)
     flat[:] = 0
     for a in range(g.dim):
+        t = _scratch.get("t", (m,), np.float64)
         np.subtract(U[:, a], g.lo, out=t)
         t /= g.resolution
+        if T is not None:
+            T[a] = t
         np.floor(t, out=t)
         if t.min() < 0 or t.max() >= g.side:
             raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
         c[:] = t  # < MAX_CELLS = 2^24: int32 sorts faster than int64
         flat *= g.side
         flat += c
+
+
+def _sub_cells(job: Job, flat: np.ndarray, T: np.ndarray, out: np.ndarray) -> int:
+    """Sub-cell indices (slot·k^d + row-major sub-cell) of the samples that fall in refined cells, into the
+    front of ``out``; returns how many."""
+    ref, g = job.refine, job.grid
+    k = ref.factor
+    words, prefix = slot_map(ref, g.side**g.dim)
+    w = np.right_shift(flat, 6, out=_scratch.get("w", flat.shape, np.int32))
+    b = np.bitwise_and(flat, 63, out=_scratch.get("b", flat.shape, np.uint64), casting="unsafe")
+    word = np.take(words, w, out=_scratch.get("word", flat.shape, np.uint64))
+    bit = np.right_shift(word, b, out=_scratch.get("bit", flat.shape, np.uint64))
+    bit &= np.uint64(1)
+    sel = np.flatnonzero(bit)
+    if sel.size == 0:
+        return 0
+    below = np.left_shift(np.uint64(1), b[sel]) - np.uint64(1)  # the bits below the cell's own
+    idx = prefix[w[sel]] + popcount(word[sel] & below)  # its slot in ref.cells
+    for a in range(g.dim):
+        t = T[a, sel]
+        sub = np.floor(t * k) - k * np.floor(t)  # exact: k is a power of two
+        idx *= k
+        idx += sub.astype(np.int64)
+    out[:sel.size] = idx
+    return sel.size
 
 
 def _distance_max(P: np.ndarray, origin: np.ndarray) -> float:
@@ -242,11 +272,13 @@ def _distance_max(P: np.ndarray, origin: np.ndarray) -> float:
     return float(np.sqrt(D.sum(axis=1, out=_scratch.get("t", (P.shape[0],), np.float64)).max()))
 
 
-def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, int]:
-    """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples."""
+def run_task(job: Job, first: int, count: int) -> tuple:
+    """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples,
+    and — when ``job.refine`` is set — sorted sub-cell indices and their counts (else empty arrays)."""
     total = min((first + count) * BLOCK, job.samples) - first * BLOCK
     flat = _scratch.get("flat", (total,), np.int32)
-    lo, hi, reach, done = np.full(3, np.inf), np.full(3, -np.inf), 0.0, 0
+    fine = _scratch.get("fine", (total,), np.int64) if job.refine is not None else None
+    lo, hi, reach, done, kept = np.full(3, np.inf), np.full(3, -np.inf), 0.0, 0, 0
     for b in range(first, first + count):
         m = min(BLOCK, job.samples - b * BLOCK)
         P = _positions(job.fk(_draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64))))
@@ -254,10 +286,16 @@ def run_task(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray, 
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
         reach = max(reach, _distance_max(P, job.base_origin))
-        _cells(job, P, flat[done:done + m])
+        if fine is None:
+            _cells(job, P, flat[done:done + m])
+        else:
+            T = _scratch.get("T", (job.grid.dim, m), np.float64)
+            _cells(job, P, flat[done:done + m], T)
+            kept += _sub_cells(job, flat[done:done + m], T, fine[kept:])
         done += m
     idx, cnt = _runs(flat)
-    return idx, cnt, lo, hi, reach, total
+    fidx, fcnt = _runs(fine[:kept]) if kept else (np.empty(0, np.int64), np.empty(0, np.uint32))
+    return idx, cnt, lo, hi, reach, total, fidx, fcnt
 
 
 def _runs(flat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

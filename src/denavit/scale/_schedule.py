@@ -127,7 +127,10 @@ def _wait(done_order, pending: set):
 
 def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
         ) -> Iterator[Any]:
-    """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler ("auto": threads)."""
+    """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler ("auto": threads).
+
+    A task ``None`` is a barrier: the results of all tasks before it are yielded before the iterator of tasks
+    is asked for the next one (so a generator of tasks may read what the caller made of those results)."""
     check_scheduler(scheduler)
     scheduler = resolve_auto(scheduler, 0)
     client, own, pool, cluster = None, False, None, None
@@ -160,6 +163,13 @@ def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", worker
     it, pending = iter(tasks), set()
     try:
         for task in it:
+            if task is None:  # a barrier: every earlier task's result is yielded before the next task is drawn
+                while pending:
+                    done, pending = _wait(done_order, pending)
+                    pending = set(pending)
+                    for f in done:
+                        yield f.result()
+                continue
             pending.add(submit(fn, *task))
             while len(pending) >= IN_FLIGHT * width:
                 done, pending = _wait(done_order, pending)

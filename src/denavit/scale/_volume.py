@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["VolumeEstimate", "estimate_volume", "coarsen", "interior", "MIN_COVERAGE"]
+__all__ = ["VolumeEstimate", "estimate_volume", "coarsen", "interior", "chao1", "MIN_COVERAGE"]
 
 #: Least Good–Turing coverage 1 − f1/N at which a level's interval is used (else only as a last resort).
 MIN_COVERAGE = 0.99
@@ -94,7 +94,7 @@ def interior(occupied: np.ndarray) -> np.ndarray:
     return out
 
 
-def _chao1(f1: int, f2: int) -> tuple[float, float]:
+def chao1(f1: int, f2: int) -> tuple[float, float]:
     """Bias-corrected Chao1 unseen count and its standard deviation (Chao 2005)."""
     f1, f2 = float(f1), float(f2)
     m = max(f1 * (f1 - 1) / (2 * (f2 + 1)), 0.0)
@@ -107,7 +107,7 @@ def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
     n_occ = int(occ.sum())
     n_in = int(interior(occ).sum())
     f1 = int((counts == 1).sum())
-    m, sd = _chao1(f1, int((counts == 2).sum()))
+    m, sd = chao1(f1, int((counts == 2).sum()))
     cell = h ** counts.ndim
     low, high = n_in * cell, (n_occ + m + 2 * sd) * cell
     coverage = 1.0 - f1 / max(float(counts.sum()), 1.0)
