@@ -1,5 +1,5 @@
-"""Workspace and reachability at scale: streamed sampling, voxel occupancy, volume with an interval,
-reachability and manipulability maps.
+"""Workspace and reachability at scale: streamed sampling, voxel occupancy, volume with an interval (refined
+at the workspace's boundary), reachability and manipulability maps.
 
 The same task functions run in this process, in a thread or process pool, or on a ``dask.distributed``
 cluster given by address (the optional extra ``denavit[scale]``); results depend on the seed only, not on
@@ -12,6 +12,7 @@ from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPosi
                        reach_bound, sampling_limits)
 from ._schedule import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
 from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
+from ._refine import MAX_REFINE, PILOT_SHARE, REFINE_CELLS, REFINE_COVERAGE, Refinement
 from ._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
 from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy,
                          new_seed, occupancy, sample_positions)
@@ -30,6 +31,11 @@ __all__ = [
     "MAX_CELLS",
     "MAX_CHUNK",
     "MAX_ORIENTATIONS",
+    "MAX_REFINE",
+    "PILOT_SHARE",
+    "REFINE_CELLS",
+    "REFINE_COVERAGE",
+    "Refinement",
     "MAX_SAMPLES",
     "MAX_WORKERS",
     "MIN_COVERAGE",

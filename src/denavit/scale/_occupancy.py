@@ -181,6 +181,12 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         COMPILED_FROM samples when numba is installed, else :class:`PositionFK` (``denavit.forward_kinematics``).
     progress : bool or None
         Progress line with ETA on stderr (``None``: when stderr is a terminal).
+    refine : {None, 0, 2, 4, 8}
+        Sub-cells per side of the boundary cells (see :mod:`denavit.scale._refine`): the first 1/8 of the
+        random blocks (the pilot) fix which cells of the finest grid are refined, the later blocks also count
+        those cells' sub-cells, and the interval is also computed at the sub-cell edges.  ``None`` (default):
+        when the pilot alone fills the finest grid to coverage REFINE_COVERAGE and no ``resolution`` is given,
+        with the largest factor whose sub-cells fit REFINE_CELLS; 0: never; 2, 4, 8: always (lowered to fit).
 
     Returns
     -------
