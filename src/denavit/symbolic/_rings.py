@@ -60,8 +60,10 @@ class TrigRing:
             consts |= {a for a in x.atoms(sp.Float, sp.Pow, sp.sin, sp.cos, sp.NumberSymbol, sp.exp)
                        if a.is_number and not a.is_Rational}
             params |= {a for a in x.free_symbols if a not in self.s and a not in self.c}
+        params -= set(self._pair_dummy.values())
         consts = {a for a in consts if not any(a != b and a.has(b) for b in consts)}  # outermost only
         self.konst = {a: sp.Dummy(f"k{i}") for i, a in enumerate(sorted(consts, key=sp.default_sort_key))}
+        self.konst.update(self._pair_dummy)  # cos α, sin α of a float twist: one generator each, ± its sign
         self.back = {v: k for k, v in self.konst.items()}
         gens = sorted(params, key=str) + list(self.konst.values()) + list(self.s) + list(self.c)
         self.R, *self.gens = ring(gens, QQ)
@@ -105,11 +107,14 @@ class TrigRing:
                 if x not in paired and y not in paired and abs(float(x) ** 2 + float(y) ** 2 - 1) < FLOAT_PAIR_TOL:
                     paired[x], paired[y] = y, x
         self._pairs = list({tuple(sorted((x, y), key=float)) for x, y in paired.items()})
+        # a paired float and its negative are one generator with a sign (−sin α is −k, not a second constant
+        # unrelated to k: that left a generic-twist 6R's determinant without cancellations for minutes)
+        self._pair_dummy = {a: sp.Dummy(f"f{i}") for i, a in enumerate(sorted(paired, key=float))}
         out: dict[sp.Float, sp.Expr] = {}
         for e in exprs:
             for f in sp.sympify(e).atoms(sp.Float):  # safe: the engine's own expressions, never text
                 a = abs(f)
-                val = a if a in paired else sp.Rational(repr(float(a)))
+                val = self._pair_dummy[a] if a in paired else sp.Rational(repr(float(a)))
                 out[f] = val if f >= 0 else -val
         return out
 

@@ -178,7 +178,7 @@ def _minors(rg: TrigRing, J: list, shape: tuple[int, int]) -> tuple[str, list]:
         return DomainMatrix([[J[i][j] for j in cols] for i in rows], (len(rows), len(cols)), dom).det()
 
     if m == k:
-        return "det J", [det(range(m), range(k))]
+        return "det J", [_laplace_det(rg, J)]
     small = min(m, k)
     minors = [det(rows, cols)
               for rows in (itertools.combinations(range(m), small) if m > k else [tuple(range(m))])
@@ -188,9 +188,34 @@ def _minors(rg: TrigRing, J: list, shape: tuple[int, int]) -> tuple[str, list]:
     return name, minors
 
 
+def _laplace_det(rg: TrigRing, J: list):
+    """det J by expansion along the last column of every leading-column minor, all minors kept (2ⁿ of them,
+    no division): the same polynomial as fraction-free elimination — the arm's product structure kept for
+    factoring — but a generic 6R's in seconds, where the exact divisions of large polynomials took minutes."""
+    n = len(J)
+    prev = {(): rg.R.one}
+    reduce = False
+    for k in range(n):
+        cur = {}
+        for rows in itertools.combinations(range(n), k + 1):
+            acc = rg.R.zero
+            for pos, r in enumerate(rows):
+                sub = prev.get(rows[:pos] + rows[pos + 1:])
+                if J[r][k] and sub:
+                    acc = acc + J[r][k] * sub if (pos + k) % 2 == 0 else acc - J[r][k] * sub  # cofactor sign
+            cur[rows] = acc
+        if not reduce and max(len(p.terms()) for p in cur.values()) > FACTOR_AS_MULTIPLIED_TERMS:
+            reduce = True  # a generic arm: no product structure to keep, and reduced minors stay ~10× smaller
+        if reduce:
+            cur = {rows: rg.reduce(p) if p else p for rows, p in cur.items()}
+        prev = cur
+    return prev[tuple(range(n))]
+
+
 # --- factoring -------------------------------------------------------------------------------------
 
 
+FACTOR_AS_MULTIPLIED_TERMS = 5000  # minors / determinants with more terms are reduced (s² + c² = 1) as formed
 BIG_RATIONAL = 10 ** 6  # a factor with a coefficient whose numerator or denominator exceeds this is shown in floats
 
 
@@ -229,6 +254,8 @@ def _factors(rg: TrigRing, minors: list) -> tuple[sp.Expr, list[tuple[sp.Expr, i
         g = g2 if rg.to_expr(g2).has(*q) else g
     if rg.const_relations:
         g = g.rem(rg.const_relations)
+    if len(g.terms()) > FACTOR_AS_MULTIPLIED_TERMS:  # a generic arm: no product structure to keep
+        g = rg.reduce(g)
     coeff, facs = g.factor_list()
     const, out = rg.R.domain.to_sympy(coeff), []
     for f, mult in facs:
