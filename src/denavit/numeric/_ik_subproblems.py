@@ -22,9 +22,10 @@ FREE_AXIS = 1e-10  # distance to axis 1 or 2, relative to the arm's size, under 
 # FREE_TOL of the closed forms)
 REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
 REFINE_STEPS = 4
-CLUSTER_RADIUS = 1e-3  # relative distance of two roots of the resultant under which the other elimination order
-# is solved too (a multiple root split by rounding: a k-fold root comes out ~ε^(1/k) apart)
-CLUSTER_SIZE = 3  # roots that close together (a double root is split ~√ε only and handled by the refinement)
+CLUSTER_SPREAD = 10.0  # k roots of the resultant within CLUSTER_SPREAD · ε^(1/k) of one (relative) are taken for a
+# k-fold root split by rounding (~ε^(1/k) apart: 6e-5 for k = 3, 1e-3 for 4, 2.5e-2 for 6); those poses are solved
+# in the other elimination order too
+CLUSTER_SIZE = 3  # smallest such k (a double root is split ~√ε only and handled by the refinement)
 SAME_ROOT = 1e-6  # joint-space distance [rad, m per L] under which a root of the other order is one already found
 _ALT_SEED = 20240602  # the other order's structural tests draw from their own fixed stream
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
@@ -258,9 +259,9 @@ class Position3:
 
     def _q3_candidates(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Real roots of the resultant in the solved joint (B, m); which poses have roots that cluster (B,):
-        CLUSTER_SIZE roots, real or not, within CLUSTER_RADIUS (in e^{iq} or in the scaled length), where a
-        multiple root of the resultant was split by rounding into roots ~ε^(1/k) apart (some of them complex);
-        and the centroid of the largest cluster (B,) (NaN where none): the mean of the k roots a k-fold root split
+        k ≥ CLUSTER_SIZE roots, real or not, within CLUSTER_SPREAD · ε^(1/k) (relative, in e^{iq} or in the
+        scaled length), where a multiple root of the resultant was split by rounding into roots ~ε^(1/k) apart
+        (some of them complex); and the centroid of the largest cluster (B,) (NaN where none): the mean of the k roots a k-fold root split
         into is exact to rounding (their sum is a coefficient's)."""
         p = self._poly(w)  # (B, 2K+1) or (B, P+1)
         if self.pv:
@@ -270,14 +271,21 @@ class Position3:
             p = p[:, _KMAX - self.degree: _KMAX + self.degree + 1]
         roots = _batched_roots(p)
         near = np.abs(roots.imag) < 0.1 * (1 + np.abs(roots.real)) if self.pv else np.abs(np.abs(roots) - 1.0) < 0.1
+        m = roots.shape[1]
         gap = np.abs(roots[:, :, None] - roots[:, None, :]) / (1 + np.abs(roots[:, :, None]))
-        gap[:, np.arange(roots.shape[1]), np.arange(roots.shape[1])] = np.inf
-        close = (gap < CLUSTER_RADIUS) & near[:, :, None] & near[:, None, :]
-        size = close.sum(axis=2)  # (B, m): other roots next to each root
-        clustered = np.any(size >= CLUSTER_SIZE - 1, axis=1)
-        big = np.argmax(size, axis=1)
-        member = np.take_along_axis(close, big[:, None, None], 1)[:, 0]
-        member[np.arange(len(big)), big] = True
+        gap[:, np.arange(m), np.arange(m)] = np.inf
+        gap = np.where(near[:, :, None] & near[:, None, :], np.nan_to_num(gap, nan=np.inf), np.inf)
+        # root i and its k − 1 nearest others form a cluster when they lie within CLUSTER_SPREAD · ε^(1/k)
+        ks = np.arange(CLUSTER_SIZE, max(m, CLUSTER_SIZE - 1) + 1)
+        reach = np.sort(gap, axis=2)[:, :, ks - 2]  # (B, m, len(ks)): distance to the (k−1)-th nearest other
+        fits = reach < CLUSTER_SPREAD * np.finfo(float).eps ** (1.0 / ks)
+        clustered = fits.any(axis=(1, 2))
+        kbest = np.where(fits, ks, 0).max(axis=2, initial=0)  # (B, m): the largest cluster around each root
+        b, big = np.arange(len(roots)), np.argmax(kbest, axis=1)
+        kb = kbest[b, big]
+        radius = reach[b, big, np.maximum(kb - CLUSTER_SIZE, 0)] if ks.size else np.zeros(len(roots))
+        member = gap[b, big] <= np.where(kb > 0, radius, -1.0)[:, None]  # the cluster of the largest k
+        member[b, big] = True
         centre = np.sum(np.where(member, np.nan_to_num(roots), 0), axis=1) / member.sum(axis=1)
         clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
         if self.pv:
