@@ -521,12 +521,15 @@ def test_random_arms_of_any_structure_are_solved_completely_or_refused_by_name()
 def _crossing_arm(rng, kinds, convention):
     """A random 3-joint arm (kinds e.g. "RRP") whose end point moves along the line of the prismatic joint 3,
     a line that meets axis 2 (no common normal between axes 2 and 3): at one q3 the point lies on axis 2.
-    Twists random (skewed axes), offsets random."""
+    Twists random (skewed axes), offsets random; in half the standard-DH arms d2 = 0 too, so that the crossing
+    is the origin of frame 1 (a 6-fold root of the resultant there, its roots ~5e-3 apart and all complex)."""
     rows = []
+    origin = convention == "standard" and rng.random() < 0.5
     for k, kind in enumerate(kinds):
         a = 0.0 if (k == 1 and convention == "standard") or (k == 2) else float(rng.uniform(-0.5, 0.5))
         pr = kind == "P"
-        rows.append(DHLink(a=a, alpha=float(rng.uniform(-3, 3)), d=float(rng.uniform(-0.5, 0.5)),
+        d = 0.0 if (k == 1 and origin) else float(rng.uniform(-0.5, 0.5))
+        rows.append(DHLink(a=a, alpha=float(rng.uniform(-3, 3)), d=d,
                            theta=float(rng.uniform(-3, 3)), joint=JointType.PRISMATIC if pr else JointType.REVOLUTE,
                            q_limits=(-1.5, 1.5) if pr else (-np.pi, np.pi)))
     return DHRobot(name="crossing", links=tuple(rows), convention=Convention(convention))
