@@ -4,9 +4,11 @@ Run:  python benchmarks/bench_symbolic.py [--arms puma560,ur5,...] [--timeout 60
 
 Cases (each in a fresh process, so no cache is shared; a case over ``--timeout`` seconds is reported as such):
 
-  dynamics       ``lagrangian_dynamics(robot, coriolis=False)``, then ``format_dynamics(..., "text",
-                 gravity_symbol=True, include=("M", "c", "g"))``: seconds to derive, seconds with the text,
-                 characters of the text (what ``denavit dynamics ROBOT --symbolic`` prints)
+  dynamics       what ``denavit dynamics ROBOT --symbolic`` prints (``dynamics_form(robot)``): the hand form,
+                 ``lagrangian_dynamics(robot, coriolis=False)`` then ``format_dynamics(..., "text",
+                 gravity_symbol=True, include=("M", "c", "g"))``, or the recursive form, ``recursive_dynamics``
+                 then ``format_recursive``: seconds to derive, seconds with the text, characters and lines
+  hand           (``--hand``) the hand form also for the arms whose default is the recursive one
   singularities  ``singularity_analysis(robot)``: seconds, number of conditions
   kane           the peer: sympy.physics.mechanics' KanesMethod on the same arm (standard DH, revolute joints),
                  written here from the DH rows (frames by body-fixed Z–X rotations, bodies at their COMs,
@@ -59,18 +61,30 @@ def _robot(name: str):
     return generic_6r() if name == "generic6r" else denavit.load_robot(name)
 
 
-def case_dynamics(name: str) -> dict:
+def case_dynamics(name: str, form: str = "auto") -> dict:
     robot = _robot(name)
     if not any(j.inertia is not None for j in robot.joints):
         return {"skipped": "no inertial data"}
-    from denavit.symbolic import format_dynamics, lagrangian_dynamics
+    from denavit.symbolic import (dynamics_form, format_dynamics, format_recursive, lagrangian_dynamics,
+                                  recursive_dynamics)
 
+    form = dynamics_form(robot, form)
     t0 = time.perf_counter()
-    terms = lagrangian_dynamics(robot, coriolis=False)
-    t1 = time.perf_counter()
-    text = format_dynamics(terms, "text", gravity_symbol=True, include=("M", "c", "g"))
+    if form == "recursive":
+        rd = recursive_dynamics(robot)
+        t1 = time.perf_counter()
+        text = format_recursive(rd, "text")
+    else:
+        terms = lagrangian_dynamics(robot, coriolis=False)
+        t1 = time.perf_counter()
+        text = format_dynamics(terms, "text", gravity_symbol=True, include=("M", "c", "g"))
     t2 = time.perf_counter()
-    return {"derive": t1 - t0, "total": t2 - t0, "chars": len(text)}
+    return {"derive": t1 - t0, "total": t2 - t0, "chars": len(text), "form": form,
+            "lines": len(text.splitlines())}
+
+
+def case_hand(name: str) -> dict:
+    return case_dynamics(name, "hand")
 
 
 def case_singularities(name: str) -> dict:
@@ -160,7 +174,7 @@ def case_kane(name: str) -> dict:
     return {"total": seconds, "chars": len(str(M)) + len(str(F))}
 
 
-CASES = {"dynamics": case_dynamics, "singularities": case_singularities, "kane": case_kane}
+CASES = {"dynamics": case_dynamics, "hand": case_hand, "singularities": case_singularities, "kane": case_kane}
 
 
 def run_case(kind: str, name: str, timeout: float) -> dict:
@@ -191,6 +205,8 @@ def main() -> None:
     ap.add_argument("--arms", default=",".join(ARMS))
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per case (default 600)")
     ap.add_argument("--markdown", help="also write the table to this file")
+    ap.add_argument("--hand", action="store_true",
+                    help="also time the hand form where the default (auto) form is the recursive one")
     ap.add_argument("--case", nargs=2, metavar=("KIND", "ARM"), help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.case:
@@ -200,7 +216,8 @@ def main() -> None:
     load0 = os.getloadavg()[0]
     results = {}
     for arm in arms:
-        for kind in ("dynamics", "singularities") + (("kane",) if arm == ANCHOR[0] else ()):
+        hand = ("hand",) if args.hand and arm in ("panda", "generic6r") else ()
+        for kind in ("dynamics",) + hand + ("singularities",) + (("kane",) if arm == ANCHOR[0] else ()):
             results[arm, kind] = r = run_case(kind, arm, args.timeout)
             print(f"  {arm:12s} {kind:14s} {r}", file=sys.stderr, flush=True)
     load1 = os.getloadavg()[0]
@@ -210,17 +227,23 @@ def main() -> None:
     lines = [f"One run, {platform.machine()} {os.cpu_count()} cores, load average {load0:.2f} → {load1:.2f}, "
              f"Python {platform.python_version()}, sympy {sympy.__version__}; each case in a fresh process"
              + (f"; ratio = time / Kane's raw Puma 560 ({anchor:.2f} s)" if anchor else "") + ".", "",
-             "| arm | M, c, g derive [s] | + text [s] | text [chars] | ratio to Kane | singularities [s] | conditions |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+             "| arm | form | M, c, g derive [s] | + text [s] | text [chars] | lines | ratio to Kane "
+             "| singularities [s] | conditions |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for arm in arms:
-        d, s = results[arm, "dynamics"], results[arm, "singularities"]
-        ratio = f"{d['total'] / anchor:.2f}" if anchor and "total" in d else "—"
-        lines.append(f"| {arm} | {_fmt(d, 'derive')} | {_fmt(d, 'total')} | {_fmt(d, 'chars')} | {ratio} "
-                     f"| {_fmt(s, 'total')} | {_fmt(s, 'conditions')} |")
+        s = results[arm, "singularities"]
+        for kind in ("dynamics", "hand"):
+            if (arm, kind) not in results:
+                continue
+            d = results[arm, kind]
+            ratio = f"{d['total'] / anchor:.2f}" if anchor and "total" in d else "—"
+            sing = (f"{_fmt(s, 'total')} | {_fmt(s, 'conditions')}" if kind == "dynamics" else "— | —")
+            lines.append(f"| {arm} | {d.get('form', 'hand' if kind == 'hand' else '—')} | {_fmt(d, 'derive')} "
+                         f"| {_fmt(d, 'total')} | {_fmt(d, 'chars')} | {_fmt(d, 'lines')} | {ratio} | {sing} |")
         if (arm, "kane") in results:
             k = results[arm, "kane"]
-            lines.append(f"| {arm}: sympy.physics.mechanics KanesMethod (raw, no trigsimp) | — | {_fmt(k, 'total')} "
-                         f"| {_fmt(k, 'chars')} | 1 | — | — |")
+            lines.append(f"| {arm}: sympy.physics.mechanics KanesMethod (raw, no trigsimp) | — | — | {_fmt(k, 'total')} "
+                         f"| {_fmt(k, 'chars')} | — | 1 | — | — |")
     table = "\n".join(lines)
     print(table)
     if args.markdown:

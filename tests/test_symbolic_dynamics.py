@@ -330,6 +330,21 @@ def test_recursive_form_of_the_panda_evaluates_to_the_numeric_m_c_g():
     robot = denavit.load_robot("panda")
     text = _recursive_text(robot)
     _check_printed(robot, text, np.random.default_rng(87), count=3)
+    try:  # and against Pinocchio (crba, computeGeneralizedGravity, computeCoriolisMatrix), when installed
+        import pinocchio as pin
+    except ImportError:
+        pin = None
+    if pin is not None:
+        from denavit.peers import to_pinocchio
+
+        model, data, _ = to_pinocchio(robot)
+        rng, parsed = np.random.default_rng(89), _parse_printed(text)
+        q, qd = rng.uniform(-np.pi, np.pi, 7), rng.uniform(-2, 2, 7)
+        M, c, g = _printed_values(text, robot, q, qd, parsed)
+        Mp = pin.crba(model, data, q)
+        np.testing.assert_allclose(M, np.triu(Mp) + np.triu(Mp, 1).T, atol=1e-4)
+        np.testing.assert_allclose(g, pin.computeGeneralizedGravity(model, data, q), atol=1e-4)
+        np.testing.assert_allclose(c, pin.computeCoriolisMatrix(model, data, q, qd) @ qd, atol=1e-4)
     lines = text.splitlines()
     assert "recursive form" in lines[0] and len(lines) < 500 and max(map(len, lines)) < 300
     assert "M[1,1] = " in text and "c[7] = " in text and "g[7] = " in text and "friction[7] = " in text

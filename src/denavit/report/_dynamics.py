@@ -5,7 +5,7 @@ as a person writes it (Spong, Hutchinson & Vidyasagar 2006, sec. 7.1–7.4): the
 link and its velocity, ω, the kinetic and potential energies, L = K − P, ∂L/∂q̇_k, d/dt ∂L/∂q̇_k, ∂L/∂q_k and
 τ_k, then the split τ = M(q) q̈ + c(q, q̇) + g(q) (+ friction).  Arms of up to :data:`HAND_FORM_MAX_DOF`
 joints get M, c, g in closed form entry by entry (``lagrangian_dynamics``, hand form); longer ones (7 joints:
-entries of pages) M, c, g at the numeric case only.  The numbers at the case come from the numeric engine
+entries of pages) as recursions in named link quantities (``recursive_dynamics``), evaluated at the case.  The numbers at the case come from the numeric engine
 (CRBA mass matrix, Christoffel c, gravity torques); the symbolic results evaluated at the same point are
 compared with them, and c + g is compared with the recursive Newton–Euler torques at q̈ = 0 (Craig 2005,
 sec. 6.5): independent routes.
@@ -108,6 +108,10 @@ def _symbolic(ctx: Context, steps: list) -> Any:
         hand = _capabilities.capability("denavit.symbolic", "lagrangian_dynamics")
         if hand is not None and robot.dof <= HAND_FORM_MAX_DOF:
             return _hand_form(ctx, steps, hand)
+        recursive = _capabilities.capability("denavit.symbolic", "recursive_dynamics")
+        if recursive is not None:
+            _recursive_form(ctx, steps, recursive)
+            return None
         steps.append(Text(f"The symbolic Lagrange derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints, "
                           f"and M, c, g in closed form for at most {HAND_FORM_MAX_DOF}; for {robot.dof} joints the "
                           "entries run to pages (the function lagrangian_dynamics of denavit.symbolic derives them, "
@@ -172,6 +176,43 @@ def _hand_form(ctx: Context, steps: list, found) -> Any:
     if any(e != 0 for e in t.friction):
         steps.append(_eq(ctx, "\\tau_f(\\dot q)", t.friction))
     return t
+
+
+def _recursive_form(ctx: Context, steps: list, found) -> None:
+    """M, c, g of an arm whose entries run to pages, as recursions in named link quantities (Craig 2005 ch. 6,
+    Featherstone 2008 ch. 6), evaluated at the case and checked against the numeric engine."""
+    from .. import numeric as N
+    from ..symbolic import format_recursive
+
+    robot = ctx.robot
+    try:
+        rd = found[1](robot)
+        tex = format_recursive(rd, "latex")
+    except Exception as exc:  # another area's function: report, do not crash the report
+        steps.append(Text(f"The symbolic dynamics ({found[0]}) failed: {type(exc).__name__}: {exc}."))
+        return
+    steps.append(Text(f"For {robot.dof} joints the entries of M, c, g expanded run to pages; they are written as "
+                      "recursions over the links instead, each quantity a short formula in the previous ones "
+                      "(evaluate in order). Body frame $B_j$: attached to body $j$, $z$ along joint $j$'s axis; "
+                      "$m^b, h^b, J^b$: mass, first moment and inertia of body $j$ about the origin of $B_j$; "
+                      "$m^c, h^c, J^c$: the same for the composite body $j \\dots n$; $p^k_j, L^k_j$: linear and "
+                      "angular momentum (about the origin of $B_j$) of composite body $k$ for a unit rate of joint "
+                      "$k$, $M_{jk}$ its $z$ component; $\\omega, \\dot\\omega, a$: Newton-Euler with $\\ddot q = 0$, "
+                      "no gravity, $F, N$ what body $j$ needs, $f, n$ what joint $j$ transmits, $c_j = n_{jz}$; "
+                      "$e_j$: direction of gravity in $B_j$, $g_j = -g\\,\\hat z\\cdot(h^c_j \\times e_j)$. "
+                      "$C_i = \\cos q_i$, $S_i = \\sin q_i$; $M$ is symmetric."))
+    body = tex.removeprefix("\\begin{aligned}\n").removesuffix("\n\\end{aligned}")
+    for row in body.split(" \\\\\n"):
+        if "&=" in row:
+            lhs, rhs = (x.strip() for x in row.split("&=", 1))
+            steps.append(Equation(lhs, rhs, shorthand=True))
+    values = {**dict(ctx.param_subs), **dict(zip(rd.q, ctx.q))}
+    values.update(zip(rd.qd, ctx.qd if ctx.qd is not None else np.zeros(robot.dof)))
+    M, c, g = rd.at(values)
+    qd = ctx.qd if ctx.qd is not None else np.zeros(robot.dof)
+    steps.append(Text("Check, these formulas at the case vs the numeric engine: "
+                      f"M {_agree(M, N.mass_matrix(robot, ctx.q))}; c {_agree(c, N.coriolis_vector(robot, ctx.q, qd))}; "
+                      f"g {_agree(g, N.gravity_torques(robot, ctx.q))}."))
 
 
 def _agree(a: np.ndarray, b: np.ndarray) -> str:

@@ -76,6 +76,17 @@ class RecursiveDynamics:
     gravity_symbol: sp.Symbol
     friction: sp.ImmutableMatrix
 
+    def at(self, values: dict) -> tuple:
+        """(M, c, g) as float arrays: the formulas evaluated in order at ``values`` (symbol → number: q, q̇ and
+        the named parameters; the gravity symbol is |g₀| unless given)."""
+        import numpy as np
+
+        env = {self.gravity_symbol: float(self.gravity or 0), **{k: sp.Float(v, 30) for k, v in values.items()}}
+        for s, formula, _ in self.definitions:
+            env[s] = formula.xreplace(env).evalf(30)
+        out = [np.array(m.xreplace(env).evalf(30).tolist(), dtype=float) for m in (self.M, self.c, self.g)]
+        return out[0], out[1].ravel(), out[2].ravel()
+
 
 def _cross(a, b):
     return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
