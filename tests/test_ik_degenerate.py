@@ -631,7 +631,7 @@ def _targets(robot, seed, k=6):
     return np.concatenate([T, far, rand])
 
 
-@settings(max_examples=25 if REDUCED else 150)
+@settings(max_examples=15 if REDUCED else 150)
 @given(robots(), st.integers(0, 2**32 - 1))
 def test_no_bare_exception_escapes_the_public_ik_functions(robot, seed):
     """analytic_ik, ik_structure, ik_plan and solve_ik either answer (every analytic solution reproduces its target
