@@ -191,7 +191,7 @@ def run_case(kind: str, name: str, timeout: float) -> dict:
 
 def _fmt(r: dict, key: str, unit: str = "") -> str:
     if "timeout" in r:
-        return f"> {r['timeout']:.0f}{unit}"
+        return f"> {r['timeout']:.0f}{unit}" if key in ("derive", "total") else "—"
     if "skipped" in r:
         return "—"
     if "error" in r:
