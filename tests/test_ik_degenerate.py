@@ -660,3 +660,27 @@ def test_no_bare_exception_escapes_the_public_ik_functions(robot, seed):
     except DenavitError:
         return
     assert np.all(np.isfinite(num.q)) and num.success.shape == (len(T) // 3 + 2,)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_cylindrical_rpp_arms_with_the_point_next_to_axis_1(convention):
+    """R with a coaxial P, then a skewed P through axis 1: the distance of the point to axis 1 is |q3 − q3*| times
+    a constant, so its square has a double root and the root put the point on the axis itself; targets 1e-8,
+    1e-9, 1e-12 from the axis were missed (the row named "q1 free" missed them by their distance, > 1e-9)."""
+    rng = np.random.default_rng([1819, convention == "standard"])
+    for _ in range(4 if REDUCED else 16):
+        alpha, d3 = float(rng.uniform(0.3, 2.8)) * rng.choice([-1, 1]), float(rng.uniform(-0.5, 0.5))
+        P = JointType.PRISMATIC
+        if convention == "standard":  # joint 2 slides along z1 = z0 (a1 = α1 = 0), joint 3 along z2 through o2
+            links = (DHLink(a=0.0, alpha=0.0, d=float(rng.uniform(-0.5, 0.5)), theta=float(rng.uniform(-3, 3))),
+                     DHLink(a=0.0, alpha=alpha, theta=float(rng.uniform(-3, 3)), joint=P, q_limits=(-1.0, 1.0)),
+                     DHLink(a=0.0, alpha=0.0, d=d3, joint=P, q_limits=(-1.0, 1.0)))
+        else:
+            links = (DHLink(a=0.0, alpha=0.0, theta=float(rng.uniform(-3, 3))),
+                     DHLink(a=0.0, alpha=0.0, d=float(rng.uniform(-0.5, 0.5)), joint=P, q_limits=(-1.0, 1.0)),
+                     DHLink(a=0.0, alpha=alpha, d=d3, theta=float(rng.uniform(-3, 3)), joint=P, q_limits=(-1.0, 1.0)))
+        robot = DHRobot(name="cyl", links=links, convention=Convention(convention))
+        Q = _uniform(robot, rng, 12)
+        Q[:, 2] = -d3 + np.repeat([1e-8, -1e-8, 1e-9, -1e-9, 1e-12, 0.0], 2)
+        assert np.all(np.hypot(*forward_kinematics(robot, Q)[:, :2, 3].T) < 1e-8)  # next to axis 1 indeed
+        _check(robot, Q, (convention, links))

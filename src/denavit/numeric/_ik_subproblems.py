@@ -336,7 +336,45 @@ class Position3:
         q[bad] = np.nan
         free = (free1 * 1 + free2 * 2 + 4 * self.free3).reshape(len(W), -1)
         q = self._refine(q, W, free)
+        if not self.pr1 and np.any(free & 1):
+            q = self._off_axis1(q, W, (free & 1) > 0)
         return q, np.where(bad, 0, self._free_after(q, W, free))
+
+    def _off_axis1(self, q: np.ndarray, W: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """Rows named "q1 free" (the target within 1e-7 L of axis 1) whose point misses a target that is not
+        exactly on the axis: q1 cannot be read from a point that the root put on the axis itself (where its distance
+        to axis 1 has a double root in q3, say, the candidate misses the target by the target's own distance
+        r ~ 1e-9 to the axis).  First order in (δ2, δ3): the height equation is linear, the distance to the axis
+        |a + B δ| = r a quadratic along its solution line; the smaller root is taken, q1 then by the angle."""
+        Wb = np.broadcast_to(W[:, None], q.shape)
+        r = np.hypot(Wb[..., 0], Wb[..., 1])
+        rows = near & np.all(np.isfinite(q), -1) & (r >= 1e-12 * self.L)
+        rows &= np.linalg.norm(self.point(np.nan_to_num(q)) - Wb, axis=-1) > REFINE_ABOVE * self.L
+        if not rows.any():
+            return q
+        x, Wr, rr = q[rows], Wb[rows], r[rows]
+        h = 1e-6
+        g0 = self.g(x[:, 1], x[:, 2])
+        V = np.stack([(self.g(x[:, 1] + h * d[0], x[:, 2] + h * d[1]) - self.g(x[:, 1] - h * d[0], x[:, 2] - h * d[1]))
+                      / (2 * h) for d in ((1.0, 0.0), (0.0, 1.0))], -1)  # (b, 3, 2): ∂g/∂(q2, q3)
+        vz = V[:, 2]  # height: vz · δ = W_z − g0_z
+        nz = np.maximum(np.sum(vz**2, -1), 1e-300)
+        d0 = vz * ((Wr[:, 2] - g0[:, 2]) / nz)[:, None]
+        n = np.stack([-vz[:, 1], vz[:, 0]], -1) / np.sqrt(nz)[:, None]
+        a = g0[:, :2] + np.einsum("bij,bj->bi", V[:, :2], d0)
+        Bn = np.einsum("bij,bj->bi", V[:, :2], n)
+        A2, A1, A0 = np.sum(Bn**2, -1), 2 * np.sum(a * Bn, -1), np.sum(a**2, -1) - rr**2
+        disc = np.maximum(A1**2 - 4 * A2 * A0, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ts = np.stack([(-A1 + np.sqrt(disc)) / (2 * A2), (-A1 - np.sqrt(disc)) / (2 * A2)], -1)
+        t = np.take_along_axis(ts, np.argmin(np.abs(np.nan_to_num(ts, nan=np.inf)), -1)[:, None], -1)[:, 0]
+        y = x.copy()
+        y[:, 1:] += d0 + np.nan_to_num(t)[:, None] * n
+        y[:, 0] = angle_about_z(self.g(y[:, 1], y[:, 2]), Wr)
+        better = np.linalg.norm(self.point(y) - Wr, axis=-1) < np.linalg.norm(self.point(x) - Wr, axis=-1)
+        out = q.copy()
+        out[rows] = np.where(better[:, None], y, x)
+        return out
 
     def _clustered(self, q, free, W, w, clustered, centre):
         """More candidates for the poses whose resultant roots cluster: a multiple root of this order's resultant
