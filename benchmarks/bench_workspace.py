@@ -2,11 +2,13 @@
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
               [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--markdown FILE]
-Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows only)
-of this process and of the largest finished worker process, the 1-minute load average at the end of the run,
-the refinement (cells refined × sub-cells per side) and the reported volume with its interval.  ``--cluster`` also runs the largest
-sample count on a local process pool and on two local dask.distributed clusters (2 worker processes; Dask's
-defaults, and scale.LOCAL_CLUSTER_CONFIG), ``--repeat`` times each, and checks the counts are identical.
+Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows
+only) of this process and of the largest finished worker process, the peak PSS of the whole process tree
+during the run (sampled every 0.5 s; shared library pages split between the processes), the 1-minute load
+average at the end of the run, the refinement (cells refined × sub-cells per side) and the reported volume
+with its interval.  ``--cluster`` also runs the largest sample count on a local process pool and on two local
+dask.distributed clusters (2 worker processes; Dask's defaults, and scale.LOCAL_CLUSTER_CONFIG),
+``--repeat`` times each, and checks the counts are identical.
 """
 
 from __future__ import annotations
@@ -26,18 +28,60 @@ def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
+class TreeMemory:
+    """Largest proportional set size (PSS: shared pages split between the processes sharing them) of this
+    process and all its descendants, sampled every ``every`` seconds in a thread (needs psutil; else nan)."""
+
+    def __init__(self, every: float = 0.5) -> None:
+        import threading
+
+        self.every, self.peak, self._stop = every, float("nan"), threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        try:
+            import psutil
+        except ImportError:
+            return
+        me = psutil.Process()
+        self.peak = 0.0
+        while True:
+            stop = self._stop.is_set()  # one last sample after the run
+            total = 0
+            for p in [me] + me.children(recursive=True):
+                try:
+                    total += p.memory_full_info().pss
+                except (psutil.Error, OSError):
+                    pass
+            self.peak = max(self.peak, total / 2**20)
+            if stop:
+                return
+            self._stop.wait(self.every)
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        self._thread.join()
+
+
 def run_samples(robot, counts, scheduler, workers) -> list[str]:
-    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] driver / largest worker | load | refined cells × k "
-            "| cell edge [m] | coverage | volume [m³] | interval [m³] | width [m³] |",
-            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
+    rows = ["| samples | wall [s] | samples/s | peak RSS [MB] driver / largest worker | peak PSS of all "
+            "processes [MB] | load | refined cells × k | cell edge [m] | coverage | volume [m³] | interval [m³] "
+            "| width [m³] |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
     for n in counts:
         t0 = time.perf_counter()
-        ws = occupancy(robot, n, seed=1, scheduler=scheduler, workers=workers, progress=None)
+        with TreeMemory() as tree:
+            ws = occupancy(robot, n, seed=1, scheduler=scheduler, workers=workers, progress=None)
         dt = time.perf_counter() - t0
         e, r = ws.estimate, ws.refinement
         kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
         ref = "–" if r is None else f"{r.cells.size} × {r.factor}"
-        rows.append(f"| {n:.0e} | {dt:.1f} | {n / dt:.3g} | {peak_mb():.0f} / {kids:.0f} | {os.getloadavg()[0]:.1f} | "
+        rows.append(f"| {n:.0e} | {dt:.1f} | {n / dt:.3g} | {peak_mb():.0f} / {kids:.0f} | {tree.peak:.0f} | "
+                    f"{os.getloadavg()[0]:.1f} | "
                     f"{ref} | {e.resolution:.3g} | {e.coverage:.4f} | {e.value:.4g} | [{e.low:.4g}, {e.high:.4g}] | "
                     f"{e.high - e.low:.3g} |")
         print(rows[-1], flush=True)

@@ -52,12 +52,12 @@ def test_analytic_reachability_agrees_with_numeric_ik():
     g = rmap.grid
     rng = np.random.default_rng(0)
     reached, missed = np.argwhere(rmap.fraction > 0), np.argwhere(rmap.fraction == 0)
-    assert len(reached) >= 6 and len(missed) >= 3
+    assert len(reached) >= 5 and len(missed) >= 2
     # reached cells (a random draw of all cells was ~95 % outside the workspace: nothing checked the reached
     # ones) and a few missed ones (each failing numeric solve costs ~0.3 s of restarts)
-    cells = np.concatenate([reached[rng.choice(len(reached), 6, replace=False)],
-                            missed[rng.choice(len(missed), 3, replace=False)]])
-    T = _poses(g, cells, rmap.orientations)  # (9, 6, 4, 4)
+    cells = np.concatenate([reached[rng.choice(len(reached), 5, replace=False)],
+                            missed[rng.choice(len(missed), 2, replace=False)]])
+    T = _poses(g, cells, rmap.orientations)  # (7, 6, 4, 4)
     agree = total = solved = 0
     for i, c in enumerate(cells):
         for k in range(len(rmap.orientations)):
@@ -72,7 +72,7 @@ def test_analytic_reachability_agrees_with_numeric_ik():
         f_direct = np.mean([denavit.analytic_ik(robot, T[i, k]).solutions.shape[0] > 0
                             for k in range(len(rmap.orientations))])
         assert rmap.fraction[tuple(c)] == pytest.approx(f_direct)
-    assert agree >= 0.9 * total and solved >= 6
+    assert agree >= 0.9 * total and solved >= 5
 
 
 def test_manipulability_is_the_best_solution_averaged():

@@ -10,12 +10,13 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
                        reach_bound, sampling_limits)
-from ._schedule import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
+from ._schedule import (CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, LOCAL_SCHEDULERS, MAX_WORKERS,
+                        check_scheduler)
 from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
 from ._refine import MAX_REFINE, PILOT_SHARE, REFINE_CELLS, REFINE_COVERAGE, Refinement
 from ._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, ReachabilityMap, orientation_set, reachability
-from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, Occupancy, load_occupancy,
-                         new_seed, occupancy, sample_positions)
+from ._occupancy import (CLUSTER_CHUNK, DEFAULT_CHUNK, MAX_CHUNK, MAX_SAMPLES, TAIL_SHARE, Occupancy,
+                         load_occupancy, new_seed, occupancy, sample_positions)
 
 __all__ = [
     "BLOCK",
@@ -35,6 +36,7 @@ __all__ = [
     "PILOT_SHARE",
     "REFINE_CELLS",
     "REFINE_COVERAGE",
+    "TAIL_SHARE",
     "Refinement",
     "MAX_SAMPLES",
     "MAX_WORKERS",

@@ -16,7 +16,7 @@ from ._schedule import POOLS, Progress, resolve_auto, run
 from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK",
-           "CLUSTER_CHUNK", "MAX_CHUNK", "new_seed"]
+           "CLUSTER_CHUNK", "MAX_CHUNK", "TAIL_SHARE", "new_seed"]
 
 #: Most samples in one run (10¹⁰ ≈ 1 h here with the default FK; bounded time).
 MAX_SAMPLES = 10**10
@@ -26,6 +26,8 @@ DEFAULT_CHUNK = 4 * BLOCK
 CLUSTER_CHUNK = 16 * BLOCK
 #: Most samples per task.
 MAX_CHUNK = 64 * BLOCK
+#: A task takes at most 1/TAIL_SHARE of the blocks left (tasks shrink towards the end of a run or a pilot).
+TAIL_SHARE = 8
 
 
 def new_seed() -> int:
@@ -55,7 +57,8 @@ class Occupancy:
         come first).
     refinement : Refinement or None
         The cells of ``counts`` that also carry sub-cell counts (see :mod:`denavit.scale._refine`).
-    fine : ndarray of uint32 (uint64 past 2³² samples after the pilot), shape (len(refinement.cells), factor**dim), or None
+    fine : ndarray of uint32 (uint64 past 2³² samples after the pilot), or None
+        Shape (len(refinement.cells), factor**dim).
         Sub-cell counts of the refined cells (row-major sub-cells; from the samples after the pilot).
     """
 
@@ -139,10 +142,16 @@ def _estimate(counts: np.ndarray, grid: Grid, ref: Refinement | None, fine) -> t
 
 
 def _tasks(samples: int, chunk: int, start: int = 0, stop: int | None = None):
+    """(first block, blocks) of each task from block ``start`` to ``stop``: ``chunk`` samples each, smaller
+    towards the end (at most 1/TAIL_SHARE of what is left), so workers finish together before a barrier or
+    the end of the run.  Results do not depend on the split."""
     blocks = -(-samples // BLOCK) if stop is None else stop
-    per = max(1, chunk // BLOCK)
-    for first in range(start, blocks, per):
-        yield first, min(per, blocks - first)
+    most = max(1, chunk // BLOCK)
+    first = start
+    while first < blocks:
+        per = min(most, max(1, -(-(blocks - first) // TAIL_SHARE)))
+        yield first, per
+        first += per
 
 
 def _check_sizes(samples: int, chunk: int) -> None:

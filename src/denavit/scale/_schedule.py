@@ -18,7 +18,8 @@ from typing import Any, Callable, Iterable, Iterator
 
 from ..errors import MissingDependencyError, ParseError
 
-__all__ = ["LOCAL_SCHEDULERS", "POOLS", "LOCAL_CLUSTER_CONFIG", "AUTO_PROCESSES_FROM", "resolve_auto", "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
+__all__ = ["LOCAL_SCHEDULERS", "POOLS", "LOCAL_CLUSTER_CONFIG", "AUTO_PROCESSES_FROM", "resolve_auto",
+           "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
 
 #: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
 LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
