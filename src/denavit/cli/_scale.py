@@ -106,7 +106,7 @@ def _write_data(args, result) -> None:
 
 
 def cmd_workspace(args: argparse.Namespace):
-    from ..scale import MIN_COVERAGE, occupancy
+    from ..scale import BLOCK, MIN_COVERAGE, occupancy
 
     check_output(args, args.output, PICTURES, kind="picture format")
     check_output(args, args.data, DATA, what="--data")
@@ -139,7 +139,8 @@ def cmd_workspace(args: argparse.Namespace):
     if ws.refinement is not None:
         r = ws.refinement
         lines.append(f"boundary refined: {r.cells.size} cells of {ws.grid.resolution:.3g} m split {r.factor} per "
-                     f"side, counted after a pilot of {r.pilot_blocks} blocks")
+                     f"side, counted after a pilot of {r.pilot_blocks} block{'s' * (r.pilot_blocks != 1)} "
+                     f"of {BLOCK} samples")
     if e.coverage < MIN_COVERAGE:
         lines.append(f"too few samples for a trusted interval (coverage below {MIN_COVERAGE}): use more samples")
     lines += [f"wrote {p}" for p in (args.output, args.data) if p]
