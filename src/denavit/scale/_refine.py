@@ -49,7 +49,7 @@ REFINE_CELLS = 2**25
 _HALO_CHUNK = 2**15  # refined cells per step of the sub-cell erosion (bounds its scratch memory)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Refinement:
     """Which cells of the finest grid carry sub-cell counts, and how finely (picklable; travels with tasks).
 
@@ -62,7 +62,7 @@ class Refinement:
     pilot_blocks : int
         Blocks of the pilot: sub-cell counts come from the blocks after them.
     token : str
-        Digest of ``cells`` (workers keep one cell → slot table per token).
+        Digest of ``cells`` (each process builds the bitmap of :func:`slot_map` once per token).
     """
 
     cells: np.ndarray
