@@ -62,9 +62,16 @@ def test_catalogue_arms_match_the_numeric_engine(name):
 
 @pytest.mark.slow
 def test_panda_matches_the_numeric_engine():
+    """The Panda's hand form (~1 MB of formulas: one lambdify, shared) against the numeric engine and, when it is
+    installed, Pinocchio (the Pinocchio test's Panda case, here so that the formulas are compiled once)."""
     robot = denavit.load_robot("panda")
     t = lagrangian_dynamics(robot, coriolis=False)
     _check_against_numeric(robot, t, np.random.default_rng(81), count=2)
+    try:
+        import pinocchio  # noqa: F401
+    except ImportError:
+        return
+    _check_against_pinocchio(robot, t)
 
 
 def _random_inertial_arm(rng, n_rows):
@@ -182,15 +189,20 @@ def test_a_generic_twist_stays_exact():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["puma560", "ur5", "panda"])
+@pytest.mark.parametrize("name", ["puma560", "ur5"])  # the Panda: in test_panda_matches_the_numeric_engine
 def test_symbolic_terms_match_pinocchio(name):
     """M (crba, armature included), g (computeGeneralizedGravity) and c = C q̇ (computeCoriolisMatrix) of
     Pinocchio, the model built by denavit.peers.to_pinocchio."""
-    pin = pytest.importorskip("pinocchio")
+    pytest.importorskip("pinocchio")
+    robot = denavit.load_robot(name)
+    _check_against_pinocchio(robot, lagrangian_dynamics(robot, coriolis=False))
+
+
+def _check_against_pinocchio(robot, t):
+    import pinocchio as pin
+
     from denavit.peers import to_pinocchio
 
-    robot = denavit.load_robot(name)
-    t = lagrangian_dynamics(robot, coriolis=False)
     f = _functions(robot, t)
     model, data, _ = to_pinocchio(robot)
     rng = np.random.default_rng(84)
