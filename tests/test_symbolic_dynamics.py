@@ -393,6 +393,12 @@ def test_generic_twist_6r_recursive_form_is_quick_and_right():
     text = _recursive_text(robot)
     assert time.perf_counter() - t0 < 120  # a generous bound (seconds on an idle machine), not a benchmark
     _check_printed(robot, text, rng, count=2)
+    from denavit.report import Equation, Text, derive  # the report writes this form too, and checks it
+
+    sec = derive(robot, q=list(rng.uniform(-1, 1, 6)), qd=[1] * 6, topics=["dynamics"]).section("dynamics")
+    assert "M_{11}" in [x.lhs for x in sec.steps if isinstance(x, Equation)]
+    texts = " ".join(x.text for x in sec.steps if isinstance(x, Text))
+    assert "these formulas at the case vs the numeric engine: M agree" in texts and "DISAGREE" not in texts
 
 
 @pytest.mark.skipif(shutil.which("pdflatex") is None, reason="no LaTeX engine")

@@ -5,7 +5,8 @@ as a person writes it (Spong, Hutchinson & Vidyasagar 2006, sec. 7.1–7.4): the
 link and its velocity, ω, the kinetic and potential energies, L = K − P, ∂L/∂q̇_k, d/dt ∂L/∂q̇_k, ∂L/∂q_k and
 τ_k, then the split τ = M(q) q̈ + c(q, q̇) + g(q) (+ friction).  Arms of up to :data:`HAND_FORM_MAX_DOF`
 joints get M, c, g in closed form entry by entry (``lagrangian_dynamics``, hand form); longer ones (7 joints:
-entries of pages) as recursions in named link quantities (``recursive_dynamics``), evaluated at the case.  The numbers at the case come from the numeric engine
+entries of pages) and arms with generic twists as recursions in named link quantities (``recursive_dynamics``,
+where ``dynamics_form`` picks it), evaluated at the case.  The numbers at the case come from the numeric engine
 (CRBA mass matrix, Christoffel c, gravity torques); the symbolic results evaluated at the same point are
 compared with them, and c + g is compared with the recursive Newton–Euler torques at q̈ = 0 (Craig 2005,
 sec. 6.5): independent routes.
@@ -106,12 +107,15 @@ def _symbolic(ctx: Context, steps: list) -> Any:
         return None
     if robot.dof > SYMBOLIC_MAX_DOF:
         hand = _capabilities.capability("denavit.symbolic", "lagrangian_dynamics")
-        if hand is not None and robot.dof <= HAND_FORM_MAX_DOF:
-            return _hand_form(ctx, steps, hand)
         recursive = _capabilities.capability("denavit.symbolic", "recursive_dynamics")
-        if recursive is not None:
+        form = _capabilities.capability("denavit.symbolic", "dynamics_form")
+        # the recursive form where the symbolic engine would pick it (7 joints, or generic twists: a generic
+        # 6R's hand form takes more than ten minutes)
+        if recursive is not None and (robot.dof > HAND_FORM_MAX_DOF or (form and form[1](robot) == "recursive")):
             _recursive_form(ctx, steps, recursive)
             return None
+        if hand is not None and robot.dof <= HAND_FORM_MAX_DOF:
+            return _hand_form(ctx, steps, hand)
         steps.append(Text(f"The symbolic Lagrange derivation is printed for arms of at most {SYMBOLIC_MAX_DOF} joints, "
                           f"and M, c, g in closed form for at most {HAND_FORM_MAX_DOF}; for {robot.dof} joints the "
                           "entries run to pages (the function lagrangian_dynamics of denavit.symbolic derives them, "
