@@ -6,7 +6,7 @@ Importing this package imports sympy (the derivation is symbolic); ``import dena
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 from ._derivation import MAX_CASES, TOPICS, Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text, derive
 from ._pdf import latex_engine, pdf_from_latex

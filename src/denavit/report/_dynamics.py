@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from ..symbolic import HAND_FORM_MAX_DOF
 from . import _capabilities
 from ._context import Context
 from ._derivation import Equation, Numbers, Section, Text
@@ -26,7 +27,6 @@ from ._derivation import Equation, Numbers, Section, Text
 __all__ = ["section_dynamics", "SYMBOLIC_MAX_DOF", "HAND_FORM_MAX_DOF", "symbolic_terms_at"]
 
 SYMBOLIC_MAX_DOF = 3
-HAND_FORM_MAX_DOF = 6  # M, c, g in closed form (lagrangian_dynamics, ~1 s for a 6-joint arm) up to this many joints
 AGREE_TOL = 1e-9
 
 

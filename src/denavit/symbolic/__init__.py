@@ -14,7 +14,7 @@ from ._dynamics import (
 )
 from ._dynamics_trig import fourier_form
 from ._dynamics_ring import PARAMETER_NAMES, regressor_sym
-from ._recursive import RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
+from ._recursive import HAND_FORM_MAX_DOF, RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
 from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
 from ._kinematics import dh_matrix_sym, forward_kinematics_sym, link_matrices_sym, link_transforms_sym
@@ -59,6 +59,7 @@ __all__ = [
     "regressor_sym",
     "RecursiveDynamics",
     "format_recursive",
+    "HAND_FORM_MAX_DOF",
     "dynamics_form",
     "recursive_dynamics",
     "LagrangeSteps",

@@ -25,7 +25,7 @@ from .. import _expr
 from ..chain import chain_of
 from ..errors import ModelError
 from ..model import DHRobot, JointType, inertial_rows
-from ._kinematics import link_matrices_sym, link_transforms_sym
+from ._kinematics import link_matrices_sym
 from ._dynamics_trig import collect_trig, fourier_form
 from ._simplify import POLICIES, shorthand, simplify_expr
 from ._symbols import joint_symbols, matrix_from_floats, parameter_symbols
