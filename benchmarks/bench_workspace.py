@@ -6,9 +6,9 @@ Each row is one run in this process: wall time, samples/s, peak resident memory 
 only) of this process and of the largest finished worker process, the peak PSS of the whole process tree
 during the run (sampled every 0.5 s; shared library pages split between the processes), the 1-minute load
 average at the end of the run, the refinement (cells refined × sub-cells per side) and the reported volume
-with its interval.  ``--cluster`` also runs the largest sample count on a local process pool and on two local
-dask.distributed clusters (2 worker processes; Dask's defaults, and scale.LOCAL_CLUSTER_CONFIG),
-``--repeat`` times each, and checks the counts are identical.
+with its interval.  ``--cluster`` also runs the largest sample count on a local process pool and on a local
+dask.distributed cluster (2 worker processes; Dask's defaults, then scale.LOCAL_CLUSTER_CONFIG; one cluster at
+a time), ``--repeat`` times each, and checks the counts are identical.
 """
 
 from __future__ import annotations
@@ -99,55 +99,45 @@ def _children_cpu() -> float:
 
 
 def run_cluster(robot, n, repeat: int = 1) -> list[str]:
-    """Local process pool of 2 against LocalClusters of 2 single-threaded worker processes — one with Dask's
-    default settings, one with ``scale.LOCAL_CLUSTER_CONFIG`` (what ``scheduler="dask"`` starts) — alternating,
-    ``repeat`` times each, same seed; medians of wall time and of CPU time (all processes of the setup: the
-    driver, which also hosts the Dask scheduler, and the workers).  The clusters are started once, before the
-    timings; each local run starts its pool (spawn and kernel load included: about a second)."""
+    """A local process pool of 2 against a LocalCluster of 2 single-threaded worker processes, one cluster at a
+    time (an idle cluster's workers and scheduler would take CPU from every other measurement): first with
+    Dask's default settings, then with ``scale.LOCAL_CLUSTER_CONFIG`` (what ``scheduler="dask"`` starts).  For
+    each, pool and cluster runs alternate ``repeat`` times (same seed); medians of wall time and of CPU time
+    (all processes of the setup: the driver, which also hosts the Dask scheduler, and the workers).  The
+    cluster is started before the timings; each pool run starts its pool (spawn and kernel load included)."""
     import dask
     from distributed import Client, LocalCluster
 
     from denavit.scale import LOCAL_CLUSTER_CONFIG
 
-    wall = {"local": [], "dask": [], "tuned": []}
-    cpu = {k: [] for k in wall}
-    same, load = True, [os.getloadavg()[0]]
-
-    def worker_cpu(client):
-        return sum(client.run(_cpu).values())
-
+    lines = [f"2 workers, {n:.0e} samples, medians of {repeat} alternating runs, one cluster at a time", "",
+             "| cluster settings | pool wall [s] | cluster wall [s] | wall ratio | pool CPU ns/sample | cluster CPU "
+             "ns/sample | CPU ratio | load | identical counts |",
+             "|---|---:|---:|---:|---:|---:|---:|---|---|"]
     kw = dict(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
-    with LocalCluster(**kw) as c1, Client(c1) as default_client:
-        with dask.config.set(LOCAL_CLUSTER_CONFIG):
-            c2 = LocalCluster(**kw)
-        with c2, Client(c2) as tuned_client:
-            for client in (default_client, tuned_client):  # warm the workers (kernel load)
-                occupancy(robot, 4 * 65536, seed=1, scheduler=client)
+    for name, config in (("Dask defaults", {}), ("LOCAL_CLUSTER_CONFIG", LOCAL_CLUSTER_CONFIG)):
+        wall, cpu, same, load = {"pool": [], "cluster": []}, {"pool": [], "cluster": []}, True, []
+        with dask.config.set(config):
+            cluster = LocalCluster(**kw)
+        with cluster, Client(cluster) as client:
+            occupancy(robot, 4 * 65536, seed=1, scheduler=client)  # warm the workers (kernel load)
             for _ in range(repeat):
                 m0, k0, t0 = _cpu(), _children_cpu(), time.perf_counter()
                 ref = occupancy(robot, n, seed=1, scheduler="processes", workers=2)
-                wall["local"].append(time.perf_counter() - t0)
-                cpu["local"].append(_cpu() - m0 + _children_cpu() - k0)
-                for key, client in (("dask", default_client), ("tuned", tuned_client)):
-                    w0, m0, t0 = worker_cpu(client), _cpu(), time.perf_counter()
-                    ws = occupancy(robot, n, seed=1, scheduler=client)
-                    wall[key].append(time.perf_counter() - t0)
-                    cpu[key].append(_cpu() - m0 + worker_cpu(client) - w0)
-                    same &= bool(np.array_equal(ws.counts, ref.counts))
+                wall["pool"].append(time.perf_counter() - t0)
+                cpu["pool"].append(_cpu() - m0 + _children_cpu() - k0)
+                w0, m0, t0 = sum(client.run(_cpu).values()), _cpu(), time.perf_counter()
+                ws = occupancy(robot, n, seed=1, scheduler=client)
+                wall["cluster"].append(time.perf_counter() - t0)
+                cpu["cluster"].append(_cpu() - m0 + sum(client.run(_cpu).values()) - w0)
+                same &= bool(np.array_equal(ws.counts, ref.counts))
                 load.append(os.getloadavg()[0])
-    med = {k: float(np.median(v)) for k, v in wall.items()}
-    cmed = {k: float(np.median(v)) for k, v in cpu.items()}
-    lines = [f"2 workers, {n:.0e} samples, medians of {repeat} alternating runs, load average "
-             f"{min(load):.1f}–{max(load):.1f}; identical counts: {same}", "",
-             "| setup | wall [s] | samples/s | wall ratio to the pool | CPU [s] | CPU ns/sample | CPU ratio |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
-    names = {"local": "local process pool", "dask": "LocalCluster, Dask defaults",
-             "tuned": "LocalCluster, LOCAL_CLUSTER_CONFIG (scheduler='dask')"}
-    for k in wall:
-        lines.append(f"| {names[k]} | {med[k]:.1f} | {n / med[k]:.3g} | {med['local'] / med[k]:.2f} | {cmed[k]:.1f} "
-                     f"| {cmed[k] / n * 1e9:.0f} | {cmed['local'] / cmed[k]:.2f} |")
-    lines.append("")
-    lines.append("each run [s]: " + "; ".join(f"{k} {', '.join(f'{t:.1f}' for t in v)}" for k, v in wall.items()))
+        w = {k: float(np.median(v)) for k, v in wall.items()}
+        c = {k: float(np.median(v)) / n * 1e9 for k, v in cpu.items()}
+        lines.append(f"| {name} | {w['pool']:.2f} | {w['cluster']:.2f} | {w['pool'] / w['cluster']:.2f} | "
+                     f"{c['pool']:.0f} | {c['cluster']:.0f} | {c['pool'] / c['cluster']:.2f} | "
+                     f"{min(load):.1f}–{max(load):.1f} | {same} |")
+        print(lines[-1], flush=True)
     return lines
 
 
