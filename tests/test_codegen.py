@@ -203,7 +203,7 @@ needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (the 'fast
 @needs_numba
 def test_simd_batches_sine_and_cosine_agree_with_libm():
     """Batches run LANES rows at once with the kernel's own vector sin/cos (Cody–Waite reduction, Taylor
-    polynomials); a one-joint arm's T[0, 0] and T[1, 0] are cos q and sin q, compared with numpy's (libm) within
+    polynomials; single calls use the same in scalar form); a one-joint arm's T[0, 0] and T[1, 0] are cos q and sin q, compared with numpy's (libm) within
     two ulps of 1 — angles across the reduction's range, at multiples of π/2 (the quadrant edges), huge ones
     (libm's path per lane), ±inf and NaN, and batch lengths that leave a scalar remainder."""
     robot = denavit.robot([denavit.revolute(a=1.0)])
@@ -217,6 +217,12 @@ def test_simd_batches_sine_and_cosine_agree_with_libm():
         T = fast.fk(q[:n, None])
         np.testing.assert_allclose(T[:, 0, 0], np.cos(q[:n]), rtol=0, atol=2 * np.finfo(float).eps)
         np.testing.assert_allclose(T[:, 1, 0], np.sin(q[:n]), rtol=0, atol=2 * np.finfo(float).eps)
+    for x in np.concatenate([q[::97], q[-90:]]):  # one configuration: the same polynomial, in scalar form
+        T = fast.fk(np.array([x]))
+        assert abs(T[0, 0] - np.cos(x)) <= 2 * np.finfo(float).eps and abs(T[1, 0] - np.sin(x)) <= 2 * np.finfo(float).eps
+    one = np.empty((4, 4))
+    fast._m.fk_1(np.array([np.inf]), one)
+    assert np.isnan(one[:2, :2]).all()
     odd = np.array([np.inf, 0.3, np.nan, -np.inf, 0.5, 0.7, 0.9])[:, None]
     out = np.empty((7, 4, 4))  # the kernel itself: the wrapper refuses non-finite q
     fast._m.fk_n(odd, out)

@@ -12,11 +12,12 @@ No fast-math flags are set: no reassociation and no fused multiply-adds, so the 
 numpy backend, operation for operation.
 
 Batches also get a third, SIMD form: the same program on ``<LANES x double>`` vectors, LANES rows at once (one
-AVX2 register).  libm has no vector sine, so there sin and cos come from :func:`_vector_sincos` — Cody–Waite
+AVX2 register).  libm has no vector sine, so there sin and cos come from :func:`_poly_sincos` — Cody–Waite
 reduction by π/2 in three parts (exact for |x| < 2**19·π/2) and Taylor polynomials on [−π/4, π/4] truncated
 below 1e-19 — within an ulp or two of libm; lanes with |x| beyond the reduction's range (or ±inf) take libm's
-``sincos``, one lane at a time.  At the end of a batch the lanes past the last row are masked (they store
-nothing), so a batch kernel holds only the vector form.
+``sincos``, one lane at a time.  The one-configuration forms use the same polynomials on doubles (an inline
+polynomial overlaps with the rest of the program; a libm call does not).  At the end of a batch the lanes
+past the last row are masked (they store nothing), so a batch kernel holds only the vector form.
 
 Program format (what the generated module embeds as literals): ``steps`` is a tuple of ``(op, a, b)`` in
 evaluation order, each operand either ``("n", j)`` (the value of step j), ``("c", x)`` (a double constant) or
@@ -49,8 +50,7 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
 
     ``f(in_0, …, in_{k-1}, out)``: the inputs are vectors and ``out`` has the kernel's shape.
     ``f_row(in_0, …, out, b)``: the inputs are (B, k) arrays and ``out`` (B,) + shape; row ``b`` is computed — no
-    array views per row, so a batch loop does no reference counting.  sin and cos of one argument are one
-    ``sincos`` call (glibc, libm).
+    array views per row, so a batch loop does no reference counting.
     ``f_rows(in_0, …, out, b)``: rows ``b … b + LANES − 1`` at once, in SIMD; lanes past the last row (B mod
     LANES at the end of a batch) compute a copy of the last row and store nothing."""
     from llvmlite import ir
@@ -152,12 +152,7 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             elif op in ("sin", "cos"):
                 pair = both.get(repr(a))
                 if pair is None:
-                    if lanes:
-                        pair = _vector_sincos(builder, A, lanes, sincos, const)
-                    else:
-                        s_ptr, c_ptr = cgutils.alloca_once(builder, dbl), cgutils.alloca_once(builder, dbl)
-                        builder.call(sincos, [A, s_ptr, c_ptr])
-                        pair = (builder.load(s_ptr), builder.load(c_ptr))
+                    pair = _poly_sincos(builder, A, lanes, sincos, const)
                     both[repr(a)] = pair
                 v = pair[0] if op == "sin" else pair[1]
             elif op == "sign":  # 1, −1 or 0 (NaN stays NaN through the multiplications it feeds)
@@ -218,15 +213,19 @@ def _intrinsic(module, name: str, ty, n_args: int):
     return cgutils.get_or_insert_function(module, ir.FunctionType(ty, [ty] * n_args), f"llvm.{name}.{suffix}")
 
 
-def _vector_sincos(builder, x, lanes: int, sincos, const):
-    """(sin x, cos x) of a ``<lanes x double>`` vector: Cody–Waite reduction x = k·π/2 + r, the Taylor
-    polynomials of sin r and cos r, and the quadrant k mod 4 choosing ±sin r / ±cos r.  Lanes with
-    |x| > _REDUCTION_RANGE (or ±inf) are recomputed by libm's scalar ``sincos``."""
+def _poly_sincos(builder, x, lanes: int, sincos, const):
+    """(sin x, cos x) of a double (``lanes`` 0) or a ``<lanes x double>`` vector: Cody–Waite reduction
+    x = k·π/2 + r, the Taylor polynomials of sin r and cos r, and the quadrant k mod 4 choosing ±sin r / ±cos r.
+    Values with |x| > _REDUCTION_RANGE (or ±inf) are recomputed by libm's scalar ``sincos``."""
     from llvmlite import ir
     from numba.core import cgutils
 
     dbl, i64 = ir.DoubleType(), ir.IntType(64)
-    vty, ity = ir.VectorType(dbl, lanes), ir.VectorType(i64, lanes)
+    vty, ity = (ir.VectorType(dbl, lanes), ir.VectorType(i64, lanes)) if lanes else (dbl, i64)
+
+    def iconst(m: int):
+        return ir.Constant(ity, [m] * lanes) if lanes else ir.Constant(i64, m)
+
     module = builder.module
     rint, fabs = _intrinsic(module, "rint", vty, 1), _intrinsic(module, "fabs", vty, 1)
     k = builder.call(rint, [builder.fmul(x, const(_TWO_OVER_PI))])
@@ -246,23 +245,24 @@ def _vector_sincos(builder, x, lanes: int, sincos, const):
                      builder.fmul(builder.fmul(z, z), horner(_COS)))
     in_range = builder.fcmp_ordered("<=", builder.call(fabs, [x]), const(_REDUCTION_RANGE))
     n = builder.fptosi(builder.select(in_range, k, const(0.0)), ity)  # the quadrant (0 where out of range or NaN)
-    bit = lambda m: builder.icmp_signed("!=", builder.and_(n, ir.Constant(ity, [m] * lanes)),  # noqa: E731
-                                        ir.Constant(ity, [0] * lanes))
-    swap = bit(1)
+    swap = builder.icmp_signed("!=", builder.and_(n, iconst(1)), iconst(0))
     sin_r, cos_r = builder.select(swap, c, s), builder.select(swap, s, c)
-    sin_v = builder.select(bit(2), builder.fneg(sin_r), sin_r)
-    n1 = builder.add(n, ir.Constant(ity, [1] * lanes))
-    cos_neg = builder.icmp_signed("!=", builder.and_(n1, ir.Constant(ity, [2] * lanes)), ir.Constant(ity, [0] * lanes))
+    sin_neg = builder.icmp_signed("!=", builder.and_(n, iconst(2)), iconst(0))
+    sin_v = builder.select(sin_neg, builder.fneg(sin_r), sin_r)
+    cos_neg = builder.icmp_signed("!=", builder.and_(builder.add(n, iconst(1)), iconst(2)), iconst(0))
     cos_v = builder.select(cos_neg, builder.fneg(cos_r), cos_r)
-    # lanes out of the reduction's range (±inf too): libm, one at a time; NaN lanes stay NaN on the vector path
+    # out of the reduction's range (±inf too): libm, one value at a time; NaN stays NaN on the polynomial path
     big = builder.and_(builder.not_(in_range), builder.fcmp_ordered("==", x, x))
-    s_vec, c_vec = cgutils.alloca_once_value(builder, sin_v), cgutils.alloca_once_value(builder, cos_v)
-    any_big = builder.icmp_unsigned("!=", builder.bitcast(big, ir.IntType(lanes)), ir.Constant(ir.IntType(lanes), 0))
+    s_out, c_out = cgutils.alloca_once_value(builder, sin_v), cgutils.alloca_once_value(builder, cos_v)
+    any_big = (builder.icmp_unsigned("!=", builder.bitcast(big, ir.IntType(lanes)), ir.Constant(ir.IntType(lanes), 0))
+               if lanes else big)
     with cgutils.if_unlikely(builder, any_big):
         s_ptr, c_ptr = cgutils.alloca_once(builder, dbl), cgutils.alloca_once(builder, dbl)
+        if not lanes:
+            builder.call(sincos, [x, s_out, c_out])
         for j in range(lanes):
             lane = ir.Constant(i64, j)
             builder.call(sincos, [builder.extract_element(x, lane), s_ptr, c_ptr])
-            builder.store(builder.insert_element(builder.load(s_vec), builder.load(s_ptr), lane), s_vec)
-            builder.store(builder.insert_element(builder.load(c_vec), builder.load(c_ptr), lane), c_vec)
-    return builder.load(s_vec), builder.load(c_vec)
+            builder.store(builder.insert_element(builder.load(s_out), builder.load(s_ptr), lane), s_out)
+            builder.store(builder.insert_element(builder.load(c_out), builder.load(c_ptr), lane), c_out)
+    return builder.load(s_out), builder.load(c_out)
