@@ -15,26 +15,9 @@ import denavit as dn
 from denavit.check import check_claims
 
 from conftest import REDUCED
-from test_check_shapes import _dh, _fk
+from test_check_shapes import _fk, dh_frames as _frames  # the test's own DH product
 
 ARMS = ["planar3r", "scara", "report000-6r", "puma560-mdh"]
-
-
-def _frames(robot, q):
-    """World poses of DH frames 0 … N (base applied), from the test's own DH matrices."""
-    T, k, out = np.asarray(robot.base_matrix, dtype=float), 0, []
-    out.append(T)
-    for link in robot.links:
-        th, d = link.theta, link.d
-        if link.is_joint:
-            if link.joint is dn.JointType.REVOLUTE:
-                th += q[k]
-            else:
-                d += q[k]
-            k += 1
-        T = T @ _dh(robot.convention.value, th, d, link.a, link.alpha)
-        out.append(T)
-    return out
 
 
 def _J0(robot, q, h=1e-6):

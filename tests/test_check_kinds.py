@@ -20,7 +20,7 @@ from denavit import symbolic as S
 from denavit.check import check_claims
 
 from conftest import REDUCED
-from test_check_shapes import _dh
+from test_check_shapes import dh_frames as _poses  # the test's own DH product
 
 ARMS = ["planar3r", "report000-planar3r", "scara", "stanford", "report000-6r", "puma560", "report004-4-rrp"]
 _ARMS_SLOW_6R = [pytest.param(a, marks=pytest.mark.slow) if a == "puma560" else a for a in ARMS]
@@ -325,23 +325,6 @@ def test_text_output_of_new_kinds_does_not_fail():
 
 
 # --- property: numeric claims at random q from an independent numeric route ------------------------------
-
-
-def _poses(robot, q):
-    """World poses of frames 0 … N by the test's own product of DH matrices (test_check_shapes._dh)."""
-    T, k, out = np.asarray(robot.base_matrix, dtype=float), 0, []
-    out.append(T)
-    for link in robot.links:
-        th, d = link.theta, link.d
-        if link.is_joint:
-            if link.joint is dn.JointType.REVOLUTE:
-                th += q[k]
-            else:
-                d += q[k]
-            k += 1
-        T = T @ _dh(robot.convention.value, th, d, link.a, link.alpha)
-        out.append(T)
-    return out
 
 
 @settings(max_examples=10 if REDUCED else 40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -28,9 +28,11 @@ def _dh(conv, th, d, a, al):
     return np.array([[ct, -st_, 0, a], [st_ * ca, ct * ca, -sa, -sa * d], [st_ * sa, ct * sa, ca, ca * d], [0, 0, 0, 1]])
 
 
-def _fk(robot, q):
-    """An independent forward kinematics: the product of the DH matrices written above (revolute joints)."""
-    T, k = np.asarray(robot.base_matrix, dtype=float), 0
+def dh_frames(robot, q):
+    """World poses of DH frames 0 … N (base applied, tool not): an independent product of the DH matrices
+    written above (revolute and prismatic joints)."""
+    T, k, out = np.asarray(robot.base_matrix, dtype=float), 0, []
+    out.append(T)
     for link in robot.links:
         th, d = link.theta, link.d
         if link.is_joint:
@@ -40,7 +42,13 @@ def _fk(robot, q):
                 d += q[k]
             k += 1
         T = T @ _dh(robot.convention.value, th, d, link.a, link.alpha)
-    return T @ np.asarray(robot.tool_matrix, dtype=float)
+        out.append(T)
+    return out
+
+
+def _fk(robot, q):
+    """An independent forward kinematics: :func:`dh_frames`' last frame, then the tool."""
+    return dh_frames(robot, q)[-1] @ np.asarray(robot.tool_matrix, dtype=float)
 
 
 def _planar3r_j(q, L=(1.0, 0.8, 0.6)):
