@@ -111,7 +111,7 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
     first = spec.inputs[0][0]
     k = spec.name
     return ([f"_{k}_steps = ("] + steps + [")", f"_{k}_outputs = ("] + outs + [")",
-            f"_{k}, _{k}_row, _{k}_rows = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
+            f"_{k}, _{k}_rows = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_1({args}, out):",
             f'    """{spec.doc}: one configuration, out {spec.shape}."""', f"    _{k}({args}, out)", "", "",
             "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",

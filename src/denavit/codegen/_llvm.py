@@ -3,7 +3,7 @@
 numba's front end (bytecode analysis, type inference, lowering) costs about a millisecond per Python
 statement, so a 1,000-statement RNEA written as Python source takes seconds to compile.  A kernel is already
 a typed straight-line program of doubles, so it needs none of that: :func:`kernel_intrinsic` makes a numba
-``@intrinsic`` that emits the program's instructions (``fadd``, ``fmul``, ``llvm.sin`` …) directly with
+``@intrinsic`` that emits the program's instructions (``fadd``, ``fmul``, …) directly with
 llvmlite's IR builder, and the generated module wraps it in two tiny ``@njit(cache=True)`` functions (one
 configuration, a batch loop).  LLVM then optimises the block as usual, numba caches the machine code on disk
 like any jitted function, and the Python-level cost is one builder call per instruction.
@@ -11,7 +11,7 @@ like any jitted function, and the Python-level cost is one builder call per inst
 No fast-math flags are set: no reassociation and no fused multiply-adds, so the numbers are those of the
 numpy backend, operation for operation.
 
-Batches also get a third, SIMD form: the same program on ``<LANES x double>`` vectors, LANES rows at once (one
+The batch form is SIMD: the same program on ``<LANES x double>`` vectors, LANES rows at once (one
 AVX2 register).  libm has no vector sine, so there sin and cos come from :func:`_poly_sincos` — Cody–Waite
 reduction by π/2 in three parts (exact for |x| < 2**19·π/2) and Taylor polynomials on [−π/4, π/4] truncated
 below 1e-19 — within an ulp or two of libm; lanes with |x| beyond the reduction's range (or ±inf) take libm's
@@ -46,13 +46,13 @@ _COS = tuple((-1.0) ** k / math.factorial(2 * k + 4) for k in range(7))
 
 
 def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
-    """Three numba intrinsics evaluating the program into ``out`` (each -> None).
+    """Two numba intrinsics evaluating the program into ``out`` (each -> None).
 
     ``f(in_0, …, in_{k-1}, out)``: the inputs are vectors and ``out`` has the kernel's shape.
-    ``f_row(in_0, …, out, b)``: the inputs are (B, k) arrays and ``out`` (B,) + shape; row ``b`` is computed — no
-    array views per row, so a batch loop does no reference counting.
-    ``f_rows(in_0, …, out, b)``: rows ``b … b + LANES − 1`` at once, in SIMD; lanes past the last row (B mod
-    LANES at the end of a batch) compute a copy of the last row and store nothing."""
+    ``f_rows(in_0, …, out, b)``: the inputs are (B, k) arrays and ``out`` (B,) + shape; rows ``b … b + LANES − 1``
+    are computed at once, in SIMD, with no array views per row (a batch loop does no reference counting);
+    lanes past the last row (B mod LANES at the end of a batch) compute a copy of the last row and store
+    nothing."""
     from llvmlite import ir
     from numba.core import cgutils, types
     from numba.extending import intrinsic
@@ -61,10 +61,10 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
     i64 = ir.IntType(64)
 
     def codegen(context, builder, sig, args, lanes):
-        batched = isinstance(sig.args[-1], types.Integer)
+        batched = bool(lanes)
         arrays = [context.make_array(ty)(context, builder, val)
                   for ty, val in zip(sig.args[:n_inputs + 1], args[:n_inputs + 1])]
-        rows = [args[-1]]
+        rows = [None]
         if lanes:  # rows b … b + lanes − 1; past the batch's end a lane reads the last row and stores nothing
             n_rows = cgutils.unpack_tuple(builder, arrays[0].shape)[0]
             last = builder.sub(n_rows, ir.Constant(i64, 1))
@@ -200,7 +200,7 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
                 return t(typingctx, a0, a1, a2, a3, a4)
         return intrinsic(kernel)
 
-    return arity(n_inputs + 1, 0), arity(n_inputs + 2, 0), arity(n_inputs + 2, LANES)
+    return arity(n_inputs + 1, 0), arity(n_inputs + 2, LANES)
 
 
 def _intrinsic(module, name: str, ty, n_args: int):
