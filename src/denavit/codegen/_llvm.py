@@ -83,9 +83,10 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
         constants: dict = {}
 
         def const(x: float):
-            c = constants.get(x)
+            key = (x, math.copysign(1.0, x))  # −0.0 == 0.0 as a key; its sign still matters
+            c = constants.get(key)
             if c is None:
-                c = constants[x] = ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
+                c = constants[key] = ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
             return c
 
         # each array's data pointer (as bytes) and strides, read once here (before any conditional block):
