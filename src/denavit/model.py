@@ -7,14 +7,14 @@ is kept in ``DHLink.symbols`` so the symbolic engine can keep ``H1`` as a symbol
 
 from __future__ import annotations
 
-import math
-import re
 from dataclasses import dataclass, field, replace
 from enum import Enum
-from typing import Any, Iterable
+from typing import Any
 
 import numpy as np
 
+from ._model_checks import (INERTIA_TOLERANCE, MAX_ANGLE, MAX_JOINTS, MAX_MAGNITUDE, MAX_POSES, POSE_LIMIT_TOL,
+                            TRIANGLE_TOLERANCE, check_inertia_tensor, checked_poses, checked_transform, finite)
 from .errors import ModelError
 
 __all__ = [
@@ -30,6 +30,8 @@ __all__ = [
     "MAX_MAGNITUDE",
     "MAX_ANGLE",
     "MAX_JOINTS",
+    "MAX_POSES",
+    "POSE_LIMIT_TOL",
     "INERTIA_TOLERANCE",
     "TRIANGLE_TOLERANCE",
 ]
@@ -75,58 +77,6 @@ class JointType(str, Enum):
     FIXED = "fixed"
 
 
-#: Bound on every length [m], mass [kg], inertia [kg m²], friction coefficient and gravity component [m/s²]
-#: of a model: far beyond any real arm, and small enough that products in the dynamics (m·L²·q̇², sums over
-#: 32 joints) stay many orders of magnitude below float overflow.
-MAX_MAGNITUDE = 1e6
-#: Bound on every angle [rad] (DH twists and offsets, revolute limits): about 160 turns.  Beyond it an angle
-#: is not a meaningful configuration (and float angles lose their precision).
-MAX_ANGLE = 1e3
-#: Bound on the number of joint variables of one arm (work grows with n² to n⁴ in Jacobians and dynamics).
-MAX_JOINTS = 32
-#: Tolerance on the inertia checks (negative principal moments, asymmetry), relative to the largest moment.
-INERTIA_TOLERANCE = 1e-9
-#: Tolerance on the triangle inequality I1 + I2 >= I3 of principal moments, relative to I3.  Published data
-#: sets are not always consistent (the PUMA 560 link 3 of Armstrong et al. misses it by 9 %), so only a clear
-#: violation is refused.
-TRIANGLE_TOLERANCE = 0.1
-
-
-def _finite(value: float, what: str, bound: float | None = None, unit: str = "") -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise ModelError(f"{what} must be a number, got {value!r:.60}") from None
-    if not math.isfinite(v):
-        raise ModelError(f"{what} must be finite, got {value!r:.60}")
-    if bound is not None and abs(v) > bound:
-        raise ModelError(f"{what} = {v:.6g}{unit} is out of range (at most {bound:g}{unit} in magnitude)")
-    return v
-
-
-def check_inertia_tensor(I: Any, mass: float = 1.0, what: str = "inertia") -> None:
-    """Refuse a 3×3 inertia tensor that no rigid body has (ModelError naming the reason).
-
-    Checks: symmetric; principal moments non-negative; and, for a body with mass, the triangle
-    inequality I1 + I2 >= I3 of the principal moments (within :data:`TRIANGLE_TOLERANCE`).  A massless
-    row may carry a rotational inertia alone (a lumped rotor, as on the PUMA 560's first link).
-    """
-    I = np.asarray(I, dtype=float)  # (3, 3)
-    scale = float(np.abs(I).max()) if I.size else 0.0
-    if scale == 0.0:
-        return
-    if np.abs(I - I.T).max() > INERTIA_TOLERANCE * scale:
-        raise ModelError(f"{what}: the 3×3 tensor is not symmetric")
-    moments = np.linalg.eigvalsh(I)  # ascending
-    if moments[0] < -INERTIA_TOLERANCE * scale:
-        raise ModelError(f"{what}: a principal moment is negative ({moments[0]:.3g} kg m²); no body has that")
-    if mass > 0 and moments[0] + moments[1] < moments[2] * (1 - TRIANGLE_TOLERANCE):
-        raise ModelError(
-            f"{what}: principal moments {moments[0]:.3g}, {moments[1]:.3g}, {moments[2]:.3g} break the triangle "
-            f"inequality I1 + I2 >= I3; no body has that"
-        )
-
-
 @dataclass(frozen=True, slots=True)
 class LinkInertia:
     """Inertial data of one link, expressed in that link's DH frame {i}.
@@ -158,17 +108,17 @@ class LinkInertia:
     symbols: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
-        if _finite(self.mass, "mass", MAX_MAGNITUDE, " kg") < 0:
+        if finite(self.mass, "mass", MAX_MAGNITUDE, " kg") < 0:
             raise ModelError(f"mass must be non-negative, got {self.mass!r}")
         if len(self.com) != 3:
             raise ModelError(f"com must have 3 values, got {len(self.com)}")
         if len(self.inertia) != 6:
             raise ModelError(f"inertia must have 6 values {INERTIA_ORDER}, got {len(self.inertia)}")
         object.__setattr__(self, "mass", float(self.mass))
-        object.__setattr__(self, "com", tuple(_finite(c, "com", MAX_MAGNITUDE, " m") for c in self.com))
-        object.__setattr__(self, "inertia", tuple(_finite(c, "inertia", MAX_MAGNITUDE, " kg m²") for c in self.inertia))
+        object.__setattr__(self, "com", tuple(finite(c, "com", MAX_MAGNITUDE, " m") for c in self.com))
+        object.__setattr__(self, "inertia", tuple(finite(c, "inertia", MAX_MAGNITUDE, " kg m²") for c in self.inertia))
         for name in ("motor_inertia", "viscous", "coulomb"):
-            if _finite(getattr(self, name), name, MAX_MAGNITUDE) < 0:
+            if finite(getattr(self, name), name, MAX_MAGNITUDE) < 0:
                 raise ModelError(f"{name} must be non-negative, got {getattr(self, name)!r}")
             object.__setattr__(self, name, float(getattr(self, name)))
         check_inertia_tensor(self.inertia_matrix, self.mass)
@@ -204,7 +154,7 @@ class DHLink:
         for name in DH_FIELDS:
             angle = name in ("alpha", "theta")
             bound, unit = (MAX_ANGLE, " rad") if angle else (MAX_MAGNITUDE, " m")
-            object.__setattr__(self, name, _finite(getattr(self, name), name, bound, unit))
+            object.__setattr__(self, name, finite(getattr(self, name), name, bound, unit))
         if not isinstance(self.joint, JointType):
             try:
                 object.__setattr__(self, "joint", JointType(self.joint))
@@ -217,7 +167,7 @@ class DHLink:
             if len(self.q_limits) != 2:
                 raise ModelError(f"limits must be [low, high], got {self.q_limits!r}")
             bound, unit = (MAX_ANGLE, " rad") if self.joint is JointType.REVOLUTE else (MAX_MAGNITUDE, " m")
-            lo, hi = (_finite(v, "limit", bound, unit) for v in self.q_limits)
+            lo, hi = (finite(v, "limit", bound, unit) for v in self.q_limits)
             if lo > hi:
                 raise ModelError(f"limits low > high: [{lo}, {hi}]")
             object.__setattr__(self, "q_limits", (lo, hi))
@@ -233,22 +183,6 @@ class DHLink:
     def expression(self, field_name: str) -> str:
         """The expression text of a DH field (its number printed if none was given)."""
         return dict(self.symbols).get(field_name, repr(getattr(self, field_name)))
-
-
-def _as_transform(value: Any, what: str) -> tuple[tuple[float, ...], ...]:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (4, 4):
-        raise ModelError(f"{what} must be a 4×4 homogeneous transform, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{what} has non-finite entries")
-    R = arr[:3, :3]
-    if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
-        raise ModelError(f"{what} rotation part is not a rotation matrix")
-    if not np.allclose(arr[3], [0, 0, 0, 1]):
-        raise ModelError(f"{what} last row must be [0, 0, 0, 1]")
-    if np.abs(arr[:3, 3]).max() > MAX_MAGNITUDE:
-        raise ModelError(f"{what} translation is out of range (at most {MAX_MAGNITUDE:g} m in magnitude)")
-    return tuple(tuple(float(x) for x in row) for row in arr)
 
 
 @dataclass(frozen=True)
@@ -317,14 +251,14 @@ class DHRobot:
         if len(rows) > MAX_JOINTS:
             raise ModelError(f"too many joints ({len(rows)}; at most {MAX_JOINTS})")
         object.__setattr__(self, "_joint_rows", rows)
-        object.__setattr__(self, "base", _as_transform(self.base, "base"))
-        object.__setattr__(self, "tool", _as_transform(self.tool, "tool"))
-        g = tuple(_finite(x, "gravity", MAX_MAGNITUDE, " m/s²") for x in self.gravity)
+        object.__setattr__(self, "base", checked_transform(self.base, "base"))
+        object.__setattr__(self, "tool", checked_transform(self.tool, "tool"))
+        g = tuple(finite(x, "gravity", MAX_MAGNITUDE, " m/s²") for x in self.gravity)
         if len(g) != 3:
             raise ModelError(f"gravity must have 3 components, got {len(g)}")
         object.__setattr__(self, "gravity", g)
-        object.__setattr__(self, "parameters", tuple((str(k), _finite(v, f"parameter {k}")) for k, v in self.parameters))
-        object.__setattr__(self, "poses", _check_poses(self.poses, self.q_limits))
+        object.__setattr__(self, "parameters", tuple((str(k), finite(v, f"parameter {k}")) for k, v in self.parameters))
+        object.__setattr__(self, "poses", checked_poses(self.poses, self.q_limits))
 
     # --- trivial derived properties -------------------------------------------------------------
     @property
@@ -415,38 +349,6 @@ class DHRobot:
         return dh_table(self, fmt="markdown")
 
 
-#: Most named poses (``qz``, ``qr``, …) one robot may carry, and how far [rad, m] a pose may sit outside a limit.
-MAX_POSES = 64
-#: Pose names that would read as a joint variable (``q3``) where a joint vector is expected.
-_RESERVED_POSE_NAME = re.compile(r"q\d+")
-POSE_LIMIT_TOL = 1e-9
-
-
-def _check_poses(poses: Any, limits: np.ndarray) -> tuple[tuple[str, tuple[float, ...]], ...]:
-    """Named configurations as ((name, q), ...): names unique, len(q) = dof, finite, within the limits."""
-    poses = tuple(poses.items()) if isinstance(poses, dict) else tuple(poses)
-    if len(poses) > MAX_POSES:
-        raise ModelError(f"too many poses ({len(poses)}; at most {MAX_POSES})")
-    out: dict[str, tuple[float, ...]] = {}
-    for name, q in poses:
-        name = str(name)
-        if not name.isidentifier() or len(name) > 40 or name in out:
-            raise ModelError(f"pose name {name[:40]!r} must be a unique identifier (letters, digits, _)")
-        if _RESERVED_POSE_NAME.fullmatch(name) or name in ("pi", "deg", "q"):
-            raise ModelError(f"pose name {name!r} is taken: q, qN (joint variables), pi and deg mean "
-                             "something else in joint values; choose another name")
-        if not isinstance(q, (tuple, list, np.ndarray)):
-            raise ModelError(f"pose {name} must be a sequence of joint values")
-        q = tuple(_finite(v, f"pose {name}") for v in q)
-        if len(q) != len(limits):
-            raise ModelError(f"pose {name} has {len(q)} values; the arm has {len(limits)} joints")
-        for k, (v, (lo, hi)) in enumerate(zip(q, limits)):
-            if not lo - POSE_LIMIT_TOL <= v <= hi + POSE_LIMIT_TOL:
-                raise ModelError(f"pose {name}: joint {k + 1} = {v:.6g} is outside its limits [{lo:.6g}, {hi:.6g}]")
-        out[name] = q
-    return tuple(out.items())
-
-
 def inertial_rows(robot: DHRobot) -> list[tuple[int, int, LinkInertia]]:
     """``(row, body, inertia)`` for every row with inertial data that moves.
 
@@ -460,16 +362,3 @@ def inertial_rows(robot: DHRobot) -> list[tuple[int, int, LinkInertia]]:
         if link.inertia is not None and body >= 0:
             out.append((row, body, link.inertia))
     return out
-
-
-def joint_names(robot: DHRobot) -> list[str]:
-    """``q1 … qn``."""
-    return [f"q{k + 1}" for k in range(robot.dof)]
-
-
-def rows_of(links: Iterable[DHLink]) -> list[dict[str, Any]]:
-    """Plain dictionaries of DH rows, for presenters."""
-    return [
-        {"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta, "joint": link.joint.value}
-        for link in links
-    ]
