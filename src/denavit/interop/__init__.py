@@ -4,18 +4,8 @@ XML from strangers is parsed safely (:mod:`denavit.interop._xml`: no DTD, no ent
 Importing this package loads no XML library beyond the standard library's expat.
 """
 
-from ._urdf_in import (
-    CHECK_SAMPLES,
-    CHECK_TOL,
-    FAR_FOOT,
-    INTERSECT_TOL,
-    PARALLEL_TOL,
-    ROW_CASES,
-    UrdfImport,
-    from_urdf,
-    import_urdf,
-    urdf_chain_fk,
-)
+from ._urdf_axes import FAR_FOOT, INTERSECT_TOL, PARALLEL_TOL, ROW_CASES
+from ._urdf_in import CHECK_SAMPLES, CHECK_TOL, UrdfImport, from_urdf, import_urdf, urdf_chain_fk
 from ._mjcf_out import MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
 from ._urdf_read import MAX_URDF_LINKS, chain_path, read_urdf
