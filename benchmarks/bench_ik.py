@@ -93,7 +93,7 @@ def bench_denavit_analytic(robot, q_true, T):
 def bench_denavit_resultant(robot, q_true, T):
     """The same pipeline forced onto the general resultant route (companion-matrix roots + polish) that Pieper arms
     used before the direct closed forms; None for arms the closed forms do not cover."""
-    from denavit.numeric._ik_analytic import _plan, _solve
+    from denavit.ik._analytic import _plan, _solve
 
     if not _plan(robot, True).route.startswith("closed form"):
         return None
@@ -105,7 +105,7 @@ def bench_denavit_general(robot, q_true, T):
     """The general 6R eigenvalue route (Raghavan–Roth / Manocha–Canny), forced on any 6R arm (on arms without a
     closed form it is what analytic_ik uses anyway)."""
     from denavit.errors import UnsupportedRobotError
-    from denavit.numeric._ik_analytic import _plan, _solve
+    from denavit.ik._analytic import _plan, _solve
 
     try:
         plan = _plan(robot, True, True)
@@ -168,7 +168,7 @@ def bench_ikpy(robot, T):
     except ImportError:
         return None
     from denavit.numeric import rpy_from_rotation
-    from denavit.numeric._ik_chain import chain_of
+    from denavit.ik._chain import chain_of
 
     ch = chain_of(robot)
     lim = robot.q_limits
@@ -205,8 +205,8 @@ def bench_ikgeo(robot, T):
         from ik_geo import Robot
     except ImportError:
         return None
-    from denavit.numeric import ik_structure
-    from denavit.numeric._ik_chain import axis_lines, chain_of
+    from denavit.ik import ik_structure
+    from denavit.ik._chain import axis_lines, chain_of
 
     ch = chain_of(robot)
     kind = ik_structure(robot)
@@ -268,7 +268,7 @@ def main(argv=None):
         if r is not None:
             rows.append((name, "denavit analytic_ik, general resultant route", args.n, *r))
         r = bench_denavit_general(robot, q, T)
-        if r is not None and denavit.numeric.ik_structure(robot) != "general":
+        if r is not None and denavit.ik.ik_structure(robot) != "general":
             rows.append((name, "denavit analytic_ik, general 6R eigenvalue route", args.n, *r))
         for label, fn in (("roboticstoolbox ets().ik_LM (per call)", lambda: bench_rtb(robot, name, T[: args.peer_n])),
                           ("IKPy inverse_kinematics_frame (per call)", lambda: bench_ikpy(robot, T[: args.peer_n])),

@@ -411,7 +411,7 @@ def _same_analytic(a, b):
 def test_compiled_analytic_ik_equals_the_plain_solver(name):
     """Every solution, label and out-of-limits solution of denavit.analytic_ik, pose by pose: at random poses
     (the compiled closed form answers) and at singular ones (it hands them to the plain solver)."""
-    from denavit.numeric import ik_plan
+    from denavit.ik import ik_plan
 
     robot = denavit.load_robot(name)
     assert ik_plan(robot).closed is not None  # the elbow + spherical-wrist class

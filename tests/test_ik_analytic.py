@@ -9,7 +9,8 @@ import pytest
 import denavit
 from denavit import (Convention, DHLink, DHRobot, UnsupportedRobotError, analytic_ik, convert_convention,
                      forward_kinematics, load_robot, solve_ik)
-from denavit.numeric import ik_structure, transform_from_xyz_rpy
+from denavit.ik import ik_structure
+from denavit.numeric import transform_from_xyz_rpy
 
 from conftest import REDUCED, random_q_in_limits as _random_q
 N = 60 if REDUCED else 250

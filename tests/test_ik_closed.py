@@ -17,9 +17,9 @@ import pytest
 from denavit import (DHLink, DHRobot, forward_kinematics, geometric_jacobian, link_transforms, load_robot,
                      solve_ik)
 from denavit.numeric import transform_from_xyz_rpy
-from denavit.numeric._ik_analytic import _plan, _solve
-from denavit.numeric._ik_closed import wrist_angles
-from denavit.numeric._ik_subproblems import rotation3
+from denavit.ik._analytic import _plan, _solve
+from denavit.ik._closed import wrist_angles
+from denavit.ik._subproblems import rotation3
 
 from conftest import REDUCED, random_q_in_limits as _random_q
 N = 60 if REDUCED else 200

@@ -268,7 +268,7 @@ def _accepted():
     out = []
     for name in denavit.catalogue_names():
         try:
-            denavit.numeric.ik_structure(denavit.load_robot(name))
+            denavit.ik.ik_structure(denavit.load_robot(name))
         except UnsupportedRobotError:
             continue
         out.append(name)
@@ -637,7 +637,7 @@ def test_no_bare_exception_escapes_the_public_ik_functions(robot, seed):
     """analytic_ik, ik_structure, ik_plan and solve_ik either answer (every analytic solution reproduces its target
     to 1e-9 on the controlled rows; solve_ik's success is decided by FK) or raise a denavit error."""
     from denavit.errors import DenavitError
-    from denavit.numeric import ik_plan, ik_structure
+    from denavit.ik import ik_plan, ik_structure
 
     T = _targets(robot, seed)
     try:

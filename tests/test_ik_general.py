@@ -15,9 +15,10 @@ import pytest
 import denavit
 from denavit import Convention, DHLink, DHRobot, JointType
 from denavit.errors import UnsupportedRobotError
-from denavit.numeric import forward_kinematics, solve_ik, transform_from_xyz_rpy
-from denavit.numeric._ik_analytic import _plan, _solve
-from denavit.numeric._ik_numeric import pose_error
+from denavit.ik import solve_ik
+from denavit.numeric import forward_kinematics, transform_from_xyz_rpy
+from denavit.ik._analytic import _plan, _solve
+from denavit.ik._numeric import pose_error
 
 from conftest import REDUCED
 
@@ -119,7 +120,7 @@ def test_jaco2_catalogue_arm():
     k = np.sin(np.pi / 6) / np.sin(np.pi / 3)  # Kinova's d4b, d5b, d6b with aa = 30 deg
     assert np.allclose([l.d for l in robot.links], [0.2755, 0, -0.0098, -(0.2073 + k * 0.0741),
                                                      -k * (0.0741 + 0.0741), -(k * 0.0741 + 0.16)], atol=1e-15)
-    assert denavit.numeric.ik_structure(robot) == "general"
+    assert denavit.ik.ik_structure(robot) == "general"
     rng = np.random.default_rng(3)
     q = rng.uniform(-np.pi, np.pi, (300 if REDUCED else 1500, 6))
     res = denavit.analytic_ik(robot, forward_kinematics(robot, q))

@@ -9,7 +9,7 @@ import pytest
 import denavit
 from denavit import ShapeError, convert_convention, forward_kinematics, load_robot, solve_ik
 from denavit.numeric import transform_from_xyz_rpy
-from denavit.numeric._ik_numeric import pose_error, rotation_log
+from denavit.ik._numeric import pose_error, rotation_log
 
 from conftest import REDUCED, random_q_in_limits as _random_q
 N = 40 if REDUCED else 150
@@ -207,7 +207,7 @@ def test_solve_ik_panda_joint6_beyond_pi():
     assert dp.max() <= 1e-9 and dw.max() <= 1e-8
 
 
-# ---- single-target fast path (numeric/_ik_single.py) ------------------------------------------------------
+# ---- single-target fast path (ik/_single.py) ------------------------------------------------------
 
 SINGLE_ARMS = ["puma560", "puma560-mdh", "ur5", "stanford"]
 
@@ -215,7 +215,7 @@ SINGLE_ARMS = ["puma560", "puma560-mdh", "ur5", "stanford"]
 @pytest.mark.parametrize("name", SINGLE_ARMS)
 def test_single_residual_and_jacobian_match_fk_and_geometric_jacobian(name):
     """Float residual = pose_error(T, FK(q)) and float Jacobian = geometric_jacobian (other modules)."""
-    from denavit.numeric._ik_single import single_chain
+    from denavit.ik._single import single_chain
     from denavit.numeric._jacobians import geometric_jacobian
 
     robot, rng = load_robot(name), np.random.default_rng(11)
@@ -228,7 +228,7 @@ def test_single_residual_and_jacobian_match_fk_and_geometric_jacobian(name):
 
 
 def test_single_damped_step_solves_normal_equations():
-    from denavit.numeric._ik_single import damped_step
+    from denavit.ik._single import damped_step
 
     rng = np.random.default_rng(5)
     for n in (1, 3, 6, 7):

@@ -21,7 +21,7 @@ from .display import dh_table
 from .interop import from_urdf, to_mjcf, to_urdf
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
-from .numeric import AnalyticIKResult, IKResult, analytic_ik, solve_ik
+from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 from .codegen import CompiledRobot, compile
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy

@@ -7,7 +7,7 @@ frame in {0}, ``T_0_N = B⁻¹ T E⁻¹`` (as in :func:`denavit.symbolic.ik_deri
 end-effector pose): ``r_{ij}``, ``p_x p_y p_z`` (also ``n_x … a_z`` for the columns, ``x y z`` and the heading
 ``\\phi = atan2(r_21, r_11)``).  The formula is correct when, at random reachable targets, every value it gives
 (for every sign) is the joint's value in an IK solution that agrees with the joints it uses.  Solution sets come
-from :func:`denavit.numeric.analytic_ik` (inside and outside the limits); a value not in that set is still
+from :func:`denavit.ik.analytic_ik` (inside and outside the limits); a value not in that set is still
 accepted if Gauss–Newton with that joint held fixed reaches the target (so a gap in the solver cannot reject a
 correct formula).
 

@@ -104,7 +104,7 @@ def _locks(args, robot) -> dict[str, float] | None:
 
 
 def _analytic(args, robot, T):
-    from ..numeric import analytic_ik
+    from ..ik import analytic_ik
 
     locked = _locks(args, robot)
     res = analytic_ik(robot, T, locked=locked)
@@ -141,7 +141,7 @@ def _analytic(args, robot, T):
 
 def _numeric(args, robot, T):
     from ..io import parse_values
-    from ..numeric import solve_ik
+    from ..ik import solve_ik
 
     rng = np.random.default_rng()
     seed = None
@@ -240,7 +240,7 @@ def cmd_ik(args: argparse.Namespace):
     if args.lock:
         method = "analytic"
     if method == "auto":
-        from ..numeric import ik_structure
+        from ..ik import ik_structure
 
         try:
             ik_structure(robot)

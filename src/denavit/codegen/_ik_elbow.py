@@ -1,6 +1,6 @@
 """Analytic IK on the generated kernels: the elbow + spherical-wrist closed form in numba.
 
-The same formulas as :class:`denavit.numeric._ik_closed.ElbowPosition` and ``wrist_angles`` (Craig 3rd ed.
+The same formulas as :class:`denavit.ik._closed.ElbowPosition` and ``wrist_angles`` (Craig 3rd ed.
 Sec. 4.7; Paden–Kahan subproblems 1 and 2; the digit-keeping half-angle forms of those modules), for the eight
 candidates of one pose at a time, each verified by the arm's compiled FK, folded into the joint limits, merged
 when equal and labelled (shoulder, elbow, wrist: the tests of docs/ik.md).

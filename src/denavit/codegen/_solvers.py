@@ -7,8 +7,8 @@ import random as _random
 import numpy as np
 
 from ..errors import ShapeError
-from ..numeric import (IK_MAX_ITERATIONS, IK_RESTARTS, IK_TOL, AnalyticIKResult, IKResult, JointLimits,
-                       analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik)
+from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
+from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
 

@@ -1,7 +1,7 @@
 """All inverse-kinematics solutions in closed form, batched over target poses.
 
-Pipeline (the same for every structure): the plan of :mod:`._ik_plans` proposes candidates (the direct closed
-forms of :mod:`._ik_closed` for elbow and Stanford Pieper arms) → one batched forward-kinematics pass checks every
+Pipeline (the same for every structure): the plan of :mod:`._plans` proposes candidates (the direct closed
+forms of :mod:`._closed` for elbow and Stanford Pieper arms) → one batched forward-kinematics pass checks every
 candidate → only those whose residual shows lost digits (general root finding near double roots) get a few
 Gauss–Newton steps and a second check → revolute angles are folded by whole turns into the joint limits, those
 that cannot be are set aside → duplicates are merged → each solution gets a branch label.
@@ -18,11 +18,11 @@ import numpy as np
 from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
-from ._ik_chain import chain_columns, chain_of, damped_solve, wrap_angle
-from ._ik_numeric import pose_error
-from ._ik_plans import Plan, make_plan
-from ._ik_kernel import kernel_of, targets_soa
-from ._kinematics import forward_kinematics
+from ._chain import chain_columns, chain_of, damped_solve, wrap_angle
+from ._numeric import pose_error
+from ._plans import Plan, make_plan
+from ._kernel import kernel_of, targets_soa
+from ..numeric import forward_kinematics
 
 __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure", "ik_plan"]
 
@@ -106,8 +106,8 @@ def _plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Pl
 def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
     plan = make_plan(robot, closed_form, general)
     if plan.closed is not None:  # what the compiled solver needs besides the geometry (denavit.codegen)
-        from ._ik_closed import FREE_TOL, RATIO_TOL
-        from ._ik_subproblems import AXES_ALIGNED_TOL
+        from ._closed import FREE_TOL, RATIO_TOL
+        from ._subproblems import AXES_ALIGNED_TOL
 
         plan.closed.update(labels=_label_table((SHOULDER, ELBOW, WRIST)),
                            theta=np.array([l.theta for l in robot.joints], float),
@@ -146,7 +146,7 @@ def _controlled(P: np.ndarray) -> str:
 def _polish(robot: DHRobot, q: np.ndarray, T: np.ndarray, P: np.ndarray) -> np.ndarray:
     """Damped Gauss–Newton steps on P·e until converged (restores the digits lost in root finding).
 
-    Residual and Jacobian come from one pass over the chain (:mod:`._ik_kernel`)."""
+    Residual and Jacobian come from one pass over the chain (:mod:`._kernel`)."""
     n = robot.dof
     kin = kernel_of(robot)
     Rt, pt = targets_soa(T)
@@ -418,7 +418,7 @@ def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fo
     Returns candidates (B, E, n) for :func:`_verify` (None when no solution is that close to a singularity), and
     the solutions that sit on a singularity (σ_min < SINGULAR_RCOND · σ_max): pose and slot indices and the
     null direction of J, for the name of their continuum."""
-    from ._jacobians import geometric_jacobian
+    from ..numeric import geometric_jacobian
 
     b, k = np.nonzero(fold)
     J = plan.projector @ geometric_jacobian(robot, q[b, k])

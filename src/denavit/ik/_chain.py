@@ -17,7 +17,7 @@ import numpy as np
 
 from ..chain import chain_of as _chain_of
 from ..model import DHRobot
-from ._transforms import inverse_transform
+from ..numeric import inverse_transform
 
 __all__ = ["Chain", "damped_solve", "chain_of", "chain_fk", "chain_columns", "joint_motion", "reverse_chain", "solve_trig", "angle_about_z",
            "wrap_angle", "axis_lines"]

@@ -1,9 +1,9 @@
 """Direct closed forms for the two common Pieper position classes, and a lean three-axis wrist, batched.
 
-The general route of :class:`._ik_subproblems.Position3` finds joints 1–3 of any Pieper arm from the roots of a
+The general route of :class:`._subproblems.Position3` finds joints 1–3 of any Pieper arm from the roots of a
 resultant (eigenvalues of a companion matrix) and leaves roots that must be polished.  The two classes most arms
 belong to have textbook closed forms that need only ``atan2``/``arccos``/``sqrt``; here they are written once, in
-the joint-screw form ``W = Rz(q1) C1 J2(q2) C2 J3(q3) P`` of :mod:`._ik_chain` (W: wrist centre in the frame
+the joint-screw form ``W = Rz(q1) C1 J2(q2) C2 J3(q3) P`` of :mod:`._chain` (W: wrist centre in the frame
 before joint 1, P: wrist centre in the frame of joint 3), so both DH conventions, offsets, base and tool are
 covered without case distinctions, and evaluated for all poses × branches at once:
 
@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._ik_chain import solve_trig
-from ._ik_subproblems import ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, split_aligned
+from ._chain import solve_trig
+from ._subproblems import ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, split_aligned
 
 __all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
 
@@ -209,7 +209,7 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     and 2; Murray, Li & Sastry 1994, Sec. 3.3; Craig 3rd ed. eq. 2.71 for the orthogonal ZYZ wrist).
     Written out per component so that no (…, 3, 3) intermediates are built.
 
-    Returns q (..., 2, 3), singular (..., 2), sign (..., 2) as :func:`._ik_subproblems.rotation3`.
+    Returns q (..., 2, 3), singular (..., 2), sign (..., 2) as :func:`._subproblems.rotation3`.
     """
     r, u = Ra[2, :], Rb[:, 2]
     qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity

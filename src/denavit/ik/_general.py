@@ -1,7 +1,7 @@
 """Every inverse-kinematics solution of a general 6R arm: Raghavan–Roth elimination, Manocha–Canny eigenproblem.
 
 The arm and its target close a loop of six rotations about local z axes (the joint-screw form of
-:mod:`._ik_chain`, target folded in)::
+:mod:`._chain`, target folded in)::
 
     Z1 G1 Z2 G2 Z3 G3 Z4 G4 Z5 G5 Z6 G6 = I,      Zk = Rz(θk),   G6 = C6 T⁻¹ C0
 
@@ -37,8 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._ik_chain import Chain, joint_motion
-from ._transforms import inverse_transform
+from ._chain import Chain, joint_motion
+from ..numeric import inverse_transform
 
 __all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "rank_formulations", "solve_general", "MAX_SOLUTIONS"]
 
@@ -355,7 +355,7 @@ def rank_formulations(chain: Chain, rng: np.random.Generator, tries: int = 4) ->
     :func:`choose_formulation`), best first.  The later ones are the fall-backs for targets where the first one's
     pencil is singular: on special arms (axes 2-4 parallel, say) a formulation can be regular for most poses
     and singular for a few, which the test targets need not show."""
-    from ._ik_chain import chain_fk
+    from ._chain import chain_fk
 
     q = rng.uniform(-np.pi, np.pi, (tries, 6))
     G = loop_of(chain, chain_fk(chain, q))

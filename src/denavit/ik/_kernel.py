@@ -102,7 +102,7 @@ class Kernel:
 
 def _log_soa(M: np.ndarray) -> np.ndarray:
     """Rotation vectors (B, 3) of rotations M (3, 3, B); see ``rotation_log`` (the near-π case is delegated)."""
-    from ._ik_numeric import rotation_log
+    from ._numeric import rotation_log
 
     cos = np.clip((M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0, -1.0, 1.0)
     theta = np.arccos(cos)

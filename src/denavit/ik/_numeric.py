@@ -18,11 +18,11 @@ from .._validate import as_joint_array, as_transform
 from ..chain import chain_of
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
-from ._ik_chain import damped_solve
-from ._ik_kernel import kernel_of, targets_soa
-from ._ik_seeds import rescue
-from ._ik_single import solve_single
-from ._kinematics import forward_kinematics
+from ._chain import damped_solve
+from ._kernel import kernel_of, targets_soa
+from ._seeds import rescue
+from ._single import solve_single
+from ..numeric import forward_kinematics
 
 __all__ = ["IKResult", "solve_ik", "pose_error", "rotation_log", "row_mask", "JointLimits", "characteristic_length",
            "TOL", "MAX_ITERATIONS", "RESTARTS"]

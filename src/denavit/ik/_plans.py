@@ -11,7 +11,7 @@ A plan is chosen from the geometry of the joint axes (computed from the table, n
 ``wrist``     3 revolute axes through one point (orientation only).
 ``position``  any other 3-joint arm: the end-effector origin is placed (position only).
 ``general``   any other 6R arm: every solution by the Raghavan–Roth / Manocha–Canny eigenvalue method
-              (:mod:`._ik_general`), up to 16.
+              (:mod:`._general`), up to 16.
 
 Coaxial consecutive revolute joints are merged first (their sum is all the pose sees); the result then
 names the free combination.
@@ -26,12 +26,12 @@ import numpy as np
 
 from ..errors import UnsupportedRobotError
 from ..model import DHRobot
-from ._ik_closed import closed_position, wrist_angles
-from ._ik_general import loop_of, rank_formulations, solve_general
-from ._ik_chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
-from ._ik_subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
+from ._closed import closed_position, wrist_angles
+from ._general import loop_of, rank_formulations, solve_general
+from ._chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
+from ._subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
                               trig_coefficients)
-from ._transforms import inverse_transform
+from ..numeric import inverse_transform
 
 __all__ = ["Plan", "make_plan", "elbow_constants"]
 
@@ -481,14 +481,14 @@ def _mirrored(solve: Callable) -> Callable:
 
 def _generic_rank(robot: DHRobot, rng) -> int:
     """Largest rank of the geometric Jacobian over a few random configurations."""
-    from ._jacobians import geometric_jacobian
+    from ..numeric import geometric_jacobian
 
     J = geometric_jacobian(robot, rng.uniform(-np.pi, np.pi, (3, robot.dof)))
     return int(max(np.linalg.matrix_rank(Jk, tol=1e-9 * max(1.0, np.abs(Jk).max())) for Jk in J))
 
 
 def _general_plan(chain: Chain, rng):
-    """The eigenvalue solver of :mod:`._ik_general` for a 6R chain, or None if every formulation degenerates.
+    """The eigenvalue solver of :mod:`._general` for a 6R chain, or None if every formulation degenerates.
 
     Targets where the best formulation's pencil is singular are solved again with the next one (and so on):
     one formulation chosen on a few random targets can be singular on a few per cent of others."""
@@ -519,7 +519,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
     """Recognise the structure of an arm and build its closed-form solver (see module notes).
 
     ``closed_form=False`` keeps Pieper arms of the elbow and Stanford classes on the general resultant route
-    (:class:`Position3`) instead of the direct formulas of :mod:`._ik_closed` (used to cross-check them).
+    (:class:`Position3`) instead of the direct formulas of :mod:`._closed` (used to cross-check them).
     ``general=True`` sends every 6R arm to the ``general`` eigenvalue solver, closed form or not (the same
     cross-check for the closed forms of Pieper and UR-type arms).
 

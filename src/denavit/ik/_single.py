@@ -1,10 +1,10 @@
 """One-target Levenberg–Marquardt attempt in plain Python floats (the single-call fast path of ``solve_ik``).
 
 For one target, numpy's fixed cost per call (~1–5 µs per ufunc on arrays of 3–36 numbers) dominates the
-batched solver of :mod:`._ik_numeric`: one iteration there is ~60 small array operations.  This module runs
+batched solver of :mod:`._numeric`: one iteration there is ~60 small array operations.  This module runs
 the *first* attempt of that solver — from the seed, joint limits ignored during the iteration and the end
 point folded by whole turns — with lists of floats and ``math``: the same joint-screw chain
-``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain` as :class:`._ik_kernel.Kernel`, the same residual and
+``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain` as :class:`._kernel.Kernel`, the same residual and
 geometric Jacobian
 
     e = W (p_t − p, log(R_t Rᵀ)),   revolute k: J_k = (z_k × (p_e − o_k), z_k),  prismatic k: J_k = (z_k, 0)
@@ -98,7 +98,7 @@ def _log(M) -> list:
     cs = (M[0][0] + M[1][1] + M[2][2] - 1.0) / 2.0
     cs = -1.0 if cs < -1.0 else (1.0 if cs > 1.0 else cs)
     if cs < -0.9:
-        from ._ik_numeric import rotation_log
+        from ._numeric import rotation_log
 
         return rotation_log(np.array(M)).tolist()
     theta = acos(cs)
@@ -228,7 +228,7 @@ def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w
                  max_iter: int, tol: float, L: float):
     """The first attempt of ``solve_ik`` for one target in floats; an ``IKResult`` when it ends in a solution
     within the limits (checked by :func:`forward_kinematics`, as the batched path does), else None."""
-    from . import _ik_numeric as ikn
+    from . import _numeric as ikn
 
     qf, it, status = first_attempt(single_chain(robot), q0.tolist(), T.tolist(), w.tolist(), limits.lo.tolist(),
                                    limits.hi.tolist(), limits.revolute.tolist(), max_iter, tol, L, ikn.LAMBDA0,
@@ -244,8 +244,8 @@ def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w
 
 def _fk_error(robot: DHRobot, q: np.ndarray, T: np.ndarray, mask: list) -> tuple[float, float]:
     """Position and orientation error norms of ``forward_kinematics(robot, q)`` against T on the masked rows:
-    ``pose_error`` of :mod:`._ik_numeric` for one pose, in floats."""
-    from ._kinematics import forward_kinematics
+    ``pose_error`` of :mod:`._numeric` for one pose, in floats."""
+    from ..numeric import forward_kinematics
 
     F, Tl = forward_kinematics(robot, q).tolist(), T.tolist()
     dp = [(Tl[i][3] - F[i][3]) if mask[i] else 0.0 for i in range(3)]

@@ -1,6 +1,6 @@
 """Subproblems of the analytic IK, batched: three-joint positioning, three-axis orientation, planar pairs.
 
-All work on the joint-screw form ``C0 J1 C1 ⋯`` of :mod:`._ik_chain` and return NaN for "no solution"
+All work on the joint-screw form ``C0 J1 C1 ⋯`` of :mod:`._chain` and return NaN for "no solution"
 so that every pose of a batch carries the same number of candidate slots.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._ik_chain import angle_about_z, damped_solve, joint_motion, solve_trig
+from ._chain import angle_about_z, damped_solve, joint_motion, solve_trig
 
 __all__ = ["Position3", "rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "split_aligned",
            "AXES_ALIGNED_TOL", "ALIGNED_EXACT"]

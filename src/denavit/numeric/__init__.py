@@ -1,8 +1,5 @@
 """The numeric engine (numpy): every function is batched over leading axes ``(..., n)``."""
 
-from ._ik_analytic import AnalyticIKResult, analytic_ik, ik_plan, ik_structure
-from ._ik_numeric import IKResult, JointLimits, characteristic_length, row_mask, solve_ik
-from ._ik_numeric import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
 from ._jacobians import (
     analytic_jacobian,
     differentiation_jacobian,
@@ -83,18 +80,6 @@ from ._transforms import (
 )
 
 __all__ = [
-    "AnalyticIKResult",
-    "analytic_ik",
-    "ik_structure",
-    "ik_plan",
-    "IKResult",
-    "solve_ik",
-    "JointLimits",
-    "characteristic_length",
-    "row_mask",
-    "IK_TOL",
-    "IK_MAX_ITERATIONS",
-    "IK_RESTARTS",
     "geometric_jacobian",
     "joint_axes",
     "analytic_jacobian",

@@ -6,8 +6,8 @@ Order (as a course report writes it; Spong, Hutchinson & Vidyasagar 2006, ch. 5;
 2. when :func:`denavit.symbolic.ik_derivation` covers the arm, every step of the derivation from the DH table
    (wrist centre, q1, q3 by the law of cosines, q2, R_3_6, q4..q6; or the planar law of cosines), then those
    formulas evaluated at the target for every sign combination σ = ±1;
-3. all closed-form solutions of :func:`denavit.numeric.analytic_ik` with their branch labels;
-4. otherwise the numeric solution of :func:`denavit.numeric.solve_ik` and its residual.
+3. all closed-form solutions of :func:`denavit.ik.analytic_ik` with their branch labels;
+4. otherwise the numeric solution of :func:`denavit.ik.solve_ik` and its residual.
 
 Every solution shown is checked here by forward kinematics (an independent route), and the derived
 formulas are matched against the analytic solver's set (two different algorithms).
@@ -199,7 +199,7 @@ def unique_labels(labels: list[str]) -> list[str]:
 
 def _analytic(ctx: Context, T_world: np.ndarray, steps: list) -> tuple[list, list, list, str, np.ndarray]:
     """(solutions within the limits, branch labels, continuum notes, rows controlled, solutions outside)."""
-    found = _capabilities.capability("denavit.numeric", "analytic_ik")
+    found = _capabilities.capability("denavit.ik", "analytic_ik")
     none = np.zeros((0, ctx.robot.dof))
     if found is None:
         return [], [], [], "pose", none
@@ -225,7 +225,7 @@ def section_ik(ctx: Context) -> Section:
     T_world = N.forward_kinematics(robot, ctx.q)
     steps: list = [Text("Target: the end-effector pose of the numeric case (so at least one solution is known: "
                         "the q of the case)."), Numbers("T_{\\text{target}}", T_world)]
-    structure = _capabilities.capability("denavit.numeric", "ik_structure")
+    structure = _capabilities.capability("denavit.ik", "ik_structure")
     kind = ""
     if structure is not None:
         try:
@@ -260,7 +260,7 @@ def section_ik(ctx: Context) -> Section:
 
 
 def _numeric(ctx: Context, T_world: np.ndarray, steps: list, have_derivation: bool) -> Section:
-    found = _capabilities.capability("denavit.numeric", "solve_ik")
+    found = _capabilities.capability("denavit.ik", "solve_ik")
     if found is None:
         status = "done" if have_derivation else "unavailable"
         return Section("ik", "Inverse kinematics", tuple(steps), status=status,

@@ -111,7 +111,8 @@ def _poses(grid: Grid, cells: np.ndarray, rot: np.ndarray) -> np.ndarray:
 
 
 def _analytic_task(robot, grid, cells, rot):
-    from ..numeric import analytic_ik, geometric_jacobian, manipulability
+    from ..ik import analytic_ik
+    from ..numeric import geometric_jacobian, manipulability
 
     res = analytic_ik(robot, _poses(grid, cells, rot))
     valid = np.asarray(res.valid)  # (B, K, S)
@@ -124,7 +125,8 @@ def _analytic_task(robot, grid, cells, rot):
 
 
 def _numeric_task(robot, grid, cells, rot, seed):
-    from ..numeric import geometric_jacobian, manipulability, solve_ik
+    from ..ik import solve_ik
+    from ..numeric import geometric_jacobian, manipulability
 
     T = _poses(grid, cells, rot)
     reached = np.zeros(T.shape[:2], dtype=bool)
@@ -166,7 +168,8 @@ def _mean_reached(best, reached):
 
 
 def _method(robot: DHRobot, ik: str) -> str:
-    from ..numeric import analytic_ik, forward_kinematics
+    from ..ik import analytic_ik
+    from ..numeric import forward_kinematics
 
     if ik not in ("auto", "analytic", "numeric"):
         raise ModelError(f"ik must be auto, analytic or numeric, got {ik!r}")

@@ -495,7 +495,7 @@ def ik_derivation(robot: DHRobot) -> IKDerivation:
     >>> d.kind, [str(s) for s in d.branches]
     ('decoupled', ['sigma1', 'sigma3', 'sigma5'])
     """
-    from ..numeric import ik_structure
+    from ..ik import ik_structure
 
     try:
         kind = ik_structure(robot)
