@@ -184,3 +184,33 @@ def test_ctrl_c_stops_cleanly(tmp_path, scheduler):
     assert time.perf_counter() - t0 < 30
     assert out == "" and "Traceback" not in err and err.strip().splitlines() == ["denavit: interrupted"], err
     assert os.listdir(tmp_path) == []
+
+
+def test_reachability_on_dask_starts_one_cluster_for_the_screen_and_the_map(tmp_path, monkeypatch):
+    """`--scheduler dask` runs the position screen and the map on one LocalCluster (counted at its constructor;
+    built in-process here to keep the test cheap), closed at the end; the map equals the synchronous one."""
+    distributed = pytest.importorskip("distributed")
+    import denavit
+    from denavit.scale import reach_bound
+    from denavit.scale._sampler import MIN_CELLS
+
+    assert 2 * reach_bound(denavit.load_robot("ur5"))[1] / 0.2 > MIN_CELLS  # fine enough for the screen to run
+
+    real, started = distributed.LocalCluster, []
+
+    def counting(*args, **kwargs):
+        started.append(real(*args, **{**kwargs, "processes": False}))
+        return started[-1]
+
+    monkeypatch.setattr(distributed, "LocalCluster", counting)
+    monkeypatch.setattr("denavit.scale._reach.SCREEN_SAMPLES", 2**17)  # a smaller screen, the same in both runs
+    argv = ["reachability", "ur5", "--resolution", "0.2", "--orientations", "4", "--json", "--seed", "5"]
+    ref = _ok(run_cli(argv + ["--scheduler", "synchronous", "--data", "s.npz"], tmp_path))
+    assert ref["voxels_reached"] > 0
+    got = _ok(run_cli(argv + ["--scheduler", "dask", "--workers", "2", "--data", "d.npz"], tmp_path))
+    assert len(started) == 1 and started[0].status.name == "closed"
+    assert {k: v for k, v in got.items() if k not in ("scheduler", "data")} == \
+        {k: v for k, v in ref.items() if k not in ("scheduler", "data")}
+    with np.load(tmp_path / "s.npz") as s, np.load(tmp_path / "d.npz") as d:
+        for key in ("fraction", "manipulability"):
+            assert np.array_equal(s[key], d[key]), key

@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import ModelError, UnsupportedRobotError
 from ..model import DHRobot
 from ._sampler import MAX_CELLS, MIN_CELLS, Grid, reach_bound, sampling_limits
-from ._schedule import Progress, run
+from ._schedule import Progress, run, session
 
 __all__ = ["ReachabilityMap", "reachability", "orientation_set", "DEFAULT_ORIENTATIONS", "MAX_ORIENTATIONS",
            "MAX_POSES", "MAX_NUMERIC_POSES", "VOXELS_PER_TASK"]
@@ -236,7 +236,15 @@ def reachability(robot: DHRobot, resolution: float = 0.05, orientations: int = D
     if ball * k > limit:
         raise ModelError(f"resolution {h:g} m and {k} orientations make about {ball * k:.3g} IK problems "
                          f"(at most {limit:.3g} with {method} IK): use a coarser resolution or fewer orientations")
-    near = _near_samples(robot, grid, seed, scheduler, workers) if screen else None
+    with session(scheduler, workers) as where:  # one cluster for the screen and the map
+        near = _near_samples(robot, grid, seed, where, workers) if screen else None
+        cells, frac, manip, rot = _map(robot, grid, centre, R, near, k, method, seed, where, workers, progress)
+    return ReachabilityMap(grid, frac, manip, rot, method, len(cells))
+
+
+def _map(robot, grid: Grid, centre, R: float, near, k: int, method: str, seed: int, scheduler, workers, progress):
+    """The tested cells (m, 3), the fraction and manipulability grids and the orientation set of a map."""
+    h, side = grid.resolution, grid.side
     jk = np.indices((side, side), dtype=np.int32).reshape(2, -1).T  # (side², 2)
     parts = []
     for i in range(side):  # one x-slice at a time: memory ∝ side², not side³
@@ -262,4 +270,4 @@ def reachability(robot: DHRobot, resolution: float = 0.05, orientations: int = D
             bar.update(len(c))
     finally:
         bar.close()
-    return ReachabilityMap(grid, frac, manip, rot, method, len(cells))
+    return cells, frac, manip, rot

@@ -9,6 +9,7 @@ Ctrl-C cancels what is pending and shuts the pool down before ``KeyboardInterrup
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import os
 import re
 import signal
@@ -19,7 +20,7 @@ from typing import Any, Callable, Iterable, Iterator
 from ..errors import MissingDependencyError, ParseError
 
 __all__ = ["LOCAL_SCHEDULERS", "POOLS", "LOCAL_CLUSTER_CONFIG", "AUTO_PROCESSES_FROM", "resolve_auto",
-           "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "run", "Progress"]
+           "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "session", "run", "Progress"]
 
 #: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
 LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
@@ -126,21 +127,43 @@ def _wait(done_order, pending: set):
     return done, pending - done
 
 
+@contextlib.contextmanager
+def session(scheduler: Any, workers: int | None = None) -> Iterator[Any]:
+    """The scheduler for every phase of one run: ``"dask"`` starts one LocalCluster (of ``workers`` processes)
+    and an address connects one Client, each closed when the run ends; a pool name or a Client passes through.
+
+    A run of several phases (a position screen, then a map) passes what this yields to each :func:`run`, so they
+    share one cluster instead of starting one each."""
+    check_scheduler(scheduler)
+    if not isinstance(scheduler, str) or scheduler in POOLS:
+        yield scheduler
+        return
+    cluster = None
+    if scheduler == "dask":
+        client, cluster = _local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS))
+    else:
+        client = _client(scheduler)
+    try:
+        yield client
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
 def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
         ) -> Iterator[Any]:
     """Yield ``fn(*task)`` for every task, in completion order, on the given scheduler ("auto": threads).
 
     A task ``None`` is a barrier: the results of all tasks before it are yielded before the iterator of tasks
-    is asked for the next one (so a generator of tasks may read what the caller made of those results)."""
-    check_scheduler(scheduler)
-    scheduler = resolve_auto(scheduler, 0)
-    client, own, pool, cluster = None, False, None, None
-    if not isinstance(scheduler, str):
-        client = scheduler
-    elif scheduler == "dask":
-        (client, cluster), own = _local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS)), True
-    elif scheduler not in LOCAL_SCHEDULERS:
-        client, own = _client(scheduler), True
+    is asked for the next one (so a generator of tasks may read what the caller made of those results).
+    ``"dask"`` or an address starts or connects a cluster for this call alone (see :func:`session`)."""
+    with session(resolve_auto(scheduler, 0), workers) as where:
+        yield from _run(fn, tasks, where, workers)
+
+
+def _run(fn: Callable, tasks: Iterable[tuple], scheduler: Any, workers: int | None) -> Iterator[Any]:
+    client, pool = (None, None) if isinstance(scheduler, str) else (scheduler, None)
     done_order = None
     if client is not None:
         from distributed import as_completed
@@ -187,10 +210,6 @@ def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", worker
             f.cancel()
         if isinstance(pool, cf.Executor):
             pool.shutdown(wait=True, cancel_futures=True)
-        if own:
-            client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 class Progress:
