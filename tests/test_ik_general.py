@@ -18,7 +18,7 @@ from denavit.errors import UnsupportedRobotError
 from denavit.ik import solve_ik
 from denavit.numeric import forward_kinematics, transform_from_xyz_rpy
 from denavit.ik._analytic import _plan, _solve
-from denavit.ik._numeric import pose_error
+from denavit.ik import pose_error
 
 from conftest import REDUCED
 

@@ -9,7 +9,7 @@ import pytest
 import denavit
 from denavit import ShapeError, convert_convention, forward_kinematics, load_robot, solve_ik
 from denavit.numeric import transform_from_xyz_rpy
-from denavit.ik._numeric import pose_error, rotation_log
+from denavit.ik import pose_error, rotation_log
 
 from conftest import REDUCED, random_q_in_limits as _random_q
 N = 40 if REDUCED else 150

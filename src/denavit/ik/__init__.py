@@ -9,8 +9,8 @@ numeric engine (:mod:`denavit.numeric`) for forward kinematics and Jacobians; no
 """
 
 from ._analytic import AnalyticIKResult, analytic_ik, ik_plan, ik_structure
-from ._numeric import MAX_ITERATIONS, RESTARTS, TOL, IKResult, JointLimits, characteristic_length, pose_error, row_mask
-from ._numeric import rotation_log, solve_ik
+from ._numeric import MAX_ITERATIONS, RESTARTS, TOL, solve_ik
+from ._residual import IKResult, JointLimits, characteristic_length, pose_error, rotation_log, row_mask
 
 __all__ = [
     "AnalyticIKResult",

@@ -19,7 +19,7 @@ from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
 from ._chain import chain_columns, chain_of, damped_solve, wrap_angle
-from ._numeric import pose_error
+from ._residual import pose_error
 from ._plans import Plan, make_plan
 from ._kernel import kernel_of, targets_soa
 from ..numeric import forward_kinematics

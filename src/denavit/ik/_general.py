@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._chain import Chain, joint_motion
+from ._chain import Chain, chain_fk, joint_motion
 from ..numeric import inverse_transform
 
 __all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "rank_formulations", "solve_general", "MAX_SOLUTIONS"]
@@ -355,7 +355,6 @@ def rank_formulations(chain: Chain, rng: np.random.Generator, tries: int = 4) ->
     :func:`choose_formulation`), best first.  The later ones are the fall-backs for targets where the first one's
     pencil is singular: on special arms (axes 2-4 parallel, say) a formulation can be regular for most poses
     and singular for a few, which the test targets need not show."""
-    from ._chain import chain_fk
 
     q = rng.uniform(-np.pi, np.pi, (tries, 6))
     G = loop_of(chain, chain_fk(chain, q))

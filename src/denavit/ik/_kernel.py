@@ -18,6 +18,7 @@ import numpy as np
 
 from ..chain import chain_of
 from ..model import DHRobot
+from ._residual import rotation_log
 
 __all__ = ["Kernel", "kernel_of", "targets_soa"]
 
@@ -102,8 +103,6 @@ class Kernel:
 
 def _log_soa(M: np.ndarray) -> np.ndarray:
     """Rotation vectors (B, 3) of rotations M (3, 3, B); see ``rotation_log`` (the near-π case is delegated)."""
-    from ._numeric import rotation_log
-
     cos = np.clip((M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0, -1.0, 1.0)
     theta = np.arccos(cos)
     v = np.stack([M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]], axis=-1)  # (B, 3)

@@ -9,16 +9,15 @@ the returned joint values, never taken from the iteration's own bookkeeping.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Sequence
 
 import numpy as np
 
 from .._validate import as_joint_array, as_transform
-from ..chain import chain_of
-from ..errors import ShapeError
-from ..model import DHRobot, JointType
+from ..model import DHRobot
 from ._chain import damped_solve
+from ._residual import (LAMBDA0, LAMBDA_MAX, IKResult, JointLimits, characteristic_length, limits_of, pose_error, row_mask,
+                        rotation_log)
 from ._kernel import kernel_of, targets_soa
 from ._seeds import rescue
 from ._single import solve_single
@@ -34,148 +33,7 @@ PARALLEL_SEEDS = 32  # at most this many seeds side by side per target once few 
 SMALL_BATCH = 512  # "few": at most this many attempts in flight
 RESTART_ITERATIONS = 0.3  # iteration budget of a restart, relative to max_iterations
 CLIPPED_SEEDS = 0.1  # share of restarts iterated inside the limits (the rest run free and are folded)
-LAMBDA0 = 1e-3  # initial damping, relative to the squared characteristic length
-LAMBDA_MAX = 1e3  # damping (relative to L²) beyond which an attempt counts as stuck
 _REASONS = ("", "iterations", "limits", "unreachable")
-
-
-@dataclass(frozen=True)
-class IKResult:
-    """Result of :func:`solve_ik` (arrays with the batch shape of the targets; scalars for one target).
-
-    Attributes
-    ----------
-    q : ndarray, shape (..., n)
-        Joint values [rad, m]: the solution, or the best point found when ``success`` is False.
-    success : bool or ndarray of bool, shape (...)
-        True when ``forward_kinematics(robot, q)`` matches the target within ``tol`` on the selected rows
-        and q is within the joint limits (decided by re-running FK, not by the iteration).
-    position_error, orientation_error : float or ndarray, shape (...)
-        Norm of the selected rows of the residual: position [m] and rotation vector log(R_t Rᵀ) [rad],
-        both in world axes.
-    iterations : int or ndarray, shape (...)
-        LM iterations spent, all restarts included.
-    restarts : int or ndarray, shape (...)
-        Random restarts used.
-    reason : str or ndarray of str, shape (...)
-        ``""`` on success; otherwise ``"unreachable"`` (no solution found even ignoring limits: the target
-        is probably outside the workspace), ``"limits"`` (a solution exists only outside the joint limits)
-        or ``"iterations"`` (the iteration budget ran out while still improving).
-    """
-
-    q: np.ndarray
-    success: Any
-    position_error: Any
-    orientation_error: Any
-    iterations: Any
-    restarts: Any
-    reason: Any
-
-    def _repr_html_(self) -> str:
-        from ..display import ik_html
-
-        return ik_html(self)
-
-
-def row_mask(mask: str | Sequence[bool] | None, dof: int | None = None) -> np.ndarray:
-    """Which pose rows (x, y, z, ωx, ωy, ωz) to match: ``"pose"``, ``"position"``, or 6 booleans."""
-    if mask is None or (isinstance(mask, str) and mask == "pose"):
-        return np.ones(6, dtype=bool)
-    if isinstance(mask, str):
-        if mask == "position":
-            return np.array([True] * 3 + [False] * 3)
-        raise ValueError(f"unknown mask {mask!r}; choose 'pose', 'position' or 6 booleans (x, y, z, wx, wy, wz)")
-    m = np.asarray(mask, dtype=bool).reshape(-1)
-    if m.shape != (6,) or not m.any():
-        raise ShapeError(f"mask: expected 6 booleans (x, y, z, wx, wy, wz) with at least one True, got {mask!r}")
-    return m
-
-
-def rotation_log(R: np.ndarray) -> np.ndarray:
-    """Rotation vector θ·u of rotation matrices (..., 3, 3) → (..., 3), θ in [0, π].
-
-    Rodrigues inverted: sin θ [u]× = (R − Rᵀ)/2, cos θ = (tr R − 1)/2; near θ = π the axis is taken from the
-    symmetric part, u uᵀ = (R + Rᵀ)/2 − cos θ I) / (1 − cos θ) (Murray, Li & Sastry 1994, Sec. 2.2).
-    """
-    R = np.asarray(R, dtype=float)
-    tr = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
-    cos = np.clip((tr - 1.0) / 2.0, -1.0, 1.0)
-    theta = np.arccos(cos)
-    v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
-    sin = np.sin(theta)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        factor = np.where(theta < 1e-6, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(sin == 0, 1, sin)))
-    out = v * factor[..., None]
-    near_pi = cos < -0.9
-    if np.any(near_pi):
-        Rn, cn, vn, tn = R[near_pi], cos[near_pi], v[near_pi], theta[near_pi]
-        S = 0.5 * (Rn + np.swapaxes(Rn, -1, -2)) - cn[:, None, None] * np.eye(3)
-        S = S / (1.0 - cn)[:, None, None]  # u uᵀ
-        k = np.argmax(np.diagonal(S, axis1=-2, axis2=-1), axis=-1)
-        u = S[np.arange(len(k)), :, k]
-        u = u / np.linalg.norm(u, axis=-1, keepdims=True)
-        sign = np.where(np.einsum("...i,...i->...", u, vn) < 0, -1.0, 1.0)
-        out[near_pi] = u * (sign * tn)[:, None]
-    return out
-
-
-def pose_error(T_target: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Residual (..., 6) = (p_t − p, log(R_t Rᵀ)) in world axes."""
-    dp = T_target[..., :3, 3] - T[..., :3, 3]
-    dw = rotation_log(T_target[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
-    return np.concatenate([dp, dw], axis=-1)
-
-
-def _char_length(robot: DHRobot) -> float:
-    """A length scale of the arm [m]: sum of |a| and |d| over the rows and the tool offset (≥ 1 mm)."""
-    memo = chain_of(robot).memo
-    if "ik_length" not in memo:
-        s = sum(abs(l.a) + abs(l.d) for l in robot.links) + float(np.linalg.norm(robot.tool_matrix[:3, 3]))
-        memo["ik_length"] = max(s, 1e-3)
-    return memo["ik_length"]
-
-
-class _Limits:
-    """Joint limits as arrays, with the rule that brings q back inside (clip; wrap a full-turn revolute)."""
-
-    def __init__(self, robot: DHRobot, ignore: bool = False) -> None:
-        lim = robot.q_limits
-        self.revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-        if ignore:
-            lim = np.tile([-np.inf, np.inf], (robot.dof, 1))
-        self.lo, self.hi = lim[:, 0], lim[:, 1]
-        self.full_turn = self.revolute & (self.hi - self.lo >= 2 * np.pi)
-
-    def project(self, q: np.ndarray) -> np.ndarray:
-        q = np.where(self.revolute, np.pi - np.mod(np.pi - q, 2 * np.pi), q)  # wrap into (−π, π]
-        shift = np.where(q < self.lo, 2 * np.pi, np.where(q > self.hi, -2 * np.pi, 0.0))
-        q = np.where(self.revolute & (shift != 0) & (q + shift >= self.lo) & (q + shift <= self.hi), q + shift, q)
-        return np.clip(q, self.lo, self.hi)
-
-    def inside(self, q: np.ndarray, tol: float = 1e-12) -> np.ndarray:
-        return np.all((q >= self.lo - tol) & (q <= self.hi + tol), axis=-1)
-
-    def sample_bounds(self, scale: float) -> tuple[np.ndarray, np.ndarray]:
-        """Where random restarts are drawn: the limits, or ±π (revolute) / ±scale (prismatic) where infinite."""
-        lo = np.where(np.isfinite(self.lo), self.lo, np.where(self.revolute, -np.pi, -scale))
-        hi = np.where(np.isfinite(self.hi), self.hi, np.where(self.revolute, np.pi, scale))
-        return lo, hi
-
-    def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
-        lo, hi = self.sample_bounds(scale)
-        return rng.uniform(lo, hi, size=shape + (len(lo),))
-
-
-JointLimits = _Limits  # public name: the compiled solver (denavit.codegen) uses the same rule
-characteristic_length = _char_length
-
-
-def _limits_of(robot: DHRobot, ignore: bool) -> _Limits:
-    memo = chain_of(robot).memo  # by identity: no hashing of the robot per call
-    key = ("ik_limits", ignore)
-    if key not in memo:
-        memo[key] = _Limits(robot, ignore)  # read-only after construction: shared between calls
-    return memo[key]
 
 
 class _Slots:
@@ -367,9 +225,9 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     T = as_transform(T, "T")
     batch = T.shape[:-2]
     w_mask = row_mask(mask)
-    n, L = robot.dof, _char_length(robot)
+    n, L = robot.dof, characteristic_length(robot)
     w = np.where(w_mask, 1.0, 0.0) * np.array([1, 1, 1, L, L, L])
-    limits = _limits_of(robot, not respect_limits)
+    limits = limits_of(robot, not respect_limits)
     Tf = T.reshape(-1, 4, 4)
     B = Tf.shape[0]
     if q0 is None:
@@ -413,7 +271,7 @@ def _reasons(robot, q, Tf, mask, success, stalled, tol, rng, respect_limits, max
     if failed.size == 0:
         return reason
     reason[failed] = "unreachable"
-    lim = _limits_of(robot, False)
+    lim = limits_of(robot, False)
     restricts = not np.all(lim.full_turn | (np.isinf(lim.lo) & np.isinf(lim.hi)))
     # does a solution exist when the limits are ignored?  (Not asked when the limits allow every value: that
     # re-solve with restarts and the bank rescue cost ~0.1 s per failed target and could only blame the limits

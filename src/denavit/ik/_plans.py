@@ -49,7 +49,8 @@ class Plan:
     notes: list[str] = field(default_factory=list)
     route: str = ""  # how joints 1-3 of a Pieper arm are found: "closed form (elbow|stanford)" or "resultant"
     closed: dict | None = None  # the constants of a direct (unmirrored, unmerged) elbow Pieper arm: the compiled
-    # solver of denavit.codegen reads them (see elbow_constants)
+    # solver of denavit.codegen reads them (see elbow_constants); for a direct unmerged 6R parallel arm an empty
+    # dict, which analytic_ik's plan cache fills with labels and tolerances (codegen._ik_parallel adds the geometry)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -561,6 +562,7 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
         if _parallel(chain, (1, 2, 3), rng) and (m == 5 or _intersect(chain, (4, 5), rng)):
             solve, point = _parallel_plan(chain, names)
             kind = "parallel"
+            closed = {} if m == 6 and not groups else None
         elif _parallel(rev, (1, 2, 3), rng) and (m == 5 or _intersect(rev, (4, 5), rng)):
             s, _ = _parallel_plan(rev, rnames)
             solve, kind = _mirrored(s), "parallel (mirrored)"

@@ -22,6 +22,8 @@ import numpy as np
 
 from ..model import DHRobot
 from ..numeric import forward_kinematics
+from ._analytic import analytic_ik, ik_structure
+from ._residual import pose_error
 
 __all__ = ["SeedBank", "seed_bank", "closed_form_seeds"]
 
@@ -76,7 +78,6 @@ def seed_bank(robot: DHRobot, lo: np.ndarray, hi: np.ndarray, L: float) -> SeedB
 @lru_cache(maxsize=64)
 def _has_closed_form(robot: DHRobot) -> bool:
     from ..errors import UnsupportedRobotError
-    from ._analytic import ik_structure
 
     try:
         ik_structure(robot)
@@ -93,7 +94,6 @@ def closed_form_seeds(robot: DHRobot, T: np.ndarray, q_ref: np.ndarray) -> tuple
     b, n = q_ref.shape
     if b == 0 or not _has_closed_form(robot):
         return np.zeros((b, 0, n)), np.zeros((b, 0), dtype=bool)
-    from ._analytic import analytic_ik
 
     res = analytic_ik(robot, T)
     q, valid = res.solutions, res.valid
@@ -113,8 +113,6 @@ def rescue(robot: DHRobot, T: np.ndarray, q_ref: np.ndarray, mask: np.ndarray, l
     nearest bank configurations; all of them are polished at once by ``polish(q0 (m, n), T (m, 4, 4))`` (LM
     without restarts) and, per target, the first seed whose polished end point passes the FK test is taken.
     Returns q (b, n) (rows not solved keep NaN) and the number of seeds used per target (b,)."""
-    from ._numeric import pose_error
-
     b, n = q_ref.shape
     qc, valid = closed_form_seeds(robot, T, q_ref)
     bank = seed_bank(robot, limits.lo, limits.hi, L)

@@ -27,6 +27,8 @@ import numpy as np
 
 from ..chain import chain_of
 from ..model import DHRobot
+from ..numeric import forward_kinematics
+from ._residual import LAMBDA0, LAMBDA_MAX, IKResult, rotation_log
 
 __all__ = ["SingleChain", "single_chain"]
 
@@ -98,8 +100,6 @@ def _log(M) -> list:
     cs = (M[0][0] + M[1][1] + M[2][2] - 1.0) / 2.0
     cs = -1.0 if cs < -1.0 else (1.0 if cs > 1.0 else cs)
     if cs < -0.9:
-        from ._numeric import rotation_log
-
         return rotation_log(np.array(M)).tolist()
     theta = acos(cs)
     if theta < 1e-6:
@@ -228,25 +228,21 @@ def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w
                  max_iter: int, tol: float, L: float):
     """The first attempt of ``solve_ik`` for one target in floats; an ``IKResult`` when it ends in a solution
     within the limits (checked by :func:`forward_kinematics`, as the batched path does), else None."""
-    from . import _numeric as ikn
-
     qf, it, status = first_attempt(single_chain(robot), q0.tolist(), T.tolist(), w.tolist(), limits.lo.tolist(),
-                                   limits.hi.tolist(), limits.revolute.tolist(), max_iter, tol, L, ikn.LAMBDA0,
-                                   ikn.LAMBDA_MAX)
+                                   limits.hi.tolist(), limits.revolute.tolist(), max_iter, tol, L, LAMBDA0,
+                                   LAMBDA_MAX)
     if status != "ok":
         return None
     q = limits.project(np.array(qf))
     pe, re = _fk_error(robot, q, T, w_mask.tolist())
     if not (pe <= tol and re <= tol and limits.inside(q)):
         return None
-    return ikn.IKResult(q, True, pe, re, it, 0, "")
+    return IKResult(q, True, pe, re, it, 0, "")
 
 
 def _fk_error(robot: DHRobot, q: np.ndarray, T: np.ndarray, mask: list) -> tuple[float, float]:
     """Position and orientation error norms of ``forward_kinematics(robot, q)`` against T on the masked rows:
     ``pose_error`` of :mod:`._numeric` for one pose, in floats."""
-    from ..numeric import forward_kinematics
-
     F, Tl = forward_kinematics(robot, q).tolist(), T.tolist()
     dp = [(Tl[i][3] - F[i][3]) if mask[i] else 0.0 for i in range(3)]
     M = [[Tl[i][0] * F[j][0] + Tl[i][1] * F[j][1] + Tl[i][2] * F[j][2] for j in range(3)] for i in range(3)]
