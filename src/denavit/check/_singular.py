@@ -19,7 +19,6 @@ searches one unit of the last written decimal around the point.
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -32,6 +31,7 @@ from .. import numeric as N
 from ..codegen import numeric_function
 from ..errors import ParseError
 from ..model import DHRobot, Frame, JointType
+from ._bounded import cpu_bounded
 from ._latex import MAX_CHARS, parse_math
 from ._resolve import robot_resolver
 from ._text import expand_pm, split_relation, split_top
@@ -49,7 +49,7 @@ MAX_VALUES = 64
 MAX_CONDITIONS = 16
 TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 #: CPU seconds the library's symbolic singularity analysis may take for one set of rows of one arm (it runs in a
-#: child process with this CPU limit; the Panda's 6 rows take ~4 s, but some row subsets of 6- and 7-joint arms do
+#: child process with this CPU limit, :func:`._bounded.cpu_bounded`; the Panda's 6 rows take ~4 s, but some row subsets of 6- and 7-joint arms do
 #: not finish in minutes).  Past it, a claim is judged on its own conditions only (never "correct").
 MAX_ANALYSIS_CPU_SECONDS = 10
 #: Arms with at most this many joints are analysed in the process itself (always fast).
@@ -366,53 +366,7 @@ def _analysis(robot: DHRobot, rows: str | None, frame: Frame):
     it needs more than MAX_ANALYSIS_CPU_SECONDS of CPU."""
     if robot.dof <= _SMALL_DOF:
         return _analyse(robot, rows, frame)
-    return _cpu_bounded(_analyse, (robot, rows, frame), MAX_ANALYSIS_CPU_SECONDS)
-
-
-def _cpu_bounded(fn, args: tuple, seconds: float):
-    """``fn(*args)`` in a forked child whose CPU time is limited (RLIMIT_CPU, so the bound does not depend on the
-    machine's load); None when it runs out.  Without fork (Windows) it runs here, unbounded."""
-    import multiprocessing as mp
-
-    try:
-        ctx = mp.get_context("fork")
-    except ValueError:
-        return fn(*args)
-    recv, send = ctx.Pipe(duplex=False)
-    child = ctx.Process(target=_child, args=(send, fn, args, seconds), daemon=True)
-    child.start()
-    send.close()
-    ok, value = False, None
-    try:
-        if recv.poll(seconds * 40 + 60):  # a wall-clock safety net only: the CPU limit ends the child first
-            ok, value = recv.recv()
-    except (EOFError, OSError):  # the child was stopped by its CPU limit
-        pass
-    finally:
-        if child.is_alive():
-            child.kill()
-        child.join()
-        recv.close()
-    if not ok and isinstance(value, Exception):
-        raise value
-    return value if ok else None
-
-
-def _child(conn, fn, args: tuple, seconds: float) -> None:  # pragma: no cover - runs in the child process
-    import os
-    import resource
-
-    try:
-        limit = max(1, int(math.ceil(seconds)))
-        _, hard = resource.getrlimit(resource.RLIMIT_CPU)
-        hard = limit + 1 if hard == resource.RLIM_INFINITY else min(hard, limit + 1)
-        resource.setrlimit(resource.RLIMIT_CPU, (min(limit, hard), hard))
-        try:
-            conn.send((True, fn(*args)))
-        except Exception as exc:  # noqa: BLE001 - handed to the parent, which raises it
-            conn.send((False, exc))
-    finally:
-        os._exit(0)
+    return cpu_bounded(_analyse, (robot, rows, frame), MAX_ANALYSIS_CPU_SECONDS, warm=("denavit.symbolic",))
 
 
 def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str] | None]:

@@ -1,0 +1,109 @@
+"""The checker's CPU-bounded symbolic analysis from a process with threads alive (Jupyter, Dask, thread pools).
+
+A forked copy of a process keeps every lock that another thread held at the fork, so a child that needs one waits
+forever without using CPU (its CPU limit never fires).  These tests hold such a lock in a thread, with a thread pool
+busy too, and ask for the analysis: it must come back promptly with the main thread's answer.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+import denavit as dn
+from denavit.check import _bounded, _singular, check_claims
+from denavit.model import Frame
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the CPU-bounded route needs fork (POSIX)")
+
+_HELD = threading.Lock()  # held by a thread of the test process while the analysis runs
+_REAL_ANALYSE = _singular._analyse
+
+
+def _analyse_needing_the_lock(*args):
+    with _HELD:  # free in a fresh worker; held for ever in a fork of the test process
+        return _REAL_ANALYSE(*args)
+
+
+def _raise_value_error(text):
+    return int(text)
+
+
+def _spin(*args):
+    while True:
+        pass
+
+
+@pytest.fixture
+def threads_alive():
+    """A thread holding _HELD and a thread pool with a running task, for the duration of the test."""
+    release, started = threading.Event(), threading.Event()
+
+    def hold():
+        with _HELD:
+            started.set()
+            release.wait(120)
+
+    holder = threading.Thread(target=hold, daemon=True)
+    holder.start()
+    assert started.wait(10)
+    pool = ThreadPoolExecutor(2)
+    busy = pool.submit(release.wait, 120)
+    try:
+        yield
+    finally:
+        release.set()
+        holder.join(10)
+        busy.result(10)
+        pool.shutdown()
+
+
+def test_a_fork_of_this_process_would_find_the_lock_held(threads_alive):
+    """The hazard is real here: a forked child sees _HELD locked (and would wait on it without using CPU)."""
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        os._exit(0 if _HELD.locked() else 1)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+
+
+def test_the_bounded_analysis_with_threads_alive_gives_the_main_threads_answer(threads_alive, monkeypatch):
+    from denavit import symbolic as S
+
+    robot = dn.load_robot("scara")  # 4 joints: analysed in a CPU-bounded child
+    assert threading.active_count() >= 3 and len(os.listdir("/proc/self/task")) >= 3
+    expected = S.singularity_analysis(robot, rows="vx,vy", frame=Frame.BASE)  # in the main thread, unbounded
+    monkeypatch.setattr(_singular, "_analyse", _analyse_needing_the_lock)
+    monkeypatch.setattr(_bounded, "WALL_SAFETY_FACTOR", 1)  # a regression (a forked child stuck on _HELD) fails
+    monkeypatch.setattr(_bounded, "WALL_SAFETY_SECONDS", 10)  # in ~50 s instead of ~8 minutes
+    _singular._analysis.cache_clear()
+    try:
+        t = time.perf_counter()
+        got = _singular._analysis(robot, "vx,vy", Frame.BASE)
+        v = check_claims(robot, [{"quantity": "singularities", "rows": "vx,vy", "value": r"\sin q_2 = 0"}]).verdicts[0]
+        elapsed = time.perf_counter() - t
+    finally:
+        _singular._analysis.cache_clear()
+    assert got is not None, "the analysis was ended by the safety net: the child was stuck"
+    assert got.conditions == expected.conditions and got.rows == expected.rows
+    assert v.verdict == "correct", v.message
+    assert elapsed < 30
+
+
+def test_cpu_bounded_from_several_threads_at_once(threads_alive):
+    with ThreadPoolExecutor(4) as pool:
+        futures = [pool.submit(_bounded.cpu_bounded, abs, (-k,), 5) for k in range(8)]
+        assert [f.result(timeout=120) for f in futures] == list(range(8))
+
+
+def test_cpu_bounded_raises_the_functions_exception_and_stops_at_its_cpu_limit(threads_alive):
+    with pytest.raises(ValueError, match="invalid literal"):
+        _bounded.cpu_bounded(_raise_value_error, ("x",), 5)
+    t = time.perf_counter()
+    assert _bounded.cpu_bounded(_spin, (), 1) is None
+    assert time.perf_counter() - t < 30
+    assert _bounded.cpu_bounded(abs, (-2.5,), 1) == 2.5  # the worker still serves after a child was stopped
