@@ -217,9 +217,11 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
         from ._ik_elbow import IK_ELBOW_SOURCE
         from ._ik_lm import IK_LM_SOURCE
+        from ._ik_parallel import IK_PARALLEL_SOURCE
 
         body.append(IK_LM_SOURCE)
         body.append(IK_ELBOW_SOURCE)
+        body.append(IK_PARALLEL_SOURCE)  # numba compiles a function on its first call only: no cost to other arms
     return "\n".join(head + body).rstrip() + "\n"
 
 

@@ -11,6 +11,7 @@ from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, T
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
+from ._ik_parallel import parallel_constants
 
 __all__ = ["IKMethods"]
 
@@ -107,7 +108,8 @@ class IKMethods:
 
     def analytic_ik(self, T) -> AnalyticIKResult:
         """Every closed-form solution of one pose: as :func:`denavit.analytic_ik` (same result), in machine code
-        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms).
+        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms) and of the UR class
+        (6R, axes 2, 3, 4 parallel and axes 5, 6 meeting: UR3/5/10 and their e-series).
 
         Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
         polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
@@ -115,17 +117,7 @@ class IKMethods:
         """
         c = self._elbow
         if c is None:
-            plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
-            if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
-                c = self._elbow = False
-            else:
-                k = dict(plan.closed)
-                lim = self.robot.q_limits
-                k.update(lo=lim[:, 0], hi=lim[:, 1],
-                         revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
-                K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
-                assert K.size == sum(size for _, size in ELBOW_LAYOUT)
-                c = self._elbow = [K, list(k["labels"]), plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
+            c = self._elbow = self._analytic_solver()
         Ta = np.asarray(T, dtype=np.float64)
         if c is False or Ta.shape != (4, 4):
             return analytic_ik(self.robot, T)
@@ -139,8 +131,8 @@ class IKMethods:
         i = np.empty((1, 11), dtype=np.int64)  # label codes (8), then kept, outside, status
         solve(Tf, K, f, i)
         if first:  # numba compiled (or loaded) them on this first call: call their machine code from now on
-            c[3] = next(iter(self._m.ik_check.overloads.values())).entry_point
-            c[4] = next(iter(self._m.ik_elbow_packed.overloads.values())).entry_point
+            c[3] = next(iter(check.overloads.values())).entry_point
+            c[4] = next(iter(solve.overloads.values())).entry_point
             c[5] = False
         if i[0, 10]:
             return analytic_ik(self.robot, T)
@@ -148,3 +140,20 @@ class IKMethods:
         g = f[0]
         return AnalyticIKResult(g[:k, :6], tuple([labels[code] for code in i[0, :k].tolist()]), _NO_FREE[:k],
                                 g[:k, 6], g[:k, 7], g[:j, 8:], kind, "pose", _ALL_VALID[k])
+
+    def _analytic_solver(self):
+        """``[K, labels, kind, check, solve, first call]`` for the compiled closed form of this arm's IK plan
+        (``solve(T, K, f, i)``: the elbow or the UR-class kernel, by plan kind), or False where there is none
+        (the plain solver answers)."""
+        plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
+        if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
+            return False
+        if plan.kind == "parallel":
+            return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, self._m.ik_check,
+                    self._m.ik_parallel_packed, True]
+        k = dict(plan.closed)
+        lim = self.robot.q_limits
+        k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
+        K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
+        assert K.size == sum(size for _, size in ELBOW_LAYOUT)
+        return [K, list(k["labels"]), plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]

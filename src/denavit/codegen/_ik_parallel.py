@@ -1,0 +1,361 @@
+"""Analytic IK on the generated kernels: the UR-class closed form (axes 2, 3, 4 parallel, axes 5, 6 meeting) in numba.
+
+The same formulas as the ``parallel`` plan of :mod:`denavit.ik` (Hawkins 2013 for the UR arms; Lynch & Park 2017,
+Sec. 6.1.2): in the frame F1 = C0 Rz(q1) C1 the parallel joints turn about z, so the z coordinate of the point Q
+where axes 5 and 6 meet is constant (Paden–Kahan subproblem 1 for q1); the z component of the last axis fixes q5
+(the digit-keeping half-angle form of ``axis_angle_roots``), the rest of the orientation q6, and a planar 3R problem
+is left for q2, q3 (law of cosines) and q4.  The eight candidates of one pose are each verified by the arm's
+compiled FK, folded into the joint limits, merged when equal and labelled (shoulder, elbow, wrist: docs/ik.md).
+
+Every case the plain solver treats specially is handed back to it (``status`` 1): a root next to a double root
+(shoulder or elbow or wrist ratio near ±1), the point Q on axis 1 or on axis 2, axis 6 parallel to axes 2–4
+(the wrist-singular continuum), a candidate that would need polishing, two solutions closer than the merge radius.
+The compiled path answers only where its answer is the plain solver's.  The text below is appended to each
+generated numba module of an arm with a 6R ``parallel`` plan; it calls that module's ``fk_1`` and the elbow
+solver's ``_elbow_half_angle``; nothing of the robot or the user is pasted into it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..chain import chain_of
+from ..numeric import inverse_transform
+
+__all__ = ["IK_PARALLEL_SOURCE", "PARALLEL_LAYOUT", "parallel_constants"]
+
+#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (175 numbers).
+PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 9), ("lo", 6), ("hi", 6),
+                   ("revolute", 6), ("theta", 6), ("tols", 8))
+
+
+def parallel_constants(robot, plan) -> np.ndarray:
+    """K of ``ik_parallel_packed`` for ``robot`` and its 6R ``parallel`` plan (``plan.closed``: labels, theta and
+    tolerances, from :func:`denavit.ik.ik_plan`): the plan's geometry, from the arm's chain constants.
+
+    Q_e (the point of axes 5, 6 in the end-effector frame) is the plan's ``point_e``; h is the z of Q in F1 at
+    q = 0; a the direction of axis 2 in the frame after joint 1; σ = ±1 as the parallel joints map z to σ z;
+    (ρ_w, base_w, β_r, β_u) the constants of ``rᵀ Rz(q5) u = m_z`` (r = row z of C4, u = axis z of C5); and
+    (2α, 2β, k0) those of the planar pair's law of cosines ``2α cos q3 + 2β sin q3 = |P_xy|² + k0``.
+    """
+    C = np.array(chain_of(robot).constants, dtype=float)  # (7, 4, 4)
+    T0 = C[0]
+    for k in range(1, 7):
+        T0 = T0 @ C[k]
+    Q_e = np.asarray(plan.point_e, dtype=float)
+    h = (inverse_transform(C[0] @ C[1]) @ T0 @ np.append(Q_e, 1.0))[2]
+    a, pc1 = C[1][:3, 2], C[1][:3, 3]
+    sigma = float(np.sign((C[2] @ C[3])[2, 2]))
+    r, u = C[4][2, :3], C[5][:3, 2]
+    aw, bw = r[0] * u[0] + r[1] * u[1], r[1] * u[0] - r[0] * u[1]
+    R2, p2, p3 = C[2][:3, :3], C[2][:3, 3], C[3][:3, 3]
+    m = R2.T @ p2
+    ap, bp, g = m[0] * p3[0] + m[1] * p3[1], m[1] * p3[0] - m[0] * p3[1], m[2] * p3[2]
+    vz = p2[2] + R2[2, 2] * p3[2]
+    scalars = [h + a @ pc1, sigma, np.hypot(aw, bw), np.arctan2(bw, aw), np.arctan2(np.hypot(r[0], r[1]), r[2]),
+               np.arctan2(np.hypot(u[0], u[1]), u[2]), 2 * ap, 2 * bp, -(p2 @ p2) - p3 @ p3 + vz**2 - 2 * g]
+    lim = robot.q_limits
+    k = dict(plan.closed, Q_e=Q_e, C0i=inverse_transform(C[0]), consts=C, a=a, scalars=scalars, lo=lim[:, 0],
+             hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types])
+    K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in PARALLEL_LAYOUT])
+    if K.size != sum(size for _, size in PARALLEL_LAYOUT):
+        raise ValueError(f"parallel IK constants: {K.size} numbers for the layout's "
+                         f"{sum(size for _, size in PARALLEL_LAYOUT)}")
+    return K
+
+
+IK_PARALLEL_SOURCE = '''
+
+@njit(cache=True, nogil=True)
+def ik_parallel_packed(T, K, f, i):
+    """All solutions of each pose T[b] of a 6R UR-class arm, the constants in K (PARALLEL_LAYOUT order); outputs as
+    ik_elbow_packed: f[b, :k, :6] solutions (folded, sorted), f[b, :k, 6:8] (position, orientation) residuals,
+    f[b, :j, 8:] the solutions outside the limits; i[b, :k] label codes (1 shoulder left, 2 elbow down, 4 wrist
+    flip), i[b, 8:] = (k, j, 1 if the plain solver must decide)."""
+    Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
+    a, sc, lo_lim, hi_lim = K[131:134], K[134:143], K[143:149], K[149:155]
+    rev, theta, tols = K[155:161], K[161:167], K[167:175]
+    # scratch: one float and one flag allocation, sliced
+    ws = np.empty(134)
+    cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \
+        ws[83:89]
+    flags = np.zeros(24, dtype=np.bool_)
+    for b in range(T.shape[0]):
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, ws[89:134])
+        kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
+                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:])
+        for r in range(3):
+            X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
+        for s in range(kept):
+            i[b, s] = _parallel_label(f[b, s, :6], X, C, theta, ws[89:125])
+        i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
+
+
+@njit(cache=True, nogil=True)
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
+    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand
+    (ws: 45 floats of scratch); returns (count, status)."""
+    c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
+    tol, aligned, reach = tols[1], tols[6], tols[7]
+    tiny = tols[0] * reach
+    status = 0
+    ncand = 0
+    V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
+    xr, w, g = ws[36:39], ws[39:42], ws[42:45]
+    for r in range(3):  # Q in the world, then in the frame of C0
+        w[r] = Tb[r, 0] * Q_e[0] + Tb[r, 1] * Q_e[1] + Tb[r, 2] * Q_e[2] + Tb[r, 3]
+    for r in range(3):
+        V[r] = C0i[r, 0] * w[0] + C0i[r, 1] * w[1] + C0i[r, 2] * w[2] + C0i[r, 3]
+    for r in range(3):  # T_R C6_R^T
+        for j in range(3):
+            TC[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
+    # q1: (Rz(q1) a) . V = h + a . pc1 (subproblem 1, as solve_trig)
+    A = a[0] * V[0] + a[1] * V[1]
+    Bq = a[0] * V[1] - a[1] * V[0]
+    c = c0 - a[2] * V[2]
+    rho = math.hypot(A, Bq)
+    if rho <= max(tiny, 1e-11):
+        return 0, 1  # Q on axis 1
+    ratio = c / rho
+    if abs(abs(ratio) - 1.0) < 1e-6:
+        status = 1  # next to a double root: the plain solver polishes and looks for partners
+    if abs(ratio) > 1.0 + tol or rho_w < 1e-12:
+        return 0, max(status, 1 if rho_w < 1e-12 else 0)
+    base1 = math.atan2(Bq, A)
+    delta = math.acos(min(1.0, max(-1.0, ratio)))
+    for s1 in range(2):
+        q1 = base1 + delta if s1 == 0 else base1 - delta
+        _frame1(C, q1, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
+        RL02 = cols[0, 0] * TC[0, 2] + cols[0, 1] * TC[1, 2] + cols[0, 2] * TC[2, 2]
+        RL12 = cols[1, 0] * TC[0, 2] + cols[1, 1] * TC[1, 2] + cols[1, 2] * TC[2, 2]
+        RL22 = cols[2, 0] * TC[0, 2] + cols[2, 1] * TC[1, 2] + cols[2, 2] * TC[2, 2]
+        ell0 = cols[2, 0] * TC[0, 0] + cols[2, 1] * TC[1, 0] + cols[2, 2] * TC[2, 0]
+        ell1 = cols[2, 0] * TC[0, 1] + cols[2, 1] * TC[1, 1] + cols[2, 2] * TC[2, 1]
+        # q5: r^T Rz(q5) u = m_z, m = (RL e_z) with its z scaled by sigma (axis_angle_roots)
+        phi = math.atan2(math.hypot(RL02, RL12), sigma * RL22)
+        dm, sm = br - bu, br + bu
+        lo = math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w
+        hi = math.sin((sm + phi) / 2) * math.sin((sm - phi) / 2) / rho_w
+        if -2.0 * tol < min(lo, hi) < 1e-12:
+            status = 1  # the two q5 roots (nearly) coincide
+        x5 = _elbow_half_angle(lo, hi, tol)
+        if x5 != x5:
+            continue
+        for s5 in range(2):
+            q5 = base_w + x5 if s5 == 0 else base_w - x5
+            c5, s5v = math.cos(q5), math.sin(q5)
+            t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
+            y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
+            y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])
+            if math.hypot(y0, y1) < 10.0 * aligned:
+                status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
+            q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
+            _tail(C, q5, q6, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
+            # X = F1^-1 T tail^-1: its origin P and first column xr
+            for r in range(3):
+                w[r] = Tb[r, 3] - cols[3, r]
+                for j in range(3):
+                    m_rj = Tb[r, 0] * tl[0, j] + Tb[r, 1] * tl[1, j] + Tb[r, 2] * tl[2, j]  # (T_R Rt^T)[r, j]
+                    w[r] -= m_rj * tl[3, j]
+            P0 = cols[0, 0] * w[0] + cols[0, 1] * w[1] + cols[0, 2] * w[2]
+            P1 = cols[1, 0] * w[0] + cols[1, 1] * w[1] + cols[1, 2] * w[2]
+            for r in range(3):
+                g[r] = Tb[r, 0] * tl[0, 0] + Tb[r, 1] * tl[1, 0] + Tb[r, 2] * tl[2, 0]
+            for r in range(3):
+                xr[r] = cols[r, 0] * g[0] + cols[r, 1] * g[1] + cols[r, 2] * g[2]
+            # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
+            if math.hypot(P0, P1) < tiny:
+                status = 1  # Q on axis 2
+            rho3 = math.hypot(ap2, bp2)
+            if rho3 <= 1e-12:
+                status = 1
+                continue
+            ratio3 = (P0 * P0 + P1 * P1 + k0) / rho3
+            if abs(abs(ratio3) - 1.0) < 1e-6:
+                status = 1  # elbow stretched or folded: a double root
+            if abs(ratio3) > 1.0 + tol:
+                continue
+            base3 = math.atan2(bp2, ap2)
+            d3 = math.acos(min(1.0, max(-1.0, ratio3)))
+            for s3 in range(2):
+                q3 = base3 + d3 if s3 == 0 else base3 - d3
+                c3, s3v = math.cos(q3), math.sin(q3)
+                u0, u1 = c3 * C[3, 0, 3] - s3v * C[3, 1, 3], s3v * C[3, 0, 3] + c3 * C[3, 1, 3]
+                v0 = C[2, 0, 3] + C[2, 0, 0] * u0 + C[2, 0, 1] * u1 + C[2, 0, 2] * C[3, 2, 3]
+                v1 = C[2, 1, 3] + C[2, 1, 0] * u0 + C[2, 1, 1] * u1 + C[2, 1, 2] * C[3, 2, 3]
+                if math.hypot(v0, v1) < tiny:
+                    status = 1
+                q2 = math.atan2(P1, P0) - math.atan2(v1, v0)
+                # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
+                c2, s2v = math.cos(q2), math.sin(q2)
+                z0, z1, z2 = c2 * xr[0] + s2v * xr[1], -s2v * xr[0] + c2 * xr[1], xr[2]
+                e0 = C[2, 0, 0] * z0 + C[2, 1, 0] * z1 + C[2, 2, 0] * z2
+                e1 = C[2, 0, 1] * z0 + C[2, 1, 1] * z1 + C[2, 2, 1] * z2
+                e2 = C[2, 0, 2] * z0 + C[2, 1, 2] * z1 + C[2, 2, 2] * z2
+                f0, f1 = c3 * e0 + s3v * e1, -s3v * e0 + c3 * e1
+                N00 = C[3, 0, 0] * f0 + C[3, 1, 0] * f1 + C[3, 2, 0] * e2
+                N10 = C[3, 0, 1] * f0 + C[3, 1, 1] * f1 + C[3, 2, 1] * e2
+                q4 = math.atan2(N10, N00)
+                cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
+                cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
+                ncand += 1
+    return ncand, status
+
+
+@njit(cache=True, nogil=True)
+def _frame1(C, q1, cols):
+    """Columns x, y, z and origin of C0 Rz(q1) C1 into cols (4, 3) (as chain_columns: x <- c x + s y, ...)."""
+    c, s = math.cos(q1), math.sin(q1)
+    for r in range(3):
+        x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
+        x, y = c * x + s * y, c * y - s * x
+        cols[0, r] = x * C[1, 0, 0] + y * C[1, 1, 0] + z * C[1, 2, 0]
+        cols[1, r] = x * C[1, 0, 1] + y * C[1, 1, 1] + z * C[1, 2, 1]
+        cols[2, r] = x * C[1, 0, 2] + y * C[1, 1, 2] + z * C[1, 2, 2]
+        cols[3, r] = C[0, r, 3] + x * C[1, 0, 3] + y * C[1, 1, 3] + z * C[1, 2, 3]
+
+
+@njit(cache=True, nogil=True)
+def _next_frame(cols, q, Ck, out):
+    """Columns and origin of F Rz(q) Ck into out (4, 3), F given by its columns cols (4, 3)."""
+    c, s = math.cos(q), math.sin(q)
+    for r in range(3):
+        x, y, z = c * cols[0, r] + s * cols[1, r], c * cols[1, r] - s * cols[0, r], cols[2, r]
+        out[0, r] = x * Ck[0, 0] + y * Ck[1, 0] + z * Ck[2, 0]
+        out[1, r] = x * Ck[0, 1] + y * Ck[1, 1] + z * Ck[2, 1]
+        out[2, r] = x * Ck[0, 2] + y * Ck[1, 2] + z * Ck[2, 2]
+        out[3, r] = cols[3, r] + x * Ck[0, 3] + y * Ck[1, 3] + z * Ck[2, 3]
+
+
+@njit(cache=True, nogil=True)
+def _tail(C, q5, q6, tl):
+    """Columns and origin of C4 Rz(q5) C5 Rz(q6) C6 into tl (4, 3)."""
+    c5, s5, c6, s6 = math.cos(q5), math.sin(q5), math.cos(q6), math.sin(q6)
+    for r in range(3):
+        x, y, z, p = C[4, r, 0], C[4, r, 1], C[4, r, 2], C[4, r, 3]
+        x, y = c5 * x + s5 * y, c5 * y - s5 * x
+        x, y, z, p = (x * C[5, 0, 0] + y * C[5, 1, 0] + z * C[5, 2, 0], x * C[5, 0, 1] + y * C[5, 1, 1] + z * C[5, 2, 1],
+                      x * C[5, 0, 2] + y * C[5, 1, 2] + z * C[5, 2, 2], p + x * C[5, 0, 3] + y * C[5, 1, 3] + z * C[5, 2, 3])
+        x, y = c6 * x + s6 * y, c6 * y - s6 * x
+        tl[0, r] = x * C[6, 0, 0] + y * C[6, 1, 0] + z * C[6, 2, 0]
+        tl[1, r] = x * C[6, 0, 1] + y * C[6, 1, 1] + z * C[6, 2, 1]
+        tl[2, r] = x * C[6, 0, 2] + y * C[6, 1, 2] + z * C[6, 2, 2]
+        tl[3, r] = p + x * C[6, 0, 3] + y * C[6, 1, 3] + z * C[6, 2, 3]
+
+
+@njit(cache=True, nogil=True)
+def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq):
+    """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
+    would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
+    status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
+    others into out_outq.  Returns (kept, outside, status)."""
+    verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
+    ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
+    status = 0
+    for k in range(ncand):
+        for j in range(6):
+            q[j] = cand[k, j]
+        fk_1(q, F)
+        pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)
+        tr = 0.0  # rotation error: the angle of R_t R^T
+        for i in range(3):
+            for j in range(3):
+                tr += Tb[i, j] * F[i, j]
+        v0 = v1 = v2 = 0.0
+        for j in range(3):
+            v0 += Tb[2, j] * F[1, j] - Tb[1, j] * F[2, j]
+            v1 += Tb[0, j] * F[2, j] - Tb[2, j] * F[0, j]
+            v2 += Tb[1, j] * F[0, j] - Tb[0, j] * F[1, j]
+        re = math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0))
+        cerr[k, 0], cerr[k, 1] = pe, re
+        size = pe + reach * re
+        if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
+            status = 1  # would be polished by the plain solver
+        ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
+    for k in range(ncand):
+        if not ok[k]:
+            continue
+        ins = True
+        for j in range(6):
+            x = cand[k, j]
+            if revolute[j] != 0.0:
+                x = math.pi - ((math.pi - x) % (2.0 * math.pi))
+                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
+                    x += 2.0 * math.pi
+                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
+                    x -= 2.0 * math.pi
+            cand[k, j] = x
+            ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
+        inside[k] = ins
+        for m in range(k):
+            if not ok[m]:
+                continue
+            dmax = 0.0
+            for j in range(6):
+                d = abs(cand[k, j] - cand[m, j])
+                if revolute[j] != 0.0:
+                    d = abs(d - 2.0 * math.pi * np.rint(d / (2.0 * math.pi)))
+                dmax = max(dmax, d)
+            if dmax < dup_tol:
+                ok[k] = False
+                break
+            if dmax < merge_r:
+                status = 1  # the plain solver merges such a pair by the FK of its midpoint
+    kept = 0
+    n_out = 0
+    for k in range(ncand):
+        if ok[k] and not inside[k]:
+            for j in range(6):
+                out_outq[n_out, j] = cand[k, j]
+            n_out += 1
+            ok[k] = False
+        elif ok[k]:
+            kept += 1
+    for k in range(8):
+        used[k] = False
+    for slot in range(kept):
+        best = -1
+        for k in range(ncand):
+            if ok[k] and not used[k]:
+                if best < 0:
+                    best = k
+                else:
+                    for j in range(6):
+                        if cand[k, j] != cand[best, j]:
+                            if cand[k, j] < cand[best, j]:
+                                best = k
+                            break
+        used[best] = True
+        for j in range(6):
+            out_q[slot, j] = cand[best, j]
+        out_err[slot, 0], out_err[slot, 1] = cerr[best, 0], cerr[best, 1]
+    return kept, n_out, status
+
+
+@njit(cache=True, nogil=True)
+def _parallel_label(qs, X, C, theta, fr):
+    """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
+    (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
+    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  fr: 36 floats of scratch."""
+    f1, f2, f3 = fr[0:12].reshape((4, 3)), fr[12:24].reshape((4, 3)), fr[24:36].reshape((4, 3))
+    _frame1(C, qs[0], f1)
+    _next_frame(f1, qs[1], C[2], f2)
+    _next_frame(f2, qs[2], C[3], f3)
+    code = 0
+    s_right = 0.0
+    for r in range(3):
+        s_right += f1[0, r] * (X[r] - C[0, r, 3])
+    if s_right < 0.0:
+        code |= 1
+    d0, d1, d2 = f3[3, 0] - f1[3, 0], f3[3, 1] - f1[3, 1], f3[3, 2] - f1[3, 2]  # W - S
+    n0 = f1[2, 1] * d2 - f1[2, 2] * d1
+    n1 = f1[2, 2] * d0 - f1[2, 0] * d2
+    n2 = f1[2, 0] * d1 - f1[2, 1] * d0
+    towards = 1.0 if C[0, 0, 2] * n0 + C[0, 1, 2] * n1 + C[0, 2, 2] * n2 >= 0.0 else -1.0
+    side = (f2[3, 0] - f1[3, 0]) * n0 + (f2[3, 1] - f1[3, 1]) * n1 + (f2[3, 2] - f1[3, 2]) * n2
+    if side * towards < 0.0:
+        code |= 2
+    if math.sin(qs[4] + theta[4]) < 0.0:
+        code |= 4
+    return code
+'''
