@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..chain import COMPONENTS, chain_of, walk
+from ..chain import COMPONENTS, FLOATS, chain_of, walk
 from ..model import DHRobot
 from ..errors import ModelError
 from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
@@ -126,40 +126,48 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
     fv = [link.inertia.viscous if link.inertia and friction else 0.0 for link in robot.joints]
     fc = [link.inertia.coulomb if link.inertia and friction else 0.0 for link in robot.joints]
 
+    def at(q0):  # the frames at q0 (joint 1 a constant: the walker on components)
+        return walk(chain, q0, COMPONENTS, frames=True)
+
     def friction(qd):
         return [fv[k] * qd[k] + fc[k] * sym_sign(qd[k]) for k in range(n)]
 
     if "rnea" in names:
         tape = Tape()
         q, qd, qdd = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("qdd", n)
-        tau = rnea_kernel(pl, q, qd, qdd, g)
+        q0 = _first_joint_at_zero(q)
+        tau = rnea_kernel(pl, q0, qd, qdd, _gravity_seen_at_zero(chain, q, g), at(q0))
         tau = [t + f for t, f in zip(tau, friction(qd))]
         out["rnea"] = KernelSpec("rnea", "tau = M(q) qdd + C(q, qd) qd + g(q) + tau_f (friction)",
                                  (("q", n), ("qd", n), ("qdd", n)), (n,), tuple(tau), tape)
     if "gravity" in names:
         tape = Tape()
         q = tape.inputs("q", n)
-        zero = [0.0] * n
+        q0, zero = _first_joint_at_zero(q), [0.0] * n
         out["gravity"] = KernelSpec("gravity", "g(q), the gravity torques", (("q", n),), (n,),
-                                    tuple(rnea_kernel(pl, q, zero, zero, g)), tape)
+                                    tuple(rnea_kernel(pl, q0, zero, zero, _gravity_seen_at_zero(chain, q, g), at(q0))),
+                                    tape)
     if "coriolis" in names:
         tape = Tape()
         q, qd = tape.inputs("q", n), tape.inputs("qd", n)
-        c = rnea_kernel(pl, q, qd, [0.0] * n, [0.0, 0.0, 0.0])
+        q0 = _first_joint_at_zero(q)
+        c = rnea_kernel(pl, q0, qd, [0.0] * n, [0.0, 0.0, 0.0], at(q0))
         out["coriolis"] = KernelSpec("coriolis", "c(q, qd) = C(q, qd) qd, the velocity torques",
                                      (("q", n), ("qd", n)), (n,), tuple(c), tape)
     if "mass_matrix" in names:
         tape = Tape()
         q = tape.inputs("q", n)
-        M = mass_matrix_kernel(pl, q)
+        q0 = _first_joint_at_zero(q)
+        M = mass_matrix_kernel(pl, q0, at(q0))
         out["mass_matrix"] = KernelSpec("mass_matrix", "M(q), the joint-space inertia matrix", (("q", n),),
                                         (n, n), tuple(e for row in M for e in row), tape)
     if "forward_dynamics" in names:
         tape = Tape()
         q, qd, tau = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("tau", n)
-        frames = walk(chain, q, COMPONENTS, frames=True)
-        bias = rnea_kernel(pl, q, qd, [0.0] * n, g, frames)
-        M = mass_matrix_kernel(pl, q, frames)
+        q0 = _first_joint_at_zero(q)
+        frames = at(q0)
+        bias = rnea_kernel(pl, q0, qd, [0.0] * n, _gravity_seen_at_zero(chain, q, g), frames)
+        M = mass_matrix_kernel(pl, q0, frames)
         rhs = [t - f - b for t, f, b in zip(tau, friction(qd), bias)]
         try:
             qdd, d = ldl_pivots_solve(M, rhs)
@@ -173,6 +181,38 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
             "forward_dynamics", "qdd = M^-1 (tau - c - g - tau_f); last entry > 0 iff M is regular",
             (("q", n), ("qd", n), ("tau", n)), (n + 1,), tuple(qdd) + (ok,), tape)
     return out
+
+
+def _first_joint_at_zero(q) -> list:
+    """q with joint 1 at 0: the dynamics kernels' configuration.
+
+    Joint 1 moves everything after it rigidly (a rotation about, or a translation along, a fixed line), and
+    kinetic energy does not change under a rigid motion of the whole moving system: M(q), and with it the
+    velocity terms c(q, q̇) built from M and its derivatives, do not depend on q1 (Featherstone 2008, Sec. 6.1;
+    Khalil & Dombre 2002, Sec. 9.4).  Tracing them at q1 = 0 folds joint 1's sine and cosine out of every frame.
+    """
+    return [0.0] + list(q[1:])
+
+
+def _gravity_seen_at_zero(chain, q, g) -> list:
+    """Gravity as the arm at q1 = 0 feels it: Rᵀ g, with R the rotation of joint 1 by q1 about its axis u.
+
+    The arm at q is the arm at q1 = 0 moved rigidly by joint 1; in gravity g it needs the torques the unmoved
+    arm needs in gravity Rᵀ g.  Rodrigues: Rᵀ g = g∥ + g⊥ cos q1 − (u × g) sin q1, with g∥ = u (u·g); for a
+    prismatic joint 1, or an axis along gravity (g⊥ = 0: most arms), Rᵀ g = g, a constant.
+    """
+    if not chain.revolute[0]:
+        return list(g)
+    u = walk(chain, [0.0] * chain.dof, FLOATS, frames=True)[chain.axis_frame[0]][2]  # fixed: before joint 1
+    ug = sum(a * b for a, b in zip(u, g))
+    par = [a * ug for a in u]
+    perp = [gi - pi for gi, pi in zip(g, par)]
+    ucg = _cross(u, g)
+    scale = 1e-15 * max(1.0, max(abs(v) for v in g))  # rounding of u's components: an axis along g
+    if max(abs(v) for v in perp) <= scale and max(abs(v) for v in ucg) <= scale:
+        return list(g)
+    c, s = q[0].cos(), q[0].sin()
+    return [par[i] + perp[i] * c - ucg[i] * s for i in range(3)]
 
 
 def has_dynamics(robot: DHRobot) -> bool:
