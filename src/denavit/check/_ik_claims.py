@@ -27,6 +27,7 @@ import numpy as np
 from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
+from ..ik import analytic_ik, ik_structure
 from ..model import DHRobot, JointType
 from ._latex import MAX_CHARS, parse_math, parse_matrix
 from ._resolve import robot_resolver
@@ -201,7 +202,7 @@ def _targets(robot: DHRobot, rng: np.random.Generator, count: int):
     for _ in range(count * 4):
         q = rng.uniform(lo, hi)
         T = N.forward_kinematics(robot, q)
-        res = N.analytic_ik(robot, T)
+        res = analytic_ik(robot, T)
         J = N.geometric_jacobian(robot, q)[_controlled_rows(res)]
         s = np.linalg.svd(J, compute_uv=False)
         if s[-1] > 1e-3 * s[0]:
@@ -320,7 +321,7 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
     if pose not in ("dh", "world"):
         raise ParseError(f"'pose' must be dh (T_0_N, default) or world (end-effector pose), got {pose!r}")
     try:
-        N.ik_structure(robot)
+        ik_structure(robot)
     except Exception as exc:
         raise ParseError(f"IK formulas cannot be checked for this arm: {exc}") from None
     tol = MATCH_TOL + (10.0 * 10.0 ** -d if (d := _decimals_of([v for _, v in versions])) >= 2 else 0.0)
@@ -439,7 +440,7 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
         raise ParseError(f"'T' must be 4×4, got {T.shape}")
     claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
     try:
-        res = N.analytic_ik(robot, T)
+        res = analytic_ik(robot, T)
     except Exception:  # no closed form: each solution is still checked by FK
         res = None
     rows = _controlled_rows(res) if res is not None else list(range(6))
