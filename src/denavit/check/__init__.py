@@ -16,7 +16,8 @@ import numpy as np
 from ..errors import DenavitError, ParseError
 from ..model import DHRobot
 from ._engine import Verdict, check_claim
-from ._latex import parse_math, parse_matrix, split_matrix
+from ._latex import parse_math
+from ._matrices import parse_matrix, split_matrix
 from ._quantities import QUANTITIES
 from ._resolve import robot_resolver
 

@@ -16,7 +16,8 @@ from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
 from ..model import Convention, DHRobot
-from ._latex import Ident, parse_matrix
+from ._matrices import parse_matrix
+from ._tokens import Ident
 
 __all__ = ["check_dh_matrix", "N_DH_POINTS"]
 

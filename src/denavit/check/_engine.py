@@ -21,7 +21,7 @@ from ..errors import ParseError
 from ..model import DHRobot
 from ._formulas import expected_formula
 from ._hints import hints_for
-from ._latex import after_last_equals
+from ._matrices import after_last_equals
 from ._points import _evaluate, _gravity_name, _points, _where_nodes, _wrench_nodes
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver

@@ -29,9 +29,11 @@ from .. import numeric as N
 from ..errors import ParseError
 from ..ik import analytic_ik, ik_structure
 from ..model import DHRobot, JointType
-from ._latex import MAX_CHARS, parse_math, parse_matrix
+from ._latex import parse_math
+from ._matrices import parse_matrix
 from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
+from ._tokens import MAX_CHARS
 from ._vectorized import vec_eval
 
 __all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS", "MAX_WHERE", "MAX_SOLUTIONS"]

@@ -9,7 +9,8 @@ Accepted: numbers, decimals and powers of ten (``1e3``, ``2.5E-4``), ``+ - * / ^
 (``2 L_1 \\cos\\theta_1``), parentheses ``( ) [ ] { } \\left( \\right)``, ``\\frac{a}{b}``, ``\\sqrt{x}``,
 ``\\sin \\cos \\tan \\arctan \\operatorname{atan2}``, ``\\sin^2 x``, ``\\pi``, Greek letters, subscripts
 (``\\theta_1``, ``L_{1}``, ``a_{i-1}``), dots (``\\dot\\theta_1``), shorthand ``C_1``, ``S_{12}``, ``c_{123}``,
-``C_{\\theta_1}``, and matrices ``\\begin{bmatrix} … & … \\\\ … \\end{bmatrix}`` (also pmatrix, Bmatrix, matrix).
+``C_{\\theta_1}`` (the tokens: :mod:`._tokens`; matrices ``\\begin{bmatrix} … \\end{bmatrix}`` and lists of
+cells: :mod:`._matrices`).
 Names are resolved by a caller-supplied function, which decides what ``L_1`` or ``\\theta_2`` means.
 Input length and nesting are capped.
 """
@@ -17,113 +18,12 @@ Input length and nesting are capped.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
-from typing import Callable
 
 from .. import _expr
 from ..errors import ParseError
+from ._tokens import FUNCS, GREEK, MAX_DEPTH, MAX_TREE_DEPTH, WRAP_CMDS, Ident, Resolver, tokenize
 
-__all__ = ["Ident", "RaggedMatrix", "tokenize", "parse_math", "parse_matrix", "split_matrix", "MAX_CHARS", "MAX_DEPTH", "MAX_TREE_DEPTH",
-           "MAX_DIGITS", "Resolver"]
-
-MAX_CHARS = 20_000
-MAX_DEPTH = 40
-MAX_TOKENS = 6_000
-#: Longest chain of operators in one expression (``1+1+…+1`` with more terms is refused): the trees are walked
-#: recursively, so this keeps every walker far from Python's recursion limit.
-MAX_TREE_DEPTH = 400
-#: Most digits in one number or subscript (a double has about 17 significant digits and overflows past 309).
-MAX_DIGITS = 40
-
-GREEK = ("alpha", "beta", "gamma", "delta", "epsilon", "varepsilon", "zeta", "eta", "theta", "vartheta", "iota",
-         "kappa", "lambda", "mu", "nu", "xi", "rho", "sigma", "tau", "phi", "varphi", "chi", "psi", "omega", "ell")
-_UNICODE = {"θ": r"\theta ", "α": r"\alpha ", "β": r"\beta ", "π": r"\pi ", "φ": r"\phi ", "ψ": r"\psi ",
-            "ω": r"\omega ", "σ": r"\sigma ", "τ": r"\tau ", "·": r"\cdot ", "×": r"\times ", "−": "-", "–": "-", "√": r"\sqrt ",
-            "²": "^2", "³": "^3", "ϑ": r"\vartheta ", "°": r"\degree "}
-FUNCS = {"sin": "sin", "cos": "cos", "tan": "tan", "arcsin": "asin", "arccos": "acos", "arctan": "atan",
-         "asin": "asin", "acos": "acos", "atan": "atan", "atan2": "atan2", "arctan2": "atan2", "sqrt": "sqrt",
-         "exp": "exp", "ln": "log", "log": "log", "abs": "abs"}
-_SKIP_CMDS = {"left", "right", "big", "Big", "bigg", "Bigg", "bigl", "bigr", "Bigl", "Bigr", "quad", "qquad",
-              "displaystyle", "textstyle", "limits", "nonumber"}
-_WRAP_CMDS = {"mathrm", "text", "mathit", "mathbf", "boldsymbol", "bm", "mathsf", "operatorname", "textrm", "rm"}
-_TOKEN = re.compile(
-    r"(?P<ws>\s+|\\[,;:! ]|~)"
-    r"|(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"  # 1e3, 2.5E-4: a number, never 1·e3
-    r"|(?P<cmd>\\[A-Za-z]+)"
-    r"|(?P<word>[A-Za-z]+[0-9]*)"
-    r"|(?P<op>\*\*|[-+*/^_(){}\[\],=|&']|\\\\|\\\{|\\\})"
-)
-
-
-class RaggedMatrix(ParseError):
-    """A matrix whose rows have different lengths (for a claim: a value of the wrong shape, not unreadable)."""
-
-
-@dataclass(frozen=True)
-class Ident:
-    """A name as written: ``base`` (``"theta"``, ``"L"``, ``"C"``), ``sub`` (subscript text, e.g. ``"12"``),
-    ``sub_tree`` (the subscript read as an expression, when it is one), ``dots`` (0, 1 or 2 time dots)."""
-
-    base: str
-    sub: str = ""
-    sub_tree: tuple | None = None
-    dots: int = 0
-
-    @property
-    def plain(self) -> str:
-        """``L_1`` → ``"L1"``, ``Lc_{2}`` → ``"Lc2"``."""
-        return self.base + re.sub(r"[^A-Za-z0-9]", "", self.sub)
-
-
-Resolver = Callable[[Ident], tuple]
-
-
-_JOINT_SPACE = re.compile(r"(\\(?:var)?theta|\\dot\{?\\theta\}?|\\ddot\{?\\theta\}?)\s+(\d)(?![\d.])")
-_OF_TIME = re.compile(r"(?<=[A-Za-z0-9}])\s*\(\s*t\s*\)")
-
-
-def _normalize(text: str) -> str:
-    text = re.sub(r"\\operatorname\{atan\}_\{?2\}?", r"\\operatorname{atan2}", text)  # sympy's atan2
-    text = re.sub(r"([θαβφψωτϑσ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
-    for k, v in _UNICODE.items():
-        text = text.replace(k, v)
-    text = _JOINT_SPACE.sub(lambda m: f"{m.group(1)}_{{{m.group(2)}}}", text)  # \\theta 2 → \\theta_{2}
-    return _OF_TIME.sub("", text)  # \\theta_1(t) → \\theta_1
-
-
-def tokenize(text: str) -> list[tuple[str, str]]:
-    """The tokens ``(kind, text)`` of a formula (kinds num, cmd, word, op), spacing commands dropped; capped."""
-    return _tokens(text)
-
-
-def _tokens(text: str) -> list[tuple[str, str]]:
-    if len(text) > MAX_CHARS:
-        raise ParseError(f"expression longer than {MAX_CHARS} characters")
-    text = _normalize(text)
-    out: list[tuple[str, str]] = []
-    pos = 0
-    while pos < len(text):
-        m = _TOKEN.match(text, pos)
-        if not m:
-            raise ParseError(f"unexpected character {text[pos]!r} at position {pos + 1}")
-        pos = m.end()
-        kind = m.lastgroup or "op"
-        if kind == "ws":
-            continue
-        tok = m.group(kind)
-        if kind == "num" and len(tok) > MAX_DIGITS:
-            raise ParseError(f"number with more than {MAX_DIGITS} digits at position {m.start() + 1}")
-        if kind == "num" and text.startswith(".", pos):
-            raise ParseError(f"malformed number {text[m.start():pos + 1]!r} at position {m.start() + 1}")
-        if kind == "word" and len(tok) > MAX_DIGITS:
-            raise ParseError(f"name longer than {MAX_DIGITS} characters at position {m.start() + 1}")
-        if kind == "cmd" and tok[1:] in _SKIP_CMDS:
-            continue
-        out.append((kind, tok))
-        if len(out) > MAX_TOKENS:
-            raise ParseError(f"expression has more than {MAX_TOKENS} tokens")
-    return out
-
+__all__ = ["parse_math", "strip_equation_number", "tree_depth"]
 
 _OPEN = {"(": ")", "[": "]", "{": "}", "\\{": "\\}"}
 
@@ -131,7 +31,7 @@ _OPEN = {"(": ")", "[": "]", "{": "}", "\\{": "\\}"}
 class _Parser:
     def __init__(self, text: str, resolve: Resolver) -> None:
         self.text = text
-        self.toks = _tokens(text)
+        self.toks = tokenize(text)
         self.i = 0
         self.depth = 0
         self.resolve = resolve
@@ -290,7 +190,7 @@ class _Parser:
             inner = self.braced_or_ident()
             return self.resolve_ident(Ident(inner.base, inner.sub, inner.sub_tree, 1 if name == "dot" else 2),
                                       allow_sub=True)
-        if name in _WRAP_CMDS:
+        if name in WRAP_CMDS:
             word = self.group_text().replace(" ", "")
             if word in FUNCS:
                 return self.function(FUNCS[word])
@@ -475,114 +375,3 @@ def tree_depth(node: tuple) -> int:
         elif kind == "call":
             stack += [(a, d + 1) for a in nd[2]]
     return deepest
-
-
-_BEGIN = re.compile(r"\\begin\{([bBpvV]?matrix|array)\}(?:\{[^{}]*\})?")
-
-
-def split_matrix(text: str) -> list[list[str]] | None:
-    """The cells of the (first) LaTeX matrix environment in ``text``, or None if there is none.
-
-    Linear time: the first ``\\begin{…matrix}`` is found by one regex search (no backtracking across the
-    text) and its ``\\end`` by a plain substring search; a ``\\begin`` without its ``\\end`` is an error.
-    """
-    if len(text) > MAX_CHARS:
-        raise ParseError(f"expression longer than {MAX_CHARS} characters")
-    text = _normalize(text)
-    m = _BEGIN.search(text)
-    if m is None:
-        return None
-    end = text.find("\\end{" + m.group(1) + "}", m.end())
-    if end < 0:
-        raise ParseError(f"\\begin{{{m.group(1)}}} without its \\end{{{m.group(1)}}}")
-    body = text[m.end():end]
-    rows = [r for r in re.split(r"\\\\(?:\[[^\]]*\])?", body) if r.strip() and not r.strip().startswith("\\hline")]
-    return [[c.strip() for c in r.split("&")] for r in rows]
-
-
-_ENV = re.compile(r"\\(begin|end)\{(?:[bBpvV]?matrix|array|smallmatrix)\*?\}")  # not split/aligned: an = there counts
-
-
-def after_last_equals(text: str) -> str:
-    """What follows the last ``=`` outside brackets and matrix environments (``J = [\\begin…] = \\begin…``)."""
-    level, cut, k = 0, -1, 0
-    while k < len(text):
-        m = _ENV.match(text, k)
-        if m:
-            level += 1 if m.group(1) == "begin" else -1
-            k = m.end()
-            continue
-        ch = text[k]
-        if ch in "({[":
-            level += 1
-        elif ch in ")}]":
-            level -= 1
-        elif ch == "=" and level == 0:
-            cut = k
-        k += 1
-    return text[cut + 1:] if cut >= 0 else text
-
-
-def split_list(text: str) -> list[list[str]] | None:
-    """``[a, b, c]`` / ``(a, b, c)`` (a column) or ``[a, b; c, d]`` / ``[[a, b], [c, d]]`` (rows), else None."""
-    t = text.strip()
-    for a, b in (("\\left[", "\\right]"), ("\\left(", "\\right)")):
-        if t.startswith(a) and t.endswith(b):
-            t = t[len(a) - 1:len(t) - len(b)] + b[-1]
-    if len(t) < 2 or (t[0], t[-1]) not in (("[", "]"), ("(", ")")) or not encloses(t):
-        return None
-    from ._text import split_top
-
-    body = t[1:-1]
-    rows = split_top(body, (";", "\\\\"))
-    if len(rows) > 1:
-        return [[c.strip() for c in split_top(r, (",", "&"))] for r in rows if r.strip()]
-    items = [c.strip() for c in split_top(body, (",",))]
-    if len(items) < 2:
-        return None
-    if all(len(i) >= 2 and i[0] == "[" and i[-1] == "]" and encloses(i) for i in items):
-        return [[c.strip() for c in split_top(i[1:-1], (",",))] for i in items]
-    return [[c] for c in items]
-
-
-def encloses(t: str) -> bool:
-    """The first bracket of ``t`` closes at its last character."""
-    level = 0
-    for k, ch in enumerate(t):
-        level += ch in "([{"
-        level -= ch in ")]}"
-        if level == 0:
-            return k == len(t) - 1
-    return False
-
-
-def parse_matrix(text: str, resolve: Resolver) -> list[list[tuple]]:
-    """A LaTeX matrix (or a single expression, as a 1×1 matrix) → rows of trees; errors name the entry.
-
-    Only the part after the last ``=`` counts (a definition pasted before it is skipped); a bracketed list
-    ``[a, b, c]`` is a column and ``[a, b; c, d]`` a matrix.  Rows of different lengths raise
-    :class:`RaggedMatrix`.
-    """
-    if len(text) > MAX_CHARS:
-        raise ParseError(f"expression longer than {MAX_CHARS} characters")
-    text = after_last_equals(strip_equation_number(text))
-    cells = split_matrix(text)
-    if cells is None:
-        cells = split_list(_normalize(text))
-    if cells is None:
-        return [[parse_math(text, resolve)]]
-    if not cells:
-        raise ParseError("empty matrix")
-    width = max(len(r) for r in cells)
-    if any(len(r) != width for r in cells):
-        raise RaggedMatrix(f"rows of different lengths {[len(r) for r in cells]} in the matrix")
-    out = []
-    for i, row in enumerate(cells, start=1):
-        out_row = []
-        for j, cell in enumerate(row, start=1):
-            try:
-                out_row.append(parse_math(cell, resolve, rhs=False))
-            except ParseError as exc:
-                raise ParseError(f"entry ({i}, {j}) {cell[:40]!r}: {exc}") from None
-        out.append(out_row)
-    return out

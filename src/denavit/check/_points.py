@@ -15,10 +15,12 @@ from .. import _expr
 from ..errors import ParseError
 from ..io import with_parameters
 from ..model import DHRobot
-from ._latex import Ident, parse_math, split_list
+from ._latex import parse_math
+from ._matrices import split_list
 from ._quantities import Point
 from ._resolve import robot_resolver
 from ._text import split_top
+from ._tokens import Ident
 from ._values import _joint_values
 
 __all__ = ["N_POINTS", "N_PARAM_SETS", "MAX_NAME", "WRENCH_BASES"]

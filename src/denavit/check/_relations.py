@@ -1,7 +1,7 @@
 """``relation`` claims: a textbook relation between the arm's vectors and matrices, such as ``\\tau = J^T F``,
 ``v = J_v \\dot q`` or the column rule ``J_i = [z_{i-1} \\times (p - p_{i-1}); z_{i-1}]``.
 
-Both sides are read by a small restricted reader of matrix expressions (the tokens of :mod:`denavit.check._latex`;
+Both sides are read by a small restricted reader of matrix expressions (the tokens of :mod:`denavit.check._tokens`;
 nothing reaches ``eval`` or sympy) and evaluated with numpy at random joint values, rates and a random wrench; the
 relation is correct when the sides are equal there.  Names (world axes, the numeric engine's values):
 
@@ -27,8 +27,8 @@ import numpy as np
 from .. import numeric as N
 from ..errors import ParseError
 from ..model import DHRobot, JointType
-from ._latex import MAX_CHARS, tokenize
 from ._text import split_top
+from ._tokens import MAX_CHARS, tokenize
 
 __all__ = ["check_relation", "N_RELATION_POINTS", "MAX_RELATION_DEPTH"]
 

@@ -14,7 +14,7 @@ from typing import Iterable
 
 from ..errors import ParseError
 from ..model import DHRobot, JointType
-from ._latex import Ident
+from ._tokens import Ident
 
 __all__ = ["robot_resolver", "JOINT_BASES"]
 
@@ -39,7 +39,7 @@ def _joint_sum(digits: str, n: int) -> tuple | None:
 
 
 def robot_resolver(robot: DHRobot, extra: Iterable[str] = ()):
-    """A resolver (see :mod:`denavit.check._latex`) for the names of ``robot``'s formulas."""
+    """A resolver (see :mod:`denavit.check._tokens`) for the names of ``robot``'s formulas."""
     params = {k for k, _ in robot.parameters}
     n = robot.dof
     extra = set(extra)

@@ -32,9 +32,10 @@ from ..codegen import numeric_function
 from ..errors import ParseError
 from ..model import DHRobot, Frame, JointType
 from ._bounded import cpu_bounded
-from ._latex import MAX_CHARS, parse_math
+from ._latex import parse_math
 from ._resolve import robot_resolver
 from ._text import expand_pm, split_relation, split_top
+from ._tokens import MAX_CHARS
 from ._vectorized import vec_eval
 
 __all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_KPI_DIVISOR", "MAX_VALUES", "MAX_CONDITIONS",

@@ -14,7 +14,8 @@ import numpy as np
 from .. import _expr
 from ..errors import ParseError
 from ..model import DHRobot, JointType
-from ._latex import RaggedMatrix, after_last_equals, encloses, parse_math, parse_matrix
+from ._latex import parse_math
+from ._matrices import RaggedMatrix, after_last_equals, encloses, parse_matrix
 from ._text import split_top
 
 __all__ = ["numbers", "ShapeMismatch", "MAX_ENTRIES", "MAX_DET_SIZE", "MAX_DET_WORK"]
