@@ -19,64 +19,30 @@ searches one unit of the last written decimal around the point.
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
 from .. import _expr
-from .. import numeric as N
 from ..codegen import numeric_function
 from ..errors import ParseError
-from ..model import DHRobot, Frame, JointType
+from ..model import DHRobot, Frame
 from ._bounded import cpu_bounded
-from ._latex import parse_math
-from ._resolve import robot_resolver
-from ._text import expand_pm, split_relation, split_top
-from ._tokens import MAX_CHARS
+from ._conditions import Cond, read_conditions
 from ._vectorized import vec_eval
+from ._zero_sets import Arm, roots_along, scale_of, zero_set_points
 
-__all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_KPI_DIVISOR", "MAX_VALUES", "MAX_CONDITIONS",
-           "MAX_ANALYSIS_CPU_SECONDS"]
+__all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_ANALYSIS_CPU_SECONDS"]
 
 SINGULAR_RTOL = 1e-7
-#: Largest n in ``q_j = k\pi/n`` (each of its 2n values is tested).
-MAX_KPI_DIVISOR = 12
-#: Most values of one joint in one claim (``q_2 = 0, \pi, …``), all conditions together.
-MAX_VALUES = 64
-#: Most conditions (values of a joint, or equations) in one claim.
-MAX_CONDITIONS = 16
 TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 #: CPU seconds the library's symbolic singularity analysis may take for one set of rows of one arm (it runs in a
-#: child process with this CPU limit, :func:`._bounded.cpu_bounded`; the Panda's 6 rows take ~4 s, but some row subsets of 6- and 7-joint arms do
-#: not finish in minutes).  Past it, a claim is judged on its own conditions only (never "correct").
+#: child process with this CPU limit, :func:`._bounded.cpu_bounded`; the Panda's 6 rows take ~4 s, but some row
+#: subsets of 6- and 7-joint arms do not finish in minutes).  Past it, a claim is judged on its own conditions only (never "correct").
 MAX_ANALYSIS_CPU_SECONDS = 10
 #: Arms with at most this many joints are analysed in the process itself (always fast).
 _SMALL_DOF = 3
-_NONE = {"none", "never", "nowhere", "no singularities", "\\emptyset", "∅", "{}"}
-_ALL = {"all", "always", "everywhere", "every configuration", "all q", "any q"}
-_SEPS = (";", "\n", " or ", "\\lor", "\\vee", "\\text{or}", "\\text{ or }", "\\quad", "\\qquad")
-_KPI = re.compile(r"^\s*(?:[kn]|\d*[kn])\s*(?:\\pi|π|pi)\s*(?:/\s*(\d+))?\s*$")
-
-
-@dataclass
-class Cond:
-    """One claimed condition: ``values`` of joint ``var`` (0-based), or the zero set of ``node``."""
-
-    text: str
-    var: int | None = None
-    values: list[float] = field(default_factory=list)
-    node: tuple | None = None
-    decimals: int = 0
-    scale: float = 1.0
-
-
-def _decimals(node: tuple) -> int:
-    from ._values import _decimals as dec
-
-    return dec(node)
 
 
 def _rows(spec: dict[str, Any]) -> list[int]:
@@ -95,182 +61,6 @@ def _rows(spec: dict[str, Any]) -> list[int]:
     return [TWIST_ROWS.index(r) for r in names]
 
 
-class _Arm:
-    """The robot, the rows of J taken and cheap numeric helpers (random q, rank ratio, limits)."""
-
-    def __init__(self, robot: DHRobot, rows: list[int], frame: Frame, rng: np.random.Generator) -> None:
-        self.robot, self.rows, self.frame, self.rng = robot, rows, frame, rng
-        self.rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-        lim = robot.q_limits
-        self.lo = np.where(np.isfinite(lim[:, 0]), lim[:, 0], np.where(self.rev, -np.pi, -1.0))
-        self.hi = np.where(np.isfinite(lim[:, 1]), lim[:, 1], np.where(self.rev, np.pi, 1.0))
-        self.lo, self.hi = np.maximum(self.lo, -np.pi), np.minimum(self.hi, np.pi)
-        self.params = dict(robot.parameters)
-
-    def random_q(self, k: int = 1) -> np.ndarray:
-        return self.rng.uniform(self.lo, self.hi, (k, self.robot.dof))
-
-    def ratio(self, Q: np.ndarray) -> np.ndarray:
-        """σ_min / σ_max of the selected rows of J at each row of Q (k, n) → (k,)."""
-        J = N.geometric_jacobian(self.robot, Q, frame=self.frame)[..., self.rows, :]
-        s = np.linalg.svd(J, compute_uv=False)
-        return s[..., -1] / np.maximum(s[..., 0], 1e-300)
-
-    def env(self, Q: np.ndarray) -> dict:
-        out: dict = dict(self.params)
-        out.update({f"q{k + 1}": Q[..., k] for k in range(self.robot.dof)})
-        return out
-
-    def same_angle(self, a, b, j: int, tol: float) -> bool:
-        d = a - b
-        if self.rev[j]:
-            d = (d + np.pi) % (2 * np.pi) - np.pi
-        return bool(abs(d) <= tol)
-
-
-# --- reading ---------------------------------------------------------------------------------------------
-
-
-def _pieces(raw: Any) -> list[str]:
-    items = [str(x) for x in raw] if isinstance(raw, list) else [str(raw)]
-    if len(items) > MAX_CONDITIONS or sum(len(x) for x in items) > MAX_CHARS:
-        raise ParseError(f"too many conditions, or longer than {MAX_CHARS} characters in all (at most "
-                         f"{MAX_CONDITIONS} conditions)")
-    out = []
-    for item in items:
-        for part in split_top(item.strip().strip("$"), _SEPS):
-            segs = split_top(part, (",",))
-            if sum("=" in s for s in segs) <= 1:
-                out.append(part)
-                continue
-            for s in segs:  # "q2 = 0, q5 = 0": one condition per '='; values without '=' continue the last
-                if "=" in s or not out:
-                    out.append(s)
-                else:
-                    out[-1] += "," + s
-    return [p.strip() for p in out if p.strip()]
-
-
-def _values(rhs: str, resolve, env: dict, rev: bool) -> tuple[list[float], int] | None:
-    """``0, \\pi, \\pm\\pi/2`` or ``k\\pi`` → numbers (None if a value depends on the joints)."""
-    vals, dec = [], 0
-    items = split_top(rhs, (",",))
-    if len(items) > MAX_VALUES:
-        raise ParseError(f"too many values in {rhs[:40]!r} ({len(items)}; at most {MAX_VALUES})")
-    for item in items:
-        m = _KPI.match(item)
-        if m and rev:
-            digits = m.group(1) or "1"
-            d = int(digits) if len(digits) <= 6 else MAX_KPI_DIVISOR + 1
-            if not 1 <= d <= MAX_KPI_DIVISOR:
-                raise ParseError(f"k\\pi/{digits[:12]}: the divisor must be from 1 to {MAX_KPI_DIVISOR} "
-                                 "(list the values instead)")
-            vals += [k * np.pi / d for k in range(-d + 1, d + 1)]
-            continue
-        for (version,) in expand_pm([item]):
-            node = parse_math(version, resolve, rhs=False)
-            if any(n.startswith("q") for n in _expr.names_in(node)):
-                return None
-            vals.append(_expr.evaluate(node, env))
-            dec = max(dec, _decimals(node))
-    return vals, dec
-
-
-def read_conditions(raw: Any, arm: _Arm) -> tuple[list[Cond], str | None]:
-    """The claimed conditions, or a special claim (``"none"`` / ``"everywhere"``)."""
-    resolve = robot_resolver(arm.robot)
-    pieces = _pieces(raw)
-    if len(pieces) == 1 and pieces[0].lower().strip(". ") in _NONE | _ALL:
-        return [], "none" if pieces[0].lower().strip(". ") in _NONE else "everywhere"
-    if not pieces:
-        raise ParseError("no singular condition given (write 'none' if there is none)")
-    if len(pieces) > MAX_CONDITIONS:
-        raise ParseError(f"too many conditions in one claim ({len(pieces)}; at most {MAX_CONDITIONS})")
-    conds = []
-    for text in pieces:
-        lhs, rhs = split_relation(text)
-        left = parse_math(lhs, resolve, rhs=False)
-        if left[0] == "name" and left[1].startswith("q") and left[1][1:].isdigit():
-            j = int(left[1][1:]) - 1
-            got = _values(rhs, resolve, arm.params, bool(arm.rev[j]))
-            if got is not None:
-                conds.append(Cond(text, var=j, values=got[0], decimals=got[1]))
-                continue
-        for (version,) in expand_pm([rhs]):
-            node = ("bin", "-", left, parse_math(version, resolve, rhs=False))
-            if not any(n.startswith("q") for n in _expr.names_in(node)):
-                raise ParseError(f"condition {text!r} names no joint variable")
-            conds.append(Cond(text, node=node, decimals=_decimals(node)))
-    if len(conds) > MAX_CONDITIONS or sum(len(c.values) for c in conds) > MAX_VALUES:
-        raise ParseError(f"too many conditions or values in one claim (at most {MAX_CONDITIONS} conditions and "
-                         f"{MAX_VALUES} joint values)")
-    return conds, None
-
-
-# --- sampling zero sets ---------------------------------------------------------------------------------
-
-
-def roots_along(fn, q: np.ndarray, j: int, lo: float, hi: float, scale: float) -> list[float]:
-    """Roots of x ↦ fn(q with q_j = x) in [lo, hi]: sign changes refined by Brent, and double roots."""
-    from scipy.optimize import brentq, minimize_scalar
-
-    xs = np.linspace(lo, hi, 721)
-    Q = np.repeat(q[None], len(xs), 0)
-    Q[:, j] = xs
-    h = fn(Q)
-
-    def f(x: float) -> float:
-        qq = q.copy()
-        qq[j] = x
-        return float(fn(qq[None])[0])
-
-    out = []
-    for k in range(len(xs) - 1):
-        a, b = h[k], h[k + 1]
-        if not (np.isfinite(a) and np.isfinite(b)):
-            continue
-        if a == 0:
-            out.append(xs[k])
-        elif a * b < 0:
-            out.append(brentq(f, xs[k], xs[k + 1], xtol=1e-15, rtol=1e-15))
-        elif 0 < k and abs(a) < 1e-2 * scale and abs(a) <= abs(h[k - 1]) and abs(a) <= abs(b):
-            r = minimize_scalar(lambda x: abs(f(x)), bounds=(xs[k - 1], xs[k + 1]), method="bounded",
-                                options={"xatol": 1e-14})
-            if abs(r.fun) <= 1e-10 * scale:
-                out.append(float(r.x))
-    if np.isfinite(h[-1]) and h[-1] == 0:
-        out.append(xs[-1])
-    return out
-
-
-def _scale(fn, arm: _Arm) -> float:
-    vals = np.abs(fn(arm.random_q(32)))
-    vals = vals[np.isfinite(vals)]
-    return float(np.median(vals)) if vals.size else 0.0
-
-
-def zero_set_points(fn, variables: list[int], arm: _Arm, scale: float, count: int = 4) -> list[np.ndarray]:
-    """Points on {fn = 0}: every root along a lone variable, or random roots along random variables."""
-    pts: list[np.ndarray] = []
-    if len(variables) == 1:
-        j = variables[0]
-        for r in roots_along(fn, arm.random_q()[0], j, arm.lo[j], arm.hi[j], scale)[:12]:
-            for q in arm.random_q(2):
-                q[j] = r
-                pts.append(q)
-        return pts
-    for _ in range(6 * count):
-        q = arm.random_q()[0]
-        j = int(arm.rng.choice(variables))
-        roots = roots_along(fn, q, j, arm.lo[j], arm.hi[j], scale)
-        if roots:
-            q[j] = roots[int(arm.rng.integers(len(roots)))]
-            pts.append(q)
-        if len(pts) >= count:
-            break
-    return pts
-
-
 # --- judging ---------------------------------------------------------------------------------------------
 
 
@@ -278,7 +68,7 @@ def _variables(node: tuple) -> list[int]:
     return sorted(int(n[1:]) - 1 for n in _expr.names_in(node) if n.startswith("q") and n[1:].isdigit())
 
 
-def _cond_points(c: Cond, arm: _Arm) -> list[np.ndarray]:
+def _cond_points(c: Cond, arm: Arm) -> list[np.ndarray]:
     if c.var is not None:
         pts = []
         for v in c.values:
@@ -287,7 +77,7 @@ def _cond_points(c: Cond, arm: _Arm) -> list[np.ndarray]:
                 pts.append(q)
         return pts
     fn = lambda Q: vec_eval(c.node, arm.env(Q))  # noqa: E731
-    c.scale = _scale(fn, arm)
+    c.scale = scale_of(fn, arm)
     if c.scale == 0.0:  # identically zero: the whole configuration space
         return list(arm.random_q(4))
     variables = _variables(c.node)
@@ -305,7 +95,7 @@ def _cond_points(c: Cond, arm: _Arm) -> list[np.ndarray]:
     return pts
 
 
-def _ratio_near(c: Cond, q: np.ndarray, arm: _Arm) -> float:
+def _ratio_near(c: Cond, q: np.ndarray, arm: Arm) -> float:
     """σ_min/σ_max at q; for rounded decimals, the least value within one unit of the last decimal."""
     from scipy.optimize import minimize_scalar
 
@@ -340,7 +130,7 @@ def _ratio_near(c: Cond, q: np.ndarray, arm: _Arm) -> float:
     return min(r, float(res.fun))
 
 
-def _member(q: np.ndarray, conds: list[Cond], arm: _Arm) -> bool:
+def _member(q: np.ndarray, conds: list[Cond], arm: Arm) -> bool:
     for c in conds:
         extra = 10.0 ** -c.decimals if c.decimals >= 2 else 0.0
         if c.var is not None:
@@ -370,7 +160,7 @@ def _analysis(robot: DHRobot, rows: str | None, frame: Frame):
     return cpu_bounded(_analyse, (robot, rows, frame), MAX_ANALYSIS_CPU_SECONDS, warm=("denavit.symbolic",))
 
 
-def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str] | None]:
+def _library(arm: Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarray]], bool, list[str] | None]:
     """Points of the library's singular set, each confirmed by the rank test: (description, q) pairs;
     whether J is singular everywhere; the library's conditions as text (None: the analysis ran out of time)."""
     import sympy as sp
@@ -403,13 +193,13 @@ def _library(arm: _Arm, spec: dict[str, Any]) -> tuple[list[tuple[str, np.ndarra
             continue
         fn0 = numeric_function(c.factor.xreplace(psub), list(qs))  # c.factor: the library's own sympy expression
         fn = lambda Q, f=fn0: np.broadcast_to(np.asarray(f(*Q.T), dtype=float), Q.shape[:1])  # noqa: E731
-        for q in zero_set_points(fn, [int(v[1:]) - 1 for v in c.variables], arm, _scale(fn, arm), 3):
+        for q in zero_set_points(fn, [int(v[1:]) - 1 for v in c.variables], arm, scale_of(fn, arm), 3):
             points.append((factor, q))
     confirmed = [(d, q) for d, q in points if arm.ratio(q[None])[0] < SINGULAR_RTOL]
     return confirmed, False, described
 
 
-def _hint_for_value(c: Cond, q: np.ndarray, arm: _Arm) -> str | None:
+def _hint_for_value(c: Cond, q: np.ndarray, arm: Arm) -> str | None:
     for v in c.values:
         for shift, why in ((np.pi / 2, "π/2 away"), (-np.pi / 2, "π/2 away"), (np.pi, "π away")):
             qq = q.copy()
@@ -427,7 +217,7 @@ def check_singularities(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.r
     frame = Frame(raw.get("frame", "base")) if raw.get("frame", "base") in ("base", "tool") else None
     if frame is None:
         raise ParseError(f"'frame' must be base or tool, got {raw.get('frame')!r}")
-    arm = _Arm(robot, _rows(raw), frame, rng)
+    arm = Arm(robot, _rows(raw), frame, rng)
     conds, special = read_conditions(raw["value"], arm)
     if deg:
         for c in conds:
