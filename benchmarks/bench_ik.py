@@ -168,7 +168,7 @@ def bench_ikpy(robot, T):
     except ImportError:
         return None
     from denavit.numeric import rpy_from_rotation
-    from denavit.ik._chain import chain_of
+    from denavit.chain import screws_of as chain_of
 
     ch = chain_of(robot)
     lim = robot.q_limits
@@ -206,7 +206,7 @@ def bench_ikgeo(robot, T):
     except ImportError:
         return None
     from denavit.ik import ik_structure
-    from denavit.ik._chain import axis_lines, chain_of
+    from denavit.chain import screw_axes as axis_lines, screws_of as chain_of
 
     ch = chain_of(robot)
     kind = ik_structure(robot)

@@ -1,7 +1,10 @@
-"""The arm as one chain ``C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn`` and its one walker.
+"""The arm as one chain ``C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn`` and its walkers.
 
 The only code that knows DH conventions, where a joint variable enters its row, fixed rows, base and tool,
-and which frame carries each joint's axis.  The numeric and symbolic engines ask it.
+and which frame carries each joint's axis.  The numeric and symbolic engines ask it.  Two forms of the same
+product: :func:`walk` goes row by row (each DH row as its elementary motions: floats, numpy batches, traced
+values or sympy), :func:`screw_walk` goes over the stacked constants C_k (numpy batches; the IK also walks
+chains derived from the arm's, reversed or with joints merged).
 
 >>> import denavit
 >>> from denavit.chain import chain_of, walk, FLOATS
@@ -12,6 +15,7 @@ and which frame carries each joint's axis.  The numeric and symbolic engines ask
 """
 
 from ._chain import Chain, Row, chain_of, cos_sin, dh_transform, joint_motion
+from ._screws import STRUCTURAL_ZERO, Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screws_of
 from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
 
@@ -41,4 +45,11 @@ __all__ = [
     "FLOATS",
     "IDENTITY_COLUMNS",
     "pack",
+    "Screws",
+    "screws_of",
+    "reverse_screws",
+    "screw_walk",
+    "screw_pose",
+    "screw_axes",
+    "STRUCTURAL_ZERO",
 ]

@@ -18,7 +18,8 @@ import numpy as np
 from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
-from ._chain import chain_columns, chain_of, damped_solve, wrap_angle
+from ..chain import screw_walk, screws_of
+from ._chain import damped_solve, wrap_angle
 from ._residual import pose_error
 from ._plans import Plan, make_plan
 from ._kernel import kernel_of, targets_soa
@@ -119,14 +120,6 @@ def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
 def ik_plan(robot: DHRobot) -> Plan:
     """The closed-form plan of ``robot`` (kind, route, solver; raises UnsupportedRobotError if none)."""
     return _plan(robot, True)
-
-
-def _chain(robot: DHRobot):
-    """The joint-screw arrays of ``robot`` (read-only use below: labels), kept with its chain."""
-    memo = dh_chain.chain_of(robot).memo
-    if "ik_screws" not in memo:
-        memo["ik_screws"] = chain_of(robot)
-    return memo["ik_screws"]
 
 
 def ik_structure(robot: DHRobot) -> str:
@@ -493,7 +486,7 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
     Each part of a label is a boolean test of q; the label is looked up from the combined bits (no string
     arithmetic per solution)."""
     B, K, n = q.shape
-    chain = _chain(robot)
+    chain = screws_of(robot)
     qq = np.nan_to_num(q)
     rev = ~chain.prismatic
     theta = _thetas(robot)
@@ -501,7 +494,7 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
     if plan.kind.startswith(("pieper", "parallel", "position")) and plan.point_e is not None or plan.kind == "position":
         pe = plan.point_e if plan.point_e is not None else np.zeros(3)
         X = (T[:, :3, :3] @ pe + T[:, :3, 3]).T[:, :, None]  # (3, B, 1)
-        x1, _, _, S = chain_columns(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
+        x1, _, _, S = screw_walk(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
         if rev[0]:  # measured from axis 1 (not from S, which a shoulder offset a1 moves along x1)
             O1 = chain.consts[0][:3, 3][:, None, None]  # a point of axis 1
             parts.append((np.sum(x1 * (X - O1), axis=0) >= 0, *SHOULDER))
@@ -509,9 +502,9 @@ def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndar
             # in the plane normal to axis 2 the two elbows are mirror images across the line from the shoulder S
             # to the point W the joints 2-3 place (the wrist centre; UR: a point of axis 4, parallel to axis 2):
             # the side of that line, with n = a2 × (W − S) oriented towards axis 1, tells them apart
-            a2 = chain_columns(chain, qq[..., :1], upto=1)[2]  # axis 2, (3, B, K)
-            E = chain_columns(chain, qq[..., :2], upto=2)[3]  # a point of axis 3
-            W = chain_columns(chain, qq[..., :3], upto=3)[3] if plan.kind.startswith("parallel") and n >= 4 else X
+            a2 = screw_walk(chain, qq[..., :1], upto=1)[2]  # axis 2, (3, B, K)
+            E = screw_walk(chain, qq[..., :2], upto=2)[3]  # a point of axis 3
+            W = screw_walk(chain, qq[..., :3], upto=3)[3] if plan.kind.startswith("parallel") and n >= 4 else X
             up = chain.consts[0][:3, 2][:, None, None]
             nrm = np.cross(a2, W - S, axis=0)
             towards = np.where(np.sum(up * nrm, axis=0) >= 0, 1.0, -1.0)

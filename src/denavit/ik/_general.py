@@ -37,7 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._chain import Chain, chain_fk, joint_motion
+from ..chain import Screws, screw_pose
+from ._chain import joint_motion
 from ..numeric import inverse_transform
 
 __all__ = ["Formulation", "loop_of", "formulations", "choose_formulation", "rank_formulations", "solve_general", "MAX_SOLUTIONS"]
@@ -89,7 +90,7 @@ def formulations() -> list[Formulation]:
     return [Formulation(k, r) for r in (False, True) for k in range(6)]
 
 
-def loop_of(chain: Chain, T: np.ndarray) -> np.ndarray:
+def loop_of(chain: Screws, T: np.ndarray) -> np.ndarray:
     """Loop constants G1..G6 (B, 6, 4, 4) of a 6R chain ``C0 Z1 C1 ⋯ Z6 C6 = T`` for targets T (B, 4, 4)."""
     C = chain.consts
     H = C[6] @ inverse_transform(T) @ C[0]
@@ -339,7 +340,7 @@ def solve_general(G: np.ndarray, form: Formulation, rng: np.random.Generator | N
     return cand[:, : max(MAX_SOLUTIONS, used)], usable
 
 
-def choose_formulation(chain: Chain, rng: np.random.Generator, tries: int = 4) -> Formulation | None:
+def choose_formulation(chain: Screws, rng: np.random.Generator, tries: int = 4) -> Formulation | None:
     """The best-conditioned formulation for this arm, or None if every one degenerates.
 
     Each formulation solves ``tries`` targets made from random configurations; its score is the worst
@@ -350,14 +351,14 @@ def choose_formulation(chain: Chain, rng: np.random.Generator, tries: int = 4) -
     return ranked[0] if ranked else None
 
 
-def rank_formulations(chain: Chain, rng: np.random.Generator, tries: int = 4) -> list[Formulation]:
+def rank_formulations(chain: Screws, rng: np.random.Generator, tries: int = 4) -> list[Formulation]:
     """Every formulation that solves the ``tries`` test targets (score under 1e-6, see
     :func:`choose_formulation`), best first.  The later ones are the fall-backs for targets where the first one's
     pencil is singular: on special arms (axes 2-4 parallel, say) a formulation can be regular for most poses
     and singular for a few, which the test targets need not show."""
 
     q = rng.uniform(-np.pi, np.pi, (tries, 6))
-    G = loop_of(chain, chain_fk(chain, q))
+    G = loop_of(chain, screw_pose(chain, q))
     scored = []
     for form in formulations():
         cand, usable = solve_general(G, form, np.random.default_rng(11))

@@ -1,7 +1,7 @@
 """The inner loop of the IK solvers: pose residual and geometric Jacobian in one pass over the chain.
 
-The chain is the joint-screw form ``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain` (its constants read
-here).  A batch of poses is kept as rotation columns x, y, z and origin p, each of shape (3, B) with the batch
+The chain is the joint-screw form ``C0 J1(q1) C1 ⋯ Jn(qn) Cn`` of :mod:`denavit.chain`, walked by its
+:func:`~denavit.chain.screw_walk`.  A batch of poses is kept as rotation columns x, y, z and origin p, each of shape (3, B) with the batch
 contiguous, so a joint rotation is two axpy's (``x ← c x + s y``, ``y ← c y − s x``) and a constant ``C_k`` is
 a handful of them (most DH constants are signed permutations: α = ±90°).  The Jacobian needs only the joint axes z_k and
 their origins o_k, which this same pass visits, and the end-effector origin p_e at the end:
@@ -16,70 +16,28 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..chain import chain_of
+from ..chain import chain_of, screw_walk, screws_of
 from ..model import DHRobot
 from ._residual import rotation_log
 
 __all__ = ["Kernel", "kernel_of", "targets_soa"]
-
-_ZERO = 1e-15  # constant entries below this are structural zeros (cos 90° = 6e-17)
-
-
-def _terms(C: np.ndarray) -> tuple:
-    """For each output column of C (x, y, z, p): the (input column, coefficient) pairs that are non-zero."""
-    out = []
-    for col in range(4):
-        out.append(tuple((j, float(C[j, col])) for j in range(3) if abs(C[j, col]) > _ZERO))
-    return tuple(out)
-
-
-def _combine(cols, terms, base=None):
-    acc = base
-    for j, c in terms:
-        t = cols[j] if c == 1.0 else (-cols[j] if c == -1.0 else c * cols[j])
-        acc = t if acc is None else acc + t
-    if acc is None:
-        return np.zeros_like(cols[0]) if base is None else base
-    return acc
 
 
 class Kernel:
     """Pose residual and Jacobian of one arm, batched; build with :func:`kernel_of` (cached per robot)."""
 
     def __init__(self, robot: DHRobot) -> None:
-        chain = chain_of(robot)
-        self.n = chain.dof
-        self.prismatic = chain.prismatic
-        self.start = chain.constants[0]
-        self.terms = tuple(_terms(C) for C in chain.constants[1:])
-
-    def pose(self, qT: np.ndarray, keep_axes: bool = False):
-        """Rotation columns x, y, z and origin p (each (3, B)) at joint values qT (n, B); optionally the
-        joint axes z_k and origins o_k (lists of (3, B))."""
-        B = qT.shape[1]
-        x, y, z, p = (np.repeat(self.start[:3, j:j + 1], B, axis=1) for j in range(4))
-        zs, os = [], []
-        for k in range(self.n):
-            if keep_axes:
-                zs.append(z)
-                os.append(p)
-            if self.prismatic[k]:
-                p = p + qT[k] * z
-            else:
-                c, s = np.cos(qT[k]), np.sin(qT[k])
-                x, y = c * x + s * y, c * y - s * x
-            cols = (x, y, z)
-            tx, ty, tz, tp = self.terms[k]
-            p = _combine(cols, tp, p)
-            x, y, z = _combine(cols, tx), _combine(cols, ty), _combine(cols, tz)
-        return x, y, z, p, zs, os
+        self.screws = screws_of(robot)
+        self.n = self.screws.n
+        self.prismatic = self.screws.prismatic
 
     def residual(self, q: np.ndarray, Rt: np.ndarray, pt: np.ndarray, w: np.ndarray, jacobian: bool = True):
         """Weighted residual ``e = W (p_t − p, log(R_t Rᵀ))`` (B, 6) and weighted J0 (B, 6, n).
 
         q (B, n); Rt (3, 3, B) and pt (3, B) the targets in the layout of :func:`targets_soa`.
         """
-        x, y, z, p, zs, os = self.pose(np.ascontiguousarray(q.T), keep_axes=jacobian)
+        walked = screw_walk(self.screws, q, axes=jacobian)  # columns (3, B), and the axes for J
+        x, y, z, p = walked[:4]
         e = np.empty((q.shape[0], 6))
         e[:, :3] = (pt - p).T
         Re = np.stack([x, y, z], axis=1)  # (3, 3, B): Re[i, j] = R[i, j]
@@ -87,6 +45,7 @@ class Kernel:
         e *= w
         if not jacobian:
             return e, None
+        zs, os = walked[4:]
         J = np.zeros((q.shape[0], 6, self.n))
         for k in range(self.n):
             if self.prismatic[k]:

@@ -28,7 +28,8 @@ from ..errors import UnsupportedRobotError
 from ..model import DHRobot
 from ._closed import closed_position, wrist_angles
 from ._general import loop_of, rank_formulations, solve_general
-from ._chain import Chain, angle_about_z, axis_lines, chain_columns, chain_fk, chain_of, reverse_chain, solve_trig
+from ..chain import Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screws_of
+from ._chain import angle_about_z, solve_trig
 from ._subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
                               trig_coefficients)
 from ..numeric import inverse_transform
@@ -57,11 +58,11 @@ class Plan:
 # structural tests
 
 
-def _scale(chain: Chain) -> float:
+def _scale(chain: Screws) -> float:
     return max(float(np.sum(np.abs(chain.consts[:, :3, 3]))), 1e-3)
 
 
-def _configs(chain: Chain, rng) -> list[np.ndarray]:
+def _configs(chain: Screws, rng) -> list[np.ndarray]:
     return [np.zeros(chain.n), rng.uniform(-np.pi, np.pi, chain.n), rng.uniform(-np.pi, np.pi, chain.n)]
 
 
@@ -78,11 +79,11 @@ def _common_point(pts: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, float]
     return x, dist
 
 
-def _intersect(chain: Chain, idx, rng) -> bool:
+def _intersect(chain: Screws, idx, rng) -> bool:
     """Do the axes ``idx`` pass through one point (and no two of them coincide) in every test pose?"""
     L = _scale(chain)
     for q in _configs(chain, rng):
-        pts, dirs = axis_lines(chain, q)
+        pts, dirs = screw_axes(chain, q)
         for a, b in zip(idx[:-1], idx[1:]):
             if np.linalg.norm(np.cross(dirs[a], dirs[b])) < 1e-6:
                 return False
@@ -91,9 +92,9 @@ def _intersect(chain: Chain, idx, rng) -> bool:
     return True
 
 
-def _parallel(chain: Chain, idx, rng) -> bool:
+def _parallel(chain: Screws, idx, rng) -> bool:
     for q in _configs(chain, rng):
-        _, dirs = axis_lines(chain, q)
+        _, dirs = screw_axes(chain, q)
         if any(np.linalg.norm(np.cross(dirs[idx[0]], dirs[k])) > GEOM_TOL for k in idx[1:]):
             return False
     return True
@@ -103,7 +104,7 @@ def _parallel(chain: Chain, idx, rng) -> bool:
 # coaxial joints and mirrored chains
 
 
-def _merge_coaxial(chain: Chain):
+def _merge_coaxial(chain: Screws):
     """Merge consecutive coaxial revolute joints; returns (chain, expand(q_reduced) -> q, [(group name, text)] of
     the merged groups, representative joint of each reduced joint, name of each reduced joint)."""
     consts, pris = list(chain.consts), list(chain.prismatic)
@@ -138,7 +139,7 @@ def _merge_coaxial(chain: Chain):
         return out
 
     reps = [g[0][0] for g in groups]
-    return Chain(np.array(consts), np.array(pris)), expand, free, reps, gnames
+    return Screws(np.array(consts), np.array(pris)), expand, free, reps, gnames
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -152,14 +153,14 @@ def _free_text(mask: np.ndarray, text: str, out: np.ndarray) -> np.ndarray:
     return np.where(mask, add, out)
 
 
-def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True,
+def _pieper(chain: Screws, rng, names, limits3, closed_form: bool = True,
             limits2=(-np.inf, np.inf)) -> tuple[Callable, np.ndarray, str]:
     L = _scale(chain)
-    pts, dirs = axis_lines(chain, np.zeros(6))
+    pts, dirs = screw_axes(chain, np.zeros(6))
     X = _common_point(pts[3:], dirs[3:])[0]
-    F3 = chain_fk(chain, np.zeros(3), upto=3)
+    F3 = screw_pose(chain, np.zeros(3), upto=3)
     P = (chain.consts[3] @ inverse_transform(F3) @ np.append(X, 1))[:3]
-    X_e = (inverse_transform(chain_fk(chain, np.zeros(6))) @ np.append(X, 1))[:3]
+    X_e = (inverse_transform(screw_pose(chain, np.zeros(6))) @ np.append(X, 1))[:3]
     fast = closed_position(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L) if closed_form else None
     pos = fast or Position3(chain.consts[1], chain.consts[2], P, chain.prismatic[:3], L, limits3, rng, limits2)
     C0i, R4, R5, R6 = inverse_transform(chain.consts[0]), chain.consts[4][:3, :3], chain.consts[5][:3, :3], \
@@ -173,7 +174,7 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True,
         if getattr(pos, "free3", False):  # wrist centre on axis 3: q3 free, but the wrist must reach what is left
             q123 = q123.copy()
             q123[..., 2] = _free_q3(chain, q123, Y, R4, R5)
-        x, y, z, _ = chain_columns(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
+        x, y, z, _ = screw_walk(chain, np.nan_to_num(q123), upto=3)  # columns of R_0_3, each (3, B, M)
         M = np.empty(q123.shape[:2] + (3, 3))  # R_0_3ᵀ R R6ᵀ
         for i, col in enumerate((x, y, z)):
             for j in range(3):
@@ -199,7 +200,7 @@ def _pieper(chain: Chain, rng, names, limits3, closed_form: bool = True,
     return solve, X_e, (f"closed form ({fast.kind})" if fast is not None else "resultant")
 
 
-def elbow_constants(chain: Chain, pos, X_e, C0i, R4, R5, R6) -> dict:
+def elbow_constants(chain: Screws, pos, X_e, C0i, R4, R5, R6) -> dict:
     """Everything the elbow + spherical-wrist closed form needs, as float arrays (for the compiled solver)."""
     r, u = R4[2, :], R5[:, 2]
     a, b, _ = rz_bilinear(r, u)
@@ -211,14 +212,14 @@ def elbow_constants(chain: Chain, pos, X_e, C0i, R4, R5, R6) -> dict:
                 scalars=np.array(scalars, float))
 
 
-def _free_q3(chain: Chain, q123: np.ndarray, Y: np.ndarray, R4: np.ndarray, R5: np.ndarray, samples: int = 24):
+def _free_q3(chain: Screws, q123: np.ndarray, Y: np.ndarray, R4: np.ndarray, R5: np.ndarray, samples: int = 24):
     """q3 for a Pieper arm whose wrist centre lies on axis 3 (q3 does not move it; the wrist follows): of
     ``samples`` values the one that puts the wrist's z-row equation ``a cos q5 + b sin q5 = M_zz − g`` farthest
     inside its range (a non-orthogonal wrist cannot reach every rotation, so q3 = 0 may leave no solution)."""
     t = 2 * np.pi * np.arange(samples) / samples
     q = np.broadcast_to(np.nan_to_num(q123)[..., None, :], q123.shape[:2] + (samples, 3)).copy()
     q[..., 2] = t
-    z = chain_columns(chain, q, upto=3)[2]  # (3, B, M, S)
+    z = screw_walk(chain, q, upto=3)[2]  # (3, B, M, S)
     Mzz = sum(z[i] * Y[:, None, None, i, 2] for i in range(3))
     r, u = R4[2, :], R5[:, 2]
     rho = max(float(np.hypot(r[0] * u[0] + r[1] * u[1], r[1] * u[0] - r[0] * u[1])), 1e-300)
@@ -247,7 +248,7 @@ def _rot_z_angle(R: np.ndarray) -> np.ndarray:
     return np.arctan2(R[..., 1, 0], R[..., 0, 0])
 
 
-def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
+def _parallel_plan(chain: Screws, names) -> tuple[Callable, np.ndarray]:
     """Axes 2, 3, 4 parallel; 6 joints with axes 5, 6 meeting at Q, or 5 joints (Q on axis 5).
 
     In the frame F1 = C0 J1 C1 the parallel joints turn about z, so the z coordinate of any point and of
@@ -257,14 +258,14 @@ def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
     """
     n = chain.n
     C = chain.consts
-    pts, dirs = axis_lines(chain, np.zeros(n))
+    pts, dirs = screw_axes(chain, np.zeros(n))
     if n == 6:
         Q = _common_point(pts[4:], dirs[4:])[0]
     else:
         Q = pts[4]
-    T0 = chain_fk(chain, np.zeros(n))
+    T0 = screw_pose(chain, np.zeros(n))
     Q_e = (inverse_transform(T0) @ np.append(Q, 1))[:3]
-    F1_0 = chain_fk(chain, np.zeros(1), upto=1)
+    F1_0 = screw_pose(chain, np.zeros(1), upto=1)
     h = (inverse_transform(F1_0) @ np.append(Q, 1))[2]  # z of Q in F1: the same for every q2, q3, q4
     Rc1, pc1 = C[1][:3, :3], C[1][:3, 3]
     a = Rc1[:, 2]  # axis 2 in the frame after joint 1
@@ -276,7 +277,7 @@ def _parallel_plan(chain: Chain, names) -> tuple[Callable, np.ndarray]:
         V = (T[:, :3, :3] @ Q_e + T[:, :3, 3]) @ C0i[:3, :3].T + C0i[:3, 3]
         q1 = solve_trig(a[0] * V[:, 0] + a[1] * V[:, 1], a[0] * V[:, 1] - a[1] * V[:, 0],
                         h + a @ pc1 - a[2] * V[:, 2], tol=1e-7)  # (B, 2)
-        F1 = chain_fk(chain, np.nan_to_num(q1)[..., None], upto=1)  # (B, 2, 4, 4)
+        F1 = screw_pose(chain, np.nan_to_num(q1)[..., None], upto=1)  # (B, 2, 4, 4)
         RL = np.swapaxes(F1[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ C[n][:3, :3].T  # (B, 2, 3, 3)
         ell = RL[..., 2, :]  # e_zᵀ R_L
         free = np.full((B, 2, 2), "", dtype=object)
@@ -349,23 +350,23 @@ def _jz(t):
     return J
 
 
-def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]:
+def _planar_plan(chain: Screws, names) -> tuple[Callable, np.ndarray, np.ndarray]:
     """All axes parallel (to z of C0): two revolute joints place a point in the plane (law of cosines),
     a prismatic joint sets the height, a third revolute joint the heading."""
     n = chain.n
     rev = [k for k in range(n) if not chain.prismatic[k]]
     pri = [k for k in range(n) if chain.prismatic[k]]
     r1, r2 = rev[0], rev[1]
-    pts, dirs = axis_lines(chain, np.zeros(n))
+    pts, dirs = screw_axes(chain, np.zeros(n))
     C0i = inverse_transform(chain.consts[0])
-    T0 = chain_fk(chain, np.zeros(n))
+    T0 = screw_pose(chain, np.zeros(n))
     Q = pts[rev[2]] if len(rev) == 3 else T0[:3, 3]
     Q_e = (inverse_transform(T0) @ np.append(Q, 1))[:3]
     c1 = (C0i @ np.append(pts[r1], 1))[:2]
     s1 = np.sign((C0i[:3, :3] @ dirs[r1])[2])
 
     def point(qfull):  # xy of the reference point in C0, (..., 2)
-        Tq = C0i @ chain_fk(chain, qfull)
+        Tq = C0i @ screw_pose(chain, qfull)
         return (Tq[..., :3, :3] @ Q_e + Tq[..., :3, 3])[..., :2] - c1
 
     probe = np.zeros((3, n))
@@ -392,14 +393,14 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
                                                          np.zeros((B, 2, 1))], -1))
         if pri:
             p = pri[0]
-            Tq = C0i @ chain_fk(chain, np.nan_to_num(q))
+            Tq = C0i @ screw_pose(chain, np.nan_to_num(q))
             sp = np.sign((C0i[:3, :3] @ dirs[p])[2])
             q[..., p] = sp * (Tl[:, None, 2, 3] - Tq[..., 2, 3])
         if len(rev) == 3:
             r3 = rev[2]
             qq = np.nan_to_num(q)
-            pre = chain_fk(chain, qq[..., :r3], upto=r3)
-            post = chain_fk(chain, qq[..., r3 + 1:], start=r3 + 1)
+            pre = screw_pose(chain, qq[..., :r3], upto=r3)
+            post = screw_pose(chain, qq[..., r3 + 1:], start=r3 + 1)
             Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
             q[..., r3] = _rot_z_angle(Rz)
         free = np.full((B, 2), "", dtype=object)
@@ -409,8 +410,8 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
             free = _free_text(on_axis1 & np.isfinite(q2), f"{names[r1]} free (point on axis {r1 + 1}{follow})", free)
         if on_axis2:  # the representative with the target's heading
             qq = np.nan_to_num(q)
-            pre = chain_fk(chain, qq[..., :r2], upto=r2)
-            post = chain_fk(chain, qq[..., r2 + 1:], start=r2 + 1)
+            pre = screw_pose(chain, qq[..., :r2], upto=r2)
+            post = screw_pose(chain, qq[..., r2 + 1:], start=r2 + 1)
             Rz = np.swapaxes(pre[..., :3, :3], -1, -2) @ T[:, None, :3, :3] @ np.swapaxes(post[..., :3, :3], -1, -2)
             q[..., r2] = _rot_z_angle(Rz)
             free = _free_text(np.isfinite(q2), f"{names[r2]} free (point on axis {r2 + 1})", free)
@@ -421,7 +422,7 @@ def _planar_plan(chain: Chain, names) -> tuple[Callable, np.ndarray, np.ndarray]
     return solve, Q_e, n_world
 
 
-def _wrist_plan(chain: Chain, names) -> Callable:
+def _wrist_plan(chain: Screws, names) -> Callable:
     C = chain.consts
 
     def solve(T: np.ndarray):
@@ -435,18 +436,18 @@ def _wrist_plan(chain: Chain, names) -> Callable:
     return solve
 
 
-def _position_rank(chain: Chain, rng) -> int:
+def _position_rank(chain: Screws, rng) -> int:
     """Largest rank of the 3×3 position Jacobian of a 3-joint chain's end point over three configurations
-    (finite differences of chain_fk, steps 1e-6: rank is decided at 1e-4 relative)."""
+    (finite differences of screw_pose, steps 1e-6: rank is decided at 1e-4 relative)."""
     best = 0
     for q in _configs(chain, rng):
-        p0 = chain_fk(chain, q)[:3, 3]
-        J = np.stack([(chain_fk(chain, q + 1e-6 * e)[:3, 3] - p0) / 1e-6 for e in np.eye(3)], axis=1)
+        p0 = screw_pose(chain, q)[:3, 3]
+        J = np.stack([(screw_pose(chain, q + 1e-6 * e)[:3, 3] - p0) / 1e-6 for e in np.eye(3)], axis=1)
         best = max(best, int(np.linalg.matrix_rank(J, tol=1e-4 * max(np.abs(J).max(), 1e-12))))
     return best
 
 
-def _position_plan(chain: Chain, rng, names, limits3, limits2=(-np.inf, np.inf)) -> Callable:
+def _position_plan(chain: Screws, rng, names, limits3, limits2=(-np.inf, np.inf)) -> Callable:
     C = chain.consts
     # the direct closed forms where the class allows (articulated RRR with axes 2 ∥ 3, spherical RRP), as for the
     # wrist centre of a Pieper arm: the resultant has multiple roots on some of these (spherical-rrp: a 6-fold one
@@ -488,7 +489,7 @@ def _generic_rank(robot: DHRobot, rng) -> int:
     return int(max(np.linalg.matrix_rank(Jk, tol=1e-9 * max(1.0, np.abs(Jk).max())) for Jk in J))
 
 
-def _general_plan(chain: Chain, rng):
+def _general_plan(chain: Screws, rng):
     """The eigenvalue solver of :mod:`._general` for a 6R chain, or None if every formulation degenerates.
 
     Targets where the best formulation's pencil is singular are solved again with the next one (and so on):
@@ -530,12 +531,12 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
         No closed form is known for this structure (use the numerical solver).
     """
     rng = np.random.default_rng(20240601)  # fixed: the structural tests must not depend on call order
-    full = chain_of(robot)
+    full = screws_of(robot)
     chain, expand, groups, reps, names = _merge_coaxial(full)
     coaxial = "; ".join(text for _, text in groups)
     m = chain.n
     rnames = names[::-1]
-    rev = reverse_chain(chain)
+    rev = reverse_screws(chain)
     lim = robot.q_limits
     eye = np.eye(6)
     all_rev = not chain.prismatic.any()
