@@ -1,0 +1,262 @@
+"""Compiled analytic IK of the UR class (``denavit.compile(robot).analytic_ik``) against the plain solver.
+
+The peer is :func:`denavit.analytic_ik` (numpy, batched; its closed forms are tested against FK, the general 6R
+eigenvalue solver and peers in test_ik_*.py).  Oracles here: the same solution sets (order-insensitive, 1e-10), the
+same labels and continuum texts, the same outside-limits sets, and FK(IK(T)) = T by the plain forward kinematics.
+Singular poses (wrist singular, shoulder singular, elbow stretched or folded) are found from the joint axes alone
+(no formula of the solver): the compiled path must hand them to the plain solver and agree with it.  That the
+compiled kernel answers the regular poses itself is checked by counting the hand-overs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+
+import numpy as np
+import pytest
+from conftest import REDUCED
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import denavit
+from denavit import Convention, DHLink, DHRobot
+from denavit.numeric import joint_axes, link_transforms, transform_from_xyz_rpy
+
+pytest.importorskip("numba")
+
+from denavit.codegen import _solvers  # noqa: E402  (the hand-over to the plain solver is counted there)
+from denavit.ik import ik_plan  # noqa: E402
+
+N_POSES = 60 if REDUCED else 250
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _kernel_cache(tmp_path_factory):
+    """One kernel folder for the run, shared by pytest-xdist's workers (as test_codegen's): each arm compiles once."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("DENAVIT_CACHE_DIR", str(base / "kernels"))
+        yield
+
+
+def _ur(name: str, d1: float, a2: float, a3: float, d4: float, d5: float, d6: float) -> DHRobot:
+    """A UR arm from Universal Robots' published standard DH table (support article 45257, "Parameters for
+    calculations of kinematics and dynamics"): alpha = (pi/2, 0, 0, pi/2, -pi/2, 0), joint range +-360 deg."""
+    rows = [(0.0, np.pi / 2, d1), (a2, 0.0, 0.0), (a3, 0.0, 0.0), (0.0, np.pi / 2, d4), (0.0, -np.pi / 2, d5),
+            (0.0, 0.0, d6)]
+    return DHRobot(name=name, links=tuple(DHLink(a=a, alpha=al, d=d, q_limits=(-2 * np.pi, 2 * np.pi))
+                                          for a, al, d in rows), convention=Convention.STANDARD)
+
+
+ARMS = {"ur5": lambda: denavit.load_robot("ur5"),
+        "ur10": lambda: _ur("ur10", 0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922),
+        "ur3e": lambda: _ur("ur3e", 0.15185, -0.24355, -0.2132, 0.13105, 0.08535, 0.0921)}
+
+
+@pytest.fixture(scope="module", params=sorted(ARMS))
+def arm(request, _kernel_cache):
+    robot = ARMS[request.param]()
+    return robot, denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+
+
+# --- comparison -------------------------------------------------------------------------------------------------
+
+
+def _match(A: np.ndarray, B: np.ndarray, tol: float) -> list[int]:
+    """Index in B of each row of A (one to one), within tol; fails if some row has no partner."""
+    assert A.shape == B.shape, (A, B)
+    free = list(range(len(B)))
+    out = []
+    for row in A:
+        d = [np.max(np.abs(row - B[k])) for k in free]
+        assert d and min(d) < tol, (row, B)
+        out.append(free.pop(int(np.argmin(d))))
+    return out
+
+
+def _same(robot, T, a, b, tol: float = 1e-10):
+    """a (compiled) and b (plain) give the same answer for T; every solution reproduces T by the plain FK."""
+    assert (a.method, a.controlled) == (b.method, b.controlled)
+    idx = _match(np.asarray(a.solutions), np.asarray(b.solutions), tol)
+    assert [a.branches[k] for k in range(len(idx))] == [b.branches[j] for j in idx]
+    assert [a.free[k] for k in range(len(idx))] == [b.free[j] for j in idx]
+    np.testing.assert_allclose(a.position_error, np.asarray(b.position_error)[idx], atol=1e-12)
+    np.testing.assert_allclose(a.orientation_error, np.asarray(b.orientation_error)[idx], atol=1e-12)
+    _match(np.asarray(a.outside_limits), np.asarray(b.outside_limits), tol)
+    if len(a.solutions):
+        F = denavit.forward_kinematics(robot, np.asarray(a.solutions))
+        L = max(1.0, sum(abs(l.a) + abs(l.d) for l in robot.links))
+        assert np.all(np.abs(F[:, :3, 3] - T[:3, 3]).max(axis=-1) < 1e-9 * L)
+        assert np.all(np.abs(F[:, :3, :3] - T[:3, :3]).max(axis=(-1, -2)) < 1e-9)
+
+
+@contextlib.contextmanager
+def _handovers():
+    """Calls of the plain solver made by the compiled analytic_ik (its status-1 path), counted in the list yielded."""
+    calls = []
+
+    def counted(robot, T, *args, **kwargs):
+        calls.append(1)
+        return denavit.analytic_ik(robot, T, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(_solvers, "analytic_ik", counted)
+        yield calls
+
+
+# --- singular configurations, from the joint axes alone ------------------------------------------------------------
+
+
+def _axes(robot, q):
+    z, o = joint_axes(robot, link_transforms(robot, q))
+    return z, o
+
+
+def _meet(z, o, i, j):
+    """The point nearest to axes i and j (their intersection when they meet)."""
+    A = np.stack([z[i], -z[j]], axis=1)
+    s = np.linalg.lstsq(A, o[j] - o[i], rcond=None)[0]
+    return 0.5 * (o[i] + s[0] * z[i] + o[j] + s[1] * z[j])
+
+
+def _shoulder(robot, q):
+    """Signed distance of the wrist point Q (axes 5, 6) from the plane of axis 1 and the direction of axis 2:
+    zero where the two shoulder solutions meet."""
+    z, o = _axes(robot, q)
+    n = np.cross(z[0], z[1])
+    return (_meet(z, o, 4, 5) - o[0]) @ n / max(np.linalg.norm(n), 1e-300)
+
+
+def _elbow(robot, q):
+    """Zero where the parallel axes 2, 3, 4 lie in one plane (elbow stretched or folded)."""
+    z, o = _axes(robot, q)
+    return np.cross(o[2] - o[1], o[3] - o[1]) @ z[1]
+
+
+def _root(fun, robot, q, k, rng):
+    """q with joint k moved onto a sign change of fun (bisection to 1e-15), or None when there is none."""
+    grid = q[k] + np.linspace(-np.pi, np.pi, 25)
+    vals = []
+    for x in grid:
+        qq = q.copy()
+        qq[k] = x
+        vals.append(fun(robot, qq))
+    flips = [i for i in range(24) if np.sign(vals[i]) != np.sign(vals[i + 1])]
+    if not flips:
+        return None
+    i = flips[int(rng.integers(len(flips)))]
+    lo, hi, flo = grid[i], grid[i + 1], vals[i]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        qq = q.copy()
+        qq[k] = mid
+        fm = fun(robot, qq)
+        if np.sign(fm) == np.sign(flo):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    qq = q.copy()
+    qq[k] = 0.5 * (lo + hi)
+    return qq
+
+
+def _singular_set(robot, rng, count: int, wrist: bool) -> np.ndarray:
+    """Configurations on the shoulder and elbow singularities (and the wrist one for UR arms: q5 = 0, pi),
+    each also moved off by 1e-9 .. 1e-2 rad (where the solver's thresholds lie)."""
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    out = []
+    for m in range(count):
+        q = rng.uniform(lim[:, 0], lim[:, 1])
+        found = _root(_shoulder, robot, q, 1, rng) if m % 2 == 0 else _root(_elbow, robot, q, 2, rng)
+        if found is not None:
+            out.append(found)
+    if wrist:
+        for m in range(count // 2):
+            q = rng.uniform(lim[:, 0], lim[:, 1])
+            q[4] = np.pi * (m % 2)
+            out.append(q)
+    base = np.array(out).reshape(-1, robot.dof)
+    moved = [base + 10.0 ** -e * rng.choice([-1.0, 1.0], base.shape) for e in (9, 6, 4, 2)]
+    return np.concatenate([base, *moved, np.round(base, 1)]), len(base)
+
+
+def _check_arm(robot, fast, rng, n_poses, n_singular, wrist):
+    lim = np.clip(robot.q_limits, -2 * np.pi, 2 * np.pi)
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (n_poses, robot.dof))
+    with _handovers() as calls:
+        for q in Q:
+            T = denavit.forward_kinematics(robot, q)
+            res = fast.analytic_ik(T)
+            _same(robot, T, res, denavit.analytic_ik(robot, T))
+            assert res.count >= 1  # q itself is a solution, inside the limits
+        assert len(calls) <= 0.1 * n_poses  # the compiled kernel answers the regular poses itself
+        singular, exact = _singular_set(robot, rng, n_singular, wrist)
+        for q in singular:
+            T = denavit.forward_kinematics(robot, q)
+            _same(robot, T, fast.analytic_ik(T), denavit.analytic_ik(robot, T))
+        assert exact == 0 or len(calls) > 0  # those on a singularity reach the plain solver
+
+
+# --- tests --------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_ur_arms_compiled_equals_plain(arm):
+    """UR5, UR10, UR3e: every solution, label and outside-limits solution of the plain solver, random and singular
+    poses; batches and unreachable poses too."""
+    robot, fast = arm
+    assert ik_plan(robot).kind == "parallel"
+    rng = np.random.default_rng(sum(robot.name.encode()))
+    _check_arm(robot, fast, rng, N_POSES, 6 if REDUCED else 16, True)
+    far = np.eye(4)
+    far[:3, 3] = (9.0, 0.0, 0.0)
+    assert fast.analytic_ik(far).count == 0 and denavit.analytic_ik(robot, far).count == 0
+    batch = denavit.forward_kinematics(robot, rng.uniform(-3, 3, (4, 6)))
+    a, b = fast.analytic_ik(batch), denavit.analytic_ik(robot, batch)  # a batch: the plain path
+    np.testing.assert_array_equal(np.isnan(a.solutions), np.isnan(b.solutions))
+    np.testing.assert_allclose(a.solutions, b.solutions, atol=1e-12)
+
+
+def _random_ur_class(seed: int) -> DHRobot:
+    """A random 6R arm with axes 2, 3, 4 parallel and axes 5, 6 meeting (either convention): random lengths,
+    offsets, twists of the non-parallel axes, joint offsets, limits, base and tool."""
+    rng = np.random.default_rng(seed)
+    conv = Convention.MODIFIED if rng.random() < 0.5 else Convention.STANDARD
+
+    def twist():
+        return float(rng.choice([-1.0, 1.0]) * rng.uniform(0.3, np.pi - 0.3))
+
+    def length():
+        return float(rng.choice([0.0, rng.uniform(-0.8, 0.8)]))
+
+    if conv is Convention.STANDARD:  # row i: z_{i-1} -> z_i; axes 2-4 are z1-z3, axes 5, 6 z4, z5
+        rows = [(length(), twist()), (rng.uniform(0.2, 0.8), 0.0), (rng.uniform(0.2, 0.8), 0.0), (length(), twist()),
+                (0.0, twist()), (length(), twist())]
+    else:  # row i carries a_{i-1}, alpha_{i-1}: z_{i-1} -> z_i; axes 2-4 are z2-z4, axes 5, 6 z5, z6
+        rows = [(length(), twist()), (length(), twist()), (rng.uniform(0.2, 0.8), 0.0), (rng.uniform(0.2, 0.8), 0.0),
+                (length(), twist()), (0.0, twist())]
+    links = []
+    for a, alpha in rows:
+        lo = float(rng.choice([-2 * np.pi, rng.uniform(-np.pi, 0.0)]))
+        links.append(DHLink(a=a, alpha=alpha, d=length(), theta=float(rng.uniform(-np.pi, np.pi)),
+                            q_limits=(lo, lo + float(rng.uniform(np.pi, 4 * np.pi)))))
+    base, tool = np.eye(4), np.eye(4)
+    if rng.random() < 0.7:
+        base = transform_from_xyz_rpy(rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3))
+        tool = transform_from_xyz_rpy(rng.uniform(-0.3, 0.3, 3), rng.uniform(-np.pi, np.pi, 3))
+    return DHRobot(name="random-ur", links=tuple(links), convention=conv, base=base, tool=tool)
+
+
+@pytest.mark.slow
+@settings(max_examples=2 if REDUCED else 5)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
+    """Random UR-class arms (both conventions, offsets, limits, base and tool) x random and singular poses."""
+    robot = _random_ur_class(seed)
+    plan = ik_plan(robot)
+    assert plan.kind == "parallel" and plan.closed is not None
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    _check_arm(robot, fast, np.random.default_rng(seed), N_POSES // 2, 4 if REDUCED else 10, False)
