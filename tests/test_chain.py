@@ -192,3 +192,46 @@ def test_import_chain_stays_light():
             "c.walk(r, [0.0] * 6, c.FLOATS); r.constants; print('sympy' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False"]
+
+
+# ---- the joint-screw form C0 J1(q1) C1 ⋯ (chain.Screws, screw_walk) ---------------------------------------------
+
+@settings(max_examples=40)
+@given(robots())
+def test_screw_walk_equals_the_elementary_product(robot):
+    """Pose (tool applied) and joint axes by the screw walker, against the row-by-row 4×4 oracle."""
+    from denavit.chain import screw_axes, screw_pose, screws_of
+    from denavit.numeric import joint_axes
+
+    rng = np.random.default_rng(robot.n_rows + 11)
+    Q = random_q(rng, robot, (2, 3))
+    screws = screws_of(robot)
+    T = screw_pose(screws, Q)
+    pts, dirs = screw_axes(screws, Q)
+    assert T.shape == (2, 3, 4, 4) and pts.shape == dirs.shape == (2, 3, robot.dof, 3)
+    for i in range(2):
+        for j in range(3):
+            T_ref, frames = oracle(robot, Q[i, j])
+            np.testing.assert_allclose(T[i, j], T_ref, atol=ATOL)
+            z, o = joint_axes(robot, np.array(frames))
+            np.testing.assert_allclose(dirs[i, j], z, atol=ATOL)
+            # a point of the same line (a prismatic joint of a modified row moves its frame's origin along it)
+            np.testing.assert_allclose(np.cross(pts[i, j] - o, z), 0.0, atol=ATOL)
+
+
+@settings(max_examples=40)
+@given(robots())
+def test_screw_walk_pieces_and_reverse_compose_to_the_whole(robot):
+    """pose(C0 ⋯ J_k C_k) · C_k⁻¹ · pose(C_k J_k+1 ⋯) = pose; the reversed chain at −q reversed is the inverse."""
+    from denavit.chain import reverse_screws, screw_pose, screws_of
+
+    rng = np.random.default_rng(robot.n_rows + 13)
+    q = random_q(rng, robot, (4,))
+    screws = screws_of(robot)
+    T = screw_pose(screws, q)
+    k = int(rng.integers(0, robot.dof + 1))
+    pre = screw_pose(screws, q[..., :k], upto=k)
+    post = screw_pose(screws, q[..., k:], start=k)
+    np.testing.assert_allclose(pre @ np.linalg.inv(screws.consts[k]) @ post, T, atol=ATOL)
+    back = screw_pose(reverse_screws(screws), -q[..., ::-1])
+    np.testing.assert_allclose(back @ T, np.broadcast_to(np.eye(4), T.shape), atol=ATOL)
