@@ -223,10 +223,14 @@ def _special(name: str):
         from ._dh_claims import check_dh_matrix
 
         return check_dh_matrix
-    if name in ("ik_formula", "ik_solutions"):
-        from . import _ik_claims
+    if name == "ik_formula":
+        from ._ik_claims import check_ik_formula
 
-        return _ik_claims.check_ik_formula if name == "ik_formula" else _ik_claims.check_ik_solutions
+        return check_ik_formula
+    if name == "ik_solutions":
+        from ._ik_solutions import check_ik_solutions
+
+        return check_ik_solutions
     return None
 
 

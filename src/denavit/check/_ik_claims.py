@@ -1,4 +1,5 @@
-"""Claims about inverse kinematics: a formula for one joint, or the solutions for one target.
+"""Claims about inverse kinematics: a formula for one joint (here), or the solutions for one target
+(:mod:`._ik_solutions`).
 
 ``ik_formula``: ``q_1 = \\operatorname{atan2}(p_y, p_x)``, with optional ``where`` definitions evaluated in order
 (``D: (p_x^2 + p_y^2 - L_1^2 - L_2^2)/(2 L_1 L_2)``), ± signs or σ_k = ±1 for branches, and the other joints
@@ -28,78 +29,21 @@ from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
 from ..ik import analytic_ik, ik_structure
-from ..model import DHRobot, JointType
+from ..model import DHRobot
+from ._ik_targets import (MATCH_TOL, POSE_COLUMNS, controlled_rows, free_joints, joint_distance, reaches,
+                          revolute_mask, target_env)
 from ._latex import parse_math
-from ._matrices import parse_matrix
 from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
 from ._tokens import MAX_CHARS
 from ._vectorized import vec_eval
 
-__all__ = ["check_ik_formula", "check_ik_solutions", "N_TARGETS", "MAX_WHERE", "MAX_SOLUTIONS"]
+__all__ = ["check_ik_formula", "N_TARGETS", "MAX_WHERE"]
 
 N_TARGETS = 6
 #: Most definitions in an ik_formula's 'where'.
 MAX_WHERE = 20
-#: Most solutions listed in an ik_solutions claim (a 6R arm has at most 16).
-MAX_SOLUTIONS = 64
-MATCH_TOL = 1e-6
 _TARGET = [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)] + ["px", "py", "pz"]
-_COLS = {"n": 0, "o": 1, "a": 2}
-
-
-def _rev(robot: DHRobot) -> np.ndarray:
-    return np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-
-
-def _dist(robot: DHRobot, a, b) -> np.ndarray:
-    """Joint-wise distance, angles modulo 2π."""
-    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
-    return np.abs(np.where(_rev(robot), (d + np.pi) % (2 * np.pi) - np.pi, d))
-
-
-def target_env(robot: DHRobot, T_world: np.ndarray, pose: str) -> dict[str, float]:
-    """The names a person uses for the target pose, with their values."""
-    T = T_world if pose == "world" else np.linalg.solve(robot.base_matrix, T_world) @ np.linalg.inv(robot.tool_matrix)
-    env = {f"r{i + 1}{j + 1}": T[i, j] for i in range(3) for j in range(3)}
-    env.update(px=T[0, 3], py=T[1, 3], pz=T[2, 3], Px=T[0, 3], Py=T[1, 3], Pz=T[2, 3])
-    for c, j in _COLS.items():
-        env.update({f"{c}{ax}": T[i, j] for i, ax in enumerate("xyz")})
-    env["phi"] = float(np.arctan2(T[1, 0], T[0, 0]))
-    params = {k for k, _ in robot.parameters}
-    env.update({k: T[i, 3] for i, k in enumerate("xyz") if k not in params})
-    return {k: v for k, v in env.items() if k not in params}
-
-
-def _controlled_rows(res: Any) -> list[int]:
-    kind = getattr(res, "controlled", "pose")
-    return {"position": [0, 1, 2], "orientation": [3, 4, 5], "position+heading": [0, 1, 2, 5]}.get(kind, list(range(6)))
-
-
-def _pose_error(robot: DHRobot, q: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """(p_t − p, rotation vector of R_t Rᵀ) in world axes, (6,)."""
-    F = N.forward_kinematics(robot, q)
-    E = T[:3, :3] @ F[:3, :3].T
-    w = np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]) / 2
-    s, c = np.linalg.norm(w), (np.trace(E) - 1) / 2
-    ang = np.arctan2(s, c)
-    rot = w * (ang / s) if s > 1e-300 else w
-    return np.concatenate([T[:3, 3] - F[:3, 3], rot])
-
-
-def reaches(robot: DHRobot, q0: np.ndarray, T: np.ndarray, fixed: list[int], rows: list[int]) -> np.ndarray | None:
-    """Gauss–Newton from q0 on the free joints (``fixed`` held); the solution if it reaches T, else None."""
-    q = q0.astype(float).copy()
-    free = [k for k in range(robot.dof) if k not in fixed]
-    if not free:
-        return q if np.max(np.abs(_pose_error(robot, q, T)[rows])) < 1e-9 else None
-    for _ in range(40):
-        e = _pose_error(robot, q, T)[rows]
-        if np.max(np.abs(e)) < 1e-11:
-            return q
-        J = N.geometric_jacobian(robot, q)[rows][:, free]
-        q[free] += np.linalg.lstsq(J, e, rcond=1e-10)[0]
-    return q if np.max(np.abs(_pose_error(robot, q, T)[rows])) < 1e-9 else None
 
 
 # --- ik_formula ------------------------------------------------------------------------------------------
@@ -140,7 +84,7 @@ def _read_formula(robot: DHRobot, raw: dict[str, Any]):
         raise ParseError(f"'where' names must start with a letter, got {list(where)}")
     signs = [f"sigma{k}" for k in range(1, 10)] + ["sigma"]
     resolve = robot_resolver(robot, extra=_TARGET + ["Px", "Py", "Pz", "phi", "x", "y", "z"]
-                             + [f"{c}{a}" for c in _COLS for a in "xyz"] + names + signs)
+                             + [f"{c}{a}" for c in POSE_COLUMNS for a in "xyz"] + names + signs)
     texts = [str(where[k]) for k in where] + [value]
     versions = []
     for version in expand_pm(texts):
@@ -205,7 +149,7 @@ def _targets(robot: DHRobot, rng: np.random.Generator, count: int):
         q = rng.uniform(lo, hi)
         T = N.forward_kinematics(robot, q)
         res = analytic_ik(robot, T)
-        J = N.geometric_jacobian(robot, q)[_controlled_rows(res)]
+        J = N.geometric_jacobian(robot, q)[controlled_rows(res)]
         s = np.linalg.svd(J, compute_uv=False)
         if s[-1] > 1e-3 * s[0]:
             out.append((q, T, res))
@@ -220,12 +164,6 @@ def _solution_set(robot: DHRobot, res: Any) -> tuple[np.ndarray, list[str]]:
     return np.concatenate([sols, outside]), list(res.free) + [""] * len(outside)
 
 
-def _free_joints(text: str) -> set[int]:
-    import re
-
-    return {int(m) - 1 for m in re.findall(r"q(\d+)", text or "")}
-
-
 def _decimals_of(nodes) -> int:
     from ._values import _decimals
 
@@ -233,7 +171,7 @@ def _decimals_of(nodes) -> int:
 
 
 def _formula_hint(robot: DHRobot, j: int, v: float, s_j: float) -> str | None:
-    rev = bool(_rev(robot)[j])
+    rev = bool(revolute_mask(robot)[j])
     wrap = (lambda x: (x + np.pi) % (2 * np.pi) - np.pi) if rev else (lambda x: x)
     for other, text in ((-s_j, "the opposite sign (a sign slip)"),
                         (s_j + np.pi, "π away: atan instead of atan2, or both atan2 arguments with the wrong sign"),
@@ -333,7 +271,7 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
         if len(bad) >= 3:
             break
         S, free = _solution_set(robot, res)
-        usable = [k for k in range(len(S)) if not (_free_joints(free[k]) & set(deps + [j]))]
+        usable = [k for k in range(len(S)) if not (free_joints(free[k]) & set(deps + [j]))]
         if not usable:
             continue
         checked += 1
@@ -345,7 +283,7 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
                 P = (np.asarray(robot.base_matrix) @ np.append(P, 1.0))[:3]
             params_ = {k for k, _ in robot.parameters}
             env0.update({k: P[i] for i, ax in enumerate("xyz") for k in (f"p{ax}", f"P{ax}", ax) if k not in params_})
-        rows = _controlled_rows(res)
+        rows = controlled_rows(res)
         hit = set()
         for s in ([S[k] for k in usable] if deps else [S[usable[0]]]):
             env = {**env0, **{f"q{i + 1}": s[i] for i in deps}}
@@ -354,9 +292,9 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
                 bad.append({"entry": [t + 1], "claimed": float("nan"), "expected": float(s[j]), "q": qg.tolist(),
                             "note": "undefined (a square root of a negative number, a division by zero, …)"})
                 break
-            same = [k for k in usable if all(_dist(robot, S[k], s)[i] < tol for i in deps)]
+            same = [k for k in usable if all(joint_distance(robot, S[k], s)[i] < tol for i in deps)]
             for v in vals[np.isfinite(vals)]:
-                match = [k for k in same if abs(_dist(robot, [S[k][j]], [v])[0] if _rev(robot)[j] else S[k][j] - v) < tol]
+                match = [k for k in same if abs(joint_distance(robot, [S[k][j]], [v])[0] if revolute_mask(robot)[j] else S[k][j] - v) < tol]
                 if match:
                     hit |= set(match)
                     continue
@@ -387,89 +325,3 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
            f"of any IK solution (nearest: {first['expected']:.6g})")
     return Verdict(cid, "ik_formula", "incorrect", msg, tuple(bad[:12]), {"q": first["q"]},
                    tuple(dict.fromkeys(hints))[:1], None, method, extra)
-
-
-# --- ik_solutions ----------------------------------------------------------------------------------------
-
-
-def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The claimed q vectors, each with the rounding unit of every entry (0 for exact entries)."""
-    from ._values import _decimals, _no_names
-
-    if isinstance(raw, str) and "\\begin" in raw:
-        rows = parse_matrix(raw, _no_names)
-    else:
-        items = raw if isinstance(raw, list) else [p for p in str(raw).split(";") if p.strip()]
-        if len(items) > MAX_SOLUTIONS:
-            raise ParseError(f"{len(items)} solutions listed; at most {MAX_SOLUTIONS}")
-        rows = []
-        for k, item in enumerate(items, start=1):
-            cells = item if isinstance(item, list) else [c for c in str(item).strip().strip("[]()").split(",")]
-            try:
-                rows.append([_expr.parse(c) if isinstance(c, (int, float)) else parse_math(str(c), _no_names, rhs=False)
-                             for c in cells])
-            except ParseError as exc:
-                raise ParseError(f"solution {k}: {exc}") from None
-    if len(rows) > MAX_SOLUTIONS:
-        raise ParseError(f"{len(rows)} solutions listed; at most {MAX_SOLUTIONS}")
-    out = []
-    rev = _rev(robot)
-    for k, row in enumerate(rows, start=1):
-        if len(row) != robot.dof:
-            raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
-        q = np.array([_expr.evaluate(c) for c in row])
-        unit = np.array([10.0 ** -d if (d := _decimals(c)) >= 2 else 0.0 for c in row])
-        if deg:
-            q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
-        out.append((q, unit))
-    if not out:
-        raise ParseError("no solution listed (an unreachable target has none: write an empty list [])")
-    return out
-
-
-def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
-    """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
-    from ._engine import Verdict
-    from ._values import _joint_values, _no_names, _values
-
-    if "q" in raw:
-        T = N.forward_kinematics(robot, _joint_values(raw["q"], robot, "q", deg))
-    elif "T" in raw:
-        T = np.array([[_expr.evaluate(c) for c in r] for r in _values(raw["T"], _no_names)])
-    else:
-        raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
-    if T.shape != (4, 4):
-        raise ParseError(f"'T' must be 4×4, got {T.shape}")
-    claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
-    try:
-        res = analytic_ik(robot, T)
-    except Exception:  # no closed form: each solution is still checked by FK
-        res = None
-    rows = _controlled_rows(res) if res is not None else list(range(6))
-    entries, reach = [], []
-    for k, (q, unit) in enumerate(claimed, start=1):
-        e = _pose_error(robot, q, T)[rows]
-        allowed = 1e-9 + 2.0 * np.abs(N.geometric_jacobian(robot, q)[rows]) @ unit
-        ok = bool(np.all(np.abs(e) <= allowed))
-        reach.append(ok)
-        if not ok:
-            entries.append({"entry": [k], "claimed": float(np.max(np.abs(e))), "expected": 0.0, "q": q.tolist(),
-                            "note": "FK(q) does not reach the target"})
-    missing = []
-    if res is not None:
-        for s, label, free in zip(np.asarray(res.solutions).reshape(-1, robot.dof), res.branches, res.free):
-            keep = [i for i in range(robot.dof) if i not in _free_joints(free)]
-            if not any(r and np.all(_dist(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
-                       for r, (q, unit) in zip(reach, claimed)):
-                missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in s) + "]")
-    method = ("FK of each claimed solution on the rows the arm controls (to the decimals written, through J); "
-              + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
-    extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
-    if not entries and not missing:
-        return Verdict(cid, "ik_solutions", "correct", f"correct: all {len(claimed)} solution(s) reach the target"
-                       + (" and none is missing" if res is not None else ""), method=method, extra=extra)
-    parts = [f"solution {e['entry'][0]} does not reach the target (error {e['claimed']:.3g})" for e in entries]
-    parts += [f"missing {m}" for m in missing]
-    return Verdict(cid, "ik_solutions", "incorrect", "incorrect: " + "; ".join(parts[:8]), tuple(entries),
-                   {"q": entries[0]["q"]} if entries else None, (), extra["solutions"], method, extra)
-

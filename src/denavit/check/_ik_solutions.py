@@ -1,0 +1,105 @@
+"""Claims of every IK solution for one target: each claimed q must reach it (FK, to the decimals written), and no
+closed-form solution of :func:`denavit.ik.analytic_ik` within the limits may be missing.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .. import _expr
+from .. import numeric as N
+from ..errors import ParseError
+from ..ik import analytic_ik
+from ..model import DHRobot
+from ._ik_targets import MATCH_TOL, controlled_rows, free_joints, joint_distance, pose_error, revolute_mask
+from ._latex import parse_math
+from ._matrices import parse_matrix
+
+__all__ = ["check_ik_solutions", "MAX_SOLUTIONS"]
+
+#: Most solutions listed in an ik_solutions claim (a 6R arm has at most 16).
+MAX_SOLUTIONS = 64
+
+
+def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The claimed q vectors, each with the rounding unit of every entry (0 for exact entries)."""
+    from ._values import _decimals, _no_names
+
+    if isinstance(raw, str) and "\\begin" in raw:
+        rows = parse_matrix(raw, _no_names)
+    else:
+        items = raw if isinstance(raw, list) else [p for p in str(raw).split(";") if p.strip()]
+        if len(items) > MAX_SOLUTIONS:
+            raise ParseError(f"{len(items)} solutions listed; at most {MAX_SOLUTIONS}")
+        rows = []
+        for k, item in enumerate(items, start=1):
+            cells = item if isinstance(item, list) else [c for c in str(item).strip().strip("[]()").split(",")]
+            try:
+                rows.append([_expr.parse(c) if isinstance(c, (int, float)) else parse_math(str(c), _no_names, rhs=False)
+                             for c in cells])
+            except ParseError as exc:
+                raise ParseError(f"solution {k}: {exc}") from None
+    if len(rows) > MAX_SOLUTIONS:
+        raise ParseError(f"{len(rows)} solutions listed; at most {MAX_SOLUTIONS}")
+    out = []
+    rev = revolute_mask(robot)
+    for k, row in enumerate(rows, start=1):
+        if len(row) != robot.dof:
+            raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
+        q = np.array([_expr.evaluate(c) for c in row])
+        unit = np.array([10.0 ** -d if (d := _decimals(c)) >= 2 else 0.0 for c in row])
+        if deg:
+            q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
+        out.append((q, unit))
+    if not out:
+        raise ParseError("no solution listed (an unreachable target has none: write an empty list [])")
+    return out
+
+
+def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
+    """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
+    from ._engine import Verdict
+    from ._values import _joint_values, _no_names, _values
+
+    if "q" in raw:
+        T = N.forward_kinematics(robot, _joint_values(raw["q"], robot, "q", deg))
+    elif "T" in raw:
+        T = np.array([[_expr.evaluate(c) for c in r] for r in _values(raw["T"], _no_names)])
+    else:
+        raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
+    if T.shape != (4, 4):
+        raise ParseError(f"'T' must be 4×4, got {T.shape}")
+    claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
+    try:
+        res = analytic_ik(robot, T)
+    except Exception:  # no closed form: each solution is still checked by FK
+        res = None
+    rows = controlled_rows(res) if res is not None else list(range(6))
+    entries, reach = [], []
+    for k, (q, unit) in enumerate(claimed, start=1):
+        e = pose_error(robot, q, T)[rows]
+        allowed = 1e-9 + 2.0 * np.abs(N.geometric_jacobian(robot, q)[rows]) @ unit
+        ok = bool(np.all(np.abs(e) <= allowed))
+        reach.append(ok)
+        if not ok:
+            entries.append({"entry": [k], "claimed": float(np.max(np.abs(e))), "expected": 0.0, "q": q.tolist(),
+                            "note": "FK(q) does not reach the target"})
+    missing = []
+    if res is not None:
+        for s, label, free in zip(np.asarray(res.solutions).reshape(-1, robot.dof), res.branches, res.free):
+            keep = [i for i in range(robot.dof) if i not in free_joints(free)]
+            if not any(r and np.all(joint_distance(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
+                       for r, (q, unit) in zip(reach, claimed)):
+                missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in s) + "]")
+    method = ("FK of each claimed solution on the rows the arm controls (to the decimals written, through J); "
+              + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
+    extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
+    if not entries and not missing:
+        return Verdict(cid, "ik_solutions", "correct", f"correct: all {len(claimed)} solution(s) reach the target"
+                       + (" and none is missing" if res is not None else ""), method=method, extra=extra)
+    parts = [f"solution {e['entry'][0]} does not reach the target (error {e['claimed']:.3g})" for e in entries]
+    parts += [f"missing {m}" for m in missing]
+    return Verdict(cid, "ik_solutions", "incorrect", "incorrect: " + "; ".join(parts[:8]), tuple(entries),
+                   {"q": entries[0]["q"]} if entries else None, (), extra["solutions"], method, extra)

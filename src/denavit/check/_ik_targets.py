@@ -1,0 +1,78 @@
+"""Targets of IK claims: the names a person uses for the target pose, the pose error, a reach test from a start,
+and joint-wise distances (angles modulo 2π) — shared by the ik_formula and ik_solutions checks.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .. import numeric as N
+from ..model import DHRobot, JointType
+
+__all__ = ["MATCH_TOL", "POSE_COLUMNS", "revolute_mask", "joint_distance", "target_env", "controlled_rows",
+           "pose_error", "reaches", "free_joints"]
+
+MATCH_TOL = 1e-6
+POSE_COLUMNS = {"n": 0, "o": 1, "a": 2}
+
+
+def revolute_mask(robot: DHRobot) -> np.ndarray:
+    return np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+
+
+def joint_distance(robot: DHRobot, a, b) -> np.ndarray:
+    """Joint-wise distance, angles modulo 2π."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    return np.abs(np.where(revolute_mask(robot), (d + np.pi) % (2 * np.pi) - np.pi, d))
+
+
+def target_env(robot: DHRobot, T_world: np.ndarray, pose: str) -> dict[str, float]:
+    """The names a person uses for the target pose, with their values."""
+    T = T_world if pose == "world" else np.linalg.solve(robot.base_matrix, T_world) @ np.linalg.inv(robot.tool_matrix)
+    env = {f"r{i + 1}{j + 1}": T[i, j] for i in range(3) for j in range(3)}
+    env.update(px=T[0, 3], py=T[1, 3], pz=T[2, 3], Px=T[0, 3], Py=T[1, 3], Pz=T[2, 3])
+    for c, j in POSE_COLUMNS.items():
+        env.update({f"{c}{ax}": T[i, j] for i, ax in enumerate("xyz")})
+    env["phi"] = float(np.arctan2(T[1, 0], T[0, 0]))
+    params = {k for k, _ in robot.parameters}
+    env.update({k: T[i, 3] for i, k in enumerate("xyz") if k not in params})
+    return {k: v for k, v in env.items() if k not in params}
+
+
+def controlled_rows(res: Any) -> list[int]:
+    kind = getattr(res, "controlled", "pose")
+    return {"position": [0, 1, 2], "orientation": [3, 4, 5], "position+heading": [0, 1, 2, 5]}.get(kind, list(range(6)))
+
+
+def pose_error(robot: DHRobot, q: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """(p_t − p, rotation vector of R_t Rᵀ) in world axes, (6,)."""
+    F = N.forward_kinematics(robot, q)
+    E = T[:3, :3] @ F[:3, :3].T
+    w = np.array([E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]) / 2
+    s, c = np.linalg.norm(w), (np.trace(E) - 1) / 2
+    ang = np.arctan2(s, c)
+    rot = w * (ang / s) if s > 1e-300 else w
+    return np.concatenate([T[:3, 3] - F[:3, 3], rot])
+
+
+def reaches(robot: DHRobot, q0: np.ndarray, T: np.ndarray, fixed: list[int], rows: list[int]) -> np.ndarray | None:
+    """Gauss–Newton from q0 on the free joints (``fixed`` held); the solution if it reaches T, else None."""
+    q = q0.astype(float).copy()
+    free = [k for k in range(robot.dof) if k not in fixed]
+    if not free:
+        return q if np.max(np.abs(pose_error(robot, q, T)[rows])) < 1e-9 else None
+    for _ in range(40):
+        e = pose_error(robot, q, T)[rows]
+        if np.max(np.abs(e)) < 1e-11:
+            return q
+        J = N.geometric_jacobian(robot, q)[rows][:, free]
+        q[free] += np.linalg.lstsq(J, e, rcond=1e-10)[0]
+    return q if np.max(np.abs(pose_error(robot, q, T)[rows])) < 1e-9 else None
+
+
+def free_joints(text: str) -> set[int]:
+    import re
+
+    return {int(m) - 1 for m in re.findall(r"q(\d+)", text or "")}
