@@ -7,9 +7,14 @@ hostile input (see the commit messages).  In-process through ``denavit.cli.main`
 import json
 import math
 
+import contextlib
+import io
+
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
+from conftest import REDUCED
 from denavit.cli import main
 
 
@@ -17,6 +22,14 @@ def run(capsys, *argv):
     code = main([str(a) for a in argv])
     out, err = capsys.readouterr()
     return code, out, err
+
+
+def run_captured(*argv):
+    """``main(argv)`` with stdout and stderr captured here (for hypothesis tests, where capsys is not per example)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([str(a) for a in argv])
+    return code, out.getvalue(), err.getvalue()
 
 
 def _strict(text):
@@ -145,3 +158,44 @@ def test_hostile_input_gives_one_short_line(capsys, tmp_path, monkeypatch, argv)
     assert len(lines[0]) < 500 and "internal error" not in err and "Traceback" not in err
     assert lines[0].startswith("denavit")
     assert not (tmp_path / "never.png").exists()
+
+
+# Degrees typed without --deg: the limit error says so, and a value beyond a full turn on a joint without limits
+# draws one warning (the robot-file reader's rule for bare angles, DEGREE_HINT).
+NO_LIMITS = """name: free-2r
+convention: standard
+joints:
+  - {a: 1.0, alpha: 0, d: 0, theta: q}
+  - {a: 0.5, alpha: 0, d: 0, theta: q}
+"""
+
+
+@settings(max_examples=15 if REDUCED else 40, deadline=None)
+@given(st.floats(10, 170), st.floats(-170, -10))
+def test_degrees_typed_without_deg_are_named_in_the_limit_error(q2_deg, q3_deg):
+    from denavit import forward_kinematics, load_robot
+
+    robot = load_robot("elbow-6r-deg")  # a file in degrees, limits within ±180°
+    q_deg = np.array([0.0, q2_deg, q3_deg, 0.0, 0.0, 0.0])
+    lim = robot.q_limits
+    assert np.all((lim[:, 0] <= np.radians(q_deg)) & (np.radians(q_deg) <= lim[:, 1]))  # inside, in degrees
+    assert not lim[1, 0] <= q_deg[1] <= lim[1, 1]  # joint 2 outside, read as radians
+    text = ", ".join(repr(float(v)) for v in q_deg)
+    code, out, err = run_captured("fk", "elbow-6r-deg", "-q", text)
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1 and "add --deg" in lines[0] and "joint 2" in lines[0]
+    code, out, err = run_captured("fk", "elbow-6r-deg", "-q", text, "--deg", "--json")
+    assert code == 0 and err == ""
+    np.testing.assert_allclose(_strict(out)["T"], forward_kinematics(robot, np.radians(q_deg)), atol=1e-12)
+
+
+def test_a_full_turn_in_radians_draws_one_warning(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "free.yaml").write_text(NO_LIMITS)
+    code, out, err = run_captured("fk", "free.yaml", "-q", "90, 45", "--json")
+    lines = err.strip().splitlines()
+    assert code == 0 and len(lines) == 1 and "warning" in lines[0] and "--deg" in lines[0] and "(and 1 more)" in lines[0]
+    _strict(out)  # stdout stays pure JSON
+    for argv in (["-q", "90, 45", "--deg"], ["-q", "6.28, -6.28"]):  # degrees said; or within a turn
+        code, out, err = run_captured("fk", "free.yaml", *argv)
+        assert code == 0 and err == "", err

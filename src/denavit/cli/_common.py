@@ -7,6 +7,7 @@ import contextlib
 import json
 import re
 import sys
+import warnings
 from typing import Any, Sequence
 
 import numpy as np
@@ -295,16 +296,33 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
         for k in range(robot.dof):
             if not (lim[k, 0] - 1e-12 <= vals[k] <= lim[k, 1] + 1e-12):
                 lo, hi, v = lim[k, 0], lim[k, 1], vals[k]
-                unit = "m"
+                unit, hint = "m", "use --ignore-limits to compute anyway"
                 if robot.joint_types[k] is JointType.REVOLUTE:
                     unit = "rad"
                     if args.deg:
                         lo, hi, v, unit = np.degrees(lo), np.degrees(hi), np.degrees(v), "deg"
+                    elif pose is None and lo <= np.radians(v) <= hi:  # degrees typed without --deg, most likely
+                        hint = f"{v:.6g} deg would be inside: add --deg for degrees, or --ignore-limits to compute anyway"
                 raise ParseError(
-                    f"{what}: joint {k + 1} = {v:.6g} {unit} is outside its limits [{lo:.6g}, {hi:.6g}] "
-                    f"(use --ignore-limits to compute anyway)"
+                    f"{what}: joint {k + 1} = {v:.6g} {unit} is outside its limits [{lo:.6g}, {hi:.6g}] ({hint})"
                 )
+    if not args.deg and pose is None and not rates:
+        _warn_full_turns(robot, vals, what)
     return vals
+
+
+def _warn_full_turns(robot, vals: np.ndarray, what: str) -> None:
+    """One warning when a revolute value typed in radians is beyond a full turn: degrees without ``--deg``?"""
+    from .._read import DEGREE_HINT
+    from ..errors import DenavitWarning
+    from ..model import JointType
+
+    big = [k for k, t in enumerate(robot.joint_types) if t is JointType.REVOLUTE and abs(vals[k]) > DEGREE_HINT]
+    if big:
+        k = big[0]
+        more = f" (and {len(big) - 1} more)" if len(big) > 1 else ""
+        warnings.warn(DenavitWarning(f"{what}: joint {k + 1} = {vals[k]:.6g} rad is more than a full turn{more}; "
+                                     "if the values are degrees, add --deg"), stacklevel=3)
 
 
 def to_json(x: Any) -> Any:
