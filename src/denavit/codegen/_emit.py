@@ -218,10 +218,12 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
         from ._ik_elbow import IK_ELBOW_SOURCE
         from ._ik_lm import IK_LM_SOURCE
         from ._ik_parallel import IK_PARALLEL_SOURCE
+        from ._ik_stanford import IK_STANFORD_SOURCE
 
         body.append(IK_LM_SOURCE)
         body.append(IK_ELBOW_SOURCE)
         body.append(IK_PARALLEL_SOURCE)  # numba compiles a function on its first call only: no cost to other arms
+        body.append(IK_STANFORD_SOURCE)
     return "\n".join(head + body).rstrip() + "\n"
 
 

@@ -8,8 +8,8 @@ is left for q2, q3 (law of cosines) and q4.  The eight candidates of one pose ar
 compiled FK, folded into the joint limits, merged when equal and labelled (shoulder, elbow, wrist: docs/ik.md).
 
 Every case the plain solver treats specially is handed back to it (``status`` 1): a root next to a double root
-(shoulder or elbow or wrist ratio near ±1), the point Q on axis 1 or on axis 2, axis 6 parallel to axes 2–4
-(the wrist-singular continuum), a candidate that would need polishing, two solutions closer than the merge radius.
+(shoulder or elbow or wrist ratio near ±1), the point Q on or next to axis 1 or axis 2, axis 6 parallel or
+nearly parallel to axes 2–4 (the wrist-singular continuum; NEAR_SINGULAR), a candidate that would need polishing, two solutions closer than the merge radius.
 The compiled path answers only where its answer is the plain solver's.  The text below is appended to each
 generated numba module of an arm with a 6R ``parallel`` plan; it calls that module's ``fk_1`` and the elbow
 solver's ``_elbow_half_angle``; nothing of the robot or the user is pasted into it.
@@ -24,8 +24,14 @@ from ..numeric import inverse_transform
 
 __all__ = ["IK_PARALLEL_SOURCE", "PARALLEL_LAYOUT", "parallel_constants"]
 
-#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (175 numbers).
-PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 9), ("lo", 6), ("hi", 6),
+#: Distance (relative to the reach) of the point Q from axis 1 or 2, or of the planar pair's point from axis 2, and
+#: sine of the angle between axis 6 and axes 2-4, under which a pose goes to the plain solver: the angles found
+#: there are ill-conditioned (rounding amplified by ~1/this), so the two solvers' answers could differ by more than
+#: 1e-10, although the pose is not one the plain solver treats specially.
+NEAR_SINGULAR = 1e-5
+
+#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (176 numbers).
+PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 10), ("lo", 6), ("hi", 6),
                    ("revolute", 6), ("theta", 6), ("tols", 8))
 
 
@@ -53,7 +59,8 @@ def parallel_constants(robot, plan) -> np.ndarray:
     ap, bp, g = m[0] * p3[0] + m[1] * p3[1], m[1] * p3[0] - m[0] * p3[1], m[2] * p3[2]
     vz = p2[2] + R2[2, 2] * p3[2]
     scalars = [h + a @ pc1, sigma, np.hypot(aw, bw), np.arctan2(bw, aw), np.arctan2(np.hypot(r[0], r[1]), r[2]),
-               np.arctan2(np.hypot(u[0], u[1]), u[2]), 2 * ap, 2 * bp, -(p2 @ p2) - p3 @ p3 + vz**2 - 2 * g]
+               np.arctan2(np.hypot(u[0], u[1]), u[2]), 2 * ap, 2 * bp, -(p2 @ p2) - p3 @ p3 + vz**2 - 2 * g,
+               NEAR_SINGULAR]
     lim = robot.q_limits
     k = dict(plan.closed, Q_e=Q_e, C0i=inverse_transform(C[0]), consts=C, a=a, scalars=scalars, lo=lim[:, 0],
              hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types])
@@ -73,8 +80,8 @@ def ik_parallel_packed(T, K, f, i):
     f[b, :j, 8:] the solutions outside the limits; i[b, :k] label codes (1 shoulder left, 2 elbow down, 4 wrist
     flip), i[b, 8:] = (k, j, 1 if the plain solver must decide)."""
     Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
-    a, sc, lo_lim, hi_lim = K[131:134], K[134:143], K[143:149], K[149:155]
-    rev, theta, tols = K[155:161], K[161:167], K[167:175]
+    a, sc, lo_lim, hi_lim = K[131:134], K[134:144], K[144:150], K[150:156]
+    rev, theta, tols = K[156:162], K[162:168], K[168:176]
     # scratch: one float and one flag allocation, sliced
     ws = np.empty(134)
     cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \
@@ -96,8 +103,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
     """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand
     (ws: 45 floats of scratch); returns (count, status)."""
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
-    tol, aligned, reach = tols[1], tols[6], tols[7]
-    tiny = tols[0] * reach
+    tol, reach = tols[1], tols[7]
+    wide = sc[9] * reach  # NEAR_SINGULAR
     status = 0
     ncand = 0
     V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
@@ -114,8 +121,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
     Bq = a[0] * V[1] - a[1] * V[0]
     c = c0 - a[2] * V[2]
     rho = math.hypot(A, Bq)
-    if rho <= max(tiny, 1e-11):
-        return 0, 1  # Q on axis 1
+    if rho <= max(wide, 1e-11):
+        return 0, 1  # Q on (or next to) axis 1
     ratio = c / rho
     if abs(abs(ratio) - 1.0) < 1e-6:
         status = 1  # next to a double root: the plain solver polishes and looks for partners
@@ -147,7 +154,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
             y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
             y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])
-            if math.hypot(y0, y1) < 10.0 * aligned:
+            if math.hypot(y0, y1) < sc[9]:
                 status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
             q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
             _tail(C, q5, q6, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
@@ -164,8 +171,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             for r in range(3):
                 xr[r] = cols[r, 0] * g[0] + cols[r, 1] * g[1] + cols[r, 2] * g[2]
             # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
-            if math.hypot(P0, P1) < tiny:
-                status = 1  # Q on axis 2
+            if math.hypot(P0, P1) < wide:
+                status = 1  # Q on (or next to) axis 2
             rho3 = math.hypot(ap2, bp2)
             if rho3 <= 1e-12:
                 status = 1
@@ -183,7 +190,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
                 u0, u1 = c3 * C[3, 0, 3] - s3v * C[3, 1, 3], s3v * C[3, 0, 3] + c3 * C[3, 1, 3]
                 v0 = C[2, 0, 3] + C[2, 0, 0] * u0 + C[2, 0, 1] * u1 + C[2, 0, 2] * C[3, 2, 3]
                 v1 = C[2, 1, 3] + C[2, 1, 0] * u0 + C[2, 1, 1] * u1 + C[2, 1, 2] * C[3, 2, 3]
-                if math.hypot(v0, v1) < tiny:
+                if math.hypot(v0, v1) < wide:
                     status = 1
                 q2 = math.atan2(P1, P0) - math.atan2(v1, v0)
                 # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr

@@ -12,6 +12,7 @@ from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, character
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
 from ._ik_parallel import parallel_constants
+from ._ik_stanford import stanford_constants
 
 __all__ = ["IKMethods"]
 
@@ -108,8 +109,9 @@ class IKMethods:
 
     def analytic_ik(self, T) -> AnalyticIKResult:
         """Every closed-form solution of one pose: as :func:`denavit.analytic_ik` (same result), in machine code
-        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms) and of the UR class
-        (6R, axes 2, 3, 4 parallel and axes 5, 6 meeting: UR3/5/10 and their e-series).
+        for arms of the elbow + spherical-wrist class (Puma 560 and most industrial 6R arms), of the UR class
+        (6R, axes 2, 3, 4 parallel and axes 5, 6 meeting: UR3/5/10 and their e-series) and of the Stanford class
+        (R R P with axes 1, 2 meeting, spherical wrist).
 
         Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
         polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
@@ -143,7 +145,7 @@ class IKMethods:
 
     def _analytic_solver(self):
         """``[K, labels, kind, check, solve, first call]`` for the compiled closed form of this arm's IK plan
-        (``solve(T, K, f, i)``: the elbow or the UR-class kernel, by plan kind), or False where there is none
+        (``solve(T, K, f, i)``: the elbow, UR-class or Stanford-class kernel, by plan kind and route), or False where there is none
         (the plain solver answers)."""
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
@@ -151,6 +153,9 @@ class IKMethods:
         if plan.kind == "parallel":
             return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, self._m.ik_check,
                     self._m.ik_parallel_packed, True]
+        if plan.route == "closed form (stanford)":
+            return [stanford_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, self._m.ik_check,
+                    self._m.ik_stanford_packed, True]
         k = dict(plan.closed)
         lim = self.robot.q_limits
         k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types])

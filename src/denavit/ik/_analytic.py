@@ -110,7 +110,8 @@ def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
         from ._closed import FREE_TOL, RATIO_TOL
         from ._subproblems import AXES_ALIGNED_TOL
 
-        plan.closed.update(labels=_label_table((SHOULDER, ELBOW, WRIST)),
+        stanford = plan.route == "closed form (stanford)"  # joint 3 slides: no elbow part in its labels
+        plan.closed.update(labels=_label_table((SHOULDER, WRIST) if stanford else (SHOULDER, ELBOW, WRIST)),
                            theta=np.array([l.theta for l in robot.joints], float),
                            tols=np.array([FREE_TOL, RATIO_TOL, VERIFY_TOL, POLISH_ABOVE, DUPLICATE_TOL, MERGE_RADIUS,
                                           AXES_ALIGNED_TOL, _reach(robot)], float))

@@ -197,6 +197,8 @@ def _pieper(chain: Screws, rng, names, limits3, closed_form: bool = True,
     solve.closed = None
     if fast is not None and fast.kind == "elbow":
         solve.closed = elbow_constants(chain, fast, X_e, C0i, R4, R5, R6)
+    elif fast is not None:  # stanford: codegen._ik_stanford computes its geometry, analytic_ik's plan cache the rest
+        solve.closed = {}
     return solve, X_e, (f"closed form ({fast.kind})" if fast is not None else "resultant")
 
 

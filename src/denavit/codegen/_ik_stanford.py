@@ -1,0 +1,211 @@
+"""Analytic IK on the generated kernels: the Stanford class (joints R R P with axes 1, 2 meeting, spherical wrist).
+
+The same formulas as :class:`denavit.ik._closed.StanfordPosition` and ``wrist_angles`` (Spong, Hutchinson &
+Vidyasagar 2006, Sec. 5.3.3; Paden–Kahan subproblems 1 and 2): turning about axes 1 and 2 keeps ``|W − O|`` (W the
+wrist centre, O the point where axes 1 and 2 meet), a quadratic in the prismatic q3 whose discriminant is written as
+``(|D| − |u⊥|)(|D| + |u⊥|)``; the height along axis 1 gives q2 (``α cos q2 + β sin q2 = γ``); q1 turns the point onto
+W; the wrist angles follow from ``R_0_3ᵀ R R6ᵀ`` as for the elbow class.  The eight candidates of one pose are each
+verified by the arm's compiled FK, folded, merged and labelled (shoulder, wrist: docs/ik.md) by the UR-class
+module's ``_ik_finish``.
+
+Every case the plain solver treats specially goes back to it (``status`` 1): q3 next to its double root (the wrist
+centre at its nearest to O), a q2 or wrist root next to a double root, the wrist centre on or next to axis 1 or
+with its arm next to axis 2 (free or ill-conditioned joints; NEAR_SINGULAR of :mod:`._ik_parallel`), the wrist
+axes 4 and 6 (nearly) aligned, a candidate needing polish, two solutions about to merge.  The text below is
+appended to each generated numba module; it calls that module's ``fk_1``, ``_elbow_half_angle`` and ``_ik_finish``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..chain import chain_of
+from ..numeric import inverse_transform
+from ._ik_parallel import NEAR_SINGULAR
+
+__all__ = ["IK_STANFORD_SOURCE", "STANFORD_LAYOUT", "stanford_constants"]
+
+#: The constants of ``ik_stanford_packed``'s vector K, in order, with their sizes (180 numbers).
+STANFORD_LAYOUT = (("X_e", 3), ("C0i", 16), ("consts", 112), ("geom", 9), ("scalars", 8), ("lo", 6), ("hi", 6),
+                   ("revolute", 6), ("theta", 6), ("tols", 8))
+
+
+def stanford_constants(robot, plan) -> np.ndarray:
+    """K of ``ik_stanford_packed`` for ``robot`` and its Stanford-class Pieper plan (``plan.closed``: labels, theta
+    and tolerances, from :func:`denavit.ik.ik_plan`), from the arm's chain constants and the plan's wrist centre.
+
+    As StanfordPosition: P is the wrist centre in the frame of joint 3, O the point of axis 2 nearest to axis 1
+    (where they meet), u the wrist centre at q3 = 0 seen from O in the frame of joint 2, z the direction of joint 3
+    there, r the row z of C1's rotation, L the arm's size (the sum of |offsets| of its constants); (ρ_w, base_w,
+    β_r, β_u) the constants of the wrist's z-row equation ``rᵀ Rz(q5) u = M_zz`` (r = row z of C4, u = axis z of C5).
+    """
+    C = np.array(chain_of(robot).constants, dtype=float)  # (7, 4, 4)
+    F = C[0]
+    for k in range(1, 7):
+        F = F @ C[k]
+    X_e = np.asarray(plan.point_e, dtype=float)
+    P = (inverse_transform(C[0] @ C[1] @ C[2]) @ F @ np.append(X_e, 1.0))[:3]
+    p1, a = C[1][:3, 3], C[1][:3, 2]
+    s0 = -(p1[0] * a[0] + p1[1] * a[1]) / (a[0] ** 2 + a[1] ** 2)
+    R2, p2 = C[2][:3, :3], C[2][:3, 3]
+    u = p2 + R2 @ P - np.array([0.0, 0.0, s0])
+    z = R2[:, 2]
+    uz = float(u @ z)
+    r4, u5 = C[4][2, :3], C[5][:3, 2]
+    aw, bw = r4[0] * u5[0] + r4[1] * u5[1], r4[1] * u5[0] - r4[0] * u5[1]
+    L = max(float(np.sum(np.abs(C[:, :3, 3]))), 1e-3)
+    scalars = [uz, float(np.linalg.norm(u - uz * z)), L, np.hypot(aw, bw), np.arctan2(bw, aw),
+               np.arctan2(np.hypot(r4[0], r4[1]), r4[2]), np.arctan2(np.hypot(u5[0], u5[1]), u5[2]), NEAR_SINGULAR]
+    lim = robot.q_limits
+    k = dict(plan.closed, X_e=X_e, C0i=inverse_transform(C[0]), consts=C, geom=[*(p1 + s0 * a), *u, *z],
+             scalars=scalars, lo=lim[:, 0], hi=lim[:, 1],
+             revolute=[float(t.value == "revolute") for t in robot.joint_types])
+    K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in STANFORD_LAYOUT])
+    if K.size != sum(size for _, size in STANFORD_LAYOUT):
+        raise ValueError(f"Stanford IK constants: {K.size} numbers for the layout's "
+                         f"{sum(size for _, size in STANFORD_LAYOUT)}")
+    return K
+
+
+IK_STANFORD_SOURCE = '''
+
+@njit(cache=True, nogil=True)
+def ik_stanford_packed(T, K, f, i):
+    """All solutions of each pose T[b] of a Stanford-class arm, the constants in K (STANFORD_LAYOUT order); outputs
+    as ik_elbow_packed (label codes: 1 shoulder left, 2 wrist flip)."""
+    X_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
+    geom, sc, lo_lim, hi_lim = K[131:140], K[140:148], K[148:154], K[154:160]
+    rev, theta, tols = K[160:166], K[166:172], K[172:180]
+    ws = np.empty(131)
+    cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \\
+        ws[83:89]
+    flags = np.zeros(24, dtype=np.bool_)
+    for b in range(T.shape[0]):
+        for r in range(3):
+            X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
+        ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
+        kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
+                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:])
+        for s in range(kept):
+            i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
+        i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
+
+
+@njit(cache=True, nogil=True)
+def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
+    """The candidates of one pose in the plain plan's order (q3 root, q2 root, wrist root; + before -) into cand
+    (ws: 42 floats of scratch); returns (count, status)."""
+    uz, uperp, L, rho_w, base_w, br, bu, near = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
+    tol = tols[1]
+    wide = near * L
+    D, Y, cols, M = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:33].reshape((3, 3))
+    for r in range(3):  # wrist centre from O, in the frame of C0
+        D[r] = C0i[r, 0] * X[0] + C0i[r, 1] * X[1] + C0i[r, 2] * X[2] + C0i[r, 3] - geom[r]
+    for r in range(3):  # T_R C6_R^T
+        for j in range(3):
+            Y[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
+    status = 0
+    if math.hypot(D[0], D[1]) < wide or rho_w < 1e-12:
+        return 0, 1  # wrist centre on or next to axis 1: q1 free or ill-conditioned
+    nD = math.sqrt(D[0] * D[0] + D[1] * D[1] + D[2] * D[2])
+    disc = (nD - uperp) * (nD + uperp)
+    if disc < near * L * L:
+        status = 1  # q3 next to its double root (or none)
+    if disc < -1e-12 * L * L:
+        return 0, status
+    root = math.sqrt(max(disc, 0.0))
+    ncand = 0
+    for s3 in range(2):
+        q3 = -uz + root if s3 == 0 else -uz - root
+        w0, w1, w2 = geom[3] + q3 * geom[6], geom[4] + q3 * geom[7], geom[5] + q3 * geom[8]
+        if math.hypot(w0, w1) < wide:
+            status = 1  # the arm next to axis 2: q2 free or ill-conditioned
+        r0, r1, r2 = C[1, 2, 0], C[1, 2, 1], C[1, 2, 2]
+        A = r0 * w0 + r1 * w1
+        Bq = r1 * w0 - r0 * w1
+        rho = math.hypot(A, Bq)
+        if rho <= 1e-12:
+            status = 1
+            continue
+        ratio = (D[2] - r2 * w2) / rho
+        if abs(abs(ratio) - 1.0) < 1e-6:
+            status = 1  # next to a double root of q2
+        if abs(ratio) > 1.0 + tol:
+            continue
+        base2 = math.atan2(Bq, A)
+        delta = math.acos(min(1.0, max(-1.0, ratio)))
+        for s2 in range(2):
+            q2 = base2 + delta if s2 == 0 else base2 - delta
+            c2, s2v = math.cos(q2), math.sin(q2)
+            x, y = c2 * w0 - s2v * w1, s2v * w0 + c2 * w1  # Rz(q2) w
+            ex = C[1, 0, 0] * x + C[1, 0, 1] * y + C[1, 0, 2] * w2
+            ey = C[1, 1, 0] * x + C[1, 1, 1] * y + C[1, 1, 2] * w2
+            q1 = math.atan2(D[1], D[0]) - math.atan2(ey, ex)
+            # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 C3 (joint 3 slides): its columns, then M = R_0_3^T Y
+            _frame1(C, q1, cols)
+            _next_frame(cols, q2, C[2], cols)
+            _next_frame(cols, 0.0, C[3], cols)
+            for r in range(3):
+                for j in range(3):
+                    M[r, j] = cols[r, 0] * Y[0, j] + cols[r, 1] * Y[1, j] + cols[r, 2] * Y[2, j]
+            ncand, status = _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status)
+    return ncand, status
+
+
+@njit(cache=True, nogil=True)
+def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status):
+    """The two wrist solutions of Rz(q4) R4 Rz(q5) R5 Rz(q6) = M (as wrist_angles: q5 from the z-row in the
+    half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand."""
+    phi = math.atan2(math.hypot(M[0, 2], M[1, 2]), M[2, 2])
+    dm, smw = br - bu, br + bu
+    lo = math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w
+    hi = math.sin((smw + phi) / 2) * math.sin((smw - phi) / 2) / rho_w
+    if -2e-7 < min(lo, hi) < 1e-12:
+        status = 1  # the two wrist roots (nearly) coincide
+    xw = _elbow_half_angle(lo, hi, 1e-9)  # axis_angle_roots' default tolerance, as wrist_angles calls it
+    if xw != xw:
+        return ncand, status
+    for s5 in range(2):
+        qb = base_w + xw if s5 == 0 else base_w - xw
+        cb, sb = math.cos(qb), math.sin(qb)
+        ux, uy, uz = C[5, 0, 2], C[5, 1, 2], C[5, 2, 2]
+        rx, ry = cb * ux - sb * uy, sb * ux + cb * uy
+        v0 = C[4, 0, 0] * rx + C[4, 0, 1] * ry + C[4, 0, 2] * uz
+        v1 = C[4, 1, 0] * rx + C[4, 1, 1] * ry + C[4, 1, 2] * uz
+        if math.hypot(v0, v1) < near:
+            status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
+        qa = math.atan2(M[1, 2], M[0, 2]) - math.atan2(v1, v0)
+        ca, sa = math.cos(qa), math.sin(qa)
+        y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]
+        N0 = N1 = 0.0
+        for jj in range(2):  # (R4 Rz(qb) R5 e_j) . (Rz(qa)^T M e_x), j = x, y
+            ex, ey, ez = C[5, 0, jj], C[5, 1, jj], C[5, 2, jj]
+            rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
+            x0 = C[4, 0, 0] * rx + C[4, 0, 1] * ry + C[4, 0, 2] * ez
+            x1 = C[4, 1, 0] * rx + C[4, 1, 1] * ry + C[4, 1, 2] * ez
+            x2 = C[4, 2, 0] * rx + C[4, 2, 1] * ry + C[4, 2, 2] * ez
+            if jj == 0:
+                N0 = x0 * y0 + x1 * y1 + x2 * n2
+            else:
+                N1 = x0 * y0 + x1 * y1 + x2 * n2
+        cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
+        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, math.atan2(N1, N0)
+        ncand += 1
+    return ncand, status
+
+
+@njit(cache=True, nogil=True)
+def _stanford_label(qs, X, C, theta):
+    """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the wrist centre),
+    2 wrist flip (sin(q5 + theta5) < 0)."""
+    c1, s1 = math.cos(qs[0]), math.sin(qs[0])
+    s_right = 0.0
+    for r in range(3):
+        x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
+        x, y = c1 * x + s1 * y, c1 * y - s1 * x
+        s_right += (x * C[1, 0, 0] + y * C[1, 1, 0] + z * C[1, 2, 0]) * (X[r] - C[0, r, 3])
+    code = 1 if s_right < 0.0 else 0
+    if math.sin(qs[4] + theta[4]) < 0.0:
+        code |= 2
+    return code
+'''
