@@ -199,3 +199,20 @@ def test_a_full_turn_in_radians_draws_one_warning(tmp_path, monkeypatch):
     for argv in (["-q", "90, 45", "--deg"], ["-q", "6.28, -6.28"]):  # degrees said; or within a turn
         code, out, err = run_captured("fk", "free.yaml", *argv)
         assert code == 0 and err == "", err
+
+
+@pytest.mark.parametrize("deg", [False, True])
+def test_simulate_text_names_the_unit_of_its_q_columns(capsys, deg):
+    # the summary line said "(11 samples, The solver successfully reached the end of the integration interval.)"
+    # and not which unit the q columns were in
+    q0 = np.array([0.3, -0.2])
+    argv = ["simulate", "planar2r", "--q0", ", ".join(map(str, np.degrees(q0) if deg else q0)), "--duration", "0.1",
+            *(["--deg"] if deg else [])]
+    code, out, err = run(capsys, *argv)
+    assert code == 0 and err == ""
+    lines = out.splitlines()
+    assert f"(q in {'deg' if deg else 'rad'})" in lines[0] and "solver" not in lines[0]
+    first = [float(x) for x in lines[2].split()]  # t, q1, q2, energy at t = 0
+    np.testing.assert_allclose(first[1:3], np.degrees(q0) if deg else q0, atol=1e-5)
+    code, out, _ = run(capsys, *argv, "--json")
+    assert _strict(out)["success"] is True

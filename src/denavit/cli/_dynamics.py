@@ -186,7 +186,8 @@ def cmd_simulate(args: argparse.Namespace):
     head = "   t [s]  " + "  ".join(f"{'q' + str(k + 1):>10}" for k in range(robot.dof)) + "      energy [J]"
     rows = [f"{t:8.3f}  " + "  ".join(f"{v:10.5f}" for v in conv(q)) + f"  {e:14.6g}"
             for t, q, e in list(zip(res.t, res.q, res.energy))[::step]]
-    lines = [f"{robot.name}: simulated {duration:g} s ({len(res.t)} samples, {res.message})", head, *rows,
+    unit = ("deg" if args.deg else "rad") + (", m for prismatic joints" if not rev.all() else "")
+    lines = [f"{robot.name}: simulated {duration:g} s, {len(res.t)} samples (q in {unit})", head, *rows,
              f"energy drift (max |E - E0|): {drift:.3g} J" + ("" if args.no_friction else " (friction dissipates)")]
     if args.output:
         with output_file(args.output) as tmp:
