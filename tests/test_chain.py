@@ -235,3 +235,18 @@ def test_screw_walk_pieces_and_reverse_compose_to_the_whole(robot):
     np.testing.assert_allclose(pre @ np.linalg.inv(screws.consts[k]) @ post, T, atol=ATOL)
     back = screw_pose(reverse_screws(screws), -q[..., ::-1])
     np.testing.assert_allclose(back @ T, np.broadcast_to(np.eye(4), T.shape), atol=ATOL)
+
+
+@settings(max_examples=40)
+@given(robots())
+def test_screw_walk_in_floats_equals_the_batched_one(robot):
+    from denavit.chain import screw_walk, screw_walk_floats, screws_of
+
+    q = random_q(np.random.default_rng(robot.n_rows + 17), robot)
+    screws = screws_of(robot)
+    rows, axes = screw_walk_floats(screws, q.tolist())
+    x, y, z, p, zs, os = screw_walk(screws, q, axes=True)
+    np.testing.assert_allclose(np.array(rows), np.stack([x, y, z, p], axis=1), atol=1e-12)
+    for k, (z0, z1, z2, o0, o1, o2) in enumerate(axes):
+        np.testing.assert_allclose([z0, z1, z2], zs[k], atol=1e-12)
+        np.testing.assert_allclose([o0, o1, o2], os[k], atol=1e-12)

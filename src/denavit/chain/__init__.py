@@ -15,7 +15,8 @@ chains derived from the arm's, reversed or with joints merged).
 """
 
 from ._chain import Chain, Row, chain_of, cos_sin, dh_transform, joint_motion
-from ._screws import STRUCTURAL_ZERO, Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screws_of
+from ._screws import (STRUCTURAL_ZERO, Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screw_walk_floats,
+                      screws_of)
 from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
 
@@ -49,6 +50,7 @@ __all__ = [
     "screws_of",
     "reverse_screws",
     "screw_walk",
+    "screw_walk_floats",
     "screw_pose",
     "screw_axes",
     "STRUCTURAL_ZERO",

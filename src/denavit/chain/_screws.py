@@ -13,12 +13,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from math import cos, sin
 
 import numpy as np
 
 from ._chain import chain_of
 
-__all__ = ["Screws", "screws_of", "reverse_screws", "screw_walk", "screw_pose", "screw_axes", "STRUCTURAL_ZERO"]
+__all__ = ["Screws", "screws_of", "reverse_screws", "screw_walk", "screw_walk_floats", "screw_pose", "screw_axes", "STRUCTURAL_ZERO"]
 
 #: Constant entries at or below this are structural zeros and skipped (cos 90° = 6e-17 in a product).
 STRUCTURAL_ZERO = 1e-15
@@ -35,6 +36,15 @@ class Screws:
     def n(self) -> int:
         """Number of joints m."""
         return len(self.prismatic)
+
+    @cached_property
+    def floats(self) -> tuple:
+        """(start, consts, prismatic) in Python floats for :func:`screw_walk_floats`: C_0's rows [R | p] as three
+        4-tuples, each C_k (k ≥ 1) as the 12 numbers (C00, C10, C20, C01, …, C23), the mask as bools."""
+        C0 = self.consts[0]
+        start = tuple(tuple(float(v) for v in C0[i, :4]) for i in range(3))
+        consts = tuple(tuple(float(C[m, j]) for j in range(4) for m in range(3)) for C in self.consts[1:])
+        return start, consts, tuple(bool(v) for v in self.prismatic)
 
     @cached_property
     def terms(self) -> tuple:
@@ -120,3 +130,34 @@ def screw_axes(screws: Screws, q) -> tuple[np.ndarray, np.ndarray]:
     if not zs:
         return np.zeros(shape + (0, 3)), np.zeros(shape + (0, 3))
     return np.moveaxis(np.stack(os, axis=-1), 0, -1), np.moveaxis(np.stack(zs, axis=-1), 0, -1)
+
+
+def screw_walk_floats(screws: Screws, q) -> tuple[tuple, list]:
+    """:func:`screw_walk` for one configuration in Python floats (no numpy call per step: for one pose numpy's
+    call overhead is most of the cost).
+
+    Returns the pose as its three rows ((x_0, y_0, z_0, p_0), (x_1, …), (x_2, …)) and, per joint, its axis
+    direction and a point on it as (z_0, z_1, z_2, o_0, o_1, o_2).  Joint k acts on columns x, y (revolute) or
+    on p (prismatic), then the constant C_k multiplies from the right.
+    """
+    rows, consts, prismatic = screws.floats
+    axes = []
+    for k in range(len(prismatic)):
+        (x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2) = rows
+        axes.append((z0, z1, z2, p0, p1, p2))
+        if prismatic[k]:
+            qk = q[k]
+            p0, p1, p2 = p0 + qk * z0, p1 + qk * z1, p2 + qk * z2
+        else:
+            c, s = cos(q[k]), sin(q[k])
+            x0, y0 = c * x0 + s * y0, c * y0 - s * x0
+            x1, y1 = c * x1 + s * y1, c * y1 - s * x1
+            x2, y2 = c * x2 + s * y2, c * y2 - s * x2
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, d0, d1, d2 = consts[k]
+        rows = ((x0 * a0 + y0 * a1 + z0 * a2, x0 * b0 + y0 * b1 + z0 * b2, x0 * c0 + y0 * c1 + z0 * c2,
+                 p0 + x0 * d0 + y0 * d1 + z0 * d2),
+                (x1 * a0 + y1 * a1 + z1 * a2, x1 * b0 + y1 * b1 + z1 * b2, x1 * c0 + y1 * c1 + z1 * c2,
+                 p1 + x1 * d0 + y1 * d1 + z1 * d2),
+                (x2 * a0 + y2 * a1 + z2 * a2, x2 * b0 + y2 * b1 + z2 * b2, x2 * c0 + y2 * c1 + z2 * c2,
+                 p2 + x2 * d0 + y2 * d1 + z2 * d2))
+    return rows, axes

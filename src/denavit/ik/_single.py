@@ -21,11 +21,11 @@ solution within the limits, so the quality of the result is that of the batched 
 
 from __future__ import annotations
 
-from math import acos, cos, pi, sin, sqrt
+from math import acos, pi, sin, sqrt
 
 import numpy as np
 
-from ..chain import chain_of
+from ..chain import chain_of, screw_walk_floats, screws_of
 from ..model import DHRobot
 from ..numeric import forward_kinematics
 from ._residual import LAMBDA0, LAMBDA_MAX, IKResult, rotation_log
@@ -40,43 +40,16 @@ def _wrap(x: float) -> float:
 
 
 class SingleChain:
-    """Float data of one arm's chain (build with :func:`single_chain`, cached per robot)."""
+    """One arm's residual and Jacobian in floats (build with :func:`single_chain`, cached per robot)."""
 
     def __init__(self, robot: DHRobot) -> None:
-        chain = chain_of(robot)
-        self.n = chain.dof
-        self.prismatic = chain.prismatic
-        C0 = chain.constants[0]
-        self.start = tuple(tuple(float(v) for v in C0[i, :4]) for i in range(3))  # rows of [R | p]
-        # C_k as the 12 numbers (C00, C10, C20, C01, …, C23): column j of R·C_k is Σ_m R[:, m] C_k[m, j]
-        self.consts = tuple(tuple(float(C[m, j]) for j in range(4) for m in range(3)) for C in chain.constants[1:])
+        self.screws = screws_of(robot)
+        self.n = self.screws.n
+        self.prismatic = self.screws.floats[2]
 
     def residual(self, q, Rt, pt, w):
-        """Weighted residual e (6 floats) and weighted Jacobian columns (n lists of 6 floats) at q.
-
-        The pose is kept as its three rows (x_i, y_i, z_i, p_i); joint k acts on columns x, y (revolute) or
-        on p (prismatic), then the constant C_k multiplies from the right.
-        """
-        rows = self.start
-        axes = []
-        for k in range(self.n):
-            (x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2) = rows
-            axes.append((z0, z1, z2, p0, p1, p2))
-            if self.prismatic[k]:
-                qk = q[k]
-                p0, p1, p2 = p0 + qk * z0, p1 + qk * z1, p2 + qk * z2
-            else:
-                c, s = cos(q[k]), sin(q[k])
-                x0, y0 = c * x0 + s * y0, c * y0 - s * x0
-                x1, y1 = c * x1 + s * y1, c * y1 - s * x1
-                x2, y2 = c * x2 + s * y2, c * y2 - s * x2
-            a0, a1, a2, b0, b1, b2, c0, c1, c2, d0, d1, d2 = self.consts[k]
-            rows = ((x0 * a0 + y0 * a1 + z0 * a2, x0 * b0 + y0 * b1 + z0 * b2, x0 * c0 + y0 * c1 + z0 * c2,
-                     p0 + x0 * d0 + y0 * d1 + z0 * d2),
-                    (x1 * a0 + y1 * a1 + z1 * a2, x1 * b0 + y1 * b1 + z1 * b2, x1 * c0 + y1 * c1 + z1 * c2,
-                     p1 + x1 * d0 + y1 * d1 + z1 * d2),
-                    (x2 * a0 + y2 * a1 + z2 * a2, x2 * b0 + y2 * b1 + z2 * b2, x2 * c0 + y2 * c1 + z2 * c2,
-                     p2 + x2 * d0 + y2 * d1 + z2 * d2))
+        """Weighted residual e (6 floats) and weighted Jacobian columns (n lists of 6 floats) at q."""
+        rows, axes = screw_walk_floats(self.screws, q)
         # M = R_t Rᵀ: M[i][j] = Σ_m Rt[i][m] R[j][m]
         pe = (rows[0][3], rows[1][3], rows[2][3])
         M = [[Rt[i][0] * R[0] + Rt[i][1] * R[1] + Rt[i][2] * R[2] for R in rows] for i in range(3)]
