@@ -216,3 +216,13 @@ def test_simulate_text_names_the_unit_of_its_q_columns(capsys, deg):
     np.testing.assert_allclose(first[1:3], np.degrees(q0) if deg else q0, atol=1e-5)
     code, out, _ = run(capsys, *argv, "--json")
     assert _strict(out)["success"] is True
+
+
+def test_compile_reports_its_stages_on_stderr_only_without_json(capsys, tmp_path, monkeypatch):
+    # a first numba compile takes 5 s and more, and printed nothing until it was done
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path))
+    code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy")
+    assert code == 0 and "generating the kernels" in err and "compiling and timing" in err
+    assert "compiling and timing" not in out and out.startswith("planar2r: 2 joints, backend numpy")
+    code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy", "--json")
+    assert code == 0 and err == "" and _strict(out)["backend"] == "numpy"

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import ParseError
-from ._common import add_common, load, output_file
+from ._common import add_common, load, output_file, stage_printer
 
 __all__ = ["register"]
 
@@ -32,8 +32,11 @@ def cmd_compile(args: argparse.Namespace):
     from ..codegen import cache_dir, compile
 
     robot = load(args)
+    show = stage_printer(args, "compile") or (lambda stage: None)
     t0 = time.perf_counter()
+    show("generating the kernels (from the cache when this arm was compiled before)")
     fast = compile(robot, backend=args.backend)
+    show(f"compiling and timing {len(fast.kernels)} kernels ({fast.backend})")
     timings = fast.warm()
     total = time.perf_counter() - t0
     lines = [f"{robot.name}: {robot.dof} joints, backend {fast.backend}, {len(fast.kernels)} kernels in "
