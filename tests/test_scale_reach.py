@@ -130,3 +130,15 @@ def test_save(tmp_path):
     rmap.save(tmp_path / "r.npz")
     with np.load(tmp_path / "r.npz", allow_pickle=False) as z:
         assert np.array_equal(z["fraction"], rmap.fraction) and z["orientations"].shape == (3, 3, 3)
+
+
+def test_progress_covers_the_screen_and_the_map(capsys, monkeypatch):
+    """The position screen (seconds on a fine grid) drew no progress line; counts read 49,531, not 4.95e+04."""
+    monkeypatch.setattr("denavit.scale._reach.SCREEN_SAMPLES", 2**17)
+    rmap = reachability(denavit.load_robot("ur5"), 0.2, 2, scheduler="synchronous", progress=True)
+    lines = capsys.readouterr().err.replace("\r", "\n").split("\n")
+    screen = [ln for ln in lines if "samples" in ln]
+    voxels = [ln for ln in lines if "voxels" in ln]
+    assert screen and f"{2**17:,}/{2**17:,} samples" in screen[-1]
+    assert voxels and f"{rmap.voxels:,}/{rmap.voxels:,} voxels" in voxels[-1] and rmap.voxels >= 1000
+    assert lines.index(screen[-1]) < lines.index(voxels[0])  # the screen first, then the map

@@ -142,7 +142,7 @@ def _numeric_task(robot, grid, cells, rot, seed):
     return cells, reached.mean(axis=-1), _mean_reached(best, reached)
 
 
-def _near_samples(robot, grid: Grid, seed: int, scheduler, workers) -> np.ndarray:
+def _near_samples(robot, grid: Grid, seed: int, scheduler, workers, progress=False) -> np.ndarray:
     """Cells of ``grid`` within SCREEN_MARGIN cells of a position sample (boolean, grid.shape)."""
     from ._occupancy import occupancy
     from ._volume import interior
@@ -151,7 +151,8 @@ def _near_samples(robot, grid: Grid, seed: int, scheduler, workers) -> np.ndarra
     if grid.side <= MIN_CELLS:  # too coarse a grid to screen: test every cell
         return everything
     try:
-        occ = occupancy(robot, SCREEN_SAMPLES, grid.resolution, seed, scheduler=scheduler, workers=workers)
+        occ = occupancy(robot, SCREEN_SAMPLES, grid.resolution, seed, scheduler=scheduler, workers=workers,
+                        progress=progress)
     except ModelError:  # a grid finer than occupancy's MAX_CELLS: test every cell
         return everything
     if occ.planar or occ.grid.side != grid.side or not np.allclose(occ.grid.centre, grid.centre):
@@ -237,7 +238,7 @@ def reachability(robot: DHRobot, resolution: float = 0.05, orientations: int = D
         raise ModelError(f"resolution {h:g} m and {k} orientations make about {ball * k:.3g} IK problems "
                          f"(at most {limit:.3g} with {method} IK): use a coarser resolution or fewer orientations")
     with session(scheduler, workers) as where:  # one cluster for the screen and the map
-        near = _near_samples(robot, grid, seed, where, workers) if screen else None
+        near = _near_samples(robot, grid, seed, where, workers, progress) if screen else None
         cells, frac, manip, rot = _map(robot, grid, centre, R, near, k, method, seed, where, workers, progress)
     return ReachabilityMap(grid, frac, manip, rot, method, len(cells))
 

@@ -229,7 +229,7 @@ class Progress:
             rate = self.done / dt
             eta = (self.total - self.done) / rate if rate > 0 else float("inf")
             pct = 100.0 * self.done / max(self.total, 1)
-            sys.stderr.write(f"\r{pct:5.1f}%  {self.done:.3g}/{self.total:.3g} {self.unit}  "
+            sys.stderr.write(f"\r{pct:5.1f}%  {_count(self.done)}/{_count(self.total)} {self.unit}  "
                              f"{rate:.3g} {self.unit}/s  ETA {_clock(eta)}   ")
             sys.stderr.flush()
 
@@ -237,6 +237,11 @@ class Progress:
         if self.enabled:
             sys.stderr.write("\n")
             sys.stderr.flush()
+
+
+def _count(n: int) -> str:
+    """A count as people read it: 49,531 below a million, 2.5e+08 above."""
+    return f"{n:,}" if n < 10**6 else f"{n:.3g}"
 
 
 def _clock(seconds: float) -> str:
