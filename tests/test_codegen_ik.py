@@ -53,7 +53,8 @@ def _ur(name: str, d1: float, a2: float, a3: float, d4: float, d5: float, d6: fl
 
 ARMS = {"ur5": lambda: denavit.load_robot("ur5"),
         "ur10": lambda: _ur("ur10", 0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922),
-        "ur3e": lambda: _ur("ur3e", 0.15185, -0.24355, -0.2132, 0.13105, 0.08535, 0.0921)}
+        "ur3e": lambda: _ur("ur3e", 0.15185, -0.24355, -0.2132, 0.13105, 0.08535, 0.0921),
+        "stanford": lambda: denavit.load_robot("stanford")}
 
 
 @pytest.fixture(scope="module", params=sorted(ARMS))
@@ -136,6 +137,30 @@ def _elbow(robot, q):
     return np.cross(o[2] - o[1], o[3] - o[1]) @ z[1]
 
 
+def _wrist_coplanar(robot, q):
+    """Triple product of axes 4, 5, 6: zero where they lie in one plane (axes 4 and 6 aligned among those)."""
+    z, _ = _axes(robot, q)
+    return np.cross(z[3], z[4]) @ z[5]
+
+
+def _stanford_reach(robot, q):
+    """(W - O) . z3, W the wrist centre (axes 4, 5), O the point of axes 1 and 2: zero where |W - O| is least
+    along the prismatic joint 3 (its two roots meet)."""
+    z, o = _axes(robot, q)
+    return (_meet(z, o, 3, 4) - _meet(z, o, 0, 1)) @ z[2]
+
+
+def _stanford_height(robot, q):
+    """(W - O) . (z1 x z2): zero where the wrist centre lies in the plane of axes 1 and 2 (the two q2 meet)."""
+    z, o = _axes(robot, q)
+    n = np.cross(z[0], z[1])
+    return (_meet(z, o, 3, 4) - _meet(z, o, 0, 1)) @ n / max(np.linalg.norm(n), 1e-300)
+
+
+UR_SINGULAR = ((_shoulder, 1), (_elbow, 2), (_wrist_coplanar, 4))  # for UR arms axes 4, 5, 6 coplanar = axis 6 ∥ 4
+STANFORD_SINGULAR = ((_stanford_reach, 2), (_stanford_height, 1), (_wrist_coplanar, 4))
+
+
 def _root(fun, robot, q, k, rng):
     """q with joint k moved onto a sign change of fun (bisection to 1e-15), or None when there is none."""
     grid = q[k] + np.linspace(-np.pi, np.pi, 25)
@@ -163,14 +188,16 @@ def _root(fun, robot, q, k, rng):
     return qq
 
 
-def _singular_set(robot, rng, count: int, wrist: bool) -> np.ndarray:
-    """Configurations on the shoulder and elbow singularities (and the wrist one for UR arms: q5 = 0, pi),
-    each also moved off by 1e-9 .. 1e-2 rad (where the solver's thresholds lie)."""
+def _singular_set(robot, rng, count: int, funs, wrist: bool = False) -> np.ndarray:
+    """Configurations on the singular sets where each of ``funs`` ((function, joint moved)) vanishes (and, for UR
+    arms, the wrist singularity q5 = 0, pi), each also moved off by 1e-9 .. 1e-2 (where the solver's thresholds
+    lie), and rounded to one decimal; returns them and how many lie on a singular set."""
     lim = np.clip(robot.q_limits, -np.pi, np.pi)
     out = []
     for m in range(count):
         q = rng.uniform(lim[:, 0], lim[:, 1])
-        found = _root(_shoulder, robot, q, 1, rng) if m % 2 == 0 else _root(_elbow, robot, q, 2, rng)
+        fun, k = funs[m % len(funs)]
+        found = _root(fun, robot, q, k, rng)
         if found is not None:
             out.append(found)
     if wrist:
@@ -183,7 +210,12 @@ def _singular_set(robot, rng, count: int, wrist: bool) -> np.ndarray:
     return np.concatenate([base, *moved, np.round(base, 1)]), len(base)
 
 
-def _check_arm(robot, fast, rng, n_poses, n_singular, wrist):
+#: the singular sets of each catalogue arm (functions, joint moved) and whether to add q5 = 0, pi (UR wrist)
+SINGULAR = {"ur5": (UR_SINGULAR, True), "ur10": (UR_SINGULAR, True), "ur3e": (UR_SINGULAR, True),
+            "stanford": (STANFORD_SINGULAR, False)}
+
+
+def _check_arm(robot, fast, rng, n_poses, n_singular, funs, wrist=False):
     lim = np.clip(robot.q_limits, -2 * np.pi, 2 * np.pi)
     Q = rng.uniform(lim[:, 0], lim[:, 1], (n_poses, robot.dof))
     with _handovers() as calls:
@@ -193,7 +225,7 @@ def _check_arm(robot, fast, rng, n_poses, n_singular, wrist):
             _same(robot, T, res, denavit.analytic_ik(robot, T))
             assert res.count >= 1  # q itself is a solution, inside the limits
         assert len(calls) <= 0.1 * n_poses  # the compiled kernel answers the regular poses itself
-        singular, exact = _singular_set(robot, rng, n_singular, wrist)
+        singular, exact = _singular_set(robot, rng, n_singular, funs, wrist)
         for q in singular:
             T = denavit.forward_kinematics(robot, q)
             _same(robot, T, fast.analytic_ik(T), denavit.analytic_ik(robot, T))
@@ -204,17 +236,18 @@ def _check_arm(robot, fast, rng, n_poses, n_singular, wrist):
 
 
 @pytest.mark.slow
-def test_ur_arms_compiled_equals_plain(arm):
-    """UR5, UR10, UR3e: every solution, label and outside-limits solution of the plain solver, random and singular
-    poses; batches and unreachable poses too."""
+def test_catalogue_arms_compiled_equals_plain(arm):
+    """UR5, UR10, UR3e, Stanford: every solution, label and outside-limits solution of the plain solver, random and
+    singular poses; batches and unreachable poses too."""
     robot, fast = arm
-    assert ik_plan(robot).kind == "parallel"
+    plan = ik_plan(robot)
+    assert plan.closed is not None and (plan.kind == "parallel" or plan.route == "closed form (stanford)")
     rng = np.random.default_rng(sum(robot.name.encode()))
-    _check_arm(robot, fast, rng, N_POSES, 6 if REDUCED else 16, True)
+    _check_arm(robot, fast, rng, N_POSES, 6 if REDUCED else 16, *SINGULAR[robot.name])
     far = np.eye(4)
     far[:3, 3] = (9.0, 0.0, 0.0)
     assert fast.analytic_ik(far).count == 0 and denavit.analytic_ik(robot, far).count == 0
-    batch = denavit.forward_kinematics(robot, rng.uniform(-3, 3, (4, 6)))
+    batch = denavit.forward_kinematics(robot, rng.uniform(robot.q_limits[:, 0], robot.q_limits[:, 1], (4, 6)))
     a, b = fast.analytic_ik(batch), denavit.analytic_ik(robot, batch)  # a batch: the plain path
     np.testing.assert_array_equal(np.isnan(a.solutions), np.isnan(b.solutions))
     np.testing.assert_allclose(a.solutions, b.solutions, atol=1e-12)
@@ -259,4 +292,53 @@ def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
     plan = ik_plan(robot)
     assert plan.kind == "parallel" and plan.closed is not None
     fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
-    _check_arm(robot, fast, np.random.default_rng(seed), N_POSES // 2, 4 if REDUCED else 10, False)
+    _check_arm(robot, fast, np.random.default_rng(seed), N_POSES // 2, 6 if REDUCED else 12, UR_SINGULAR)
+
+
+def _random_stanford_class(seed: int) -> DHRobot:
+    """A random R R P arm with axes 1, 2 meeting and a spherical wrist (either convention): random offsets, twists
+    (half of the wrists with equal outer twists, so that axes 4 and 6 can align), limits, base and tool."""
+    rng = np.random.default_rng(seed)
+    conv = Convention.MODIFIED if rng.random() < 0.5 else Convention.STANDARD
+
+    def twist():
+        return float(rng.choice([-1.0, 1.0]) * rng.uniform(0.3, np.pi - 0.3))
+
+    def length():
+        return float(rng.choice([0.0, rng.uniform(-0.6, 0.6)]))
+
+    t4 = twist()
+    t5 = -t4 if rng.random() < 0.5 else twist()
+    if conv is Convention.STANDARD:  # (a, alpha, d) of z_{i-1} -> z_i; axes 1, 2 = z0, z1; wrist z3, z4, z5 at o4
+        rows = [(0.0, twist(), length()), (length(), twist(), length()), (length(), twist(), 0.0),
+                (0.0, t4, length()), (0.0, t5, 0.0), (length(), twist(), length())]
+    else:  # (a_{i-1}, alpha_{i-1}, d_i); axes 1, 2 = z1, z2; wrist z4, z5, z6 at o4 = o5
+        rows = [(length(), twist(), length()), (0.0, twist(), length()), (length(), twist(), 0.0),
+                (length(), twist(), length()), (0.0, t4, 0.0), (0.0, t5, length())]
+    links = []
+    for k, (a, alpha, d) in enumerate(rows):
+        if k == 2:  # the prismatic joint: its travel
+            lo = float(rng.uniform(-0.5, 0.5))
+            links.append(DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)), joint="prismatic",
+                                q_limits=(lo, lo + float(rng.uniform(0.3, 1.5)))))
+            continue
+        lo = float(rng.choice([-2 * np.pi, rng.uniform(-np.pi, 0.0)]))
+        links.append(DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)),
+                            q_limits=(lo, lo + float(rng.uniform(np.pi, 4 * np.pi)))))
+    base, tool = np.eye(4), np.eye(4)
+    if rng.random() < 0.7:
+        base = transform_from_xyz_rpy(rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3))
+        tool = transform_from_xyz_rpy(rng.uniform(-0.3, 0.3, 3), rng.uniform(-np.pi, np.pi, 3))
+    return DHRobot(name="random-stanford", links=tuple(links), convention=conv, base=base, tool=tool)
+
+
+@pytest.mark.slow
+@settings(max_examples=2 if REDUCED else 5)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_random_stanford_class_arms_compiled_equals_plain(seed, _kernel_cache):
+    """Random Stanford-class arms (both conventions, offsets, limits, base and tool) x random and singular poses."""
+    robot = _random_stanford_class(seed)
+    plan = ik_plan(robot)
+    assert plan.route == "closed form (stanford)" and plan.closed is not None
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    _check_arm(robot, fast, np.random.default_rng(seed), N_POSES // 2, 6 if REDUCED else 12, STANFORD_SINGULAR)
