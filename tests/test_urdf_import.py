@@ -279,3 +279,27 @@ def test_arms_of_any_size_import_exactly_or_are_refused_cleanly(seed, exponent):
         return
     size = max(1.0, factor)
     assert result.position_error < 1e-9 * size and result.rotation_error < 1e-9
+
+
+def test_small_arm_file_shows_the_urdf_decimals(tmp_path):
+    """The flange 0.05 m beyond the wrist and the wrist's centre of mass 0.03 m behind the flange (0.02 from the
+    wrist link's origin, by hand) came out 0.050000000000000044 and -0.030000000000000027 in the written file."""
+    robot = import_urdf(SMALL_ARM).robot
+    assert robot.links[3].d == 0.05 and robot.links[3].inertia.com == (0.0, 0.0, -0.03)
+    assert robot.links[2].inertia.com == (0.0, 0.0, -0.1)
+    denavit.save_robot(robot, tmp_path / "arm.yaml")
+    text = (tmp_path / "arm.yaml").read_text()
+    assert "0000000" not in text and "9999999" not in text
+
+
+@settings(max_examples=200 if REDUCED else 1000, deadline=None)
+@given(st.integers(-10**9, 10**9), st.integers(0, 12), st.integers(-8, 8),
+       st.floats(-1e6, 1e6, allow_nan=False, allow_subnormal=False))
+def test_tidy_snaps_noise_only(mantissa, exponent, ulps, x):
+    from denavit.interop._urdf_in import TIDY_ULPS, tidy
+
+    decimal = mantissa / 10**exponent  # a short decimal (at most 10 significant digits)
+    assert tidy(decimal + ulps * np.spacing(abs(decimal))) == decimal
+    assert tidy(ulps * np.spacing(1.0), 1.0) == 0.0  # noise around zero, at the scale of the quantity
+    assert abs(tidy(x) - x) <= TIDY_ULPS * np.spacing(abs(x))  # any value moves by a few ulps at most
+    assert abs(tidy(x, 1.0) - x) <= TIDY_ULPS * np.spacing(max(abs(x), 1.0))

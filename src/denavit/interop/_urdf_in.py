@@ -19,7 +19,8 @@ from ._export import combine_inertia
 from ._urdf_axes import FAR_FOOT, dh_geometry
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
 
-__all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "CHECK_SAMPLES", "CHECK_TOL"]
+__all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "tidy", "CHECK_SAMPLES", "CHECK_TOL",
+           "TIDY_DIGITS", "TIDY_ULPS"]
 
 #: Random configurations of the import's FK self-check.
 CHECK_SAMPLES = 200
@@ -57,6 +58,24 @@ class UrdfImport:
     rotation_error: float
     notes: tuple[str, ...]
     samples: int = CHECK_SAMPLES
+
+
+#: Lengths, masses, centres of mass and inertias the import computes (sums, projections) carry rounding noise
+#: (0.05 came out 0.050000000000000044, which a written robot file shows): a value within TIDY_ULPS units in the
+#: last place of a decimal of TIDY_DIGITS significant digits is taken as that decimal, and one within TIDY_ULPS
+#: units in the last place of the quantity's scale (the chain's size; a body's largest inertia) as 0.
+TIDY_DIGITS = 12
+TIDY_ULPS = 16
+
+
+def tidy(x: float, scale: float = 0.0) -> float:
+    """``x``, or the decimal of :data:`TIDY_DIGITS` significant digits within :data:`TIDY_ULPS` ulps of it, or 0
+    when ``|x|`` is within TIDY_ULPS ulps of ``scale``."""
+    x = float(x)
+    if abs(x) <= TIDY_ULPS * np.spacing(float(scale)):
+        return 0.0
+    short = float(f"{x:.{TIDY_DIGITS}g}")
+    return short if abs(short - x) <= TIDY_ULPS * np.spacing(abs(x)) else x
 
 
 def urdf_chain_fk(path: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
@@ -117,7 +136,7 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
     theta, d, a, alpha, cases, F0, approximated = dh_geometry(P, Z, T, scale)
     robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
-    robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base)
+    robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base, scale)
     pos, rot = _self_check(robot, path, rng)
     if pos > CHECK_TOL * scale or rot > CHECK_TOL:
         warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
@@ -192,7 +211,7 @@ def _robot_rows(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], the
         ak, alk = (a[k], alpha[k]) if conv is Convention.STANDARD else ((a[k - 1], alpha[k - 1]) if k else (0.0, 0.0))
         kind = JointType.PRISMATIC if j.kind == "prismatic" else JointType.REVOLUTE
         limits = j.limits if j.limits is None or j.limits[0] < j.limits[1] else None  # [0, 0]: no range given
-        links.append(DHLink(a=ak, alpha=alk, d=d[k], theta=theta[k], joint=kind, q_limits=limits))
+        links.append(DHLink(a=tidy(ak), alpha=alk, d=tidy(d[k]), theta=theta[k], joint=kind, q_limits=limits))
     names = ", ".join(j.name for j in moving)
     robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=F0,
                     description=f"imported from URDF; rows are the joints {names}"[:2000])
@@ -203,8 +222,9 @@ def _robot_rows(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], the
 
 
 def _with_inertia(robot: DHRobot, model: UrdfModel, path: list[UrdfJoint], link_pose: dict, link_body: dict,
-                  base: str) -> tuple[DHRobot, tuple[str, ...]]:
-    """Each body's links (and rigid branches hanging from them, locked at 0) as one inertia in its DH frame."""
+                  base: str, scale: float) -> tuple[DHRobot, tuple[str, ...]]:
+    """Each body's links (and rigid branches hanging from them, locked at 0) as one inertia in its DH frame
+    (``scale``: the chain's size [m], for :func:`tidy`)."""
     n = robot.dof
     notes: list[str] = []
     frames = link_transforms(robot, np.zeros(n))  # (n+1, 4, 4) frames {0} … {n} at q = 0, base link axes
@@ -240,7 +260,9 @@ def _with_inertia(robot: DHRobot, model: UrdfModel, path: list[UrdfJoint], link_
     for k in range(n):
         m, c, I = combine_inertia(pieces[k]) if pieces[k] else (0.0, np.zeros(3), np.zeros((3, 3)))
         try:
-            li = LinkInertia(mass=m, com=tuple(c), inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
+            i6 = (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])
+            li = LinkInertia(mass=tidy(m), com=tuple(tidy(v, scale) for v in c),
+                             inertia=tuple(tidy(v, float(np.abs(I).max())) for v in i6),
                              viscous=moving[k].damping, coulomb=moving[k].friction)
         except ModelError as exc:
             raise model.error(f"the links moved by joint {moving[k].name[:40]!r}: {exc}") from None
