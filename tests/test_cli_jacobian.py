@@ -4,6 +4,9 @@ import json
 
 import numpy as np
 import pytest
+from conftest import REDUCED, robots
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from denavit import forward_kinematics, load_robot
 from denavit import numeric as N
@@ -210,3 +213,116 @@ def test_symbolic_velocity_and_statics_defaults_and_refusals(capsys):
     assert "--qd" in run_error(capsys, "velocity", "planar2r", "-q", "0, 1")
     assert "--wrench" in run_error(capsys, "statics", "planar2r", "-q", "0, 1")
     assert "--steps" in run_error(capsys, "statics", "planar2r", "--symbolic", "--steps")
+
+
+# --- jacobian --frame i: the Jacobian in the axes of DH frame {i} --------------------------------------------------
+
+
+def _fd_J0(robot, q, h=1e-6):
+    """J0 by central differences of FK (world axes, end-effector origin): no Jacobian code involved."""
+    from denavit import forward_kinematics
+
+    R = forward_kinematics(robot, q)[:3, :3]
+    cols = []
+    for k in range(robot.dof):
+        e = np.eye(robot.dof)[k] * h
+        dT = (forward_kinematics(robot, q + e) - forward_kinematics(robot, q - e)) / (2 * h)
+        W = dT[:3, :3] @ R.T
+        cols.append(np.concatenate([dT[:3, 3], [W[2, 1], W[0, 2], W[1, 0]]]))
+    return np.array(cols).T
+
+
+def _in_frame(robot, q, J0, i):
+    """ⁱJ from J0: both blocks rotated by R_0_iᵀ, R_0_i the world orientation of DH frame i (FK's frames)."""
+    from denavit import link_transforms
+
+    R = link_transforms(robot, q)[i][:3, :3]
+    return np.vstack([R.T @ J0[:3], R.T @ J0[3:]])
+
+
+@settings(max_examples=6 if REDUCED else 25)
+@given(robot=robots(), seed=st.integers(0, 2**32 - 1), method=st.sampled_from(["geometric", "differentiation",
+                                                                                "propagation"]))
+def test_jacobian_frame_i_is_finite_difference_J0_rotated_into_frame_i(tmp_path_factory, robot, seed, method):
+    from _hostile import run_cli
+
+    from denavit import dump_robot
+
+    rng = np.random.default_rng(seed)
+    folder = tmp_path_factory.mktemp("frame")
+    (folder / "arm.json").write_text(dump_robot(robot, "json"))
+    arm = load_robot(str(folder / "arm.json"))
+    q = rng.uniform(-np.pi, np.pi, arm.dof)
+    i = int(rng.integers(0, arm.n_rows + 1))
+    o = run_cli(["jacobian", "arm.json", "-q", ", ".join(repr(float(x)) for x in q), "--frame", str(i), "--method",
+                 method, "--json"], folder)
+    assert o.code == 0, o.describe()
+    data = json.loads(o.out)
+    assert data["frame"] == i and data["method"] == method
+    np.testing.assert_allclose(np.array(data["J"]), _in_frame(arm, q, _fd_J0(arm, q), i), atol=1e-6)
+    np.testing.assert_allclose(N.geometric_jacobian(arm, q, frame=i), np.array(data["J"]), atol=1e-6)
+
+
+def test_jacobian_frame_i_text_and_identities(capsys):
+    """Frame 0 of an arm without a base is J0; its last frame without a tool is Je; the text names the frame."""
+    robot = load_robot("puma560")
+    assert np.allclose(robot.base_matrix, np.eye(4)) and np.allclose(robot.tool_matrix, np.eye(4))
+    J = {f: np.array(run_json(capsys, "jacobian", "puma560", "-q", Q_PUMA, "--frame", f)["J"])
+         for f in ("base", "tool", "0", str(robot.n_rows), "3")}
+    np.testing.assert_allclose(J["0"], J["base"], atol=1e-12)
+    np.testing.assert_allclose(J[str(robot.n_rows)], J["tool"], atol=1e-12)
+    np.testing.assert_allclose(J["3"], _in_frame(robot, Q_PUMA_VALUES, _fd_J0(robot, Q_PUMA_VALUES), 3), atol=1e-6)
+    assert main(["jacobian", "puma560", "-q", "0, 45, -90, 0, 60, 0", "--deg", "--frame", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "axes of DH frame {3}" in out and "3J" in out
+    rows = [line.split()[0] for line in out.splitlines()[-6:]]
+    assert rows == ["vx", "vy", "vz", "wx", "wy", "wz"]
+    deg = np.array(run_json(capsys, "jacobian", "puma560", "-q", "0, 45, -90, 0, 60, 0", "--deg", "--frame", "3")["J"])
+    np.testing.assert_allclose(deg, _in_frame(robot, np.radians([0, 45, -90, 0, 60, 0]),
+                                              _fd_J0(robot, np.radians([0, 45, -90, 0, 60, 0])), 3), atol=1e-6)
+
+
+@pytest.mark.parametrize("name, frame, method", [("planar3r", 3, "geometric"), ("stanford", 4, "differentiation")])
+def test_jacobian_frame_i_symbolic_equals_the_rotated_finite_differences(capsys, name, frame, method, rng):
+    robot = load_robot(name)
+    data = run_json(capsys, "jacobian", name, "--frame", str(frame), "--method", method)
+    assert data["frame"] == frame
+    for q in rng.uniform(-np.pi, np.pi, (2, robot.dof)):
+        got = np.array([_evaluate(row, robot, q) for row in data["J_symbolic"]])
+        np.testing.assert_allclose(got, _in_frame(robot, q, _fd_J0(robot, q), frame), atol=1e-6)
+
+
+def test_jacobian_frame_3_of_the_planar_3r_is_craigs_form(capsys):
+    """Planar 3R, end-effector point L3 along x3 (Craig 2005, sec. 5.8, with the reference point moved to the tip):
+    ³J's linear rows are [L1 s23 + L2 s3, L2 s3, 0; L1 c23 + L2 c3 + L3, L2 c3 + L3, L3] — short, not a rotated J0."""
+    data = run_json(capsys, "jacobian", "planar3r", "--frame", "3")
+    assert data["J_symbolic"][0] == ["L1*sin(q2 + q3) + L2*sin(q3)", "L2*sin(q3)", "0"]
+    assert data["J_symbolic"][1] == ["L1*cos(q2 + q3) + L2*cos(q3) + L3", "L2*cos(q3) + L3", "L3"]
+
+
+@pytest.mark.parametrize("value, mentions", [
+    ("99", ["--frame", "99"]), ("7", ["--frame", "7", "0 ... 6"]), ("-1", ["--frame", "-1"]), ("x", ["--frame"]),
+    ("", ["--frame"]), ("1e1", ["--frame"]), ("3.0", ["--frame"]), ("٣", ["--frame"]), ("9" * 5000, ["--frame"]),
+    ("base,tool", ["--frame"]), ("Base", ["--frame"]), ("0x3", ["--frame"]), ("+3", ["--frame"]),
+])
+@pytest.mark.parametrize("symbolic", [False, True])
+def test_jacobian_bad_frame_values_are_refused_in_one_line(tmp_path, value, mentions, symbolic):
+    from _hostile import assert_refused, run_cli
+
+    argv = ["jacobian", "puma560", "--frame", value] + ([] if symbolic else ["-q", Q_PUMA])
+    assert_refused(run_cli(argv, tmp_path), mentions=mentions)
+    assert_refused(run_cli(["jacobian", "puma560", f"--frame={value}", "-q", Q_PUMA, "--json"], tmp_path),
+                   mentions=["--frame"])
+
+
+def test_geometric_jacobian_frame_index_batches_and_refuses_bad_values(rng):
+    robot = load_robot("stanford")
+    Q = rng.uniform(-np.pi, np.pi, (3, 2, robot.dof))
+    for i in (0, 2, np.int64(robot.n_rows)):
+        batch = N.geometric_jacobian(robot, Q, frame=i)
+        assert batch.shape == (3, 2, 6, robot.dof)
+        for idx in np.ndindex(3, 2):
+            np.testing.assert_allclose(batch[idx], _in_frame(robot, Q[idx], _fd_J0(robot, Q[idx]), int(i)), atol=1e-6)
+    for bad in (-1, robot.n_rows + 1, True, "3", 2.0, "side"):
+        with pytest.raises(ValueError, match="base, tool"):
+            N.geometric_jacobian(robot, Q[0, 0], frame=bad)

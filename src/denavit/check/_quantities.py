@@ -89,13 +89,9 @@ def jacobian_in(p: Point, spec: dict[str, Any]) -> np.ndarray:
     """J0, Je, or ⁱJ = blockdiag(R_0_iᵀ, R_0_iᵀ) J0 with R_0_i the world orientation of DH frame i (reference point
     the end-effector origin in every case)."""
     f = axes_frame(spec)
-    if isinstance(f, Frame):
-        return N.geometric_jacobian(p.robot, p.q, frame=f)
-    if not 0 <= f <= p.robot.n_rows:
+    if not isinstance(f, Frame) and not 0 <= f <= p.robot.n_rows:
         raise ParseError(f"'frame' {f} is not a DH frame of this robot (0 … {p.robot.n_rows})")
-    J0 = N.geometric_jacobian(p.robot, p.q, frame=Frame.BASE)
-    R = _frames(p)[f][:3, :3]
-    return np.vstack([R.T @ J0[:3], R.T @ J0[3:]])
+    return N.geometric_jacobian(p.robot, p.q, frame=f)
 
 
 def _jacobian(p: Point, spec: dict[str, Any]) -> np.ndarray:

@@ -6,6 +6,7 @@ Each handler parses, calls the library, and formats; results carry their frame, 
 from __future__ import annotations
 
 import argparse
+import re
 
 import numpy as np
 
@@ -19,10 +20,13 @@ REFERENCE = "end-effector origin (after the tool transform)"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("jacobian", help="Jacobian J0 (base axes) or Je (tool axes), numeric or symbolic")
+    p = sub.add_parser("jacobian", help="Jacobian J0 (base axes), Je (tool axes) or iJ (DH frame i's axes), numeric "
+                       "or symbolic")
     add_common(p)
     add_q(p, required=False)
-    add_frame(p)
+    p.add_argument("--frame", type=_frame_arg, default="base", metavar="{base,tool,i}",
+                   help="axes of the result: base/world (J0), tool (Je) or the DH frame i = 0 ... N (iJ = "
+                        "diag(R_0_i^T, R_0_i^T) J0; same reference point)")
     p.add_argument("--method", choices=["geometric", "differentiation", "propagation"], default="geometric",
                    help="route: joint axes of the frames, differentiation of FK, or Craig's velocity propagation")
     p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
@@ -60,8 +64,28 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 
-def _header(frame: str, what: str = "J") -> str:
-    axes = "base/world axes (J0)" if frame == "base" else "tool axes (Je)"
+def _frame_arg(text: str) -> str | int:
+    """``--frame``: base, tool or a DH frame index (checked against the arm once it is loaded)."""
+    t = text.strip()
+    if t in ("base", "tool"):
+        return t
+    if re.fullmatch(r"[0-9]{1,3}", t):
+        return int(t)
+    raise argparse.ArgumentTypeError(f"expected base, tool or a DH frame index 0 ... N, got {text[:20]!r}")
+
+
+def _check_frame(robot, frame: str | int) -> None:
+    if isinstance(frame, int) and not 0 <= frame <= robot.n_rows:
+        raise ParseError(f"--frame {frame}: {robot.name} has DH frames 0 ... {robot.n_rows} (or use base, tool)")
+
+
+def _name(frame: str | int) -> str:
+    return "J0" if frame == "base" else "Je" if frame == "tool" else f"{frame}J"
+
+
+def _header(frame: str | int, what: str = "J") -> str:
+    axes = ("base/world axes (J0)" if frame == "base" else "tool axes (Je)" if frame == "tool" else
+            f"the axes of DH frame {{{frame}}} ({frame}J = diag(R_0_{frame}^T, R_0_{frame}^T) J0)")
     return f"{what} in {axes}; reference point: {REFERENCE}; rows (vx, vy, vz, wx, wy, wz)"
 
 
@@ -82,8 +106,17 @@ def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
     require_symbolic_size(robot, "jacobian --symbolic")
     q = S.joint_symbols(robot.dof).q
     fmt = sym_formatter(args, q)
-    J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
-    name = "J0" if args.frame == "base" else "Je"
+    if isinstance(args.frame, int):  # iJ = diag(R_w_iᵀ, R_w_iᵀ) J0, R_w_i = base · T_0_i (as the numeric route)
+        J0 = S.jacobian_sym(robot, args.method, "base", args.simplify)
+        R = (S.matrix_from_floats(robot.base_matrix) * S.link_transforms_sym(robot, args.simplify)[args.frame])[:3, :3]
+        J = sp.diag(R.T, R.T) * J0
+        if args.simplify != "none":  # sin² = 1 − cos² first: the rotation leaves sin²(θ) + cos²(θ) of sums of angles
+            a = sp.Wild("a")
+            J = J.applyfunc(lambda e: sp.expand(sp.expand(e).replace(sp.sin(a) ** 2, 1 - sp.cos(a) ** 2)))
+        J = S.simplify_matrix(J, args.simplify)
+    else:
+        J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
+    name = _name(args.frame)
     lines = [f"{robot.name}: symbolic Jacobian by {args.method}", _header(args.frame), f"{name} =", fmt(J)]
     data = {"J_symbolic": J, "J_latex": sp.latex(J)}
     if args.steps:
@@ -111,6 +144,7 @@ def cmd_jacobian(args: argparse.Namespace):
     from .. import numeric as N
 
     robot = load(args)
+    _check_frame(robot, args.frame)
     data: dict = {"robot": robot.name, "frame": args.frame, "method": args.method, "reference_point": REFERENCE,
                   "rows": list(ROWS)}
     lines: list[str] = []
@@ -143,8 +177,12 @@ def cmd_jacobian(args: argparse.Namespace):
                       f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
                       f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
         else:
-            J = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
-                 "propagation": N.propagation_jacobian}[args.method](robot, q, args.frame)
+            route = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
+                     "propagation": N.propagation_jacobian}[args.method]
+            if isinstance(args.frame, int) and args.method != "geometric":  # iJ from this route's J0
+                J = N.jacobian_tool_from_base(route(robot, q, "base"), N.link_transforms(robot, q)[args.frame])
+            else:
+                J = route(robot, q, args.frame)
             require_finite("jacobian", J)
             data["J"] = J
             if lines:

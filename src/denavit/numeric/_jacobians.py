@@ -55,7 +55,24 @@ def joint_axes(robot: DHRobot, frames: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return sel[..., :3, 2], sel[..., :3, 3]
 
 
-def geometric_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np.ndarray:
+def _frame_of(robot: DHRobot, frame: Frame | str | int) -> Frame | int:
+    """The axes a Jacobian is asked in: :class:`Frame` (``"base"``, ``"tool"``) or a DH frame index 0 … N.
+
+    Raises ``ValueError`` naming the choices for anything else (a bool, an index outside the arm, another word).
+    """
+    if isinstance(frame, (int, np.integer)) and not isinstance(frame, (bool, np.bool_)):
+        if not 0 <= frame <= robot.n_rows:
+            raise ValueError(f"frame {int(frame)} is not a DH frame of {robot.name!r}: choose base, tool or an index "
+                             f"from 0 to {robot.n_rows}")
+        return int(frame)
+    try:
+        return Frame(frame)
+    except ValueError:
+        raise ValueError(f"frame {str(frame)[:40]!r}: choose base, tool or a DH frame index from 0 to "
+                         f"{robot.n_rows}") from None
+
+
+def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE) -> np.ndarray:
     """Geometric Jacobian of the end-effector origin, shape (..., 6, n), rows (v, ω).
 
     Column i is [z_i × (p_e − o_i); z_i] for a revolute joint and [z_i; 0] for a prismatic one
@@ -65,11 +82,27 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str = Frame.BASE) -> np
     ----------
     robot : DHRobot
     q : array_like, shape (..., n)
-    frame : Frame or {"base", "tool"}
-        ``base``: J0, velocities in world/base axes; ``tool``: Je, in end-effector axes.
+    frame : Frame, {"base", "tool"} or int
+        ``base``: J0, velocities in world/base axes; ``tool``: Je, in end-effector axes; an integer i
+        (0 … N, the DH frames): ⁱJ = diag(R_0_iᵀ, R_0_iᵀ) J0, the same velocities in the axes of DH frame {i}
+        (R_0_i its orientation in the world, ``base`` applied; Craig 2005, eq. 5.101).  The reference point is
+        the end-effector origin in every case.
+
+    Examples
+    --------
+    >>> import numpy as np, denavit
+    >>> robot = denavit.load_robot("planar2r")
+    >>> q = [0.3, 0.5]
+    >>> R_0_1 = denavit.link_transforms(robot, q)[1, :3, :3]
+    >>> J1 = geometric_jacobian(robot, q, frame=1)
+    >>> bool(np.allclose(J1[:3], R_0_1.T @ geometric_jacobian(robot, q)[:3]))
+    True
     """
-    frame = Frame(frame)
+    frame = _frame_of(robot, frame)
     q = as_joint_array(q, robot.dof)
+    if not isinstance(frame, Frame):
+        J0 = geometric_jacobian(robot, q, Frame.BASE)
+        return jacobian_tool_from_base(J0, link_transforms(robot, q)[..., frame, :, :])
     if q.ndim > 1:
         return _geometric_jacobian_batch(robot, q, frame)
     frames = link_transforms(robot, q)  # (N+1, 4, 4)
@@ -186,7 +219,8 @@ def _rotate_rows(J: np.ndarray, R: np.ndarray) -> np.ndarray:
 def jacobian_tool_from_base(J0, T_w_e) -> np.ndarray:
     """Je = diag(Rᵀ, Rᵀ) J0 with R the end-effector orientation in world axes (Siciliano eq. 3.112).
 
-    ``T_w_e`` is the end-effector pose (..., 4, 4) or its rotation (..., 3, 3). Same reference point.
+    ``T_w_e`` is the end-effector pose (..., 4, 4) or its rotation (..., 3, 3). Same reference point.  Given the
+    world pose of another frame {i} instead, the result is ⁱJ, the Jacobian in {i}'s axes.
     """
     return _rotate_rows(J0, np.swapaxes(_rotation(T_w_e), -1, -2))
 
