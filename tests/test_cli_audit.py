@@ -226,3 +226,14 @@ def test_compile_reports_its_stages_on_stderr_only_without_json(capsys, tmp_path
     assert "compiling and timing" not in out and out.startswith("planar2r: 2 joints, backend numpy")
     code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy", "--json")
     assert code == 0 and err == "" and _strict(out)["backend"] == "numpy"
+
+
+def test_animate_says_it_is_rendering_on_stderr_only_without_json(capsys, tmp_path):
+    # a default 2 s move of the PUMA took 5 s to render with nothing on the terminal
+    pytest.importorskip("matplotlib")
+    argv = ["animate", "planar2r", "--from", "0,0", "--to", "0.1,0.1", "--duration", "0.2", "--fps", "5"]
+    code, out, err = run(capsys, *argv, "-o", tmp_path / "a.gif")
+    assert code == 0 and err.strip() == f"denavit animate: rendering 2 frames to {tmp_path / 'a.gif'}"
+    assert out.startswith(f"wrote {tmp_path / 'a.gif'} (2 frames")
+    code, out, err = run(capsys, *argv, "-o", tmp_path / "b.gif", "--json")
+    assert code == 0 and err == "" and _strict(out)["frames"] == 2

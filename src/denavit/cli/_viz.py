@@ -8,7 +8,8 @@ import numpy as np
 
 from ..errors import ParseError
 from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
-                      joint_values, load, numbers_text, output_file, require_finite)
+                      joint_values, load, numbers_text, output_file, require_finite,
+                      stage_printer)
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 PICTURES = (".png", ".svg", ".pdf")
@@ -124,6 +125,9 @@ def cmd_animate(args: argparse.Namespace):
     qs, cp = _move(args, robot, q1, q2, k)
     ee = forward_kinematics(robot, qs)[:, :3, 3]
     require_finite("animate", qs, ee)
+    show = stage_printer(args, "animate")
+    if show:  # a few seconds for a default 2 s move; no per-frame progress from the renderer
+        show(f"rendering {k} frames to {args.output}")
     with output_file(args.output) as tmp:
         animate_robot(robot, qs, tmp, fps=args.fps, frames=not args.no_frames)
     unit = "deg" if args.deg else "rad"
