@@ -107,3 +107,41 @@ def test_cpu_bounded_raises_the_functions_exception_and_stops_at_its_cpu_limit(t
     assert _bounded.cpu_bounded(_spin, (), 1) is None
     assert time.perf_counter() - t < 30
     assert _bounded.cpu_bounded(abs, (-2.5,), 1) == 2.5  # the worker still serves after a child was stopped
+
+
+def test_a_fork_of_the_caller_gets_its_own_worker_even_while_a_thread_holds_the_callers_turn(threads_alive):
+    """A process forked while another thread is inside cpu_bounded (holding its lock) must not wait for that
+    lock, nor talk to the parent's worker."""
+    assert _bounded.cpu_bounded(abs, (-1,), 1) == 1  # the parent's worker is running
+    parent_worker = _bounded._worker
+    inside, leave = threading.Event(), threading.Event()
+
+    def hold_the_turn():
+        with _bounded._lock:
+            inside.set()
+            leave.wait(60)
+
+    t = threading.Thread(target=hold_the_turn, daemon=True)
+    t.start()
+    assert inside.wait(10)
+    try:
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child
+            ok = False
+            try:
+                ok = _bounded.cpu_bounded(abs, (-4,), 1) == 4 and _bounded._worker is not parent_worker
+                _bounded._stop_worker()
+            finally:
+                os._exit(0 if ok else 1)
+        deadline = time.monotonic() + 60
+        while (done := os.waitpid(pid, os.WNOHANG))[0] == 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        if done[0] == 0:
+            os.kill(pid, 9)
+            os.waitpid(pid, 0)
+            pytest.fail("the forked child waited on the parent's lock")
+        assert os.waitstatus_to_exitcode(done[1]) == 0
+    finally:
+        leave.set()
+        t.join(10)
+    assert _bounded._worker is parent_worker and _bounded.cpu_bounded(abs, (-2,), 1) == 2

@@ -11,7 +11,8 @@ using CPU, so its CPU limit never ends it.  A process that has imported numpy al
 ``sys.executable`` (a fresh interpreter, single-threaded, with the modules named in ``warm`` imported once), forks
 one child per call.  The function and its arguments travel by pickle (so ``fn`` must be a module-level function);
 the first call pays the worker's start (~1 s with sympy), later calls only a fork.  Calls from several threads
-take turns.  The worker ends when this process ends (its requests pipe closes).
+take turns.  The worker ends when this process ends (its requests pipe closes); a fork of this process starts its
+own (it neither waits for a turn held by one of the parent's threads nor talks to the parent's worker).
 
 Where the OS has no ``fork`` or no ``RLIMIT_CPU`` (Windows), each call runs in a fresh interpreter
 (multiprocessing's ``spawn``) and the bound is wall-clock time: :data:`WALL_SECONDS_WITHOUT_CPU_LIMIT` times
@@ -202,7 +203,15 @@ def _stop_worker() -> None:
             pass
 
 
+def _forget_worker() -> None:
+    """In a fork of this process: the parent's worker and lock are the parent's (the lock may be held)."""
+    global _lock, _worker
+    _lock, _worker = threading.Lock(), None
+
+
 atexit.register(_stop_worker)
+if hasattr(os, "register_at_fork"):  # POSIX
+    os.register_at_fork(after_in_child=_forget_worker)
 
 
 def _wall(seconds: float) -> float:
