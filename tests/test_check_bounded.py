@@ -145,3 +145,31 @@ def test_a_fork_of_the_caller_gets_its_own_worker_even_while_a_thread_holds_the_
         leave.set()
         t.join(10)
     assert _bounded._worker is parent_worker and _bounded.cpu_bounded(abs, (-2,), 1) == 2
+
+
+def _sleep_then(value, seconds):
+    time.sleep(seconds)
+    return value
+
+
+def test_an_interrupted_call_leaves_no_stale_reply_for_the_next(threads_alive):
+    """An exception in the waiting caller (Ctrl-C in Jupyter, an alarm) ends the worker: the next call gets its own
+    answer, not the interrupted call's."""
+    import signal
+
+    class Interrupted(BaseException):
+        pass
+
+    def interrupt(signum, frame):
+        raise Interrupted
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        with pytest.raises(Interrupted):
+            _bounded.cpu_bounded(_sleep_then, ("stale", 1.5), 5)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    time.sleep(1.5)  # the interrupted call's reply would be waiting by now
+    assert _bounded.cpu_bounded(_sleep_then, ("fresh", 0.0), 5) == "fresh"

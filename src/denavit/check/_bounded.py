@@ -257,7 +257,11 @@ def _run_in_worker(fn: Callable, args: tuple, seconds: float, warm: tuple[str, .
         except OSError:
             _stop_worker()
             continue
-        reply = _read(_worker.stdout.fileno(), time.monotonic() + _wall(seconds) + _WORKER_START_SECONDS)
+        try:
+            reply = _read(_worker.stdout.fileno(), time.monotonic() + _wall(seconds) + _WORKER_START_SECONDS)
+        except BaseException:  # interrupted (KeyboardInterrupt, an alarm): its reply would answer the next request
+            _stop_worker()
+            raise
         if reply is None:  # past the safety net, or the worker died: it is ended, and started again next time
             _stop_worker()
             return "limit", None
