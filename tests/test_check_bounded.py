@@ -98,6 +98,8 @@ def test_cpu_bounded_from_several_threads_at_once(threads_alive):
     with ThreadPoolExecutor(4) as pool:
         futures = [pool.submit(_bounded.cpu_bounded, abs, (-k,), 5) for k in range(8)]
         assert [f.result(timeout=120) for f in futures] == list(range(8))
+    if os.path.isdir("/proc/self/task"):  # the worker, which forks, has a single thread (no BLAS pool)
+        assert len(os.listdir(f"/proc/{_bounded._worker.pid}/task")) == 1
 
 
 def test_cpu_bounded_raises_the_functions_exception_and_stops_at_its_cpu_limit(threads_alive):

@@ -50,6 +50,10 @@ except ImportError:  # pragma: no cover - Windows
     resource = None  # type: ignore[assignment]
 
 _CAN_FORK = hasattr(os, "fork") and resource is not None
+#: Thread-pool sizes set to 1 in the worker, so that it really has one thread when it forks (numpy's BLAS would
+#: otherwise start its own threads at import).
+_THREAD_POOLS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXPR_NUM_THREADS",
+                 "VECLIB_MAXIMUM_THREADS", "NUMBA_NUM_THREADS")
 _WORKER_START_SECONDS = 30  # the worker's own start (an interpreter, and the warm imports) on a loaded machine
 _HEADER = struct.Struct("<Q")
 _lock = threading.Lock()
@@ -182,8 +186,10 @@ def _start_worker() -> subprocess.Popen:
     import json
 
     code = "import json, sys; sys.path[:] = json.loads(sys.argv[1]); from denavit.check._bounded import serve; serve()"
+    env = dict(os.environ, **{name: "1" for name in _THREAD_POOLS})  # no BLAS threads: the worker forks
     return subprocess.Popen([sys.executable, "-c", code, json.dumps(sys.path)], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True, close_fds=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True, close_fds=True,
+                            env=env)
 
 
 def _stop_worker() -> None:
