@@ -237,3 +237,32 @@ def test_animate_says_it_is_rendering_on_stderr_only_without_json(capsys, tmp_pa
     assert out.startswith(f"wrote {tmp_path / 'a.gif'} (2 frames")
     code, out, err = run(capsys, *argv, "-o", tmp_path / "b.gif", "--json")
     assert code == 0 and err == "" and _strict(out)["frames"] == 2
+
+
+ONE_JOINT = """name: one
+convention: standard
+joints:
+  - {a: 1.0, alpha: 0, d: 0, theta: q}
+"""
+
+
+def test_one_joint_arm_reads_in_the_singular(capsys, tmp_path, monkeypatch):
+    # "1 joints (R)" in show, "1 joints q1 … q1" in export-urdf
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "one.yaml").write_text(ONE_JOINT)
+    code, out, _ = run(capsys, "show", "one.yaml")
+    assert code == 0 and "1 joint (R)" in out and "joints" not in out.splitlines()[1]
+    code, out, _ = run(capsys, "export-urdf", "one.yaml", "-o", "one.urdf")
+    assert code == 0 and "1 joint q1," in out and "joints" not in out
+    code, out, _ = run(capsys, "show", "puma560")
+    assert "6 joints (RRRRRR)" in out
+
+
+def test_a_missing_convention_says_it_is_missing(capsys, tmp_path, monkeypatch):
+    # was: "'convention' must be standard or modified, got None"
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "arm.yaml").write_text(ONE_JOINT.replace("convention: standard\n", ""))
+    code, out, err = run(capsys, "show", "arm.yaml")
+    lines = err.strip().splitlines()
+    assert code == 2 and out == "" and len(lines) == 1
+    assert "arm.yaml: convention" in lines[0] and "missing" in lines[0] and "None" not in lines[0]

@@ -96,6 +96,9 @@ def robot_from_dict(data: Mapping[str, Any], where: str = "<robot>") -> DHRobot:
     unknown = set(map(str, data)) - _TOP_KEYS
     if unknown:
         raise ParseError(f"unknown key {sorted(unknown)[0]!r}; allowed: {', '.join(sorted(_TOP_KEYS))}", where=where)
+    if data.get("convention") is None:
+        raise ParseError("'convention' is missing: add 'convention: standard' (Spong, distal) or 'convention: "
+                         "modified' (Craig, proximal)", where=f"{where}: convention")
     conv = str(data.get("convention", "")).strip().lower()
     if conv not in ("standard", "modified"):
         raise ParseError(

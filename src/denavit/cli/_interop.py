@@ -78,6 +78,11 @@ def cmd_export(args: argparse.Namespace):
     if args.output:
         with output_file(args.output) as tmp:
             Path(tmp).write_text(text, encoding="utf-8")
-        return data, f"wrote {args.output} ({args.fmt.upper()}, {robot.dof} joints q1 … q{robot.dof}, tool frame 'tool')"
+        return data, f"wrote {args.output} ({args.fmt.upper()}, {_joints(robot.dof)}, tool frame 'tool')"
     data["text"] = text
     return data, text
+
+
+def _joints(n: int) -> str:
+    """``1 joint q1``, ``2 joints q1, q2``, ``6 joints q1 … q6``."""
+    return {1: "1 joint q1", 2: "2 joints q1, q2"}.get(n, f"{n} joints q1 … q{n}")

@@ -207,7 +207,7 @@ def cmd_import_table(args: argparse.Namespace):
     if out is not None:
         with output_file(str(out)) as tmp:
             Path(tmp).write_text(file_text, encoding="utf-8")
-        msg = f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} rows, {robot.dof} joints)"
+        msg = f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} row{'s' * (robot.n_rows != 1)}, {robot.dof} joint{'s' * (robot.dof != 1)})"
         msg += "".join(f"\nnote: {n}" for n in result.notes)
     else:
         msg = file_text

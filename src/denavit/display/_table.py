@@ -94,7 +94,7 @@ def _title(robot: DHRobot, deg: bool) -> tuple[str, str]:
     first = f"{robot.name}" + (f": {robot.description}" if robot.description else "")
     formula = ("A_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i)" if robot.convention.value == "standard"
                else "A_i = Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ_i) Tz(d_i)")
-    second = (f"{robot.convention.value} DH ({formula}), {robot.dof} joints ({kinds}), "
+    second = (f"{robot.convention.value} DH ({formula}), {robot.dof} joint{'s' * (robot.dof != 1)} ({kinds}), "
               f"angles in {'degrees' if deg else 'radians'}")
     return first, second
 
