@@ -266,3 +266,27 @@ def test_a_missing_convention_says_it_is_missing(capsys, tmp_path, monkeypatch):
     lines = err.strip().splitlines()
     assert code == 2 and out == "" and len(lines) == 1
     assert "arm.yaml: convention" in lines[0] and "missing" in lines[0] and "None" not in lines[0]
+
+
+@pytest.mark.parametrize("name", ["stanford", "puma560", "elbow-6r-deg"])
+def test_show_json_says_its_angle_unit_and_follows_deg(capsys, name):
+    # show --json ignored --deg (radians, unlabelled) where fk --json --deg gives degrees and says so
+    from denavit import load_robot
+
+    robot = load_robot(name)
+    code, out, _ = run(capsys, "show", name, "--json")
+    rad = _strict(out)
+    code2, out, _ = run(capsys, "show", name, "--json", "--deg")
+    deg = _strict(out)
+    assert code == code2 == 0 and rad["angle_unit"] == "rad" and deg["angle_unit"] == "deg"
+    for link, r, d in zip(robot.links, rad["rows"], deg["rows"]):
+        assert (r["alpha"], r["theta"], r["a"], r["d"]) == (link.alpha, link.theta, link.a, link.d)
+        assert d["alpha"] == pytest.approx(np.degrees(link.alpha)) and d["theta"] == pytest.approx(np.degrees(link.theta))
+        assert (d["a"], d["d"]) == (link.a, link.d)
+        if link.q_limits is not None:
+            scale = np.degrees(1.0) if link.joint.value == "revolute" else 1.0
+            assert d["limits"] == pytest.approx([v * scale for v in link.q_limits]) and r["limits"] == list(link.q_limits)
+    assert rad["poses"] == {k: list(q) for k, q in robot.poses}
+    revolute = np.array([t.value == "revolute" for t in robot.joint_types])
+    for k, q in robot.poses:
+        assert deg["poses"][k] == pytest.approx(np.where(revolute, np.degrees(q), q).tolist())

@@ -65,14 +65,21 @@ def cmd_robots(args: argparse.Namespace):
 def cmd_show(args: argparse.Namespace):
     """The DH table as ``print(robot)`` shows it (``denavit.dh_table``), and the model as JSON."""
     from ..display import dh_table
+    from ..model import JointType
 
     robot = load(args)
     text = dh_table(robot, deg=True if args.deg else None)
     text += f"\ninertial data: {'yes' if robot.has_dynamics else 'no'}"
-    data_rows = [{"a": link.a, "alpha": link.alpha, "d": link.d, "theta": link.theta, "joint": link.joint.value,
-                  "limits": list(link.q_limits) if link.q_limits else None, "expressions": dict(link.symbols)}
+    angle = (lambda x: float(np.degrees(x))) if args.deg else float  # noqa: E731  (--deg: angles in degrees)
+    data_rows = [{"a": link.a, "alpha": angle(link.alpha), "d": link.d, "theta": angle(link.theta),
+                  "joint": link.joint.value, "expressions": dict(link.symbols),
+                  "limits": None if not link.q_limits else
+                  [angle(v) if link.joint is JointType.REVOLUTE else v for v in link.q_limits]}
                  for link in robot.links]
-    data = {"robot": robot.name, "convention": robot.convention.value, "dof": robot.dof, "rows": data_rows,
+    poses = {name: [angle(v) if t is JointType.REVOLUTE else v for v, t in zip(q, robot.joint_types)]
+             for name, q in robot.poses}
+    data = {"robot": robot.name, "convention": robot.convention.value, "dof": robot.dof,
+            "angle_unit": "deg" if args.deg else "rad", "rows": data_rows, "poses": poses,
             "parameters": dict(robot.parameters), "base": robot.base_matrix, "tool": robot.tool_matrix,
             "gravity": list(robot.gravity), "dynamics": robot.has_dynamics}
     return data, text
