@@ -45,7 +45,7 @@ class Cond:
 
 
 def _decimals(node: tuple) -> int:
-    from ._values import _decimals as dec
+    from ._values import decimals as dec
 
     return dec(node)
 

@@ -22,10 +22,10 @@ from ..model import DHRobot
 from ._formulas import expected_formula
 from ._hints import hints_for
 from ._matrices import after_last_equals
-from ._points import _evaluate, _gravity_name, _points, _where_nodes, _wrench_nodes
+from ._points import evaluate_cells, gravity_names, sample_points, where_nodes, wrench_nodes
 from ._quantities import Point, quantity
 from ._resolve import robot_resolver
-from ._values import MAX_DET_SIZE, ShapeMismatch, _decimals, _determinant, _readings, _shape_to, _values
+from ._values import MAX_DET_SIZE, ShapeMismatch, claim_cells, decimals, determinant, shape_readings, shape_to
 
 __all__ = ["Verdict", "check_claim", "EXACT_RTOL"]
 
@@ -75,11 +75,11 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         qty, extra = quantity(raw.get("quantity"))
         spec = {**extra, **{k: v for k, v in raw.items() if k not in ("id", "quantity", "value")}}
         deg = bool(spec.get("deg", deg))
-        wrench = _wrench_nodes(spec["wrench"], robot) if "wrench" in spec else None
+        wrench = wrench_nodes(spec["wrench"], robot) if "wrench" in spec else None
         symbols = sorted({n for nd in wrench or () for n in _expr.names_in(nd)} - {k for k, _ in robot.parameters})
-        where = _where_nodes(spec.get("where"), robot, symbols + _gravity_name(robot))
+        where = where_nodes(spec.get("where"), robot, symbols + gravity_names(robot))
         spec["_where"] = where
-        cells = _values(raw["value"], robot_resolver(robot, extra=symbols + _gravity_name(robot)
+        cells = claim_cells(raw["value"], robot_resolver(robot, extra=symbols + gravity_names(robot)
                                                      + [n for n, _ in where]))
         if qty.name == "det_jacobian" and len(cells) * len(cells[0]) > 1 and 1 in (len(cells), len(cells[0])):
             factors = [c for row in cells for c in row]  # det J written as a list of its factors
@@ -88,7 +88,7 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
                 prod = ("bin", "*", prod, f)
             cells = [[prod]]
         elif qty.name == "det_jacobian" and 1 < len(cells) == len(cells[0]) <= MAX_DET_SIZE:
-            cells = [[_determinant(cells)]]  # |a b; c d| (a vmatrix): the determinant of the matrix written
+            cells = [[determinant(cells)]]  # |a b; c d| (a vmatrix): the determinant of the matrix written
         names: set[str] = set()
         for row in cells:
             for c in row:
@@ -99,12 +99,12 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
                 if n in used:
                     used |= _expr.names_in(nd)
             names = (names | used) - {n for n, _ in where}
-        points = _points(robot, spec, names, qty.needs, rng, deg, wrench=wrench, symbols=symbols)
+        points = sample_points(robot, spec, names, qty.needs, rng, deg, wrench=wrench, symbols=symbols)
         if "entry" in spec:  # one entry of the quantity: hints then compare that entry too
             qty = replace(qty, truth=_entry_of(qty.truth))
         truth = np.array([np.asarray(qty.truth(p, spec), dtype=float) for p in points])  # (P, *shape)
         try:
-            readings = _readings(qty, spec, truth.shape[1:], cells)
+            readings = shape_readings(qty, spec, truth.shape[1:], cells)
         except ShapeMismatch as exc:
             return Verdict(cid, qty.name, "incorrect", f"incorrect: shape: {exc}", expected=truth[0].tolist(),
                            method="the shape of the value compared with the quantity's")
@@ -123,12 +123,12 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
     for label, fn in readings:
         q2 = replace(qty, truth=lambda p, s, f=fn, t=qty.truth: f(np.asarray(t(p, s), dtype=float)))
         t2 = np.array([fn(t) for t in truth])
-        v = _compare(robot, cid, q2, spec, _shape_to(cells, t2.shape[1:]), points, t2, rng, False)
+        v = _compare(robot, cid, q2, spec, shape_to(cells, t2.shape[1:]), points, t2, rng, False)
         if v.verdict == "correct":
             return replace(v, message=f"{v.message}, read as {label}")
         verdicts.append((len(v.entries), label, q2, t2))
     _, label, q2, t2 = min(verdicts, key=lambda x: x[0])
-    v = _compare(robot, cid, q2, spec, _shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
+    v = _compare(robot, cid, q2, spec, shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
     others = "; ".join(lb for _, lb, _, _ in verdicts if lb != label)
     return replace(v, message=f"{v.message}, read as {label}" + (f" (also wrong read as {others})" if others else ""))
 
@@ -145,11 +145,11 @@ def _says_transpose(text: str) -> bool:
 def _compare(robot, cid, qty, spec, cells, points, truth, rng, detail) -> Verdict:
     """The verdict on claimed cells (already of the truth's shape) against the truth at the points."""
     try:
-        cells = _shape_to(cells, truth.shape[1:])
-        claimed = np.array([_evaluate(cells, p, spec.get("_where", ())).reshape(truth.shape[1:]) for p in points])
+        cells = shape_to(cells, truth.shape[1:])
+        claimed = np.array([evaluate_cells(cells, p, spec.get("_where", ())).reshape(truth.shape[1:]) for p in points])
     except ParseError as exc:
         return Verdict(cid, qty.name, "unreadable", str(exc))
-    dec = np.array([[_decimals(c) for c in row] for row in cells]).reshape(truth.shape[1:])
+    dec = np.array([[decimals(c) for c in row] for row in cells]).reshape(truth.shape[1:])
     tol = np.where(dec >= 2, 10.0 ** (-dec.astype(float)), 0.0)  # one unit of the last decimal written
     scale = np.maximum(1.0, np.abs(truth))
     ok_tight = np.abs(claimed - truth) <= EXACT_RTOL * scale

@@ -11,7 +11,7 @@ from typing import Any
 from .. import _expr
 from ..errors import DenavitError, ParseError
 from ..model import DHRobot
-from ._points import _wrench_nodes
+from ._points import wrench_nodes
 
 __all__ = ["expected_formula", "MAX_FORMULA_DOF_DYNAMICS", "MAX_FORMULA_DOF_STATICS"]
 
@@ -42,7 +42,7 @@ def _expected_statics(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | 
     if robot.dof > MAX_FORMULA_DOF_STATICS or str(spec.get("frame", "tool")) != "tool" or "wrench" not in spec:
         return None
     try:
-        nodes = _wrench_nodes(spec["wrench"], robot)
+        nodes = wrench_nodes(spec["wrench"], robot)
         syms = {n: sp.Symbol(n[0] + "_" + n[1:]) for nd in nodes for n in _expr.names_in(nd)}
         params = {k: sp.Symbol(k) for k, _ in robot.parameters}
         values = [_expr.to_sympy(nd, {**params, **syms}) for nd in nodes]

@@ -165,9 +165,9 @@ def _solution_set(robot: DHRobot, res: Any) -> tuple[np.ndarray, list[str]]:
 
 
 def _decimals_of(nodes) -> int:
-    from ._values import _decimals
+    from ._values import decimals
 
-    return max((_decimals(nd) for nd in nodes), default=0)
+    return max((decimals(nd) for nd in nodes), default=0)
 
 
 def _formula_hint(robot: DHRobot, j: int, v: float, s_j: float) -> str | None:

@@ -25,10 +25,10 @@ MAX_SOLUTIONS = 64
 
 def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.ndarray, np.ndarray]]:
     """The claimed q vectors, each with the rounding unit of every entry (0 for exact entries)."""
-    from ._values import _decimals, _no_names
+    from ._values import decimals, no_names
 
     if isinstance(raw, str) and "\\begin" in raw:
-        rows = parse_matrix(raw, _no_names)
+        rows = parse_matrix(raw, no_names)
     else:
         items = raw if isinstance(raw, list) else [p for p in str(raw).split(";") if p.strip()]
         if len(items) > MAX_SOLUTIONS:
@@ -37,7 +37,7 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
         for k, item in enumerate(items, start=1):
             cells = item if isinstance(item, list) else [c for c in str(item).strip().strip("[]()").split(",")]
             try:
-                rows.append([_expr.parse(c) if isinstance(c, (int, float)) else parse_math(str(c), _no_names, rhs=False)
+                rows.append([_expr.parse(c) if isinstance(c, (int, float)) else parse_math(str(c), no_names, rhs=False)
                              for c in cells])
             except ParseError as exc:
                 raise ParseError(f"solution {k}: {exc}") from None
@@ -49,7 +49,7 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
         if len(row) != robot.dof:
             raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
         q = np.array([_expr.evaluate(c) for c in row])
-        unit = np.array([10.0 ** -d if (d := _decimals(c)) >= 2 else 0.0 for c in row])
+        unit = np.array([10.0 ** -d if (d := decimals(c)) >= 2 else 0.0 for c in row])
         if deg:
             q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
         out.append((q, unit))
@@ -61,12 +61,12 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
 def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
     """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
     from ._engine import Verdict
-    from ._values import _joint_values, _no_names, _values
+    from ._values import claim_cells, joint_values, no_names
 
     if "q" in raw:
-        T = N.forward_kinematics(robot, _joint_values(raw["q"], robot, "q", deg))
+        T = N.forward_kinematics(robot, joint_values(raw["q"], robot, "q", deg))
     elif "T" in raw:
-        T = np.array([[_expr.evaluate(c) for c in r] for r in _values(raw["T"], _no_names)])
+        T = np.array([[_expr.evaluate(c) for c in r] for r in claim_cells(raw["T"], no_names)])
     else:
         raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
     if T.shape != (4, 4):

@@ -21,9 +21,10 @@ from ._quantities import Point
 from ._resolve import robot_resolver
 from ._text import split_top
 from ._tokens import Ident
-from ._values import _joint_values
+from ._values import joint_values
 
-__all__ = ["N_POINTS", "N_PARAM_SETS", "MAX_NAME", "WRENCH_BASES"]
+__all__ = ["sample_points", "evaluate_cells", "gravity_names", "where_nodes", "wrench_nodes", "N_POINTS",
+           "N_PARAM_SETS", "MAX_NAME", "WRENCH_BASES"]
 
 N_POINTS = 6
 N_PARAM_SETS = 2
@@ -38,7 +39,7 @@ def _sample_q(robot: DHRobot, rng: np.random.Generator) -> np.ndarray:
     return rng.uniform(np.maximum(lo, -np.pi), np.minimum(hi, np.pi))
 
 
-def _gravity_name(robot: DHRobot) -> list[str]:
+def gravity_names(robot: DHRobot) -> list[str]:
     """``g`` (the magnitude of the robot's gravity) is a known name unless the robot has a parameter g."""
     return [] if "g" in robot.parameter_values else ["g"]
 
@@ -47,7 +48,7 @@ def _gravity_name(robot: DHRobot) -> list[str]:
 WRENCH_BASES = ("f", "F", "n", "N", "m", "M")
 
 
-def _wrench_nodes(raw: Any, robot: DHRobot) -> list[tuple]:
+def wrench_nodes(raw: Any, robot: DHRobot) -> list[tuple]:
     """A claim's 'wrench': 6 entries (f, n) or 3 (a pure force), numbers or symbols such as ``f_x``."""
     known = robot_resolver(robot)
 
@@ -76,7 +77,7 @@ def _wrench_nodes(raw: Any, robot: DHRobot) -> list[tuple]:
     return out + [zero] * (6 - len(out))
 
 
-def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, deg: bool, *,
+def sample_points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, deg: bool, *,
             wrench: list[tuple] | None = None, symbols: list[str] = ()) -> list[Point]:
     """Evaluation points: the claim's q (or random ones), its q̇/wrench (or random), robot parameter sets."""
     params = [k for k, _ in robot.parameters]
@@ -89,9 +90,9 @@ def _points(robot: DHRobot, spec: dict[str, Any], names: set[str], needs, rng, d
             if "g" in names and "g" not in params:  # the symbol g: the same direction, another magnitude
                 r = r.replace(gravity=tuple(float(x) * rng.uniform(0.6, 1.4) for x in r.gravity))
             robots.append(r)
-    fixed_q = _joint_values(spec["q"], robot, "q", deg) if "q" in spec else None
-    fixed_qd = _joint_values(spec["qd"], robot, "qd", deg) if "qd" in spec else None
-    fixed_qdd = _joint_values(spec["qdd"], robot, "qdd", deg) if "qdd" in spec else None
+    fixed_q = joint_values(spec["q"], robot, "q", deg) if "q" in spec else None
+    fixed_qd = joint_values(spec["qd"], robot, "qd", deg) if "qd" in spec else None
+    fixed_qdd = joint_values(spec["qdd"], robot, "qdd", deg) if "qdd" in spec else None
     uses_qdd = any(n.startswith("qdd") and n[3:].isdigit() for n in names)
     if "wrench" in needs and wrench is None:
         raise ParseError("this claim needs 'wrench' (6 numbers or symbols f, n; or 3 for a force)")
@@ -132,7 +133,7 @@ def _env(p: Point) -> dict[str, float]:
     return env
 
 
-def _where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, tuple]]:
+def where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, tuple]]:
     """A claim's 'where': names a derivation introduces (``k: a_2``, ``x_c: p_x - d_6 a_x``…), each a formula in
     the robot's names and the names defined before it, in order."""
     from ._ik_claims import MAX_WHERE
@@ -166,7 +167,7 @@ def _where_nodes(raw: Any, robot: DHRobot, extra: list[str]) -> list[tuple[str, 
     return out
 
 
-def _evaluate(cells: list[list[tuple]], p: Point, where: list[tuple[str, tuple]] = ()) -> np.ndarray:
+def evaluate_cells(cells: list[list[tuple]], p: Point, where: list[tuple[str, tuple]] = ()) -> np.ndarray:
     env = _env(p)
     for name, node in where:
         env[name] = _expr.evaluate(node, env)

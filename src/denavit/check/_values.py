@@ -18,13 +18,14 @@ from ._latex import parse_math
 from ._matrices import RaggedMatrix, after_last_equals, encloses, parse_matrix
 from ._text import split_top
 
-__all__ = ["numbers", "ShapeMismatch", "MAX_ENTRIES", "MAX_DET_SIZE", "MAX_DET_WORK"]
+__all__ = ["numbers", "claim_cells", "decimals", "no_names", "joint_values", "determinant", "shape_readings",
+           "shape_to", "ShapeMismatch", "MAX_ENTRIES", "MAX_DET_SIZE", "MAX_DET_WORK"]
 
 #: Most entries in one claimed value (a 64-joint mass matrix has 4096).
 MAX_ENTRIES = 4096
 
 
-def _values(raw: Any, resolve) -> list[list[tuple]]:
+def claim_cells(raw: Any, resolve) -> list[list[tuple]]:
     """A claim's value: a LaTeX/plain string (matrix or scalar) or a YAML list (of lists)."""
     if isinstance(raw, (int, float)) and not isinstance(raw, bool):
         return [[_expr.parse(raw)]]
@@ -55,18 +56,18 @@ def _values(raw: Any, resolve) -> list[list[tuple]]:
     raise ParseError("'value' must be a formula (string) or a list of entries / rows")
 
 
-def _decimals(node: tuple) -> int:
+def decimals(node: tuple) -> int:
     """The most decimals of any number written in a tree (0 if none)."""
     kind = node[0]
     if kind == "num":
         s = node[1]
         return len(s.split(".")[1]) if "." in s and "e" not in s.lower() else 0
     if kind == "neg":
-        return _decimals(node[1])
+        return decimals(node[1])
     if kind == "bin":
-        return max(_decimals(node[2]), _decimals(node[3]))
+        return max(decimals(node[2]), decimals(node[3]))
     if kind == "call":
-        return max((_decimals(a) for a in node[2]), default=0)
+        return max((decimals(a) for a in node[2]), default=0)
     return 0
 
 
@@ -91,7 +92,7 @@ def _fits(claimed: list[list[tuple]], shape: tuple[int, ...]) -> bool:
     return (r, c) == shape
 
 
-def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
+def shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[tuple]]:
     r, c = len(claimed), len(claimed[0])
     if not _fits(claimed, shape):
         raise ShapeMismatch(f"expected {_describe(shape)}, got a {r}×{c} value")
@@ -103,7 +104,7 @@ def _shape_to(claimed: list[list[tuple]], shape: tuple[int, ...]) -> list[list[t
 _ROW_NAMES = ("vx", "vy", "vz", "ωx", "ωy", "ωz")
 
 
-def _readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: list[list[tuple]]):
+def shape_readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: list[list[tuple]]):
     """Ways to read a value of another shape as part of the quantity: [(label or None, function on one truth)].
 
     A 3×4 value of a pose is its top rows [R | p]; a 3-row (or 2-row) Jacobian or twist written without 'rows' is
@@ -138,7 +139,7 @@ def _readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: list[lis
     return out
 
 
-def _no_names(ident) -> tuple:
+def no_names(ident) -> tuple:
     raise ParseError(f"unknown symbol {ident.plain!r} (joint values are numbers; pi is allowed)")
 
 
@@ -171,7 +172,7 @@ def numbers(raw: Any, n: int, what: str, *, marked: list[bool] | None = None) ->
     out = []
     for i, v in enumerate(items, start=1):
         try:
-            node = _expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), _no_names, rhs=False)
+            node = _expr.parse(v) if isinstance(v, (int, float)) else parse_math(str(v), no_names, rhs=False)
             out.append(_expr.evaluate(node))
         except ParseError as exc:
             raise ParseError(f"{what}: value {i} ({str(v)[:40]!r}): {exc}") from None
@@ -212,7 +213,7 @@ def _has_degrees(node: tuple) -> bool:
 _DEG_HEADER = re.compile(r"\[\s*deg\s*\]|\(\s*deg\s*\)|\[\s*°\s*\]|\\text\{\s*deg\s*\}")
 
 
-def _joint_values(raw: Any, robot: DHRobot, what: str, deg: bool) -> np.ndarray:
+def joint_values(raw: Any, robot: DHRobot, what: str, deg: bool) -> np.ndarray:
     if isinstance(raw, str) and "=" in raw and _DEG_HEADER.search(raw[:raw.rindex("=")]):
         deg = True  # (θ_1, …, θ_6)[deg] = (0, 45, …): the unit is written before the values
     marked: list[bool] = []
@@ -229,7 +230,7 @@ MAX_DET_SIZE = 6
 MAX_DET_WORK = 200_000
 
 
-def _determinant(cells: list[list[tuple]]) -> tuple:
+def determinant(cells: list[list[tuple]]) -> tuple:
     """det of a square matrix of trees, by Laplace expansion (sums balanced, so the tree stays shallow)."""
     import itertools
 
