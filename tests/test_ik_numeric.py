@@ -320,3 +320,26 @@ def test_reason_is_never_limits_when_the_limits_allow_every_angle():
     assert (~res.success).sum() > 0  # two iterations from random seeds: most fail
     assert not np.any(res.reason == "limits"), set(res.reason)
     assert np.all(np.isin(res.reason[~res.success], ["iterations", "unreachable"]))
+
+
+@pytest.mark.parametrize("name", ["puma560", "stanford"])
+def test_targets_beyond_reach_are_unreachable_at_once_without_warnings(name):
+    """|p − t(C0)| ≤ Σ|t(C_k)| + Σ max|q_prismatic| bounds every reachable point: targets beyond are answered
+    without iterating, and targets up to 1e300 m raise nothing (no OverflowError, no RuntimeWarning)."""
+    import warnings
+
+    robot = denavit.load_robot(name)
+    rng = np.random.default_rng(5)
+    lo, hi = np.maximum(robot.q_limits[:, 0], -0.5), np.minimum(robot.q_limits[:, 1], 0.5)
+    T = denavit.forward_kinematics(robot, rng.uniform(lo, hi, (4, robot.dof)))
+    T[1, :3, 3] = [1e300, -1e300, 1e300]
+    T[3, :3, 3] = [0.0, 0.0, 1e200]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = denavit.solve_ik(robot, T, rng=np.random.default_rng(0))
+        one = denavit.solve_ik(robot, T[1])
+    assert list(res.reason[[1, 3]]) == ["unreachable"] * 2 and not res.success[[1, 3]].any()
+    assert (res.iterations[[1, 3]] == 0).all() and np.isfinite(res.position_error).all()
+    assert res.success[[0, 2]].all()  # the others are solved as before
+    np.testing.assert_allclose(denavit.forward_kinematics(robot, res.q[[0, 2]]), T[[0, 2]], atol=1e-8)
+    assert one.reason == "unreachable" and one.iterations == 0 and one.position_error > 1e299

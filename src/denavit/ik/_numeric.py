@@ -16,6 +16,7 @@ import numpy as np
 from .._validate import as_joint_array, as_transform
 from ..model import DHRobot
 from ._chain import damped_solve
+from ..chain import screws_of
 from ._residual import (LAMBDA0, LAMBDA_MAX, IKResult, JointLimits, characteristic_length, limits_of, pose_error, row_mask,
                         rotation_log)
 from ._kernel import kernel_of, targets_soa
@@ -167,9 +168,27 @@ def _converged(e, w, tol_p, tol_r, L):
 
 def _residuals(robot, q, T_t, mask):
     e = pose_error(T_t, forward_kinematics(robot, q))
-    pe = np.linalg.norm(e[..., :3] * mask[:3], axis=-1)
-    re = np.linalg.norm(e[..., 3:] * mask[3:], axis=-1)
-    return pe, re
+    return _norm3(e[..., :3] * mask[:3]), _norm3(e[..., 3:] * mask[3:])
+
+
+def _norm3(v: np.ndarray) -> np.ndarray:
+    """|v| over the last axis (3) without overflow for components up to the largest float."""
+    return np.hypot(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
+
+
+def _out_of_reach(robot: DHRobot, Tf: np.ndarray, w_mask: np.ndarray, limits, tol: float) -> np.ndarray:
+    """Targets (B,) whose (masked) position is farther from the base than the arm reaches within the limits.
+
+    |p(q) − t(C0)| ≤ Σ_{k≥1} |t(C_k)| + Σ_prismatic max |q_k| for the chain C0 J1 C1 ⋯ Jn Cn (rotations keep
+    lengths), and a masked distance is at most the full one: such a target is unreachable for every q, with
+    no iteration.  Arms with an unlimited prismatic joint reach everywhere: nothing is screened."""
+    screws = screws_of(robot)
+    lim = np.maximum(np.abs(limits.lo), np.abs(limits.hi))[screws.prismatic]
+    R = float(np.hypot.reduce(screws.consts[1:, :3, 3], axis=-1).sum() + lim.sum())
+    if not np.isfinite(R):
+        return np.zeros(len(Tf), dtype=bool)
+    d = _norm3((Tf[:, :3, 3] - screws.consts[0, :3, 3]) * w_mask[:3])
+    return ~(d <= R * (1.0 + 1e-12) + tol)  # NaN distances too: never iterated
 
 
 def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = "pose", tol: float = TOL,
@@ -238,11 +257,32 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
     q = limits.project(q)
     q_seed = q
+    far = _out_of_reach(robot, Tf, w_mask, limits, tol)
+    if far.any():  # answered without iterating; the others solved as a batch of their own
+        pe, re = _residuals(robot, q, Tf, w_mask)
+        success, iters, used = np.zeros(B, dtype=bool), np.zeros(B, dtype=int), np.zeros(B, dtype=int)
+        reason = np.full(B, "unreachable", dtype=object)
+        near = np.flatnonzero(~far)
+        if len(near):
+            rest = solve_ik(robot, Tf[near], q[near], mask=mask, tol=tol, max_iterations=max_iterations,
+                            restarts=restarts, respect_limits=respect_limits, rng=rng)
+            q[near], success[near], pe[near], re[near] = rest.q, rest.success, rest.position_error, rest.orientation_error
+            iters[near], used[near], reason[near] = rest.iterations, rest.restarts, rest.reason
+        return _pack(batch, n, q, success, pe, re, iters, used, reason)
     if batch == ():  # one target: its first attempt in floats; the batched search below if that fails
         single = solve_single(robot, q[0], Tf[0], w, w_mask, limits, max_iterations, tol, L)
         if single is not None:
             return single
     rng = np.random.default_rng() if rng is None else rng
+    with np.errstate(over="ignore", invalid="ignore"):  # targets ~1e300 m away (an unlimited prismatic joint)
+        return _solve_batch(robot, batch, n, q, q_seed, Tf, w, w_mask, mask, limits, max_iterations, restarts,
+                            respect_limits, tol, L, rng)
+
+
+def _solve_batch(robot, batch, n, q, q_seed, Tf, w, w_mask, mask, limits, max_iterations, restarts, respect_limits,
+                 tol, L, rng) -> IKResult:
+    """The batched search of :func:`solve_ik`: LM with restarts, then the rescue, then the reasons.  Overflow on
+    the way (a target 1e300 m away) makes non-finite steps, which fail the FK test like any bad step."""
     q, iters, n_restarts, stalled = _search(robot, q, Tf, w, limits, max_iterations, restarts, tol, L, rng)
     q = limits.project(q)
     pe, re = _residuals(robot, q, Tf, w_mask)

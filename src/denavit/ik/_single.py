@@ -21,7 +21,7 @@ solution within the limits, so the quality of the result is that of the batched 
 
 from __future__ import annotations
 
-from math import acos, pi, sin, sqrt
+from math import acos, hypot, pi, sin, sqrt
 
 import numpy as np
 
@@ -144,8 +144,8 @@ def first_attempt(chain: SingleChain, q0, T, w, lo, hi, revolute, max_iter: int,
     floor, stuck = 1e-12 * L * L, lambda_max * L * L
     while True:
         # converged: the same margin below tol as the batched solver's test
-        pe = sqrt(sum((e[i] * wp[i]) ** 2 for i in range(3)))
-        re = sqrt(sum((e[i + 3] * wr[i]) ** 2 for i in range(3)))
+        pe = hypot(e[0] * wp[0], e[1] * wp[1], e[2] * wp[2])
+        re = hypot(e[3] * wr[0], e[4] * wr[1], e[5] * wr[2])
         if pe <= 0.5 * tol and re <= 0.5 * tol:
             qf = _fold(q, lo, hi, revolute)
             inside = all(lo[k] - 1e-12 <= qf[k] <= hi[k] + 1e-12 for k in range(n))
@@ -170,8 +170,8 @@ def first_attempt(chain: SingleChain, q0, T, w, lo, hi, revolute, max_iter: int,
 
 
 def _conv(e, wp, wr, tol):
-    pe = sqrt(sum((e[i] * wp[i]) ** 2 for i in range(3)))
-    re = sqrt(sum((e[i + 3] * wr[i]) ** 2 for i in range(3)))
+    pe = hypot(e[0] * wp[0], e[1] * wp[1], e[2] * wp[2])
+    re = hypot(e[3] * wr[0], e[4] * wr[1], e[5] * wr[2])
     return pe <= 0.5 * tol and re <= 0.5 * tol
 
 
@@ -220,4 +220,4 @@ def _fk_error(robot: DHRobot, q: np.ndarray, T: np.ndarray, mask: list) -> tuple
     dp = [(Tl[i][3] - F[i][3]) if mask[i] else 0.0 for i in range(3)]
     M = [[Tl[i][0] * F[j][0] + Tl[i][1] * F[j][1] + Tl[i][2] * F[j][2] for j in range(3)] for i in range(3)]
     dw = [v if mask[3 + i] else 0.0 for i, v in enumerate(_log(M))]
-    return sqrt(dp[0] ** 2 + dp[1] ** 2 + dp[2] ** 2), sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2)
+    return hypot(dp[0], dp[1], dp[2]), hypot(dw[0], dw[1], dw[2])
