@@ -33,11 +33,6 @@ def _raise_value_error(text):
     return int(text)
 
 
-def _spin(*args):
-    while True:
-        pass
-
-
 @pytest.fixture
 def threads_alive():
     """A thread holding _HELD and a thread pool with a running task, for the duration of the test."""
@@ -102,13 +97,11 @@ def test_cpu_bounded_from_several_threads_at_once(threads_alive):
         assert len(os.listdir(f"/proc/{_bounded._worker.pid}/task")) == 1
 
 
-def test_cpu_bounded_raises_the_functions_exception_and_stops_at_its_cpu_limit(threads_alive):
+def test_cpu_bounded_raises_the_functions_exception(threads_alive):
+    """(None past the CPU limit: test_check_limits' spinning analysis.)"""
     with pytest.raises(ValueError, match="invalid literal"):
         _bounded.cpu_bounded(_raise_value_error, ("x",), 5)
-    t = time.perf_counter()
-    assert _bounded.cpu_bounded(_spin, (), 1) is None
-    assert time.perf_counter() - t < 30
-    assert _bounded.cpu_bounded(abs, (-2.5,), 1) == 2.5  # the worker still serves after a child was stopped
+    assert _bounded.cpu_bounded(abs, (-2.5,), 1) == 2.5
 
 
 def test_a_fork_of_the_caller_gets_its_own_worker_even_while_a_thread_holds_the_callers_turn(threads_alive):
@@ -167,11 +160,11 @@ def test_an_interrupted_call_leaves_no_stale_reply_for_the_next(threads_alive):
 
     old = signal.signal(signal.SIGALRM, interrupt)
     try:
-        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        signal.setitimer(signal.ITIMER_REAL, 0.2)
         with pytest.raises(Interrupted):
-            _bounded.cpu_bounded(_sleep_then, ("stale", 1.5), 5)
+            _bounded.cpu_bounded(_sleep_then, ("stale", 0.5), 5)
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
-    time.sleep(1.5)  # the interrupted call's reply would be waiting by now
+    time.sleep(0.6)  # the interrupted call's reply would be waiting by now
     assert _bounded.cpu_bounded(_sleep_then, ("fresh", 0.0), 5) == "fresh"
