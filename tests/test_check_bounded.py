@@ -168,3 +168,11 @@ def test_an_interrupted_call_leaves_no_stale_reply_for_the_next(threads_alive):
         signal.signal(signal.SIGALRM, old)
     time.sleep(0.6)  # the interrupted call's reply would be waiting by now
     assert _bounded.cpu_bounded(_sleep_then, ("fresh", 0.0), 5) == "fresh"
+
+
+def test_without_an_interpreter_to_start_the_call_counts_as_out_of_time(monkeypatch):
+    """An embedded Python whose sys.executable cannot be started: None (a claim is then judged on its own
+    conditions, never 'correct'), not a crash."""
+    monkeypatch.setattr(_bounded, "_worker", None)
+    monkeypatch.setattr(_bounded.sys, "executable", "/nonexistent/python")
+    assert _bounded.cpu_bounded(abs, (-3,), 1) is None

@@ -258,7 +258,10 @@ def _run_in_worker(fn: Callable, args: tuple, seconds: float, warm: tuple[str, .
     for _ in range(2):  # a worker that has ended (past its safety net, or killed by its user) is started again once
         if _worker is None or _worker.poll() is not None:
             _stop_worker()
-            _worker = _start_worker()
+            try:
+                _worker = _start_worker()
+            except OSError:  # no interpreter to start (an embedded Python): the bound cannot be kept
+                return "limit", None
         try:
             _write(_worker.stdin, request)
         except OSError:
