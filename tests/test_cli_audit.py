@@ -32,6 +32,19 @@ def run_captured(*argv):
     return code, out.getvalue(), err.getvalue()
 
 
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def run_tty(*argv):
+    """``main(argv)`` with stderr a terminal (progress notes shown) and stdout captured."""
+    out, err = io.StringIO(), _Terminal()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([str(a) for a in argv])
+    return code, out.getvalue(), err.getvalue()
+
+
 def _strict(text):
     """json.loads that rejects NaN / Infinity (RFC 8259), as a browser or jq would."""
     def bad(c):
@@ -220,23 +233,29 @@ def test_simulate_text_names_the_unit_of_its_q_columns(capsys, deg):
 
 def test_compile_reports_its_stages_on_stderr_only_without_json(capsys, tmp_path, monkeypatch):
     # a first numba compile takes 5 s and more, and printed nothing until it was done
+    # (at a terminal: piped, a failure must stay one line on stderr)
     monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path))
-    code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy")
+    code, out, err = run_tty("compile", "planar2r", "--backend", "numpy")
     assert code == 0 and "generating the kernels" in err and "compiling and timing" in err
     assert "compiling and timing" not in out and out.startswith("planar2r: 2 joints, backend numpy")
-    code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy", "--json")
+    code, out, err = run_tty("compile", "planar2r", "--backend", "numpy", "--json")
     assert code == 0 and err == "" and _strict(out)["backend"] == "numpy"
+    code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy")
+    assert code == 0 and err == ""
 
 
 def test_animate_says_it_is_rendering_on_stderr_only_without_json(capsys, tmp_path):
     # a default 2 s move of the PUMA took 5 s to render with nothing on the terminal
     pytest.importorskip("matplotlib")
+    # (at a terminal: piped, a failure such as a full disk must stay one line on stderr)
     argv = ["animate", "planar2r", "--from", "0,0", "--to", "0.1,0.1", "--duration", "0.2", "--fps", "5"]
-    code, out, err = run(capsys, *argv, "-o", tmp_path / "a.gif")
+    code, out, err = run_tty(*argv, "-o", tmp_path / "a.gif")
     assert code == 0 and err.strip() == f"denavit animate: rendering 2 frames to {tmp_path / 'a.gif'}"
     assert out.startswith(f"wrote {tmp_path / 'a.gif'} (2 frames")
-    code, out, err = run(capsys, *argv, "-o", tmp_path / "b.gif", "--json")
+    code, out, err = run_tty(*argv, "-o", tmp_path / "b.gif", "--json")
     assert code == 0 and err == "" and _strict(out)["frames"] == 2
+    code, out, err = run(capsys, *argv, "-o", tmp_path / "c.gif")
+    assert code == 0 and err == ""
 
 
 ONE_JOINT = """name: one
@@ -290,3 +309,29 @@ def test_show_json_says_its_angle_unit_and_follows_deg(capsys, name):
     revolute = np.array([t.value == "revolute" for t in robot.joint_types])
     for k, q in robot.poses:
         assert deg["poses"][k] == pytest.approx(np.where(revolute, np.degrees(q), q).tolist())
+
+
+@settings(max_examples=15 if REDUCED else 50, deadline=None)
+@given(st.sampled_from(["scara", "stanford", "puma560", "cylindrical-rpp"]), st.data())
+def test_deg_reads_each_value_in_its_own_unit(name, data):
+    # with --deg, "90deg" and "pi/2" were converted twice (read as 1.57 degrees), and fk --json gave a prismatic
+    # joint's metres multiplied by 180/pi
+    from denavit import forward_kinematics, load_robot
+
+    robot = load_robot(name)
+    lim = np.clip(robot.q_limits, -3.0, 3.0)
+    q = np.array([data.draw(st.floats(lo, hi)) for lo, hi in lim])
+    parts = []
+    for v, t in zip(q, robot.joint_types):
+        if t.value != "revolute":
+            parts.append(repr(float(v)))  # metres whatever --deg says
+        else:
+            form = data.draw(st.sampled_from(["plain", "deg", "pi"]))
+            parts.append({"plain": repr(float(np.degrees(v))), "deg": f"{float(np.degrees(v))!r}deg",
+                          "pi": f"{float(v / np.pi)!r}*pi"}[form])
+    code, out, err = run_captured("fk", name, "-q", ", ".join(parts), "--deg", "--json")
+    assert code == 0, err
+    got = _strict(out)
+    np.testing.assert_allclose(got["T"], forward_kinematics(robot, q), atol=1e-9)
+    revolute = np.array([t.value == "revolute" for t in robot.joint_types])
+    np.testing.assert_allclose(got["q"], np.where(revolute, np.degrees(q), q), rtol=1e-12, atol=1e-9)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -32,7 +33,8 @@ def cmd_compile(args: argparse.Namespace):
     from ..codegen import cache_dir, compile
 
     robot = load(args)
-    show = stage_printer(args, "compile") or (lambda stage: None)
+    # at a terminal only, so that a failure (no numba, an unwritable cache) stays one line on stderr
+    show = (stage_printer(args, "compile") if sys.stderr.isatty() else None) or (lambda stage: None)
     t0 = time.perf_counter()
     show("generating the kernels (from the cache when this arm was compiled before)")
     fast = compile(robot, backend=args.backend)

@@ -281,6 +281,9 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
     else:
         try:
             vals = check_values(parse_values(text, robot.dof, what=what), what)
+            if args.deg:  # plain numbers of revolute joints in degrees; a value with pi or deg says its unit
+                revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
+                vals = np.where(revolute, parse_values(text, robot.dof, what=what, deg=True), vals)
         except ParseError:
             name = text.strip()
             if not rates and name.isidentifier() and len(name) <= 40:
@@ -288,9 +291,6 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
                 raise ParseError(f"{what}: {name!r} is neither {robot.dof} joint values nor a named pose of "
                                  f"{robot.name} (its poses: {known})") from None
             raise
-    if args.deg and pose is None:
-        revolute = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-        vals = np.where(revolute, np.radians(vals), vals)
     if check_limits and not rates and not getattr(args, "ignore_limits", False):
         lim = robot.q_limits
         for k in range(robot.dof):

@@ -118,6 +118,7 @@ def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:
 
 def cmd_fk(args: argparse.Namespace):
     from ..numeric import forward_kinematics, link_transforms, rpy_from_rotation, zyz_from_rotation
+    from ._shared import q_out, q_text
 
     robot = load(args)
     data: dict = {"robot": robot.name, "convention": robot.convention.value}
@@ -135,12 +136,11 @@ def cmd_fk(args: argparse.Namespace):
         zyz = zyz_from_rotation(T[:3, :3])
         unit = "deg" if args.deg else "rad"
         conv = np.degrees if args.deg else (lambda x: x)
-        data.update({"q": conv(q) if args.deg else q, "angle_unit": unit, "T": T, "position": T[:3, 3],
+        data.update({"q": q_out(args, robot, q), "angle_unit": unit, "T": T, "position": T[:3, 3],
                      "rpy": conv(rpy), "zyz": conv(zyz)})
         if lines:
             lines.append("")
-        lines += [f"{robot.name}: end-effector pose at q = [{numbers_text(conv(q) if args.deg else q)}]"
-                  f" ({unit})", "T_0_e =", matrix_text(T),
+        lines += [f"{robot.name}: end-effector pose at {q_text(args, robot, q)}", "T_0_e =", matrix_text(T),
                   f"position [m]: {numbers_text(T[:3, 3])}",
                   f"RPY (roll, pitch, yaw) [{unit}]: {numbers_text(conv(rpy))}",
                   f"ZYZ (phi, theta, psi) [{unit}]: {numbers_text(conv(zyz))}"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 import numpy as np
 
@@ -10,6 +11,7 @@ from ..errors import ParseError
 from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
                       joint_values, load, numbers_text, output_file, require_finite,
                       stage_printer)
+from ._shared import q_out
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
 PICTURES = (".png", ".svg", ".pdf")
@@ -62,15 +64,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=cmd_view)
 
 
-def _out_q(args, robot, q: np.ndarray) -> np.ndarray:
-    from ..model import JointType
-
-    if not args.deg:
-        return q
-    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-    return np.where(rev, np.degrees(q), q)
-
-
 def _fmt(v) -> str:
     return "[" + numbers_text(v) + "]"
 
@@ -94,9 +87,9 @@ def cmd_plot(args: argparse.Namespace):
     with output_file(args.output) as tmp:
         save_figure(fig, tmp, dpi=args.dpi)
     unit = "deg" if args.deg else "rad"
-    data = {"robot": robot.name, "q": _out_q(args, robot, q), "angle_unit": unit, "output": args.output,
+    data = {"robot": robot.name, "q": q_out(args, robot, q), "angle_unit": unit, "output": args.output,
             "T": geom.end_effector, "joint_positions": geom.joint_positions, "skeleton": geom.skeleton}
-    return data, f"wrote {args.output} ({robot.name} at q = {_fmt(_out_q(args, robot, q))} {unit})"
+    return data, f"wrote {args.output} ({robot.name} at q = {_fmt(q_out(args, robot, q))} {unit})"
 
 
 def _move(args, robot, q1: np.ndarray, q2: np.ndarray, k: int):
@@ -125,13 +118,13 @@ def cmd_animate(args: argparse.Namespace):
     qs, cp = _move(args, robot, q1, q2, k)
     ee = forward_kinematics(robot, qs)[:, :3, 3]
     require_finite("animate", qs, ee)
-    show = stage_printer(args, "animate")
+    show = stage_printer(args, "animate") if sys.stderr.isatty() else None  # at a terminal: a failure stays one line
     if show:  # a few seconds for a default 2 s move; no per-frame progress from the renderer
         show(f"rendering {k} frames to {args.output}")
     with output_file(args.output) as tmp:
         animate_robot(robot, qs, tmp, fps=args.fps, frames=not args.no_frames)
     unit = "deg" if args.deg else "rad"
-    data = {"robot": robot.name, "q_from": _out_q(args, robot, q1), "q_to": _out_q(args, robot, q2),
+    data = {"robot": robot.name, "q_from": q_out(args, robot, q1), "q_to": q_out(args, robot, q2),
             "angle_unit": unit, "profile": args.profile, "duration": args.duration, "fps": args.fps, "frames": k,
             "output": args.output, "end_effector_path": ee, "success": True}
     text = [f"wrote {args.output} ({k} frames, {args.duration:g} s, {args.profile} profile)"]
@@ -161,7 +154,7 @@ def cmd_view(args: argparse.Namespace):
         write_viewer(robot, tmp, q)
         size = Path(tmp).stat().st_size
     path = Path(args.output)
-    data = {"robot": robot.name, "q": _out_q(args, robot, q), "angle_unit": "deg" if args.deg else "rad",
+    data = {"robot": robot.name, "q": q_out(args, robot, q), "angle_unit": "deg" if args.deg else "rad",
             "output": str(path), "bytes": size}
     return data, f"wrote {path} ({size // 1024} KiB, self-contained: open it in any browser, no network needed)"
 
