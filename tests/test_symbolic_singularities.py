@@ -198,11 +198,11 @@ def test_determinant_by_expansion_equals_fraction_free_elimination():
     determinant of the same polynomial matrix (Puma 560 with a generic 0.7 rad twist on row 2)."""
     from sympy.polys.matrices import DomainMatrix
 
-    from denavit.symbolic._singularities import _laplace_det, _wrist_frame_jacobian
+    from denavit.symbolic._singular_ring import laplace_det, wrist_frame_jacobian
 
-    _, _, rg, J = _wrist_frame_jacobian(_puma_with_twist(1), "none")
+    _, _, rg, J = wrist_frame_jacobian(_puma_with_twist(1), "none")
     bareiss = DomainMatrix([list(row) for row in J], (6, 6), rg.R.to_domain()).det()
-    assert rg.reduce(_laplace_det(rg, J) - bareiss) == 0 and bareiss != 0
+    assert rg.reduce(laplace_det(rg, J) - bareiss) == 0 and bareiss != 0
 
 
 def test_a_float_twist_and_its_negative_are_one_generator():
