@@ -4,16 +4,12 @@ Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the r
 """
 
 from ._ik import IKDerivation, IKStep, ik_derivation
-from ._dynamics import (
-    DynamicsTerms,
-    christoffel_matrix,
-    christoffel_symbols,
-    format_dynamics,
-    inertial_pieces,
-    lagrangian_dynamics,
-)
+from ._dynamics import christoffel_matrix, christoffel_symbols, lagrangian_dynamics
+from ._dynamics_data import inertial_pieces
+from ._dynamics_format import format_dynamics
 from ._dynamics_trig import fourier_form
-from ._dynamics_ring import PARAMETER_NAMES, regressor_sym
+from ._dynamics_types import DynamicsTerms
+from ._regressor import PARAMETER_NAMES, regressor_sym
 from ._recursive import HAND_FORM_MAX_DOF, RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
 from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
@@ -37,7 +33,8 @@ from ._propagation import (
     velocity_propagation_sym,
     wrench_symbols,
 )
-from ._singularities import SingularCondition, SingularityAnalysis, SingularSolution, singularity_analysis
+from ._singularities import singularity_analysis
+from ._singular_types import SingularCondition, SingularityAnalysis, SingularSolution
 from ._simplify import POLICIES, shorthand, shorthand_matrix, simplify_expr, simplify_matrix
 from ._symbols import JointSymbols, exact_or_float, joint_symbols, matrix_from_floats, parameter_symbols, row_expressions
 

@@ -17,18 +17,9 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..model import DHRobot, JointType
-from ._dynamics import (
-    DynamicsTerms,
-    Progress,
-    _report,
-    friction_vector,
-    gravity_base,
-    inertial_pieces,
-    joint_axes_sym,
-    joint_parameters,
-    make_simplifier,
-    terms_from_tau,
-)
+from ._dynamics import make_simplifier, terms_from_tau
+from ._dynamics_data import friction_vector, gravity_base, inertial_pieces, joint_axes_sym, joint_parameters
+from ._dynamics_types import DynamicsTerms, Progress, report_progress
 from ._kinematics import link_transforms_sym
 from ._symbols import joint_symbols
 
@@ -94,7 +85,7 @@ def lagrange_steps(robot: DHRobot, simplify: str = "trig", numeric: bool = False
     pieces = inertial_pieces(robot, numeric)
     p_c, pd_c, omega, K_parts, P_parts = [], [], [], [], []
     for idx, p in enumerate(pieces):
-        _report(progress, "Lagrange: energies", idx, len(pieces))
+        report_progress(progress, "Lagrange: energies", idx, len(pieces))
         F = T[p.row + 1]
         R = F[:3, :3]
         pc = vsimp(R * p.com + F[:3, 3])
@@ -117,7 +108,7 @@ def lagrange_steps(robot: DHRobot, simplify: str = "trig", numeric: bool = False
     K = simp(sp.Add(*K_parts))
     P = simp(sp.Add(*P_parts))
     L = K - P
-    _report(progress, "Lagrange: Euler-Lagrange equations", 0, 1)
+    report_progress(progress, "Lagrange: Euler-Lagrange equations", 0, 1)
     dL_dqd = tuple(simp(sp.diff(L, s)) for s in qd)
     ddt = tuple(simp(time_derivative(e, q, qd, qdd)) for e in dL_dqd)
     dL_dq = tuple(simp(sp.diff(L, s)) for s in q)
@@ -125,7 +116,7 @@ def lagrange_steps(robot: DHRobot, simplify: str = "trig", numeric: bool = False
     rigid = [simp(a - b) for a, b in zip(ddt, dL_dq)]
     tau = sp.ImmutableMatrix([r + f for r, f in zip(rigid, friction)])
     terms = terms_from_tau(sp.Matrix(rigid), q, qd, qdd, friction, simp)
-    _report(progress, "done", 1, 1)
+    report_progress(progress, "done", 1, 1)
     return LagrangeSteps(
         q, qd, qdd, tuple((p.row, p.body) for p in pieces), g0, tuple(p_c), tuple(pd_c), tuple(omega),
         tuple(K_parts), tuple(P_parts), K, P, L, dL_dqd, ddt, dL_dq, tau, terms,

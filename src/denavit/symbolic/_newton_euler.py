@@ -22,17 +22,9 @@ import sympy as sp
 
 from ..chain import Symbolic, chain_of
 from ..model import DHRobot, JointType
-from ._dynamics import (
-    DynamicsTerms,
-    Progress,
-    _report,
-    friction_vector,
-    gravity_base,
-    inertial_pieces,
-    joint_parameters,
-    make_simplifier,
-    terms_from_tau,
-)
+from ._dynamics import make_simplifier, terms_from_tau
+from ._dynamics_data import friction_vector, gravity_base, inertial_pieces, joint_parameters
+from ._dynamics_types import DynamicsTerms, Progress, report_progress
 from ._symbols import joint_symbols
 
 __all__ = ["NewtonEulerSteps", "newton_euler_dynamics"]
@@ -95,7 +87,7 @@ def newton_euler_dynamics(robot: DHRobot, simplify: str = "trig", numeric: bool 
     w, wd, a = sp.zeros(3, 1), sp.zeros(3, 1), -sp.Matrix(gravity_base(robot))
     W, WD, ACC, F_body, N_body = [], [], [], [], []
     for k in range(n):
-        _report(progress, "Newton-Euler: outward", k, n)
+        report_progress(progress, "Newton-Euler: outward", k, n)
         R, p = steps[k][:3, :3], steps[k][:3, 3]
         a = R.T * (a + wd.cross(p) + w.cross(w.cross(p)))
         wd, w = R.T * wd, R.T * w
@@ -126,7 +118,7 @@ def _inward(robot, js, steps, W, WD, ACC, F_body, N_body, simp, numeric, progres
     f, m = sp.zeros(3, 1), sp.zeros(3, 1)
     rigid = [sp.Integer(0)] * n
     for k in range(n - 1, -1, -1):
-        _report(progress, "Newton-Euler: inward", n - 1 - k, n)
+        report_progress(progress, "Newton-Euler: inward", n - 1 - k, n)
         if k < n - 1:
             R, p = steps[k + 1][:3, :3], steps[k + 1][:3, 3]
             f_next = R * f
@@ -139,7 +131,7 @@ def _inward(robot, js, steps, W, WD, ACC, F_body, N_body, simp, numeric, progres
     rigid = [simp(r + armature[k] * qdd[k]) for k, r in enumerate(rigid)]
     friction = friction_vector(robot, qd, numeric)
     terms = terms_from_tau(sp.Matrix(rigid), q, qd, qdd, friction, simp)
-    _report(progress, "done", 1, 1)
+    report_progress(progress, "done", 1, 1)
     return NewtonEulerSteps(q, qd, qdd, tuple(sp.ImmutableMatrix(s) for s in steps), tuple(W), tuple(WD),
                             tuple(ACC), tuple(f_out), tuple(n_out),
                             sp.ImmutableMatrix([r + fr for r, fr in zip(rigid, friction)]), terms)

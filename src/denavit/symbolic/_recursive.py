@@ -175,7 +175,7 @@ def recursive_dynamics(robot: DHRobot, numeric: bool = False) -> RecursiveDynami
     >>> [(str(name), str(formula)) for name, formula, _ in rd.definitions if str(name) == "hb2x"]
     [('hb2x', 'L2*m2')]
     """
-    from ._dynamics import friction_vector, gravity_base, inertial_pieces, joint_parameters
+    from ._dynamics_data import friction_vector, gravity_base, inertial_pieces, joint_parameters
 
     n = robot.dof
     js = joint_symbols(n)
@@ -321,7 +321,7 @@ def format_recursive(rd: RecursiveDynamics, style: str = "text", digits: int | N
     Sines and cosines are written S3, C3 (LaTeX S_{3}); fractions with denominators above 12 as decimals of
     ``digits`` significant digits; M by its upper triangle.
     """
-    from ._dynamics import _display, _tex_label, _trim
+    from ._dynamics_format import display_entry, tex_label, trim_zeros
 
     if style not in ("text", "latex", "markdown"):
         raise ValueError(f"unknown style {style!r}; choose one of text, latex, markdown")
@@ -329,7 +329,7 @@ def format_recursive(rd: RecursiveDynamics, style: str = "text", digits: int | N
     def show(e):
         if digits is not None:  # float constants (cos 0.7 of a generic twist) to the same digits as fractions
             e = e.xreplace({x: sp.Float(x, digits) for x in e.atoms(sp.Float)})
-        return _display(e, rd.q, digits, True, collapse=False)
+        return display_entry(e, rd.q, digits, True, collapse=False)
 
     blocks: list[tuple[str, list[tuple[str, sp.Expr]]]] = []
     for key in list(SECTIONS)[:-1]:
@@ -346,15 +346,15 @@ def format_recursive(rd: RecursiveDynamics, style: str = "text", digits: int | N
     notes = ["body frame B_j: attached to body j, z along joint j's axis; vectors in B_j axes",
              "M is symmetric: M[k,j] = M[j,k]", "Ci = cos(qi), Si = sin(qi)"]
     if rd.gravity is not None:
-        notes.insert(0, f"g = {_trim(sp.sstr(sp.Float(rd.gravity, 6)))} m/s^2 (gravitational acceleration)")
+        notes.insert(0, f"g = {trim_zeros(sp.sstr(sp.Float(rd.gravity, 6)))} m/s^2 (gravitational acceleration)")
     if style == "text":
         lines = [head] + [f"  {x}" for x in notes]
         for key, rows in blocks:
-            lines += ["", f"# {SECTIONS[key]}"] + [f"{k} = {_trim(sp.sstr(e))}" for k, e in rows]
+            lines += ["", f"# {SECTIONS[key]}"] + [f"{k} = {trim_zeros(sp.sstr(e))}" for k, e in rows]
         return "\n".join(lines)
     names = {s: _tex_name(str(s)) for _, rows in blocks for _, e in rows for s in e.free_symbols}
     names.update({s: f"\\dot{{q}}_{{{k + 1}}}" for k, s in enumerate(rd.qd)})
-    label = lambda k: _tex_label(k) if "[" in k else _tex_name(k)  # noqa: E731
+    label = lambda k: tex_label(k) if "[" in k else _tex_name(k)  # noqa: E731
     tex = [(key, [(label(k), sp.latex(e, symbol_names=names)) for k, e in rows]) for key, rows in blocks]
     if style == "latex":
         rows = [f"{k} &= {v}" for _, block in tex for k, v in block] + ["M_{kj} &= M_{jk} \\quad (j < k)"]
