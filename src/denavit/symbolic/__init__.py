@@ -3,7 +3,8 @@
 Results are ``sympy.ImmutableMatrix`` in the joint symbols ``q1…qn`` and the robot's named parameters.
 """
 
-from ._ik import IKDerivation, IKStep, ik_derivation
+from ._ik import ik_derivation
+from ._ik_types import IKDerivation, IKStep
 from ._dynamics import christoffel_matrix, christoffel_symbols, lagrangian_dynamics
 from ._dynamics_data import inertial_pieces
 from ._dynamics_format import format_dynamics
