@@ -335,3 +335,27 @@ def test_deg_reads_each_value_in_its_own_unit(name, data):
     np.testing.assert_allclose(got["T"], forward_kinematics(robot, q), atol=1e-9)
     revolute = np.array([t.value == "revolute" for t in robot.joint_types])
     np.testing.assert_allclose(got["q"], np.where(revolute, np.degrees(q), q), rtol=1e-12, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["stanford", "puma560", "ur5"])
+def test_export_notes_what_the_file_cannot_carry(capsys, tmp_path, name):
+    # an arm without inertial data went out with placeholder masses (MJCF) or none (URDF) and not a word said
+    from denavit import load_robot
+
+    robot = load_robot(name)
+    joints = [link.inertia for link in robot.joints]
+    for fmt, ext in (("urdf", ".urdf"), ("mjcf", ".xml")):
+        path = tmp_path / f"{name}{ext}"
+        code, out, err = run(capsys, f"export-{fmt}", name, "-o", path)
+        assert code == 0
+        notes = [ln for ln in out.splitlines() if ln.startswith("note: ")]
+        code, jout, _ = run(capsys, f"export-{fmt}", name, "--json")
+        assert code == 0 and [f"note: {n}" for n in _strict(jout)["notes"]] == notes
+        text = path.read_text()
+        if all(li is None for li in joints):
+            assert len(notes) == 1 and "no inertial data" in notes[0]
+            assert ("<inertial" not in text) if fmt == "urdf" else ('mass="1e-06"' in text)
+        elif fmt == "urdf" and any(li.motor_inertia > 0 for li in joints):
+            assert len(notes) == 1 and "motor" in notes[0]
+        else:
+            assert notes == []

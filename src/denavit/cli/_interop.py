@@ -75,12 +75,31 @@ def cmd_export(args: argparse.Namespace):
     text = (to_urdf if args.fmt == "urdf" else to_mjcf)(robot)
     data = {"robot": robot.name, "format": args.fmt, "output": args.output, "joints": [f"q{k + 1}" for k in range(robot.dof)],
             "dynamics": robot.has_dynamics}
+    notes = _export_notes(robot, args.fmt)
+    data["notes"] = notes
     if args.output:
         with output_file(args.output) as tmp:
             Path(tmp).write_text(text, encoding="utf-8")
-        return data, f"wrote {args.output} ({args.fmt.upper()}, {_joints(robot.dof)}, tool frame 'tool')"
+        return data, "\n".join([f"wrote {args.output} ({args.fmt.upper()}, {_joints(robot.dof)}, tool frame 'tool')"]
+                               + [f"note: {n}" for n in notes])
     data["text"] = text
     return data, text
+
+
+def _export_notes(robot, fmt: str) -> list[str]:
+    """What the exported file cannot carry of the arm (its JSON lists them; written to stdout they would mix with
+    the XML, so the text shows them only with -o)."""
+    from ..interop import MJCF_MIN_MASS
+
+    rows = [link.inertia for link in robot.joints]
+    if not robot.has_dynamics:
+        missing = sum(li is None for li in rows)
+        return [f"{robot.name} has no inertial data for {missing} of its {robot.dof} joints: " + (
+            "those links have no <inertial> (dynamics in other tools are not the arm's)" if fmt == "urdf" else
+            f"those bodies get a placeholder mass of {MJCF_MIN_MASS:g} kg (MuJoCo's dynamics are not the arm's)")]
+    if fmt == "urdf" and any(li.motor_inertia for li in rows if li is not None):
+        return ["URDF has no place for motor (rotor) inertia: left out, so M differs from denavit's on its diagonal"]
+    return []
 
 
 def _joints(n: int) -> str:
