@@ -1,0 +1,115 @@
+"""Finding the DH table in pasted text: the header row (columns a, alpha, d, theta in any order, tab, ``|`` or ``&``
+separated) and the data rows under it, within the size limits below (see :mod:`denavit.tables`)."""
+
+from __future__ import annotations
+
+import re
+
+from .errors import ParseError
+
+__all__ = ["find_table", "column_kind", "plain_cell", "COLUMNS", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS", "MAX_COLUMNS",
+           "MAX_LINE_CHARS", "MAX_CELL_CHARS"]
+
+#: Largest pasted text read (characters).
+MAX_TABLE_CHARS = 200_000
+#: Most data rows in one table (as many as a robot file's rows).
+MAX_TABLE_ROWS = 64
+#: Most columns in a table row.
+MAX_COLUMNS = 16
+#: Longest line that can be a table row; longer lines (prose) are skipped when looking for the header.
+MAX_LINE_CHARS = 4_000
+#: Longest cell.
+MAX_CELL_CHARS = 500
+COLUMNS = ("a", "alpha", "d", "theta")
+_RULE_CHARS = frozenset(" \t:|-")
+
+
+def _cells(line: str) -> list[str]:
+    s = line.strip()
+    if "\t" in s:
+        cells = s.split("\t")
+    elif s.startswith("|") or s.count("|") >= 3:
+        cells = s.strip("|").split("|")
+    elif "&" in s:
+        cells = _strip_row_end(s).split("&")
+    else:
+        return []
+    return [c.strip() for c in cells]
+
+
+def _strip_row_end(s: str) -> str:
+    """A LaTeX row without its trailing ``\\\\`` (and ``\\hline``), by plain string tests (no backtracking)."""
+    t = s.rstrip()
+    if t.endswith("\\hline"):
+        u = t[:-len("\\hline")].rstrip()
+        if u.endswith("\\\\"):
+            return u[:-2]
+    if t.endswith("\\\\"):
+        return t[:-2]
+    return s
+
+
+def _is_rule(line: str) -> bool:
+    """A Markdown rule such as ``|---|:--:|``: only spaces, tabs, ``:``, ``|`` and ``-`` (with a ``-``)."""
+    return "-" in line and set(line) <= _RULE_CHARS
+
+
+def plain_cell(cell: str) -> str:
+    s = cell.replace("$", " ").replace("\\", " ").replace("{", " ").replace("}", " ").lower()
+    s = s.replace("θ", "theta").replace("α", "alpha").replace("ϑ", "theta")
+    return re.sub(r"\s+", " ", s).strip()
+
+
+def column_kind(cell: str) -> str | None:
+    """``a``/``alpha``/``d``/``theta``/``index`` from a header cell, or None."""
+    s = re.sub(r"\([^()]*\)|\[[^\[\]]*\]", " ", plain_cell(cell)).strip()  # drop units and "(z_{i-1})" remarks
+    head = re.match(r"[a-z]+", s)
+    word = head.group(0) if head else ""
+    if word in ("theta", "vartheta", "heta", "q", "joint_angle") or re.fullmatch(r"q(_?i|_?n)?", s.replace(" ", "")):
+        return "theta"
+    if word in ("alpha", "twist"):
+        return "alpha"
+    if word in ("d", "offset"):
+        return "d"
+    if word in ("a", "r", "length"):
+        return "a"
+    if word in ("i", "link", "joint", "n", "frame", "row", "no", "axis"):
+        return "index"
+    return None
+
+
+def find_table(text: str) -> tuple[list[str], list[list[str]]]:
+    """The header cells and data rows of the first DH table in ``text``."""
+    if len(text) > MAX_TABLE_CHARS:
+        raise ParseError(f"file too large for a table ({len(text)} characters; at most {MAX_TABLE_CHARS})")
+    lines = text.splitlines()
+    for k, line in enumerate(lines):
+        if len(line) > MAX_LINE_CHARS:
+            continue  # prose, not a header
+        cells = _cells(line)
+        if len(cells) > MAX_COLUMNS or any(len(c) > MAX_CELL_CHARS for c in cells):
+            continue
+        kinds = [column_kind(c) for c in cells]
+        if len(cells) >= 4 and all(c in kinds for c in COLUMNS):
+            rows = []
+            for n, nxt in enumerate(lines[k + 1:], start=k + 2):
+                if _is_rule(nxt):
+                    continue  # Markdown rule
+                if len(nxt) > MAX_LINE_CHARS:
+                    raise ParseError(f"line {n}: longer than {MAX_LINE_CHARS} characters")
+                c = _cells(nxt)
+                if len(c) != len(cells) or not any(x.strip() for x in c):
+                    if rows:
+                        break
+                    continue
+                long = [x for x in c if len(x) > MAX_CELL_CHARS]
+                if long:
+                    raise ParseError(f"line {n}: a cell longer than {MAX_CELL_CHARS} characters")
+                rows.append(c)
+                if len(rows) > MAX_TABLE_ROWS:
+                    raise ParseError(f"line {n}: more than {MAX_TABLE_ROWS} rows in the table")
+            if not rows:
+                raise ParseError(f"line {k + 1}: a DH header but no rows under it")
+            return cells, rows
+    raise ParseError("no DH table found: expected a header row naming the columns a, alpha, d, theta "
+                     "(tab, | or & separated)")
