@@ -359,3 +359,27 @@ def test_export_notes_what_the_file_cannot_carry(capsys, tmp_path, name):
             assert len(notes) == 1 and "motor" in notes[0]
         else:
             assert notes == []
+
+
+def test_dynamics_deg_keeps_prismatic_joints_in_metres(capsys, tmp_path):
+    # dynamics --deg showed a prismatic joint's 0.1 m as 5.73 (all of q, qd, qdd went through np.degrees)
+    import pathlib
+
+    from denavit import load_robot, rnea, save_robot
+    from denavit.interop import import_urdf
+
+    robot = import_urdf(pathlib.Path(__file__).resolve().parents[1] / "examples" / "urdf" / "small_arm.urdf").robot
+    path = tmp_path / "arm.yaml"  # R R P R, with inertial data
+    save_robot(robot, path)
+    q, qd = np.array([0.2, -0.3, 0.1, 0.4]), np.array([0.5, 0.1, -0.05, 0.2])
+    rev = np.array([t.value == "revolute" for t in load_robot(str(path)).joint_types])
+    as_deg = lambda v: ", ".join(repr(float(x)) for x in np.where(rev, np.degrees(v), v))  # noqa: E731
+    code, out, err = run(capsys, "dynamics", path, "-q", as_deg(q), "--qd", as_deg(qd), "--deg", "--json")
+    assert code == 0, err
+    got = _strict(out)
+    np.testing.assert_allclose(got["q"], np.where(rev, np.degrees(q), q), rtol=1e-12)
+    np.testing.assert_allclose(got["qd"], np.where(rev, np.degrees(qd), qd), rtol=1e-12)
+    np.testing.assert_allclose(got["tau"], rnea(robot, q, qd, np.zeros(4)), rtol=1e-9, atol=1e-12)
+    code, out, err = run(capsys, "simulate", path, "--q0", as_deg(q), "--duration", "0.02", "--deg", "--json")
+    assert code == 0, err
+    np.testing.assert_allclose(_strict(out)["q"][0], np.where(rev, np.degrees(q), q), rtol=1e-12)

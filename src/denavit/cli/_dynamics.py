@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import MissingDependencyError, ParseError
 from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_force, add_q, check_output, check_values, joint_values, load, matrix_text,
                       numbers_text, output_file, require_finite, require_symbolic_size)
+from ._shared import q_out
 
 #: simulate: most output samples (--duration / --dt) and most evaluations of the dynamics in one run (about
 #: half a minute on a 6-joint arm); beyond it the run is refused with a message, not left to run for hours.
@@ -106,11 +107,11 @@ def _numeric(robot, args):
     c, g, f = C @ qd, gravity_torques(robot, q), friction_torques(robot, qd)
     tau = rnea(robot, q, qd, qdd)
     require_finite("dynamics", M, C, g, f, tau)
-    show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
+    show = lambda v: q_out(args, robot, v)  # noqa: E731  (--deg: revolute joints in degrees, prismatic in m)
     unit = "deg" if args.deg else "rad"
     vec = numbers_text
-    lines = [f"{robot.name}: dynamics at q = [{vec(show(q))}] ({unit}), qd = [{vec(show(qd))}], "
-             f"qdd = [{vec(show(qdd))}]",
+    lines = [f"{robot.name}: dynamics at q = [{vec(show(q))}] ({unit}{' for revolute joints' if args.deg else ''}), "
+             f"qd = [{vec(show(qd))}], qdd = [{vec(show(qdd))}]",
              "M(q) [kg m^2 / kg] =", matrix_text(M), "C(q, qd) =", matrix_text(C),
              f"c = C qd: [{vec(c)}]", f"g(q): [{vec(g)}]", f"friction: [{vec(f)}]",
              f"tau = M qdd + c + g + friction [N m / N]: [{vec(tau)}]"]
@@ -174,9 +175,8 @@ def cmd_simulate(args: argparse.Namespace):
         tau = check_values(parse_values(args.tau, robot.dof, what="--tau"), "--tau")
     res = _budgeted(robot, q0, qd0, duration, tau, dt, not args.no_friction)
     require_finite("simulate", res.q, res.qd, res.energy)
-    show = (lambda v: np.degrees(v)) if args.deg else (lambda v: v)
     rev = np.array([t.value == "revolute" for t in robot.joint_types])
-    conv = lambda a: np.where(rev, show(a), a)  # noqa: E731
+    conv = lambda a: q_out(args, robot, a)  # noqa: E731  (--deg: revolute joints in degrees)
     drift = float(np.abs(res.energy - res.energy[0]).max())
     data = {"robot": robot.name, "q0": conv(q0), "qd0": conv(qd0), "duration": duration, "dt": dt,
             "angle_unit": "deg" if args.deg else "rad", "t": res.t, "q": conv(res.q), "qd": conv(res.qd),

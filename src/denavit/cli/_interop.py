@@ -94,7 +94,8 @@ def _export_notes(robot, fmt: str) -> list[str]:
     rows = [link.inertia for link in robot.joints]
     if not robot.has_dynamics:
         missing = sum(li is None for li in rows)
-        return [f"{robot.name} has no inertial data for {missing} of its {robot.dof} joints: " + (
+        which = "" if missing == robot.dof else f" for {missing} of its {robot.dof} joints"
+        return [f"{robot.name} has no inertial data{which}: " + (
             "those links have no <inertial> (dynamics in other tools are not the arm's)" if fmt == "urdf" else
             f"those bodies get a placeholder mass of {MJCF_MIN_MASS:g} kg (MuJoCo's dynamics are not the arm's)")]
     if fmt == "urdf" and any(li.motor_inertia for li in rows if li is not None):
