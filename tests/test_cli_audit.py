@@ -383,3 +383,22 @@ def test_dynamics_deg_keeps_prismatic_joints_in_metres(capsys, tmp_path):
     code, out, err = run(capsys, "simulate", path, "--q0", as_deg(q), "--duration", "0.02", "--deg", "--json")
     assert code == 0, err
     np.testing.assert_allclose(_strict(out)["q"][0], np.where(rev, np.degrees(q), q), rtol=1e-12)
+
+
+def test_symbolic_dynamics_progress_is_a_few_lines_per_stage(capsys, monkeypatch):
+    # the mass matrix of a 6-joint arm printed a line per entry (22 lines), and so did every later stage
+    import collections
+
+    import denavit.cli._dynamics as dyn
+
+    def stages(every):
+        monkeypatch.setattr(dyn, "PROGRESS_EVERY", every)
+        code, out, err = run(capsys, "dynamics", "planar3r", "--symbolic")
+        assert code == 0 and out
+        lines = [ln.removeprefix("denavit dynamics: ") for ln in err.splitlines()]
+        return collections.Counter(ln.rsplit(" ", 1)[0] for ln in lines), lines
+
+    quiet, qlines = stages(1e9)
+    every, elines = stages(0.0)
+    assert "mass matrix" in quiet and set(quiet) == set(every)
+    assert max(quiet.values()) <= 2 and len(elines) > len(qlines) and max(every.values()) > 2

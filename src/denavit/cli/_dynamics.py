@@ -68,8 +68,22 @@ def _rates(args, robot, text, what):
     return np.zeros(robot.dof) if text is None else joint_values(args, robot, text, what, rates=True)
 
 
-def _progress(stage: str, done: int, total: int) -> None:
-    print(f"denavit dynamics: {stage} {done}/{total}", file=sys.stderr, flush=True)
+#: Seconds between two progress lines of one stage of the symbolic dynamics (its first and last are always shown).
+PROGRESS_EVERY = 1.0
+
+
+def _progress_printer():
+    """A progress callback: ``denavit dynamics: <stage> k/n`` on stderr, at most every PROGRESS_EVERY seconds per
+    stage (a 6-joint arm's 21 mass-matrix entries printed 22 lines)."""
+    last: dict[str, float] = {}
+
+    def show(stage: str, done: int, total: int) -> None:
+        now = time.perf_counter()
+        if stage not in last or done >= total or now - last[stage] >= PROGRESS_EVERY:
+            last[stage] = now
+            print(f"denavit dynamics: {stage} {done}/{total}", file=sys.stderr, flush=True)
+
+    return show
 
 
 def cmd_dynamics(args: argparse.Namespace):
@@ -136,7 +150,7 @@ def _symbolic(robot, args):
                 "M_symbolic": rd.M, "c_symbolic": rd.c, "g_symbolic": rd.g, "symbolic_text": text,
                 "format": args.format, "method": args.method, "seconds": round(elapsed, 3)}
         return data, [f"{robot.name}: equations of motion ({args.method}, recursive form, {elapsed:.2f} s)", text]
-    kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=None if args.json else _progress)
+    kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=None if args.json else _progress_printer())
     if args.method == "newton-euler":
         terms = S.newton_euler_dynamics(robot, **kw).terms
     elif args.method == "steps":
