@@ -326,3 +326,91 @@ def test_geometric_jacobian_frame_index_batches_and_refuses_bad_values(rng):
     for bad in (-1, robot.n_rows + 1, True, "3", 2.0, "side"):
         with pytest.raises(ValueError, match="base, tool"):
             N.geometric_jacobian(robot, Q[0, 0], frame=bad)
+
+
+# --- velocity and statics --frame i: the twist and the wrench in the axes of DH frame {i} --------------------------
+
+
+def _numbers(x) -> str:
+    return ", ".join(repr(float(v)) for v in x)
+
+
+@settings(max_examples=6 if REDUCED else 25)
+@given(robot=robots(), seed=st.integers(0, 2**32 - 1))
+def test_velocity_and_statics_frame_i_are_rotated_finite_differences_and_virtual_work(tmp_path_factory, robot, seed):
+    """velocity --frame i: ⁱJ q̇ with ⁱJ = J0 (differences of FK) rotated by R_0_i; statics --frame i, both methods:
+    the wrench F_w given in frame i's axes (ⁱF = diag(R_0_iᵀ, R_0_iᵀ) F_w) balances τ = J0ᵀ F_w (virtual work)."""
+    from _hostile import run_cli
+
+    from denavit import dump_robot, link_transforms
+
+    rng = np.random.default_rng(seed)
+    folder = tmp_path_factory.mktemp("frame_i")
+    (folder / "arm.json").write_text(dump_robot(robot, "json"))
+    arm = load_robot(str(folder / "arm.json"))
+    q, qd = rng.uniform(-np.pi, np.pi, arm.dof), rng.uniform(-2, 2, arm.dof)
+    i = int(rng.integers(0, arm.n_rows + 1))
+    J0 = _fd_J0(arm, q)
+    o = run_cli(["velocity", "arm.json", "-q", _numbers(q), "--qd", _numbers(qd), "--frame", str(i), "--json"], folder)
+    assert o.code == 0, o.describe()
+    data = json.loads(o.out)
+    assert data["frame"] == i
+    np.testing.assert_allclose(data["twist"], _in_frame(arm, q, J0, i) @ qd, atol=1e-6 * (1 + np.abs(qd).sum()))
+    R = link_transforms(arm, q)[i][:3, :3]
+    F_w = rng.normal(size=6)
+    F_i = np.concatenate([R.T @ F_w[:3], R.T @ F_w[3:]])
+    for method in ("jacobian", "propagation"):
+        o = run_cli(["statics", "arm.json", "-q", _numbers(q), "--wrench", _numbers(F_i), "--frame", str(i),
+                     "--method", method, "--json"], folder)
+        assert o.code == 0, o.describe()
+        data = json.loads(o.out)
+        assert data["frame"] == i and data["method"] == method
+        np.testing.assert_allclose(data["tau"], J0.T @ F_w, atol=1e-6 * (1 + np.abs(F_w).sum()))
+
+
+@pytest.mark.parametrize("name, frame", [("planar3r", 2), ("stanford", 3)])
+def test_velocity_and_statics_frame_i_symbolic_equal_the_rotated_finite_differences(capsys, name, frame, rng):
+    robot = load_robot(name)
+    vel = run_json(capsys, "velocity", name, "--frame", str(frame))
+    sta = run_json(capsys, "statics", name, "--frame", str(frame))
+    assert vel["frame"] == sta["frame"] == frame
+    for q in rng.uniform(-np.pi, np.pi, (2, robot.dof)):
+        qd, F_i = rng.normal(size=robot.dof), rng.normal(size=6)
+        J_i = _in_frame(robot, q, _fd_J0(robot, q), frame)
+        twist = np.concatenate([_evaluate(vel["v_symbolic"], robot, q, qd),
+                                _evaluate(vel["omega_symbolic"], robot, q, qd)])
+        np.testing.assert_allclose(twist, J_i @ qd, atol=1e-6)
+        np.testing.assert_allclose(_evaluate(sta["tau_symbolic"], robot, q, wrench=F_i), J_i.T @ F_i, atol=1e-6)
+
+
+def test_velocity_and_statics_frame_i_text_and_end_frames(capsys):
+    """Frame 0 of an arm without a base is the base; its last frame without a tool is the tool; the text says so."""
+    robot = load_robot("puma560")
+    N_ = str(robot.n_rows)
+    vel = {f: run_json(capsys, "velocity", "puma560", "-q", Q_PUMA, "--qd", "1, -2, 3, 0.5, -1, 2", "--frame", f)
+           for f in ("base", "0", "tool", N_)}
+    np.testing.assert_allclose(vel["0"]["twist"], vel["base"]["twist"], atol=1e-12)
+    np.testing.assert_allclose(vel[N_]["twist"], vel["tool"]["twist"], atol=1e-12)
+    sta = {f: run_json(capsys, "statics", "puma560", "-q", Q_PUMA, "--wrench", "1, 2, -3, 0.4, 0.5, -0.6", "--frame", f)
+           for f in ("base", "0", "tool", N_)}
+    np.testing.assert_allclose(sta["0"]["tau"], sta["base"]["tau"], atol=1e-12)
+    np.testing.assert_allclose(sta[N_]["tau"], sta["tool"]["tau"], atol=1e-12)
+    assert main(["statics", "puma560", "-q", Q_PUMA, "--wrench", "0, 0, -10", "--frame", "3"]) == 0
+    assert "in the axes of DH frame {3}" in capsys.readouterr().out
+    assert main(["velocity", "puma560", "-q", Q_PUMA, "--qd", "1, 0, 0, 0, 0, 0", "--frame", "3"]) == 0
+    assert "axes of DH frame {3}" in capsys.readouterr().out
+    assert "tool" in run_error(capsys, "statics", "planar2r", "--method", "propagation", "--frame", "1")
+
+
+@pytest.mark.parametrize("value, mentions", [
+    ("99", ["--frame", "99"]), ("7", ["--frame", "7", "0 ... 6"]), ("-1", ["--frame", "-1"]), ("x", ["--frame"]),
+    ("1e1", ["--frame"]), ("+3", ["--frame"]), ("9" * 5000, ["--frame"]),
+])
+@pytest.mark.parametrize("command", ["velocity", "statics"])
+@pytest.mark.parametrize("symbolic", [False, True])
+def test_velocity_and_statics_bad_frame_values_are_refused_in_one_line(tmp_path, value, mentions, command, symbolic):
+    from _hostile import assert_refused, run_cli
+
+    values = ["--qd", "1, 2, 3, 4, 5, 6"] if command == "velocity" else ["--wrench", "1, 2, 3"]
+    argv = [command, "puma560", "--frame", value] + ([] if symbolic else ["-q", Q_PUMA, *values])
+    assert_refused(run_cli(argv, tmp_path), mentions=mentions)

@@ -14,7 +14,7 @@ from ..errors import ParseError
 from ..numeric import TWIST_ROWS as ROWS
 from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
                       require_symbolic_size)
-from ._shared import add_frame, add_sym_format, q_out, q_text, sym_formatter
+from ._shared import add_sym_format, q_out, q_text, sym_formatter
 
 REFERENCE = "end-effector origin (after the tool transform)"
 
@@ -39,7 +39,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_common(p)
     add_q(p, required=False)
     p.add_argument("--qd", metavar="QD", help="joint rates [rad/s or m/s; deg/s with --deg] (numeric route)")
-    add_frame(p)
+    p.add_argument("--frame", type=_frame_arg, default="base", metavar="{base,tool,i}",
+                   help="axes of the twist: base/world (J0 qd), tool (Je qd) or the DH frame i = 0 ... N (iJ qd)")
     p.add_argument("--steps", action="store_true", help="omega_i and v_i of every frame (outward propagation)")
     p.add_argument("--symbolic", action="store_true",
                    help="the formulas in q and qd (the default when -q is not given)")
@@ -51,9 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_q(p, required=False)
     p.add_argument("--wrench", metavar="W",
                    help="fx, fy, fz[, nx, ny, nz] [N, N m] exerted by the end effector, at its origin (numeric route)")
-    p.add_argument("--frame", choices=["base", "tool"], default=None,
-                   help="axes of the wrench: base/world or tool (default base; tool for --symbolic --method "
-                        "propagation, whose wrench starts in tool axes)")
+    p.add_argument("--frame", type=_frame_arg, default=None, metavar="{base,tool,i}",
+                   help="axes of the wrench: base/world, tool or the DH frame i = 0 ... N (tau = iJ^T iF) (default "
+                        "base; tool for --symbolic --method propagation, whose wrench starts in tool axes)")
     p.add_argument("--method", choices=["jacobian", "propagation"], default="jacobian",
                    help="tau = J^T F, or Craig's inward force propagation")
     p.add_argument("--steps", action="store_true", help="f_i and n_i of every frame (inward propagation)")
@@ -89,6 +90,11 @@ def _header(frame: str | int, what: str = "J") -> str:
     return f"{what} in {axes}; reference point: {REFERENCE}; rows (vx, vy, vz, wx, wy, wz)"
 
 
+def _axes(frame: str | int) -> str:
+    return ("base/world axes" if frame == "base" else "tool axes" if frame == "tool" else
+            f"the axes of DH frame {{{frame}}}")
+
+
 def _labelled(M: np.ndarray, labels=ROWS) -> str:
     body = matrix_text(M).split("\n")
     width = max(len(lab) for lab in labels)
@@ -96,6 +102,24 @@ def _labelled(M: np.ndarray, labels=ROWS) -> str:
 
 
 # --- jacobian ------------------------------------------------------------------------------------------
+
+
+def _jacobian_sym(robot, method: str, frame: str | int, simplify: str):
+    """J0, Je or ⁱJ as formulas (the symbolic side of ``--frame``)."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    if not isinstance(frame, int):
+        return S.jacobian_sym(robot, method, frame, simplify)
+    # iJ = diag(R_w_iᵀ, R_w_iᵀ) J0, R_w_i = base · T_0_i (as the numeric route)
+    J0 = S.jacobian_sym(robot, method, "base", simplify)
+    R = (S.matrix_from_floats(robot.base_matrix) * S.link_transforms_sym(robot, simplify)[frame])[:3, :3]
+    J = sp.diag(R.T, R.T) * J0
+    if simplify != "none":  # sin² = 1 − cos² first: the rotation leaves sin²(θ) + cos²(θ) of sums of angles
+        a = sp.Wild("a")
+        J = J.applyfunc(lambda e: sp.expand(sp.expand(e).replace(sp.sin(a) ** 2, 1 - sp.cos(a) ** 2)))
+    return S.simplify_matrix(J, simplify)
 
 
 def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
@@ -106,16 +130,7 @@ def _symbolic_jacobian(robot, args) -> tuple[dict, list[str]]:
     require_symbolic_size(robot, "jacobian --symbolic")
     q = S.joint_symbols(robot.dof).q
     fmt = sym_formatter(args, q)
-    if isinstance(args.frame, int):  # iJ = diag(R_w_iᵀ, R_w_iᵀ) J0, R_w_i = base · T_0_i (as the numeric route)
-        J0 = S.jacobian_sym(robot, args.method, "base", args.simplify)
-        R = (S.matrix_from_floats(robot.base_matrix) * S.link_transforms_sym(robot, args.simplify)[args.frame])[:3, :3]
-        J = sp.diag(R.T, R.T) * J0
-        if args.simplify != "none":  # sin² = 1 − cos² first: the rotation leaves sin²(θ) + cos²(θ) of sums of angles
-            a = sp.Wild("a")
-            J = J.applyfunc(lambda e: sp.expand(sp.expand(e).replace(sp.sin(a) ** 2, 1 - sp.cos(a) ** 2)))
-        J = S.simplify_matrix(J, args.simplify)
-    else:
-        J = S.jacobian_sym(robot, args.method, args.frame, args.simplify)
+    J = _jacobian_sym(robot, args.method, args.frame, args.simplify)
     name = _name(args.frame)
     lines = [f"{robot.name}: symbolic Jacobian by {args.method}", _header(args.frame), f"{name} =", fmt(J)]
     data = {"J_symbolic": J, "J_latex": sp.latex(J)}
@@ -204,7 +219,7 @@ def _symbolic_velocity(robot, args) -> tuple[dict, list[str]]:
     require_symbolic_size(robot, "velocity --symbolic")
     js = S.joint_symbols(robot.dof)
     fmt = sym_formatter(args, js.q)
-    J = S.jacobian_sym(robot, "geometric", args.frame, args.simplify)
+    J = _jacobian_sym(robot, "geometric", args.frame, args.simplify)
     twist = S.simplify_matrix(J * sp.Matrix(js.qd), args.simplify)
     v, w = sp.ImmutableMatrix(twist[:3, :]), sp.ImmutableMatrix(twist[3:, :])
     lines = [f"{robot.name}: symbolic end-effector twist = J q̇", _header(args.frame, "twist (v, w)"),
@@ -219,6 +234,7 @@ def _symbolic_velocity(robot, args) -> tuple[dict, list[str]]:
 
 def cmd_velocity(args: argparse.Namespace):
     robot = load(args)
+    _check_frame(robot, args.frame)
     if args.q is not None and args.qd is None:
         raise ParseError("--qd is required with -q (the joint rates); for formulas leave out -q or add --symbolic")
     if args.symbolic or args.q is None:
@@ -240,7 +256,10 @@ def cmd_velocity_numeric(args: argparse.Namespace, robot):
 
     q = joint_values(args, robot, args.q)
     qd = joint_values(args, robot, args.qd, what="qd", rates=True)
-    twist = N.end_effector_twist(robot, q, qd, args.frame)
+    if isinstance(args.frame, int):  # ⁱJ q̇ (geometric_jacobian rotates J0 into DH frame i's axes)
+        twist = N.geometric_jacobian(robot, q, frame=args.frame) @ qd
+    else:
+        twist = N.end_effector_twist(robot, q, qd, args.frame)
     require_finite("velocity", twist)
     ang = np.degrees if args.deg else (lambda x: x)
     aunit = "deg/s" if args.deg else "rad/s"
@@ -284,14 +303,13 @@ def _symbolic_statics(robot, args) -> tuple[dict, list[str]]:
     q = S.joint_symbols(robot.dof).q
     fmt = sym_formatter(args, q)
     W = sp.Matrix(S.wrench_symbols())
-    axes = "base/world" if args.frame == "base" else "tool"
     lines = [f"{robot.name}: symbolic joint torques", f"wrench (f_x, f_y, f_z, n_x, n_y, n_z) exerted by the end "
-             f"effector, in {axes} axes, at the {REFERENCE}"]
+             f"effector, in {_axes(args.frame)}, at the {REFERENCE}"]
     data: dict = {"wrench_symbols": [str(x) for x in W]}
     if args.method == "propagation":
-        if args.frame == "base":
+        if args.frame != "tool":
             raise ParseError("--symbolic --method propagation starts from the wrench in tool axes (Craig 5.80-5.81): "
-                             "use --frame tool, or --method jacobian for a wrench in base axes")
+                             f"use --frame tool, or --method jacobian for a wrench in {_axes(args.frame)}")
         prop = S.force_propagation_sym(robot, args.simplify)
         tau = sp.ImmutableMatrix(prop.tau)
         lines.append("method: inward force propagation (Craig 5.80-5.81): tau_i = n_i . z_i (revolute), f_i . z_i "
@@ -309,7 +327,7 @@ def _symbolic_statics(robot, args) -> tuple[dict, list[str]]:
     else:
         if args.steps:
             raise ParseError("--steps goes with --method propagation")
-        J = S.jacobian_sym(robot, "geometric", args.frame, args.simplify)
+        J = _jacobian_sym(robot, "geometric", args.frame, args.simplify)
         tau = S.simplify_matrix(J.T * W, args.simplify)
         lines.append("method: tau = J^T F")
     lines += ["tau =", fmt(tau)]
@@ -321,6 +339,7 @@ def cmd_statics(args: argparse.Namespace):
     robot = load(args)
     if args.frame is None:
         args.frame = "tool" if (args.symbolic or args.q is None) and args.method == "propagation" else "base"
+    _check_frame(robot, args.frame)
     if args.q is not None and args.wrench is None:
         raise ParseError("--wrench is required with -q; for formulas leave out -q or add --symbolic")
     if args.symbolic or args.q is None:
@@ -343,17 +362,22 @@ def cmd_statics_numeric(args: argparse.Namespace, robot):
 
     q = joint_values(args, robot, args.q)
     W = _wrench(args.wrench)
-    prop = N.force_propagation(robot, q, W, args.frame)
-    tau = N.joint_torques(robot, q, W, args.frame) if args.method == "jacobian" else prop.tau
+    if isinstance(args.frame, int):  # τ = ⁱJᵀ ⁱF; the propagation starts from the same wrench in world axes
+        W_w = N.wrench_base_from_tool(W, N.link_transforms(robot, q)[args.frame])  # R_w_i: base · T_0_i
+        prop = N.force_propagation(robot, q, W_w, "base")
+        tau = N.joint_torques_from_jacobian(N.geometric_jacobian(robot, q, frame=args.frame), W)
+    else:
+        prop = N.force_propagation(robot, q, W, args.frame)
+        tau = N.joint_torques(robot, q, W, args.frame)
+    tau = tau if args.method == "jacobian" else prop.tau
     require_finite("statics", tau, prop.f, prop.n)
     units = ["N m" if t is JointType.REVOLUTE else "N" for t in robot.joint_types]
     F6 = N.as_wrench(W)
     data = {"robot": robot.name, "q": q_out(args, robot, q), "wrench": F6, "frame": args.frame,
             "method": args.method, "reference_point": REFERENCE, "tau": tau, "units": units}
-    axes = "base/world" if args.frame == "base" else "tool"
     lines = [f"{robot.name}: joint torques at {q_text(args, robot, q)}",
              f"wrench (f, n) = [{numbers_text(F6)}] N, N m exerted by the end effector, "
-             f"in {axes} axes, at the {REFERENCE}",
+             f"in {_axes(args.frame)}, at the {REFERENCE}",
              f"method: {'tau = J^T F' if args.method == 'jacobian' else 'inward force propagation (Craig 5.80-5.81)'}"]
     tau_text = numbers_text(tau, sep="\n").split("\n")
     lines += [f"  tau{k + 1} = {t} {u}" for k, (t, u) in enumerate(zip(tau_text, units))]
