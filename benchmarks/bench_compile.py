@@ -237,7 +237,7 @@ def main() -> None:
             print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {100 * r[4]:.1f} % |")
     print("\n| robot | analytic IK, one pose per call | median [µs] | p95 [µs] | solutions / pose |")
     print("|---|---|---:|---:|---:|")
-    for name in ("puma560", "ur5"):  # elbow + spherical wrist; UR class (axes 2-4 parallel)
+    for name in ("puma560", "ur5", "stanford"):  # elbow + spherical wrist; UR class (axes 2-4 parallel); R R P
         for r in analytic_rows(name, args.targets):
             print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {r[4]:.2f} |")
     print("\n| robot | compile, empty cache [s] | compile, from the cache [s] | numba + denavit import [s] |")

@@ -9,10 +9,11 @@ compiled FK, folded into the joint limits, merged when equal and labelled (shoul
 
 Every case the plain solver treats specially is handed back to it (``status`` 1): a root next to a double root
 (shoulder or elbow or wrist ratio near ±1), the point Q on or next to axis 1 or axis 2, axis 6 parallel or
-nearly parallel to axes 2–4 (the wrist-singular continuum; NEAR_SINGULAR), a candidate that would need polishing, two solutions closer than the merge radius.
-The compiled path answers only where its answer is the plain solver's.  The text below is appended to each
-generated numba module of an arm with a 6R ``parallel`` plan; it calls that module's ``fk_1`` and the elbow
-solver's ``_elbow_half_angle``; nothing of the robot or the user is pasted into it.
+nearly parallel to axes 2–4 (the wrist-singular continuum; NEAR_SINGULAR), a target beyond the bound where the
+plain solver substitutes a reachable stand-in (``far``), a candidate that would need polishing, two solutions
+closer than the merge radius.  The compiled path answers only where its answer is the plain solver's.  The text
+below is appended to each generated numba module (numba compiles it for the arms that call it); it calls that
+module's ``fk_1`` and the elbow solver's ``_elbow_half_angle``; nothing of the robot or the user is pasted into it.
 """
 
 from __future__ import annotations
@@ -29,10 +30,17 @@ __all__ = ["IK_PARALLEL_SOURCE", "PARALLEL_LAYOUT", "parallel_constants"]
 #: there are ill-conditioned (rounding amplified by ~1/this), so the two solvers' answers could differ by more than
 #: 1e-10, although the pose is not one the plain solver treats specially.
 NEAR_SINGULAR = 1e-5
+#: Largest estimated rounding error of a candidate, in units of the double-precision epsilon (2.2e-16), that the
+#: compiled path answers.  Each step's error is its inputs' errors (plus one rounding) times its condition: 1/sin of
+#: an arccos-type root's distance from its double root, 1/|xy| of a direction turned by atan2, reach/distance of a
+#: point from an axis (a bound: the differences measured on random arms stay ~100 times below it).  Beyond 1e6 ε
+#: the compiled answer and the plain solver's (the same formulas evaluated in another order) could differ by more
+#: than 1e-10: such a pose goes to the plain solver (about 1 pose in 100 of random UR5 poses).
+COND_MAX = 1e6
 
-#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (176 numbers).
-PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 10), ("lo", 6), ("hi", 6),
-                   ("revolute", 6), ("theta", 6), ("tols", 8))
+#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (178 numbers).
+PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 11), ("lo", 6), ("hi", 6),
+                   ("revolute", 6), ("theta", 6), ("tols", 8), ("far", 1))
 
 
 def parallel_constants(robot, plan) -> np.ndarray:
@@ -60,7 +68,7 @@ def parallel_constants(robot, plan) -> np.ndarray:
     vz = p2[2] + R2[2, 2] * p3[2]
     scalars = [h + a @ pc1, sigma, np.hypot(aw, bw), np.arctan2(bw, aw), np.arctan2(np.hypot(r[0], r[1]), r[2]),
                np.arctan2(np.hypot(u[0], u[1]), u[2]), 2 * ap, 2 * bp, -(p2 @ p2) - p3 @ p3 + vz**2 - 2 * g,
-               NEAR_SINGULAR]
+               NEAR_SINGULAR, COND_MAX]
     lim = robot.q_limits
     k = dict(plan.closed, Q_e=Q_e, C0i=inverse_transform(C[0]), consts=C, a=a, scalars=scalars, lo=lim[:, 0],
              hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types])
@@ -80,14 +88,17 @@ def ik_parallel_packed(T, K, f, i):
     f[b, :j, 8:] the solutions outside the limits; i[b, :k] label codes (1 shoulder left, 2 elbow down, 4 wrist
     flip), i[b, 8:] = (k, j, 1 if the plain solver must decide)."""
     Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
-    a, sc, lo_lim, hi_lim = K[131:134], K[134:144], K[144:150], K[150:156]
-    rev, theta, tols = K[156:162], K[162:168], K[168:176]
+    a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
+    rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
     # scratch: one float and one flag allocation, sliced
     ws = np.empty(134)
     cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \
         ws[83:89]
     flags = np.zeros(24, dtype=np.bool_)
     for b in range(T.shape[0]):
+        if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
+            i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
+            continue
         ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, ws[89:134])
         kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
                                      f[b, :, :6], f[b, :, 6:8], f[b, :, 8:])
@@ -105,6 +116,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
+    scale = max(reach, 1e-3)
     status = 0
     ncand = 0
     V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
@@ -130,6 +142,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
         return 0, max(status, 1 if rho_w < 1e-12 else 0)
     base1 = math.atan2(Bq, A)
     delta = math.acos(min(1.0, max(-1.0, ratio)))
+    e1 = max(1.0, scale / rho) / max(math.sin(delta), 1e-300)  # rounding error of q1 [eps] (COND_MAX)
     for s1 in range(2):
         q1 = base1 + delta if s1 == 0 else base1 - delta
         _frame1(C, q1, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
@@ -148,6 +161,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
         x5 = _elbow_half_angle(lo, hi, tol)
         if x5 != x5:
             continue
+        e5 = (1.0 + e1) / max(rho_w * math.sin(x5), 1e-300)
         for s5 in range(2):
             q5 = base_w + x5 if s5 == 0 else base_w - x5
             c5, s5v = math.cos(q5), math.sin(q5)
@@ -157,6 +171,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             if math.hypot(y0, y1) < sc[9]:
                 status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
             q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
+            e6 = (1.0 + e1 + e5) / max(math.hypot(y0, y1), 1e-300)
+            eP = 1.0 + e1 + e5 + e6  # of the point P, per reach
             _tail(C, q5, q6, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
             # X = F1^-1 T tail^-1: its origin P and first column xr
             for r in range(3):
@@ -184,6 +200,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
                 continue
             base3 = math.atan2(bp2, ap2)
             d3 = math.acos(min(1.0, max(-1.0, ratio3)))
+            e3 = eP * 2.0 * math.hypot(P0, P1) * scale / max(rho3 * math.sin(d3), 1e-300)
             for s3 in range(2):
                 q3 = base3 + d3 if s3 == 0 else base3 - d3
                 c3, s3v = math.cos(q3), math.sin(q3)
@@ -192,6 +209,9 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
                 v1 = C[2, 1, 3] + C[2, 1, 0] * u0 + C[2, 1, 1] * u1 + C[2, 1, 2] * C[3, 2, 3]
                 if math.hypot(v0, v1) < wide:
                     status = 1
+                e2 = (eP + e3) * scale / max(min(math.hypot(P0, P1), math.hypot(v0, v1)), 1e-300)
+                if e2 + e3 + eP > sc[10]:  # q4's error is about that sum
+                    status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
                 q2 = math.atan2(P1, P0) - math.atan2(v1, v0)
                 # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
                 c2, s2v = math.cos(q2), math.sin(q2)

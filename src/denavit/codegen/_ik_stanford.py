@@ -11,7 +11,8 @@ module's ``_ik_finish``.
 Every case the plain solver treats specially goes back to it (``status`` 1): q3 next to its double root (the wrist
 centre at its nearest to O), a q2 or wrist root next to a double root, the wrist centre on or next to axis 1 or
 with its arm next to axis 2 (free or ill-conditioned joints; NEAR_SINGULAR of :mod:`._ik_parallel`), the wrist
-axes 4 and 6 (nearly) aligned, a candidate needing polish, two solutions about to merge.  The text below is
+axes 4 and 6 (nearly) aligned, a candidate whose estimated rounding error exceeds COND_MAX, a target beyond the plain solver's bound (prismatic travel included: it then
+reports no solution, not even outside the limits), a candidate needing polish, two solutions about to merge.  The text below is
 appended to each generated numba module; it calls that module's ``fk_1``, ``_elbow_half_angle`` and ``_ik_finish``.
 """
 
@@ -21,13 +22,13 @@ import numpy as np
 
 from ..chain import chain_of
 from ..numeric import inverse_transform
-from ._ik_parallel import NEAR_SINGULAR
+from ._ik_parallel import COND_MAX, NEAR_SINGULAR
 
 __all__ = ["IK_STANFORD_SOURCE", "STANFORD_LAYOUT", "stanford_constants"]
 
-#: The constants of ``ik_stanford_packed``'s vector K, in order, with their sizes (180 numbers).
-STANFORD_LAYOUT = (("X_e", 3), ("C0i", 16), ("consts", 112), ("geom", 9), ("scalars", 8), ("lo", 6), ("hi", 6),
-                   ("revolute", 6), ("theta", 6), ("tols", 8))
+#: The constants of ``ik_stanford_packed``'s vector K, in order, with their sizes (182 numbers).
+STANFORD_LAYOUT = (("X_e", 3), ("C0i", 16), ("consts", 112), ("geom", 9), ("scalars", 9), ("lo", 6), ("hi", 6),
+                   ("revolute", 6), ("theta", 6), ("tols", 8), ("far", 1))
 
 
 def stanford_constants(robot, plan) -> np.ndarray:
@@ -55,7 +56,8 @@ def stanford_constants(robot, plan) -> np.ndarray:
     aw, bw = r4[0] * u5[0] + r4[1] * u5[1], r4[1] * u5[0] - r4[0] * u5[1]
     L = max(float(np.sum(np.abs(C[:, :3, 3]))), 1e-3)
     scalars = [uz, float(np.linalg.norm(u - uz * z)), L, np.hypot(aw, bw), np.arctan2(bw, aw),
-               np.arctan2(np.hypot(r4[0], r4[1]), r4[2]), np.arctan2(np.hypot(u5[0], u5[1]), u5[2]), NEAR_SINGULAR]
+               np.arctan2(np.hypot(r4[0], r4[1]), r4[2]), np.arctan2(np.hypot(u5[0], u5[1]), u5[2]), NEAR_SINGULAR,
+               COND_MAX]
     lim = robot.q_limits
     k = dict(plan.closed, X_e=X_e, C0i=inverse_transform(C[0]), consts=C, geom=[*(p1 + s0 * a), *u, *z],
              scalars=scalars, lo=lim[:, 0], hi=lim[:, 1],
@@ -74,13 +76,16 @@ def ik_stanford_packed(T, K, f, i):
     """All solutions of each pose T[b] of a Stanford-class arm, the constants in K (STANFORD_LAYOUT order); outputs
     as ik_elbow_packed (label codes: 1 shoulder left, 2 wrist flip)."""
     X_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
-    geom, sc, lo_lim, hi_lim = K[131:140], K[140:148], K[148:154], K[154:160]
-    rev, theta, tols = K[160:166], K[166:172], K[172:180]
+    geom, sc, lo_lim, hi_lim = K[131:140], K[140:149], K[149:155], K[155:161]
+    rev, theta, tols, far = K[161:167], K[167:173], K[173:181], K[181]
     ws = np.empty(131)
     cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \\
         ws[83:89]
     flags = np.zeros(24, dtype=np.bool_)
     for b in range(T.shape[0]):
+        if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
+            i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond the bound of _solve (prismatic travel included): its stand-in
+            continue
         for r in range(3):
             X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
         ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
@@ -114,6 +119,7 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
     if disc < -1e-12 * L * L:
         return 0, status
     root = math.sqrt(max(disc, 0.0))
+    e3 = 1.0 + L / max(root, 1e-300)  # rounding error of q3 [eps, per L]: as COND_MAX of _ik_parallel
     ncand = 0
     for s3 in range(2):
         q3 = -uz + root if s3 == 0 else -uz - root
@@ -134,6 +140,7 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
             continue
         base2 = math.atan2(Bq, A)
         delta = math.acos(min(1.0, max(-1.0, ratio)))
+        e2 = (1.0 + e3) * max(1.0, L / rho) / max(math.sin(delta), 1e-300)
         for s2 in range(2):
             q2 = base2 + delta if s2 == 0 else base2 - delta
             c2, s2v = math.cos(q2), math.sin(q2)
@@ -141,6 +148,7 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
             ex = C[1, 0, 0] * x + C[1, 0, 1] * y + C[1, 0, 2] * w2
             ey = C[1, 1, 0] * x + C[1, 1, 1] * y + C[1, 1, 2] * w2
             q1 = math.atan2(D[1], D[0]) - math.atan2(ey, ex)
+            e1 = (1.0 + e2 + e3) * L / max(min(math.hypot(D[0], D[1]), math.hypot(ex, ey)), 1e-300)
             # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 C3 (joint 3 slides): its columns, then M = R_0_3^T Y
             _frame1(C, q1, cols)
             _next_frame(cols, q2, C[2], cols)
@@ -148,14 +156,16 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
             for r in range(3):
                 for j in range(3):
                     M[r, j] = cols[r, 0] * Y[0, j] + cols[r, 1] * Y[1, j] + cols[r, 2] * Y[2, j]
-            ncand, status = _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status)
+            ncand, status = _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status,
+                                            1.0 + e1 + e2 + e3, sc[8])
     return ncand, status
 
 
 @njit(cache=True, nogil=True)
-def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status):
+def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status, eM, cond_max):
     """The two wrist solutions of Rz(q4) R4 Rz(q5) R5 Rz(q6) = M (as wrist_angles: q5 from the z-row in the
-    half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand."""
+    half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand; eM: the
+    rounding error of M [eps], for the COND_MAX test."""
     phi = math.atan2(math.hypot(M[0, 2], M[1, 2]), M[2, 2])
     dm, smw = br - bu, br + bu
     lo = math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w
@@ -165,6 +175,7 @@ def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, 
     xw = _elbow_half_angle(lo, hi, 1e-9)  # axis_angle_roots' default tolerance, as wrist_angles calls it
     if xw != xw:
         return ncand, status
+    e5 = eM / max(rho_w * math.sin(xw), 1e-300)
     for s5 in range(2):
         qb = base_w + xw if s5 == 0 else base_w - xw
         cb, sb = math.cos(qb), math.sin(qb)
@@ -175,6 +186,8 @@ def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, 
         if math.hypot(v0, v1) < near:
             status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
         qa = math.atan2(M[1, 2], M[0, 2]) - math.atan2(v1, v0)
+        if eM + e5 + (eM + e5) / max(math.hypot(v0, v1), 1e-300) > cond_max:
+            status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
         ca, sa = math.cos(qa), math.sin(qa)
         y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]
         N0 = N1 = 0.0

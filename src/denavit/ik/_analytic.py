@@ -114,7 +114,8 @@ def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
         plan.closed.update(labels=_label_table((SHOULDER, WRIST) if stanford else (SHOULDER, ELBOW, WRIST)),
                            theta=np.array([l.theta for l in robot.joints], float),
                            tols=np.array([FREE_TOL, RATIO_TOL, VERIFY_TOL, POLISH_ABOVE, DUPLICATE_TOL, MERGE_RADIUS,
-                                          AXES_ALIGNED_TOL, _reach(robot)], float))
+                                          AXES_ALIGNED_TOL, _reach(robot)], float),
+                           far=2 * _bound(robot) + 1.0)  # farther targets get _solve's stand-in
     return plan
 
 
