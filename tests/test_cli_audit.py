@@ -195,6 +195,8 @@ joints:
 
 
 def test_one_joint_arm_reads_in_the_singular(capsys, tmp_path, monkeypatch):
+    import pathlib
+
     # "1 joints (R)" in show, "1 joints q1 … q1" in export-urdf
     monkeypatch.chdir(tmp_path)
     (tmp_path / "one.yaml").write_text(ONE_JOINT)
@@ -204,6 +206,10 @@ def test_one_joint_arm_reads_in_the_singular(capsys, tmp_path, monkeypatch):
     assert code == 0 and "1 joint q1," in out and "joints" not in out
     code, out, _ = run(capsys, "show", "puma560")
     assert "6 joints (RRRRRR)" in out
+    urdf = pathlib.Path(__file__).resolve().parents[1] / "examples" / "urdf" / "small_arm.urdf"
+    code, out, _ = run(capsys, "import-urdf", urdf, "--tip", "shoulder")  # the pan joint alone
+    first = out.splitlines()[0]
+    assert code == 0 and first.endswith("as 1 standard DH row") and "1 joint (R)" in out
 
 
 def test_a_missing_convention_says_it_is_missing(capsys, tmp_path, monkeypatch):

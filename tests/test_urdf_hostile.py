@@ -96,6 +96,7 @@ CASES = {
     "duplicate link": (_swap('<link name="base"/>', '<link name="base"/><link name="base"/>'),
                        ["arm.urdf", "base", "already"]),
     "no moving joint": (GOOD.replace('type="revolute"', 'type="fixed"'), ["arm.urdf", "no revolute"]),
+    "no joint": ('<robot name="r"><link name="a"/></robot>', ["arm.urdf", "'a'", "has no joints"]),
     "deep nesting": ("<robot>" + "<a>" * 5000 + "</a>" * 5000 + "</robot>", ["arm.urdf", "nested"]),
     "too many elements": ("<robot>" + "<link name='x'/>" * 100_001 + "</robot>", ["arm.urdf", "elements"]),
 }
@@ -119,6 +120,8 @@ def test_good_urdf_accepted(tmp_path):
     (["--tip", "nowhere"], ["nowhere", "no such link"]),
     (["--base", "l2", "--tip", "l1"], ["not below"]),
     (["--convention", "craig"], ["convention"]),
+    (["--base", "l2"], ["'l2'", "empty", "nearer the root"]),  # was: "no revolute ... between 'l2' and 'l2'"
+    (["--base", "l1", "--tip", "l1"], ["'l1'", "empty", "--tip below --base"]),
     (["-o", "arm.png"], ["arm.png"]),
 ])
 def test_bad_options_refused(argv, mentions, tmp_path):

@@ -44,7 +44,7 @@ def cmd_import_urdf(args: argparse.Namespace):
     robot = result.robot
     width = max([len("URDF joint")] + [len(n) for n in result.joint_names])
     lines = [f"{robot.name}: the chain {result.base_link} -> {result.tip_link} of {args.urdf} as {robot.dof} "
-             f"{robot.convention.value} DH rows", "",
+             f"{robot.convention.value} DH row{'s' * (robot.dof != 1)}", "",
              f"row  {'URDF joint'.ljust(width)}  axis and the next one"]
     lines += [f"{k + 1:>3}  {name.ljust(width)}  {case}"
               for k, (name, case) in enumerate(zip(result.joint_names, result.cases))]

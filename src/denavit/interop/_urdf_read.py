@@ -337,6 +337,11 @@ def chain_path(model: UrdfModel, base: str | None = None, tip: str | None = None
         base = roots[0]
     if tip is None:
         tip = _default_tip(model, base)
+    if tip == base:
+        why = ("choose --tip below --base" if model.child_joints.get(base) else
+               f"no link hangs below {base[:60]!r}; choose a --base nearer the root" if base in model.parent_joint
+               else "the URDF has no joints")
+        raise model.error(f"the chain from link {base[:60]!r} to link {tip[:60]!r} is empty: {why}")
     path: list[UrdfJoint] = []
     link = tip
     while link != base:
