@@ -129,6 +129,13 @@ def test_bad_options_refused(argv, mentions, tmp_path):
     assert_refused(o, mentions=mentions)
 
 
+@pytest.mark.parametrize("name", ["arm.yaml", "arm.TOML", "arm.json"])
+def test_a_robot_file_given_as_urdf_says_so(tmp_path, name):
+    # was: "malformed XML (not well-formed)" at line 1
+    o = run_cli(["import-urdf", name], tmp_path, {name: "name: arm\nconvention: standard\n"})
+    assert_refused(o, mentions=[name, "a robot file, not a URDF"])
+
+
 def test_existing_output_kept_without_force(tmp_path):
     o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml"], tmp_path, {"arm.urdf": GOOD, "arm.yaml": "mine\n"})
     assert_refused(o, mentions=["arm.yaml", "--force"])

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import ParseError
 from ._common import add_common, check_output, load, output_file
 
 #: File types ``import-urdf -o`` writes (a denavit robot file).
@@ -40,6 +41,9 @@ def cmd_import_urdf(args: argparse.Namespace):
     from ..io import dump_robot, robot_to_dict
 
     check_output(args, args.output, ROBOT_SUFFIXES)  # before any work
+    if Path(args.urdf).suffix.lower() in (".yaml", ".yml", ".toml", ".json"):  # was: "malformed XML" at line 1
+        raise ParseError(f"{args.urdf[:200]}: a robot file, not a URDF: other commands take it as ROBOT as it is "
+                         "(denavit show, fk, export-urdf ...)")
     result = import_urdf(args.urdf, args.base, args.tip, args.convention, xacro=args.xacro)
     robot = result.robot
     width = max([len("URDF joint")] + [len(n) for n in result.joint_names])
