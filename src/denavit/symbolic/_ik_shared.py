@@ -114,7 +114,7 @@ def cosine_law_steps(lhs_sq, expr_q, q, robot, rng, title, text):
     s = sp.sin(q)
     return [
         IKStep(title, lhs_sq, K0 + K1 * c + K2 * s, text),
-        IKStep(f"The constant K of the law of cosines", Ksym, sp.factor_terms((lhs_sq - K0) / f),
+        IKStep("The constant K of the law of cosines", Ksym, sp.factor_terms((lhs_sq - K0) / f),
                f"Dividing by {sp.sstr(f)}: {sp.sstr(k1 * c + k2 * s)} = K.", assign=True),
         IKStep(f"{q} (two roots)", q,
                sp.atan2(k2, k1) + sig * sp.atan2(sp.sqrt(k1**2 + k2**2 - Ksym**2), Ksym),

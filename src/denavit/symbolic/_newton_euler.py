@@ -78,7 +78,7 @@ def newton_euler_dynamics(robot: DHRobot, simplify: str = "trig", numeric: bool 
                           progress: Progress | None = None) -> NewtonEulerSteps:
     """Joint torques τ(q, q̇, q̈) by the symbolic recursive Newton–Euler algorithm (see module notes)."""
     js = joint_symbols(robot.dof)
-    q, qd, qdd = js.q, js.qd, js.qdd
+    qd, qdd = js.qd, js.qdd
     n = robot.dof
     simp = make_simplifier(robot, simplify)
     vs = lambda v: sp.ImmutableMatrix(sp.Matrix(v).applyfunc(simp))  # noqa: E731

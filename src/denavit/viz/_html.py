@@ -19,7 +19,6 @@ import numpy as np
 from ..errors import ParseError
 from ..model import DHRobot, JointType
 from ._geometry import arm_geometry, default_configuration, robot_scale
-from ._workspace import sampling_limits
 
 __all__ = ["viewer_html", "write_viewer", "slider_limits", "VIEW_SAMPLES"]
 
