@@ -204,6 +204,11 @@ def test_one_joint_arm_reads_in_the_singular(capsys, tmp_path, monkeypatch):
     assert code == 0 and "1 joint (R)" in out and "joints" not in out.splitlines()[1]
     code, out, _ = run(capsys, "export-urdf", "one.yaml", "-o", "one.urdf")
     assert code == 0 and "1 joint q1," in out and "joints" not in out
+    code, out, _ = run(capsys, "convert", "one.yaml", "--to", "standard", "-o", "same.yaml")
+    assert code == 0 and out.strip() == "wrote same.yaml (standard DH, 1 row) (it was already in that convention: " \
+                                         "rows unchanged)"
+    code, out, _ = run(capsys, "convert", "one.yaml", "--to", "modified", "-o", "mdh.yaml")
+    assert code == 0 and out.startswith("wrote mdh.yaml (modified DH, ") and "already" not in out
     code, out, _ = run(capsys, "show", "puma560")
     assert "6 joints (RRRRRR)" in out
     urdf = pathlib.Path(__file__).resolve().parents[1] / "examples" / "urdf" / "small_arm.urdf"

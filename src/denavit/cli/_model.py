@@ -163,7 +163,8 @@ def cmd_convert(args: argparse.Namespace):
         path = Path(args.output)
         with output_file(args.output) as tmp:
             Path(tmp).write_text(dump_robot(out, "json" if path.suffix.lower() == ".json" else "yaml"), encoding="utf-8")
-        text = f"wrote {path} ({out.convention.value} DH, {out.n_rows} rows)"
+        same = " (it was already in that convention: rows unchanged)" if out.convention is robot.convention else ""
+        text = f"wrote {path} ({out.convention.value} DH, {out.n_rows} row{'s' * (out.n_rows != 1)}){same}"
     else:
         text = dump_robot(out)
     return {"robot": robot.name, "from": robot.convention.value, "to": out.convention.value,
