@@ -268,3 +268,36 @@ def test_symbolic_dynamics_progress_is_a_few_lines_per_stage(capsys, monkeypatch
     every, elines = stages(0.0)
     assert "mass matrix" in quiet and set(quiet) == set(every)
     assert max(quiet.values()) <= 2 and len(elines) > len(qlines) and max(every.values()) > 2
+
+
+NO_ANGLES = [
+    ["workspace", "planar2r", "--samples", "2000", "--seed", "3", "--scheduler", "synchronous"],
+    ["convert", "puma560", "--to", "modified"],
+    ["export-urdf", "stanford"],
+    ["check", "planar2r", "examples/claims/planar2r.yaml"],
+]
+
+
+@pytest.mark.parametrize("argv", NO_ANGLES, ids=[a[0] for a in NO_ANGLES])
+def test_deg_says_it_has_no_effect_where_there_are_no_angles(capsys, monkeypatch, argv):
+    # `workspace --help` promised "angles in and out in degrees" for a command without angles: --deg changes nothing
+    import pathlib
+
+    monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])
+    code, out, _ = run(capsys, *argv, "--json")
+    code_deg, out_deg, _ = run(capsys, *argv, "--json", "--deg")
+    assert code == code_deg == 0 and _strict(out) == _strict(out_deg)
+
+
+def test_help_of_commands_without_angles_says_deg_has_no_effect():
+    # every command takes --deg (README); where it changes nothing, its help says so
+    from denavit.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command").choices
+    for name, parser in sub.items():
+        deg = next((a for a in parser._actions if a.dest == "deg"), None)
+        if deg is None:
+            continue
+        quiet = name in {"workspace", "reachability", "convert", "check", "compile", "export", "export-urdf",
+                         "export-mjcf"}
+        assert ("no effect" in deg.help) == quiet, name

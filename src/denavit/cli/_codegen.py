@@ -16,12 +16,12 @@ __all__ = ["register"]
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("compile", help="generate and cache an arm's kernels (FK, Jacobians, dynamics); time them")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("--backend", choices=["numba", "numpy"], help="default: numba when installed (the 'fast' extra)")
     p.set_defaults(handler=cmd_compile)
 
     p = sub.add_parser("export", help="write an arm's kernels as standalone C99 or numpy-only Python source")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into (made if absent)")
     p.add_argument("--prefix", help="C function / module name prefix (default: from the robot's name)")

@@ -147,12 +147,13 @@ def require_symbolic_size(robot, what: str, limit: int = MAX_SYMBOLIC_JOINTS) ->
                          f"{limit} joints (its expressions grow too fast to finish); use the numeric route with -q")
 
 
-def add_common(p: argparse.ArgumentParser, robot: bool = True) -> None:
-    """ROBOT, --json and --deg."""
+def add_common(p: argparse.ArgumentParser, robot: bool = True, angles: bool = True) -> None:
+    """ROBOT, --json and --deg (``angles=False``: a command without angles says --deg has no effect there)."""
     if robot:
         p.add_argument("robot", metavar="ROBOT", help="built-in name or robot file")
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
-    p.add_argument("--deg", action="store_true", help="angles in and out in degrees (radians otherwise)")
+    p.add_argument("--deg", action="store_true", help="angles in and out in degrees (radians otherwise)" if angles else
+                   "no effect here: this command reads and writes no angles (taken so that every command takes it)")
     p.add_argument(
         "--param", action="append", default=[], metavar="NAME=VALUE", help="override a robot parameter (repeatable)"
     )

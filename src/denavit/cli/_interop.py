@@ -29,7 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     for fmt, suffix, help_text in (("urdf", ".urdf", "the arm as URDF (links, joints, limits, inertials, visuals)"),
                                    ("mjcf", ".xml", "the arm as MJCF for MuJoCo (bodies, joints, inertials, armature)")):
         p = sub.add_parser(f"export-{fmt}", help=help_text)
-        add_common(p)
+        add_common(p, angles=False)
         p.add_argument("-o", "--output", metavar="FILE", help=f"file to write ({suffix}); stdout if absent")
         p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
         p.set_defaults(handler=cmd_export, fmt=fmt, suffixes=(suffix,) if fmt == "mjcf" else (".urdf", ".xml"))

@@ -36,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=cmd_fk)
 
     p = sub.add_parser("convert", help="write the same arm in the other DH convention")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("--to", required=True, choices=["standard", "modified"], help="target convention")
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
     p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")

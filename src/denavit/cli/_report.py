@@ -37,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=cmd_report)
 
     p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("claims", metavar="CLAIMS_FILE", help="YAML claims file (see docs/claims.md)")
     p.add_argument("--seed", type=nonneg_int, default=0, help="seed of the random test points (default 0)")
     p.set_defaults(handler=cmd_check)
@@ -207,7 +207,8 @@ def cmd_import_table(args: argparse.Namespace):
     if out is not None:
         with output_file(str(out)) as tmp:
             Path(tmp).write_text(file_text, encoding="utf-8")
-        msg = f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} row{'s' * (robot.n_rows != 1)}, {robot.dof} joint{'s' * (robot.dof != 1)})"
+        msg = (f"wrote {out} ({robot.convention.value} DH, {robot.n_rows} row{'s' * (robot.n_rows != 1)}, "
+               f"{robot.dof} joint{'s' * (robot.dof != 1)})")
         msg += "".join(f"\nnote: {n}" for n in result.notes)
     else:
         msg = file_text

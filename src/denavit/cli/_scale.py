@@ -69,7 +69,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     from ..scale import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, MAX_SAMPLES
 
     p = sub.add_parser("workspace", help="reachable workspace by streamed sampling: bounds, volume with an interval")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("-o", "--output", metavar="FILE", help="picture to write (.png, .svg, .pdf); numbers only if absent")
     p.add_argument("--samples", type=sample_count(SAMPLES_MIN, MAX_SAMPLES), default=100_000,
                    help=f"random configurations (default 100000; {SAMPLES_MIN} to {MAX_SAMPLES:.0e}; 1e9 is fine)")
@@ -84,7 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(handler=cmd_workspace)
 
     p = sub.add_parser("reachability", help="per voxel, the share of orientations the arm reaches; manipulability")
-    add_common(p)
+    add_common(p, angles=False)
     p.add_argument("-o", "--output", metavar="FILE", help="picture of horizontal slices (.png, .svg, .pdf)")
     p.add_argument("--resolution", type=bounded_float(*REACH_RESOLUTION_RANGE), default=0.05,
                    help="voxel edge [m] (default 0.05; 0.001 to 1000)")
