@@ -123,3 +123,33 @@ def test_cli_general_6r_and_lock(tmp_path):
         r = run("panda", "--from-q", "0.1,0.2,0.3,-1.4,0.5,1.6,0.7", *bad)
         assert r.returncode == 2 and msg in r.stderr and "Traceback" not in r.stderr
         assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_ik_pose_and_seed_with_deg_take_each_value_in_its_own_unit(capsys):
+    """--deg: plain roll/pitch/yaw numbers are degrees, a value written with deg or pi keeps its unit (was converted
+    twice); a --seed's prismatic entry stays in metres."""
+    from denavit.numeric import transform_from_xyz_rpy
+
+    robot = load_robot("puma560")
+    T = forward_kinematics(robot, [0.2, -0.3, 0.4, 0.5, 0.6, 0.7])
+    from denavit.numeric import rpy_from_rotation
+
+    r, p, y = np.degrees(rpy_from_rotation(T[:3, :3]))
+    x = ",".join(f"{v:.15g}" for v in T[:3, 3])
+    for pose in (f"{x},{r:.15g},{p:.15g},{y:.15g}", f"{x},{r:.15g}deg,{p:.15g},{np.radians(y):.15g}*pi/pi"):
+        code, out, err = _run(capsys, "ik", "puma560", "--pose=" + pose, "--deg", "--json")
+        assert code == 0, err
+        data = json.loads(out)
+        np.testing.assert_allclose(data["T"], T, atol=1e-9)
+        sols = np.radians(np.array(data["solutions"]))
+        np.testing.assert_allclose(forward_kinematics(robot, sols), np.broadcast_to(T, (len(sols), 4, 4)), atol=1e-8)
+    stanford = load_robot("stanford")
+    q = np.array([0.2, -0.4, 0.6, 0.3, 0.5, -0.2])  # joint 3 prismatic [m]
+    Ts = forward_kinematics(stanford, q)
+    seed = ",".join(f"{v:.15g}" for v in [np.degrees(q[0]), np.degrees(q[1]), q[2], *np.degrees(q[3:])])
+    code, out, err = _run(capsys, "ik", "stanford", "--T=" + ",".join(f"{v:.17g}" for v in Ts.ravel()),
+                          "--method", "numeric", "--seed", seed, "--deg", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["success"] is True and data["iterations"] <= 3  # the seed is the solution: nothing to iterate
+    assert abs(data["q"][2] - q[2]) < 1e-9  # metres, not degrees

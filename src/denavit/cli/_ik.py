@@ -53,8 +53,9 @@ def _target(args, robot) -> np.ndarray:
 
     if args.pose is not None:
         v = check_values(parse_values(args.pose, 6, what="--pose"), "--pose")
-        rpy = np.radians(v[3:]) if args.deg else v[3:]
-        return transform_from_xyz_rpy(v[:3], rpy)
+        if args.deg:  # plain roll, pitch, yaw in degrees; a value with pi or deg says its own unit
+            v[3:] = parse_values(args.pose, 6, what="--pose", deg=True)[3:]
+        return transform_from_xyz_rpy(v[:3], v[3:])
     if args.T is not None:
         v = check_values(parse_values(args.T, 16, what="--T"), "--T").reshape(4, 4)
         if not np.allclose(v[3], [0, 0, 0, 1]):
@@ -140,13 +141,12 @@ def _analytic(args, robot, T):
 
 
 def _numeric(args, robot, T):
-    from ..io import parse_values
     from ..ik import solve_ik
 
     rng = np.random.default_rng()
     seed = None
     if args.seed is not None:
-        seed = check_values(parse_values(args.seed, robot.dof, what="--seed", deg=args.deg), "--seed")
+        seed = joint_values(args, robot, args.seed, what="--seed", check_limits=False)  # degrees: revolute only
     if args.all:
         n = 256
         seeds = rng.uniform(*_seed_ranges(robot).T, (n, robot.dof))
