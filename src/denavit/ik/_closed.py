@@ -1,6 +1,6 @@
 """Direct closed forms for the two common Pieper position classes, and a lean three-axis wrist, batched.
 
-The general route of :class:`._subproblems.Position3` finds joints 1–3 of any Pieper arm from the roots of a
+The general route of :class:`._position3.Position3` finds joints 1–3 of any Pieper arm from the roots of a
 resultant (eigenvalues of a companion matrix) and leaves roots that must be polished.  The two classes most arms
 belong to have textbook closed forms that need only ``atan2``/``arccos``/``sqrt``; here they are written once, in
 the joint-screw form ``W = Rz(q1) C1 J2(q2) C2 J3(q3) P`` of :mod:`._chain` (W: wrist centre in the frame

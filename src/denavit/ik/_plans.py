@@ -30,7 +30,8 @@ from ._closed import closed_position, wrist_angles
 from ._general import loop_of, rank_formulations, solve_general
 from ..chain import Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screws_of
 from ._chain import angle_about_z, solve_trig
-from ._subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, Position3, axis_angle_roots, rotation3, rz_bilinear,
+from ._position3 import Position3
+from ._subproblems import (ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, rotation3, rz_bilinear,
                               trig_coefficients)
 from ..numeric import inverse_transform
 
