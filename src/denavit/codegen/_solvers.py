@@ -145,8 +145,8 @@ class IKMethods:
 
     def _analytic_solver(self):
         """``[K, labels, kind, check, solve, first call]`` for the compiled closed form of this arm's IK plan
-        (``solve(T, K, f, i)``: the elbow, UR-class or Stanford-class kernel, by plan kind and route), or False where there is none
-        (the plain solver answers)."""
+        (``solve(T, K, f, i)``: the elbow, UR-class or Stanford-class kernel, by plan kind and route), or False
+        where there is none (the plain solver answers)."""
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
             return False
