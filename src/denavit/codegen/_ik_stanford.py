@@ -11,9 +11,10 @@ module's ``_ik_finish``.
 Every case the plain solver treats specially goes back to it (``status`` 1): q3 next to its double root (the wrist
 centre at its nearest to O), a q2 or wrist root next to a double root, the wrist centre on or next to axis 1 or
 with its arm next to axis 2 (free or ill-conditioned joints; NEAR_SINGULAR of :mod:`._ik_parallel`), the wrist
-axes 4 and 6 (nearly) aligned, a candidate whose estimated rounding error exceeds COND_MAX, a target beyond the plain solver's bound (prismatic travel included: it then
-reports no solution, not even outside the limits), a candidate needing polish, two solutions about to merge.  The text below is
-appended to each generated numba module; it calls that module's ``fk_1``, ``_elbow_half_angle`` and ``_ik_finish``.
+axes 4 and 6 (nearly) aligned, a candidate whose estimated rounding error exceeds COND_MAX, a target beyond the
+plain solver's bound (prismatic travel included: it then reports no solution, not even outside the limits), a
+candidate needing polish, two solutions about to merge.  The text below is appended to each generated numba
+module; it calls that module's ``fk_1``, ``_elbow_half_angle`` and ``_ik_finish``.
 """
 
 from __future__ import annotations
