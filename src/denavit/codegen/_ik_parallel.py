@@ -91,28 +91,31 @@ def ik_parallel_packed(T, K, f, i):
     a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
     rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
     # scratch: one float and one flag allocation, sliced
-    ws = np.empty(134)
+    ws = np.empty(190)
     cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \
         ws[83:89]
+    f1, f2, f3 = ws[89:101].reshape((4, 3)), ws[101:113].reshape((4, 3)), ws[113:125].reshape((4, 3))  # labels
+    trig, perm = ws[134:182].reshape((8, 6)), ws[182:190]  # cos, sin of q1, q2, q3 per candidate; sorted order
     flags = np.zeros(24, dtype=np.bool_)
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
             continue
-        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, ws[89:134])
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, trig, ws[89:134])
         kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
-                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:])
+                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm)
         for r in range(3):
             X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
         for s in range(kept):
-            i[b, s] = _parallel_label(f[b, s, :6], X, C, theta, ws[89:125])
+            i[b, s] = _parallel_label(trig[int(perm[s])], f[b, s, 4], X, C, theta, f1, f2, f3)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
 @njit(cache=True, nogil=True)
-def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
-    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand
-    (ws: 45 floats of scratch); returns (count, status)."""
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
+    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand,
+    the cosines and sines of their q1, q2, q3 into trig (for the labels); ws: 45 floats of scratch.  Returns
+    (count, status)."""
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
@@ -145,7 +148,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
     e1 = max(1.0, scale / rho) / max(math.sin(delta), 1e-300)  # rounding error of q1 [eps] (COND_MAX)
     for s1 in range(2):
         q1 = base1 + delta if s1 == 0 else base1 - delta
-        _frame1(C, q1, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
+        c1, s1v = math.cos(q1), math.sin(q1)
+        _frame1(C, c1, s1v, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
         RL02 = cols[0, 0] * TC[0, 2] + cols[0, 1] * TC[1, 2] + cols[0, 2] * TC[2, 2]
         RL12 = cols[1, 0] * TC[0, 2] + cols[1, 1] * TC[1, 2] + cols[1, 2] * TC[2, 2]
         RL22 = cols[2, 0] * TC[0, 2] + cols[2, 1] * TC[1, 2] + cols[2, 2] * TC[2, 2]
@@ -225,14 +229,16 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
                 q4 = math.atan2(N10, N00)
                 cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                 cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
+                trig[ncand, 0], trig[ncand, 1], trig[ncand, 2] = c1, s1v, c2
+                trig[ncand, 3], trig[ncand, 4], trig[ncand, 5] = s2v, c3, s3v
                 ncand += 1
     return ncand, status
 
 
 @njit(cache=True, nogil=True)
-def _frame1(C, q1, cols):
-    """Columns x, y, z and origin of C0 Rz(q1) C1 into cols (4, 3) (as chain_columns: x <- c x + s y, ...)."""
-    c, s = math.cos(q1), math.sin(q1)
+def _frame1(C, c, s, cols):
+    """Columns x, y, z and origin of C0 Rz(q1) C1 into cols (4, 3), c, s = cos q1, sin q1 (as the chain's
+    walker: x <- c x + s y, ...)."""
     for r in range(3):
         x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
         x, y = c * x + s * y, c * y - s * x
@@ -243,9 +249,9 @@ def _frame1(C, q1, cols):
 
 
 @njit(cache=True, nogil=True)
-def _next_frame(cols, q, Ck, out):
-    """Columns and origin of F Rz(q) Ck into out (4, 3), F given by its columns cols (4, 3)."""
-    c, s = math.cos(q), math.sin(q)
+def _next_frame(cols, c, s, Ck, out):
+    """Columns and origin of F Rz(q) Ck into out (4, 3), F given by its columns cols (4, 3), c, s = cos q, sin q
+    (out may be cols)."""
     for r in range(3):
         x, y, z = c * cols[0, r] + s * cols[1, r], c * cols[1, r] - s * cols[0, r], cols[2, r]
         out[0, r] = x * Ck[0, 0] + y * Ck[1, 0] + z * Ck[2, 0]
@@ -273,11 +279,11 @@ def _tail(C, q5, q6, tl):
 
 
 @njit(cache=True, nogil=True)
-def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq):
+def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq, perm):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
     would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
     status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
-    others into out_outq.  Returns (kept, outside, status)."""
+    others into out_outq, perm[slot] the candidate in each slot.  Returns (kept, outside, status)."""
     verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
     ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     status = 0
@@ -355,6 +361,7 @@ def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flag
                                 best = k
                             break
         used[best] = True
+        perm[slot] = best
         for j in range(6):
             out_q[slot, j] = cand[best, j]
         out_err[slot, 0], out_err[slot, 1] = cerr[best, 0], cerr[best, 1]
@@ -362,14 +369,15 @@ def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flag
 
 
 @njit(cache=True, nogil=True)
-def _parallel_label(qs, X, C, theta, fr):
+def _parallel_label(t, q5, X, C, theta, f1, f2, f3):
     """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
     (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
-    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  fr: 36 floats of scratch."""
-    f1, f2, f3 = fr[0:12].reshape((4, 3)), fr[12:24].reshape((4, 3)), fr[24:36].reshape((4, 3))
-    _frame1(C, qs[0], f1)
-    _next_frame(f1, qs[1], C[2], f2)
-    _next_frame(f2, qs[2], C[3], f3)
+    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  t: cos, sin of q1, q2, q3 (from before the
+    folding into the limits, which moves them by whole turns); f1, f2, f3: (4, 3) scratch for the frames after
+    joints 1, 2, 3."""
+    _frame1(C, t[0], t[1], f1)
+    _next_frame(f1, t[2], t[3], C[2], f2)
+    _next_frame(f2, t[4], t[5], C[3], f3)
     code = 0
     s_right = 0.0
     for r in range(3):
@@ -384,7 +392,7 @@ def _parallel_label(qs, X, C, theta, fr):
     side = (f2[3, 0] - f1[3, 0]) * n0 + (f2[3, 1] - f1[3, 1]) * n1 + (f2[3, 2] - f1[3, 2]) * n2
     if side * towards < 0.0:
         code |= 2
-    if math.sin(qs[4] + theta[4]) < 0.0:
+    if math.sin(q5 + theta[4]) < 0.0:
         code |= 4
     return code
 '''

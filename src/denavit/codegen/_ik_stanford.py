@@ -79,7 +79,7 @@ def ik_stanford_packed(T, K, f, i):
     X_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
     geom, sc, lo_lim, hi_lim = K[131:140], K[140:149], K[149:155], K[155:161]
     rev, theta, tols, far = K[161:167], K[167:173], K[173:181], K[181]
-    ws = np.empty(131)
+    ws = np.empty(139)
     cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \\
         ws[83:89]
     flags = np.zeros(24, dtype=np.bool_)
@@ -91,7 +91,7 @@ def ik_stanford_packed(T, K, f, i):
             X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
         ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
         kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
-                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:])
+                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139])
         for s in range(kept):
             i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
@@ -151,9 +151,9 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
             q1 = math.atan2(D[1], D[0]) - math.atan2(ey, ex)
             e1 = (1.0 + e2 + e3) * L / max(min(math.hypot(D[0], D[1]), math.hypot(ex, ey)), 1e-300)
             # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 C3 (joint 3 slides): its columns, then M = R_0_3^T Y
-            _frame1(C, q1, cols)
-            _next_frame(cols, q2, C[2], cols)
-            _next_frame(cols, 0.0, C[3], cols)
+            _frame1(C, math.cos(q1), math.sin(q1), cols)
+            _next_frame(cols, c2, s2v, C[2], cols)
+            _next_frame(cols, 1.0, 0.0, C[3], cols)  # joint 3 slides: no turn
             for r in range(3):
                 for j in range(3):
                     M[r, j] = cols[r, 0] * Y[0, j] + cols[r, 1] * Y[1, j] + cols[r, 2] * Y[2, j]
