@@ -9,8 +9,9 @@ Every case the plain solver treats specially is handed back to it (``status`` 1)
 pose (wrist centre on axis 1 or 2, wrist axes aligned), a root next to a double root (|ratio| near 1), a
 candidate that would need polishing, or two solutions closer than the merge radius.  The compiled path answers
 only where its answer is the plain solver's.  The text below is appended to each generated numba module of an
-arm whose IK plan is this closed form; it calls that module's ``fk_1``; nothing of the robot or the user is
-pasted into it.
+arm whose IK plan is this closed form; it calls that module's ``fk_1`` and the verification, folding, merging and
+sorting of the UR kernel (``_ik_finish`` of :mod:`._ik_parallel`, appended to the same module); nothing of the robot
+or the user is pasted into it.
 """
 
 from __future__ import annotations
@@ -56,18 +57,17 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide)."""
     h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
-    free_tol, ratio_tol, verify_tol, polish_above, dup_tol, merge_r, aligned_tol = (
-        tols[0], tols[1], tols[2], tols[3], tols[4], tols[5], tols[6])
+    free_tol, ratio_tol, aligned_tol = tols[0], tols[1], tols[6]  # the others: _ik_finish's
     tiny = free_tol * L
-    reach = tols[7]
     # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
-    ws = np.empty(137)
+    ws = np.empty(145)
     F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
     Xw, W, Y, M = ws[86:89], ws[89:92], ws[92:101].reshape((3, 3)), ws[101:110].reshape((3, 3))
     cx, cy, cz = ws[110:113], ws[113:116], ws[116:119]
     x1, y1c, z1, S, E, dW = ws[119:122], ws[122:125], ws[125:128], ws[128:131], ws[131:134], ws[134:137]
+    perm = ws[137:145]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
-    ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
+    ok = flags[0:8]
     for b in range(T.shape[0]):
         status = 0
         # wrist centre and the target rotation without the last constant
@@ -179,89 +179,13 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                         cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                         cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
                         ncand += 1
-        # verify each candidate by the FK
-        for k in range(ncand):
-            for j in range(6):
-                q[j] = cand[k, j]
-            fk_1(q, F)
-            pe = math.sqrt((F[0, 3] - T[b, 0, 3]) ** 2 + (F[1, 3] - T[b, 1, 3]) ** 2 + (F[2, 3] - T[b, 2, 3]) ** 2)
-            # rotation error: angle of R_t R^T
-            tr = 0.0
-            for i in range(3):
-                for j in range(3):
-                    tr += T[b, i, j] * F[i, j]
-            v0 = 0.0
-            v1 = 0.0
-            v2 = 0.0
-            for j in range(3):
-                v0 += T[b, 2, j] * F[1, j] - T[b, 1, j] * F[2, j]
-                v1 += T[b, 0, j] * F[2, j] - T[b, 2, j] * F[0, j]
-                v2 += T[b, 1, j] * F[0, j] - T[b, 0, j] * F[1, j]
-            re = math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0))
-            cerr[k, 0], cerr[k, 1] = pe, re
-            size = pe + reach * re
-            if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
-                status = 1  # would be polished by the plain solver
-            ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
-        # fold into the limits; duplicates (and near-duplicates) decided as the plain solver does
-        for k in range(ncand):
-            if not ok[k]:
-                continue
-            ins = True
-            for j in range(6):
-                x = cand[k, j]
-                if revolute[j] != 0.0:
-                    x = math.pi - ((math.pi - x) % (2.0 * math.pi))
-                    if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
-                        x += 2.0 * math.pi
-                    if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
-                        x -= 2.0 * math.pi
-                cand[k, j] = x
-                ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
-            inside[k] = ins
-            for m in range(k):
-                if not ok[m]:
-                    continue
-                dmax = 0.0
-                for j in range(6):
-                    d = abs(cand[k, j] - cand[m, j])
-                    if revolute[j] != 0.0:
-                        d = abs(d - 2.0 * math.pi * np.rint(d / (2.0 * math.pi)))
-                    dmax = max(dmax, d)
-                if dmax < dup_tol:
-                    ok[k] = False
-                    break
-                if dmax < merge_r:
-                    status = 1  # the plain solver merges such a pair by the FK of its midpoint
-        kept = 0
-        n_out = 0
-        for k in range(ncand):
-            if ok[k] and not inside[k]:
-                for j in range(6):
-                    out_outq[b, n_out, j] = cand[k, j]
-                n_out += 1
-                ok[k] = False
-            elif ok[k]:
-                kept += 1
-        # sorted lexicographically (as the plain solver returns one pose), with labels
-        for k in range(8):
-            used[k] = False
+        # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
+        # UR and Stanford kernels); then the labels
+        kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags,
+                                     out_q[b], out_err[b], out_outq[b], perm)
+        status = max(status, st)
         for slot in range(kept):
-            best = -1
-            for k in range(ncand):
-                if ok[k] and not used[k]:
-                    if best < 0:
-                        best = k
-                    else:
-                        for j in range(6):
-                            if cand[k, j] != cand[best, j]:
-                                if cand[k, j] < cand[best, j]:
-                                    best = k
-                                break
-            used[best] = True
-            for j in range(6):
-                out_q[b, slot, j] = cand[best, j]
-            out_err[b, slot, 0], out_err[b, slot, 1] = cerr[best, 0], cerr[best, 1]
+            best = int(perm[slot])
             # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5))
             q1 = cand[best, 0]
             c1, s1v = math.cos(q1), math.sin(q1)
