@@ -438,7 +438,7 @@ def test_compiled_analytic_ik_equals_the_plain_solver(name):
 def test_compiled_analytic_ik_other_arms_and_bad_input():
     from denavit.errors import UnsupportedRobotError
 
-    for name in ("stanford", "ur5"):  # closed forms of other classes: answered by the plain solver
+    for name in ("stanford", "ur5", "scara"):  # compiled (UR, Stanford classes: tests/test_codegen_ik.py) or plain
         robot = denavit.load_robot(name)
         fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
         T = denavit.forward_kinematics(robot, np.full(robot.dof, 0.3))
