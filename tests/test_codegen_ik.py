@@ -16,7 +16,7 @@ import os
 import numpy as np
 import pytest
 from conftest import REDUCED
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import denavit
@@ -289,6 +289,7 @@ def _random_ur_class(seed: int) -> DHRobot:
 @pytest.mark.slow
 @settings(max_examples=2 if REDUCED else 5)
 @given(seed=st.integers(0, 2**32 - 1))
+@example(seed=391)  # a singular pose with q3 = 0 at a limit of −2π: the folding's knife edge (FOLD_EDGE)
 def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
     """Random UR-class arms (both conventions, offsets, limits, base and tool) x random and singular poses."""
     robot = _random_ur_class(seed)

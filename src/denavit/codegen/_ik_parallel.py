@@ -37,6 +37,10 @@ NEAR_SINGULAR = 1e-5
 #: formulas evaluated in another order) stay 20-1000 times below this estimate, so beyond 1e6 ε they could approach
 #: 1e-10: such a pose goes to the plain solver (about 1 random UR5 pose in 100; the median time is unchanged).
 COND_MAX = 1e6
+#: Distance [rad, m] of a folded candidate from a decision of the folding — a joint limit, the limit ∓ 2π, or ±π where
+#: angles wrap — under which the pose goes to the plain solver: a rounding difference there moves a solution by a
+#: whole turn or across a limit (hypothesis found q3 = −1.3e-15 against the plain solver's +0 at a limit of −2π).
+FOLD_EDGE = 1e-9
 
 #: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (178 numbers).
 PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 11), ("lo", 6), ("hi", 6),
@@ -79,7 +83,7 @@ def parallel_constants(robot, plan) -> np.ndarray:
     return K
 
 
-IK_PARALLEL_SOURCE = '''
+IK_PARALLEL_SOURCE = f"\n_FOLD_EDGE = {FOLD_EDGE!r}\n" + '''
 
 @njit(cache=True, nogil=True)
 def ik_parallel_packed(T, K, f, i):
@@ -279,6 +283,17 @@ def _tail(C, q5, q6, tl):
 
 
 @njit(cache=True, nogil=True)
+def _near_fold_edge(x, lo, hi):
+    """A wrapped angle x within _FOLD_EDGE of ±π or of a limit (itself, or shifted by a whole turn)."""
+    if math.pi - abs(x) < _FOLD_EDGE:
+        return True
+    for shift in (-2.0 * math.pi, 0.0, 2.0 * math.pi):
+        if abs(x + shift - lo) < _FOLD_EDGE or abs(x + shift - hi) < _FOLD_EDGE:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
 def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq, perm):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
     would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
@@ -315,10 +330,14 @@ def _ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flag
             x = cand[k, j]
             if revolute[j] != 0.0:
                 x = math.pi - ((math.pi - x) % (2.0 * math.pi))
+                if _near_fold_edge(x, lo_lim[j], hi_lim[j]):
+                    status = 1  # a rounding difference could fold it elsewhere: the plain solver decides
                 if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
                     x += 2.0 * math.pi
                 if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
                     x -= 2.0 * math.pi
+            elif abs(x - lo_lim[j]) < _FOLD_EDGE or abs(x - hi_lim[j]) < _FOLD_EDGE:
+                status = 1
             cand[k, j] = x
             ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
         inside[k] = ins
