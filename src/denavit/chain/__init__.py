@@ -15,7 +15,7 @@ chains derived from the arm's, reversed or with joints merged).
 """
 
 from ._chain import Chain, Row, chain_of, cos_sin, dh_transform, joint_motion
-from ._screws import (STRUCTURAL_ZERO, Screws, reverse_screws, screw_axes, screw_pose, screw_walk, screw_walk_floats,
+from ._screws import (STRUCTURAL_ZERO, Screws, reach_ball, reverse_screws, screw_axes, screw_pose, screw_walk, screw_walk_floats,
                       screws_of)
 from ._walk import COMPONENTS, FLOATS, IDENTITY_COLUMNS, Batch, Components, Floats, Symbolic, pack, walk
 
@@ -53,5 +53,6 @@ __all__ = [
     "screw_walk_floats",
     "screw_pose",
     "screw_axes",
+    "reach_ball",
     "STRUCTURAL_ZERO",
 ]

@@ -19,7 +19,7 @@ import numpy as np
 
 from ._chain import chain_of
 
-__all__ = ["Screws", "screws_of", "reverse_screws", "screw_walk", "screw_walk_floats", "screw_pose", "screw_axes", "STRUCTURAL_ZERO"]
+__all__ = ["Screws", "screws_of", "reverse_screws", "screw_walk", "screw_walk_floats", "screw_pose", "screw_axes", "reach_ball", "STRUCTURAL_ZERO"]
 
 #: Constant entries at or below this are structural zeros and skipped (cos 90° = 6e-17 in a product).
 STRUCTURAL_ZERO = 1e-15
@@ -61,6 +61,17 @@ def screws_of(robot) -> Screws:
     if hit is None:
         hit = chain.memo["screws"] = Screws(np.array(chain.constants), np.array(chain.prismatic, dtype=bool))
     return hit
+
+
+def reach_ball(screws: Screws, lo, hi) -> tuple[np.ndarray, float]:
+    """Centre c (3,) and radius R of a ball holding the end-effector origin for every q with lo ≤ q ≤ hi.
+
+    With T = C0 J1 C1 ⋯ Jn Cn, rotations keep lengths and a prismatic joint adds q_k along a unit axis, so
+    |p − t(C0)| ≤ Σ_{k≥1} |t(C_k)| + Σ_prismatic max(|lo_k|, |hi_k|); R is inf when a prismatic joint is unbounded.
+    """
+    travel = np.maximum(np.abs(np.asarray(lo, float)), np.abs(np.asarray(hi, float)))[screws.prismatic]
+    R = float(np.hypot.reduce(screws.consts[1:, :3, 3], axis=-1).sum() + travel.sum())
+    return np.array(screws.consts[0, :3, 3], dtype=float), R
 
 
 def reverse_screws(screws: Screws) -> Screws:

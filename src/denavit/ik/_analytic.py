@@ -18,7 +18,7 @@ import numpy as np
 from .. import chain as dh_chain
 from .._validate import as_transform
 from ..model import DHRobot, JointType
-from ..chain import screw_walk, screws_of
+from ..chain import reach_ball, screw_walk, screws_of
 from ._chain import damped_solve, wrap_angle
 from ._residual import pose_error
 from ._plans import Plan, make_plan
@@ -448,12 +448,10 @@ def _null_text(v: np.ndarray) -> str:
 
 def _bound(robot: DHRobot) -> float:
     """An upper bound of |p| over every configuration within the limits (inf with an unbounded prismatic joint):
-    the base and tool offsets plus every |a|, |d| and prismatic travel."""
+    |c| + R of the chain's :func:`~denavit.chain.reach_ball`."""
     lim = robot.q_limits
-    pr = np.array([t is JointType.PRISMATIC for t in robot.joint_types], dtype=bool)
-    travel = float(np.sum(np.max(np.abs(lim[pr]), axis=-1))) if pr.any() else 0.0
-    return (float(np.linalg.norm(np.asarray(robot.base, float)[:3, 3])) + _reach(robot) + travel
-            + float(np.linalg.norm(np.asarray(robot.tool, float)[:3, 3])))
+    centre, R = reach_ball(screws_of(robot), lim[:, 0], lim[:, 1])
+    return float(np.linalg.norm(centre)) + R
 
 
 def _stand_in(robot: DHRobot) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 from .._validate import as_joint_array, as_transform
 from ..model import DHRobot
 from ._chain import damped_solve
-from ..chain import screws_of
+from ..chain import reach_ball, screws_of
 from ._residual import (LAMBDA0, LAMBDA_MAX, IKResult, JointLimits, characteristic_length, limits_of, pose_error, row_mask,
                         rotation_log)
 from ._kernel import kernel_of, targets_soa
@@ -182,12 +182,10 @@ def _out_of_reach(robot: DHRobot, Tf: np.ndarray, w_mask: np.ndarray, limits, to
     |p(q) − t(C0)| ≤ Σ_{k≥1} |t(C_k)| + Σ_prismatic max |q_k| for the chain C0 J1 C1 ⋯ Jn Cn (rotations keep
     lengths), and a masked distance is at most the full one: such a target is unreachable for every q, with
     no iteration.  Arms with an unlimited prismatic joint reach everywhere: nothing is screened."""
-    screws = screws_of(robot)
-    lim = np.maximum(np.abs(limits.lo), np.abs(limits.hi))[screws.prismatic]
-    R = float(np.hypot.reduce(screws.consts[1:, :3, 3], axis=-1).sum() + lim.sum())
+    centre, R = reach_ball(screws_of(robot), limits.lo, limits.hi)
     if not np.isfinite(R):
         return np.zeros(len(Tf), dtype=bool)
-    d = _norm3((Tf[:, :3, 3] - screws.consts[0, :3, 3]) * w_mask[:3])
+    d = _norm3((Tf[:, :3, 3] - centre) * w_mask[:3])
     return ~(d <= R * (1.0 + 1e-12) + tol)  # NaN distances too: never iterated
 
 

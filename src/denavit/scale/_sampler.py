@@ -63,14 +63,10 @@ def reach_bound(robot: DHRobot) -> tuple[np.ndarray, float]:
     With the chain T = C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn (J a rotation about z or a translation along z),
     |p − t(C0)| ≤ Σ_{k≥1} |t(C_k)| + Σ_prismatic max |q_k|  (rotations keep lengths).
     """
-    from ..chain import chain_of
+    from ..chain import reach_ball, screws_of
 
-    chain = chain_of(robot)
-    C = chain.constants
     lim = sampling_limits(robot)
-    R = sum(float(np.linalg.norm(M[:3, 3])) for M in C[1:])
-    R += sum(float(np.abs(lim[k]).max()) for k in range(robot.dof) if chain.prismatic[k])
-    return np.array(C[0][:3, 3], dtype=float), R
+    return reach_ball(screws_of(robot), lim[:, 0], lim[:, 1])
 
 
 class PositionFK:
