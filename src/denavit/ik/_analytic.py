@@ -9,87 +9,23 @@ that cannot be are set aside → duplicates are merged → each solution gets a 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
 from .. import chain as dh_chain
 from .._validate import as_transform
+from ..chain import reach_ball, screws_of
 from ..model import DHRobot, JointType
-from ..chain import reach_ball, screw_walk, screws_of
-from ._chain import damped_solve, wrap_angle
-from ._residual import pose_error
-from ._plans import Plan, make_plan
-from ._kernel import kernel_of, targets_soa
 from ..numeric import forward_kinematics
+from ._candidates import (DUPLICATE_TOL, FOLD_RESIDUAL, MERGE_RADIUS, POLISH_ABOVE, VERIFY_TOL, arm_reach,
+                          fold_partners, new_solutions, null_text, verify)
+from ._chain import wrap_angle
+from ._labels import ELBOW, SHOULDER, WRIST, branch_labels, label_table
+from ._plans import Plan, make_plan
+from ._residual import AnalyticIKResult, pose_error
 
 __all__ = ["AnalyticIKResult", "analytic_ik", "ik_structure", "ik_plan"]
-
-SHOULDER, ELBOW, WRIST = ("shoulder right", "shoulder left"), ("elbow up", "elbow down"), ("wrist noflip", "wrist flip")
-VERIFY_TOL = 1e-9  # position [m] and orientation [rad] a solution must reproduce
-POLISH_STEPS = 30
-DUPLICATE_TOL = 1e-6  # joint-space distance under which two solutions are the same [rad, m]
-MERGE_RADIUS = 1e-5  # up to this distance two solutions are also the same when their midpoint reproduces the pose
-# (copies of one root found to ~√ε; two exact solutions of a pose 1e-4 from a singularity lie ~1e-4 apart and stay)
-POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
-PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
-FOLD_ROUGH = 1e-10  # candidate residual [m, rad] (relative to the reach) above which a root lost ~half its digits
-FOLD_SIGMA = 1e-3  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
-SINGULAR_RCOND = 1e-8  # σ_min/σ_max of such a solution under which it is on the singularity: named a continuum
-FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
-FOLD_STEPS = np.array([1e-2, 1e-3, 1e-4])  # offsets [rad, m] along the singular direction for that search
-
-
-@dataclass(frozen=True)
-class AnalyticIKResult:
-    """All closed-form IK solutions of one target pose (or of a batch of poses).
-
-    Attributes
-    ----------
-    solutions : ndarray, shape (k, n) — or (..., K, n) for a batch, NaN rows where ``valid`` is False
-        Joint values [rad, m], each verified by the forward kinematics, within the joint limits.
-    branches : tuple of str (k,) — or ndarray of str (..., K)
-        Branch labels such as ``"shoulder right, elbow up, wrist noflip"`` (definitions in docs/ik.md).
-    free : tuple of str (k,) — or ndarray of str (..., K)
-        ``""`` for an isolated solution; otherwise the joint combination that stays free along a continuum
-        of solutions (coaxial joints, wrist singularity), of which the row is one representative.
-    position_error, orientation_error : ndarray (k,) or (..., K)
-        FK residual of each solution on the rows the arm controls [m], [rad].
-    outside_limits : ndarray, shape (j, n) — or int count per pose for a batch
-        Solutions that were found but lie outside the joint limits.
-    method : str
-        The structure recognised (``pieper``, ``parallel``, ``planar``, ``wrist``, ``position`` …).
-    controlled : str
-        Which rows of the pose the arm controls (``pose``, ``position``, ``orientation``, ``position+heading``).
-    valid : ndarray of bool, shape (..., K) — batch only (all True for one pose)
-    """
-
-    solutions: np.ndarray
-    branches: Any
-    free: Any
-    position_error: np.ndarray
-    orientation_error: np.ndarray
-    outside_limits: Any
-    method: str
-    controlled: str
-    valid: np.ndarray
-
-    def _repr_html_(self) -> str:
-        from ..display import ik_html
-
-        return ik_html(self)
-
-    @property
-    def count(self):
-        """Number of solutions (per pose for a batch)."""
-        return self.valid.sum(axis=-1) if self.valid.ndim > 1 else int(self.valid.sum())
-
-    @property
-    def continuum(self):
-        """True where a solution stands for a continuum (``free`` is not empty)."""
-        return np.asarray(self.free, dtype=object) != ""
 
 
 def _plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -> Plan:
@@ -111,10 +47,10 @@ def _plan_of_value(robot: DHRobot, closed_form: bool, general: bool) -> Plan:
         from ._subproblems import AXES_ALIGNED_TOL
 
         stanford = plan.route == "closed form (stanford)"  # joint 3 slides: no elbow part in its labels
-        plan.closed.update(labels=_label_table((SHOULDER, WRIST) if stanford else (SHOULDER, ELBOW, WRIST)),
+        plan.closed.update(labels=label_table((SHOULDER, WRIST) if stanford else (SHOULDER, ELBOW, WRIST)),
                            theta=np.array([l.theta for l in robot.joints], float),
                            tols=np.array([FREE_TOL, RATIO_TOL, VERIFY_TOL, POLISH_ABOVE, DUPLICATE_TOL, MERGE_RADIUS,
-                                          AXES_ALIGNED_TOL, _reach(robot)], float),
+                                          AXES_ALIGNED_TOL, arm_reach(robot)], float),
                            far=2 * _bound(robot) + 1.0)  # farther targets get _solve's stand-in
     return plan
 
@@ -129,36 +65,13 @@ def ik_structure(robot: DHRobot) -> str:
     return _plan(robot, True).kind
 
 
-def _controlled(P: np.ndarray) -> str:
+def controlled_rows(P: np.ndarray) -> str:
     pos, rot = np.trace(P[:3, :3]) > 0.5, np.trace(P[3:, 3:])
     if pos and rot > 2.5:
         return "pose"
     if pos and rot > 0.5:
         return "position+heading"
     return "position" if pos else "orientation"
-
-
-def _polish(robot: DHRobot, q: np.ndarray, T: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """Damped Gauss–Newton steps on P·e until converged (restores the digits lost in root finding).
-
-    Residual and Jacobian come from one pass over the chain (:mod:`._kernel`)."""
-    n = robot.dof
-    kin = kernel_of(robot)
-    Rt, pt = targets_soa(T)
-    q = q.copy()
-    act = np.arange(len(q))
-    w = np.ones(6)
-    for _ in range(POLISH_STEPS):
-        e, J = kin.residual(q[act], Rt[..., act], pt[:, act], w)
-        e = e @ P.T  # (b, 6)
-        moving = np.max(np.abs(e), axis=-1) > 1e-15
-        act, e, J = act[moving], e[moving], P @ J[moving]
-        if act.size == 0:
-            break
-        Jt = np.swapaxes(J, -1, -2)
-        A = Jt @ J + 1e-14 * np.eye(n)
-        q[act] += damped_solve(A, np.einsum("bij,bj->bi", Jt, e)[..., None])[..., 0]
-    return q
 
 
 def _fold(robot: DHRobot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -202,7 +115,7 @@ def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray, T: np.ndarray | Non
         step = np.where(rev, wrap_angle(qj - qi), qj - qi)
         mid = qi + 0.5 * step
         e = pose_error(T[b], forward_kinematics(robot, mid)) @ P.T
-        L = max(1.0, _reach(robot))
+        L = max(1.0, arm_reach(robot))
         one = (np.linalg.norm(e[:, :3], axis=-1) <= VERIFY_TOL * L) & (np.linalg.norm(e[:, 3:], axis=-1) <= VERIFY_TOL)
         for bb, jj, ii in zip(b[one], j[p[one]], i[p[one]]):  # in slot order: a later copy goes, once
             if keep[bb, ii]:
@@ -315,25 +228,25 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
         n = robot.dof
         return AnalyticIKResult(np.zeros(batch + (0, n)), np.zeros(batch + (0,), dtype=object),
                                 np.zeros(batch + (0,), dtype=object), np.zeros(batch + (0,)), np.zeros(batch + (0,)),
-                                np.zeros(batch, dtype=int), plan.kind, _controlled(plan.projector),
+                                np.zeros(batch, dtype=int), plan.kind, controlled_rows(plan.projector),
                                 np.zeros(batch + (0,), dtype=bool))
     # a target beyond every reachable point (|p| above the bound below) has no solution: the plan is given a
     # reachable stand-in instead (its candidates then fail the FK check against the real target), so that
     # targets like 1e300 m never reach the root finders, whose intermediate quantities would overflow
     far = np.linalg.norm(Tf[:, :3, 3], axis=-1) > 2 * _bound(robot) + 1.0
     cand, free = plan.solve(np.where(far[:, None, None], _stand_in(robot), Tf) if far.any() else Tf)  # (B, K, n)
-    q, ok, pe, re, lost = _verify(robot, plan, Tf, cand)
+    q, ok, pe, re, lost = verify(robot, plan, Tf, cand)
     fold = ok & lost & (free == "")
     if fold.any():  # roots near a double root that needed polishing: look for the partner of the pair
-        extra, (sb, sk, null) = _fold_partners(robot, plan, Tf, q, fold)
+        extra, (sb, sk, null) = fold_partners(robot, plan, Tf, q, fold)
         if len(sb):  # polished onto a singularity: a continuum the plan could not name; named by J's null space
-            free[sb, sk] = [_null_text(v) for v in null]
+            free[sb, sk] = [null_text(v) for v in null]
         if extra is not None:
-            q2, ok2, pe2, re2, _ = _verify(robot, plan, Tf, extra)
+            q2, ok2, pe2, re2, _ = verify(robot, plan, Tf, extra)
             # a true partner is a regular root: Newton lands on it to rounding; a seed that crawls towards the
             # fold itself stops at a residual ~ its distance to the target, which must not pass as a solution
-            ok2 &= (pe2 <= FOLD_RESIDUAL * max(1.0, _reach(robot))) & (re2 <= FOLD_RESIDUAL)
-            ok2 &= _new(robot, q, ok, q2, ok2)  # most seeds land back on a solution already there
+            ok2 &= (pe2 <= FOLD_RESIDUAL * max(1.0, arm_reach(robot))) & (re2 <= FOLD_RESIDUAL)
+            ok2 &= new_solutions(robot, q, ok, q2, ok2)  # most seeds land back on a solution already there
             if ok2.any():
                 keep = np.argsort(~ok2, axis=1, kind="stable")[:, : int(ok2.sum(axis=1).max())]
                 pick = lambda a: np.take_along_axis(a, keep.reshape(keep.shape + (1,) * (a.ndim - 2)), 1)  # noqa
@@ -352,98 +265,8 @@ def _solve(robot: DHRobot, T: np.ndarray, plan: Plan) -> AnalyticIKResult:
     ok = _dedupe(robot, np.where(ok[..., None], q, np.nan), ok, Tf, plan.projector)
     outside = ok & ~inside
     ok &= inside
-    labels = _labels(robot, plan, q, Tf)
+    labels = branch_labels(robot, plan, q, Tf)
     return _pack(batch, q, ok, labels, free, pe, re, outside, plan)
-
-
-def _verify(robot: DHRobot, plan: Plan, Tf: np.ndarray, cand: np.ndarray):
-    """FK residual of every candidate; far-off ones dropped, rough ones (roots near double roots) polished and
-    re-checked; the rest are kept as computed.  Returns q (B, K, n) (NaN where dropped), ok, position and
-    orientation residuals (B, K) on the rows the arm controls."""
-    B, K, _ = cand.shape
-    L = _reach(robot)
-    ok = np.all(np.isfinite(cand), axis=-1)
-    Tk = np.broadcast_to(Tf[:, None], (B, K, 4, 4))
-    q = np.full(cand.shape, np.nan)
-    pe = np.full((B, K), np.inf)
-    re = np.full((B, K), np.inf)
-    if ok.any():  # one FK for all candidates; false roots are far off: drop them before the (costly) polish
-        e = pose_error(Tk[ok], forward_kinematics(robot, cand[ok])) @ plan.projector.T
-        pe[ok], re[ok] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
-        size = np.where(ok, pe + L * np.where(ok, re, 0.0), np.inf)
-        near = ok & (size < PREFILTER * max(L, 1e-3))
-        rough = near & (size > POLISH_ABOVE * max(L, 1.0))  # only candidates that lost digits are polished
-        lost = near & (size > FOLD_ROUGH * max(L, 1.0))  # lost about half the digits: maybe one of a merged pair
-        ok = near
-        q[ok] = cand[ok]
-        if rough.any():
-            q[rough] = _polish(robot, cand[rough], Tk[rough], plan.projector)
-            fine = np.all(np.isfinite(q), axis=-1) & rough
-            e = pose_error(Tk[fine], forward_kinematics(robot, q[fine])) @ plan.projector.T
-            pe0, re0 = pe.copy(), re.copy()
-            pe[fine], re[fine] = np.linalg.norm(e[:, :3], axis=-1), np.linalg.norm(e[:, 3:], axis=-1)
-            # next to a singular set (J's σ_min ~1e-9) a step can run off: the polish never makes a candidate worse
-            with np.errstate(invalid="ignore"):
-                worse = rough & ~(pe + L * re <= pe0 + L * re0)
-            q[worse], pe[worse], re[worse] = cand[worse], pe0[worse], re0[worse]
-    else:
-        lost = np.zeros_like(ok)
-    ok &= np.all(np.isfinite(q), axis=-1)
-    ok &= (pe <= VERIFY_TOL * max(1.0, L)) & (re <= VERIFY_TOL)
-    return q, ok, pe, re, lost
-
-
-def _new(robot: DHRobot, q: np.ndarray, ok: np.ndarray, q2: np.ndarray, ok2: np.ndarray) -> np.ndarray:
-    """Which of the extra solutions q2 (B, E, n) are farther than DUPLICATE_TOL from every solution of q (B, K, n)
-    of their pose (the extras among themselves are left to :func:`_dedupe`)."""
-    rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-    b = np.flatnonzero(ok2.any(axis=1))
-    d = np.abs(q2[b][:, :, None] - q[b][:, None])  # (b, E, K, n)
-    d = np.where(rev, np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi))), d).max(axis=-1)
-    dup = (np.where(ok[b][:, None], np.nan_to_num(d, nan=np.inf), np.inf) < DUPLICATE_TOL).any(axis=-1)
-    out = ok2.copy()
-    out[b] &= ~dup
-    return out
-
-
-def _fold_partners(robot: DHRobot, plan: Plan, Tf: np.ndarray, q: np.ndarray, fold: np.ndarray):
-    """Candidates for the second root of a pair that nearly coincide (a pose within ~FOLD_SIGMA of a
-    singularity, where root finding returns one root for two): from each polished solution whose controlled
-    Jacobian has σ_min < FOLD_SIGMA · σ_max, Newton steps from q ± t v (v: the singular direction, t = FOLD_STEPS).
-    Returns candidates (B, E, n) for :func:`_verify` (None when no solution is that close to a singularity), and
-    the solutions that sit on a singularity (σ_min < SINGULAR_RCOND · σ_max): pose and slot indices and the
-    null direction of J, for the name of their continuum."""
-    from ..numeric import geometric_jacobian
-
-    b, k = np.nonzero(fold)
-    J = plan.projector @ geometric_jacobian(robot, q[b, k])
-    n = q.shape[-1]
-    sv = np.linalg.svd(J, compute_uv=False)
-    at = sv[:, n - 1] < SINGULAR_RCOND * sv[:, 0]  # on the singularity (to rounding): a continuum, no partner
-    near = ~at & (sv[:, n - 1] < FOLD_SIGMA * sv[:, 0])
-    singular = (b[at], k[at], np.linalg.svd(J[at])[2][:, n - 1] if at.any() else np.zeros((0, n)))
-    if not near.any():
-        return None, singular
-    b, k, v = b[near], k[near], np.linalg.svd(J[near])[2][:, n - 1]  # (m,), (m, n)
-    steps = np.concatenate([FOLD_STEPS, -FOLD_STEPS])
-    seeds = q[b, k][:, None] + steps[None, :, None] * v[:, None]  # (m, S, n)
-    m, S = seeds.shape[:2]
-    flat = _polish(robot, seeds.reshape(-1, n), np.repeat(Tf[b], S, axis=0), plan.projector)
-    # per pose: the seeds of all its near-singular solutions, in extra slots
-    per = np.bincount(b, minlength=len(Tf)) * S
-    out = np.full((len(Tf), int(per.max()), n), np.nan)
-    slot = np.arange(m * S) - np.repeat(np.concatenate([[0], np.cumsum(per)[:-1]])[b], S)
-    out[np.repeat(b, S), slot] = flat
-    return out, singular
-
-
-def _null_text(v: np.ndarray) -> str:
-    """The continuum through a solution where J is singular, named by its null direction v (unit, (n,)):
-    e.g. ``0.71 q4 - 0.71 q6 free (J singular: its null direction)``."""
-    v = v * np.sign(v[np.argmax(np.abs(v))])
-    terms = [(c, k) for k, c in enumerate(v) if abs(c) > 0.05]
-    text = " ".join(f"{'-' if c < 0 else '+'} {abs(c):.2f} q{k + 1}" for c, k in terms).lstrip("+ ")
-    return f"{text} free (J singular: its null direction)"
 
 
 def _bound(robot: DHRobot) -> float:
@@ -458,13 +281,9 @@ def _stand_in(robot: DHRobot) -> np.ndarray:
     return forward_kinematics(robot, np.zeros(robot.dof))
 
 
-def _reach(robot: DHRobot) -> float:
-    return sum(abs(l.a) + abs(l.d) for l in robot.links)
-
-
 def _pack(batch, q, ok, labels, free, pe, re, outside, plan) -> AnalyticIKResult:
     n = q.shape[-1]
-    ctrl = _controlled(plan.projector)
+    ctrl = controlled_rows(plan.projector)
     if batch == ():
         sel = ok[0]
         order = np.lexsort(q[0][sel].T[::-1]) if sel.any() else np.zeros(0, int)
@@ -480,57 +299,3 @@ def _pack(batch, q, ok, labels, free, pe, re, outside, plan) -> AnalyticIKResult
         ok.reshape(batch + (K,)))
 
 
-def _labels(robot: DHRobot, plan: Plan, q: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Branch labels (B, K); definitions in docs/ik.md.
-
-    Each part of a label is a boolean test of q; the label is looked up from the combined bits (no string
-    arithmetic per solution)."""
-    B, K, n = q.shape
-    chain = screws_of(robot)
-    qq = np.nan_to_num(q)
-    rev = ~chain.prismatic
-    theta = _thetas(robot)
-    parts = []  # (test (B, K) bool, label where True, label where False)
-    if plan.kind.startswith(("pieper", "parallel", "position")) and plan.point_e is not None or plan.kind == "position":
-        pe = plan.point_e if plan.point_e is not None else np.zeros(3)
-        X = (T[:, :3, :3] @ pe + T[:, :3, 3]).T[:, :, None]  # (3, B, 1)
-        x1, _, _, S = screw_walk(chain, qq[..., :1], upto=1)  # frame after joint 1 (shoulder), (3, B, K)
-        if rev[0]:  # measured from axis 1 (not from S, which a shoulder offset a1 moves along x1)
-            O1 = chain.consts[0][:3, 3][:, None, None]  # a point of axis 1
-            parts.append((np.sum(x1 * (X - O1), axis=0) >= 0, *SHOULDER))
-        if n >= 3 and rev[1] and rev[2]:
-            # in the plane normal to axis 2 the two elbows are mirror images across the line from the shoulder S
-            # to the point W the joints 2-3 place (the wrist centre; UR: a point of axis 4, parallel to axis 2):
-            # the side of that line, with n = a2 × (W − S) oriented towards axis 1, tells them apart
-            a2 = screw_walk(chain, qq[..., :1], upto=1)[2]  # axis 2, (3, B, K)
-            E = screw_walk(chain, qq[..., :2], upto=2)[3]  # a point of axis 3
-            W = screw_walk(chain, qq[..., :3], upto=3)[3] if plan.kind.startswith("parallel") and n >= 4 else X
-            up = chain.consts[0][:3, 2][:, None, None]
-            nrm = np.cross(a2, W - S, axis=0)
-            towards = np.where(np.sum(up * nrm, axis=0) >= 0, 1.0, -1.0)
-            parts.append((np.sum((E - S) * nrm, axis=0) * towards >= 0, *ELBOW))
-        if n == 6 and rev[4] and plan.kind.startswith(("pieper", "parallel")):
-            parts.append((np.sin(qq[..., 4] + theta[4]) >= 0, *WRIST))
-    elif plan.kind == "planar":
-        r = np.flatnonzero(rev)
-        parts.append((np.sin(qq[..., r[1]] + theta[r[1]]) >= 0, "elbow up", "elbow down"))
-    elif plan.kind == "wrist":
-        parts.append((np.sin(qq[..., 1] + theta[1]) >= 0, "wrist noflip", "wrist flip"))
-    code = np.zeros((B, K), dtype=np.intp)
-    for i, (test, _, _) in enumerate(parts):
-        code |= np.where(test, 0, 1 << i)
-    return _label_table(tuple(p[1:] for p in parts))[code]
-
-
-@lru_cache(maxsize=64)
-def _label_table(names: tuple) -> np.ndarray:
-    """Label of every bit code: bit i set picks the second name of part i."""
-    return np.array([", ".join(p[(c >> i) & 1] for i, p in enumerate(names)) for c in range(1 << len(names))],
-                    dtype=object)
-
-
-def _thetas(robot: DHRobot) -> np.ndarray:
-    memo = dh_chain.chain_of(robot).memo
-    if "ik_thetas" not in memo:
-        memo["ik_thetas"] = np.array([l.theta for l in robot.joints])  # read-only use
-    return memo["ik_thetas"]

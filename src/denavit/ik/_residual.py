@@ -14,7 +14,7 @@ from ..chain import chain_of
 from ..errors import ShapeError
 from ..model import DHRobot, JointType
 
-__all__ = ["IKResult", "row_mask", "rotation_log", "pose_error", "JointLimits", "characteristic_length", "limits_of",
+__all__ = ["IKResult", "AnalyticIKResult", "row_mask", "rotation_log", "pose_error", "JointLimits", "characteristic_length", "limits_of",
            "LAMBDA0", "LAMBDA_MAX"]
 
 LAMBDA0 = 1e-3  # initial damping, relative to the squared characteristic length
@@ -57,6 +57,56 @@ class IKResult:
         from ..display import ik_html
 
         return ik_html(self)
+
+
+@dataclass(frozen=True)
+class AnalyticIKResult:
+    """All closed-form IK solutions of one target pose (or of a batch of poses).
+
+    Attributes
+    ----------
+    solutions : ndarray, shape (k, n) — or (..., K, n) for a batch, NaN rows where ``valid`` is False
+        Joint values [rad, m], each verified by the forward kinematics, within the joint limits.
+    branches : tuple of str (k,) — or ndarray of str (..., K)
+        Branch labels such as ``"shoulder right, elbow up, wrist noflip"`` (definitions in docs/ik.md).
+    free : tuple of str (k,) — or ndarray of str (..., K)
+        ``""`` for an isolated solution; otherwise the joint combination that stays free along a continuum
+        of solutions (coaxial joints, wrist singularity), of which the row is one representative.
+    position_error, orientation_error : ndarray (k,) or (..., K)
+        FK residual of each solution on the rows the arm controls [m], [rad].
+    outside_limits : ndarray, shape (j, n) — or int count per pose for a batch
+        Solutions that were found but lie outside the joint limits.
+    method : str
+        The structure recognised (``pieper``, ``parallel``, ``planar``, ``wrist``, ``position`` …).
+    controlled : str
+        Which rows of the pose the arm controls (``pose``, ``position``, ``orientation``, ``position+heading``).
+    valid : ndarray of bool, shape (..., K) — batch only (all True for one pose)
+    """
+
+    solutions: np.ndarray
+    branches: Any
+    free: Any
+    position_error: np.ndarray
+    orientation_error: np.ndarray
+    outside_limits: Any
+    method: str
+    controlled: str
+    valid: np.ndarray
+
+    def _repr_html_(self) -> str:
+        from ..display import ik_html
+
+        return ik_html(self)
+
+    @property
+    def count(self):
+        """Number of solutions (per pose for a batch)."""
+        return self.valid.sum(axis=-1) if self.valid.ndim > 1 else int(self.valid.sum())
+
+    @property
+    def continuum(self):
+        """True where a solution stands for a continuum (``free`` is not empty)."""
+        return np.asarray(self.free, dtype=object) != ""
 
 
 def row_mask(mask: str | Sequence[bool] | None, dof: int | None = None) -> np.ndarray:
