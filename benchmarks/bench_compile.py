@@ -5,7 +5,8 @@ Prints Markdown tables: single calls (µs, ratio to Pinocchio), batched throughp
 and compile times (cold: an empty cache; warm: a new process reading the cache).  Every library is first checked
 to agree with denavit on the numbers it is timed on.
 
-Single call: one configuration, best of `repeat` × `number` calls, each returning what a user gets:
+Single call: one configuration, best of 3·`repeat` rounds of `number` calls, denavit and Pinocchio taking turns
+within each round, each returning what a user gets:
   FK     denavit fast.fk(q) → 4×4 array; Pinocchio framesForwardKinematics + data.oMf[tool] (an SE3)
   J      fast.jacobian(q) (J0); Pinocchio computeFrameJacobian(..., LOCAL_WORLD_ALIGNED) (includes its FK)
   RNEA   fast.rnea(q, qd, qdd); pin.rnea      M  fast.mass_matrix(q); pin.crba (upper triangle only)
@@ -27,7 +28,7 @@ import time
 import numpy as np
 
 import denavit
-from _peers import best_time, to_pinocchio
+from _peers import best_time, best_times, to_pinocchio
 
 ROBOTS = ("puma560", "panda")
 
@@ -64,8 +65,7 @@ def single_rows(name: str, repeat: int, number: int):
     rows = []
     for op, ours, peer, agree in ops:
         assert agree(ours(), peer()), f"{name} {op}: Pinocchio disagrees"
-        t_ours = best_time(ours, repeat, number)
-        t_peer = best_time(peer, repeat, number)
+        t_ours, t_peer = best_times([ours, peer], 3 * repeat, number)  # taking turns: the ratio sees one machine
         t_plain = best_time(plain[op], max(2, repeat // 2), max(100, number // 20))
         rows.append((name, op, t_ours * 1e6, t_peer * 1e6, t_ours / t_peer, t_plain * 1e6))
     return rows
