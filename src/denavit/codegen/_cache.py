@@ -60,7 +60,7 @@ _FALLBACK: Path | None = None
 #: Part of every cache key, with a digest of the sources that shape the generated code (the generator, the
 #: chain walker, the dynamics kernels): a changed generator never reads a stale module.
 GENERATOR_VERSION = "1"
-_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_ik_elbow.py", "codegen/_ik_parallel.py", "codegen/_ik_stanford.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
+_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_ik_elbow.py", "codegen/_ik_finish.py", "codegen/_ik_parallel.py", "codegen/_ik_stanford.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
             "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py")
 _DIGEST: list[str] = []
 

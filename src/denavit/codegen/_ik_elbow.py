@@ -9,9 +9,9 @@ Every case the plain solver treats specially is handed back to it (``status`` 1)
 pose (wrist centre on axis 1 or 2, wrist axes aligned), a root next to a double root (|ratio| near 1), a
 candidate that would need polishing, or two solutions closer than the merge radius.  The compiled path answers
 only where its answer is the plain solver's.  The text below is appended to each generated numba module of an
-arm whose IK plan is this closed form; it calls that module's ``fk_1`` and the verification, folding, merging and
-sorting of the UR kernel (``_ik_finish`` of :mod:`._ik_parallel`, appended to the same module); nothing of the robot
-or the user is pasted into it.
+arm whose IK plan is this closed form; it calls that module's ``fk_1`` and the verification, folding, merging
+and sorting shared by the three closed forms (``_ik_finish`` of :mod:`._ik_finish`, appended to the same module);
+nothing of the robot or the user is pasted into it.
 """
 
 from __future__ import annotations
