@@ -148,3 +148,18 @@ def test_cli_import_table_writes_refuses_overwrite_and_json(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["convention"] == "standard" and len(data["robot_file"]["joints"]) == 2
     assert main(["import-table", str(tmp_path / "missing.txt")]) == 2
+
+
+def test_import_table_space_separated_tables(capsys):
+    """A header whose every word names a column (``i a alpha d theta``) makes a space-separated table: the same
+    arm as the tab-separated one; a cell holding a space there is refused naming the line; prose is no header."""
+    rows = [("1", "0", "pi/2", "0.3", "q1"), ("2", "0.4", "0", "0", "q2 + pi/6"), ("3", "0.2", "-pi/2", "0.1", "q3")]
+    tabbed = "i\ta\talpha\td\ttheta\n" + "\n".join("\t".join(r) for r in rows)
+    spaced = "i  a alpha   d theta\n" + "\n".join(" ".join(c.replace(" ", "") for c in r) for r in rows)
+    a, b = import_table(tabbed).robot, import_table(spaced).robot
+    assert a.dof == b.dof == 3
+    _same_fk(a, b, np.random.default_rng(5))
+    with pytest.raises(dn.errors.ParseError, match=r"line 3: 7 cells .* cannot hold a space"):
+        import_table("i a alpha d theta\n" + "\n".join(" ".join(r) for r in rows))
+    with pytest.raises(dn.errors.ParseError, match="no DH table found"):
+        import_table("The a alpha d theta values are in the table below, which is missing.\n")

@@ -37,6 +37,11 @@ def _cells(line: str) -> list[str]:
     return [c.strip() for c in cells]
 
 
+def _spaced(line: str) -> list[str]:
+    """The cells of a row of a space-separated table (its header named a column with every word)."""
+    return line.split()
+
+
 def _strip_row_end(s: str) -> str:
     """A LaTeX row without its trailing ``\\\\`` (and ``\\hline``), by plain string tests (no backtracking)."""
     t = s.rstrip()
@@ -86,7 +91,9 @@ def find_table(text: str) -> tuple[list[str], list[list[str]]]:
     for k, line in enumerate(lines):
         if len(line) > MAX_LINE_CHARS:
             continue  # prose, not a header
-        cells = _cells(line)
+        cells, split = _cells(line), _cells
+        if not cells and 4 <= len(line.split()) <= MAX_COLUMNS and all(map(column_kind, line.split())):
+            cells, split = line.split(), _spaced  # "i a alpha d theta": every word names a column
         if len(cells) > MAX_COLUMNS or any(len(c) > MAX_CELL_CHARS for c in cells):
             continue
         kinds = [column_kind(c) for c in cells]
@@ -97,7 +104,11 @@ def find_table(text: str) -> tuple[list[str], list[list[str]]]:
                     continue  # Markdown rule
                 if len(nxt) > MAX_LINE_CHARS:
                     raise ParseError(f"line {n}: longer than {MAX_LINE_CHARS} characters")
-                c = _cells(nxt)
+                c = split(nxt)
+                if split is _spaced and len(c) > len(cells):
+                    raise ParseError(f"line {n}: {len(c)} cells under a header of {len(cells)} separated by spaces: "
+                                     "a cell of such a table cannot hold a space (write pi/2, not pi / 2; or "
+                                     "separate the columns with tabs or |)")
                 if len(c) != len(cells) or not any(x.strip() for x in c):
                     if rows:
                         break
@@ -112,4 +123,4 @@ def find_table(text: str) -> tuple[list[str], list[list[str]]]:
                 raise ParseError(f"line {k + 1}: a DH header but no rows under it")
             return cells, rows
     raise ParseError("no DH table found: expected a header row naming the columns a, alpha, d, theta "
-                     "(tab, | or & separated)")
+                     "(tab, |, & or space separated)")
