@@ -405,3 +405,17 @@ def test_animate_mp4_when_ffmpeg_exists(tmp_path):
                            capture_output=True, text=True, check=True).stdout.strip()
     codec, frames = probe.split(",")
     assert codec and int(frames) == 13  # 1 s at 12 fps, both end points
+
+
+def test_workspace_pictures_explain_their_colours():
+    """The point cloud's colours (height) and the occupancy pictures' (log sample count) each have a colour bar."""
+    from denavit import scale
+    from denavit.viz import plot_occupancy, plot_workspace, workspace
+
+    robot = denavit.load_robot("puma560")
+    fig = plot_workspace(workspace(robot, samples=2000, rng=np.random.default_rng(0)), "puma560")
+    assert any(ax.get_ylabel() == "height z [m]" for ax in fig.axes)
+    for name in ("puma560", "planar2r"):
+        fig = plot_occupancy(scale.occupancy(denavit.load_robot(name), samples=20_000, seed=1), name)
+        bars = [ax for ax in fig.axes if "samples per cell" in ax.get_ylabel()]
+        assert len(bars) == 1  # one scale for every panel

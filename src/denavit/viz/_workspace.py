@@ -149,7 +149,8 @@ def plot_workspace(ws: Workspace, title: str = "", max_points: int = 20_000, fig
     fig = new_figure(figsize, dpi)
     pts = ws.points[:: max(1, len(ws.points) // max_points)]
     ax3 = fig.add_subplot(1, 3, 1, projection="3d")
-    ax3.scatter(*pts.T, s=0.6, c=pts[:, 2], cmap="viridis", alpha=0.5, depthshade=False, linewidths=0)
+    cloud = ax3.scatter(*pts.T, s=0.6, c=pts[:, 2], cmap="viridis", alpha=0.5, depthshade=False, linewidths=0)
+    fig.colorbar(cloud, ax=ax3, label="height z [m]", shrink=0.6, pad=0.12)
     set_equal_axes(ax3, np.vstack([ws.points.min(axis=0), ws.points.max(axis=0)]), margin=0.02)
     ax3.view_init(elev=22, azim=-58)
     ax3.set_box_aspect((1, 1, 1), zoom=0.82)  # room for the z label beside the next panel
@@ -205,6 +206,9 @@ def _crop(ax, lo, hi, pad: float) -> None:
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
 
 
+_DENSITY = "ln(1 + samples per cell): sampling density"
+
+
 def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
     """Pictures of a :class:`denavit.scale.Occupancy`: x–y projection, x–z and y–z sections through the base.
 
@@ -220,11 +224,12 @@ def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
     dens = np.log1p(counts.astype(float))
     hit = np.argwhere(counts > 0)
     lo_u, hi_u = g.lo + hit.min(axis=0) * h, g.lo + (hit.max(axis=0) + 1) * h  # occupied box, grid coordinates
-    fig = new_figure(figsize, dpi)
+    fig = new_figure((min(figsize[0], 6.4), figsize[1] + 0.6) if occ.planar else figsize, dpi)
     if occ.planar:
         ax = fig.add_subplot(1, 1, 1)
-        _image(ax, dens, (*span, *span), "u [m] (in the arm's plane)", "v [m]", "viridis",
-               "sampled cells (log count)")
+        im = _image(ax, dens, (*span, *span), "u [m] (in the arm's plane)", "v [m]", "viridis",
+                    "sampled cells (log count)")
+        fig.colorbar(im, ax=ax, label=_DENSITY, shrink=0.8)
         ax.set_aspect("equal")
         _crop(ax, lo_u, hi_u, 2 * h)
         size = f"area {e.value:.4g} m² ∈ [{e.low:.4g}, {e.high:.4g}]"
@@ -236,13 +241,14 @@ def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
         for k, (img, (a, b), name) in enumerate(panels):
             ax = fig.add_subplot(1, 3, k + 1)
             c = g.centre[[a, b]]
-            _image(ax, img, (c[0] + span[0], c[0] + span[1], c[1] + span[0], c[1] + span[1]), "xyz"[a] + " [m]",
-                   "xyz"[b] + " [m]", "viridis", name, vmax=float(dens.max()) or 1.0)
+            im = _image(ax, img, (c[0] + span[0], c[0] + span[1], c[1] + span[0], c[1] + span[1]),
+                        "xyz"[a] + " [m]", "xyz"[b] + " [m]", "viridis", name, vmax=float(dens.max()) or 1.0)
             ax.set_aspect("equal")
             _crop(ax, c + lo_u[[a, b]], c + hi_u[[a, b]], 2 * h)
+        fig.colorbar(im, ax=fig.axes, label=_DENSITY, shrink=0.8)  # one scale (vmax) for the three panels
         size = f"volume {e.value:.4g} m³ ∈ [{e.low:.4g}, {e.high:.4g}]"
-    fig.suptitle(f"{title} workspace — {size} ({e.resolution:.3g} m cells, {occ.samples:,} samples), "
-                 f"reach {occ.reach:.3g} m", fontsize=10)
+    fig.suptitle(f"{title} workspace — {size}{chr(10) if occ.planar else ' '}({e.resolution:.3g} m cells, "
+                 f"{occ.samples:,} samples), reach {occ.reach:.3g} m", fontsize=10)  # two lines on the narrow figure
     return fig
 
 
