@@ -303,3 +303,18 @@ def test_tidy_snaps_noise_only(mantissa, exponent, ulps, x):
     assert tidy(ulps * np.spacing(1.0), 1.0) == 0.0  # noise around zero, at the scale of the quantity
     assert abs(tidy(x) - x) <= TIDY_ULPS * np.spacing(abs(x))  # any value moves by a few ulps at most
     assert abs(tidy(x, 1.0) - x) <= TIDY_ULPS * np.spacing(max(abs(x), 1.0))
+
+
+def test_cli_import_urdf_deg_prints_the_table_in_degrees_and_writes_radians(tmp_path, capsys):
+    from denavit.cli import main
+
+    src = Path(__file__).resolve().parents[1] / "examples" / "urdf" / "small_arm.urdf"
+    out = tmp_path / "arm.yaml"
+    assert main(["import-urdf", str(src), "--deg", "-o", str(out)]) == 0
+    shown = capsys.readouterr().out
+    assert "angles in degrees" in shown and "-90°" in shown
+    again = tmp_path / "plain.yaml"
+    assert main(["import-urdf", str(src), "-o", str(again)]) == 0
+    capsys.readouterr()
+    assert out.read_text() == again.read_text()  # the file does not depend on --deg (radians)
+    assert "angle_unit: rad" in out.read_text()

@@ -24,6 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
     p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.add_argument("--deg", action="store_true", help="the printed DH table's angles in degrees (the robot file is "
+                                                      "written in radians, as every robot file denavit writes)")
     p.set_defaults(handler=cmd_import_urdf)
 
     for fmt, suffix, help_text in (("urdf", ".urdf", "the arm as URDF (links, joints, limits, inertials, visuals)"),
@@ -55,7 +57,7 @@ def cmd_import_urdf(args: argparse.Namespace):
     lines += ["", f"FK self-check at {result.samples} random configurations: worst position error "
                   f"{result.position_error:.2g} m, rotation error {result.rotation_error:.2g}"]
     lines += [f"note: {note}" for note in result.notes]
-    lines += ["", dh_table(robot)]
+    lines += ["", dh_table(robot, deg=True if args.deg else None)]
     fmt = "json" if args.output and Path(args.output).suffix.lower() == ".json" else "yaml"
     if args.output:
         with output_file(args.output) as tmp:
