@@ -22,6 +22,7 @@ import numpy as np
 
 from ..chain import chain_of
 from ..numeric import inverse_transform
+from ._ik_finish import pack_constants
 
 __all__ = ["IK_PARALLEL_SOURCE", "PARALLEL_LAYOUT", "parallel_constants"]
 
@@ -72,11 +73,7 @@ def parallel_constants(robot, plan) -> np.ndarray:
     lim = robot.q_limits
     k = dict(plan.closed, Q_e=Q_e, C0i=inverse_transform(C[0]), consts=C, a=a, scalars=scalars, lo=lim[:, 0],
              hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types])
-    K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in PARALLEL_LAYOUT])
-    if K.size != sum(size for _, size in PARALLEL_LAYOUT):
-        raise ValueError(f"parallel IK constants: {K.size} numbers for the layout's "
-                         f"{sum(size for _, size in PARALLEL_LAYOUT)}")
-    return K
+    return pack_constants(k, PARALLEL_LAYOUT, "parallel")
 
 
 IK_PARALLEL_SOURCE = '''

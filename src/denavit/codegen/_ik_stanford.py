@@ -24,6 +24,7 @@ import numpy as np
 from ..chain import chain_of
 from ..numeric import inverse_transform
 from ._ik_parallel import COND_MAX, NEAR_SINGULAR
+from ._ik_finish import pack_constants
 
 __all__ = ["IK_STANFORD_SOURCE", "STANFORD_LAYOUT", "stanford_constants"]
 
@@ -63,11 +64,7 @@ def stanford_constants(robot, plan) -> np.ndarray:
     k = dict(plan.closed, X_e=X_e, C0i=inverse_transform(C[0]), consts=C, geom=[*(p1 + s0 * a), *u, *z],
              scalars=scalars, lo=lim[:, 0], hi=lim[:, 1],
              revolute=[float(t.value == "revolute") for t in robot.joint_types])
-    K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in STANFORD_LAYOUT])
-    if K.size != sum(size for _, size in STANFORD_LAYOUT):
-        raise ValueError(f"Stanford IK constants: {K.size} numbers for the layout's "
-                         f"{sum(size for _, size in STANFORD_LAYOUT)}")
-    return K
+    return pack_constants(k, STANFORD_LAYOUT, "Stanford")
 
 
 IK_STANFORD_SOURCE = '''

@@ -11,6 +11,7 @@ from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, T
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
+from ._ik_finish import pack_constants
 from ._ik_parallel import parallel_constants
 from ._ik_stanford import stanford_constants
 
@@ -159,6 +160,5 @@ class IKMethods:
         k = dict(plan.closed)
         lim = self.robot.q_limits
         k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
-        K = np.concatenate([np.asarray(k[name], dtype=np.float64).ravel() for name, _ in ELBOW_LAYOUT])
-        assert K.size == sum(size for _, size in ELBOW_LAYOUT)
+        K = pack_constants(k, ELBOW_LAYOUT, "elbow")
         return [K, list(k["labels"]), plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
