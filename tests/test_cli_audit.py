@@ -34,7 +34,7 @@ def run_tty(*argv):
     return code, out.getvalue(), err.getvalue()
 
 
-def _strict(text):
+def strict_json(text):
     """json.loads that rejects NaN / Infinity (RFC 8259), as a browser or jq would."""
     def bad(c):
         raise ValueError(f"non-standard JSON constant {c}")
@@ -45,7 +45,7 @@ def test_json_is_strict_at_a_singular_configuration(capsys):
     # planar 2R stretched out: the force ellipsoid has an infinite radius, which used to print 'Infinity'
     code, out, _ = run(capsys, "singularities", "planar2r", "-q", "0,0", "--json")
     assert code == 0
-    data = _strict(out)
+    data = strict_json(out)
     radii = data["measures"]["force_ellipsoid"]["radii"]
     assert None in radii                          # the infinite radius is null ...
     assert all(r is None or math.isfinite(r) for r in radii)
@@ -102,7 +102,7 @@ def test_progress_on_stderr_only_without_json(capsys, argv, stage):
     assert stage not in out
     code, out, err = run(capsys, *argv, "--json")
     assert code == 0 and err == ""
-    _strict(out)
+    strict_json(out)
 
 
 def test_values_may_start_with_a_minus_sign(capsys):
@@ -114,12 +114,12 @@ def test_values_may_start_with_a_minus_sign(capsys):
     for text, q in [("-0.5,0.3", [-0.5, 0.3]), ("-pi/4,0.3", [-np.pi / 4, 0.3]), ("-.5,-1e-1", [-0.5, -0.1])]:
         code, out, err = run(capsys, "fk", "planar2r", "-q", text, "--json")
         assert code == 0, err
-        assert np.allclose(_strict(out)["T"], forward_kinematics(robot, np.array(q)), atol=1e-12)
+        assert np.allclose(strict_json(out)["T"], forward_kinematics(robot, np.array(q)), atol=1e-12)
     code, out, err = run(capsys, "dynamics", "planar2r", "-q", "0.1,0.2", "--qd", "-0.5,0.3", "--qdd", "-1,-2", "--json")
     assert code == 0, err
-    assert _strict(out)["qd"] == [-0.5, 0.3]
+    assert strict_json(out)["qd"] == [-0.5, 0.3]
     code, out, err = run(capsys, "fk", "planar2r", "-q1,2", "--json")   # attached short option still works
-    assert code == 0 and _strict(out)["q"] == [1.0, 2.0]
+    assert code == 0 and strict_json(out)["q"] == [1.0, 2.0]
     code, out, err = run(capsys, "fk", "planar2r", "-q", "-0.5")        # a wrong count is still an error
     assert code == 2 and len(err.strip().splitlines()) == 1
 
@@ -170,7 +170,7 @@ def test_compile_reports_its_stages_on_stderr_only_without_json(capsys, tmp_path
     assert code == 0 and "generating the kernels" in err and "compiling and timing" in err
     assert "compiling and timing" not in out and out.startswith("planar2r: 2 joints, backend numpy")
     code, out, err = run_tty("compile", "planar2r", "--backend", "numpy", "--json")
-    assert code == 0 and err == "" and _strict(out)["backend"] == "numpy"
+    assert code == 0 and err == "" and strict_json(out)["backend"] == "numpy"
     code, out, err = run(capsys, "compile", "planar2r", "--backend", "numpy")
     assert code == 0 and err == ""
 
@@ -184,7 +184,7 @@ def test_animate_says_it_is_rendering_on_stderr_only_without_json(capsys, tmp_pa
     assert code == 0 and err.strip() == f"denavit animate: rendering 2 frames to {tmp_path / 'a.gif'}"
     assert out.startswith(f"wrote {tmp_path / 'a.gif'} (2 frames")
     code, out, err = run(capsys, *argv, "-o", tmp_path / "c.gif", "--json")  # piped: nothing on stderr
-    assert code == 0 and err == "" and _strict(out)["frames"] == 2
+    assert code == 0 and err == "" and strict_json(out)["frames"] == 2
 
 
 ONE_JOINT = """name: one
@@ -240,7 +240,7 @@ def test_export_notes_what_the_file_cannot_carry(capsys, tmp_path, name):
         assert code == 0
         notes = [ln for ln in out.splitlines() if ln.startswith("note: ")]
         code, jout, _ = run(capsys, f"export-{fmt}", name, "--json")
-        assert code == 0 and [f"note: {n}" for n in _strict(jout)["notes"]] == notes
+        assert code == 0 and [f"note: {n}" for n in strict_json(jout)["notes"]] == notes
         text = path.read_text()
         if all(li is None for li in joints):
             assert len(notes) == 1 and "no inertial data" in notes[0]
@@ -286,7 +286,7 @@ def test_deg_says_it_has_no_effect_where_there_are_no_angles(capsys, monkeypatch
     monkeypatch.chdir(pathlib.Path(__file__).resolve().parents[1])
     code, out, _ = run(capsys, *argv, "--json")
     code_deg, out_deg, _ = run(capsys, *argv, "--json", "--deg")
-    assert code == code_deg == 0 and _strict(out) == _strict(out_deg)
+    assert code == code_deg == 0 and strict_json(out) == strict_json(out_deg)
 
 
 def test_help_of_commands_without_angles_says_deg_has_no_effect():

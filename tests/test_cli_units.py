@@ -7,7 +7,6 @@ degrees typed without --deg, JSON that did not say its angle unit.  In-process t
 
 import contextlib
 import io
-import json
 
 import numpy as np
 import pytest
@@ -15,6 +14,8 @@ from hypothesis import given, settings, strategies as st
 
 from conftest import REDUCED
 from denavit.cli import main
+
+from test_cli_audit import strict_json as _strict  # RFC 8259: no NaN / Infinity
 
 
 def run(capsys, *argv):
@@ -29,13 +30,6 @@ def run_captured(*argv):
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main([str(a) for a in argv])
     return code, out.getvalue(), err.getvalue()
-
-
-def _strict(text):
-    """json.loads that rejects NaN / Infinity (RFC 8259)."""
-    def bad(c):
-        raise ValueError(f"non-standard JSON constant {c}")
-    return json.loads(text, parse_constant=bad)
 
 
 # Degrees typed without --deg: the limit error says so, and a value beyond a full turn on a joint without limits
