@@ -1,0 +1,13 @@
+"""Grading a report as written: a student's Markdown/LaTeX derivation in, a verdict on every result out.
+
+``grade_report(path, robot=None, arms=None)`` reads the report's DH table(s) (or uses the arm(s) given),
+finds every stated result (display math, inline results, ``⇒`` chains), turns each into the claims the
+YAML claims format already expresses and has :mod:`denavit.check` judge them — one judging engine.
+See ``docs/grading.md``.
+"""
+
+from __future__ import annotations
+
+from ._types import VERDICTS, ArmInfo, GradedClaim, GradedReport
+
+__all__ = ["VERDICTS", "ArmInfo", "GradedClaim", "GradedReport"]
