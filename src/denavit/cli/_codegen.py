@@ -9,7 +9,8 @@ import time
 from pathlib import Path
 
 from ..errors import ParseError
-from ._common import add_common, load, output_file, stage_printer
+from ._common import add_common, load, stage_printer
+from ._output import output_file
 
 __all__ = ["register"]
 

@@ -9,8 +9,9 @@ import time
 import numpy as np
 
 from ..errors import MissingDependencyError, ParseError
-from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_force, add_q, check_output, check_values, joint_values, load, matrix_text,
-                      numbers_text, output_file, require_finite, require_symbolic_size)
+from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_q, check_values, joint_values, load, matrix_text,
+                      numbers_text, require_finite, require_symbolic_size)
+from ._output import add_force, check_output, output_file
 from ._shared import q_out
 
 #: simulate: most output samples (--duration / --dt) and most evaluations of the dynamics in one run (about

@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import ParseError
-from ._common import add_common, check_output, load, output_file
+from ._common import add_common, load
+from ._output import check_output, output_file
 
 #: File types ``import-urdf -o`` writes (a denavit robot file).
 ROBOT_SUFFIXES = (".yaml", ".yml", ".json")

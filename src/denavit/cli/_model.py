@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParseError
-from ._common import add_common, add_q, check_output, joint_values, load, matrix_text, numbers_text, output_file
+from ._common import add_common, add_q, joint_values, load, matrix_text, numbers_text
+from ._output import check_output, output_file
 
 #: File types ``convert -o`` writes.
 CONVERT_SUFFIXES = (".yaml", ".yml", ".json")

@@ -9,7 +9,8 @@ from typing import Any
 
 from ..errors import ParseError
 from ..io import parse_values, resolve_pose, split_values
-from ._common import add_common, add_force, check_output, joint_values, load, nonneg_int, output_file, stage_printer
+from ._common import add_common, joint_values, load, nonneg_int, stage_printer
+from ._output import add_force, check_output, output_file
 
 #: Suffixes of a report file (the format follows the suffix).
 REPORT_SUFFIXES = (".md", ".markdown", ".tex", ".html", ".htm", ".pdf")

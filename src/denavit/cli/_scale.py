@@ -8,8 +8,8 @@ from decimal import Decimal, InvalidOperation
 
 import numpy as np
 
-from ._common import (add_common, add_force, bounded_float, bounded_int, check_output, load, nonneg_int, number_text,
-                      output_file, require_finite)
+from ._common import add_common, bounded_float, bounded_int, load, nonneg_int, number_text, require_finite
+from ._output import add_force, check_output, output_file
 
 PICTURES = (".png", ".svg", ".pdf")
 DATA = (".npz",)

@@ -8,9 +8,9 @@ import sys
 import numpy as np
 
 from ..errors import ParseError
-from ._common import (add_common, add_force, add_q, bounded_float, bounded_int, check_output, finite_float,
-                      joint_values, load, numbers_text, output_file, require_finite,
-                      stage_printer)
+from ._common import (add_common, add_q, bounded_float, bounded_int, finite_float, joint_values, load, numbers_text,
+                      require_finite, stage_printer)
+from ._output import add_force, check_output, output_file
 from ._shared import q_out
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
