@@ -10,7 +10,17 @@ from typing import Any
 
 from ._derivation import MAX_CASES, TOPICS, Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text, derive
 from ._pdf import latex_engine, pdf_from_latex
-from ._render import FORMATS, math_of, number_text, render, render_html, render_latex, render_markdown
+from ._render import (
+    FORMATS,
+    KATEX_TYPESET_SCRIPT,
+    katex_bundle,
+    math_of,
+    number_text,
+    render,
+    render_html,
+    render_latex,
+    render_markdown,
+)
 
 __all__ = [
     "TOPICS",
@@ -31,6 +41,8 @@ __all__ = [
     "math_of",
     "number_text",
     "FORMATS",
+    "katex_bundle",
+    "KATEX_TYPESET_SCRIPT",
     "latex_engine",
     "pdf_from_latex",
     "write_report",
