@@ -299,13 +299,13 @@ def test_local_dask_cluster_gives_the_same_counts(monkeypatch):
     robot = denavit.load_robot("puma560")
     n = 3 * BLOCK
     ref = occupancy(robot, n, 0.05, seed=9, scheduler="synchronous")
-    client, cluster = sched._local_cluster(1)
+    client, cluster = sched.start_local_cluster(1)
     try:
         assert list(client.run(_worker_settings).values()) == [(False, str(2**30))]  # LOCAL_CLUSTER_CONFIG
         _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler=client, chunk=BLOCK))
         _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler=cluster.scheduler_address, chunk=2 * BLOCK))
         asked = []
-        monkeypatch.setattr(sched, "_local_cluster", lambda workers: asked.append(workers) or (client, cluster))
+        monkeypatch.setattr(sched, "start_local_cluster", lambda workers: asked.append(workers) or (client, cluster))
         _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler="dask", workers=1))
         assert asked == [1] and cluster.status.name == "closed"
     finally:
@@ -357,9 +357,9 @@ def test_unreachable_scheduler_is_refused_in_bounded_time(monkeypatch):
     pytest.importorskip("distributed")
     import socket
 
-    import denavit.scale._schedule as sched
+    import denavit.scale._cluster as cluster_module
 
-    monkeypatch.setattr(sched, "CONNECT_TIMEOUT", 1.0)
+    monkeypatch.setattr(cluster_module, "CONNECT_TIMEOUT", 1.0)
     with socket.socket() as s:  # a port nobody listens on
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]

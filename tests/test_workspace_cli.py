@@ -129,9 +129,9 @@ def test_any_bad_scheduler_text_is_one_line(tmp_path_factory, text):
 
 def test_unreachable_scheduler_is_one_line(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
-    import denavit.scale._schedule as sched
+    import denavit.scale._cluster as cluster_module
 
-    monkeypatch.setattr(sched, "CONNECT_TIMEOUT", 1.0)
+    monkeypatch.setattr(cluster_module, "CONNECT_TIMEOUT", 1.0)
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]

@@ -10,8 +10,8 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
                        reach_bound, sampling_limits)
-from ._schedule import (CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, LOCAL_SCHEDULERS, MAX_WORKERS,
-                        check_scheduler)
+from ._cluster import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG
+from ._schedule import LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
 from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
 from ._refine import MAX_REFINE, PILOT_SHARE, REFINE_CELLS, REFINE_COVERAGE, Refinement
 from ._reach import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, ReachabilityMap, orientation_set, reachability

@@ -17,28 +17,17 @@ import sys
 import time
 from typing import Any, Callable, Iterable, Iterator
 
-from ..errors import MissingDependencyError, ParseError
+from ..errors import ParseError
+from ._cluster import connect, start_local_cluster
 
-__all__ = ["LOCAL_SCHEDULERS", "POOLS", "LOCAL_CLUSTER_CONFIG", "AUTO_PROCESSES_FROM", "resolve_auto",
-           "CONNECT_TIMEOUT", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "session", "run", "Progress"]
+__all__ = ["LOCAL_SCHEDULERS", "POOLS", "AUTO_PROCESSES_FROM", "resolve_auto", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "session", "run", "Progress"]
 
 #: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
 LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
 #: The local schedulers that run without Dask.
 POOLS = ("auto", "synchronous", "threads", "processes")
-#: Dask settings of the LocalCluster that ``scheduler="dask"`` starts (single-threaded worker processes): the
-#: workers' statistical profiler (a stack sample every 10 ms) and 0.1–0.5 s monitors cost an idle worker ~4 % of
-#: a core; the C library's trim threshold is raised from the nanny's 64 kB for FK callables with large temporaries.
-LOCAL_CLUSTER_CONFIG = {
-    "distributed.worker.profile.enabled": False,
-    "distributed.admin.system-monitor.interval": "2s",
-    "distributed.worker.memory.monitor-interval": "1s",
-    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 2**30,
-}
 #: "auto" runs on processes from this many samples on (FK threads contend for the GIL), on threads below.
 AUTO_PROCESSES_FROM = 10_000_000
-#: Seconds to wait for a dask.distributed scheduler to answer.
-CONNECT_TIMEOUT = 10.0
 #: Tasks submitted ahead per worker (bounds the results held at once).
 IN_FLIGHT = 2
 #: Most local workers.
@@ -87,37 +76,6 @@ class _Inline:
         return f
 
 
-def _client(address: str):
-    try:
-        from distributed import Client
-    except ImportError:
-        raise MissingDependencyError("a cluster scheduler needs dask.distributed: pip install 'denavit[scale]'") \
-            from None
-    try:
-        return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise ParseError(f"scheduler {address}: no dask scheduler answered within {CONNECT_TIMEOUT:g} s "
-                         f"({type(exc).__name__})") from None
-
-
-def _local_cluster(workers: int):
-    """A LocalCluster of ``workers`` single-threaded processes and its Client."""
-    try:
-        import dask
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise MissingDependencyError("scheduler 'dask' needs dask.distributed: pip install 'denavit[scale]'") \
-            from None
-    with dask.config.set(LOCAL_CLUSTER_CONFIG):
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-    try:
-        client = Client(cluster, set_as_default=False)
-    except BaseException:
-        cluster.close()
-        raise
-    return client, cluster
-
-
 def _wait(done_order, pending: set):
     """(done, not done) once at least one pending future is done; ``done_order`` is a dask ``as_completed``
     for a cluster (``distributed.wait`` needs a default client, and ours is not made the default)."""
@@ -140,9 +98,9 @@ def session(scheduler: Any, workers: int | None = None) -> Iterator[Any]:
         return
     cluster = None
     if scheduler == "dask":
-        client, cluster = _local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS))
+        client, cluster = start_local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS))
     else:
-        client = _client(scheduler)
+        client = connect(scheduler)
     try:
         yield client
     finally:
