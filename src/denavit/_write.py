@@ -1,11 +1,15 @@
 """Writing robot files: a robot as plain data and as YAML a person can read (re-exported by :mod:`denavit.io`).
 
-Expressions are kept as written (``d1``, ``q + 5*pi/4``, ``-90deg``), exact multiples of π stay exact, numbers
-are written unquoted and rounding noise as 0; every file written loads back to the same arm.
+Expressions are kept as written (``d1``, ``q + 5*pi/4``, ``-90deg``); a number is written as ``pi/2`` or ``170deg``
+only when that text reads back to it bit for bit, else with ``repr``'s shortest exact digits; base and tool are
+left out only when exactly the identity.  So every file written loads back to the same arm, bit for bit.  Free
+text (name, description, pose names) is data: quoted and escaped (:mod:`denavit._text`), and one line in the
+header comment.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import re
@@ -14,7 +18,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from . import _expr
+from . import _expr, _text
+from ._read_row import DEGREE_HINT
 from .errors import ParseError
 from .model import DH_FIELDS, DHRobot, JointType
 
@@ -22,22 +27,40 @@ __all__ = ["robot_to_dict", "dump_robot", "save_robot", "value_text", "expressio
 
 
 def _num_text(x: float, angle: bool = False) -> Any:
-    """A value for a written file: an int when whole, an exact multiple of π as text (``5*pi/4``), with
-    ``angle=True`` a whole number of degrees as ``170deg``, else the float."""
+    """A value for a written file, read back to exactly ``x``: an int when whole, a multiple of π as text
+    (``5*pi/4``) when that text evaluates to ``x`` bit for bit, with ``angle=True`` a whole number of degrees
+    (``170deg``) under the same condition, else the float (written with ``repr``: shortest exact digits).
+
+    An angle beyond a full turn that has no exact form is written ``rad(6.981317007977318)``: it says its unit,
+    so reading the file does not warn "more than a full turn — degrees?" about a genuine multi-turn limit.
+    """
     x = float(x)
     if x == int(x) and abs(x) < 1e15:
         return int(x)
     for k in (1, 2, 3, 4, 6, 8, 12):
-        m = x * k / math.pi
-        num = round(m)
-        if num and abs(m - num) < 1e-12 * max(1.0, abs(m)):
+        num = round(x * k / math.pi)
+        if num:
             coef = {1: "", -1: "-"}.get(num, f"{num}*")
-            return f"{coef}pi" + (f"/{k}" if k != 1 else "")
+            text = f"{coef}pi" + (f"/{k}" if k != 1 else "")
+            if _exact(text, x):
+                return text
     if angle:
-        d = math.degrees(x)
-        if abs(d - round(d)) < 1e-9 and abs(d) <= 3600:
-            return f"{round(d)}deg"
+        d = round(math.degrees(x))
+        if d and abs(d) <= 3600 and _exact(f"{d}deg", x):
+            return f"{d}deg"
+        if abs(x) > DEGREE_HINT:
+            return f"rad({x!r})"
     return x
+
+
+@functools.lru_cache(maxsize=4096)
+def _value(text: str) -> float:
+    return _expr.evaluate(_expr.parse(text))
+
+
+def _exact(text: str, x: float) -> bool:
+    """Whether ``text`` reads back (through the reader's own evaluator) to exactly ``x``."""
+    return _value(text) == x
 
 
 def _text_value(text: str) -> Any:
@@ -49,7 +72,15 @@ def _text_value(text: str) -> Any:
     if _expr.is_literal(tree):
         value = _expr.evaluate(tree)
         return int(value) if value == int(value) and abs(value) < 1e15 else value
-    return _DEG_CALL.sub(r"\1deg", text)
+    short = _DEG_CALL.sub(r"\1deg", text)  # deg(90) -> 90deg; deg(-90) stays (-90deg reads as -(90deg))
+    return short if short == text or _same_tree(short, tree) else text
+
+
+def _same_tree(text: str, tree: _expr.Node) -> bool:
+    try:
+        return _expr.parse(text) == tree
+    except ParseError:
+        return False
 
 
 _DEG_CALL = re.compile(r"\bdeg\((-?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\)")
@@ -65,10 +96,11 @@ def value_text(x: float, angle: bool = False) -> str:
 
 
 def expression_text(text: str) -> str:
-    """A stored field expression as it is best read: ``deg(-90)`` → ``-90deg``; others unchanged.
+    """A stored field expression as it is best read: ``deg(90)`` → ``90deg``; others unchanged (``deg(-90)`` too:
+    ``-90deg`` reads as ``-(90deg)``, another expression of the same value).
 
-    >>> expression_text("deg(-90)"), expression_text("L1 + 0.1")
-    ('-90deg', 'L1 + 0.1')
+    >>> expression_text("deg(90)"), expression_text("deg(-90)"), expression_text("L1 + 0.1")
+    ('90deg', 'deg(-90)', 'L1 + 0.1')
     """
     return str(_text_value(text))
 
@@ -81,11 +113,6 @@ def _with_q(offset: Any) -> str:
     return f"q - {text[1:]}" if text.startswith("-") else f"q + {text}"
 
 
-def _clean(x: float, scale: float = 1.0) -> float:
-    """Rounding noise (|x| below 1e-12 of ``scale``) written as 0."""
-    return 0.0 if abs(x) < 1e-12 * max(scale, 1e-300) else float(x)
-
-
 def _transform_dict(robot: DHRobot, place: str) -> Any:
     sym = dict(robot.symbols)
     if f"{place}.m0" in sym:
@@ -93,9 +120,7 @@ def _transform_dict(robot: DHRobot, place: str) -> Any:
     if f"{place}.xyz0" in sym:
         return {"xyz": [_text_value(sym[f"{place}.xyz{i}"]) for i in range(3)],
                 "rpy": [_text_value(sym[f"{place}.rpy{i}"]) for i in range(3)]}
-    M = getattr(robot, f"{place}_matrix")
-    scale = max(1.0, float(np.abs(M[:3, 3]).max()))
-    return [[_num_text(_clean(x, scale)) for x in r] for r in M]
+    return [[_num_text(x) for x in r] for r in getattr(robot, f"{place}_matrix")]
 
 
 def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
@@ -117,17 +142,15 @@ def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
         if link.inertia is not None:
             li = link.inertia
             s = dict(li.symbols)
-            scale = max(abs(x) for x in li.inertia) or 1.0
-            cscale = max(abs(x) for x in li.com) or 1.0
-            get = lambda key, x, sc: _text_value(s[key]) if key in s else _num_text(_clean(x, sc))  # noqa: E731
+            get = lambda key, x: _text_value(s[key]) if key in s else _num_text(x)  # noqa: E731
             inertia: dict[str, Any] = {
-                "mass": get("mass", li.mass, 1.0),
-                "com": [get(f"com{i}", c, cscale) for i, c in enumerate(li.com)],
-                "inertia": [get(f"inertia{i}", c, scale) for i, c in enumerate(li.inertia)],
+                "mass": get("mass", li.mass),
+                "com": [get(f"com{i}", c) for i, c in enumerate(li.com)],
+                "inertia": [get(f"inertia{i}", c) for i, c in enumerate(li.inertia)],
             }
             for k in ("motor_inertia", "viscous", "coulomb"):
                 if getattr(li, k) or k in s:
-                    inertia[k] = get(k, getattr(li, k), 1.0)
+                    inertia[k] = get(k, getattr(li, k))
             row["inertia"] = inertia
         rows.append(row)
     out: dict[str, Any] = {"name": robot.name}
@@ -138,15 +161,16 @@ def robot_to_dict(robot: DHRobot) -> dict[str, Any]:
     if robot.parameters:
         out["parameters"] = {k: _num_text(v) if v == int(v) else v for k, v in robot.parameters}
     out["joints"] = rows
-    if robot.symbols and any(k.startswith("tool.") for k, _ in robot.symbols) or not np.allclose(robot.tool_matrix, np.eye(4)):
-        out["tool"] = _transform_dict(robot, "tool")
-    if robot.symbols and any(k.startswith("base.") for k, _ in robot.symbols) or not np.allclose(robot.base_matrix, np.eye(4)):
-        out["base"] = _transform_dict(robot, "base")
+    for place in ("tool", "base"):  # left out only when exactly the identity: 1e-12 off it is still written
+        if any(k.startswith(f"{place}.") for k, _ in robot.symbols) or not np.array_equal(
+                getattr(robot, f"{place}_matrix"), np.eye(4)):
+            out[place] = _transform_dict(robot, place)
     gsym = dict(robot.symbols)
     out["gravity"] = ([_text_value(gsym[f"gravity{i}"]) for i in range(3)] if "gravity0" in gsym
                       else [_num_text(g) for g in robot.gravity])
     if robot.poses:
-        out["poses"] = {k: [_num_text(v) for v in q] for k, q in robot.poses}
+        revolute = [t is JointType.REVOLUTE for t in robot.joint_types]
+        out["poses"] = {k: [_num_text(v, r) for v, r in zip(q, revolute)] for k, q in robot.poses}
     return out
 
 
@@ -160,8 +184,7 @@ def _yaml_value(v: Any) -> str:
     if isinstance(v, int):
         return str(v)
     if isinstance(v, float):
-        short = float(f"{v:.15g}")
-        text = repr(short if abs(short - v) <= 2 * math.ulp(v) else v)  # 0.014100000000000003 -> 0.0141
+        text = repr(v)  # the shortest digits that read back to exactly v
         return text.replace("e", ".0e") if "e" in text and "." not in text else text  # YAML 1.1 floats need a dot
     if isinstance(v, dict):
         return "{" + ", ".join(f"{_yaml_value(str(k))}: {_yaml_value(x)}" for k, x in v.items()) + "}"
@@ -170,9 +193,10 @@ def _yaml_value(v: Any) -> str:
     text = str(v)
     if _PLAIN.fullmatch(text) and not text.startswith(("- ", " ")) and _plain_is_text(text):
         return text
-    return json.dumps(text, ensure_ascii=False)
+    return _text.yaml_string(text)
 
 
+@functools.lru_cache(maxsize=4096)
 def _plain_is_text(text: str) -> bool:
     import yaml
 
@@ -197,12 +221,12 @@ def dump_robot(robot: DHRobot, fmt: str = "yaml") -> str:
     """The robot as file text (``yaml`` or ``json``).
 
     The YAML is written for people: one line per DH row, inertial data on their own lines, numbers
-    unquoted, expressions and exact multiples of π kept as text, rounding noise written as 0.
+    unquoted, expressions and exact multiples of π kept as text; it loads back to exactly ``robot``.
     """
     data = robot_to_dict(robot)
     if fmt == "json":
         return json.dumps(data, indent=2)
-    out = [f"# {robot.name}: written by denavit"]
+    out = [f"# {_text.visible(robot.name)}: written by denavit"]  # a comment: one line, whatever the name holds
     for key, value in data.items():
         if key == "joints":
             out.append("joints:\n" + "".join(_yaml_row(row) for row in value).rstrip("\n"))
