@@ -1,4 +1,5 @@
-"""``denavit compile`` (build and cache an arm's kernels) and ``denavit export`` (standalone C or Python)."""
+"""``denavit compile`` (build and cache an arm's kernels), ``denavit cache`` (where, how big; ``--clear``) and
+``denavit export`` (standalone C or Python)."""
 
 from __future__ import annotations
 
@@ -21,6 +22,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--backend", choices=["numba", "numpy"], help="default: numba when installed (the 'fast' extra)")
     p.set_defaults(handler=cmd_compile)
 
+    p = sub.add_parser("cache", help="the kernel cache: the folder in use and its size; --clear deletes the kernels")
+    p.add_argument("--clear", action="store_true", help="delete every cached kernel (rebuilt when next needed)")
+    p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
+    p.add_argument("--deg", action="store_true", help="accepted like every command's --deg (the cache has no angles)")
+    p.set_defaults(handler=cmd_cache)
+
     p = sub.add_parser("export", help="write an arm's kernels as standalone C99 or numpy-only Python source")
     add_common(p, angles=False)
     p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
@@ -31,7 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_compile(args: argparse.Namespace):
-    from ..codegen import cache_dir, compile
+    from ..codegen import compile
 
     robot = load(args)
     # at a terminal only, so that a failure (no numba, an unwritable cache) stays one line on stderr
@@ -42,11 +49,23 @@ def cmd_compile(args: argparse.Namespace):
     show(f"compiling and timing {len(fast.kernels)} kernels ({fast.backend})")
     timings = fast.warm()
     total = time.perf_counter() - t0
+    folder = fast.path.parent  # the folder actually used (the configured one may have been unsafe or unwritable)
     lines = [f"{robot.name}: {robot.dof} joints, backend {fast.backend}, {len(fast.kernels)} kernels in "
-             f"{total:.2f} s (cache: {cache_dir()})"]
+             f"{total:.2f} s (cache: {folder})"]
     lines += [f"  {name:<17} {dt * 1e3:8.1f} ms" for name, dt in timings.items()]
     return {"robot": robot.name, "backend": fast.backend, "kernels": list(fast.kernels), "seconds": total,
-            "kernel_seconds": timings, "cache": str(cache_dir())}, "\n".join(lines)
+            "kernel_seconds": timings, "cache": str(folder)}, "\n".join(lines)
+
+
+def cmd_cache(args: argparse.Namespace):
+    from ..codegen import cache_info, clear_cache
+
+    info = clear_cache() if args.clear else cache_info()
+    size = f"{info['files']} files, {info['bytes'] / 1e6:.1f} MB"
+    text = (f"removed {size} from {info['folder']}" if args.clear else f"kernel cache: {info['folder']} ({size})")
+    if info["reason"]:
+        text += f"\n(configured {info['configured']}: not used, {info['reason']})"
+    return {**info, "cleared": bool(args.clear)}, text
 
 
 def cmd_export(args: argparse.Namespace):
