@@ -8,6 +8,8 @@ See ``docs/grading.md``.
 
 from __future__ import annotations
 
+from ._render import CHECKED_FORMATS, render_checked_html, render_checked_markdown, write_checked
 from ._types import VERDICTS, ArmInfo, GradedClaim, GradedReport
 
-__all__ = ["VERDICTS", "ArmInfo", "GradedClaim", "GradedReport"]
+__all__ = ["VERDICTS", "ArmInfo", "GradedClaim", "GradedReport",
+           "render_checked_markdown", "render_checked_html", "write_checked", "CHECKED_FORMATS"]
