@@ -61,7 +61,8 @@ def test_to_json_maps_nonfinite_to_null():
     json.dumps(got, allow_nan=False)
 
 
-# Every command that writes -o FILE: an existing file is kept unless --force.
+# Every command that writes -o FILE: an existing file is replaced (run twice, both succeed); --no-clobber keeps it;
+# the old --force is accepted and changes nothing.
 WRITERS = [
     ("plot", ["plot", "planar2r", "-q", "0.1,0.2"], ".png"),
     ("animate", ["animate", "planar2r", "--from", "0,0", "--to", "0.1,0.1", "--duration", "0.2", "--fps", "5"], ".gif"),
@@ -74,17 +75,25 @@ WRITERS = [
 
 
 @pytest.mark.parametrize("name,argv,ext", WRITERS, ids=[w[0] for w in WRITERS])
-def test_existing_output_is_not_overwritten_without_force(capsys, tmp_path, name, argv, ext):
+def test_existing_output_is_replaced_unless_no_clobber(capsys, tmp_path, name, argv, ext):
     path = tmp_path / f"mine{ext}"
-    path.write_text("precious\n")
     code, out, err = run(capsys, *argv, "-o", path)
+    assert code == 0, err
+    first = path.read_bytes()
+    code, out, err = run(capsys, *argv, "-o", path)  # the same command again: it succeeds, as savefig would
+    assert code == 0, err
+    assert len(path.read_bytes()) > 0
+    path.write_text("precious\n")
+    code, out, err = run(capsys, *argv, "-o", path, "--no-clobber")
     assert code == 2
     assert path.read_text() == "precious\n"
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and "exists" in lines[0] and "--force" in lines[0] and "Traceback" not in err
-    code, out, err = run(capsys, *argv, "-o", path, "--force")
+    assert len(lines) == 1 and "exists" in lines[0] and "--no-clobber" in lines[0] and "Traceback" not in err
+    code, out, err = run(capsys, *argv, "-o", path, "--force")  # the old flag: accepted, replaces as without it
     assert code == 0, err
-    assert path.read_bytes() != b"precious\n"
+    assert path.read_bytes() != b"precious\n" and len(path.read_bytes()) > 0
+    if ext in (".md", ".yaml"):  # text outputs of a deterministic command: the same bytes each time
+        assert path.read_bytes() == first
 
 
 # Long-running commands report their stages on stderr, and stay quiet with --json (stdout is pure JSON).

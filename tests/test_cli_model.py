@@ -84,10 +84,13 @@ def test_convert_writes_a_file_with_identical_fk(capsys, tmp_path):
     assert b.convention.value == "modified"
     q = np.random.default_rng(1).uniform(-2, 2, (10, 6))
     np.testing.assert_allclose(denavit.forward_kinematics(b, q), denavit.forward_kinematics(a, q), atol=1e-12)
-    # refuses to overwrite, leaves the file as it was
+    # --no-clobber refuses and leaves the file as it was; without it the same command runs again
     before = out_file.read_text()
+    code, _, err = run(capsys, "convert", "puma560", "--to", "modified", "-o", str(out_file), "--no-clobber")
+    assert code == 2 and "--no-clobber" in err and out_file.read_text() == before
+    out_file.write_text("mine")
     code, _, err = run(capsys, "convert", "puma560", "--to", "modified", "-o", str(out_file))
-    assert code == 2 and "not overwriting" in err and out_file.read_text() == before
+    assert code == 0 and out_file.read_text() == before
 
 
 BAD_INPUT = [

@@ -72,7 +72,7 @@ def test_cli_report_pdf_needs_an_engine(tmp_path, capsys, monkeypatch):
         assert out.read_bytes().startswith(b"%PDF")
     monkeypatch.setenv("PATH", str(tmp_path))  # no engine on PATH
     capsys.readouterr()
-    out2 = tmp_path / "r2.pdf"  # a new name: an existing r.pdf would be refused first (exists, no --force)
+    out2 = tmp_path / "r2.pdf"  # a new name, so that "not written" can be seen
     assert main(["report", "planar2r", "--topics", "model", "-o", str(out2)]) == 1
     _one_line_error(capsys, "LaTeX engine")
     assert not out2.exists()
@@ -94,7 +94,7 @@ def test_cli_check_examples_run_and_judge_every_claim(example, capsys):
             assert (c["entries"] and c["counterexample"]["q"]) or c.get("missing")
 
 
-# --- output paths (issue 14): checked before any work, nothing overwritten without --force -------------------------
+# --- output paths (issues 14, 29): checked before any work; replaced (with the pictures) only after it -------------
 
 def _hostile():
     import sys
@@ -106,11 +106,14 @@ def _hostile():
 
 
 @pytest.mark.parametrize("suffix", ["md", "tex"])
-def test_cli_report_refuses_to_overwrite_its_picture(tmp_path, suffix):
-    """``report -o r.md`` writes r-planar2r-arm.png beside it: an existing one is refused (before the derivation)."""
+def test_cli_report_no_clobber_refuses_its_picture(tmp_path, suffix):
+    """``report -o r.md --no-clobber`` writes r-planar2r-arm.png beside it: an existing one is refused (before the
+    derivation)."""
     h = _hostile()
-    o = h.run_cli(["report", "planar2r", "-o", f"r.{suffix}"], tmp_path, {"r-planar2r-arm.png": b"my picture"})
-    h.assert_refused(o, mentions=["r-planar2r-arm.png", "exists", "--force"])
+    o = h.run_cli(["report", "planar2r", "-o", f"r.{suffix}", "--no-clobber"], tmp_path,
+                  {"r-planar2r-arm.png": b"my picture"})
+    h.assert_refused(o, mentions=["r-planar2r-arm.png", "exists", "--no-clobber"])
+    assert (tmp_path / "r-planar2r-arm.png").read_bytes() == b"my picture"
     assert o.seconds < 3, o.describe()  # refused before any work
 
 
@@ -121,19 +124,22 @@ def test_cli_report_writes_the_picture_it_names(tmp_path):
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == ["r-planar2r-arm.png", "r.md"], names  # the name checked beforehand is the one written
     assert "(r-planar2r-arm.png)" in (tmp_path / "r.md").read_text()
-    o = h.run_cli(["report", "planar2r", "--topics", "model,figures", "-o", "r.md", "--force"], tmp_path, {})
+    png = (tmp_path / "r-planar2r-arm.png").read_bytes()
+    (tmp_path / "r-planar2r-arm.png").write_bytes(b"old picture")
+    o = h.run_cli(["report", "planar2r", "--topics", "model,figures", "-o", "r.md"], tmp_path, {})
     assert o.code == 0 and sorted(p.name for p in tmp_path.iterdir()) == names, o.describe()
+    assert (tmp_path / "r-planar2r-arm.png").read_bytes() == png  # the picture replaced with the report
 
 
 @pytest.mark.parametrize("out, files, words", [
     ("r.docx", {}, ["r.docx", ".md"]),
     ("missing/r.md", {}, ["missing"]),
-    ("r.md", {"r.md": "my notes"}, ["r.md", "exists"]),
+    ("r.md", {"r.md": "my notes"}, ["r.md", "exists", "--no-clobber"]),
     ("d.md", {"d.md/keep": "x"}, ["not a regular file"]),
 ])
 def test_cli_report_bad_output_refused_before_the_work(tmp_path, out, files, words):
     h = _hostile()
-    o = h.run_cli(["report", "report000-6r", "-o", out], tmp_path, files)
+    o = h.run_cli(["report", "report000-6r", "-o", out, "--no-clobber"], tmp_path, files)
     h.assert_refused(o, mentions=words)
     assert o.seconds < 3, o.describe()
 

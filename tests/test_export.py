@@ -106,7 +106,7 @@ def test_python_export_needs_only_numpy_and_matches_the_library(name, tmp_path):
         mod.fk(np.zeros(robot.dof + 1))
 
 
-def test_export_cli_writes_both_languages_and_keeps_existing_files(tmp_path):
+def test_export_cli_writes_both_languages_and_replaces_existing_files(tmp_path):
     out = tmp_path / "gen"
     done = subprocess.run([sys.executable, "-m", "denavit", "export", "puma560", "--lang", "c", "-o", str(out),
                            "--json"], capture_output=True, text=True)
@@ -115,9 +115,13 @@ def test_export_cli_writes_both_languages_and_keeps_existing_files(tmp_path):
     header = (out / "puma560.h").read_text()
     assert "void puma560_fk(const double q[6], double out[16]);" in header and "Usage:" in header
     (out / "puma560.h").write_text("mine")
-    again = run_cli(["export", "puma560", "--lang", "c", "-o", str(out)], tmp_path, {})
-    assert_refused(again, mentions=["puma560.h", "--force"])
+    again = run_cli(["export", "puma560", "--lang", "c", "-o", str(out), "--no-clobber"], tmp_path, {})
+    assert_refused(again, mentions=["puma560.h", "--no-clobber"])
     assert (out / "puma560.h").read_text() == "mine"
+    again = run_cli(["export", "puma560", "--lang", "c", "-o", str(out)], tmp_path, {})
+    assert again.code == 0, again.err
+    assert (out / "puma560.h").read_text() == header  # replaced, by the same text
+    assert sorted(p.name for p in out.iterdir()) == ["puma560.c", "puma560.h"]  # no temporary file left
     done = subprocess.run([sys.executable, "-m", "denavit", "export", "puma560", "--lang", "python", "-o", str(out),
                            "--prefix", "puma_fast"], capture_output=True, text=True)
     assert done.returncode == 0 and (out / "puma_fast.py").exists()

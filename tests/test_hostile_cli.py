@@ -273,7 +273,7 @@ def _make(folder, kind: str, ext: str, tag: str) -> tuple[str, list[str]]:
     if kind == "existing":
         p = folder / f"e{tag}{ext}"
         p.write_bytes(b"the user's own file " + tag.encode())
-        return p.name, [p.name, "force"]
+        return p.name, [p.name, "--no-clobber"]  # refused with --no-clobber only
     if kind == "suffix":
         return f"out-{tag}.txt", [f"out-{tag}.txt"]
     if kind == "empty-suffix":
@@ -297,18 +297,19 @@ def test_bad_output_paths(folder, command):
         else:
             path, mentions = _make(folder, kind, ext, tag)
         t0 = time.perf_counter()
-        o = _check(folder, argv + ["-o", path], mentions=mentions)
+        o = _check(folder, argv + ["-o", path] + ["--no-clobber"] * (kind == "existing"), mentions=mentions)
         assert o.seconds < 5 and time.perf_counter() - t0 < 10, o.describe()
 
     case()
 
 
 @pytest.mark.parametrize("command", sorted(WRITERS))
-def test_existing_file_replaced_only_with_force(folder, command, tmp_path):
+def test_existing_file_replaced_unless_no_clobber(folder, command, tmp_path):
     argv, ext = WRITERS[command]
     (tmp_path / f"mine{ext}").write_bytes(b"keep me")
-    assert_refused(run_cli(argv + ["-o", f"mine{ext}"], tmp_path), mentions=[f"mine{ext}", "force"])
-    o = run_cli(argv + ["-o", f"mine{ext}", "--force"], tmp_path)
+    assert_refused(run_cli(argv + ["-o", f"mine{ext}", "--no-clobber"], tmp_path), mentions=[f"mine{ext}", "clobber"])
+    assert (tmp_path / f"mine{ext}").read_bytes() == b"keep me"
+    o = run_cli(argv + ["-o", f"mine{ext}"], tmp_path)
     assert_accepted_quietly(o)
     written = (tmp_path / f"mine{ext}").read_bytes()
     assert written != b"keep me" and len(written) > 100

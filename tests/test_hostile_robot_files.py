@@ -566,5 +566,5 @@ def test_convert_writes_json_and_yml_that_load_back(tmp_path, suffix):
     a, b = load_robot("puma560"), load_robot(tmp_path / f"c{suffix}")
     q = np.random.default_rng(3).uniform(-1, 1, (5, 6))
     np.testing.assert_allclose(forward_kinematics(b, q), forward_kinematics(a, q), atol=1e-12)
-    again = run_cli(["convert", "puma560", "--to", "modified", "-o", f"c{suffix}"], tmp_path)
-    assert_refused(again, mentions=[f"c{suffix}", "not overwriting"])
+    again = run_cli(["convert", "puma560", "--to", "modified", "-o", f"c{suffix}", "--no-clobber"], tmp_path)
+    assert_refused(again, mentions=[f"c{suffix}", "--no-clobber"])

@@ -142,7 +142,6 @@ GOOD = HEAD + "| 1 | 0.5 | 0 | 0 | \\theta_1 |\n"
     ("out.png", {}, ["out.png", "unsupported"]),
     ("out", {}, ["out", "unsupported"]),
     ("missing/out.yaml", {}, ["missing"]),
-    ("out.yaml", {"out.yaml": "mine\n"}, ["exists", "--force"]),
     ("d.yaml", {"d.yaml/keep": "x"}, ["not a regular file"]),
     ("x" * 300 + ".yaml", {}, ["255"]),
 ])
@@ -156,8 +155,21 @@ def test_bad_output_path_is_refused_even_for_a_missing_table(tmp_path):
     assert_refused(o, mentions=["out.png"])
 
 
-def test_force_replaces_atomically(tmp_path):
-    o = run_cli(["import-table", "t.txt", "-o", "out.yaml", "--force"], tmp_path, {"t.txt": GOOD, "out.yaml": "old"})
+def test_output_equal_to_the_table_is_refused(tmp_path):
+    o = run_cli(["import-table", "t.yaml", "-o", "t.yaml"], tmp_path, {"t.yaml": GOOD})
+    assert_refused(o, mentions=["t.yaml", "input file"])
+    assert (tmp_path / "t.yaml").read_text() == GOOD
+
+
+def test_existing_output_refused_with_no_clobber(tmp_path):
+    o = run_cli(["import-table", "t.txt", "-o", "out.yaml", "--no-clobber"], tmp_path,
+                {"t.txt": GOOD, "out.yaml": "mine\n"})
+    assert_refused(o, mentions=["out.yaml", "exists", "--no-clobber"])
+    assert (tmp_path / "out.yaml").read_text() == "mine\n"
+
+
+def test_existing_output_replaced_atomically(tmp_path):
+    o = run_cli(["import-table", "t.txt", "-o", "out.yaml"], tmp_path, {"t.txt": GOOD, "out.yaml": "old"})
     robot = _imported(o, tmp_path)
     assert robot.links[0].a == 0.5
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml", "t.txt"]  # no temporary file left

@@ -137,10 +137,11 @@ def test_cli_import_table_writes_refuses_overwrite_and_json(tmp_path, capsys):
     r = dn.load_robot(out)
     np.testing.assert_allclose(dn.forward_kinematics(r, [0, 0])[:3, 3], [1.5, 0, 0], atol=1e-12)
     capsys.readouterr()
-    assert main(["import-table", str(src), "-o", str(out)]) == 2
+    assert main(["import-table", str(src), "-o", str(out), "--no-clobber"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "exists" in err and "--force" in err
-    assert main(["import-table", str(src), "-o", str(out), "--force"]) == 0
+    assert err.count("\n") == 1 and "exists" in err and "--no-clobber" in err
+    assert main(["import-table", str(src), "-o", str(out)]) == 0  # replaced
+    assert main(["import-table", str(src), "-o", str(out), "--force"]) == 0  # the old flag: accepted, no effect
     capsys.readouterr()
     assert main(["import-table", str(src), "--json"]) == 0
     import json

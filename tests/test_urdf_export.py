@@ -128,8 +128,10 @@ def test_cli_export_urdf(tmp_path, capsys):
     q = np.linspace(-1, 1, robot.dof)
     np.testing.assert_allclose(denavit.forward_kinematics(back, q), denavit.forward_kinematics(robot, q), atol=1e-12)
     out.write_text("mine")
-    assert main(["export-urdf", "stanford", "-o", str(out)]) == 2  # no --force: kept
+    assert main(["export-urdf", "stanford", "-o", str(out), "--no-clobber"]) == 2  # kept
     assert out.read_text() == "mine"
+    assert main(["export-urdf", "stanford", "-o", str(out)]) == 0  # replaced, as savefig would
+    assert denavit.from_urdf(out).dof == robot.dof
     assert main(["export-urdf", "stanford", "-o", str(tmp_path / "arm.png")]) == 2
     assert not (tmp_path / "arm.png").exists()
 

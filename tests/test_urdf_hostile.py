@@ -136,10 +136,16 @@ def test_a_robot_file_given_as_urdf_says_so(tmp_path, name):
     assert_refused(o, mentions=[name, "a robot file, not a URDF"])
 
 
-def test_existing_output_kept_without_force(tmp_path):
-    o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml"], tmp_path, {"arm.urdf": GOOD, "arm.yaml": "mine\n"})
-    assert_refused(o, mentions=["arm.yaml", "--force"])
+def test_existing_output_replaced_unless_no_clobber(tmp_path):
+    o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml", "--no-clobber"], tmp_path,
+                {"arm.urdf": GOOD, "arm.yaml": "mine\n"})
+    assert_refused(o, mentions=["arm.yaml", "--no-clobber"])
     assert (tmp_path / "arm.yaml").read_text() == "mine\n"
+    o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml"], tmp_path, {})
+    assert o.code == 0, o.err
+    import denavit
+
+    assert denavit.load_robot(tmp_path / "arm.yaml").dof > 0
 
 
 def test_missing_file(tmp_path):

@@ -140,12 +140,12 @@ def test_unreachable_scheduler_is_one_line(tmp_path, monkeypatch):
     assert o.seconds < 15
 
 
-def test_existing_data_file_is_kept_without_force(tmp_path):
+def test_existing_data_file_is_kept_with_no_clobber(tmp_path):
     (tmp_path / "w.npz").write_bytes(b"mine")
-    assert_refused(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz"], tmp_path),
-                   mentions=["w.npz"])
+    assert_refused(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz", "--no-clobber"],
+                           tmp_path), mentions=["w.npz", "--no-clobber"])
     assert (tmp_path / "w.npz").read_bytes() == b"mine"
-    _ok(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz", "--force"], tmp_path))
+    _ok(run_cli(["workspace", "planar2r", "--samples", "200", "--data", "w.npz"], tmp_path))
     assert (tmp_path / "w.npz").read_bytes()[:2] == b"PK"  # a zip (.npz), replaced
 
 

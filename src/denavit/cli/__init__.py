@@ -80,8 +80,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError:
         return _fail(args.command, "out of memory (the input asks for more work than this machine can hold)", 1)
     except OSError as exc:  # a file the user named: unreadable, a directory, a name too long, a full disk ...
-        where = exc.filename if exc.filename is not None else None
-        what = (f"{where!r}: " if where else "") + f"{exc.strerror or exc}"
+        where = f"{exc.filename!r}" if exc.filename is not None else ""
+        if where and exc.filename2 is not None:  # a rename or link: both names
+            where += f" -> {exc.filename2!r}"
+        what = (f"{where}: " if where else "") + f"{exc.strerror or exc}"
         return _fail(args.command, one_line(what), 2)
     except Exception as exc:  # a bug of ours: one line, the traceback only on request
         if os.environ.get("DENAVIT_DEBUG"):

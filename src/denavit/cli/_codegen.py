@@ -4,14 +4,13 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
 from ..errors import ParseError
 from ._common import add_common, load, stage_printer
-from ._output import output_file
+from ._output import add_no_clobber, check_output, output_files
 
 __all__ = ["register"]
 
@@ -33,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into (made if absent)")
     p.add_argument("--prefix", help="C function / module name prefix (default: from the robot's name)")
-    p.add_argument("--force", action="store_true", help="replace files of the same names in DIR")
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_export)
 
 
@@ -74,6 +73,8 @@ def cmd_export(args: argparse.Namespace):
     if args.prefix is not None and not _valid_prefix(args.prefix):
         raise ParseError(f"--prefix {args.prefix!r}: expected a C identifier (letters, digits, _; "
                          "not a digit first; at most 40)")
+    if not args.output.strip():
+        raise ParseError(f"-o {args.output!r}: empty path; name the folder to write into (. for this one)")
     folder = Path(args.output)
     if folder.exists() and not folder.is_dir():
         raise ParseError(f"-o {args.output!r} is not a folder")
@@ -81,18 +82,15 @@ def cmd_export(args: argparse.Namespace):
         raise ParseError(f"-o {args.output!r}: its parent folder does not exist")
     robot = load(args)
     files = export_sources(robot, args.lang, args.prefix)
-    clash = [name for name in files if os.path.lexists(folder / name)]
-    if clash and not args.force:
-        raise ParseError(f"{folder / clash[0]} exists; not overwriting it (choose another folder or pass --force)")
-    for name in clash:
-        if not (folder / name).is_file():
-            raise ParseError(f"{folder / name} exists and is not a regular file")
+    if folder.is_dir():  # each file replaced like -o FILE: a regular file, not an input, --no-clobber refuses
+        for name in files:
+            check_output(args, str(folder / name), ())
     try:
         folder.mkdir(exist_ok=True)
     except OSError as exc:
         raise ParseError(f"-o {args.output!r}: {exc.strerror}") from None
-    for name, text in files.items():
-        with output_file(str(folder / name)) as tmp:
+    with output_files([str(folder / name) for name in files]) as tmps:  # replaced together
+        for tmp, text in zip(tmps, files.values()):
             Path(tmp).write_text(text, encoding="utf-8")
     written = [str(folder / name) for name in files]
     return {"robot": robot.name, "lang": args.lang, "files": written}, "wrote " + ", ".join(written)

@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import MissingDependencyError, ParseError
 from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_q, check_values, joint_values, load, matrix_text,
                       numbers_text, require_finite, require_symbolic_size)
-from ._output import add_force, check_output, output_file
+from ._output import add_no_clobber, check_output, output_file
 from ._shared import q_out
 
 #: simulate: most output samples (--duration / --dt) and most evaluations of the dynamics in one run (about
@@ -52,7 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="PNG",
                    help="plot of the joint trajectories and energy: .png, .svg or .pdf (needs denavit[plot])")
     p.add_argument("--ignore-limits", action="store_true", help="accept q0 outside the joint limits")
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_simulate)
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import ParseError
 from ._common import add_common, load
-from ._output import check_output, output_file
+from ._output import add_no_clobber, check_output, output_file
 
 #: File types ``import-urdf -o`` writes (a denavit robot file).
 ROBOT_SUFFIXES = (".yaml", ".yml", ".json")
@@ -23,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--xacro", action="store_true", help="expand a xacro file first (needs denavit[xacro]); xacro "
                                                          "evaluates Python expressions: only for files you trust")
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
-    p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+    add_no_clobber(p)
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
     p.add_argument("--deg", action="store_true", help="the printed DH table's angles in degrees (the robot file is "
                                                       "written in radians, as every robot file denavit writes)")
@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         p = sub.add_parser(f"export-{fmt}", help=help_text)
         add_common(p, angles=False)
         p.add_argument("-o", "--output", metavar="FILE", help=f"file to write ({suffix}); stdout if absent")
-        p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+        add_no_clobber(p)
         p.set_defaults(handler=cmd_export, fmt=fmt, suffixes=(suffix,) if fmt == "mjcf" else (".urdf", ".xml"))
 
 

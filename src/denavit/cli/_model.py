@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ParseError
 from ._common import add_common, add_q, joint_values, load, matrix_text, numbers_text
-from ._output import check_output, output_file
+from ._output import add_no_clobber, check_output, output_file
 
 #: File types ``convert -o`` writes.
 CONVERT_SUFFIXES = (".yaml", ".yml", ".json")
@@ -40,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_common(p, angles=False)
     p.add_argument("--to", required=True, choices=["standard", "modified"], help="target convention")
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
-    p.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_convert)
 
 

@@ -10,7 +10,7 @@ from typing import Any
 from ..errors import ParseError
 from ..io import parse_values, resolve_pose, split_values
 from ._common import add_common, joint_values, load, nonneg_int, stage_printer
-from ._output import add_force, check_output, output_file
+from ._output import add_no_clobber, check_output, output_file, output_files
 
 #: Suffixes of a report file (the format follows the suffix).
 REPORT_SUFFIXES = (".md", ".markdown", ".tex", ".html", ".htm", ".pdf")
@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="FILE", help="report file: .md, .tex, .html or .pdf (Markdown on stdout if absent)")
     p.add_argument("--topics", metavar="LIST", help="comma-separated sections to include (default: all)")
     p.add_argument("--simplify", choices=["none", "trig", "full"], default="trig", help="simplification policy")
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_report)
 
     p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
@@ -48,7 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="ROBOT_FILE", help="robot file to write (.yaml or .json); stdout if absent")
     p.add_argument("--convention", choices=["standard", "modified"], help="override the convention read from the header")
     p.add_argument("--name", help="robot name (default: the file's stem)")
-    p.add_argument("--force", action="store_true", help="overwrite ROBOT_FILE if it exists")
+    add_no_clobber(p)
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
     p.add_argument("--deg", action="store_true", help="the table's angles are in degrees")
     p.set_defaults(handler=cmd_import_table)
@@ -65,15 +65,16 @@ def _figure_names(args: argparse.Namespace, robot, fmt: str) -> list[str]:
 
 
 def _check_beside(args: argparse.Namespace, names: list[str]) -> list[str]:
-    """The paths of files written beside -o; each refused like -o itself (exists without --force, not a file)."""
+    """The paths of files written beside -o; each refused like -o itself (not a regular file, an input, or
+    existing with --no-clobber), before the work: they are replaced together with -o."""
     if not names:
         return []
-    folder = os.path.dirname(args.output) or "."
+    folder = os.path.dirname(args.output)
     paths = []
     for name in names:
         if os.path.basename(name) != name or name in (".", ".."):
             raise ParseError(f"-o {args.output!r}: cannot write a picture named {name!r} beside it")
-        path = os.path.join(folder, name)
+        path = os.path.join(folder, name) if folder else name
         check_output(args, path, (), what="picture")
         paths.append(path)
     return paths
@@ -105,12 +106,10 @@ def cmd_report(args: argparse.Namespace):
         else:
             text, beside = render(d, fmt, prefix)
             main_bytes = text.encode("utf-8")
-        paths = _check_beside(args, list(beside))  # again, now that the names are known: nothing is overwritten
-        for path, blob in zip(paths, beside.values()):
-            with output_file(path, what="picture") as tmp:
+        paths = _check_beside(args, list(beside))  # again, now that the names are known
+        with output_files([args.output, *paths]) as tmps:  # the report and its pictures replaced together
+            for tmp, blob in zip(tmps, [main_bytes, *beside.values()]):
                 Path(tmp).write_bytes(blob)
-        with output_file(args.output) as tmp:
-            Path(tmp).write_bytes(main_bytes)
         written = [Path(args.output)] + [Path(p) for p in paths]
         data["output"] = [str(p) for p in written]
         done = sum(s.status == "done" for s in d.sections)

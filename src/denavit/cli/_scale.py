@@ -9,7 +9,7 @@ from decimal import Decimal, InvalidOperation
 import numpy as np
 
 from ._common import add_common, bounded_float, bounded_int, load, nonneg_int, number_text, require_finite
-from ._output import add_force, check_output, output_file
+from ._output import add_no_clobber, check_output, output_file
 
 PICTURES = (".png", ".svg", ".pdf")
 DATA = (".npz",)
@@ -80,7 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="sub-cells per side of the boundary cells, counted after a pilot of 1/8 of the samples "
                         "(default auto: when the pilot fills the finest grid and no --resolution is given; 0: off)")
     _add_run_options(p)
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_workspace)
 
     p = sub.add_parser("reachability", help="per voxel, the share of orientations the arm reaches; manipulability")
@@ -95,7 +95,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=nonneg_int, default=0, help="seed of the position screen and numeric restarts")
     p.add_argument("--no-screen", action="store_true", help="test every voxel of the reach ball")
     _add_run_options(p)
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_reachability)
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ParseError
 from ._common import (add_common, add_q, bounded_float, bounded_int, finite_float, joint_values, load, numbers_text,
                       require_finite, stage_printer)
-from ._output import add_force, check_output, output_file
+from ._output import add_no_clobber, check_output, output_file
 from ._shared import q_out
 
 PROFILES = ("quintic", "trapezoidal", "cartesian")
@@ -37,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--azim", type=finite_float, help="view azimuth [deg]")
     p.add_argument("--dpi", type=bounded_int(*DPI_RANGE), default=120,
                    help=f"resolution of a .png (default 120; {DPI_RANGE[0]} to {DPI_RANGE[1]})")
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_plot)
 
     p = sub.add_parser("animate", help="animation of a move between two configurations (.gif, .mp4)")
@@ -53,14 +53,14 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"frames per second (default 15, at most {MAX_FPS:g}); duration × fps <= {MAX_FRAMES}")
     p.add_argument("--no-frames", action="store_true", help="leave out the DH frame triads")
     p.add_argument("--ignore-limits", action="store_true", help="accept configurations outside the joint limits")
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_animate)
 
     p = sub.add_parser("view", help="interactive 3-D viewer as one self-contained HTML file")
     add_common(p)
     add_q(p, required=False)
     p.add_argument("-o", "--output", required=True, metavar="FILE", help="HTML file to write")
-    add_force(p)
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_view)
 
 
