@@ -84,7 +84,6 @@ def robot_key(robot: DHRobot, backend: str, friction: bool, kernels) -> str:
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:24]
 
 
-
 class _Damaged(Exception):
     """A cache entry that is not what the cache wrote (the message says how)."""
 
@@ -103,17 +102,18 @@ def load_module(key: str, tag: str, make_source):
                                          f"your code); using {choice.folder}"), stacklevel=3)
         folder = choice.folder
         path, pyc = folder / f"{modname}.py", folder / f"{modname}.pyc"
+        numba = tag == "numba"
+        if numba:
+            _numba_folder(folder)
         source = _entry(path, lambda data: _check_source(data, key), modname)
         if source is None:
             source = _stamped(key, make_source())
             _write(path, source)
+            remove_entry(pyc)  # a leftover of another source (its .py deleted by hand): stale, not damage
         code = _entry(pyc, lambda data: _check_code(data, source, path), modname)
         if code is None:
             code = builtins.compile(source, str(path), "exec", dont_inherit=True)
             _write(pyc, _pyc(source, code))
-        numba = tag == "numba"
-        if numba:
-            _numba_folder(folder)
         mod = _execute(modname, path, code)
         if numba:
             _guard_numba(mod)
@@ -129,9 +129,11 @@ def _entry(path: Path, check, modname: str):
         return None if data is None else check(data)
     except _Damaged as exc:
         victims = [path]
+        pycache = path.parent / "__pycache__"
         if path.suffix == ".py":
             victims.append(path.with_suffix(".pyc"))
-            victims += sorted((path.parent / "__pycache__").glob(f"{modname}.*"))
+            if pycache.is_dir() and not pycache.is_symlink():  # never into a folder elsewhere
+                victims += sorted(pycache.glob(f"{modname}.*"))
         for victim in victims:
             remove_entry(victim)
         _note(f"{path} was damaged ({exc}): deleted, built again")
@@ -151,12 +153,12 @@ def _read(path: Path) -> bytes | None:
         return None
     except OSError as exc:  # ELOOP: a symlink; ENXIO: a socket
         raise _Damaged(f"not a regular file: {exc.strerror}") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_uid != _folder.current_uid():
+        os.close(fd)
+        raise _Damaged("not a regular file" if not stat.S_ISREG(st.st_mode) else
+                       f"owned by another user (uid {st.st_uid})")
     with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise _Damaged("not a regular file")
-        if st.st_uid != _folder.current_uid():
-            raise _Damaged(f"owned by another user (uid {st.st_uid})")
         return fh.read()
 
 
