@@ -14,10 +14,11 @@ from typing import Iterator
 
 import numpy as np
 
-from ..errors import MissingDependencyError, ParseError
+from ..errors import ParseError
 from ..model import MAX_ANGLE, MAX_MAGNITUDE
 from ..numeric import transform_from_xyz_rpy
-from ._xml import MAX_XML_BYTES, Element, parse_xml, read_xml_source
+from ._xacro import expand_xacro
+from ._xml import Element, parse_xml, read_xml_source
 
 __all__ = ["UrdfInertial", "UrdfLink", "UrdfJoint", "UrdfModel", "read_urdf", "chain_path", "MOVING", "MAX_URDF_LINKS"]
 
@@ -186,32 +187,6 @@ def _joint(where: str, el: Element, links: dict[str, UrdfLink]) -> UrdfJoint:
                      axis / norm if norm > 0 else axis, limits, damping, friction, el.find("mimic") is not None, el.line)
 
 
-def _expand_xacro(data: bytes, where: str, rootdir) -> bytes:
-    """A xacro document expanded to URDF by xacrodoc (no ROS needed); its messages are kept off the terminal."""
-    import contextlib
-    import io
-
-    try:
-        from xacrodoc import XacroDoc
-    except ImportError as exc:
-        if exc.name and exc.name.split(".")[0] != "xacrodoc":
-            raise
-        raise MissingDependencyError("expanding xacro needs xacrodoc: pip install 'denavit[xacro]'") from None
-    chatter = io.StringIO()
-    try:
-        with contextlib.redirect_stderr(chatter), contextlib.redirect_stdout(chatter):
-            doc = XacroDoc.from_string(data.decode("utf-8"), rootdir=rootdir, resolve_packages=False)
-            text = doc.to_urdf_string(use_protocols=True)
-    except (MemoryError, RecursionError):
-        raise ParseError("xacro: the expansion grew beyond what can be held", where=where) from None
-    except Exception as exc:  # xacro's own errors on the user's document: one line
-        raise ParseError(f"xacro: {' '.join(str(exc).split())[:200] or type(exc).__name__}", where=where) from None
-    out = text.encode("utf-8")
-    if len(out) > MAX_XML_BYTES:
-        raise ParseError(f"xacro: the expanded URDF is larger than {MAX_XML_BYTES} bytes", where=where)
-    return out
-
-
 def read_urdf(source, *, xacro: bool = False) -> UrdfModel:
     """The checked links, joints and tree of a URDF file or text (ParseError naming file, element and line).
 
@@ -228,7 +203,7 @@ def read_urdf(source, *, xacro: bool = False) -> UrdfModel:
     if xacro:
         import os
 
-        data = _expand_xacro(data, where, os.path.dirname(os.path.abspath(str(source))) if is_path else None)
+        data = expand_xacro(data, where, os.path.dirname(os.path.abspath(str(source))) if is_path else None)
         where = f"{where} (expanded)"
         root = parse_xml(data, where)
     if root.tag != "robot":
