@@ -26,10 +26,26 @@ from pathlib import Path
 from ..errors import DenavitWarning
 from ..model import DHRobot
 from . import _cache_folder as _folder
-from ._cache_folder import CACHE_ENV, MODULE_PREFIX, cache_dir, choose_folder, ours, remove_entry
+from ._cache_folder import (
+    CACHE_ENV,
+    MODULE_PREFIX,
+    cache_dir,
+    choose_folder,
+    ours,
+    remove_entry,
+)
 
-__all__ = ["cache_dir", "active_cache_dir", "cache_info", "clear_cache", "numba_available", "robot_key",
-           "load_module", "GENERATOR_VERSION", "CACHE_ENV"]
+__all__ = [
+    "CACHE_ENV",
+    "GENERATOR_VERSION",
+    "active_cache_dir",
+    "cache_dir",
+    "cache_info",
+    "clear_cache",
+    "load_module",
+    "numba_available",
+    "robot_key",
+]
 
 _LOCK = threading.Lock()
 _LOADED: dict[str, object] = {}  # module name → module, per process
@@ -257,7 +273,7 @@ class _GuardedCache:
     def load_overload(self, sig, target_context):
         try:
             return self._inner.load_overload(sig, target_context)
-        except Exception as exc:  # a truncated or garbage index or data file (pickles), a folder in their place
+        except Exception as exc:  # noqa: BLE001 — whatever a truncated or garbage pickle, or a folder, raises
             base = getattr(getattr(self._inner, "_impl", None), "filename_base", None)
             folder = Path(self._inner.cache_path)
             victims = sorted(folder.glob(f"{base}.*")) if base else []
@@ -270,7 +286,7 @@ class _GuardedCache:
     def save_overload(self, sig, data):
         try:
             self._inner.save_overload(sig, data)
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 — a full disk, a read-only folder: the kernel still works
             _note(f"could not save a compiled kernel in {self._inner.cache_path} ({exc}); it works, uncached")
 
 

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import NamedTuple
 
-__all__ = ["cache_dir", "current_uid", "choose_folder", "remove_entry", "tidy", "ours", "CACHE_ENV", "MODULE_PREFIX"]
+__all__ = ["CACHE_ENV", "MODULE_PREFIX", "cache_dir", "choose_folder", "current_uid", "ours", "remove_entry", "tidy"]
 
 CACHE_ENV = "DENAVIT_CACHE_DIR"
 #: Every file the cache holds starts with this (the generated modules and numba's files about them).
@@ -42,8 +42,12 @@ def cache_dir() -> Path:
 
 
 def current_uid() -> int:
-    """The user the cache must belong to (a function, so that tests can play another user)."""
-    return os.geteuid()
+    """The user the cache must belong to (a function, so that tests can play another user).  Windows has no
+    uids (``st_uid`` is 0, access is by ACL, profile folders are private): 0 there, and modes are not judged."""
+    return os.geteuid() if _POSIX else 0
+
+
+_POSIX = hasattr(os, "geteuid")
 
 
 class Choice(NamedTuple):
@@ -57,6 +61,8 @@ def _untrusted(folder: Path, private: bool = False) -> str:
     st = os.lstat(folder)
     if not stat.S_ISDIR(st.st_mode):
         return "not a folder (a symlink or a file)"
+    if not _POSIX:
+        return ""
     if st.st_uid != current_uid():
         return f"owned by another user (uid {st.st_uid})"
     if st.st_mode & (0o077 if private else 0o022):
