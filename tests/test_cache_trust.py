@@ -362,3 +362,21 @@ def test_cache_command_names_the_folder_used_when_the_configured_one_is_unsafe(e
     out, err = capsys.readouterr()
     assert code == 0 and f"(cache: {env / 'tmp' / f'denavit-kernels-{os.geteuid()}'})" in out
     assert len(err.splitlines()) == 1 and "warning: kernel cache" in err and "not used" in err
+
+
+@pytest.mark.slow  # a new Python process importing denavit: ~2 s
+def test_a_fresh_private_folder_is_gone_when_the_process_ends(env):
+    """The last fallback (the per-user folder is not safe) lives as long as the process: removed at exit."""
+    import subprocess
+    import sys
+
+    (env / "blocker").write_text("")
+    (env / "tmp" / f"denavit-kernels-{os.geteuid()}").mkdir(mode=0o777)
+    (env / "tmp" / f"denavit-kernels-{os.geteuid()}").chmod(0o777)
+    script = ("import denavit; f = denavit.compile(denavit.load_robot('planar2r'), backend='numpy', kernels=['fk']);"
+              "print(f.path.parent)")
+    run = subprocess.run([sys.executable, "-W", "ignore", "-c", script], capture_output=True, text=True, check=True,
+                         env={**os.environ, "TMPDIR": str(env / "tmp"), "DENAVIT_CACHE_DIR": str(env / "blocker" / "k")})
+    used = Path(run.stdout.strip())
+    assert used.parent == env / "tmp" and used.name.startswith(f"denavit-kernels-{os.geteuid()}-")
+    assert not used.exists() and sorted(p.name for p in (env / "tmp").iterdir()) == [f"denavit-kernels-{os.geteuid()}"]
