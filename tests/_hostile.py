@@ -7,9 +7,16 @@ A bad input — a robot file, a claims file, a pasted table, a command-line valu
 * nothing on stdout,
 * nothing the user had written or overwritten (every file in the case's folder keeps its bytes; no new file
   appears unless the case says so),
-* within a time bound (a hang is reported as such) and, for the cases run in a child process, a memory bound.
+* within a bound on its CPU time (a hang is reported as such) and, for the cases run in a child process, a
+  memory bound.
 
-``run_cli`` runs ``denavit.cli.main`` in this process with stdout/stderr captured and a wall-clock alarm;
+Time bounds are on CPU seconds, not wall-clock seconds, so that a busy machine (other processes sharing the cores)
+does not turn a correct run into a failure (issue 31): ``Outcome.seconds`` is the CPU time the run used
+(``time.process_time`` in this process, ``resource.getrusage`` in the child), and the alarm that stops a runaway
+case counts CPU time (``ITIMER_PROF`` in this process, ``RLIMIT_CPU`` in the child).  A case that waits without
+using CPU is caught by a wall-clock backstop ``WALL_FACTOR`` times longer.
+
+``run_cli`` runs ``denavit.cli.main`` in this process with stdout/stderr captured and a CPU-time alarm;
 ``run_cli_limited`` runs it in a child Python with an address-space limit, for the memory-bomb families.
 ``assert_refused`` checks the contract on an outcome.  Hostile test files build cases (hypothesis strategies
 and specific triggers) and call these two.
@@ -21,7 +28,9 @@ import contextlib
 import hashlib
 import io
 import json
+import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -37,8 +46,10 @@ def corpus(n: int) -> int:
     return max(5, n // 5) if os.environ.get("DENAVIT_QUICK_TESTS") == "1" else n
 
 
-#: Wall-clock bound for one bad input run in-process (generous: the machine is shared and noisy).
+#: CPU-time bound (seconds) for one bad input.
 TIME_LIMIT = 10.0
+#: The wall-clock backstop (for a case that waits rather than computes) is this many times the CPU bound.
+WALL_FACTOR = 10
 #: Address-space bound for the child-process runner (bytes).
 MEMORY_LIMIT = 3 * 1024**3
 
@@ -53,7 +64,7 @@ class Outcome:
     code: int | None
     out: str
     err: str
-    seconds: float
+    seconds: float  # CPU seconds of the run
     hung: bool = False
     before: dict[str, str] = field(default_factory=dict)   # file name -> sha256 before the run
     after: dict[str, str] = field(default_factory=dict)    # ... and after
@@ -98,13 +109,14 @@ def run_cli(argv: Sequence[str], folder: Path, files: Mapping[str, str | bytes] 
     def alarm(signum, frame):  # noqa: ARG001
         raise Hang()
 
-    previous = signal.signal(signal.SIGALRM, alarm)
-    t0 = time.perf_counter()
+    previous = signal.signal(signal.SIGALRM, alarm), signal.signal(signal.SIGPROF, alarm)
+    t0 = time.process_time()
     try:
         os.chdir(folder)
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), warnings.catch_warnings():
             warnings.simplefilter("default")  # as a user's interpreter would: warnings shown, on stderr
-            signal.setitimer(signal.ITIMER_REAL, time_limit)
+            signal.setitimer(signal.ITIMER_PROF, time_limit)  # CPU time of this process
+            signal.setitimer(signal.ITIMER_REAL, WALL_FACTOR * time_limit)  # the backstop for a wait
             try:
                 code = main(list(argv))
             except Hang:
@@ -112,46 +124,61 @@ def run_cli(argv: Sequence[str], folder: Path, files: Mapping[str, str | bytes] 
             except SystemExit as exc:  # main() should never let one escape; recorded as its code
                 code = exc.code if isinstance(exc.code, int) else 1
             finally:
+                signal.setitimer(signal.ITIMER_PROF, 0)
                 signal.setitimer(signal.ITIMER_REAL, 0)
     finally:
-        signal.signal(signal.SIGALRM, previous)
+        signal.signal(signal.SIGALRM, previous[0])
+        signal.signal(signal.SIGPROF, previous[1])
         os.chdir(old_cwd)
-    seconds = time.perf_counter() - t0
+    seconds = time.process_time() - t0
     return Outcome(list(argv), code, out.getvalue(), err.getvalue(), seconds, hung, before, _hashes(folder))
 
 
 _CHILD = r"""
 import json, os, resource, sys, time, io, contextlib
-limit = int(sys.argv[1])
+limit, cpu = int(sys.argv[1]), int(sys.argv[3])
 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 5))  # SIGXCPU past the CPU bound: the child dies
 argv = json.loads(sys.argv[2])
 from denavit.cli import main
+def cpu_now():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
 out, err = io.StringIO(), io.StringIO()
-t0 = time.perf_counter()
+t0 = cpu_now()
 try:
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main(argv)
 except MemoryError:
     code = "MemoryError"
-print(json.dumps({"code": code, "out": out.getvalue(), "err": err.getvalue(), "t": time.perf_counter() - t0}))
+print(json.dumps({"code": code, "out": out.getvalue(), "err": err.getvalue(), "t": cpu_now() - t0}))
 """
+
+
+def _children_cpu() -> float:
+    """CPU seconds used so far by this process's waited-for children."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def run_cli_limited(argv: Sequence[str], folder: Path, files: Mapping[str, str | bytes] | None = None,
                     time_limit: float = 3 * TIME_LIMIT, memory_limit: int = MEMORY_LIMIT) -> Outcome:
-    """Run ``denavit`` in a child Python with an address-space limit; a MemoryError or a kill is a failure."""
+    """Run ``denavit`` in a child Python with an address-space limit and a CPU-time limit (``time_limit`` CPU
+    seconds, the child's start included); a MemoryError or a kill is a failure, a CPU-limit kill a hang."""
     write_files(folder, files)
     before = _hashes(folder)
-    t0 = time.perf_counter()
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env.pop("DENAVIT_DEBUG", None)
+    c0 = _children_cpu()
     try:
-        proc = subprocess.run([sys.executable, "-c", _CHILD, str(memory_limit), json.dumps(list(argv))],
-                              cwd=folder, capture_output=True, text=True, timeout=time_limit, env=env,
-                              stdin=subprocess.DEVNULL)
+        proc = subprocess.run([sys.executable, "-c", _CHILD, str(memory_limit), json.dumps(list(argv)),
+                               str(max(1, math.ceil(time_limit)))], cwd=folder, capture_output=True, text=True,
+                              timeout=WALL_FACTOR * time_limit, env=env, stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired:
-        return Outcome(list(argv), None, "", "", time.perf_counter() - t0, True, before, _hashes(folder))
-    seconds = time.perf_counter() - t0
+        return Outcome(list(argv), None, "", "", time_limit, True, before, _hashes(folder))
+    seconds = _children_cpu() - c0  # the whole child; its own figure (the run alone) replaces it below
+    if proc.returncode == -signal.SIGXCPU:
+        return Outcome(list(argv), None, "", proc.stderr[-800:], time_limit, True, before, _hashes(folder))
     try:
         got = json.loads(proc.stdout.strip().splitlines()[-1])
     except (ValueError, IndexError):

@@ -76,17 +76,14 @@ def test_the_bounded_analysis_with_threads_alive_gives_the_main_threads_answer(t
     monkeypatch.setattr(_bounded, "WALL_SAFETY_FACTOR", 1)  # a regression (a forked child stuck on _HELD) fails
     monkeypatch.setattr(_bounded, "WALL_SAFETY_SECONDS", 10)  # in ~50 s instead of ~8 minutes
     _singular._analysis.cache_clear()
-    try:
-        t = time.perf_counter()
+    try:  # a stuck child shows as None (the safety net), so no clock is needed here
         got = _singular._analysis(robot, "vx,vy", Frame.BASE)
         v = check_claims(robot, [{"quantity": "singularities", "rows": "vx,vy", "value": r"\sin q_2 = 0"}]).verdicts[0]
-        elapsed = time.perf_counter() - t
     finally:
         _singular._analysis.cache_clear()
     assert got is not None, "the analysis was ended by the safety net: the child was stuck"
     assert got.conditions == expected.conditions and got.rows == expected.rows
     assert v.verdict == "correct", v.message
-    assert elapsed < 30
 
 
 def test_cpu_bounded_from_several_threads_at_once(threads_alive):

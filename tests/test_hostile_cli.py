@@ -13,7 +13,6 @@ import errno
 import json
 import os
 import re
-import time
 
 import numpy as np
 import pytest
@@ -224,17 +223,15 @@ _BAD_LOCK = st.one_of(
 @MANY
 @given(_BAD_LOCK)
 def test_bad_lock(folder, text):
-    t0 = time.perf_counter()
-    _check(folder, ["ik", "planar2r", "--pose", "1,1,0,0,0,0", f"--lock={text}"], mentions=["lock"])
-    assert time.perf_counter() - t0 < 3
+    o = _check(folder, ["ik", "planar2r", "--pose", "1,1,0,0,0,0", f"--lock={text}"], mentions=["lock"])
+    assert o.seconds < 3, o.describe()  # CPU seconds
 
 
 def test_lock_parsing_is_linear(folder):
     for k in (10_000, 200_000):
-        t0 = time.perf_counter()
-        _check(folder, ["ik", "planar2r", "--pose", "1,1,0,0,0,0", "--lock", "q1" + " " * k + "=" + " " * k + "x"],
-               mentions=["lock"])
-        assert time.perf_counter() - t0 < 2
+        o = _check(folder, ["ik", "planar2r", "--pose", "1,1,0,0,0,0", "--lock", "q1" + " " * k + "=" + " " * k + "x"],
+                   mentions=["lock"])
+        assert o.seconds < 2, o.describe()  # CPU seconds
 
 
 # --- output paths -------------------------------------------------------------------------------------------
@@ -296,9 +293,8 @@ def test_bad_output_paths(folder, command):
             path, mentions = f"out-{tag}{e}", [f"out-{tag}{e}"]
         else:
             path, mentions = _make(folder, kind, ext, tag)
-        t0 = time.perf_counter()
         o = _check(folder, argv + ["-o", path] + ["--no-clobber"] * (kind == "existing"), mentions=mentions)
-        assert o.seconds < 5 and time.perf_counter() - t0 < 10, o.describe()
+        assert o.seconds < 5, o.describe()  # CPU seconds
 
     case()
 
@@ -404,10 +400,9 @@ def test_numeric_jacobian_of_a_large_arm_is_quick_and_right(tmp_path):
 
     (tmp_path / "big.yaml").write_text(_chain(32))
     q = np.random.default_rng(3).uniform(-1, 1, 32)
-    t0 = time.perf_counter()
     o = run_cli(["jacobian", "big.yaml", "-q", ",".join(repr(float(v)) for v in q), "--json"], tmp_path)
     assert_accepted_quietly(o)
-    assert time.perf_counter() - t0 < 5
+    assert o.seconds < 5, o.describe()  # CPU seconds
     J = np.array(json.loads(o.out)["J"])
     robot = load_robot(str(tmp_path / "big.yaml"))
     h = 1e-6

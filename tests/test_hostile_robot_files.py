@@ -411,9 +411,9 @@ def test_parse_values_is_linear_and_capped():
     from denavit.io import MAX_VALUES, parse_values
 
     text = ", ".join(["(1)"] * MAX_VALUES)
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     assert parse_values(text).sum() == MAX_VALUES
-    assert time.perf_counter() - t0 < 3.0
+    assert time.process_time() - t0 < 3.0  # CPU seconds
     with pytest.raises(ParseError, match="more than"):
         parse_values(", ".join(["1"] * 20_000))
     with pytest.raises(ParseError, match="longer than"):

@@ -425,10 +425,9 @@ def test_readme_first_command_shows_a_well_known_arm_with_every_section_filled(t
     assert robot.has_dynamics and robot.dof == 6 and not robot.source.startswith("catalogue:report")
     out = tmp_path / "report.html"
     argv = [a if a != "report.html" else str(out) for a in argv[1:]]
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     assert main(argv) == 0
-    elapsed = time.perf_counter() - t0
-    assert elapsed < 60  # the README says "a few seconds"; generous for a loaded CI machine
+    assert time.process_time() - t0 < 60  # CPU seconds in this process (10-13 when measured), not a benchmark
     html = unescape(out.read_text(encoding="utf-8"))
     for k, title in enumerate(["Model: DH table and convention", "Link transforms", "Forward kinematics",
                                "Numeric case", "Jacobian", "Velocity", "Statics", "Singularities",

@@ -366,7 +366,7 @@ def test_unreachable_scheduler_is_refused_in_bounded_time(monkeypatch):
     t0 = time.perf_counter()
     with pytest.raises(ParseError, match=f"127.0.0.1:{port}"):
         occupancy(denavit.load_robot("planar2r"), 1000, seed=0, scheduler=f"tcp://127.0.0.1:{port}")
-    assert time.perf_counter() - t0 < 15
+    assert time.perf_counter() - t0 < 60  # a wait on the network (1 s) plus imports: over 10x a quiet run
 
 
 @pytest.mark.parametrize("kw", [{"samples": 0}, {"samples": 10**11}, {"samples": 2.5}, {"chunk": 10},
