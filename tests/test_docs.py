@@ -1,8 +1,9 @@
 """The README and docs/*.md run: every ```python block, every `denavit ...` line of a ```bash / ```console block.
 
 - Python: the blocks of one file run in order in one fresh namespace (so a later block may use an earlier
-  block's names; a ``print(...)  # -> text`` line must print that text), in a temporary working directory holding the files the docs refer to (``my_arm.yaml``,
-  ``table.txt``, …, see ``FIXTURES``; ``examples/`` is copied there too), with matplotlib's Agg backend.
+  block's names; a ``print(...)  # -> text`` line must print that text), in a temporary working directory
+  holding a copy of ``examples/`` (the files the docs' commands use, ``examples/my_arm.yaml``,
+  ``examples/table.txt``, …, are shipped there), with matplotlib's Agg backend.
 - Shell: each line starting with ``denavit `` (after an optional ``$ `` prompt) runs through
   ``denavit.cli.main`` in-process in such a directory; it must exit 0.  Other lines (``pip install``,
   ``python -m pytest``, …) are not run.  In a ```console block, the lines under a ``$`` command up to the next
@@ -13,6 +14,9 @@
   slow (symbolic 6-DOF work, big reports).
 - Fences without a language (command synopses with ``[options]``, error messages, output) and data blocks
   (```yaml, ```json) are text, not run; yaml blocks that are whole robot files are loaded (``load_robot``).
+- What the prose names must exist: a module or attribute of denavit (``denavit.x.y``, ``cli._common.MAX_VALUE``,
+  outside code blocks), and the target of a relative link (the file, and the heading an ``#anchor`` points to).
+- README.md's figures (test counts, times) stand only in the block scripts/readme_figures.py writes.
 """
 
 from __future__ import annotations
@@ -30,22 +34,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DOC_FILES = [ROOT / "README.md"] + sorted((ROOT / "docs").glob("*.md"))
 
-#: Files the docs' commands and code name as "your own" files (my_arm.yaml, a pasted table.txt / table.md),
-#: written into the working directory.
-FIXTURES = {
-    "my_arm.yaml": """\
-name: my-arm
-convention: standard
-angle_unit: deg
-parameters: {L1: 0.4, L2: 0.3, L3: 0.2}
-joints:
-  - {a: 0,  alpha: 90, d: L1, theta: q}
-  - {a: L2, alpha: 0,  d: 0,  theta: q}
-  - {a: L3, alpha: 0,  d: 0,  theta: q}
-""",
-    "table.txt": "i\ta_{i-1}\talpha_{i-1}\td_i\ttheta_i\n1\t0\t0\t0\tq1\n2\t0.4\t0\t0\tq2\n",
-    "table.md": "| i | a | alpha | d | theta |\n|---|---|---|---|---|\n| 1 | 0.4 | 0 | 0 | q1 |\n| 2 | 0.3 | 0 | 0 | q2 |\n",
-}
 #: Shipped files copied into the working directory under the names the docs use.
 COPIES = {"examples": "examples"}
 
@@ -104,8 +92,6 @@ def _rel(path: Path) -> str:
 
 
 def _workdir(tmp_path: Path) -> Path:
-    for name, text in FIXTURES.items():
-        (tmp_path / name).write_text(text, encoding="utf-8")
     for name, src in COPIES.items():
         s = ROOT / src
         if s.is_dir():
@@ -260,3 +246,143 @@ def test_robot_files_shown_in_the_docs_load(block, tmp_path):
 
     T = denavit.forward_kinematics(robot, np.zeros(robot.dof))
     assert robot.dof > 0 and T.shape == (4, 4) and np.all(np.isfinite(T))
+
+
+# ---------------------------------------------------------------------------------------------------------
+# what the prose names: modules and attributes of denavit, relative links
+
+_SRC = ROOT / "src" / "denavit"
+#: denavit's top-level modules and subpackages: a dotted name starting with one of them (or with ``denavit``)
+#: is a name in denavit (``cli._common.MAX_VALUE``, ``denavit.symbolic.forward_kinematics_sym``).
+_MODULES = sorted({p.stem if p.is_file() else p.name for p in _SRC.iterdir()
+                   if (p.suffix == ".py" or (p / "__init__.py").is_file()) and not p.name.startswith("__")})
+_NAME = re.compile(r"(?<![\w./-])((?:denavit|" + "|".join(map(re.escape, _MODULES)) + r")(?:\.[A-Za-z_]\w*)+)(?![\w/-])")
+_FILE_NAME = re.compile(r"\.(?:html?|md|tex|pdf|ya?ml|png|py|json|csv|npz|txt|urdf|xml|gif|mp4|svg|toml|c|h|js)$")
+#: Dotted names in the docs that are not denavit's, each with whose they are.
+FOREIGN_NAMES = {"model.armature": "Pinocchio's Model (docs/interop.md, docs/dynamics.md)"}
+_LINK = re.compile(r"\[[^\]\n]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+
+
+def _prose(text: str) -> str:
+    """The Markdown text without its fenced code blocks (their names are checked by running them)."""
+    return re.sub(r"^\s*```.*?^\s*```", "", text, flags=re.S | re.M)
+
+
+def denavit_names(text: str) -> list[str]:
+    """Dotted names of denavit's modules and attributes in ``text``'s prose (file names left out)."""
+    return [n for n in _NAME.findall(_prose(text)) if not _FILE_NAME.search(n) and n not in FOREIGN_NAMES]
+
+
+def name_exists(name: str) -> bool:
+    """``name`` (``denavit.`` implied) is an importable module or an attribute reached from one."""
+    import importlib
+    import types
+
+    parts = name.split(".")
+    parts = parts[1:] if parts[0] == "denavit" else parts
+    obj, module = importlib.import_module("denavit"), "denavit"
+    for part in parts:
+        if hasattr(obj, part):
+            obj = getattr(obj, part)
+            module = obj.__name__ if isinstance(obj, types.ModuleType) else None
+            continue
+        if module is None:  # an attribute of an object that has no such attribute
+            return False
+        try:
+            obj = importlib.import_module(f"{module}.{part}")
+        except ImportError:
+            return False
+        module = obj.__name__
+    return True
+
+
+def heading_anchors(path: Path) -> set[str]:
+    """GitHub's anchors of a Markdown file's headings (lower case, punctuation dropped, spaces to ``-``,
+    repeats numbered ``-1``, ``-2``), plus explicit ``<a id=...>`` / ``<a name=...>``."""
+    text = path.read_text(encoding="utf-8")
+    out: set[str] = set()
+    for line in _prose(text).splitlines():
+        m = re.match(r"#{1,6}\s+(.*?)\s*#*\s*$", line)
+        if m:
+            slug = base = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-")
+            k = 1
+            while slug in out:
+                slug, k = f"{base}-{k}", k + 1
+            out.add(slug)
+    return out | set(re.findall(r'<a\s+(?:id|name)="([^"]+)"', text))
+
+
+def dangling_links(path: Path, text: str) -> list[str]:
+    """Relative links of ``text`` (the Markdown file at ``path``) whose file, or heading, does not exist."""
+    bad = []
+    for target in _LINK.findall(_prose(text)):
+        if re.match(r"[A-Za-z][A-Za-z0-9+.-]*:", target):  # http:, https:, mailto:
+            continue
+        file, _, anchor = target.partition("#")
+        dest = (path.parent / file) if file else path
+        if not dest.exists() or (anchor and dest.suffix == ".md" and anchor not in heading_anchors(dest)):
+            bad.append(target)
+    return bad
+
+
+@pytest.mark.parametrize("path", DOC_FILES, ids=_rel)
+def test_names_of_denavit_in_the_docs_exist(path):
+    names = denavit_names(path.read_text(encoding="utf-8"))
+    missing = sorted({n for n in names if not name_exists(n)})
+    assert not missing, f"{_rel(path)} names what denavit does not have: {missing}"
+
+
+@pytest.mark.parametrize("path", DOC_FILES, ids=_rel)
+def test_relative_links_in_the_docs_reach_their_target(path):
+    bad = dangling_links(path, path.read_text(encoding="utf-8"))
+    assert not bad, f"{_rel(path)}: links to a missing file or heading: {bad}"
+
+
+def test_the_name_and_link_checks_catch_a_dangling_one():
+    text = ("Use `cli._viz.SAMPLES_RANGE` and `denavit.symbolic.no_such_thing` (not `cli._common.MAX_VALUE`, "
+            "`denavit.symbolic.forward_kinematics_sym`, `report.html`).\n\n"
+            "See [robot files](robot-file.md#limits), [gone](no-such-page.md), [bad](robot-file.md#no-such-heading)."
+            "\n```python\ndenavit.not_checked_in_code\n```\n")
+    names = denavit_names(text)
+    assert names == ["cli._viz.SAMPLES_RANGE", "denavit.symbolic.no_such_thing", "cli._common.MAX_VALUE",
+                     "denavit.symbolic.forward_kinematics_sym"]
+    assert [n for n in names if not name_exists(n)] == ["cli._viz.SAMPLES_RANGE", "denavit.symbolic.no_such_thing"]
+    assert dangling_links(ROOT / "docs" / "x.md", text) == ["no-such-page.md", "robot-file.md#no-such-heading"]
+
+
+# ---------------------------------------------------------------------------------------------------------
+# README.md's figures
+
+_FIGURE = re.compile(r"\d[\d,.]*\s*(?:k\s+)?(?:tests?|ms|s|seconds?|min|minutes?|hours?|characters)\b"
+                     r"|\b(?:a few|about an?|several|half an?|one|two|three|four|five|six|seven|eight|nine|ten|"
+                     r"twenty|thirty|in|within|under) (?:seconds?|minutes?|hours?)\b|\ba minute and a half\b", re.I)
+
+
+def _readme_figures():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_figures", ROOT / "scripts" / "readme_figures.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def figures_outside_the_block(readme: str, block: str) -> list[str]:
+    return _FIGURE.findall(_prose(readme.replace(block, "")))
+
+
+def test_readme_figures_stand_only_in_the_block_the_script_writes():
+    rf = _readme_figures()
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = rf.block_of(readme)
+    assert rf.render(rf.parse(block)) == block, "README.md's figures block was edited by hand: run the script"
+    assert rf.parse(block)["tests"] > rf.parse(block)["quick"] > 0
+    assert figures_outside_the_block(readme, block) == [], "a figure in README.md that no script measures"
+    assert rf.report_command(readme)[:2] == ["denavit", "report"]
+
+
+def test_the_figures_check_catches_a_figure_outside_the_block():
+    block = "<!-- figures: begin x -->\n2,860 tests in 90 s\n<!-- figures: end -->"
+    text = f"Writes, in a few seconds, a report.\n{block}\nThe suite (3,289 tests, about six minutes).\n"
+    assert figures_outside_the_block(text, block) == ["a few seconds", "3,289 tests", "six minutes"]
+    assert figures_outside_the_block("The second installs the tests' dependencies (Python ≥ 3.10).", "") == []
