@@ -179,9 +179,9 @@ def test_ctrl_c_stops_cleanly(tmp_path, scheduler):
     time.sleep(4)
     proc.send_signal(signal.SIGINT)
     t0 = time.perf_counter()
-    out, err = proc.communicate(timeout=60)
+    out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
-    assert time.perf_counter() - t0 < 30
+    assert time.perf_counter() - t0 < 60  # an interrupt answered in about a second; 60 s holds on a busy machine
     assert out == "" and "Traceback" not in err and err.strip().splitlines() == ["denavit: interrupted"], err
     assert os.listdir(tmp_path) == []
 
