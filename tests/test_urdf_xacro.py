@@ -69,3 +69,76 @@ def test_xacro_still_refuses_a_dtd(tmp_path):
     bomb = '<!DOCTYPE r [<!ENTITY a "aaaa">]>' + XACRO.split("?>", 1)[1]
     o = run_cli(["import-urdf", "arm.xacro", "--xacro"], tmp_path, {"arm.xacro": bomb})
     assert_refused(o, mentions=["arm.xacro", "DOCTYPE"])
+
+
+# --- a xacro document is a program: its expansion runs under bounds (issue 29) -------------------------------------
+
+def _program(body: str) -> str:
+    return ('<?xml version="1.0"?>\n<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+            f'{body}\n  <link name="base"/>\n</robot>\n')
+
+
+# 2**40 expansions: hours without a bound
+EXPONENTIAL = _program('''  <xacro:macro name="boom" params="n">
+    <xacro:if value="${n &lt; 40}"><xacro:boom n="${n+1}"/><xacro:boom n="${n+1}"/></xacro:if>
+  </xacro:macro>
+  <xacro:boom n="0"/>''')
+RECURSIVE = _program('''  <xacro:macro name="loop" params="n"><xacro:loop n="${n+1}"/></xacro:macro>
+  <xacro:loop n="0"/>''')
+
+
+def _children_cpu() -> float:
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="RLIMIT_CPU is POSIX")
+def test_a_runaway_xacro_macro_is_stopped_by_its_cpu_bound(tmp_path, monkeypatch):
+    pytest.importorskip("xacrodoc")
+    import denavit.interop._xacro as xacro_module
+
+    monkeypatch.setattr(xacro_module, "XACRO_CPU_SECONDS", 1)
+    before = _children_cpu()
+    o = run_cli(["import-urdf", "boom.xacro", "--xacro"], tmp_path,
+                {"boom.xacro": EXPONENTIAL}, time_limit=120)
+    assert_refused(o, mentions=["boom.xacro", "xacro", "CPU"])
+    assert _children_cpu() - before < 5  # 1 s of CPU for the expansion (plus the interpreter's start), not hours
+
+
+def test_a_recursive_xacro_macro_is_one_line(tmp_path):
+    pytest.importorskip("xacrodoc")
+    o = run_cli(["import-urdf", "loop.xacro", "--xacro"], tmp_path, {"loop.xacro": RECURSIVE})
+    assert_refused(o, mentions=["loop.xacro", "xacro"])
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="RLIMIT_AS is POSIX")
+def test_a_xacro_expression_asking_for_gigabytes_is_refused_by_the_memory_bound(tmp_path, monkeypatch):
+    pytest.importorskip("xacrodoc")
+    import denavit.interop._xacro as xacro_module
+
+    monkeypatch.setattr(xacro_module, "XACRO_MEMORY_BYTES", 300 << 20)
+    text = _program('''  <xacro:property name="big" value="${'x' * 500000000}"/>\n  <link name="l${big}"/>''')
+    o = run_cli(["import-urdf", "big.xacro", "--xacro"], tmp_path, {"big.xacro": text}, time_limit=120)
+    assert_refused(o, mentions=["big.xacro", "xacro"])  # 500 MB cannot be had within 300 MB
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "mkfifo"), reason="needs a FIFO")
+def test_a_xacro_waiting_on_a_fifo_is_stopped_by_the_wall_clock_bound(tmp_path, monkeypatch):
+    pytest.importorskip("xacrodoc")
+    import os
+
+    import denavit.interop._xacro as xacro_module
+
+    monkeypatch.setattr(xacro_module, "XACRO_WALL_SECONDS", 2)
+    os.mkfifo(tmp_path / "pipe.xacro")
+    text = _program('  <xacro:include filename="pipe.xacro"/>')
+    o = run_cli(["import-urdf", "inc.xacro", "--xacro"], tmp_path, {"inc.xacro": text}, time_limit=120)
+    assert_refused(o, mentions=["inc.xacro", "took longer than 2 s"])
+
+
+def test_the_xacro_bounds_are_public():
+    from denavit.interop import XACRO_CPU_SECONDS, XACRO_MEMORY_BYTES, XACRO_WALL_SECONDS
+
+    assert 0 < XACRO_CPU_SECONDS < XACRO_WALL_SECONDS and XACRO_MEMORY_BYTES >= 256 << 20

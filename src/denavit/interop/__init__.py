@@ -9,6 +9,7 @@ from ._urdf_in import CHECK_SAMPLES, CHECK_TOL, UrdfImport, from_urdf, import_ur
 from ._mjcf_out import MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
 from ._urdf_read import MAX_URDF_LINKS, chain_path, read_urdf
+from ._xacro import XACRO_CPU_SECONDS, XACRO_MEMORY_BYTES, XACRO_WALL_SECONDS
 from ._xml import MAX_XML_BYTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
 
 __all__ = [
@@ -32,4 +33,7 @@ __all__ = [
     "MAX_XML_DEPTH",
     "MAX_XML_ELEMENTS",
     "MAX_URDF_LINKS",
+    "XACRO_CPU_SECONDS",
+    "XACRO_MEMORY_BYTES",
+    "XACRO_WALL_SECONDS",
 ]
