@@ -7,7 +7,7 @@ import re
 
 from .errors import ParseError
 
-__all__ = ["find_table", "column_kind", "plain_cell", "COLUMNS", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS", "MAX_COLUMNS",
+__all__ = ["find_table", "find_tables", "column_kind", "plain_cell", "COLUMNS", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS", "MAX_COLUMNS",
            "MAX_LINE_CHARS", "MAX_CELL_CHARS"]
 
 #: Largest pasted text read (characters).
@@ -83,44 +83,81 @@ def column_kind(cell: str) -> str | None:
     return None
 
 
+def _header_at(line: str):
+    """(cells, splitter) when ``line`` is a DH header row (names a, alpha, d and theta), else None."""
+    if len(line) > MAX_LINE_CHARS:
+        return None  # prose, not a header
+    cells, split = _cells(line), _cells
+    if not cells and 4 <= len(line.split()) <= MAX_COLUMNS and all(map(column_kind, line.split())):
+        cells, split = line.split(), _spaced  # "i a alpha d theta": every word names a column
+    if len(cells) > MAX_COLUMNS or any(len(c) > MAX_CELL_CHARS for c in cells):
+        return None
+    kinds = [column_kind(c) for c in cells]
+    if len(cells) >= 4 and all(c in kinds for c in COLUMNS):
+        return cells, split
+    return None
+
+
+def _rows_under(lines: list[str], k: int, cells: list[str], split) -> tuple[list[list[str]], int]:
+    """The data rows under the header on line ``k`` (0-based) and the index of the last line read."""
+    rows: list[list[str]] = []
+    last = k
+    for n, nxt in enumerate(lines[k + 1:], start=k + 2):
+        if _is_rule(nxt):
+            continue  # Markdown rule
+        if len(nxt) > MAX_LINE_CHARS:
+            raise ParseError(f"line {n}: longer than {MAX_LINE_CHARS} characters")
+        c = split(nxt)
+        if split is _spaced and len(c) > len(cells):
+            raise ParseError(f"line {n}: {len(c)} cells under a header of {len(cells)} separated by spaces: "
+                             "a cell of such a table cannot hold a space (write pi/2, not pi / 2; or "
+                             "separate the columns with tabs or |)")
+        if len(c) != len(cells) or not any(x.strip() for x in c):
+            if rows:
+                break
+            continue
+        long = [x for x in c if len(x) > MAX_CELL_CHARS]
+        if long:
+            raise ParseError(f"line {n}: a cell longer than {MAX_CELL_CHARS} characters")
+        rows.append(c)
+        last = n - 1
+        if len(rows) > MAX_TABLE_ROWS:
+            raise ParseError(f"line {n}: more than {MAX_TABLE_ROWS} rows in the table")
+    if not rows:
+        raise ParseError(f"line {k + 1}: a DH header but no rows under it")
+    return rows, last
+
+
 def find_table(text: str) -> tuple[list[str], list[list[str]]]:
     """The header cells and data rows of the first DH table in ``text``."""
     if len(text) > MAX_TABLE_CHARS:
         raise ParseError(f"file too large for a table ({len(text)} characters; at most {MAX_TABLE_CHARS})")
     lines = text.splitlines()
     for k, line in enumerate(lines):
-        if len(line) > MAX_LINE_CHARS:
-            continue  # prose, not a header
-        cells, split = _cells(line), _cells
-        if not cells and 4 <= len(line.split()) <= MAX_COLUMNS and all(map(column_kind, line.split())):
-            cells, split = line.split(), _spaced  # "i a alpha d theta": every word names a column
-        if len(cells) > MAX_COLUMNS or any(len(c) > MAX_CELL_CHARS for c in cells):
-            continue
-        kinds = [column_kind(c) for c in cells]
-        if len(cells) >= 4 and all(c in kinds for c in COLUMNS):
-            rows = []
-            for n, nxt in enumerate(lines[k + 1:], start=k + 2):
-                if _is_rule(nxt):
-                    continue  # Markdown rule
-                if len(nxt) > MAX_LINE_CHARS:
-                    raise ParseError(f"line {n}: longer than {MAX_LINE_CHARS} characters")
-                c = split(nxt)
-                if split is _spaced and len(c) > len(cells):
-                    raise ParseError(f"line {n}: {len(c)} cells under a header of {len(cells)} separated by spaces: "
-                                     "a cell of such a table cannot hold a space (write pi/2, not pi / 2; or "
-                                     "separate the columns with tabs or |)")
-                if len(c) != len(cells) or not any(x.strip() for x in c):
-                    if rows:
-                        break
-                    continue
-                long = [x for x in c if len(x) > MAX_CELL_CHARS]
-                if long:
-                    raise ParseError(f"line {n}: a cell longer than {MAX_CELL_CHARS} characters")
-                rows.append(c)
-                if len(rows) > MAX_TABLE_ROWS:
-                    raise ParseError(f"line {n}: more than {MAX_TABLE_ROWS} rows in the table")
-            if not rows:
-                raise ParseError(f"line {k + 1}: a DH header but no rows under it")
-            return cells, rows
+        head = _header_at(line)
+        if head is not None:
+            rows, _ = _rows_under(lines, k, *head)
+            return head[0], rows
     raise ParseError("no DH table found: expected a header row naming the columns a, alpha, d, theta "
                      "(tab, |, & or space separated)")
+
+
+def find_tables(lines: list[str]) -> list[tuple[int, int, str | None]]:
+    """Every DH table among ``lines``: (first line, last line, None) 1-based, or (line, line, why) for a header
+    whose rows cannot be read.  Tables follow one another; a header inside a table's rows starts no new one."""
+    found: list[tuple[int, int, str | None]] = []
+    k = 0
+    while k < len(lines):
+        head = _header_at(lines[k])
+        if head is None:
+            k += 1
+            continue
+        try:
+            _, last = _rows_under(lines, k, *head)
+        except ParseError as exc:
+            found.append((k + 1, k + 1, str(exc)))
+            k += 1
+            continue
+        found.append((k + 1, last + 1, None))
+        k = last + 1
+    return found

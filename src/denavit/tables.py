@@ -34,11 +34,11 @@ from . import _expr
 from ._table_cells import (LENGTH_UNITS, MM_HINT, CellReader, is_degrees, large_angle, length_unit, row_values,
                            to_metres, warn_if_millimetres)
 from ._table_find import (COLUMNS, MAX_CELL_CHARS, MAX_COLUMNS, MAX_LINE_CHARS, MAX_TABLE_CHARS, MAX_TABLE_ROWS,
-                          column_kind, find_table, plain_cell)
+                          column_kind, find_table, find_tables, plain_cell)
 from .errors import ParseError
 from .model import DHRobot
 
-__all__ = ["TableImport", "import_table", "find_table", "table_file_text", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS",
+__all__ = ["TableImport", "import_table", "find_table", "find_tables", "table_file_text", "MAX_TABLE_CHARS", "MAX_TABLE_ROWS",
            "MAX_COLUMNS", "MAX_LINE_CHARS", "MAX_CELL_CHARS", "LENGTH_UNITS", "MM_HINT"]
 
 
