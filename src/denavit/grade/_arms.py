@@ -1,0 +1,128 @@
+"""The arm(s) of a report: its own DH tables (read as ``import-table`` reads them), or arms given by the user.
+
+Each table governs the report from its own section on, until the next table.  A section whose heading names a
+different number of joints ("Equation of Motion for 3DOF Manipulator" after a 6-joint table) gets no arm unless
+one is given for it (``--arm 6=planar3r-lagrange``): judging it against the wrong arm would call right results
+wrong.  Lengths a table names without a value (``a_2``, ``d_4``) stay symbols for formulas; for numeric work they
+get distinct generic values (never 1, so that no two lengths coincide by accident).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ..errors import DenavitError
+from ..io import robot_from_dict
+from ..model import DHRobot
+from ..tables import find_tables, import_table
+from ._document import Document, Heading
+from ._types import ArmInfo
+
+__all__ = ["Arm", "Section", "sections_of", "arms_of", "GENERIC_LENGTHS"]
+
+#: Values given to lengths a table names without a value (distinct, not round, so no two coincide).
+GENERIC_LENGTHS = (0.537, 0.419, 0.3271, 0.6143, 0.2789, 0.4657, 0.3917, 0.7129, 0.2473, 0.5861)
+_DOF = re.compile(r"(\d)\s*-?\s*(?:dof|d\.o\.f|axis|axes|joints?\b|link\b)|\b(\d)\s*-?\s*[rRpP]{0,1}\s*(?:arm|robot|"
+                  r"manipulator)|\b([RP]{2,7})\b", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class Section:
+    heading: Heading | None
+    line: int
+    end_line: int
+
+
+@dataclass
+class Arm:
+    robot: DHRobot | None
+    info: ArmInfo
+    problem: str = ""
+
+
+def sections_of(doc: Document) -> list[Section]:
+    """Top-level sections: each heading of the smallest level used starts one (the text before is section 0)."""
+    heads = [h for h in doc.items if isinstance(h, Heading)]
+    n = len(doc.lines)
+    if not heads:
+        return [Section(None, 1, n)]
+    top = min(h.level for h in heads)
+    starts = [h for h in heads if h.level == top]
+    out = [Section(None, 1, starts[0].line - 1)] if starts[0].line > 1 else []
+    for a, b in zip(starts, starts[1:] + [None]):
+        out.append(Section(a, a.line, (b.line - 1) if b else n))
+    return out
+
+
+def _dof_named(title: str) -> int | None:
+    m = _DOF.search(title)
+    if not m:
+        return None
+    if m.group(3):
+        return len(m.group(3))
+    return int(m.group(1) or m.group(2))
+
+
+_NO_VALUE = re.compile(r"parameter (\w{1,40}) has no value")
+
+
+def _generic(robot: DHRobot, data: dict, notes: tuple[str, ...], where: str) -> tuple[DHRobot, list[str]]:
+    """The table's robot with every parameter that had no value set to a distinct generic length."""
+    missing = [m.group(1) for n in notes for m in [_NO_VALUE.search(n)] if m]
+    if not missing:
+        return robot, []
+    params = dict(data["parameters"])
+    for k, name in enumerate(missing):
+        params[name] = GENERIC_LENGTHS[k % len(GENERIC_LENGTHS)] * (1 + k // len(GENERIC_LENGTHS))
+    return robot_from_dict({**data, "parameters": params}, where=where), missing
+
+
+def _table_arm(doc: Document, first: int, last: int, source: str, title: str, end_line: int) -> Arm:
+    text = "\n".join(doc.lines[first - 1:last])
+    where = f"{source}: table at line {first}"
+    try:
+        imp = import_table(text, name=f"table-line-{first}", where=where)
+        robot, free = _generic(imp.robot, imp.data, imp.notes, where)
+    except DenavitError as exc:
+        info = ArmInfo(f"table-line-{first}", title, first, end_line, f"table at lines {first}-{last}", "", 0)
+        return Arm(None, info, f"the DH table at line {first} cannot be read: {exc}")
+    notes = tuple(n for n in imp.notes if "set to 1" not in n)
+    if free:
+        notes += (f"{', '.join(free)} kept as symbols (no value in the table; numbers need them)",)
+    info = ArmInfo(robot.name, title, first, end_line, f"table at lines {first}-{last}", robot.convention.value,
+                   robot.dof, notes)
+    return Arm(robot, info)
+
+
+def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, DHRobot]) -> list[tuple[Section, Arm | None]]:
+    """The arm that governs each section (None: no arm for it)."""
+    sections = sections_of(doc)
+    tables = find_tables(list(doc.lines))
+    out: list[tuple[Section, Arm | None]] = []
+    current: Arm | None = None
+    if robot is not None:
+        current = Arm(robot, ArmInfo(robot.name, "", 1, len(doc.lines), f"ROBOT {robot.name}",
+                                     robot.convention.value, robot.dof))
+    for sec in sections:
+        title = sec.heading.title if sec.heading else ""
+        key = sec.heading.key if sec.heading else ""
+        if key in given:
+            g = given[key]
+            out.append((sec, Arm(g, ArmInfo(g.name, title, sec.line, sec.end_line, f"--arm {key}={g.name}",
+                                            g.convention.value, g.dof))))
+            continue
+        inside = [t for t in tables if sec.line <= t[0] <= sec.end_line]
+        if robot is None:
+            for first, last, why in inside:
+                if why is None:
+                    current = _table_arm(doc, first, last, source, title, sec.end_line)
+        named = _dof_named(title)
+        if current is not None and current.robot is not None and named is not None and named != current.robot.dof \
+                and not inside:
+            out.append((sec, Arm(None, ArmInfo("", title, sec.line, sec.end_line, "none", "", 0),
+                                 f"this section is about a {named}-joint arm and has no DH table of its own "
+                                 f"(give one: --arm {key or 'SECTION'}=ROBOT)")))
+            continue
+        out.append((sec, current))
+    return out

@@ -1,0 +1,335 @@
+"""From a report's equations to claims of the YAML claims format: one walk in reading order, carrying givens.
+
+Every equation becomes a :class:`Pending`: a claim for :mod:`denavit.check` (with the context it needs: the case's
+q, q̇, the wrench, names defined earlier) and the other readings of its left-hand side — or a verdict decided here
+("not a claim" for a given or a definition, "unreadable" when no arm governs its section).  Singular
+configurations stated over several lines ("θ₃ = 0° … θ₃ = 180° … and when L₂C₂ + L₃C₂₃ = 0") are one claim.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+from ._arms import Arm
+from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
+                       rates_or_wrench, vector_entries)
+from ._document import Document, Heading, Math, Prose
+from ._lhs import read_symbol
+from ._names import Reading, joint_of, read_name
+from ._split import Equation, split_block
+
+__all__ = ["Pending", "walk"]
+
+_IK_FUNCS = re.compile(r"atan|arctan|arccos|arcsin|\\cos\^\{?-1|\\sin\^\{?-1|\\tan\^\{?-1|acos|asin|\\sqrt|[pP]_\{?[xyz]"
+                       r"|r_\{?\d\d|[xyz]_[cw]|\\operatorname")
+_TRIG_LHS = re.compile(r"^\\?(cos|sin|tan)\s*\(?\s*\\?(?:var)?(?:theta|q|Q)_\{?\d\}?\s*\)?$")
+_SINGULAR = re.compile(r"singular", re.I)
+_CASE = re.compile(r"\bcase\s*\d", re.I)
+_WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
+_PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
+
+
+@dataclass
+class Pending:
+    """One equation on its way to a verdict."""
+
+    line: int
+    end_line: int
+    latex: str
+    arm: Arm | None
+    claim: dict[str, Any] | None = None
+    understood: str = ""
+    alternatives: list[tuple[dict[str, Any], str]] = field(default_factory=list)
+    equivalent: list[tuple[dict[str, Any], str]] = field(default_factory=list)
+    sure: bool = True
+    verdict: str = ""
+    message: str = ""
+    quantity: str = ""
+    numeric_without_case: bool = False
+
+
+class _Walker:
+    def __init__(self, doc: Document, arms: list) -> None:
+        self.doc, self.arms = doc, arms
+        self.out: list[Pending] = []
+        self.ctx = Context()
+        self.sing: list[tuple[Equation, str]] = []
+        self.sing_arm: Arm | None = None
+        from ..tables import find_tables
+        self.tables = [(a, b) for a, b, why in find_tables(list(doc.lines)) if why is None]
+
+    def in_table(self, line: int) -> bool:
+        return any(a <= line <= b for a, b in self.tables)
+
+    def arm_at(self, line: int) -> Arm | None:
+        for sec, arm in self.arms:
+            if sec.line <= line <= sec.end_line:
+                return arm
+        return None
+
+    def run(self) -> list[Pending]:
+        items = list(self.doc.items)
+        k = 0
+        top = min((h.level for h in items if isinstance(h, Heading)), default=1)
+        while k < len(items):
+            it = items[k]
+            if isinstance(it, Heading):
+                self.flush()
+                self.ctx.singular = bool(_SINGULAR.search(it.title))
+                if it.level == top:
+                    self.ctx = Context(singular=self.ctx.singular)
+                elif _CASE.search(it.title):
+                    self.ctx.q = None
+            elif isinstance(it, Prose):
+                if _SINGULAR.search(it.text):
+                    self.ctx.singular = True
+                if _CASE.search(it.text):
+                    self.ctx.q, self.ctx.partial = None, {}
+            elif isinstance(it, Math) and not self.in_table(it.line):
+                it, k = self._joined(items, k)
+                self.math(it)
+            k += 1
+        self.flush()
+        return self.out
+
+    def _joined(self, items: list, k: int) -> tuple[Math, int]:
+        """An equation split over consecutive display blocks (brackets left open) as one block."""
+        it = items[k]
+        while it.display and k + 1 < len(items):
+            nxt = items[k + 1]
+            if not isinstance(nxt, Math) or not nxt.display or nxt.line - it.end_line > 3:
+                break
+            head = nxt.latex.lstrip()
+            open_first = it.latex.count("(") > it.latex.count(")")
+            closes_next = "=" not in nxt.latex and (nxt.latex.count(")") > nxt.latex.count("(")
+                                                    or head[:1] in "+-*" or head.startswith("\\cdot"))
+            if not (open_first or closes_next):
+                break
+            it = Math(it.line, nxt.end_line, it.latex + "\n" + nxt.latex, True)
+            k += 1
+        return it, k
+
+    def math(self, m: Math) -> None:
+        arm = self.arm_at(m.line)
+        for eq in split_block(m.latex, m.line, m.end_line):
+            if len(eq.parts) < 2 or not eq.parts[0]:
+                continue
+            if _PROPAGATION.search(eq.parts[0]):
+                self.ctx.propagation = True
+            self.equation(eq, arm)
+
+    def note(self, eq: Equation, arm: Arm | None, verdict: str, message: str, quantity: str = "") -> None:
+        self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, verdict=verdict, message=message,
+                                quantity=quantity))
+
+    def equation(self, eq: Equation, arm: Arm | None) -> None:
+        if arm is None or arm.robot is None:
+            why = arm.problem if arm is not None else "no DH table governs this part of the report (give ROBOT, or " \
+                "--arm SECTION=ROBOT)"
+            if self.givens(eq, None):
+                return
+            self.note(eq, arm, "unreadable", f"not judged: {why}")
+            return
+        if self.givens(eq, arm):
+            return
+        if self.ctx.singular and self.condition(eq, arm):
+            return
+        self.flush()
+        self.result(eq, arm)
+
+    def givens(self, eq: Equation, arm: Arm | None) -> bool:
+        """A case's q, rates, a wrench: remembered, and the equation is "not a claim"."""
+        robot = arm.robot if arm is not None else None
+        lhs, last = eq.parts[0], eq.parts[-1]
+        if robot is not None and case_of(eq.parts, eq.text, robot):
+            self.ctx.q, self.ctx.partial = eq.text, {}
+            self.note(eq, arm, "not a claim", "the configuration of this case (used for the numeric results "
+                      "below)", "given: q")
+            return True
+        vec = vector_entries(last)
+        if vec and all(is_numeric(v) for v in vec) and is_rate_name(lhs):
+            self.ctx.qd = "[" + ", ".join(vec) + "]"
+            self.note(eq, arm, "not a claim", "the joint rates of this case", "given: q̇")
+            return True
+        if vec and is_wrench_name(lhs) and len(vec) in (3, 6):
+            self.ctx.wrench = "[" + ", ".join(vec) + "]"
+            self.note(eq, arm, "not a claim", "the wrench at the end effector", "given: wrench")
+            return True
+        for part in eq.parts[1:]:
+            rw = rates_or_wrench(part)
+            if rw is not None:
+                if rw[0] == "JT" or "tau" in lhs:
+                    self.ctx.wrench = rw[1]
+                else:
+                    self.ctx.qd = rw[1]
+        if robot is not None and not self.ctx.singular:
+            sym = read_symbol(lhs)
+            jv = joint_value(sym, last, robot) if sym is not None and len(eq.parts) == 2 else None
+            if jv is not None:
+                self.ctx.partial[jv[0]] = f"q_{jv[0]} = {jv[1]}"
+                if len(self.ctx.partial) == robot.dof:
+                    self.ctx.q = ", ".join(self.ctx.partial[k] for k in sorted(self.ctx.partial))
+                self.note(eq, arm, "not a claim", f"a given joint value (θ{jv[0]})", "given: q")
+                return True
+        return False
+
+    def condition(self, eq: Equation, arm: Arm) -> bool:
+        """A singular condition (``θ₂ = 0°, 180°``, ``s₂ = 0``, ``L₂C₂ + L₃C₂₃ = 0``) joins the current group."""
+        lhs, last = eq.parts[0], eq.parts[-1]
+        sym = read_symbol(lhs)
+        if sym is not None and sym.det:
+            if len(eq.parts) > 2 and last.strip() == "0":
+                self._det(eq, arm, eq.parts[-2], sym)
+            return True
+        if lhs.strip().startswith("\\begin{vmatrix}") or lhs.strip().startswith("|"):
+            if len(eq.parts) > 2:
+                self._det(eq, arm, eq.parts[-2] if last.strip() == "0" else last, None)
+                self.sing.append((eq, f"{eq.parts[-2]} = 0"))
+            else:
+                self._det(eq, arm, last, None)
+            self.sing_arm = arm
+            return True
+        joint = joint_of(sym, arm.robot) if sym is not None else None
+        if joint is not None and not _IK_FUNCS.search(last):
+            self.sing.append((eq, f"{lhs} = {', '.join(eq.parts[1:])}"))
+            self.sing_arm = arm
+            return True
+        if last.strip() == "0" and has_joint_names(lhs) and (sym is None or read_name(sym, arm.robot) is None):
+            self.sing.append((eq, f"{lhs} = 0"))
+            self.sing_arm = arm
+            return True
+        return False
+
+    def _det(self, eq: Equation, arm: Arm, value: str, sym: Any) -> None:
+        claim: dict[str, Any] = {"quantity": "det_jacobian", "value": value}
+        if sym is not None and sym.pre_sup.strip().isdigit():
+            claim["frame"] = int(sym.pre_sup.strip())
+        rows = "planar" if arm.robot.dof <= 3 else None
+        p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
+                    quantity="det_jacobian")
+        p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in ("vx,vy", "linear", "planar",
+                                                                                   "vx,vy,vz", "wx,wy,wz")
+                        if r != rows]
+        if rows:
+            claim["rows"] = rows
+        self.out.append(p)
+
+    def flush(self) -> None:
+        """The singular conditions collected so far, as one claim."""
+        if not self.sing:
+            return
+        eqs = [e for e, _ in self.sing]
+        claim = {"quantity": "singularities", "value": [c for _, c in self.sing]}
+        first = Equation(eqs[0].line, max(e.end_line for e in eqs), "; ".join(c for _, c in self.sing), (), "=")
+        p = Pending(first.line, first.end_line, first.text, self.sing_arm, claim,
+                    "the singular configurations", quantity="singularities")
+        p.equivalent = [({**claim, "rows": r}, f"the singular configurations of the rows {r}")
+                        for r in ("linear", "planar", "vx,vy")]
+        self.out.append(p)
+        self.sing, self.sing_arm = [], None
+
+    def result(self, eq: Equation, arm: Arm) -> None:
+        robot = arm.robot
+        lhs, value = eq.parts[0], eq.parts[-1]
+        sym = read_symbol(lhs)
+        if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
+            if _IK_FUNCS.search(value) and len(eq.parts) == 2:
+                claim = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
+                used = _used_where(self.ctx.where, value)
+                if used:
+                    claim["where"] = used
+                self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, claim,
+                                        f"{lhs}: an inverse-kinematics formula", quantity="ik_formula"))
+            else:
+                self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
+                          "the joint in terms of the target")
+            return
+        reading = read_name(sym, robot, value) if sym is not None else None
+        if reading is not None and _names_product(value):
+            self.note(eq, arm, "not a claim", "a definition: the product of other results", reading.spec["quantity"])
+            return
+        if reading is None:
+            params = {k for k, _ in robot.parameters}
+            name = _plain(lhs)
+            if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
+                    and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params:
+                self.ctx.define(name, value)
+            self.note(eq, arm, "not a claim", f"not judged: {lhs[:60]} names no result denavit checks (a definition "
+                      "or an intermediate step)")
+            return
+        self.out.append(self.claim(eq, arm, reading, value))
+
+    def claim(self, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
+        claim: dict[str, Any] = {**reading.spec, "value": value}
+        numeric = not has_joint_names(value)
+        p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure,
+                    quantity=str(reading.spec.get("quantity")))
+        p.alternatives = [({**alt, "value": value}, words) for alt, words in reading.alternatives]
+        if numeric:
+            if self.ctx.q:
+                claim["q"] = self.ctx.q
+            else:
+                p.numeric_without_case = True
+        if "qd" in reading.needs and numeric and self.ctx.qd:
+            claim["qd"] = self.ctx.qd
+        if "wrench" in reading.needs:
+            if _WRENCH_NAMES.search(value) or not numeric:
+                claim["wrench"] = "[f_x, f_y, f_z, n_x, n_y, n_z]"
+            elif self.ctx.wrench:
+                claim["wrench"] = self.ctx.wrench
+            if claim["quantity"] == "torques":
+                first, second = ("tool", "base") if self.ctx.propagation else ("base", "tool")
+                claim["frame"] = first
+                p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+        used = _used_where(self.ctx.where, value)
+        if used:
+            claim["where"] = used
+        vec = vector_entries(value)
+        if vec is not None and len(vec) == 2 and claim["quantity"] in ("position", "com_position", "com_velocity",
+                                                                      "origin"):
+            flat = {**claim, "value": "[" + ", ".join(vec + ["0"]) + "]"}
+            p.equivalent.append((flat, "the (x, y) of a planar arm, z = 0"))
+        for alt, _ in p.alternatives:
+            for key in ("q", "qd", "wrench", "where"):
+                if key in claim and key not in alt:
+                    alt[key] = claim[key]
+        return p
+
+
+_NAMED = re.compile(r"(?:\{\}\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?[A-Z]\s*"
+                    r"(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?")
+_FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times)|\.{2,}|[\s{}]")
+
+
+def _names_product(value: str) -> bool:
+    """``T_0^1 T_1^2 ⋯``, ``{}^0T_1{}^1T_2``: a product of named transforms (a definition, not a value)."""
+    if len(value) > 400 or "\\begin" in value:
+        return False
+    names = _NAMED.findall(value)
+    rest = _FILLER.sub("", _NAMED.sub("", value))
+    return len(names) >= 2 and not rest
+
+
+def _used_where(where: dict[str, str], value: str) -> dict[str, str]:
+    """The definitions a value uses (and those they use), in the order they were made."""
+    def uses(text: str, name: str) -> bool:
+        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z])", _plain(text)) is not None
+
+    need = {k for k in where if uses(value, k)}
+    for _ in range(len(where)):
+        more = {k for k in where for n in need if k not in need and uses(where[n], k)}
+        if not more:
+            break
+        need |= more
+    return {k: v for k, v in where.items() if k in need}
+
+
+def _plain(lhs: str) -> str:
+    return re.sub(r"\s+", "", lhs)
+
+
+def walk(doc: Document, arms: list) -> list[Pending]:
+    """Every equation of ``doc`` as a :class:`Pending`, in reading order."""
+    return _Walker(doc, arms).run()

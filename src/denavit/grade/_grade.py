@@ -1,0 +1,152 @@
+"""Grading a report: read it, find its arms and results, have the one checker judge them, place the verdicts.
+
+The reader only decides *what* each equation claims; :func:`denavit.check.check_claims` decides whether it is
+right, exactly as for a YAML claims file.  What the reader cannot be sure of never becomes "incorrect": a
+left-hand side with two readings (``T_1^0`` or its inverse), a guessed name (``x`` for the end effector's x), or
+a number stated without its case is "ambiguous" when the default reading disagrees, and says which reading decides.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+from ..check import MAX_FILE_BYTES, check_claims
+from ..errors import DenavitError, ParseError
+from ..model import DHRobot
+from ._arms import arms_of
+from ._claims import Pending, walk
+from ._document import read_document
+from ._types import ArmInfo, GradedClaim, GradedReport
+
+__all__ = ["grade_report", "grade_text", "REPORT_SUFFIXES", "MAX_JUDGED"]
+
+#: Report suffixes and the format each is read as.
+REPORT_SUFFIXES = {".md": "md", ".markdown": "md", ".tex": "tex", ".txt": "txt", ".text": "txt"}
+#: Most equations judged in one report (the rest are listed as not judged).
+MAX_JUDGED = 600
+_UNKNOWN = re.compile(r"unknown symbol '\\*((?:dot\{?\\*)?[A-Za-z]+)|unsupported LaTeX command \\*(partial|delta|nabla|int)")
+_RESULT_LETTERS = {"T", "A", "R", "J", "e", "z", "p", "P", "F", "f", "n", "I", "O", "tau", "omega", "w", "v", "E",
+                   "M", "K", "dot{p", "dotp", "dot{x", "vartheta", "nu", "x", "y", "hat"}
+
+
+def _judge(robot: DHRobot, claim: dict[str, Any], seed: int) -> Any:
+    try:
+        return check_claims(robot, [dict(claim)], seed=seed).verdicts[0]
+    except DenavitError as exc:
+        from ..check import Verdict
+        return Verdict("", str(claim.get("quantity")), "unreadable", f"could not be judged: {str(exc)[:300]}")
+
+
+def _constant(robot: DHRobot, claim: dict[str, Any]) -> bool:
+    """A quantity that does not depend on q (a fixed row's transform): a number without a case is fine there."""
+    rows = robot.links
+    if claim.get("quantity") == "link_transform":
+        k = claim.get("index", 0)
+        return isinstance(k, int) and 1 <= k <= len(rows) and not rows[k - 1].is_joint
+    if claim.get("quantity") == "transform":
+        a, b = sorted((claim.get("from", 0), claim.get("to", len(rows))))
+        return all(not r.is_joint for r in rows[a:b])
+    return False
+
+
+def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
+    """(verdict, message, fix, details) of one pending claim."""
+    robot = p.arm.robot
+    v = _judge(robot, p.claim, seed)
+    details = v.to_json()
+    if v.verdict == "correct" or v.verdict == "ambiguous":
+        return v.verdict, v.message, "", details
+    if v.verdict == "unreadable":
+        m = _UNKNOWN.search(v.message)
+        name = m and (m.group(1) or m.group(2))
+        if name and (name in _RESULT_LETTERS or name[:1] in ("T", "J", "R") or m.group(2)):
+            return "not a claim", ("not judged: written in terms of other results (" + name + " …): a "
+                                   "definition or a relation between them"), "", details
+        for alt, words in p.equivalent:
+            w = _judge(robot, alt, seed)
+            if w.verdict == "correct":
+                return "correct", f"correct ({words})", "", w.to_json()
+        return "unreadable", v.message, "", details
+    for alt, words in p.equivalent:
+        w = _judge(robot, alt, seed)
+        if w.verdict == "correct":
+            return "correct", f"correct ({words})", "", w.to_json()
+    for alt, words in p.alternatives:
+        w = _judge(robot, alt, seed)
+        if w.verdict == "correct":
+            return "ambiguous", (f"correct if the left-hand side means {words}; read as {p.understood} it is not "
+                                 f"({v.message})"), "", details
+    if not p.sure:
+        return "ambiguous", f"read as {p.understood} (a guess from the name), it is not: {v.message}", "", details
+    if p.numeric_without_case and not _constant(robot, p.claim):
+        return "ambiguous", ("numbers, but no configuration (Case …: q = (…)) stated before them; at random "
+                             f"configurations: {v.message}"), "", details
+    return "incorrect", v.message, str(v.extra.get("expected_latex") or ""), details
+
+
+def _graded(p: Pending, seed: int) -> GradedClaim:
+    arm = p.arm.info.name if p.arm is not None else ""
+    if p.claim is None:
+        return GradedClaim(p.line, p.end_line, p.quantity, arm, p.verdict, p.message, p.latex, p.understood)
+    try:
+        verdict, message, fix, details = _decide(p, seed)
+    except Exception as exc:  # noqa: BLE001 - one equation's failure is that equation's verdict
+        verdict, message, fix, details = ("unreadable", f"could not be judged: the checker failed on it "
+                                          f"({type(exc).__name__}: {str(exc)[:160]})", "", {})
+    return GradedClaim(p.line, p.end_line, p.quantity, arm, verdict, message, p.latex, p.understood, fix, details)
+
+
+def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
+               arms: dict[str, DHRobot] | None = None, source: str = "<report>", seed: int = 0) -> GradedReport:
+    """Grade the report ``text`` (see :func:`grade_report`)."""
+    doc = read_document(text, fmt)
+    governed = arms_of(doc, source, robot, dict(arms or {}))
+    pending = walk(doc, governed)
+    notes = list(doc.notes)
+    if len(pending) > MAX_JUDGED:
+        notes.append(f"only the first {MAX_JUDGED} equations were judged ({len(pending)} found)")
+    graded = [_graded(p, seed) for p in pending[:MAX_JUDGED]]
+    seen: dict[str, ArmInfo] = {}
+    for _, arm in governed:
+        if arm is not None and arm.info.name and arm.info.name not in seen:
+            seen[arm.info.name] = arm.info
+        if arm is not None and arm.problem and arm.problem not in notes:
+            notes.append(arm.problem)
+    if not seen:
+        notes.append("no DH table found in the report: give the arm (denavit check ROBOT REPORT)")
+    return GradedReport(source, text, fmt, tuple(seen.values()), tuple(graded), tuple(notes))
+
+
+def grade_report(path: str | Path, robot: DHRobot | None = None, arms: dict[str, Any] | None = None, *,
+                 seed: int = 0) -> GradedReport:
+    """Grade a student's report as written: every stated result judged in place.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.md``/``.markdown``/``.tex``/``.txt`` report (UTF-8, at most ``denavit.check.MAX_FILE_BYTES``).
+    robot : DHRobot, optional
+        The arm for the whole report; without it each DH table of the report governs its part.
+    arms : dict, optional
+        Arms for sections, by section key (the heading's number, ``"3"`` for "3) …" or "## 3. …"): robots or
+        catalogue names.
+    """
+    from ..io import load_robot
+
+    path = Path(path)
+    where = str(path)
+    fmt = REPORT_SUFFIXES.get(path.suffix.lower())
+    if fmt is None:
+        raise ParseError(f"not a report: {where!r} (a report is .md, .markdown, .tex or .txt)")
+    if not path.is_file():
+        raise ParseError(f"no such report: {where!r}" if not path.exists() else f"{where!r} is not a regular file")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ParseError(f"report too large (at most {MAX_FILE_BYTES} bytes)", where=where)
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
+    given = {str(k): (v if isinstance(v, DHRobot) else load_robot(str(v))) for k, v in (arms or {}).items()}
+    return grade_text(text, fmt, robot=robot, arms=given, source=where, seed=seed)
