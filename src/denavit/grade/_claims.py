@@ -103,9 +103,9 @@ class _Walker:
                 break
             head = nxt.latex.lstrip()
             open_first = it.latex.count("(") > it.latex.count(")")
-            closes_next = "=" not in nxt.latex and (nxt.latex.count(")") > nxt.latex.count("(")
-                                                    or head[:1] in "+-*" or head.startswith("\\cdot"))
-            if not (open_first or closes_next):
+            closes_next = nxt.latex.count(")") > nxt.latex.count("(") or head[:1] in "+-*" or \
+                head.startswith("\\cdot")
+            if "=" in nxt.latex or not (open_first or closes_next):
                 break
             it = Math(it.line, nxt.end_line, it.latex + "\n" + nxt.latex, True)
             k += 1
@@ -234,6 +234,12 @@ class _Walker:
         robot = arm.robot
         lhs, value = eq.parts[0], eq.parts[-1]
         sym = read_symbol(lhs)
+        last = read_symbol(value)
+        if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
+            lhs, value, sym = value, lhs, last  # "\arctan(P_y, P_x) = q_1"
+        if len(eq.parts) >= 2 and _define_chain(self.ctx, eq.parts, robot):
+            self.note(eq, arm, "not a claim", "a name the derivation introduces")
+            return
         if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
             if _IK_FUNCS.search(value) and len(eq.parts) == 2:
                 claim = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
@@ -298,15 +304,33 @@ class _Walker:
         return p
 
 
+def _define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
+    """``d_4 = a_2 = k`` or ``k \\cos q_3 \\to \\{AA\\}``: a new name for a known one (remembered for later claims)."""
+    params = {k for k, _ in robot.parameters}
+    last = _plain(parts[-1]).strip("{}")
+    bare = re.fullmatch(r"\\?\{?([A-Za-z]{1,3}(?:_\{?\w{1,3}\}?)?)\\?\}?", last)
+    if bare is None or len(parts) < 3 and not parts[-1].strip().startswith("\\{"):
+        return False
+    name = bare.group(1)
+    if name.replace("_", "").replace("{", "").replace("}", "") in params or read_symbol(name) is None:
+        return False
+    sym = read_symbol(name)
+    if sym is None or sym.base in ("theta", "q", "Q", "x", "y", "z", "p", "P", "J", "T", "R", "A"):
+        return False
+    ctx.define(name, parts[-2])
+    return True
+
+
 _NAMED = re.compile(r"(?:\{\}\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?[A-Z]\s*"
                     r"(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?")
-_FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times)|\.{2,}|[\s{}]")
+_FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times|left|right)|\.|[\s{}()]|\^\{?T\}?")
 
 
 def _names_product(value: str) -> bool:
     """``T_0^1 T_1^2 ⋯``, ``{}^0T_1{}^1T_2``: a product of named transforms (a definition, not a value)."""
     if len(value) > 400 or "\\begin" in value:
         return False
+    value = re.sub(r"\^\s*\{?\s*(?:T|\\top|-1)\s*\}?", " ", value)
     names = _NAMED.findall(value)
     rest = _FILLER.sub("", _NAMED.sub("", value))
     return len(names) >= 2 and not rest
@@ -315,7 +339,7 @@ def _names_product(value: str) -> bool:
 def _used_where(where: dict[str, str], value: str) -> dict[str, str]:
     """The definitions a value uses (and those they use), in the order they were made."""
     def uses(text: str, name: str) -> bool:
-        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z])", _plain(text)) is not None
+        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z])", re.sub(r"\s+", " ", text)) is not None
 
     need = {k for k in where if uses(value, k)}
     for _ in range(len(where)):

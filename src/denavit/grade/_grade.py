@@ -68,6 +68,9 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
             w = _judge(robot, alt, seed)
             if w.verdict == "correct":
                 return "correct", f"correct ({words})", "", w.to_json()
+        if re.search(r"the formula for q\d+ uses q\d+ itself", v.message):
+            return "incorrect", (v.message + ": it does not solve for the joint (a formula for it must use the "
+                                 "target's entries r_ij, p_x … and joints found before it)"), "", details
         return "unreadable", v.message, "", details
     for alt, words in p.equivalent:
         w = _judge(robot, alt, seed)

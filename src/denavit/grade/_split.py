@@ -70,6 +70,7 @@ def top_level_split(text: str, seps: tuple[str, ...]) -> list[str]:
 
 def clean(text: str) -> str:
     """Alignment marks, equation numbers and spacing dropped; the mathematics kept."""
+    text = re.sub(r"=\s+>", lambda _: " \\Rightarrow ", text)
     t = "".join(" " if text[k] == "&" and d == 0 else text[k] for k, d in _levels(text))
     t = re.sub(r"\\(?:nonumber|notag|displaystyle|qquad|quad)(?![A-Za-z])|\\[,;!:]|(?<!\\)\\ ", " ", t)
     t = _EQNUM.sub(" ", t.strip())
@@ -103,6 +104,7 @@ def _unwrap(latex: str) -> str:
 
 def _pieces(row: str) -> list[str]:
     """A row split at arrows, at ``\\quad`` between equations and at a comma between equations."""
+    row = re.sub(r"=\s+>", lambda _: " \\Rightarrow ", row)
     row = _TEXT.sub(lambda m: " \\Rightarrow " if m.group(1).strip().lower() in ("or", "and", "or when", "and when")
                     else " ", row)
     out: list[str] = []
