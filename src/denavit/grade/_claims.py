@@ -19,6 +19,7 @@ from ._document import Document, Heading, Math, Prose
 from ._lhs import read_symbol
 from ._names import Reading, joint_of, read_name
 from ._split import Equation, split_block
+from ._values import WRENCH_NAMES, expand_product, numeric_value, wrench_symbols
 
 __all__ = ["Pending", "walk"]
 
@@ -105,6 +106,10 @@ class _Walker:
             open_first = it.latex.count("(") > it.latex.count(")")
             closes_next = nxt.latex.count(")") > nxt.latex.count("(") or head[:1] in "+-*" or \
                 head.startswith("\\cdot")
+            if head.startswith("=") and "=" in it.latex:
+                it = Math(it.line, nxt.end_line, it.latex.split("=", 1)[0] + " " + head, True)
+                k += 1
+                continue
             if "=" in nxt.latex or not (open_first or closes_next):
                 break
             it = Math(it.line, nxt.end_line, it.latex + "\n" + nxt.latex, True)
@@ -132,6 +137,8 @@ class _Walker:
                 return
             self.note(eq, arm, "unreadable", f"not judged: {why}")
             return
+        if wrench_symbols(eq.text):
+            self.ctx.wrench_texts.append(eq.text[:2000])
         if self.givens(eq, arm):
             return
         if self.ctx.singular and self.condition(eq, arm):
@@ -186,7 +193,8 @@ class _Walker:
         if lhs.strip().startswith("\\begin{vmatrix}") or lhs.strip().startswith("|"):
             if len(eq.parts) > 2:
                 self._det(eq, arm, eq.parts[-2] if last.strip() == "0" else last, None)
-                self.sing.append((eq, f"{eq.parts[-2]} = 0"))
+                if "\\begin" not in eq.parts[-2]:
+                    self.sing.append((eq, f"{eq.parts[-2]} = 0"))
             else:
                 self._det(eq, arm, last, None)
             self.sing_arm = arm
@@ -260,7 +268,8 @@ class _Walker:
             params = {k for k, _ in robot.parameters}
             name = _plain(lhs)
             if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
-                    and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params:
+                    and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params \
+                    and "\\begin" not in value:
                 self.ctx.define(name, value)
             self.note(eq, arm, "not a claim", f"not judged: {lhs[:60]} names no result denavit checks (a definition "
                       "or an intermediate step)")
@@ -268,10 +277,22 @@ class _Walker:
         self.out.append(self.claim(eq, arm, reading, value))
 
     def claim(self, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
-        claim: dict[str, Any] = {**reading.spec, "value": value}
-        numeric = not has_joint_names(value)
+        expanded = expand_product(value)
+        if expanded is not None and reading.spec.get("quantity") in ("torques", "twist", "end_effector"):
+            value = expanded
+            if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
+                reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
+        qty = str(reading.spec.get("quantity"))
+        vec = vector_entries(value)
+        spec = dict(reading.spec)
+        if qty in ("torques", "equations_of_motion") and "entry" in spec and vec and len(vec) == arm.robot.dof:
+            spec.pop("entry")  # "τ_2 = [2 entries]": the subscript is a label
+            reading = Reading(spec, "the joint torques τ (the subscript read as a label)", sure=False,
+                              needs=reading.needs)
+        claim: dict[str, Any] = {**spec, "value": value}
+        numeric = numeric_value(value)
         p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure,
-                    quantity=str(reading.spec.get("quantity")))
+                    quantity=qty)
         p.alternatives = [({**alt, "value": value}, words) for alt, words in reading.alternatives]
         if numeric:
             if self.ctx.q:
@@ -281,27 +302,44 @@ class _Walker:
         if "qd" in reading.needs and numeric and self.ctx.qd:
             claim["qd"] = self.ctx.qd
         if "wrench" in reading.needs:
-            if _WRENCH_NAMES.search(value) or not numeric:
-                claim["wrench"] = "[f_x, f_y, f_z, n_x, n_y, n_z]"
-            elif self.ctx.wrench:
-                claim["wrench"] = self.ctx.wrench
-            if claim["quantity"] == "torques":
-                first, second = ("tool", "base") if self.ctx.propagation else ("base", "tool")
-                claim["frame"] = first
-                p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+            self._wrench(p, claim, value, numeric)
+        if qty == "jacobian" and "frame" not in claim and self.ctx.jacobian_frame is not None:
+            claim["frame"] = self.ctx.jacobian_frame
+            p.understood += f" (in the axes of frame {self.ctx.jacobian_frame}, as the ⁱJ before it)"
+            p.alternatives.append(({**claim, "frame": "base"}, "J0, in base axes"))
+        elif qty == "jacobian" and "frame" not in claim:
+            p.alternatives += [({**claim, "frame": f}, f"ⁱJ in the axes of frame {f}")
+                               for f in range(1, arm.robot.n_rows + 1)] + [({**claim, "frame": "tool"}, "Je")]
+        if qty == "jacobian" and isinstance(claim.get("frame"), int):
+            self.ctx.jacobian_frame = claim["frame"]
         used = _used_where(self.ctx.where, value)
         if used:
             claim["where"] = used
-        vec = vector_entries(value)
-        if vec is not None and len(vec) == 2 and claim["quantity"] in ("position", "com_position", "com_velocity",
-                                                                      "origin"):
+        if vec is not None and len(vec) == 2 and qty in ("position", "com_position", "com_velocity", "origin"):
             flat = {**claim, "value": "[" + ", ".join(vec + ["0"]) + "]"}
             p.equivalent.append((flat, "the (x, y) of a planar arm, z = 0"))
-        for alt, _ in p.alternatives:
+        for alt, _ in p.alternatives + p.equivalent:
             for key in ("q", "qd", "wrench", "where"):
                 if key in claim and key not in alt:
                     alt[key] = claim[key]
         return p
+
+    def _wrench(self, p: Pending, claim: dict[str, Any], value: str, numeric: bool) -> None:
+        """The wrench a τ, ⁱfᵢ or ⁱnᵢ claim is about: the stated numbers, or the symbols the section names."""
+        if numeric and self.ctx.wrench and claim["quantity"] == "torques":
+            claim["wrench"] = self.ctx.wrench
+        else:
+            names = wrench_symbols(value, *self.ctx.wrench_texts)
+            if names:
+                claim["wrench"] = "[" + ", ".join(n if n in names else "0" for n in WRENCH_NAMES) + "]"
+            elif numeric and self.ctx.wrench:
+                claim["wrench"] = self.ctx.wrench
+            else:
+                claim["wrench"] = "[" + ", ".join(WRENCH_NAMES) + "]"
+        if claim["quantity"] == "torques":
+            first, second = ("tool", "base") if self.ctx.propagation else ("base", "tool")
+            claim["frame"] = first
+            p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
 
 
 def _define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:

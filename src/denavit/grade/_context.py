@@ -41,6 +41,8 @@ class Context:
     where: dict[str, str] = field(default_factory=dict)
     singular: bool = False
     propagation: bool = False
+    jacobian_frame: int | None = None
+    wrench_texts: list[str] = field(default_factory=list)
 
     def define(self, name: str, value: str) -> None:
         self.where.pop(name, None)

@@ -196,17 +196,17 @@ def _position(sym: Symbol, robot: DHRobot) -> Reading | None:
     return None
 
 
-def _coordinate(sym: Symbol) -> Reading | None:
+def _coordinate(sym: Symbol, robot: DHRobot) -> Reading | None:
     """``x``, ``y``, ``z`` and their rates: the end effector's coordinates (a guess: x may name something else)."""
     k = {"x": 1, "y": 2, "z": 3}[sym.base]
     if sym.sub or sym.sup or sym.pre_sup:
         return None
     if sym.dots == 1:
-        return Reading({"quantity": "twist", "entry": k}, f"ẋ: the end-effector velocity's {sym.base} entry",
-                       sure=False, needs=("q", "qd"))
+        return Reading({"quantity": "twist", "entry": k}, f"the end-effector velocity's {sym.base} entry",
+                       sure=robot.dof <= 4, needs=("q", "qd"))
     if sym.dots == 0:
-        return Reading({"quantity": "position", "entry": k}, f"the end effector's {sym.base} coordinate", sure=False,
-                       needs=("q",))
+        return Reading({"quantity": "position", "entry": k}, f"the end effector's {sym.base} coordinate",
+                       sure=robot.dof <= 4, needs=("q",))
     return None
 
 
@@ -276,7 +276,7 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
     if b in ("p", "P", "o", "O") and not sym.det:
         return _position(sym, robot)
     if b in ("x", "y", "z"):
-        return _coordinate(sym)
+        return _coordinate(sym, robot)
     if b in ("omega", "w", "v", "f", "n"):
         if not sym.pre_sup and b in ("omega", "v") and not sym.sub:
             rows = "angular" if b == "omega" else "linear"
