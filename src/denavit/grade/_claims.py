@@ -19,7 +19,7 @@ from ._document import Document, Heading, Math, Prose
 from ._lhs import read_symbol
 from ._names import Reading, joint_of, read_name
 from ._split import Equation, split_block
-from ._values import WRENCH_NAMES, expand_product, numeric_value, wrench_symbols
+from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, wrench_symbols
 
 __all__ = ["Pending", "walk"]
 
@@ -234,7 +234,7 @@ class _Walker:
         p = Pending(first.line, first.end_line, first.text, self.sing_arm, claim,
                     "the singular configurations", quantity="singularities")
         p.equivalent = [({**claim, "rows": r}, f"the singular configurations of the rows {r}")
-                        for r in ("linear", "planar", "vx,vy")]
+                        for r in ("vx,vy,vz", "vx,vy,wz", "vx,vy", "wx,wy,wz")]
         self.out.append(p)
         self.sing, self.sing_arm = [], None
 
@@ -277,11 +277,17 @@ class _Walker:
         self.out.append(self.claim(eq, arm, reading, value))
 
     def claim(self, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
-        expanded = expand_product(value)
-        if expanded is not None and reading.spec.get("quantity") in ("torques", "twist", "end_effector"):
-            value = expanded
-            if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
-                reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
+        if "\\begin" in value:
+            mats = matrices(value)
+            expanded = expand_product(value) if mats is not None and len(mats) == 2 else None
+            if mats is None or len(mats) > 2 or (len(mats) == 2 and expanded is None):
+                return Pending(eq.line, eq.end_line, eq.text, arm, None, reading.understood, verdict="not a claim",
+                               message="not judged: a matrix expression (products, sums with other results), not "
+                               "one value; the result after it is judged", quantity=str(reading.spec.get("quantity")))
+            if expanded is not None:
+                value = expanded
+                if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
+                    reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
         qty = str(reading.spec.get("quantity"))
         vec = vector_entries(value)
         spec = dict(reading.spec)

@@ -13,7 +13,7 @@ import re
 from ._context import is_numeric, vector_entries
 from ._split import top_level_split
 
-__all__ = ["expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES"]
+__all__ = ["matrices", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES"]
 
 _MAT = re.compile(r"\\begin\{([bBpv]?matrix)\}")
 #: The wrench's symbols, in the order (f, n), as the checker names them.
@@ -21,7 +21,7 @@ WRENCH_NAMES = ("f_x", "f_y", "f_z", "n_x", "n_y", "n_z")
 _SYMBOL = re.compile(r"(?<![A-Za-z\\])([fFnN])_\{?([xyz])\}?")
 
 
-def _matrices(text: str) -> list[str] | None:
+def matrices(text: str) -> list[str] | None:
     """``text`` as a sequence of whole matrix environments (and nothing else but spaces), or None."""
     out, k = [], 0
     t = text.strip()
@@ -51,7 +51,7 @@ def _cells(matrix: str) -> list[list[str]]:
 
 def expand_product(value: str) -> str | None:
     """``[M] [v]`` (a matrix times a column vector) written out as one column vector, or None if not that form."""
-    mats = _matrices(value)
+    mats = matrices(value)
     if mats is None or len(mats) != 2:
         return None
     a = _cells(mats[0])
