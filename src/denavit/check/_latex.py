@@ -234,6 +234,8 @@ class _Parser:
         if t is not None and t[1] == "^":  # \sin^2 x
             self.take()
             power = self.exponent()
+            if fname in _INVERSE and _is_minus_one(power):  # \cos^{-1} x is arccos x, as textbooks write it
+                fname, power = _INVERSE[fname], None
         t = self.peek()
         nxt = self.peek(1)
         wrapped = t is not None and t[1] == "{" and nxt is not None and nxt[1] in ("(", "[")  # f{\left(a, b\right)}
@@ -318,6 +320,19 @@ class _Parser:
 
     def resolve_ident(self, ident: Ident, allow_sub: bool) -> tuple:
         return self.resolve(ident)
+
+
+_INVERSE = {"sin": "asin", "cos": "acos", "tan": "atan"}
+
+
+def _is_minus_one(node: tuple) -> bool:
+    """The exponent ``-1`` (``^{-1}``): read on a function as its inverse (``\\sin^{-1}`` = arcsin), never 1/sin."""
+    if _expr.names_in(node):
+        return False
+    try:
+        return _expr.evaluate(node) == -1.0
+    except Exception:  # noqa: BLE001 - any exponent that does not evaluate is simply not -1
+        return False
 
 
 def _strip_rhs(text: str) -> str:

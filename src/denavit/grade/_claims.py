@@ -27,6 +27,7 @@ _IK_FUNCS = re.compile(r"atan|arctan|arccos|arcsin|\\cos\^\{?-1|\\sin\^\{?-1|\\t
                        r"|r_\{?\d\d|[xyz]_[cw]|\\operatorname")
 _TRIG_LHS = re.compile(r"^\\?(cos|sin|tan)\s*\(?\s*\\?(?:var)?(?:theta|q|Q)_\{?\d\}?\s*\)?$")
 _SINGULAR = re.compile(r"singular", re.I)
+_MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
 _PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
@@ -189,6 +190,8 @@ class _Walker:
         if sym is not None and sym.det:
             if len(eq.parts) > 2 and last.strip() == "0":
                 self._det(eq, arm, eq.parts[-2], sym)
+            elif last.strip() != "0":
+                self._det(eq, arm, last, sym)
             return True
         if lhs.strip().startswith("\\begin{vmatrix}") or lhs.strip().startswith("|"):
             if len(eq.parts) > 2:
@@ -261,6 +264,11 @@ class _Walker:
                           "the joint in terms of the target")
             return
         reading = read_name(sym, robot, value) if sym is not None else None
+        if reading is not None and reading.spec.get("quantity") in _MATRIX_QUANTITIES and "\\begin" not in value \
+                and "[" not in value:
+            self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "
+                      "matrix)", reading.spec["quantity"])
+            return
         if reading is not None and _names_product(value):
             self.note(eq, arm, "not a claim", "a definition: the product of other results", reading.spec["quantity"])
             return
@@ -300,11 +308,10 @@ class _Walker:
         p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure,
                     quantity=qty)
         p.alternatives = [({**alt, "value": value}, words) for alt, words in reading.alternatives]
-        if numeric:
-            if self.ctx.q:
-                claim["q"] = self.ctx.q
-            else:
-                p.numeric_without_case = True
+        if not has_joint_names(value) and self.ctx.q:
+            claim["q"] = self.ctx.q  # a value without joint variables, after a case: that case's value
+        elif numeric:
+            p.numeric_without_case = True
         if "qd" in reading.needs and numeric and self.ctx.qd:
             claim["qd"] = self.ctx.qd
         if "wrench" in reading.needs:

@@ -61,6 +61,8 @@ def _frame(tok: str, robot: DHRobot) -> int | str | None:
 def _transform(sym: Symbol, robot: DHRobot) -> Reading | None:
     """T, A, R, H with frames; ``R`` claims are the rotation block (the checker reads a 3×3 that way)."""
     n, kind = robot.n_rows, "rotation" if sym.base == "R" else "transform"
+    if sym.base in ("A", "T") and re.fullmatch(r"\{?[ikn]\}?", sym.sub.strip()) and not sym.sup and not sym.pre_sup:
+        return Reading({"quantity": "dh_matrix"}, "the general DH link matrix")
     if sym.base == "A" and sym.sub and not sym.sup and not sym.pre_sup:
         k = _digit(sym.sub)
         if k is not None and 1 <= k <= n:
