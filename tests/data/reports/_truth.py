@@ -83,6 +83,97 @@ def f01():
     ]
 
 
+# --- 02: articulated RRR, Craig, tab-separated, tool row, propagation ------------------------------------------
+
+@fixture("02_elbow_rrr_craig.md")
+def f02():
+    arm = Arm("mdh", [(0, 0, 0, t1), (0, pi / 2, 0, t2), (L2, 0, 0, t3), (L3, 0, 0, 0)],
+              [("R", t1), ("R", t2), ("R", t3), None])
+    C1, S1, C2, S2, C3, S3 = c(t1), s(t1), c(t2), s(t2), c(t3), s(t3)
+    C23, S23 = c(t2 + t3), s(t2 + t3)
+    w1, w2, w3 = sp.symbols("qd1:4", real=True)
+    fx, fy, fz = sp.symbols("f_x f_y f_z", real=True)
+    am1 = sp.Symbol("alpha_im1", real=True)
+    gen = M([c(thi), -s(thi), 0, ai], [s(thi) * c(am1), c(thi) * c(am1), -s(am1), -s(am1) * di],
+            [s(thi) * s(am1), c(thi) * s(am1), c(am1), c(am1) * di], [0, 0, 0, 1])
+    om = [frame_velocity(arm, k)[0] for k in (1, 2, 3)]
+    v3, v4 = frame_velocity(arm, 3)[1], frame_velocity(arm, 4)[1]
+    f2, n2 = force_moment(arm, 2, [fx, fy, fz], [0, 0, 0])
+    n3 = force_moment(arm, 3, [fx, fy, fz], [0, 0, 0])[1]
+    J = arm.jacobian()
+    detv = J[:3, :].det()
+    return [
+        R("correct", "general Craig matrix", gen, link("mdh", ai, am1, di, thi)),
+        R("correct", "0T1", M([C1, -S1, 0, 0], [S1, C1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]), arm.A(1)),
+        R("correct", "1T2", M([C2, -S2, 0, 0], [0, 0, -1, 0], [S2, C2, 0, 0], [0, 0, 0, 1]), arm.A(2)),
+        R("incorrect", "2T3: rotation transposed", M([C3, S3, 0, L2], [-S3, C3, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]),
+          arm.A(3)),
+        R("correct", "3T4 (tool row)", M([1, 0, 0, L3], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]), arm.A(4)),
+        R(NC, "0T4 as the product"),
+        R("correct", "p_E", col(C1 * (L2 * C2 + L3 * C23), S1 * (L2 * C2 + L3 * C23), L2 * S2 + L3 * S23),
+          arm.T(0)[:3, 3]),
+        R(NC, "propagation rule for omega"),
+        R("correct", "1w1", col(0, 0, w1), om[0]),
+        R("correct", "2w2", col(S2 * w1, C2 * w1, w2), om[1]),
+        R("correct", "3w3", col(S23 * w1, C23 * w1, w2 + w3), om[2]),
+        R("incorrect", "3v3: sign of the z entry", col(L2 * S3 * w2, L2 * C3 * w2, L2 * C2 * w1), v3),
+        R("correct", "4v4", col(L2 * S3 * w2, (L2 * C3 + L3) * w2 + L3 * w3, -(L2 * C2 + L3 * C23) * w1), v4),
+        R("correct", "4J", M([0, L2 * S3, 0], [0, L2 * C3 + L3, L3], [-L2 * C2 - L3 * C23, 0, 0], [S23, 0, 0],
+                             [C23, 0, 0], [0, 1, 1]), arm.jacobian_in(4)),
+        R("correct", "3n3", col(0, -L3 * fz, L3 * fy), n3),
+        R("correct", "2f2", col(C3 * fx - S3 * fy, S3 * fx + C3 * fy, fz), f2),
+        R("incorrect", "2n2: the L3 C3 term of the y entry missing",
+          col(L3 * S3 * fz, -L2 * fz, L2 * S3 * fx + (L2 * C3 + L3) * fy), n2),
+        R("correct", "tau = J^T F: the virtual-work identity, true by definition", test=lambda: True),
+        R("correct", "det J_v", -L2 * L3 * S3 * (L2 * C2 + L3 * C23), detv),
+        R("correct", "singular: s3 = 0 and L2 c2 + L3 c23 = 0",
+          test=lambda: singular_set_ok(detv, [S3, L2 * C2 + L3 * C23])),
+    ]
+
+
+# --- 03: SCARA RRPR, Spong, space-separated table, numbers, degrees --------------------------------------------
+
+@fixture("03_scara_spaces.md")
+def f03():
+    D3 = sp.Symbol("d3", real=True)
+    r = sp.Rational
+    arm = Arm("std", [(r(35, 100), 0, r(40, 100), t1), (r(30, 100), pi, 0, t2), (0, 0, D3, 0), (0, 0, r(10, 100), t4)],
+              [("R", t1), ("R", t2), ("P", D3), ("R", t4)])
+    c1, s1, c2, s2, c4, s4 = c(t1), s(t1), c(t2), s(t2), c(t4), s(t4)
+    c12, s12, ca, sa = c(t1 + t2), s(t1 + t2), c(t1 + t2 - t4), s(t1 + t2 - t4)
+    T04, J = arm.T(0), arm.jacobian()
+    f = sp.Float
+    case = {t1: pi / 6, t2: pi / 4, D3: r(12, 100), t4: pi / 2}
+    ikd3 = lambda tg, q: 0.30 - tg["pz"]                                       # noqa: E731
+    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 0.2125) / 0.21)  # noqa: E731
+    return [
+        R("correct", "T01", M([c1, -s1, 0, f(0.35) * c1], [s1, c1, 0, f(0.35) * s1], [0, 0, 1, f(0.40)], [0, 0, 0, 1]),
+          arm.A(1)),
+        R("correct", "T12", M([c2, s2, 0, f(0.30) * c2], [s2, -c2, 0, f(0.30) * s2], [0, 0, -1, 0], [0, 0, 0, 1]),
+          arm.A(2)),
+        R("correct", "T23", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, D3], [0, 0, 0, 1]), arm.A(3)),
+        R("incorrect", "T34: the offset d4 = 0.10 left out", M([c4, -s4, 0, 0], [s4, c4, 0, 0], [0, 0, 1, 0],
+                                                               [0, 0, 0, 1]), arm.A(4)),
+        R(NC, "T04 as the product"),
+        R("correct", "T04", M([ca, sa, 0, f(0.35) * c1 + f(0.30) * c12], [sa, -ca, 0, f(0.35) * s1 + f(0.30) * s12],
+                              [0, 0, -1, f(0.30) - D3], [0, 0, 0, 1]), T04),
+        R("correct", "p_x", f(0.35) * c1 + f(0.30) * c12, T04[0, 3]),
+        R("correct", "p_y", f(0.35) * s1 + f(0.30) * s12, T04[1, 3]),
+        R("incorrect", "p_z: d4 added instead of subtracted", f(0.50) - D3, T04[2, 3]),
+        R("correct", "case 2 T04 (4 decimals)", M([0.9659, -0.2588, 0, 0.3808], [-0.2588, -0.9659, 0, 0.4648],
+                                                  [0, 0, -1, 0.18], [0, 0, 0, 1]), T04.subs(case), tol=1e-4),
+        R("correct", "J_v", M([-f(0.35) * s1 - f(0.30) * s12, -f(0.30) * s12, 0, 0],
+                              [f(0.35) * c1 + f(0.30) * c12, f(0.30) * c12, 0, 0], [0, 0, -1, 0]), J[:3, :]),
+        R("incorrect", "J_omega: sign of the roll column", M([0, 0, 0, 0], [0, 0, 0, 0], [1, 1, 0, 1]), J[3:, :]),
+        R("correct", "J_11", -f(0.35) * s1 - f(0.30) * s12, J[0, 0]),
+        R("correct", "singular when theta2 = 0 or 180 deg",
+          test=lambda: singular_set_ok(J.extract([0, 1, 2, 5], [0, 1, 2, 3]).det(), [s2])),
+        R("correct", "d3 = 0.30 - p_z", test=lambda: ik_ok(arm, 3, ikd3)),
+        R("correct", "theta2 = +-acos(...)", test=lambda: ik_ok(arm, 2, ik2, signs={t2: 1})
+          and ik_ok(arm, 2, lambda tg, q: -ik2(tg, q), signs={t2: -1})),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
