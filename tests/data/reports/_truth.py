@@ -174,6 +174,44 @@ def f03():
     ]
 
 
+# --- 04: spherical RRP, Spong, LaTeX tabular in a .tex file, prismatic joint, IK ------------------------------
+
+@fixture("04_spherical_rrp.tex")
+def f04():
+    D3 = sp.Symbol("d3", real=True)
+    arm = Arm("std", [(0, -pi / 2, H1, t1), (0, pi / 2, d2, t2), (0, 0, D3, 0)], [("R", t1), ("R", t2), ("P", D3)])
+    c1, s1, c2, s2 = c(t1), s(t1), c(t2), s(t2)
+    T03, J = arm.T(0), arm.jacobian()
+    # the IK formulas are checked at H1 = 0.7, d2 = 0.25 (the report's symbols; any positive values would do)
+    armn = Arm("std", [(0, -pi / 2, 0.7, t1), (0, pi / 2, 0.25, t2), (0, 0, D3, 0)], [("R", t1), ("R", t2), ("P", D3)])
+    r = lambda tg: math.sqrt(tg["px"] ** 2 + tg["py"] ** 2 - 0.25 ** 2)   # noqa: E731
+    ik1 = lambda tg, q: math.atan2(tg["py"], tg["px"]) - math.atan2(0.25, r(tg))   # noqa: E731
+    ikd3 = lambda tg, q: math.hypot(r(tg), tg["pz"] - 0.7)   # noqa: E731
+    ik2 = lambda tg, q: math.atan2(tg["pz"] - 0.7, r(tg))   # noqa: E731
+    branch = {t2: 1, D3: 1}
+    detv = J[:3, :].det()
+    return [
+        R("correct", "A_1", M([c1, 0, -s1, 0], [s1, 0, c1, 0], [0, -1, 0, H1], [0, 0, 0, 1]), arm.A(1)),
+        R("incorrect", "A_2: c2 for s2 in (1,3)", M([c2, 0, c2, 0], [s2, 0, -c2, 0], [0, 1, 0, d2], [0, 0, 0, 1]),
+          arm.A(2)),
+        R("correct", "A_3", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, D3], [0, 0, 0, 1]), arm.A(3)),
+        R(NC, "T^0_3 = A_1 A_2 A_3"),
+        R("correct", "T^0_3", M([c1 * c2, -s1, c1 * s2, c1 * s2 * D3 - s1 * d2],
+                                [s1 * c2, c1, s1 * s2, s1 * s2 * D3 + c1 * d2], [-s2, 0, c2, H1 + D3 * c2],
+                                [0, 0, 0, 1]), T03),
+        R("correct", "p_x", -d2 * s1 + D3 * c1 * s2, T03[0, 3]),
+        R("incorrect", "p_y: sign of the d3 term", d2 * c1 - D3 * s1 * s2, T03[1, 3]),
+        R("correct", "p_z", H1 + D3 * c2, T03[2, 3]),
+        R("correct", "J", M([-d2 * c1 - D3 * s1 * s2, D3 * c1 * c2, c1 * s2], [-d2 * s1 + D3 * c1 * s2, D3 * s1 * c2, s1 * s2],
+                            [0, -D3 * s2, c2], [0, -s1, 0], [0, c1, 0], [1, 0, 0]), J),
+        R("correct", "det J_v", -D3 ** 2 * s2, detv),
+        R("correct", "position singular: d3 = 0 or theta2 = 0, pi", test=lambda: singular_set_ok(detv, [D3 ** 2, s2])),
+        R("correct", "theta1 (branch d3 sin theta2 > 0)", test=lambda: ik_ok(armn, 1, ik1, signs=branch)),
+        R("correct", "d3 (branch d3 > 0)", test=lambda: ik_ok(armn, 3, ikd3, signs=branch)),
+        R("incorrect", "theta2: atan2 arguments swapped", test=lambda: ik_ok(armn, 2, ik2, signs=branch)),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
