@@ -167,7 +167,7 @@ def f03():
         R("incorrect", "J_omega: sign of the roll column", M([0, 0, 0, 0], [0, 0, 0, 0], [1, 1, 0, 1]), J[3:, :]),
         R("correct", "J_11", -f(0.35) * s1 - f(0.30) * s12, J[0, 0]),
         R("correct", "singular when theta2 = 0 or 180 deg",
-          test=lambda: singular_set_ok(J.extract([0, 1, 2, 5], [0, 1, 2, 3]).det(), [s2])),
+          test=lambda: singular_set_ok(J.extract([0, 1, 2, 5], [0, 1, 2, 3]).det(), [s2], joints=(t1, t2, D3, t4))),
         R("correct", "d3 = 0.30 - p_z", test=lambda: ik_ok(arm, 3, ikd3)),
         R("correct", "theta2 = +-acos(...)", test=lambda: ik_ok(arm, 2, ik2, signs={t2: 1})
           and ik_ok(arm, 2, lambda tg, q: -ik2(tg, q), signs={t2: -1})),
@@ -205,10 +205,51 @@ def f04():
         R("correct", "J", M([-d2 * c1 - D3 * s1 * s2, D3 * c1 * c2, c1 * s2], [-d2 * s1 + D3 * c1 * s2, D3 * s1 * c2, s1 * s2],
                             [0, -D3 * s2, c2], [0, -s1, 0], [0, c1, 0], [1, 0, 0]), J),
         R("correct", "det J_v", -D3 ** 2 * s2, detv),
-        R("correct", "position singular: d3 = 0 or theta2 = 0, pi", test=lambda: singular_set_ok(detv, [D3 ** 2, s2])),
+        R("correct", "position singular: d3 = 0 or theta2 = 0, pi", test=lambda: singular_set_ok(detv, [D3 ** 2, s2], joints=(t1, t2, D3))),
         R("correct", "theta1 (branch d3 sin theta2 > 0)", test=lambda: ik_ok(armn, 1, ik1, signs=branch)),
         R("correct", "d3 (branch d3 > 0)", test=lambda: ik_ok(armn, 3, ikd3, signs=branch)),
         R("incorrect", "theta2: atan2 arguments swapped", test=lambda: ik_ok(armn, 2, ik2, signs=branch)),
+    ]
+
+
+# --- 05: cylindrical RPP, Craig, pipe table without outer pipes, a .txt, numeric case, statics -----------------
+
+@fixture("05_cylindrical_rpp.txt")
+def f05():
+    D2, D3 = sp.symbols("d2 d3", real=True)
+    r, f = sp.Rational, sp.Float
+    arm = Arm("mdh", [(0, 0, r(1, 4), t1), (0, 0, D2, 0), (0, -pi / 2, D3, 0), (0, 0, r(1, 10), 0)],
+              [("R", t1), ("P", D2), ("P", D3), None])
+    c1, s1 = c(t1), s(t1)
+    T04, J = arm.T(0), arm.jacobian()
+    fx, fy, fz = sp.symbols("f_x f_y f_z", real=True)
+    qd = sp.Matrix(sp.symbols("qd1:4", real=True))
+    case = {t1: pi / 3, D2: r(1, 2), D3: r(3, 10)}
+    e = D3 + f(0.1)
+    Jv = M([-e * c1, 0, -s1], [-e * s1, 0, c1], [0, 1, 0])
+    n1, n2, n3 = (force_moment(arm, k, [fx, fy, fz], [0, 0, 0])[1] for k in (1, 2, 3))
+    f2 = force_moment(arm, 2, [fx, fy, fz], [0, 0, 0])[0]
+    detv = J[:3, :].det()
+    return [
+        R("correct", "0_1T", M([c1, -s1, 0, 0], [s1, c1, 0, 0], [0, 0, 1, f(0.25)], [0, 0, 0, 1]), arm.A(1)),
+        R("correct", "1_2T", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, D2], [0, 0, 0, 1]), arm.A(2)),
+        R("incorrect", "2_3T: d3 in the z row", M([1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, D3], [0, 0, 0, 1]), arm.A(3)),
+        R("correct", "3_4T (tool row)", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, f(0.1)], [0, 0, 0, 1]), arm.A(4)),
+        R("correct", "0_4T", M([c1, 0, -s1, -e * s1], [s1, 0, c1, e * c1], [0, -1, 0, D2 + f(0.25)], [0, 0, 0, 1]), T04),
+        R("incorrect", "case 1: p_x without the tool offset",
+          M([0.5, 0, -0.866, -0.260], [0.866, 0, 0.5, 0.200], [0, -1, 0, 0.750], [0, 0, 0, 1]), T04.subs(case),
+          tol=1e-3),
+        R("correct", "linear velocity = J_v qdot", Jv * qd, J[:3, :] * qd),
+        R("correct", "0J", sp.Matrix.vstack(Jv, M([0, 0, 0], [0, 0, 0], [1, 0, 0])), J),
+        R("correct", "det J_v", e, detv),
+        R("incorrect", "singular only when d3 = 0 (the tool offset forgotten)",
+          test=lambda: singular_set_ok(detv, [D3], joints=(t1, D2, D3))),
+        R("correct", "3n3", col(-f(0.1) * fy, f(0.1) * fx, 0), n3),
+        R("correct", "2f2", col(fx, fz, -fy), f2),
+        R("incorrect", "2n2: sign of the z entry", col(-e * fy, 0, e * fx), n2),
+        R("correct", "1n1", col(-D2 * fz - e * fy, D2 * fx, -e * fx), n1),
+        R("correct", "tau at case 1 (F in base axes)", col(-3.464, -5, 5),
+          (J.T * col(0, 10, -5, 0, 0, 0)).subs(case), tol=1e-3),
     ]
 
 

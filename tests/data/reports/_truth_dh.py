@@ -182,14 +182,15 @@ def expects(path: Path) -> list[str]:
 
 # --- singular sets and inverse kinematics -------------------------------------------------------------------
 
-def singular_set_ok(det_expr, conditions: list, joint_values: list[dict] | None = None) -> bool:
+def singular_set_ok(det_expr, conditions: list, joints=T) -> bool:
     """The claimed conditions (expressions that vanish on each claimed set) are the zero set of ``det_expr``:
-    det_expr factors into exactly those factors (up to constants and the non-zero link lengths)."""
+    det_expr factors into exactly those factors (up to constants and the non-zero link lengths): the ratio is
+    free of the joint variables ``joints``."""
     prod = sp.Integer(1)
     for cond in conditions:
         prod *= cond
     ratio = sp.simplify(det_expr / prod)
-    return not (ratio.free_symbols & set(T)) and ratio != 0
+    return not (ratio.free_symbols & set(joints)) and ratio != 0
 
 
 def ik_ok(arm: Arm, joint: int, formula: Callable[[dict, dict], float], n: int = 6, seed: int = 3,
