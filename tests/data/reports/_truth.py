@@ -268,14 +268,14 @@ def main() -> int:
         want, got = expects(HERE / name), [r.verdict for r in records]
         if want != got:
             failures.append(f"{name}: expect comments {want} != records {got}")
-        for r in records:
-            ok = r.holds()
+        held = [r.holds() for r in records]
+        for r, ok in zip(records, held):
             if r.verdict == "correct" and ok is not True:
                 failures.append(f"{name}: {r.label}: expected correct but the truth differs")
             if r.verdict == "incorrect" and ok is not False:
                 failures.append(f"{name}: {r.label}: expected incorrect but it equals the truth")
         print(f"{name}: {len(records)} verdicts, {sum(r.verdict == 'incorrect' for r in records)} slips, "
-              f"{sum(r.holds() is not None for r in records)} checked against the truth")
+              f"{sum(ok is not None for ok in held)} checked against the truth")
     for f in failures:
         print("FAIL", f)
     return 1 if failures else 0

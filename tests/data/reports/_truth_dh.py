@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
 import sympy as sp
 
 HERE = Path(__file__).resolve().parent
@@ -70,7 +71,7 @@ class Arm:
         M = sp.eye(4)
         for k in range(i + 1, j + 1):
             M = M * self.A(k)
-        return M.applyfunc(sp.simplify)
+        return M
 
     @property
     def q(self) -> list:
@@ -91,13 +92,13 @@ class Arm:
                 cols.append(sp.Matrix.vstack(z.cross(p - o), z))
             else:
                 cols.append(sp.Matrix.vstack(z, sp.zeros(3, 1)))
-        return sp.Matrix.hstack(*cols).applyfunc(sp.simplify)
+        return sp.Matrix.hstack(*cols)
 
     def jacobian_in(self, k: int) -> sp.Matrix:
         R = self.T(0, k)[:3, :3]
         Z = sp.zeros(3, 3)
         B = sp.Matrix(sp.BlockMatrix([[R.T, Z], [Z, R.T]]))
-        return (B * self.jacobian()).applyfunc(sp.simplify)
+        return (B * self.jacobian())
 
 
 def qd_symbols(arm: Arm) -> list:
@@ -110,10 +111,10 @@ def frame_velocity(arm: Arm, k: int) -> tuple[sp.Matrix, sp.Matrix]:
     Tk = arm.T(0, k)
     R, p = Tk[:3, :3], Tk[:3, 3]
     Rdot = sum((R.diff(q) * w for q, w in zip(arm.q, qd)), sp.zeros(3, 3))
-    W = (R.T * Rdot).applyfunc(sp.simplify)       # skew(ᵏω)
+    W = (R.T * Rdot)       # skew(ᵏω)
     omega = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
     pdot = sum((p.diff(q) * w for q, w in zip(arm.q, qd)), sp.zeros(3, 1))
-    return omega.applyfunc(sp.simplify), (R.T * pdot).applyfunc(sp.simplify)
+    return omega, (R.T * pdot)
 
 
 def force_moment(arm: Arm, k: int, f_tip, n_tip) -> tuple[sp.Matrix, sp.Matrix]:
@@ -123,7 +124,7 @@ def force_moment(arm: Arm, k: int, f_tip, n_tip) -> tuple[sp.Matrix, sp.Matrix]:
     Tkn = arm.T(k, n)
     R, p = Tkn[:3, :3], Tkn[:3, 3]
     f = R * sp.Matrix(f_tip)
-    return f.applyfunc(sp.simplify), (R * sp.Matrix(n_tip) + p.cross(f)).applyfunc(sp.simplify)
+    return f, (R * sp.Matrix(n_tip) + p.cross(f))
 
 
 # --- comparison --------------------------------------------------------------------------------------------
@@ -138,16 +139,21 @@ def _points(exprs, n=6, seed=7):
              else rnd.uniform(0.3, 1.4) for x in syms} for _ in range(n)]
 
 
+def _matrix(x) -> sp.Matrix:
+    return sp.Matrix([x]) if isinstance(x, (sp.Expr, int, float)) else sp.Matrix(x)
+
+
 def same(claimed, truth, tol=1e-9) -> bool:
     """Equal as formulas: numerically at random points of every free symbol (entries within ``tol``)."""
-    C, Tm = sp.Matrix(claimed) if not isinstance(claimed, sp.Expr) else sp.Matrix([claimed]), None
-    Tm = sp.Matrix(truth) if not isinstance(truth, sp.Expr) else sp.Matrix([truth])
+    C, Tm = _matrix(claimed), _matrix(truth)
     if C.shape != Tm.shape:
         return False
+    syms = sorted(C.free_symbols | Tm.free_symbols, key=str)
+    fc, ft = sp.lambdify(syms, C, "numpy"), sp.lambdify(syms, Tm, "numpy")
     for pt in _points([C, Tm]):
-        a = C.subs(pt).evalf()
-        b = Tm.subs(pt).evalf()
-        if any(abs(complex(x) - complex(y)) > tol * max(1.0, abs(complex(y))) for x, y in zip(a, b)):
+        args = [pt[x] for x in syms]
+        a, b = np.asarray(fc(*args), dtype=float), np.asarray(ft(*args), dtype=float)
+        if np.any(np.abs(a - b) > tol * np.maximum(1.0, np.abs(b))):
             return False
     return True
 
@@ -189,8 +195,15 @@ def singular_set_ok(det_expr, conditions: list, joints=T) -> bool:
     prod = sp.Integer(1)
     for cond in conditions:
         prod *= cond
-    ratio = sp.simplify(det_expr / prod)
-    return not (ratio.free_symbols & set(joints)) and ratio != 0
+    ratio = det_expr / prod
+    others = sorted(ratio.free_symbols - set(joints), key=str)
+    rnd = random.Random(11)
+    fixed = {x: rnd.uniform(0.3, 1.4) for x in others}
+    values = []
+    for _ in range(6):
+        pt = {**fixed, **{x: rnd.uniform(-3, 3) for x in joints}}
+        values.append(complex(ratio.subs(pt).evalf()))
+    return abs(values[0]) > 1e-9 and all(abs(v - values[0]) < 1e-9 * abs(values[0]) for v in values)
 
 
 def ik_ok(arm: Arm, joint: int, formula: Callable[[dict, dict], float], n: int = 6, seed: int = 3,
