@@ -43,7 +43,7 @@ def _floats(robot: DHRobot) -> list[float]:
     return out
 
 
-def _plain(robot: DHRobot) -> DHRobot:
+def plain_model(robot: DHRobot) -> DHRobot:
     """The arm without the expression texts a file reader records (``deg(170)``, ``pi/2``): an arm built in
     Python has none, the same arm read from a file has them; the numbers are what must not change."""
     def link(l: DHLink) -> DHLink:
@@ -59,7 +59,7 @@ def _assert_same(back: DHRobot, robot: DHRobot) -> None:
     """Bit for bit (float.hex of every number) and equal as models; an arm that came from a file keeps its
     expression texts too (full equality)."""
     assert [x.hex() for x in _floats(back)] == [x.hex() for x in _floats(robot)]
-    assert _plain(back) == _plain(robot)
+    assert plain_model(back) == plain_model(robot)
     if robot.symbols or any(l.symbols or (l.inertia is not None and l.inertia.symbols) for l in robot.links):
         assert back == robot
 

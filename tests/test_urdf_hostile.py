@@ -183,3 +183,27 @@ def test_mutated_urdf_refused_cleanly_or_accepted(data, tmp_path):
         assert_accepted_quietly(o)
     else:
         assert_refused(o, mentions=["arm.urdf"])
+
+
+@pytest.mark.parametrize("encoding", ["x-nonexistent", "utf-7", "utf-32", "rot13"])
+def test_unknown_xml_encoding_is_one_line(encoding, tmp_path):
+    """encoding="x-nonexistent" or "utf-7" in the XML declaration: one line naming it (was an internal error)."""
+    text = GOOD.replace('<?xml version="1.0"?>', f'<?xml version="1.0" encoding="{encoding}"?>')
+    o = run_cli(["import-urdf", "arm.urdf"], tmp_path, {"arm.urdf": text})
+    assert_refused(o, mentions=["arm.urdf", repr(encoding), "UTF-8"])
+
+
+def test_long_valid_number_is_a_number(tmp_path):
+    """A 45-character decimal is a number (was "not a number"): the same arm as with the short one; a number of
+    more than MAX_NUMBER_CHARS characters is refused by its length."""
+    from denavit.interop import MAX_NUMBER_CHARS, import_urdf
+
+    long = "0.3000000000000000000000000000000000000000001"
+    assert len(long) == 45
+    (tmp_path / "short.urdf").write_text(GOOD)
+    (tmp_path / "long.urdf").write_text(_swap('<origin xyz="0 0 0.3"/>', f'<origin xyz="0 0 {long}"/>'))
+    assert import_urdf(str(tmp_path / "long.urdf")).robot.links == import_urdf(str(tmp_path / "short.urdf")).robot.links
+    huge = "0." + "3" * MAX_NUMBER_CHARS
+    o = run_cli(["import-urdf", "arm.urdf"], tmp_path, {"arm.urdf": _swap('<origin xyz="0 0 0.3"/>',
+                                                                          f'<origin xyz="0 0 {huge}"/>')})
+    assert_refused(o, mentions=["arm.urdf", f"longer than {MAX_NUMBER_CHARS} characters"])

@@ -30,7 +30,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from . import _expr
+from . import _expr, _text
 from ._table_cells import (LENGTH_UNITS, MM_HINT, CellReader, is_degrees, large_angle, length_unit, row_values,
                            to_metres, warn_if_millimetres)
 from ._table_find import (COLUMNS, MAX_CELL_CHARS, MAX_COLUMNS, MAX_LINE_CHARS, MAX_TABLE_CHARS, MAX_TABLE_ROWS,
@@ -126,8 +126,9 @@ def table_file_text(result: TableImport, fmt: str = "yaml", source: str = "") ->
         return json.dumps(result.data, indent=2) + "\n"
     import yaml
 
-    head = [f"# {result.data['name']}: imported by denavit import-table" + (f" from {source}" if source else "")]
-    head += [f"# note: {n}" for n in result.notes]
+    head = [f"# {_text.visible(result.data['name'])}: imported by denavit import-table"
+            + (f" from {_text.visible(source)}" if source else "")]  # comments: one line each, whatever they quote
+    head += [f"# note: {_text.visible(n)}" for n in result.notes]
     body = {k: v for k, v in result.data.items() if k != "joints"}
     text = yaml.safe_dump(body, sort_keys=False, default_flow_style=None)
     rows = "".join("  - " + yaml.safe_dump(r, default_flow_style=True, sort_keys=False, width=10_000).strip() + "\n"

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import terminal_text
 from ..errors import ParseError
 
 __all__ = ["OneLineParser", "add_common", "finite_float", "nonneg_int", "one_line", "positive_float", "add_q", "emit", "load", "joint_values",
@@ -60,7 +61,7 @@ MAX_MESSAGE = 300
 
 def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
     """An error message as one line of at most about ``limit`` characters (long user text is cut in the middle)."""
-    text = " ".join(str(message).split())
+    text = " ".join(terminal_text(str(message)).split())  # user text in a message is shown, not obeyed
     if len(text) > limit:
         text = text[: limit * 2 // 3] + " ... " + text[-(limit // 3):]
     return text
@@ -317,4 +318,5 @@ def emit(args: argparse.Namespace, data: Any, text: str) -> None:
         json.dump(to_json(data), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     elif text:
+        text = terminal_text(text)  # a name's ESC or U+202E is shown as \x1b, \u202e: the terminal never obeys it
         sys.stdout.write(text if text.endswith("\n") else text + "\n")

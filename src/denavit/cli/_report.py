@@ -61,7 +61,9 @@ def _figure_names(args: argparse.Namespace, robot, fmt: str) -> list[str]:
     topics = [t.strip() for t in args.topics.split(",")] if args.topics else None
     if topics is not None and "figures" not in topics:
         return []
-    return [f"{Path(args.output).stem}-{robot.name}-arm.png"]
+    from ..report import arm_picture_name
+
+    return [f"{Path(args.output).stem}-{arm_picture_name(robot.name)}"]
 
 
 def _check_beside(args: argparse.Namespace, names: list[str]) -> list[str]:
@@ -193,8 +195,8 @@ def cmd_import_table(args: argparse.Namespace):
 
     path = Path(args.file)
     check_output(args, args.output, ROBOT_SUFFIXES)
-    if not path.is_file():
-        raise ParseError(f"no such file: {str(path)!r}")
+    if not path.is_file():  # /dev/zero, a folder, a FIFO: not read (a device never ends)
+        raise ParseError(f"{'not a regular file' if path.exists() else 'no such file'}: {str(path)!r}")
     if path.stat().st_size > MAX_TABLE_FILE_BYTES:
         raise ParseError(f"{str(path)!r} is too large for a DH table (at most {MAX_TABLE_FILE_BYTES} bytes)")
     text = path.read_text(encoding="utf-8", errors="replace")

@@ -12,6 +12,7 @@ from ._results import (
     ik_html,
     singularities_markdown,
 )
+from ._terminal import one_line_text, terminal_text
 from ._table import PICTURE_DPI, PICTURE_SIZE, TABLE_FORMATS, dh_table, robot_html, robot_summary
 
 __all__ = [
@@ -26,4 +27,6 @@ __all__ = [
     "dynamics_latex",
     "derivation_markdown",
     "singularities_markdown",
+    "terminal_text",
+    "one_line_text",
 ]

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..model import DHRobot, JointType
+from ._terminal import one_line_text
 from ._cells import Cell, _angle, _expression, _field, _joint_value, _length, _limits, _plus, _use_degrees
 
 TABLE_FORMATS = ("text", "markdown", "latex", "html")
@@ -91,7 +92,7 @@ def _notes(robot: DHRobot, deg: bool) -> list[tuple[str, Cell]]:
 
 def _title(robot: DHRobot, deg: bool) -> tuple[str, str]:
     kinds = "".join("R" if t is JointType.REVOLUTE else "P" for t in robot.joint_types)
-    first = f"{robot.name}" + (f": {robot.description}" if robot.description else "")
+    first = one_line_text(robot.name) + (f": {one_line_text(robot.description)}" if robot.description else "")
     formula = ("A_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i)" if robot.convention.value == "standard"
                else "A_i = Rx(α_{i-1}) Tx(a_{i-1}) Rz(θ_i) Tz(d_i)")
     second = (f"{robot.convention.value} DH ({formula}), {robot.dof} joint{'s' * (robot.dof != 1)} ({kinds}), "

@@ -8,7 +8,7 @@ from ._urdf_axes import FAR_FOOT, INTERSECT_TOL, PARALLEL_TOL, ROW_CASES
 from ._urdf_in import CHECK_SAMPLES, CHECK_TOL, UrdfImport, from_urdf, import_urdf, urdf_chain_fk
 from ._mjcf_out import MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
-from ._urdf_read import MAX_URDF_LINKS, chain_path, read_urdf
+from ._urdf_read import MAX_NUMBER_CHARS, MAX_URDF_LINKS, chain_path, read_urdf
 from ._xacro import XACRO_CPU_SECONDS, XACRO_MEMORY_BYTES, XACRO_WALL_SECONDS
 from ._xml import MAX_XML_BYTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
 
@@ -36,4 +36,5 @@ __all__ = [
     "XACRO_CPU_SECONDS",
     "XACRO_MEMORY_BYTES",
     "XACRO_WALL_SECONDS",
+    "MAX_NUMBER_CHARS",
 ]

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..chain import chain_of
+from ..errors import ModelError
 from ..model import DHRobot, inertial_rows
 
 __all__ = ["Body", "export_plan", "combine_inertia", "quaternion_wxyz", "num", "nums", "xml_safe"]
@@ -139,7 +140,19 @@ def nums(values) -> str:
 _NOT_XML = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
 
 
-def xml_safe(text: str, limit: int = 200) -> str:
-    """Free text (a robot's name) without the characters XML 1.0 cannot hold (control characters, lone
-    surrogates), cut to ``limit`` characters; quoting is the caller's (``quoteattr``)."""
-    return _NOT_XML.sub("?", str(text))[:limit]
+def xml_safe(text: str, what: str = "the robot name") -> str:
+    """Free text (a robot's name) for an XML 1.0 attribute, returned unchanged when XML can carry it; quoting is
+    the caller's (``quoteattr`` writes newline, CR and tab as ``&#10;`` ``&#13;`` ``&#9;``, so they come back).
+
+    Raises
+    ------
+    ModelError
+        The text holds a character XML 1.0 cannot carry at all, not even as ``&#...;`` (a control character other
+        than tab, newline and CR, such as ESC; a lone surrogate; U+FFFE, U+FFFF): refused rather than changed, so
+        the file never names a different robot.
+    """
+    bad = _NOT_XML.search(str(text))
+    if bad is not None:
+        raise ModelError(f"{what} holds U+{ord(bad.group()):04X} at position {bad.start() + 1}, a character XML 1.0 "
+                         "cannot carry; rename the robot ('name:' in its file) to export it")
+    return str(text)

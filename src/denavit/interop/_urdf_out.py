@@ -9,10 +9,11 @@ keeps it as ``armature``).  A prismatic joint without limits gets ±:data:`denav
 
 from __future__ import annotations
 
-from xml.sax.saxutils import escape, quoteattr
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from .. import _text
 from ..model import MAX_MAGNITUDE, DHRobot
 from ..numeric import rpy_from_rotation
 from ._export import GLYPH_FRACTION, export_plan, num, nums, xml_safe
@@ -65,7 +66,7 @@ def to_urdf(robot: DHRobot) -> str:
     bodies, tool, base_rods = export_plan(robot)
     r = GLYPH_FRACTION * robot_scale(robot)
     name = xml_safe(robot.name)
-    out = ['<?xml version="1.0"?>', f"<!-- {escape(name).replace('--', '- -')}: written by denavit -->",
+    out = ['<?xml version="1.0"?>', f"<!-- {_text.xml_comment(name)}: written by denavit -->",
            f"<robot name={quoteattr(name)}>",
            '  <material name="link"><color rgba="0.55 0.55 0.55 1"/></material>',
            '  <material name="joint"><color rgba="0.25 0.45 0.75 1"/></material>',

@@ -20,7 +20,8 @@ from ..numeric import transform_from_xyz_rpy
 from ._xacro import expand_xacro
 from ._xml import Element, parse_xml, read_xml_source
 
-__all__ = ["UrdfInertial", "UrdfLink", "UrdfJoint", "UrdfModel", "read_urdf", "chain_path", "MOVING", "MAX_URDF_LINKS"]
+__all__ = ["UrdfInertial", "UrdfLink", "UrdfJoint", "UrdfModel", "read_urdf", "chain_path", "MOVING", "MAX_URDF_LINKS",
+           "MAX_NUMBER_CHARS"]
 
 #: Joint types that move and can be a DH row; ``fixed`` folds into the geometry; ``floating`` and ``planar``
 #: (6 and 3 degrees of freedom) have no DH row and are refused on the chain.
@@ -28,6 +29,12 @@ MOVING = ("revolute", "continuous", "prismatic")
 JOINT_TYPES = MOVING + ("fixed", "floating", "planar")
 #: Most links in one URDF.
 MAX_URDF_LINKS = 1000
+
+#: Longest robot name kept (a robot file's limit too); a longer <robot name> is cut.
+MAX_NAME_CHARS = 2000
+#: Longest number read from an attribute, in characters: a 45-digit decimal (an exporter printing many digits) is
+#: a number; a megabyte of digits is refused before it is converted.
+MAX_NUMBER_CHARS = 1000
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\Z")
 
@@ -103,7 +110,9 @@ def _numbers(where: str, el: Element, attr: str, count: int, default: tuple[floa
         raise _fail(where, el, f"{attr}={text[:60]!r}: expected {count} number{'s' if count > 1 else ''}")
     out = []
     for p in parts:
-        if len(p) > 40 or not _NUMBER.match(p):
+        if len(p) > MAX_NUMBER_CHARS:
+            raise _fail(where, el, f"{attr}={text[:60]!r}...: a number longer than {MAX_NUMBER_CHARS} characters")
+        if not _NUMBER.match(p):
             raise _fail(where, el, f"{attr}={text[:60]!r}: {p[:40]!r} is not a number")
         v = float(p)
         if not math.isfinite(v) or abs(v) > bound:
@@ -234,7 +243,7 @@ def read_urdf(source, *, xacro: bool = False) -> UrdfModel:
         joints.append(j)
         parent_joint[j.child] = j
         child_joints.setdefault(j.parent, []).append(j)
-    model = UrdfModel(str(root.attrib.get("name", ""))[:200] or "urdf", where, links, tuple(joints), parent_joint,
+    model = UrdfModel(str(root.attrib.get("name", ""))[:MAX_NAME_CHARS] or "urdf", where, links, tuple(joints), parent_joint,
                       child_joints)
     _check_tree(model)
     return model

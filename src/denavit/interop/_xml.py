@@ -10,6 +10,7 @@ no ``<!DOCTYPE`` is accepted at all.  URDF never needs one.  Every error is one
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Iterator
 
@@ -142,6 +143,11 @@ def parse_xml(data: bytes, where: str) -> Element:
     except expat.ExpatError as exc:
         reason = expat.ErrorString(exc.code)
         raise ParseError(f"line {exc.lineno}: malformed XML ({reason})", where=where) from None
+    except (LookupError, ValueError) as exc:  # encoding="x-nonexistent" (LookupError), "utf-7" (ValueError)
+        declared = re.match(rb"""\s*<\?xml[^>]{0,200}?encoding\s*=\s*["']([^"']{0,40})""", data)
+        name = declared.group(1).decode("ascii", "replace") if declared else "?"
+        raise ParseError(f"line 1: the XML declaration names the encoding {name!r}, which cannot be read here "
+                         f"({' '.join(str(exc).split())[:80]}); save the file as UTF-8", where=where) from None
     except RecursionError:
         raise ParseError(f"nested more than {MAX_XML_DEPTH} levels deep", where=where) from None
     if not root:

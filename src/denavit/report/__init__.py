@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ._capabilities import arm_picture_name
 from ._derivation import MAX_CASES, TOPICS, Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text, derive
 from ._pdf import latex_engine, pdf_from_latex
 from ._render import (
@@ -23,6 +24,7 @@ from ._render import (
 )
 
 __all__ = [
+    "arm_picture_name",
     "TOPICS",
     "MAX_CASES",
     "Derivation",

@@ -10,6 +10,7 @@ IK solutions by forward kinematics, singular values against the Jacobian's rank.
 from __future__ import annotations
 
 import importlib
+import re
 from typing import Any, Callable
 
 import numpy as np
@@ -19,7 +20,19 @@ from ._context import Context
 from ._derivation import Equation, Figure, Numbers, Section, Table, Text
 from ._sections import latex
 
-__all__ = ["section_singularities", "section_figures", "capability"]
+__all__ = ["section_singularities", "section_figures", "capability", "arm_picture_name"]
+
+
+def arm_picture_name(robot_name: str) -> str:
+    """The file name of a report's picture of the arm: ``<name>-arm.png`` with every character of the robot's name
+    other than letters, digits, ``_``, ``.`` and ``-`` written ``_`` (the name is free text; the file name lands in
+    ``\\includegraphics{...}`` and ``![...](...)``, where ``}``, ``)``, ``/`` or a newline would be syntax).
+
+    >>> arm_picture_name("UR5e"), arm_picture_name("x}\\input{/etc/passwd")
+    ('UR5e-arm.png', 'x__input__etc_passwd-arm.png')
+    """
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", robot_name)[:80].lstrip(".-") or "robot"
+    return f"{stem}-arm.png"
 
 
 def capability(module: str, *names: str) -> tuple[str, Callable[..., Any]] | None:
@@ -128,4 +141,4 @@ def section_figures(ctx: Context) -> Section:
         return Section("figures", "Figures", (), status="unavailable",
                        reason=f"the picture could not be drawn ({type(exc).__name__}: {exc})")
     caption = "The arm at the numeric case, with its DH frames."
-    return Section("figures", "Figures", (Figure(buf.getvalue(), caption, f"{ctx.robot.name}-arm.png"),))
+    return Section("figures", "Figures", (Figure(buf.getvalue(), caption, arm_picture_name(ctx.robot.name)),))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from .. import _text
 from .. import symbolic as S
 from ..model import Convention, JointType
 from ..numeric import forward_kinematics, link_transforms
@@ -52,7 +53,9 @@ def section_model(ctx: Context) -> Section:
                      f"\\text{{{link.joint.value}}}"))
     kinds = ", ".join(t.value for t in robot.joint_types)
     steps: list = [
-        Text(f"{robot.description or robot.name}. {robot.dof} joints ({kinds}); {robot.n_rows} DH rows."),
+        # free text: one line, and no $ (a Text's $...$ is mathematics, raw LaTeX in a .tex report): ＄ instead
+        Text(f"{_text.visible(robot.description or robot.name).replace('$', '＄')}. {robot.dof} joints ({kinds}); "
+             f"{robot.n_rows} DH rows."),
         Text(_formula_text(robot.convention)),
         Text("Joint variables are $q_1, \\dots, q_n$: $q_i$ is $\\theta_i$ of a revolute joint and $d_i$ of a "
              "prismatic one.  Lengths in m, angles in rad."),
