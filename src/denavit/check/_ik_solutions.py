@@ -13,7 +13,8 @@ from .. import numeric as N
 from ..errors import ParseError
 from ..ik import analytic_ik
 from ..model import DHRobot
-from ._ik_targets import MATCH_TOL, controlled_rows, free_joints, joint_distance, pose_error, revolute_mask
+from ._ik_targets import (MATCH_TOL, controlled_rows, free_joints, joint_distance, pose_error, revolute_mask,
+                          rigid_target)
 from ._latex import parse_math
 from ._matrices import parse_matrix
 
@@ -71,6 +72,7 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
         raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
     if T.shape != (4, 4):
         raise ParseError(f"'T' must be 4×4, got {T.shape}")
+    rigid_target(T)  # a matrix that is no pose (bottom row 5 5 5 5) makes the claim unreadable, not judged
     claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
     try:
         res = analytic_ik(robot, T)

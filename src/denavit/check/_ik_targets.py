@@ -9,13 +9,35 @@ from typing import Any
 import numpy as np
 
 from .. import numeric as N
+from ..errors import ParseError
 from ..model import DHRobot, JointType
 
-__all__ = ["MATCH_TOL", "POSE_COLUMNS", "revolute_mask", "joint_distance", "target_env", "controlled_rows",
-           "pose_error", "reaches", "free_joints"]
+__all__ = ["MATCH_TOL", "POSE_COLUMNS", "RIGID_TOL", "revolute_mask", "joint_distance", "target_env",
+           "controlled_rows", "pose_error", "reaches", "free_joints", "rigid_target"]
 
 MATCH_TOL = 1e-6
 POSE_COLUMNS = {"n": 0, "o": 1, "a": 2}
+#: A claimed target's rotation R may be off orthonormal by this much (max |RᵀR − I|): entries written with a few
+#: decimals (0.707 for √2/2 is 3e-4 off); a matrix further off is no pose, and the claim is unreadable.
+RIGID_TOL = 1e-2
+
+
+def rigid_target(T: np.ndarray) -> np.ndarray:
+    """``T`` when it is a rigid transform (finite, bottom row 0 0 0 1, R orthonormal within :data:`RIGID_TOL` and
+    det R > 0: a rotation, no reflection); ParseError naming what is wrong otherwise (the claim is unreadable)."""
+    if not np.all(np.isfinite(T)):
+        raise ParseError("'T' has entries that are not finite; it is not a pose")
+    if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], rtol=0.0, atol=1e-12):
+        raise ParseError("'T' is not a rigid transform: its bottom row is [" + ", ".join(f"{x:.6g}" for x in T[3])
+                         + "], expected [0, 0, 0, 1]")
+    R = T[:3, :3]
+    err = float(np.abs(R.T @ R - np.eye(3)).max())
+    if err > RIGID_TOL:
+        raise ParseError(f"'T' is not a rigid transform: its rotation part is not orthonormal (max |RᵀR − I| = "
+                         f"{err:.3g} > {RIGID_TOL:g})")
+    if np.linalg.det(R) < 0:
+        raise ParseError("'T' is not a rigid transform: its rotation part is a reflection (det R < 0)")
+    return T
 
 
 def revolute_mask(robot: DHRobot) -> np.ndarray:
