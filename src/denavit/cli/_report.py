@@ -37,10 +37,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_no_clobber(p)
     p.set_defaults(handler=cmd_report)
 
-    p = sub.add_parser("check", help="check a person's derivation (claims file) against the library")
-    add_common(p, angles=False)
-    p.add_argument("claims", metavar="CLAIMS_FILE", help="YAML claims file (see docs/claims.md)")
+    p = sub.add_parser("check", help="grade a report as written (.md/.tex/.txt) or a claims file, result by result",
+                       description="denavit check [ROBOT] REPORT.md grades a derivation as written (the arm from the "
+                       "report's own DH table(s) unless ROBOT is given); denavit check ROBOT CLAIMS.yaml judges a "
+                       "claims file. See docs/grading.md and docs/claims.md.")
+    add_common(p, robot=False, angles=False)
+    p.add_argument("robot", metavar="ROBOT", help="built-in name or robot file (optional for a report)")
+    p.add_argument("claims", metavar="REPORT", nargs="?",
+                   help="the report (.md, .markdown, .tex, .txt) or a YAML claims file (see docs/claims.md)")
+    p.add_argument("--arm", action="append", default=[], metavar="SECTION=ROBOT",
+                   help="the arm of one section of a report (SECTION: the heading's number, e.g. 3 for '3) …' or "
+                        "'## 3. …'); repeatable")
+    p.add_argument("-o", "--output", metavar="FILE", help="the report handed back annotated: .html (typeset, a mark "
+                   "beside every judged equation) or .md (verdicts as quotes under each equation)")
+    p.add_argument("--all", action="store_true", help="list the equations that state no result too")
     p.add_argument("--seed", type=nonneg_int, default=0, help="seed of the random test points (default 0)")
+    add_no_clobber(p)
     p.set_defaults(handler=cmd_check)
 
     p = sub.add_parser("import-table", help="read a DH table pasted from a document and write a robot file")
@@ -181,12 +193,62 @@ def derivation_json(d) -> dict[str, Any]:
     return {**d.inputs, "title": d.title, "sections": sections}
 
 
+#: Files ``check -o`` writes: the annotated report.
+CHECKED_SUFFIXES = (".html", ".htm", ".md", ".markdown")
+
+
+def _arms(items: list[str]) -> dict[str, Any]:
+    from ..io import load_robot
+
+    arms: dict[str, Any] = {}
+    for item in items:
+        key, sep, name = item.partition("=")
+        if not sep or not key.strip() or not name.strip():
+            raise ParseError(f"--arm {item[:80]!r}: expected SECTION=ROBOT, e.g. --arm 3=articulated-rrr")
+        if key.strip() in arms:
+            raise ParseError(f"--arm: section {key.strip()[:40]!r} given twice")
+        arms[key.strip()] = load_robot(name.strip())
+    return arms
+
+
 def cmd_check(args: argparse.Namespace):
+    from ..grade import REPORT_SUFFIXES
+
+    if args.claims is None:
+        args.robot, args.claims = None, args.robot
+    path = Path(args.claims)
+    if path.suffix.lower() in REPORT_SUFFIXES:
+        return _check_report(args, path)
+    if args.robot is None:
+        raise ParseError(f"{args.claims!r}: a claims file needs the arm: denavit check ROBOT {args.claims} (a report "
+                         f"is {', '.join(REPORT_SUFFIXES)})")
+    if args.output or args.arm:
+        raise ParseError("-o and --arm are for reports (.md, .tex, .txt), not claims files")
     from ..check import check_file, verdicts_text
 
     robot = load(args)
-    result = check_file(robot, Path(args.claims), seed=args.seed)
+    result = check_file(robot, path, seed=args.seed)
     return result.to_json(), verdicts_text(result)
+
+
+def _check_report(args: argparse.Namespace, path: Path):
+    from ..grade import grade_report, render_checked_html, render_checked_markdown
+    from ..grade._present import graded_text
+
+    check_output(args, args.output, CHECKED_SUFFIXES)
+    robot = load(args) if args.robot is not None else None
+    report = grade_report(path, robot, _arms(args.arm), seed=args.seed)
+    msg = graded_text(report, show_all=args.all)
+    if args.output:
+        render = render_checked_html if Path(args.output).suffix.lower() in (".html", ".htm") else \
+            render_checked_markdown
+        text = render(report)
+        with output_file(args.output) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+        msg += f"\nwrote {args.output}"
+    data = report.to_json()
+    data.pop("text", None)
+    return {**data, "output": args.output}, msg
 
 
 def cmd_import_table(args: argparse.Namespace):
