@@ -253,6 +253,45 @@ def f05():
     ]
 
 
+# --- 06: two arms in two sections, each with its own table ------------------------------------------------------
+
+@fixture("06_two_arms.md")
+def f06():
+    a1, a2 = sp.symbols("a1 a2", positive=True)
+    D2 = sp.Symbol("d2", real=True)
+    arm = Arm("mdh", [(0, 0, 0, t1), (a1, 0, 0, t2), (a2, 0, 0, 0)], [("R", t1), ("R", t2), None])
+    c1, s1, c2, s2, c12, s12 = c(t1), s(t1), c(t2), s(t2), c(t1 + t2), s(t1 + t2)
+    w1, w2 = sp.symbols("qd1:3", real=True)
+    fx, fy = sp.symbols("f_x f_y", real=True)
+    J3 = arm.jacobian_in(3)
+    tau = J3.T * col(fx, fy, 0, 0, 0, 0)          # the wrench in frame 3 (tool) axes
+    rp = Arm("std", [(0, pi / 2, sp.Rational(3, 10), t1), (0, 0, D2, 0)], [("R", t1), ("P", D2)])
+    Jrp = rp.jacobian()
+    f = sp.Float
+    return [
+        R("correct", "0T3", M([c12, -s12, 0, a1 * c1 + a2 * c12], [s12, c12, 0, a1 * s1 + a2 * s12], [0, 0, 1, 0],
+                              [0, 0, 0, 1]), arm.T(0)),
+        R("incorrect", "2v2: entries swapped", col(a1 * c2 * w1, a1 * s2 * w1, 0), frame_velocity(arm, 2)[1]),
+        R("correct", "3v3", col(a1 * s2 * w1, a1 * c2 * w1 + a2 * (w1 + w2), 0), frame_velocity(arm, 3)[1]),
+        R("incorrect", "3J: c2 for s2 in (1,1)", M([a1 * c2, 0], [a1 * c2 + a2, a2], [0, 0], [0, 0], [0, 0], [1, 1]), J3),
+        R("correct", "1n1", col(0, 0, a1 * s2 * fx + (a1 * c2 + a2) * fy), force_moment(arm, 1, [fx, fy, 0], [0, 0, 0])[1]),
+        R("correct", "tau_1", a1 * s2 * fx + (a1 * c2 + a2) * fy, tau[0]),
+        R("correct", "tau_2", a2 * fy, tau[1]),
+        R("correct", "det 3J_v", a1 * a2 * s2, J3[:2, :].det()),
+        R("correct", "singular theta2 = 0, pi", test=lambda: singular_set_ok(J3[:2, :].det(), [s2])),
+        R("correct", "general Spong matrix T_{i-1}^i",
+          M([c(thi), -s(thi) * c(ali), s(thi) * s(ali), ai * c(thi)], [s(thi), c(thi) * c(ali), -c(thi) * s(ali), ai * s(thi)],
+            [0, s(ali), c(ali), di], [0, 0, 0, 1]), link("std", ai, ali, di, thi)),
+        R("correct", "T_0^1", M([c1, 0, s1, 0], [s1, 0, -c1, 0], [0, 1, 0, f(0.3)], [0, 0, 0, 1]), rp.A(1)),
+        R("correct", "T_1^2", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, D2], [0, 0, 0, 1]), rp.A(2)),
+        R("incorrect", "T_0^2: sign of (2,4)", M([c1, 0, s1, D2 * s1], [s1, 0, -c1, D2 * c1], [0, 1, 0, f(0.3)],
+                                                 [0, 0, 0, 1]), rp.T(0)),
+        R("correct", "J (vx, vy, wz)", M([D2 * c1, s1], [D2 * s1, -c1], [1, 0]), Jrp.extract([0, 1, 5], [0, 1])),
+        R("correct", "det J_v", -D2, Jrp[:2, :].det()),
+        R("correct", "singular when d2 = 0", test=lambda: singular_set_ok(Jrp[:2, :].det(), [D2], joints=(t1, D2))),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
