@@ -292,6 +292,52 @@ def f06():
     ]
 
 
+# --- 07: planar 3R Lagrangian dynamics, catalogue arm (robot=planar3r-lagrange), no table -----------------------
+
+@fixture("07_planar3r_lagrange.md")
+def f07():
+    from _truth_dh import planar_lagrange
+    L = sp.symbols("L1:4", positive=True)
+    Lc = sp.symbols("Lc1:4", positive=True)
+    m = sp.symbols("m1:4", positive=True)
+    II = sp.symbols("I1:4", positive=True)
+    g = sp.Symbol("g", positive=True)
+    pcs, vcs, K, V, Mq, G = planar_lagrange(3, L, Lc, m, II, g)
+    c1, s1, c2, c3 = c(t1), s(t1), c(t2), c(t3)
+    c12, s12, c23, c123, s123 = c(t1 + t2), s(t1 + t2), c(t2 + t3), c(t1 + t2 + t3), s(t1 + t2 + t3)
+    w1, w2, w3 = sp.symbols("qd1:4", real=True)
+    L1_, L2_, L3_ = L
+    Lc1, Lc2, Lc3 = Lc
+    m1, m2, m3 = m
+    I1, I2, I3 = II
+    # the catalogue's values (the report states them in step 4)
+    num = {L1_: 1, L2_: 0.8, L3_: 0.6, Lc1: 0.5, Lc2: 0.4, Lc3: 0.3, m1: 2, m2: 1.5, m3: 1, I1: 1 / 6, I2: 0.08,
+           I3: 0.03, g: 9.81}
+    case = {t1: 0, t2: pi / 2, t3: -pi / 2}
+    return [
+        R("correct", "p_c1", col(Lc1 * c1, Lc1 * s1, 0), pcs[0]),
+        R("correct", "p_c2", col(L1_ * c1 + Lc2 * c12, L1_ * s1 + Lc2 * s12, 0), pcs[1]),
+        R("correct", "pdot_c3", col(-L1_ * s1 * w1 - L2_ * s12 * (w1 + w2) - Lc3 * s123 * (w1 + w2 + w3),
+                                    L1_ * c1 * w1 + L2_ * c12 * (w1 + w2) + Lc3 * c123 * (w1 + w2 + w3), 0), vcs[2]),
+        R("correct", "V", g * (m1 * Lc1 * s1 + m2 * (L1_ * s1 + Lc2 * s12) + m3 * (L1_ * s1 + L2_ * s12 + Lc3 * s123)), V),
+        R(NC, "Lagrange's equation"),
+        R("correct", "M11", I1 + I2 + I3 + m1 * Lc1 ** 2 + m2 * (L1_ ** 2 + Lc2 ** 2 + 2 * L1_ * Lc2 * c2)
+          + m3 * (L1_ ** 2 + L2_ ** 2 + Lc3 ** 2 + 2 * L1_ * L2_ * c2 + 2 * L1_ * Lc3 * c23 + 2 * L2_ * Lc3 * c3), Mq[0, 0]),
+        R("correct", "M12", I2 + I3 + m2 * (Lc2 ** 2 + L1_ * Lc2 * c2)
+          + m3 * (L2_ ** 2 + Lc3 ** 2 + L1_ * L2_ * c2 + L1_ * Lc3 * c23 + 2 * L2_ * Lc3 * c3), Mq[0, 1]),
+        R("incorrect", "M22: the factor 2 of 2 L2 Lc3 c3 missing",
+          I2 + I3 + m2 * Lc2 ** 2 + m3 * (L2_ ** 2 + Lc3 ** 2 + L2_ * Lc3 * c3), Mq[1, 1]),
+        R("correct", "M23", I3 + m3 * (Lc3 ** 2 + L2_ * Lc3 * c3), Mq[1, 2]),
+        R("correct", "M33", I3 + m3 * Lc3 ** 2, Mq[2, 2]),
+        R("incorrect", "g(theta): sign of the m3 Lc3 c123 term of g_2",
+          g * col((m1 * Lc1 + m2 * L1_ + m3 * L1_) * c1 + (m2 * Lc2 + m3 * L2_) * c12 + m3 * Lc3 * c123,
+                  (m2 * Lc2 + m3 * L2_) * c12 - m3 * Lc3 * c123, m3 * Lc3 * c123), G),
+        R("correct", "M(q) at the case", M([4.8467, 1.38, 0.42], [1.38, 1.08, 0.12], [0.42, 0.12, 0.12]),
+          Mq.subs(num).subs(case), tol=1e-4),
+        R("correct", "g(q) at the case", col(37.278, 2.943, 2.943), G.subs(num).subs(case), tol=1e-3),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:

@@ -233,3 +233,25 @@ def ik_ok(arm: Arm, joint: int, formula: Callable[[dict, dict], float], n: int =
     return True
 
 
+
+
+def planar_lagrange(n: int, L, Lc, m, I, g):
+    """Planar nR arm in a vertical plane (gravity −y): centre of mass of link i at Lc_i along it, inertia I_i
+    about it. Returns (p_c list, ṗ_c list, K, V, M, gravity vector) from K = Σ ½ mᵢ|ṗ_ci|² + ½ Iᵢ ωᵢ²."""
+    q = T[:n]
+    qd = [sp.Symbol("qd%d" % k, real=True) for k in range(1, n + 1)]
+    pcs, vcs = [], []
+    K = 0
+    for i in range(n):
+        ang = [sum(q[:k + 1]) for k in range(i + 1)]
+        x = sum(L[k] * c(ang[k]) for k in range(i)) + Lc[i] * c(ang[i])
+        y = sum(L[k] * s(ang[k]) for k in range(i)) + Lc[i] * s(ang[i])
+        p = sp.Matrix([x, y, 0])
+        v = sum((p.diff(qq) * w for qq, w in zip(q, qd)), sp.zeros(3, 1))
+        pcs.append(p)
+        vcs.append(v)
+        K += m[i] * (v.T * v)[0] / 2 + I[i] * sum(qd[:i + 1]) ** 2 / 2
+    V = sum(m[i] * g * pcs[i][1] for i in range(n))
+    Mq = sp.Matrix(n, n, lambda i, j: sp.diff(K, qd[i], qd[j]))
+    G = sp.Matrix([sp.diff(V, qq) for qq in q])
+    return pcs, vcs, sp.expand(K), V, Mq, G
