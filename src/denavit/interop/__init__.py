@@ -6,7 +6,7 @@ Importing this package loads no XML library beyond the standard library's expat.
 
 from ._urdf_axes import FAR_FOOT, INTERSECT_TOL, PARALLEL_TOL, ROW_CASES
 from ._urdf_in import CHECK_SAMPLES, CHECK_TOL, UrdfImport, from_urdf, import_urdf, urdf_chain_fk
-from ._mjcf_out import MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
+from ._mjcf_out import MJCF_BALANCE_MARGIN, MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
 from ._urdf_read import MAX_NUMBER_CHARS, MAX_URDF_LINKS, chain_path, read_urdf
 from ._xacro import XACRO_CPU_SECONDS, XACRO_MEMORY_BYTES, XACRO_WALL_SECONDS
@@ -18,6 +18,7 @@ __all__ = [
     "to_mjcf",
     "MJCF_MIN_MASS",
     "MJCF_MIN_INERTIA",
+    "MJCF_BALANCE_MARGIN",
     "import_urdf",
     "UrdfImport",
     "read_urdf",

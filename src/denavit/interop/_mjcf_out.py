@@ -20,7 +20,7 @@ from ..errors import DenavitWarning
 from ..model import DHRobot
 from ._export import GLYPH_FRACTION, export_plan, num, nums, quaternion_wxyz, xml_safe
 
-__all__ = ["to_mjcf", "MJCF_MIN_MASS", "MJCF_MIN_INERTIA"]
+__all__ = ["to_mjcf", "MJCF_MIN_MASS", "MJCF_MIN_INERTIA", "MJCF_BALANCE_MARGIN"]
 
 #: Smallest principal moment of inertia written [kg m²]: MuJoCo refuses a tensor that is not positive definite
 #: (point masses, thin rods), so smaller moments are raised to this (a change far below any arm's M).
@@ -28,6 +28,9 @@ MJCF_MIN_INERTIA = 1e-10
 #: Mass [kg] (and inertia 1e-3 of it [kg m²] per axis) given to a body without inertial data: MuJoCo refuses a
 #: moving body without mass.  Dynamics of such an arm in MuJoCo are then not denavit's (it has none).
 MJCF_MIN_MASS = 1e-6
+#: Relative margin by which the MJCF's principal moments meet A + B >= C: MuJoCo recomputes the moments from
+#: ``fullinertia`` and refuses any shortfall, so an exactly balanced tensor (a flat plate) fails about half the time.
+MJCF_BALANCE_MARGIN = 1e-9
 
 
 def _pose(T: np.ndarray) -> str:
@@ -36,18 +39,27 @@ def _pose(T: np.ndarray) -> str:
 
 def _mujoco_inertia(I: np.ndarray, body: str) -> np.ndarray:
     """``I`` as MuJoCo accepts it: principal moments at least :data:`MJCF_MIN_INERTIA`, and meeting the triangle
-    inequality A + B >= C (a massless rotor's lone moment about its axis breaks it): the two smaller moments are
-    then raised, with a warning (exact for the first body, which only turns about its axis)."""
+    inequality with a margin, A + B >= C (1 + :data:`MJCF_BALANCE_MARGIN`).
+
+    MuJoCo (``user_objects.cc``) refuses A + B < C with no tolerance, on moments it computes itself from
+    ``fullinertia``: a tensor balanced exactly in numpy's eigenvalues (a flat plate, C = A + B; a thin rod raised to
+    the minimum moment) comes out a few ulps short there about half the time.  The two smaller moments are raised
+    by (C (1 + margin) - A - B) / 2 each; a body truly off the inequality (a massless rotor's lone moment about
+    its axis) draws a warning saying by how much (exact for the first body, which only turns about its axis).
+    """
     w, V = np.linalg.eigh(I)  # ascending
-    if w[0] >= MJCF_MIN_INERTIA and w[0] + w[1] >= w[2]:
+    need = w[2] * (1 + MJCF_BALANCE_MARGIN)
+    if w[0] >= MJCF_MIN_INERTIA and w[0] + w[1] >= need:
         return I
     w = np.maximum(w, MJCF_MIN_INERTIA)
-    gap = w[2] - w[0] - w[1]
+    need = w[2] * (1 + MJCF_BALANCE_MARGIN)
+    gap = need - w[0] - w[1]
     if gap > 0:
         w[0] += gap / 2
         w[1] += gap / 2
-        warnings.warn(f"{body}: its principal moments break MuJoCo's A + B >= C; the two smaller ones are raised "
-                      f"by {gap / 2:.3g} kg m² in the MJCF", DenavitWarning, stacklevel=3)
+        if gap > 2 * MJCF_BALANCE_MARGIN * w[2]:  # more than the margin itself: the tensor broke the inequality
+            warnings.warn(f"{body}: its principal moments break MuJoCo's A + B >= C; the two smaller ones are raised "
+                          f"by {gap / 2:.3g} kg m² in the MJCF", DenavitWarning, stacklevel=3)
     return (V * w) @ V.T
 
 
