@@ -246,6 +246,6 @@ def save_robot(robot: DHRobot, path: str | Path, *, overwrite: bool = False) -> 
     if path.suffix.lower() not in (".yaml", ".yml", ".json"):
         raise ParseError(f"{str(path)!r}: unsupported file type {path.suffix or '(none)'!r}; expected .yaml, .yml or .json")
     if path.exists() and not overwrite:
-        raise ParseError(f"{str(path)!r} exists; not overwriting it (choose another name or pass --force)")
+        raise ParseError(f"{str(path)!r} exists; not overwriting it (choose another name or pass overwrite=True)")
     fmt = "json" if path.suffix.lower() == ".json" else "yaml"
     path.write_text(dump_robot(robot, fmt), encoding="utf-8")
