@@ -1,0 +1,226 @@
+"""The report reader of ``denavit check REPORT``: what it understands, where it places verdicts, what it refuses.
+
+The truths here are textbook results written by hand (the planar 2R arm of Spong, Sec. 3.2: x = L1 c1 + L2 c12 …)
+and the library's own catalogue arms; the fixture corpus (tests/test_grade_corpus.py) covers whole reports.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import subprocess
+import sys
+
+import pytest
+
+from denavit.cli import main
+from denavit.grade import grade_text
+from denavit.grade._lhs import read_symbol
+from denavit.grade._names import read_name
+from denavit.grade._split import split_block
+from denavit.io import load_robot
+
+TABLE = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | $L_1$ | 0 | 0 | $\\theta_1$ |
+| 2 | $L_2$ | 0 | 0 | $\\theta_2$ |
+"""
+
+
+def _report(*blocks: str) -> str:
+    return "# Planar arm\n\n" + TABLE + "\n" + "\n\n".join(blocks) + "\n"
+
+
+def _verdicts(text: str, **kw) -> list[tuple[int, str, str]]:
+    r = grade_text(text, **kw)
+    return [(c.line, c.quantity, c.verdict) for c in r.claims]
+
+
+@pytest.mark.parametrize("lhs, spec", [
+    ("{}^{0}T_{1}", {"quantity": "link_transform", "index": 1}),
+    ("^{0}_{1}T", {"quantity": "link_transform", "index": 1}),
+    ("T_0^1", {"quantity": "link_transform", "index": 1}),
+    ("T_1^0", {"quantity": "link_transform", "index": 1}),
+    ("A_2", {"quantity": "link_transform", "index": 2}),
+    ("T01", {"quantity": "link_transform", "index": 1}),
+    ("{}^{1}R_{3}", {"quantity": "transform", "from": 1, "to": 3}),
+    ("T_{i-1}^{i}", {"quantity": "dh_matrix"}),
+    ("p_x", {"quantity": "position", "entry": 1}),
+    ("p_E", {"quantity": "position"}),
+    ("\\dot{p}_{c3}", {"quantity": "com_velocity", "index": 3}),
+    ("J", {"quantity": "jacobian"}),
+    ("J_v", {"quantity": "jacobian", "rows": "linear"}),
+    ("J_\\omega", {"quantity": "jacobian", "rows": "angular"}),
+    ("J_{11}", {"quantity": "jacobian", "entry": [1, 1]}),
+    ("J_{\\vartheta_2}", {"quantity": "jacobian", "column": 2}),
+    ("{}^0J", {"quantity": "jacobian", "frame": 0}),
+    ("{}^3J", {"quantity": "jacobian", "frame": 3}),
+    ("J^T", {"quantity": "jacobian", "transpose": True}),
+    ("\\tau", {"quantity": "torques"}),
+    ("{}^2\\omega_2", {"quantity": "omega", "index": 2}),
+    ("{}^1 v_1", {"quantity": "velocity", "index": 1}),
+    ("{}^2\\mathbf{f}_2", {"quantity": "force", "index": 2}),
+    ("{}^1n_1", {"quantity": "moment", "index": 1}),
+    ("\\det J", {"quantity": "det_jacobian"}),
+    ("M(q)", {"quantity": "mass_matrix"}),
+    ("M_{12}", {"quantity": "mass_matrix", "entry": [1, 2]}),
+    ("g(\\theta)", {"quantity": "gravity"}),
+])
+def test_left_hand_sides_are_read_as_textbooks_write_them(lhs, spec):
+    robot = load_robot("articulated-rrr")
+    sym = read_symbol(lhs)
+    assert sym is not None, lhs
+    reading = read_name(sym, robot)
+    assert reading is not None, lhs
+    assert {k: reading.spec.get(k) for k in spec} == spec
+
+
+@pytest.mark.parametrize("lhs", ["\\delta d", "(\\delta q)^T \\tau", "e_{z_i}", "p_p", "J_{\\vartheta_{Li}}",
+                                 "{}^4 w_0", "x^2 + y^2"])
+def test_names_that_are_no_result_get_no_reading(lhs):
+    robot = load_robot("articulated-rrr")
+    sym = read_symbol(lhs)
+    assert sym is None or read_name(sym, robot) is None
+
+
+def test_aligned_rows_chains_and_quads_split_into_equations():
+    eqs = split_block("\\begin{aligned} x &= L_1 c_1 \\\\ y &= L_1 s_1 \\\\ &\\quad + L_2 s_{12} \\end{aligned}", 5, 7)
+    assert [e.parts[0] for e in eqs] == ["x", "y"]
+    assert "L_2 s_{12}" in eqs[1].parts[-1]
+    eqs = split_block("\\det J = 0 \\Rightarrow L_1 L_2 s_2 = 0 \\Rightarrow \\theta_2 = 0", 3, 3)
+    assert len(eqs) == 3 and eqs[-1].parts == ("\\theta_2", "0")
+    eqs = split_block("x = L_1 c_1 \\quad \\dot{x} = -L_1 s_1 \\dot\\theta_1", 1, 1)
+    assert [e.parts[0] for e in eqs] == ["x", "\\dot{x}"]
+    eqs = split_block("\\theta_2 = 0, \\pi", 1, 1)  # a comma inside a list of values splits nothing
+    assert len(eqs) == 1
+
+
+def test_verdicts_land_on_the_lines_of_their_equations():
+    text = _report("$$T_0^2 = \\begin{bmatrix} c_{12} & -s_{12} & 0 & L_1 c_1 + L_2 c_{12} \\\\ s_{12} & c_{12} & 0 & "
+                   "L_1 s_1 + L_2 s_{12} \\\\ 0 & 0 & 1 & 0 \\\\ 0 & 0 & 0 & 1 \\end{bmatrix}$$",
+                   "$$x = L_1 c_1 - L_2 c_{12}$$")
+    got = _verdicts(text)
+    lines = text.splitlines()
+    t_line = 1 + next(k for k, s in enumerate(lines) if s.startswith("$$T_0^2"))
+    x_line = 1 + next(k for k, s in enumerate(lines) if s.startswith("$$x ="))
+    assert got == [(t_line, "end_effector", "correct"), (x_line, "position", "incorrect")]
+
+
+def test_a_misread_name_is_ambiguous_never_incorrect():
+    """T_1^0 with the inverse of A_1 under it: right for one reading of the name, so a question, not a mistake."""
+    inverse = ("$$T_1^0 = \\begin{bmatrix} c_1 & s_1 & 0 & -L_1 \\\\ -s_1 & c_1 & 0 & 0 \\\\ 0 & 0 & 1 & 0 \\\\ "
+               "0 & 0 & 0 & 1 \\end{bmatrix}$$")
+    (line, qty, verdict), = _verdicts(_report(inverse))
+    assert (qty, verdict) == ("link_transform", "ambiguous")
+    craig = inverse.replace("T_1^0", "{}^{1}T_{0}")  # Craig's left superscript is explicit: the inverse, correct
+    assert _verdicts(_report(craig))[0][2] == "correct"
+
+
+def test_case_numbers_are_judged_at_that_case_and_without_a_case_are_not_called_wrong():
+    at_case = _report("Case 1: $q = (0, \\pi/2)$", "$$p_x = L_1$$")  # x = L1 c1 + L2 c12 = L1 at (0, π/2)
+    assert [v for *_, v in _verdicts(at_case)] == ["not a claim", "correct"]
+    wrong = _report("Case 1: $q = (0, \\pi/2)$", "$$p_x = L_2$$")
+    assert [v for *_, v in _verdicts(wrong)][-1] == "incorrect"
+    robot = load_robot("planar2r")
+    no_case = "# arm\n\n$$p_x = 0.5$$\n"
+    assert _verdicts(no_case, robot=robot)[0][2] == "ambiguous"
+
+
+def test_inverse_trig_as_textbooks_write_it_is_the_inverse_function():
+    text = _report("$$\\theta_2 = \\cos^{-1}\\left(\\frac{p_x^2 + p_y^2 - L_1^2 - L_2^2}{2 L_1 L_2}\\right)$$")
+    assert _verdicts(text)[0][1:] == ("ik_formula", "correct")
+
+
+def test_singular_configurations_in_words_are_one_claim():
+    right = _report("The arm is singular when $\\theta_2 = 0$ or $\\theta_2 = \\pi$.")
+    wrong = _report("The arm is singular when $\\theta_1 = 0$.")
+    assert [v for _, q, v in _verdicts(right) if q == "singularities"] == ["correct"]
+    assert [v for _, q, v in _verdicts(wrong) if q == "singularities"] == ["incorrect"]
+
+
+def test_definitions_and_givens_are_not_claims():
+    got = _verdicts(_report("$$T_0^2 = A_1 A_2$$", "$$\\tau = J^T F$$", "$$F = \\begin{bmatrix} 1 \\\\ 2 \\\\ 0 "
+                                                                    "\\end{bmatrix}$$"))
+    assert [v for *_, v in got] == ["not a claim", "not a claim", "not a claim"]
+
+
+def test_each_table_governs_its_own_section():
+    two = ("## 1. First arm\n\n" + TABLE + "\n$$x = L_1 c_1 + L_2 c_{12}$$\n\n## 2. Second arm\n\n"
+           "| i | $a_{i-1}$ | $\\alpha_{i-1}$ | $d_i$ | $\\theta_i$ |\n|---|---|---|---|---|\n"
+           "| 1 | 0 | 0 | 0 | $\\theta_1$ |\n| 2 | $L_1$ | 0 | 0 | $\\theta_2$ |\n\n$$x = L_1 c_1$$\n")
+    r = grade_text(two)
+    assert [a.convention for a in r.arms] == ["standard", "modified"]
+    assert [c.verdict for c in r.claims] == ["correct", "correct"]  # the second arm's tip is joint 2's axis
+    assert r.claims[0].arm != r.claims[1].arm
+
+
+def test_a_section_about_another_arm_without_a_table_is_not_judged_against_the_first():
+    text = _report("$$x = L_1 c_1 + L_2 c_{12}$$") + "\n# 2. Dynamics of a 3DOF arm\n\n$$x = L_1 c_1$$\n"
+    got = grade_text(text).claims
+    assert [c.verdict for c in got] == ["correct", "unreadable"]
+    assert "--arm" in got[1].message
+
+
+def test_pathological_equations_are_their_own_unreadable_and_the_run_is_bounded():
+    evil = ["$$x = " + "(" * 5000 + "$$", "$$J = \\begin{bmatrix}" + " 1 &" * 20000 + "\\end{bmatrix}$$",
+            "$$p_x = " + " + ".join(["L_1"] * 3000) + "$$", "$$" + "{" * 3000 + "$$", "$$x = L_1 c_1 + L_2 c_{12}$$"]
+    start = resource.getrusage(resource.RUSAGE_SELF).ru_utime
+    r = grade_text(_report(*evil))
+    spent = resource.getrusage(resource.RUSAGE_SELF).ru_utime - start
+    assert r.claims[-1].verdict == "correct"  # the good one after the bad ones is still judged
+    assert all(c.verdict in ("unreadable", "not a claim", "incorrect") for c in r.claims[:-1])
+    assert spent < 60
+
+
+def test_cli_report_json_has_lines_verdicts_and_arms(tmp_path, capsys):
+    rep = tmp_path / "hw.md"
+    text = _report("$$x = L_1 c_1 + L_2 c_{12}$$", "$$y = L_1 s_1$$")
+    rep.write_text(text, encoding="utf-8")
+    assert main(["check", str(rep), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    claims = [{k: c[k] for k in ("line", "end_line", "quantity", "verdict")} for c in data["claims"]]
+    x, y = (1 + text.splitlines().index(s) for s in ("$$x = L_1 c_1 + L_2 c_{12}$$", "$$y = L_1 s_1$$"))
+    assert claims == [{"line": x, "end_line": x, "quantity": "position", "verdict": "correct"},
+                      {"line": y, "end_line": y, "quantity": "position", "verdict": "incorrect"}]
+    assert all({"arm", "message"} <= set(c) for c in data["claims"]) and data["arms"][0]["dof"] == 2
+
+
+def test_cli_annotated_markdown_keeps_every_line_and_refuses_to_overwrite_the_report(tmp_path, capsys):
+    rep = tmp_path / "hw.md"
+    text = _report("$$x = L_1 c_1 + L_2 c_{12}$$")
+    rep.write_text(text, encoding="utf-8")
+    out = tmp_path / "checked.md"
+    assert main(["check", str(rep), "-o", str(out)]) == 0
+    marked = out.read_text(encoding="utf-8").splitlines()
+    it = iter(marked)
+    assert all(any(line == m for m in it) for line in text.splitlines())  # the original, in order
+    assert any("correct" in m and m.startswith(">") for m in marked)
+    assert main(["check", str(rep), "-o", str(rep)]) == 2
+    assert rep.read_text(encoding="utf-8") == text
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("content, expect", [
+    (b"\xff\xfe\x00garbage", "not UTF-8"),
+    (b"", "no DH table"),
+])
+def test_cli_bad_reports_one_line(tmp_path, content, expect):
+    rep = tmp_path / "bad.md"
+    rep.write_bytes(content)
+    res = subprocess.run([sys.executable, "-m", "denavit", "check", str(rep)], capture_output=True, text=True,
+                         timeout=600)
+    out = res.stdout + res.stderr
+    assert expect in out and "Traceback" not in out
+    assert res.returncode in (0, 2)
+    if expect == "not UTF-8":
+        assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+
+
+def test_cli_report_without_a_table_or_arm_says_what_to_give(tmp_path, capsys):
+    rep = tmp_path / "hw.md"
+    rep.write_text("# hw\n\n$$x = L_1 c_1$$\n", encoding="utf-8")
+    assert main(["check", str(rep)]) == 0
+    out = capsys.readouterr().out
+    assert "no DH table" in out and "unreadable" in out
+    assert main(["check", "planar2r", str(rep)]) == 0
+    assert "INCORRECT" in capsys.readouterr().out  # planar2r's x is L1 c1 + L2 c12
