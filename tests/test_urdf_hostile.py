@@ -84,8 +84,6 @@ CASES = {
                                     ' ixz="0" iyz="0"/></inertial></link>\n  <link name="l2">'),
                               ["arm.urdf", "l1", "ixy"]),
     "negative mass": (_swap('<mass value="1"/>', '<mass value="-1"/>'), ["arm.urdf", "negative"]),
-    "impossible inertia": (_swap('ixx="0.1" iyy="0.1" izz="0.1"', 'ixx="0.1" iyy="0.1" izz="5"'),
-                           ["arm.urdf", "j1", "triangle"]),
     "zero axis": (_swap('<axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>\n  <joint',
                         '<axis xyz="0 0 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>\n  <joint'),
                   ["arm.urdf", "zero"]),
@@ -107,6 +105,15 @@ def test_hostile_urdf_refused(case, tmp_path):
     text, mentions = CASES[case]
     o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml"], tmp_path, {"arm.urdf": text})
     assert_refused(o, mentions=mentions)
+
+
+def test_impossible_inertia_keeps_the_kinematics(tmp_path):
+    """A link's tensor breaking the triangle inequality is no longer refused (issue 29): one warning line naming
+    the <link> and its line, the kinematics written without inertial data (tests/test_urdf_inertia_gravity.py)."""
+    text = _swap('ixx="0.1" iyy="0.1" izz="0.1"', 'ixx="0.1" iyy="0.1" izz="5"')
+    o = run_cli(["import-urdf", "arm.urdf", "-o", "arm.yaml"], tmp_path, {"arm.urdf": text})
+    assert o.code == 0 and (tmp_path / "arm.yaml").is_file()
+    assert o.err.count("\n") == 1 and "<link name='l1'> (line 4)" in o.err and "triangle" in o.err
 
 
 def test_good_urdf_accepted(tmp_path):

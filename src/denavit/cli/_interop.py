@@ -22,6 +22,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--convention", choices=["standard", "modified"], default="standard", help="DH convention")
     p.add_argument("--xacro", action="store_true", help="expand a xacro file first (needs denavit[xacro]); xacro "
                                                          "evaluates Python expressions: only for files you trust")
+    inertia = p.add_mutually_exclusive_group()
+    inertia.add_argument("--fix-inertia", dest="inertia", action="store_const", const="fix", default="check",
+                         help="replace a link's inertia that no rigid body has (triangle inequality broken) by the "
+                              "nearest physical tensor, stated in the notes (default: warn and import without "
+                              "inertial data)")
+    inertia.add_argument("--no-inertia", dest="inertia", action="store_const", const="none",
+                         help="import the kinematics only, without inertial data")
     p.add_argument("-o", "--output", metavar="FILE", help="robot file to write (.yaml or .json); stdout if absent")
     add_no_clobber(p)
     p.add_argument("--json", action="store_true", help="machine-readable JSON on stdout")
@@ -47,7 +54,7 @@ def cmd_import_urdf(args: argparse.Namespace):
     if Path(args.urdf).suffix.lower() in (".yaml", ".yml", ".toml", ".json"):  # was: "malformed XML" at line 1
         raise ParseError(f"{args.urdf[:200]}: a robot file, not a URDF: other commands take it as ROBOT as it is "
                          "(denavit show, fk, export-urdf ...)")
-    result = import_urdf(args.urdf, args.base, args.tip, args.convention, xacro=args.xacro)
+    result = import_urdf(args.urdf, args.base, args.tip, args.convention, xacro=args.xacro, inertia=args.inertia)
     robot = result.robot
     width = max([len("URDF joint")] + [len(n) for n in result.joint_names])
     lines = [f"{robot.name}: the chain {result.base_link} -> {result.tip_link} of {args.urdf} as {robot.dof} "

@@ -5,7 +5,8 @@ Importing this package loads no XML library beyond the standard library's expat.
 """
 
 from ._urdf_axes import FAR_FOOT, INTERSECT_TOL, PARALLEL_TOL, ROW_CASES
-from ._urdf_in import CHECK_SAMPLES, CHECK_TOL, UrdfImport, from_urdf, import_urdf, urdf_chain_fk
+from ._urdf_in import (CHECK_SAMPLES, CHECK_TOL, INERTIA_CHOICES, URDF_GRAVITY, UrdfImport, from_urdf, import_urdf,
+                       nearest_physical_inertia, urdf_chain_fk)
 from ._mjcf_out import MJCF_BALANCE_MARGIN, MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
 from ._urdf_read import MAX_NUMBER_CHARS, MAX_URDF_LINKS, chain_path, read_urdf
@@ -28,6 +29,9 @@ __all__ = [
     "INTERSECT_TOL",
     "CHECK_SAMPLES",
     "CHECK_TOL",
+    "INERTIA_CHOICES",
+    "URDF_GRAVITY",
+    "nearest_physical_inertia",
     "FAR_FOOT",
     "ROW_CASES",
     "MAX_XML_BYTES",

@@ -19,9 +19,12 @@ from ._export import combine_inertia
 from ._urdf_axes import FAR_FOOT, dh_geometry
 from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
 
-__all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "tidy", "CHECK_SAMPLES", "CHECK_TOL",
+__all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "tidy", "nearest_physical_inertia",
+           "INERTIA_CHOICES", "URDF_GRAVITY", "CHECK_SAMPLES", "CHECK_TOL",
            "TIDY_DIGITS", "TIDY_ULPS"]
 
+#: What :func:`import_urdf` does with the links' inertial data (``inertia=``; ``--fix-inertia``, ``--no-inertia``).
+INERTIA_CHOICES = ("check", "fix", "none")
 #: Random configurations of the import's FK self-check.
 CHECK_SAMPLES = 200
 #: Self-check errors (relative to the chain's size, at least 1 m) beyond which the import warns.
@@ -98,7 +101,7 @@ def urdf_chain_fk(path: list[UrdfJoint], q: np.ndarray) -> np.ndarray:
 
 
 def import_urdf(source, base: str | None = None, tip: str | None = None, convention: str = "standard", *,
-                xacro: bool = False, rng: np.random.Generator | None = None) -> UrdfImport:
+                xacro: bool = False, rng: np.random.Generator | None = None, inertia: str = "check") -> UrdfImport:
     """Extract the DH model of the serial chain from link ``base`` to link ``tip`` of a URDF, with its report.
 
     Parameters
@@ -114,6 +117,13 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         only for files you trust; a ``*.xacro`` path without it is refused.
     rng : numpy.random.Generator, optional
         For the self-check's random configurations (default: a fixed seed, so reports repeat).
+    inertia : {"check", "fix", "none"}
+        What to do with the links' inertial data.  ``"check"``: used when every link's tensor is one a rigid body
+        can have; a link's tensor that breaks the triangle inequality (xArm6's link 3, 13.5 % off; Pinocchio
+        and pybullet load it) draws a warning naming the ``<link>`` and its line, and the arm is imported
+        without inertial data (its kinematics are not refused).  ``"fix"``: each such tensor is replaced by the
+        nearest physical one (:func:`nearest_physical_inertia`), stated in the notes.  ``"none"``: no inertial
+        data at all (kinematics only).
 
     Returns
     -------
@@ -129,6 +139,8 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     conv = Convention(convention) if convention in ("standard", "modified") else None
     if conv is None:
         raise ParseError(f"convention {str(convention)[:40]!r}: choose one of standard, modified")
+    if inertia not in INERTIA_CHOICES:
+        raise ParseError(f"inertia {str(inertia)[:40]!r}: choose one of {', '.join(INERTIA_CHOICES)}")
     model = read_urdf(source, xacro=xacro)
     base, tip, path = chain_path(model, base, tip)
     moving = _moving_joints(model, path, base, tip)
@@ -136,7 +148,10 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
     theta, d, a, alpha, cases, F0, approximated = dh_geometry(P, Z, T, scale)
     robot = _robot(model, conv, moving, theta, d, a, alpha, F0, T)
+    robot, gravity_notes = _gravity_in_base(robot, model, base)
+    model, inertia_notes = _physical_inertials(model, inertia)
     robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base, scale)
+    notes = gravity_notes + inertia_notes + notes
     pos, rot = _self_check(robot, path, rng)
     if pos > CHECK_TOL * scale or rot > CHECK_TOL:
         warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
@@ -221,6 +236,88 @@ def _robot_rows(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], the
     return robot.replace(tool=tool)
 
 
+#: Gravity of a URDF, in its root link's frame [m/s²] (URDF has no gravity element; ROS and simulators use -z).
+URDF_GRAVITY = (0.0, 0.0, -9.81)
+
+
+def _gravity_in_base(robot: DHRobot, model: UrdfModel, base: str) -> tuple[DHRobot, tuple[str, ...]]:
+    """The robot's gravity in the ``base`` link's frame: g_base = R_root_baseᵀ g_root, with R_root_base the base
+    link's orientation in the URDF's root frame when the joints above it are at 0 (their ``origin`` rotations
+    composed).  A base that is the root, or sits in it unturned, keeps (0, 0, -9.81)."""
+    R = np.eye(3)
+    link, seen = base, 0
+    while link in model.parent_joint and seen <= len(model.links):  # up to the root (a cycle was refused earlier)
+        j = model.parent_joint[link]
+        R = j.origin[:3, :3] @ R
+        link, seen = j.parent, seen + 1
+    g = R.T @ np.array(URDF_GRAVITY)
+    if np.array_equal(R, np.eye(3)):
+        return robot, ()
+    g = np.where(np.abs(g) < 1e-15 * 9.81, 0.0, g)  # rounding noise of the rotation
+    note = (f"gravity {URDF_GRAVITY[2]:g} m/s² along z of the root link {link[:40]!r} turned into the base link "
+            f"{base[:40]!r} (joints above it at 0): ({', '.join(f'{v:.6g}' for v in g)}) m/s²")
+    return robot.replace(gravity=tuple(float(v) for v in g)), (note,)
+
+
+def nearest_physical_inertia(I: np.ndarray) -> np.ndarray:
+    """The inertia tensor nearest to ``I`` (Frobenius norm) that a rigid body can have: principal moments
+    non-negative and meeting the triangle inequality A + B >= C, principal axes kept.
+
+    The moments (ascending w0 <= w1 <= w2) are clipped at 0, then, if w0 + w1 < w2, moved onto the plane
+    w0 + w1 = w2 along its normal (1, 1, -1): each by δ = (w2 - w0 - w1) / 3 — the Euclidean projection onto that
+    half-space, and for a tensor with fixed axes the nearest matrix (von Neumann's trace inequality).
+
+    >>> np.linalg.eigvalsh(nearest_physical_inertia(np.diag([1.0, 1.0, 3.0]))).round(6).tolist()
+    [1.333333, 1.333333, 2.666667]
+    """
+    w, V = np.linalg.eigh(np.asarray(I, dtype=float))  # ascending
+    w = np.maximum(w, 0.0)
+    delta = (w[2] - w[0] - w[1]) / 3
+    if delta > 0:
+        w = w + np.array([delta, delta, -delta])
+    return (V * w) @ V.T
+
+
+def _physical_inertials(model: UrdfModel, how: str) -> tuple[UrdfModel, tuple[str, ...]]:
+    """The model with each link's inertial checked (see :func:`import_urdf`, ``inertia=``) and notes on what was
+    done; ``"none"`` drops every inertial."""
+    from dataclasses import replace
+
+    if how == "none":
+        return replace(model, links={k: replace(v, inertial=None) for k, v in model.links.items()}), (
+            "inertial data left out (--no-inertia): kinematics only",)
+    bad = []
+    for link in model.links.values():
+        el = link.inertial
+        if el is None:
+            continue
+        I = el.inertia
+        try:
+            LinkInertia(mass=el.mass, inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
+        except ModelError as exc:
+            bad.append((link, str(exc).removeprefix("inertia: ")))
+    if not bad:
+        return model, ()
+    where = "; ".join(f"<link name={link.name[:40]!r}> (line {link.line}): {why}" for link, why in bad[:3])
+    more = f" and {len(bad) - 3} more links" if len(bad) > 3 else ""
+    if how == "check":
+        warnings.warn(f"{model.where}: {where}{more}; the arm is imported without inertial data (kinematics only): "
+                      "--fix-inertia uses the nearest physical tensor, --no-inertia leaves inertia out quietly",
+                      DenavitWarning, stacklevel=3)
+        return replace(model, links={k: replace(v, inertial=None) for k, v in model.links.items()}), (
+            f"inertial data left out: {len(bad)} link{'s' * (len(bad) > 1)} with a tensor no rigid body has",)
+    links = dict(model.links)
+    notes = []
+    for link, _ in bad:
+        before = np.linalg.eigvalsh(link.inertial.inertia)
+        fixed = nearest_physical_inertia(link.inertial.inertia)
+        links[link.name] = replace(link, inertial=replace(link.inertial, inertia=fixed))
+        notes.append(f"<link name={link.name[:40]!r}> (line {link.line}): inertia replaced by the nearest physical "
+                     f"tensor (principal moments {', '.join(f'{w:.4g}' for w in before)} -> "
+                     f"{', '.join(f'{w:.4g}' for w in np.linalg.eigvalsh(fixed))} kg m², axes kept)")
+    return replace(model, links=links), tuple(notes)
+
+
 def _with_inertia(robot: DHRobot, model: UrdfModel, path: list[UrdfJoint], link_pose: dict, link_body: dict,
                   base: str, scale: float) -> tuple[DHRobot, tuple[str, ...]]:
     """Each body's links (and rigid branches hanging from them, locked at 0) as one inertia in its DH frame
@@ -286,7 +383,7 @@ def _self_check(robot: DHRobot, path: list[UrdfJoint], rng: np.random.Generator 
 
 
 def from_urdf(source, base: str | None = None, tip: str | None = None, convention: str = "standard", *,
-              xacro: bool = False) -> DHRobot:
+              xacro: bool = False, inertia: str = "check") -> DHRobot:
     """The DH model of a URDF's serial chain from link ``base`` to link ``tip`` (see :func:`import_urdf`).
 
     Examples
@@ -299,4 +396,4 @@ def from_urdf(source, base: str | None = None, tip: str | None = None, conventio
     >>> robot.links[0].d, robot.links[0].q_limits
     (0.5, (-1.0, 1.0))
     """
-    return import_urdf(source, base, tip, convention, xacro=xacro).robot
+    return import_urdf(source, base, tip, convention, xacro=xacro, inertia=inertia).robot
