@@ -264,6 +264,35 @@ def test_html_summary_counts_and_arms():
     assert "exercise-1" in head and "table at line 3" in head and "Legend" in head
 
 
+def test_html_bracket_delimiters_are_mathematics_not_escaped_brackets():
+    r"""CommonMark reads ``\(`` and ``\[`` as escaped brackets; in a report they delimit mathematics."""
+    text = "Inline \\(x = 1\\) and display \\[y = 2\\] in a line.\n\\[ z = 3 \\]\n"
+    tags = _tags(render_checked_html(GradedReport("r.md", text, "md", (ARM,), ())))
+    classes = [a.get("class") for t, a in tags if t in ("span", "div") and "math" in (a.get("class") or "")]
+    assert classes == ["math-inline", "math-display", "math-display"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("unit, fmt", [("\\[\n", "md"), ("\\begin{align}\n", "md"), ("$$ a\nb $$ c\n", "md"),
+                                       ("\\(", "md"), ("\\[\n", "tex"), ("\\begin{align}\n\\end{x}\n", "tex")])
+def test_hostile_report_costs_no_more_than_plain_text(unit, fmt):
+    """12,000 unclosed openers cost under ten times the CPU of 12,000 lines of plain text (0.1 s at least):
+    a rescan to the end of the block window for each opener used to cost 20-40 times.  The 499 claims on it
+    are all placed."""
+    import time
+
+    def cpu(text):
+        claims = tuple(GradedClaim(k, k, "q", "a", "incorrect", "m", fix="x") for k in range(1, 500))
+        report = GradedReport("r", text, fmt, (ARM,), claims)
+        t = time.process_time()
+        page, md = render_checked_html(report), render_checked_markdown(report)
+        assert page.count('class="verdict v-incorrect" id="claim-') == 499 and md.count("> ✗ **incorrect**") == 499
+        return time.process_time() - t
+
+    cpu("x\n" * 200)  # warm-up: imports and the KaTeX bundle
+    assert cpu(unit * 12000) < 10 * max(cpu("word x\n" * 12000), 0.1)
+
+
 # --- writing ----------------------------------------------------------------------------------------------
 
 

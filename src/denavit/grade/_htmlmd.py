@@ -10,6 +10,8 @@ name, never fetched.
 
 from __future__ import annotations
 
+from bisect import bisect_right
+
 from ._html import Numbered, choose_span, corrections_html, display_html, esc, marks_html
 from ._markdown import MATH_BLOCKS, markdown_parser
 from ._types import GradedReport
@@ -18,41 +20,46 @@ __all__ = ["markdown_body"]
 
 _INLINE_MATH = ("math_inline", "math_inline_double")
 _CODE = ("fence", "code_block")
+_BREAKS = ("softbreak", "hardbreak")
 
 
 def _inline_lines(token) -> None:
-    """Give each child of an ``inline`` token the 0-based report lines it spans (``meta["lines"]``)."""
+    """Give each child of an ``inline`` token the 0-based report lines it spans (``meta["lines"]``; a line
+    break belongs to the line it ends), so the children's first lines never decrease."""
     line = token.map[0]
     for child in token.children or []:
-        if child.type in ("softbreak", "hardbreak"):
-            line += 1
-            continue
         last = line + child.content.count("\n")
         child.meta = {**(child.meta or {}), "lines": (line, last)}
-        line = last
+        line = last + (child.type in _BREAKS)
 
 
-def _anchor(children, first: int, last: int) -> int:
-    """Where a claim on 0-based lines ``first``..``last`` gets its mark among an inline token's children:
-    after the last formula overlapping those lines, else at the end of line ``last``, else at the end."""
-    def lines(child) -> tuple[int, int]:
-        return (child.meta or {}).get("lines", (-1, -1))
-
-    maths = [j for j, ch in enumerate(children) if ch.type in _INLINE_MATH and lines(ch)[0] <= last
-             and lines(ch)[1] >= first]
-    if maths:
-        return maths[-1] + 1
-    on_line = [j for j, ch in enumerate(children) if 0 <= lines(ch)[0] <= last]
-    return on_line[-1] + 1 if on_line else len(children)
+def _anchors(children, claims: list[Numbered]) -> dict[int, list[Numbered]]:
+    """{position among an inline token's children: the claims whose marks go there}.  A claim on lines
+    ``line``..``end_line`` goes after the last formula overlapping those lines, else at the end of its last
+    line, else at the end (formulas do not overlap, so their lines only grow: bisection, not a scan per claim)."""
+    spans = [(child.meta or {}).get("lines", (-1, -1)) for child in children]
+    maths = [j for j, child in enumerate(children) if child.type in _INLINE_MATH]
+    math_starts = [spans[j][0] for j in maths]
+    starts = [a for a, _ in spans]
+    at: dict[int, list[Numbered]] = {}
+    for k, c in claims:
+        first, last = c.line - 1, c.end_line - 1
+        m = bisect_right(math_starts, last) - 1
+        if m >= 0 and spans[maths[m]][1] >= first:
+            pos = maths[m] + 1
+        else:  # the end of its last line: before the line break that ends it
+            pos = bisect_right(starts, last) or len(children)
+            if pos > 0 and children[pos - 1].type in _BREAKS:
+                pos -= 1
+        at.setdefault(pos, []).append((k, c))
+    return at
 
 
 def _attach_inline(tokens, i: int, claims: list[Numbered], token_cls) -> None:
-    """Each claim's mark right after its formula in inline token ``i`` (see :func:`_anchor`); the corrections
+    """Each claim's mark right after its formula in inline token ``i`` (see :func:`_anchors`); the corrections
     after the block holding it."""
     children = tokens[i].children or []
-    at: dict[int, list[Numbered]] = {}
-    for k, c in claims:
-        at.setdefault(_anchor(children, c.line - 1, c.end_line - 1), []).append((k, c))
+    at = _anchors(children, claims)
     for pos in sorted(at, reverse=True):
         marks = token_cls("verdict_marks", "", 0)
         marks.meta = {"claims": at[pos]}

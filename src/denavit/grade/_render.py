@@ -92,10 +92,11 @@ def insertion_points(report: GradedReport) -> dict[int, list[GradedClaim]]:
         blocks = tex_blocks(report.text)
     else:
         blocks = markdown_blocks(markdown_parser().parse(report.text))
+    starts = [b.start for b in blocks]
     points: dict[int, list[GradedClaim]] = defaultdict(list)
     for c in sorted(report.claims, key=lambda c: (c.end_line, c.line)):
         last = min(max(c.end_line, 1), n) - 1  # 0-based
-        points[min(block_end(blocks, last), n)].append(c)
+        points[min(block_end(blocks, starts, last), n)].append(c)
     return dict(points)
 
 
