@@ -338,6 +338,41 @@ def f07():
     ]
 
 
+# --- 08: spherical wrist, Craig, tab table with units, rotations, IK in r_ij ------------------------------------
+
+@fixture("08_spherical_wrist.md")
+def f08():
+    arm = Arm("mdh", [(0, 0, 0, t1), (0, -pi / 2, 0, t2), (0, pi / 2, 0, t3)], [("R", t1), ("R", t2), ("R", t3)])
+    c1, s1, c2, s2, c3, s3 = c(t1), s(t1), c(t2), s(t2), c(t3), s(t3)
+    w1, w2, w3 = sp.symbols("qd1:4", real=True)
+    R03 = arm.T(0)[:3, :3]
+    J, J3 = arm.jacobian(), arm.jacobian_in(3)
+    h = sp.sqrt(3) / 2
+    half = sp.Rational(1, 2)
+    Z = sp.zeros(3, 3)
+    ik2 = lambda tg, q: math.atan2(math.hypot(tg["r31"], tg["r32"]), tg["r33"])   # noqa: E731
+    ik1 = lambda tg, q: math.atan2(tg["r23"], tg["r13"])   # noqa: E731
+    ik3 = lambda tg, q: math.atan2(tg["r32"], tg["r31"])   # noqa: E731
+    up = {t2: 1}
+    return [
+        R("correct", "1T2", M([c2, -s2, 0, 0], [0, 0, 1, 0], [-s2, -c2, 0, 0], [0, 0, 0, 1]), arm.A(2)),
+        R("incorrect", "2T3: sign of (2,3)", M([c3, -s3, 0, 0], [0, 0, 1, 0], [s3, c3, 0, 0], [0, 0, 0, 1]), arm.A(3)),
+        R("correct", "0R3", M([c1 * c2 * c3 - s1 * s3, -c1 * c2 * s3 - s1 * c3, c1 * s2],
+                              [s1 * c2 * c3 + c1 * s3, -s1 * c2 * s3 + c1 * c3, s1 * s2], [-s2 * c3, s2 * s3, c2]), R03),
+        R("incorrect", "0R3 at (90, 60, 0) deg: transposed", M([0, half, -h], [-1, 0, 0], [0, h, half]),
+          R03.subs({t1: pi / 2, t2: pi / 3, t3: 0})),
+        R("correct", "2w2", col(-s2 * w1, -c2 * w1, w2), frame_velocity(arm, 2)[0]),
+        R("correct", "3w3", col(-s2 * c3 * w1 + s3 * w2, s2 * s3 * w1 + c3 * w2, c2 * w1 + w3), frame_velocity(arm, 3)[0]),
+        R("correct", "3J", sp.Matrix.vstack(Z, M([-s2 * c3, s3, 0], [s2 * s3, c3, 0], [c2, 0, 1])), J3),
+        R("correct", "0J", sp.Matrix.vstack(Z, M([0, -s1, c1 * s2], [0, c1, s1 * s2], [1, 0, c2])), J),
+        R("correct", "det J_w", -s2, J[3:, :].det()),
+        R("correct", "singular when theta2 = 0 or pi", test=lambda: singular_set_ok(J[3:, :].det(), [s2])),
+        R("correct", "theta2 (sin theta2 > 0)", test=lambda: ik_ok(arm, 2, ik2, signs=up)),
+        R("correct", "theta1 (sin theta2 > 0)", test=lambda: ik_ok(arm, 1, ik1, signs=up)),
+        R("incorrect", "theta3: sign of r31", test=lambda: ik_ok(arm, 3, ik3, signs=up)),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
