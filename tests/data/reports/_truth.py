@@ -373,6 +373,43 @@ def f08():
     ]
 
 
+# --- 09: PRRR lift, Craig, lengths defined in the table, degrees, tool row, q_i notation --------------------------
+
+@fixture("09_lift_prrr.md")
+def f09():
+    D1, f = sp.Symbol("d1", real=True), sp.Float
+    l2, l3, l4 = f(0.4), f(0.3), f(0.15)
+    arm = Arm("mdh", [(0, 0, D1, 0), (0, 0, 0, t2), (l2, 0, 0, t3), (l3, 0, 0, t4), (l4, 0, 0, pi / 2)],
+              [("P", D1), ("R", t2), ("R", t3), ("R", t4), None])
+    c2, s2, c23, s23, c234, s234 = c(t2), s(t2), c(t2 + t3), s(t2 + t3), c(t2 + t3 + t4), s(t2 + t3 + t4)
+    T05, J = arm.T(0), arm.jacobian()
+    x, y = l2 * c2 + l3 * c23 + l4 * c234, l2 * s2 + l3 * s23 + l4 * s234
+    Jsq = J.extract([0, 1, 2, 5], [0, 1, 2, 3])
+
+    def ik3(tg, q):
+        phi = math.atan2(tg["r21"], tg["r11"])
+        return math.acos(((tg["px"] - 0.15 * math.sin(phi)) ** 2 + (tg["py"] + 0.15 * math.cos(phi)) ** 2 - 0.25)
+                         / 0.24)
+    return [
+        R("correct", "0T1", M([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, D1], [0, 0, 0, 1]), arm.A(1)),
+        R("correct", "1T2", M([c2, -s2, 0, 0], [s2, c2, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]), arm.A(2)),
+        R("correct", "4T5 (tool row, 90 deg)", M([0, -1, 0, l4], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]), arm.A(5)),
+        R(NC, "0T5 as the product"),
+        R("correct", "0T5", M([-s234, -c234, 0, x], [c234, -s234, 0, y], [0, 0, 1, D1], [0, 0, 0, 1]), T05),
+        R("incorrect", "case 2: a wrong p_y", M([-0.7071, -0.7071, 0, 0.7423], [0.7071, -0.7071, 0, 0.3284],
+                                                [0, 0, 1, 0.2], [0, 0, 0, 1]),
+          T05.subs({D1: 0.2, t2: pi / 6, t3: -pi / 4, t4: pi / 3}), tol=1e-4),
+        R("correct", "case 3: p_E", col(0.55, 0.3, 0.5), T05[:3, 3].subs({D1: 0.5, t2: 0, t3: pi / 2, t4: -pi / 2})),
+        R("incorrect", "J: the L4 s234 term of (1,3) missing",
+          M([0, -l2 * s2 - l3 * s23 - l4 * s234, -l3 * s23, -l4 * s234], [0, x, l3 * c23 + l4 * c234, l4 * c234],
+            [1, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0], [0, 1, 1, 1]), J),
+        R("correct", "det J (rows vx, vy, vz, wz)", f(0.12) * s(t3), Jsq.det()),
+        R("correct", "singular q3 = 0 or pi", test=lambda: singular_set_ok(Jsq.det(), [s(t3)], joints=(D1, t2, t3, t4))),
+        R("correct", "q1 = p_z", test=lambda: ik_ok(arm, 1, lambda tg, q: tg["pz"])),
+        R("correct", "q3 = acos(...) (branch q3 > 0)", test=lambda: ik_ok(arm, 3, ik3, signs={t3: 1})),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
