@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _truth_dh import (HERE, Arm, R, force_moment, frame_velocity, ik_ok, link, pi, qd_symbols,  # noqa: E402
                        same, singular_set_ok, sp, t1, t2, t3, t4, t5, t6)
-from _truth_dh import c, s  # noqa: E402
+from _truth_dh import c, np, s  # noqa: E402
 
 FIXTURES: dict = {}
 
@@ -410,6 +410,69 @@ def f09():
     ]
 
 
+# --- 10: 6R elbow arm with a spherical wrist, Spong in degrees (array table), decoupled IK, an ambiguous P ------
+
+@fixture("10_elbow6r_ik.md")
+def f10():
+    d1, a2_, d4_, d6_ = sp.symbols("d1 a2 d4 d6", positive=True)
+    rows = [(0, pi / 2, d1, t1), (a2_, 0, 0, t2), (0, pi / 2, 0, t3), (0, -pi / 2, d4_, t4), (0, pi / 2, 0, t5),
+            (0, 0, d6_, t6)]
+    arm = Arm("std", rows, [("R", t) for t in (t1, t2, t3, t4, t5, t6)])
+    C1, S1, C2, S2, C4, S4, C5, S5, C6, S6 = (f(t) for t in (t1, t2, t4, t5, t6) for f in (c, s))
+    C23, S23 = c(t2 + t3), s(t2 + t3)
+    # the IK formulas are checked at d1 = 0.4, a2 = 0.5, d4 = 0.45, d6 = 0.1 (any positive lengths would do)
+    num = {d1: 0.4, a2_: 0.5, d4_: 0.45, d6_: 0.1}
+    armn = Arm("std", [tuple(sp.sympify(x).subs(num) for x in r) for r in rows], arm.joints)
+    wrist = armn.T(0, 4)[:3, 3]
+
+    def centre(tg):
+        return (tg["px"] - 0.1 * tg["r13"], tg["py"] - 0.1 * tg["r23"], tg["pz"] - 0.1 * tg["r33"])
+
+    def ik3(tg, q):
+        x, y, z = centre(tg)
+        return math.asin((x * x + y * y + (z - 0.4) ** 2 - 0.25 - 0.2025) / (2 * 0.5 * 0.45))
+
+    def ik2(sign):
+        def fn(tg, q):
+            x, y, z = centre(tg)
+            return math.atan2(z - 0.4, math.hypot(x, y)) + sign * math.atan2(
+                0.45 * math.cos(q["theta3"]), 0.5 + 0.45 * math.sin(q["theta3"]))
+        return fn
+
+    def ik1_centre(tg, q):
+        x, y, _ = centre(tg)
+        return math.atan2(y, x)
+
+    branch = {t2: 1, t3: 1}
+    atan_p = lambda tg, q: math.atan2(tg["py"], tg["px"])   # noqa: E731
+
+    def wrist_only_incomplete():
+        """J (6x6, numeric) is singular at an elbow-stretched pose with sin θ5 ≠ 0: the claimed set misses it."""
+        J = sp.lambdify(armn.q, armn.jacobian(), "numpy")
+        sv = np.linalg.svd(np.asarray(J(0.3, 0.5, math.pi / 2, 0.7, 0.9, -0.4), dtype=float), compute_uv=False)
+        sw = np.linalg.svd(np.asarray(J(0.3, 0.5, 0.8, 0.7, 0.0, -0.4), dtype=float), compute_uv=False)
+        return not (sv[-1] / sv[0] < 1e-9 and sw[-1] / sw[0] < 1e-9)
+
+    return [
+        R("correct", "0T3", M([C1 * C23, S1, C1 * S23, a2_ * C1 * C2], [S1 * C23, -C1, S1 * S23, a2_ * S1 * C2],
+                              [S23, 0, -C23, d1 + a2_ * S2], [0, 0, 0, 1]), arm.T(0, 3)),
+        R("correct", "3R6", M([C4 * C5 * C6 - S4 * S6, -C4 * C5 * S6 - S4 * C6, C4 * S5],
+                              [S4 * C5 * C6 + C4 * S6, -S4 * C5 * S6 + C4 * C6, S4 * S5], [-S5 * C6, S5 * S6, C5]),
+          arm.T(3, 6)[:3, :3]),
+        R("ambiguous", "theta1 = atan2(p_y, p_x): wrong for the flange, right for the wrist centre",
+          test=lambda: not ik_ok(armn, 1, atan_p, signs=branch) and ik_ok(armn, 1, atan_p, signs=branch, point=wrist)),
+        R(NC, "x_c, y_c, z_c definitions"),
+        R(NC, "3R6 = (0R3)^T R"),
+        R("correct", "theta1 = atan2(y_c, x_c)", test=lambda: ik_ok(armn, 1, ik1_centre, signs=branch)),
+        R("correct", "sin theta3 = D", test=lambda: ik_ok(armn, 3, ik3, signs=branch)),
+        R("correct", "theta3 = asin(D)", test=lambda: ik_ok(armn, 3, ik3, signs=branch)),
+        R("correct", "theta2 (+)", test=lambda: ik_ok(armn, 2, ik2(+1), signs=branch)),
+        R("incorrect", "theta2 (-): sign of the second atan2", test=lambda: ik_ok(armn, 2, ik2(-1), signs=branch)),
+        R("incorrect", "singular only when theta5 = 0 or pi (the elbow cos θ3 = 0 missing)",
+          test=wrist_only_incomplete),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
@@ -431,6 +494,8 @@ def main() -> int:
                 failures.append(f"{name}: {r.label}: expected correct but the truth differs")
             if r.verdict == "incorrect" and ok is not False:
                 failures.append(f"{name}: {r.label}: expected incorrect but it equals the truth")
+            if r.verdict == "ambiguous" and ok is False:
+                failures.append(f"{name}: {r.label}: expected ambiguous but its test fails")
         print(f"{name}: {len(records)} verdicts, {sum(r.verdict == 'incorrect' for r in records)} slips, "
               f"{sum(ok is not None for ok in held)} checked against the truth")
     for f in failures:

@@ -216,15 +216,18 @@ def ik_ok(arm: Arm, joint: int, formula: Callable[[dict, dict], float], n: int =
     T0n = arm.T(0)
     if params:
         T0n = T0n.subs(params)
+    pose = sp.lambdify(arm.q, T0n, "numpy")
+    where = sp.lambdify(arm.q, point.subs(params or {}), "numpy") if point is not None else None
     for _ in range(n):
         qv = {q: rnd.uniform(0.2, 1.3) * (signs or {}).get(q, rnd.choice((-1, 1))) for q in arm.q}
-        M = T0n.subs(qv).evalf()
-        tgt = {"px": float(M[0, 3]), "py": float(M[1, 3]), "pz": float(M[2, 3])}
-        if point is not None:
-            tgt.update({k: float(v) for k, v in zip(("px", "py", "pz"), point.subs(params or {}).subs(qv).evalf())})
+        args = [qv[q] for q in arm.q]
+        Mn = np.asarray(pose(*args), dtype=float)
+        tgt = {"px": Mn[0, 3], "py": Mn[1, 3], "pz": Mn[2, 3]}
+        if where is not None:
+            tgt.update(zip(("px", "py", "pz"), np.asarray(where(*args), dtype=float).ravel()))
         for i in range(3):
             for j in range(3):
-                tgt["r%d%d" % (i + 1, j + 1)] = float(M[i, j])
+                tgt["r%d%d" % (i + 1, j + 1)] = Mn[i, j]
         got = formula(tgt, {str(k): float(v) for k, v in qv.items()})
         want = float(qv[arm.q[joint - 1]])
         d = (got - want + 3.141592653589793) % 6.283185307179586 - 3.141592653589793
