@@ -17,7 +17,7 @@ from ..io import robot_from_dict
 from ..model import DHRobot
 from ..tables import find_tables, import_table
 from ._document import Document, Heading
-from ._types import ArmInfo
+from ._types import ArmInfo, GradedClaim
 
 __all__ = ["Arm", "Section", "sections_of", "arms_of", "GENERIC_LENGTHS"]
 
@@ -125,4 +125,44 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
                                  f"(give one: --arm {key or 'SECTION'}=ROBOT)")))
             continue
         out.append((sec, current))
+    return out
+
+
+def compare_tables(doc: Document, robot: DHRobot, source: str) -> list[GradedClaim]:
+    """The report's own DH tables against the arm given on the command line: the first finding.
+
+    Two tables describe the same arm when they have the same joints (revolute/prismatic, in order) and the
+    same end-effector pose T_0_N at random configurations (lengths the report leaves as symbols are compared
+    structurally only: they have no value to compare).
+    """
+    import numpy as np
+
+    from .. import numeric as N
+
+    out = []
+    for first, last, why in find_tables(list(doc.lines)):
+        if why is not None:
+            continue
+        arm = _table_arm(doc, first, last, source, "", last)
+        if arm.robot is None:
+            out.append(GradedClaim(first, last, "dh_table", robot.name, "unreadable", arm.problem))
+            continue
+        mine, theirs = arm.robot, robot
+        if mine.joint_types != theirs.joint_types:
+            msg = (f"the report's table has joints {''.join(t.value[0].upper() for t in mine.joint_types)}, "
+                   f"{robot.name} has {''.join(t.value[0].upper() for t in theirs.joint_types)}")
+            out.append(GradedClaim(first, last, "dh_table", robot.name, "incorrect", msg, understood="the DH table"))
+            continue
+        if any("kept as symbols" in n for n in arm.info.notes):
+            out.append(GradedClaim(first, last, "dh_table", robot.name, "ambiguous", "same joints as "
+                                   f"{robot.name}; the table's lengths are symbols, so only its structure was "
+                                   "compared", understood="the DH table"))
+            continue
+        rng = np.random.default_rng(0)
+        q = rng.uniform(-np.pi, np.pi, (4, theirs.dof))
+        same = np.allclose(N.forward_kinematics(mine, q), N.forward_kinematics(theirs, q), atol=1e-9)
+        out.append(GradedClaim(first, last, "dh_table", robot.name, "correct" if same else "incorrect",
+                               f"the same arm as {robot.name}" if same else
+                               f"not the arm {robot.name}: its end-effector pose differs at the same joint values "
+                               "(the verdicts below use ROBOT)", understood="the DH table"))
     return out

@@ -9,13 +9,14 @@ a number stated without its case is "ambiguous" when the default reading disagre
 from __future__ import annotations
 
 import re
+import time
 from pathlib import Path
 from typing import Any
 
 from ..check import MAX_FILE_BYTES, check_claims
 from ..errors import DenavitError, ParseError
 from ..model import DHRobot
-from ._arms import arms_of
+from ._arms import arms_of, compare_tables
 from ._claims import Pending, walk
 from ._document import read_document
 from ._types import ArmInfo, GradedClaim, GradedReport
@@ -26,6 +27,8 @@ __all__ = ["grade_report", "grade_text", "REPORT_SUFFIXES", "MAX_JUDGED"]
 REPORT_SUFFIXES = {".md": "md", ".markdown": "md", ".tex": "tex", ".txt": "txt", ".text": "txt"}
 #: Most equations judged in one report (the rest are listed as not judged).
 MAX_JUDGED = 600
+#: CPU seconds one report may spend on judging; equations after that are "unreadable: not judged (time)".
+MAX_GRADING_CPU = 240.0
 _UNKNOWN = re.compile(r"unknown symbol '\\*((?:dot\{?\\*)?[A-Za-z]+)|unsupported LaTeX command \\*(partial|delta|nabla|int)")
 _RESULT_LETTERS = {"T", "A", "R", "J", "e", "z", "p", "P", "F", "f", "n", "I", "O", "tau", "omega", "w", "v", "E",
                    "M", "K", "dot{p", "dotp", "dot{x", "vartheta", "nu", "x", "y", "hat"}
@@ -110,7 +113,17 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
     notes = list(doc.notes)
     if len(pending) > MAX_JUDGED:
         notes.append(f"only the first {MAX_JUDGED} equations were judged ({len(pending)} found)")
-    graded = [_graded(p, seed) for p in pending[:MAX_JUDGED]]
+    graded = []
+    start = time.process_time()
+    for p in pending[:MAX_JUDGED]:
+        if time.process_time() - start > MAX_GRADING_CPU and p.claim is not None:
+            graded.append(GradedClaim(p.line, p.end_line, p.quantity, p.arm.info.name if p.arm else "", "unreadable",
+                                      f"not judged: the report used its {MAX_GRADING_CPU:.0f} s of checking time",
+                                      p.latex, p.understood))
+            continue
+        graded.append(_graded(p, seed))
+    if robot is not None:
+        graded[:0] = compare_tables(doc, robot, source)
     seen: dict[str, ArmInfo] = {}
     for _, arm in governed:
         if arm is not None and arm.info.name and arm.info.name not in seen:
