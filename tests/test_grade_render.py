@@ -272,6 +272,25 @@ def test_html_bracket_delimiters_are_mathematics_not_escaped_brackets():
     assert classes == ["math-inline", "math-display", "math-display"]
 
 
+def test_claims_in_a_table_row_and_a_list_item():
+    """A claim in a table row: its mark in the row's cell with the formula, its correction under the whole table
+    (never inside a row); a claim in a list item: its mark after its formula; both Markdown quotes after the
+    table and after the whole list, never inside them."""
+    text = ("| i | $a_i$ |\n|---|---|\n| 1 | $a_1 = L_1$ |\n| 2 | $a_2 = 0$ |\n\n"
+            "- first $p_x = 1$\n- second $p_y = 2$\n\nEnd.\n")
+    claims = (GradedClaim(4, 4, "a_2", "a", "incorrect", "a_2 is L_2", fix="L_2"),
+              GradedClaim(7, 7, "p_y", "a", "correct", "ok"))
+    report = GradedReport("r.md", text, "md", (ARM,), claims)
+    page = render_checked_html(report)
+    body = page[page.index('<article class="report">'):page.index("</article>")]
+    mark0, mark1 = body.index('data-claim="0" data-line="4"'), body.index('data-claim="1" data-line="7"')
+    assert body.index("a_2 = 0") < mark0 < body.index("</td>", body.index("a_2 = 0")) < body.index("</table>")
+    assert body.index("</table>") < body.index('<div class="correction" data-claim="0"') < body.index("<ul>")
+    assert body.index("p_y = 2") < mark1 < body.index("</li>", body.index("p_y = 2"))
+    inserted = _inserted(text, render_checked_markdown(report))
+    assert sorted(inserted) == [4, 7]  # after the table's last row, after the list's last item
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("unit, fmt", [("\\[\n", "md"), ("\\begin{align}\n", "md"), ("$$ a\nb $$ c\n", "md"),
                                        ("\\(", "md"), ("\\[\n", "tex"), ("\\begin{align}\n\\end{x}\n", "tex")])

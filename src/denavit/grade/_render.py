@@ -87,7 +87,8 @@ def insertion_points(report: GradedReport) -> dict[int, list[GradedClaim]]:
     A claim goes after the block (Markdown's top-level block, or a LaTeX display environment / paragraph)
     that holds its ``end_line``; a claim whose ``end_line`` lies outside the text goes after the last line.
     """
-    n = len(_split_lines(report.text))
+    lines = _split_lines(report.text)
+    n = len(lines)
     if report.format == "tex":
         blocks = tex_blocks(report.text)
     else:
@@ -96,7 +97,10 @@ def insertion_points(report: GradedReport) -> dict[int, list[GradedClaim]]:
     points: dict[int, list[GradedClaim]] = defaultdict(list)
     for c in sorted(report.claims, key=lambda c: (c.end_line, c.line)):
         last = min(max(c.end_line, 1), n) - 1  # 0-based
-        points[min(block_end(blocks, starts, last), n)].append(c)
+        at = min(block_end(blocks, starts, last), n)
+        while at - 1 > last and not lines[at - 1].strip():  # a list's range takes in the blank line after it
+            at -= 1
+        points[at].append(c)
     return dict(points)
 
 
