@@ -59,8 +59,29 @@ class _Walker:
         self.ctx = Context()
         self.sing: list[tuple[Equation, str]] = []
         self.sing_arm: Arm | None = None
+        self.offsets: dict = {}
+        self.notes: list[str] = []
         from ..tables import find_tables
         self.tables = [(a, b) for a, b, why in find_tables(list(doc.lines)) if why is None]
+
+    def offset_of(self, line: int, arm: Arm | None) -> int:
+        """How far the section's joint numbers are shifted (a wrist written θ4…θ6 for a 3-joint arm: 3)."""
+        if arm is None or arm.robot is None:
+            return 0
+        for sec, a in self.arms:
+            if sec.line <= line <= sec.end_line:
+                key = (sec.line, id(a))
+                if key not in self.offsets:
+                    texts = [it.latex for it in self.doc.items if isinstance(it, Math)
+                             and sec.line <= it.line <= sec.end_line]
+                    self.offsets[key] = joint_offset(texts, arm.robot.dof)
+                    if self.offsets[key]:
+                        k = self.offsets[key]
+                        self.notes.append(f"lines {sec.line}-{sec.end_line}: joints {k + 1}…{k + arm.robot.dof} "
+                                          f"and frames {k}…{k + arm.robot.n_rows} of the report read as 1…"
+                                          f"{arm.robot.dof} and 0…{arm.robot.n_rows} of {arm.info.name}")
+                return self.offsets[key]
+        return 0
 
     def in_table(self, line: int) -> bool:
         return any(a <= line <= b for a, b in self.tables)
@@ -119,7 +140,9 @@ class _Walker:
 
     def math(self, m: Math) -> None:
         arm = self.arm_at(m.line)
-        for eq in split_block(m.latex, m.line, m.end_line):
+        offset = self.offset_of(m.line, arm)
+        latex = renumber(m.latex, offset, arm.robot.n_rows) if offset else m.latex
+        for eq in split_block(latex, m.line, m.end_line):
             if len(eq.parts) < 2 or not eq.parts[0]:
                 continue
             if _PROPAGATION.search(eq.parts[0]):
@@ -405,6 +428,30 @@ def _plain(lhs: str) -> str:
     return re.sub(r"\s+", "", lhs)
 
 
-def walk(doc: Document, arms: list) -> list[Pending]:
-    """Every equation of ``doc`` as a :class:`Pending`, in reading order."""
-    return _Walker(doc, arms).run()
+_JOINT_INDEX = re.compile(r"(?:\\(?:var)?theta|\bq|\bQ|(?<![A-Za-z\\])[cCsS])\s*_\s*\{?\s*(\d{1,4})")
+_SUBSCRIPT = re.compile(r"(_\s*\{?\s*)(\d{1,4})(?!\.)")
+_LEFT_SUP = re.compile(r"(\{\}\s*\^\s*\{?\s*)(\d)")
+
+
+def joint_offset(texts: list[str], dof: int) -> int:
+    """The shift of a section's joint numbers: every index it writes lies in o+1 … o+dof, with o ≥ 1."""
+    idx = {int(d) for t in texts for m in _JOINT_INDEX.finditer(t) for d in m.group(1)}
+    if not idx or max(idx) <= dof:
+        return 0
+    lo = min(idx)
+    return lo - 1 if lo > 1 and max(idx) - lo < dof else 0
+
+
+def renumber(latex: str, offset: int, n_rows: int) -> str:
+    """Subscripts and left superscripts of a section written with shifted joint and frame numbers, shifted back."""
+    def shift(m: re.Match) -> str:
+        digits = "".join(str(int(d) - offset) if offset <= int(d) <= offset + n_rows else d for d in m.group(2))
+        return m.group(1) + digits
+
+    return _LEFT_SUP.sub(shift, _SUBSCRIPT.sub(shift, latex))
+
+
+def walk(doc: Document, arms: list) -> tuple[list[Pending], list[str]]:
+    """Every equation of ``doc`` as a :class:`Pending`, in reading order, and notes on how it was read."""
+    w = _Walker(doc, arms)
+    return w.run(), w.notes

@@ -109,8 +109,8 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
     """Grade the report ``text`` (see :func:`grade_report`)."""
     doc = read_document(text, fmt)
     governed = arms_of(doc, source, robot, dict(arms or {}))
-    pending = walk(doc, governed)
-    notes = list(doc.notes)
+    pending, read_notes = walk(doc, governed)
+    notes = list(doc.notes) + read_notes
     if len(pending) > MAX_JUDGED:
         notes.append(f"only the first {MAX_JUDGED} equations were judged ({len(pending)} found)")
     graded = []

@@ -296,6 +296,9 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         words = "the joint torques" if qty == "torques" else "the equations of motion τ = M q̈ + c + g"
         return Reading(spec, words + (f", entry {k}" if k else ""),
                        needs=("q", "wrench") if qty == "torques" else ("q", "qd", "qdd"))
+    rate = _rate_row(sym, robot)
+    if rate is not None:
+        return rate
     if b in _TWIST and not sym.sub and not sym.pre_sup:
         return Reading({"quantity": "twist"}, "the end-effector twist (v, ω) = J q̇", needs=("q", "qd"))
     if b in ("M", "G", "g", "c", "C", "h"):
@@ -318,3 +321,21 @@ def joint_of(sym: Symbol, robot: DHRobot) -> int | None:
         params = {p for p, _ in robot.parameters}
         return None if f"d{k}" in params else k
     return None
+
+
+def _rate_row(sym: Symbol, robot: DHRobot) -> Reading | None:
+    """``\\dot\\theta_z``, ``\\omega_z``, ``\\dot\\alpha`` (the heading rate of a planar arm): one angular twist row."""
+    axis = re.sub(r"[{}\s]", "", sym.sub)
+    if sym.pre_sup or sym.sup:
+        return None
+    if sym.base in ("theta", "phi", "psi") and sym.dots == 1 and axis in ("x", "y", "z"):
+        k = {"x": 4, "y": 5, "z": 6}[axis]
+    elif sym.base in ("omega", "w") and sym.dots == 0 and axis in ("x", "y", "z"):
+        k = {"x": 4, "y": 5, "z": 6}[axis]
+    elif sym.base in ("alpha", "phi", "psi", "varphi") and sym.dots == 1 and not axis and robot.dof <= 4:
+        return Reading({"quantity": "twist", "entry": 6}, "the rate of the heading angle (ω_z)", sure=False,
+                       needs=("q", "qd"))
+    else:
+        return None
+    return Reading({"quantity": "twist", "entry": k}, f"the end effector's angular velocity ω_{axis}",
+                   needs=("q", "qd"))
