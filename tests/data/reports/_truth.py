@@ -476,6 +476,47 @@ def f10():
     ]
 
 
+# --- 11: two catalogue arms by section (arms=1:planar2r,2:scara-rrrp), no tables ---------------------------------
+
+@fixture("11_catalogue_sections.md")
+def f11():
+    from _truth_dh import planar_lagrange
+    m1, m2, g = sp.symbols("m1 m2 g", positive=True)
+    _, _, _, _, Mq, G = planar_lagrange(2, (L1, L2), (L1, L2), (m1, m2), (0, 0), g)   # point masses at the ends
+    two = Arm("std", [(1, 0, 0, t1), (1, 0, 0, t2)], [("R", t1), ("R", t2)])
+    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 2) / 2)   # noqa: E731
+    ik1 = lambda tg, q: (math.atan(tg["py"] / tg["px"])   # noqa: E731
+                         - math.atan(math.sin(q["theta2"]) / (1 + math.cos(q["theta2"]))))
+    D4, f = sp.Symbol("d4", real=True), sp.Float
+    sc = Arm("mdh", [(0, 0, 0, t1), (f(0.35), 0, 0, t2), (f(0.3), 0, 0, t3), (0, pi, D4, 0)],
+             [("R", t1), ("R", t2), ("R", t3), ("P", D4)])
+    C1, S1, C3, S3 = c(t1), s(t1), c(t3), s(t3)
+    C12, S12, C23, S23, C123, S123 = c(t1 + t2), s(t1 + t2), c(t2 + t3), s(t2 + t3), c(t1 + t2 + t3), s(t1 + t2 + t3)
+    w1, w2, w3, w4 = sp.symbols("qd1:5", real=True)
+    om4, v4 = frame_velocity(sc, 4)
+    J = sc.jacobian()
+    Jsq = J.extract([0, 1, 2, 5], [0, 1, 2, 3])
+    return [
+        R("correct", "q2 = acos((x^2 + y^2 - 2)/2) (branch q2 > 0)", test=lambda: ik_ok(two, 2, ik2, signs={t2: 1})),
+        R("incorrect", "q1 with the one-argument arctangent (wrong by pi when x < 0)",
+          test=lambda: ik_ok(two, 1, ik1, n=40)),
+        R("correct", "M(q)", M([(m1 + m2) * L1 ** 2 + m2 * L2 ** 2 + 2 * m2 * L1 * L2 * c(t2), m2 * L2 ** 2 + m2 * L1 * L2 * c(t2)],
+                               [m2 * L2 ** 2 + m2 * L1 * L2 * c(t2), m2 * L2 ** 2]), Mq),
+        R("incorrect", "g(q): cos q1 for cos(q1 + q2) in g_2",
+          col((m1 + m2) * g * L1 * c(t1) + m2 * g * L2 * c(t1 + t2), m2 * g * L2 * c(t1)), G),
+        R("correct", "3T4", M([1, 0, 0, 0], [0, -1, 0, 0], [0, 0, -1, -D4], [0, 0, 0, 1]), sc.A(4)),
+        R("correct", "0T4", M([C123, S123, 0, f(0.35) * C1 + f(0.3) * C12], [S123, -C123, 0, f(0.35) * S1 + f(0.3) * S12],
+                              [0, 0, -1, -D4], [0, 0, 0, 1]), sc.T(0)),
+        R("correct", "4w4", col(0, 0, -(w1 + w2 + w3)), om4),
+        R("incorrect", "4v4: z entry -d4dot (the slide moves along +z4)",
+          col(f(0.35) * S23 * w1 + f(0.3) * S3 * (w1 + w2), -f(0.35) * C23 * w1 - f(0.3) * C3 * (w1 + w2), -w4), v4),
+        R("correct", "J_v", M([-f(0.35) * S1 - f(0.3) * S12, -f(0.3) * S12, 0, 0], [f(0.35) * C1 + f(0.3) * C12, f(0.3) * C12, 0, 0],
+                              [0, 0, 0, -1]), J[:3, :]),
+        R("correct", "det of rows vx, vy, vz, wz", f(0.105) * s(t2), Jsq.det()),
+        R("correct", "singular theta2 = 0 or pi", test=lambda: singular_set_ok(Jsq.det(), [s(t2)], joints=(t1, t2, t3, D4))),
+    ]
+
+
 # --- the check ----------------------------------------------------------------------------------------------
 
 def main() -> int:
