@@ -214,3 +214,17 @@ def test_urdf_import_with_rounded_angles_writes_the_arm_it_checked(tmp_path):
     back, warned = _reload(result.robot, tmp_path / "arm.yaml")
     _assert_same(back, result.robot)
     assert warned == []
+
+
+@pytest.mark.parametrize("limits, unit", [("[-400, 400]", "deg"), ("[-rad(9.42), rad(9.42)]", "rad"),
+                                          ("[-6.2832deg * 180 / pi, 6.2832deg * 180 / pi]", "rad")])
+def test_genuine_multi_turn_limits_written_by_denavit_read_back_quietly(limits, unit, tmp_path):
+    """IRB140's ±400°, ANYmal's ±9.42 rad, UR's ±2π as 6.2832: read once, written by denavit, read again
+    without the "more than a full turn" warning (issue 29), to the same limits."""
+    src = tmp_path / "src.yaml"
+    src.write_text(f"name: arm\nconvention: standard\nangle_unit: {unit}\njoints:\n"
+                   f"  - {{a: 0.07, alpha: 0, d: 0.35, theta: q, limits: {limits}}}\n")
+    robot = load_robot(src)
+    back, warned = _reload(robot, tmp_path / "arm.yaml")
+    assert warned == [] and back.links[0].q_limits == robot.links[0].q_limits
+    assert abs(robot.links[0].q_limits[1]) > 2 * math.pi
