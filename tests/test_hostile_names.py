@@ -222,3 +222,15 @@ def test_import_table_of_a_device_says_not_a_regular_file(tmp_path):
     assert_refused(o, mentions=["not a regular file"])
     o = run_cli(["import-table", "missing.md"], tmp_path)
     assert_refused(o, mentions=["no such file"])
+
+
+def test_report_picture_file_name_is_made_of_safe_characters(tmp_path):
+    """The arm picture beside a .tex report is named from the robot: its name's }, \\, newline never reach
+    \\includegraphics{...} (nor a path)."""
+    pytest.importorskip("matplotlib")
+    save_robot(_named("x}\\write18{ls} (a)\n#/..", "planar2r"), tmp_path / "arm.yaml")
+    o = run_cli(["report", "arm.yaml", "-o", "r.tex", "--topics", "figures"], tmp_path, time_limit=60)
+    assert o.code == 0, o.describe()
+    pictures = [p.name for p in tmp_path.glob("*.png")]
+    assert len(pictures) == 1 and re.fullmatch(r"r-[A-Za-z0-9_.-]+-arm\.png", pictures[0])
+    assert f"\\includegraphics[width=0.7\\linewidth]{{{pictures[0]}}}" in (tmp_path / "r.tex").read_text()
