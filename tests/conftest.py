@@ -3,8 +3,8 @@
 - ``CI`` (and the ``ci`` fixture): true when the environment variable ``CI`` is ``"true"`` (``.ci/run`` sets it).
   ``REDUCED``: true on CI and in the quick subset; tests use it to run fewer random cases (what each case
   asserts does not change).
-- Hypothesis profiles: ``ci`` (derandomized, so a CI failure reproduces; no deadline: the machine is shared)
-  and ``dev`` (random, no deadline), chosen by ``CI``; ``HYPOTHESIS_PROFILE=...`` overrides.  Example counts
+- Hypothesis profiles: ``ci`` (derandomized, so a CI failure reproduces) and ``dev`` (random), chosen by
+  ``CI``; neither has a deadline nor the "input generation is slow" health check (the machine may be busy); ``HYPOTHESIS_PROFILE=...`` overrides.  Example counts
   stay those of each test's own ``@settings``.
 - ``robots(**options)``: a hypothesis strategy of random DH arms (``_random_robots.random_robot``: both
   conventions, prismatic joints, offsets, fixed rows, base and tool), drawn from a seed so a failure reproduces.
@@ -12,7 +12,8 @@
   is infinite); the ``rng`` fixture is a fresh ``numpy.random.Generator`` per test (seeded, reproducible).
 - ``SEED_REPORTS``: the project's shared seed reports (``../shared/seeds`` beside the clone, outside the
   repository); the tests that read them (test_import_table.py) skip with a reason when they are absent.
-- Slow tests carry ``@pytest.mark.slow``; tests marked ``browser`` are slow too (a real browser starts), so
+- Slow tests carry ``@pytest.mark.slow``, or are listed in tests/slow_tests.txt (those over 2 s in a
+  ``--durations`` report, scripts/slow_tests.py); tests marked ``browser`` are slow too (a real browser starts), so
   ``python -m pytest -m "not slow"`` is the quick subset.  In the quick subset the generated hostile-input
   corpora (tests/test_hostile_*.py) run a fifth of their cases (``_hostile.corpus``); the full suite, and CI,
   run them all.
@@ -37,7 +38,7 @@ REDUCED = CI
 
 settings.register_profile("ci", deadline=None, derandomize=True, print_blob=True,
                           suppress_health_check=[HealthCheck.too_slow])
-settings.register_profile("dev", deadline=None)
+settings.register_profile("dev", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if CI else "dev"))
 
 _HERE = Path(__file__).resolve().parent
@@ -80,8 +81,14 @@ def pytest_configure(config):
         REDUCED = True
 
 
+#: Tests that took more than 2 s in the quick subset (tests/slow_tests.txt, written by scripts/slow_tests.py from
+#: a --durations report): marked ``slow`` here, so that the quick subset stays within about two minutes of CPU.
+SLOW_TESTS = frozenset(line.strip() for line in (_HERE / "slow_tests.txt").read_text(encoding="utf-8").splitlines()
+                       if line.strip() and not line.startswith("#"))
+
+
 def pytest_collection_modifyitems(config, items):
     slow = pytest.mark.slow
     for item in items:
-        if item.get_closest_marker("browser") is not None:
+        if item.get_closest_marker("browser") is not None or item.nodeid in SLOW_TESTS:
             item.add_marker(slow)

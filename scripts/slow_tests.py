@@ -1,0 +1,56 @@
+"""Write tests/slow_tests.txt, the tests of the quick subset that took more than 2 s, from a pytest run's
+``--durations=0`` report (issue 31: the quick subset, ``python -m pytest -m "not slow"``, stays small).
+
+    python -m pytest -q -m "not slow" --durations=0 -p no:cacheprovider > durations.txt
+    python scripts/slow_tests.py durations.txt            # adds the tests over 2 s to tests/slow_tests.txt
+
+tests/conftest.py gives every test listed there the ``slow`` mark.  A test's time is the sum of its setup, call
+and teardown, in wall-clock seconds of the run the report comes from: on a busy machine that is more than its
+CPU time, so the list errs towards the quick subset being smaller.  Entries already listed stay (a test that
+was slow once is not timed in the quick subset again); remove a line by hand to bring a test back.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+LIST = ROOT / "tests" / "slow_tests.txt"
+HEADER = ("# Tests given the `slow` mark by tests/conftest.py (written by scripts/slow_tests.py from a --durations\n"
+          "# report of the quick subset: each took more than the threshold). One pytest node id a line.\n")
+_LINE = re.compile(r"^([\d.]+)s (setup|call|teardown)\s+(\S.*?)\s*$")
+
+
+def slow_ids(report: str, threshold: float) -> set[str]:
+    total: dict[str, float] = defaultdict(float)
+    for line in report.splitlines():
+        m = _LINE.match(line)
+        if m:
+            total[m.group(3)] += float(m.group(1))
+    return {node for node, seconds in total.items() if seconds > threshold}
+
+
+def read_list(path: Path = LIST) -> set[str]:
+    if not path.exists():
+        return set()
+    return {line.strip() for line in path.read_text(encoding="utf-8").splitlines()
+            if line.strip() and not line.startswith("#")}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("report", type=Path, help="the output of pytest --durations=0")
+    ap.add_argument("--threshold", type=float, default=2.0, help="seconds (default 2)")
+    args = ap.parse_args(argv)
+    ids = read_list() | slow_ids(args.report.read_text(encoding="utf-8", errors="replace"), args.threshold)
+    LIST.write_text(HEADER + "".join(f"{node}\n" for node in sorted(ids)), encoding="utf-8")
+    print(f"{len(ids)} tests listed in {LIST.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
