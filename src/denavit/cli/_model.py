@@ -99,7 +99,7 @@ def _symbolic_fk(robot, args) -> tuple[dict, list[str]]:
     elif args.latex:
         fmt = sp.latex
     else:
-        fmt = lambda M: sp.pretty(M, use_unicode=True, wrap_line=False)  # noqa: E731
+        from ..display import matrix_text as fmt  # wrapped to the terminal's width
     show = (lambda M: S.shorthand_matrix(M, q)) if args.shorthand else (lambda M: M)
     lines = []
     As = S.link_matrices_sym(robot)

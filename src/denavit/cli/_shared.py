@@ -34,7 +34,9 @@ def sym_formatter(args, q):
         return lambda M: "$$\n" + sp.latex(show(M)) + "\n$$"
     if getattr(args, "latex", False):
         return lambda M: sp.latex(show(M))
-    return lambda M: sp.pretty(show(M), use_unicode=True, wrap_line=False)
+    from ..display import matrix_text
+
+    return lambda M: matrix_text(show(M))  # wrapped to the terminal's width
 
 
 def q_out(args, robot, q):

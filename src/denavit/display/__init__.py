@@ -5,6 +5,7 @@ Results stay data; this package only turns them into text.  It needs numpy only,
 symbolic (sympy is then already loaded) and for the optional picture of the arm (matplotlib, when installed).
 """
 
+from ._matrix import matrix_text, terminal_width
 from ._results import (
     MAX_HTML_ROWS,
     derivation_markdown,
@@ -29,4 +30,6 @@ __all__ = [
     "singularities_markdown",
     "terminal_text",
     "one_line_text",
+    "matrix_text",
+    "terminal_width",
 ]
