@@ -291,21 +291,26 @@ def _worker_settings():
 
 @pytest.mark.slow
 def test_local_dask_cluster_gives_the_same_counts(monkeypatch):
-    """One LocalCluster (the tuned one scheduler="dask" starts): reached as a Client, by its address, and as
-    scheduler="dask", which closes it; no default client exists (distributed.wait would need one)."""
-    pytest.importorskip("distributed")
-    import denavit.scale._schedule as sched
+    """One LocalCluster (the tuned one scheduler="dask" starts): reached as a Client, by its address with its
+    credentials, and as scheduler="dask", which closes it; no default client exists (distributed.wait would
+    need one).  Its address alone, without the credentials, is refused."""
+    distributed = pytest.importorskip("distributed")
+    import denavit.scale._cluster as cluster_module
 
     robot = denavit.load_robot("puma560")
     n = 3 * BLOCK
     ref = occupancy(robot, n, 0.05, seed=9, scheduler="synchronous")
-    client, cluster = sched.start_local_cluster(1)
+    client, cluster = cluster_module.start_local_cluster(1)
     try:
         assert list(client.run(_worker_settings).values()) == [(False, str(2**30))]  # LOCAL_CLUSTER_CONFIG
         _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler=client, chunk=BLOCK))
-        _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler=cluster.scheduler_address, chunk=2 * BLOCK))
+        with distributed.Client(cluster.scheduler_address, security=cluster.security, set_as_default=False) as c2:
+            _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler=c2, chunk=2 * BLOCK))
+        with pytest.raises(ParseError, match="credentials"):
+            occupancy(robot, n, 0.05, seed=9, scheduler=cluster.scheduler_address)
         asked = []
-        monkeypatch.setattr(sched, "start_local_cluster", lambda workers: asked.append(workers) or (client, cluster))
+        monkeypatch.setattr(cluster_module, "start_local_cluster",
+                            lambda workers, dashboard=False: asked.append(workers) or (client, cluster))
         _same(ref, occupancy(robot, n, 0.05, seed=9, scheduler="dask", workers=1))
         assert asked == [1] and cluster.status.name == "closed"
     finally:

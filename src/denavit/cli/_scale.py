@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import re
+import sys
 from decimal import Decimal, InvalidOperation
 
 import numpy as np
@@ -55,14 +57,41 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("--scheduler", type=scheduler_name, default="auto", metavar="WHERE",
                    help=f"{', '.join(LOCAL_SCHEDULERS)} (default auto: processes for 1e7 samples or more, threads "
-                        "below; dask: a dask.distributed LocalCluster of --workers processes, started for the run) "
-                        "or a dask.distributed scheduler address such as tcp://10.0.0.5:8786 (dask and addresses "
-                        "need denavit[scale])")
+                        "below; dask: a private dask.distributed LocalCluster of --workers processes on TLS, "
+                        "started for the run) or the address of a dask.distributed scheduler you trust (it "
+                        "receives pickles), tcp://HOST:PORT or tls://HOST:PORT (dask and addresses need "
+                        "denavit[scale])")
+    p.add_argument("--dashboard", action="store_true",
+                   help="with --scheduler dask: serve Dask's dashboard on 127.0.0.1 at a free port, printed on "
+                        "stderr (needs bokeh; readable by any local user)")
     p.add_argument("--workers", type=bounded_int(1, MAX_WORKERS), metavar="N",
                    help=f"local threads or processes (default: the CPU count; at most {MAX_WORKERS})")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress line with ETA on stderr (default: when stderr is a terminal)")
     p.add_argument("--data", metavar="FILE", help="also save the arrays to FILE.npz (numpy.load reads it)")
+
+
+def check_dashboard(args: argparse.Namespace) -> None:
+    """--dashboard only with --scheduler dask (a cluster of the user's serves its own), refused before any work."""
+    from ..errors import ParseError
+
+    if args.dashboard and args.scheduler != "dask":
+        raise ParseError("--dashboard: only with --scheduler dask (a scheduler of your own serves its own "
+                         "dashboard)")
+
+
+@contextlib.contextmanager
+def where_to_run(args: argparse.Namespace):
+    """The scheduler to pass on: ``args.scheduler``, or with --dashboard the Client of a LocalCluster started
+    here with a dashboard (its address printed on stderr), closed afterwards."""
+    if not args.dashboard:
+        yield args.scheduler
+        return
+    from ..scale import local_cluster
+
+    with local_cluster(args.workers, dashboard=True) as client:
+        print(f"denavit {args.command}: Dask dashboard at {client.dashboard_link}", file=sys.stderr, flush=True)
+        yield client
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -110,10 +139,11 @@ def cmd_workspace(args: argparse.Namespace):
 
     check_output(args, args.output, PICTURES, kind="picture format")
     check_output(args, args.data, DATA, what="--data")
+    check_dashboard(args)
     robot = load(args)
-    ws = occupancy(robot, args.samples, args.resolution, args.seed, scheduler=args.scheduler,
-                   workers=args.workers, progress=args.progress,
-                   refine=None if args.refine == "auto" else int(args.refine))
+    with where_to_run(args) as where:
+        ws = occupancy(robot, args.samples, args.resolution, args.seed, scheduler=where, workers=args.workers,
+                       progress=args.progress, refine=None if args.refine == "auto" else int(args.refine))
     require_finite("workspace", ws.bounds_min, ws.bounds_max, ws.reach)
     if args.output:
         from ..viz import plot_occupancy, save_figure
@@ -152,9 +182,11 @@ def cmd_reachability(args: argparse.Namespace):
 
     check_output(args, args.output, PICTURES, kind="picture format")
     check_output(args, args.data, DATA, what="--data")
+    check_dashboard(args)
     robot = load(args)
-    rmap = reachability(robot, args.resolution, args.orientations, ik=args.ik, scheduler=args.scheduler,
-                        workers=args.workers, seed=args.seed, screen=not args.no_screen, progress=args.progress)
+    with where_to_run(args) as where:
+        rmap = reachability(robot, args.resolution, args.orientations, ik=args.ik, scheduler=where,
+                            workers=args.workers, seed=args.seed, screen=not args.no_screen, progress=args.progress)
     if args.output:
         from ..viz import plot_reachability, save_figure
 

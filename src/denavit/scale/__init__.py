@@ -2,7 +2,8 @@
 at the workspace's boundary), reachability and manipulability maps.
 
 The same task functions run in this process, in a thread or process pool, or on a ``dask.distributed``
-cluster given by address (the optional extra ``denavit[scale]``); results depend on the seed only, not on
+cluster: a private one started for the run (TLS with temporary credentials) or one given by a ``tcp://`` or
+``tls://`` address, which is trusted (it receives pickles) (the optional extra ``denavit[scale]``); results depend on the seed only, not on
 the number of workers or the chunk size.  See ``docs/workspace.md``.
 
 Importing this package needs numpy only; dask is imported when a cluster or a dask array is asked for.
@@ -10,7 +11,7 @@ Importing this package needs numpy only; dask is imported when a cluster or a da
 
 from ._sampler import (BLOCK, COMPILED_FROM, FINE_CELLS, MAX_CELLS, CompiledPositionFK, Grid, PositionFK, default_fk,
                        reach_bound, sampling_limits)
-from ._cluster import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG
+from ._cluster import CONNECT_TIMEOUT, LOCAL_CLUSTER_CONFIG, SCHEMES, local_cluster
 from ._schedule import LOCAL_SCHEDULERS, MAX_WORKERS, check_scheduler
 from ._volume import MIN_COVERAGE, VolumeEstimate, coarsen, estimate_volume
 from ._refine import MAX_REFINE, PILOT_SHARE, REFINE_CELLS, REFINE_COVERAGE, Refinement
@@ -36,6 +37,7 @@ __all__ = [
     "PILOT_SHARE",
     "REFINE_CELLS",
     "REFINE_COVERAGE",
+    "SCHEMES",
     "TAIL_SHARE",
     "Refinement",
     "MAX_SAMPLES",
@@ -51,6 +53,7 @@ __all__ = [
     "coarsen",
     "estimate_volume",
     "load_occupancy",
+    "local_cluster",
     "new_seed",
     "occupancy",
     "orientation_set",

@@ -11,16 +11,15 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import os
-import re
 import signal
 import sys
 import time
 from typing import Any, Callable, Iterable, Iterator
 
-from ..errors import ParseError
-from ._cluster import connect, start_local_cluster
+from ._cluster import check_address, cluster_failure, connect, local_cluster
 
-__all__ = ["LOCAL_SCHEDULERS", "POOLS", "AUTO_PROCESSES_FROM", "resolve_auto", "IN_FLIGHT", "MAX_WORKERS", "check_scheduler", "session", "run", "Progress"]
+__all__ = ["LOCAL_SCHEDULERS", "POOLS", "AUTO_PROCESSES_FROM", "resolve_auto", "IN_FLIGHT", "MAX_WORKERS",
+           "check_scheduler", "session", "run", "Progress"]
 
 #: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
 LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
@@ -32,23 +31,14 @@ AUTO_PROCESSES_FROM = 10_000_000
 IN_FLIGHT = 2
 #: Most local workers.
 MAX_WORKERS = 256
-_ADDRESS = re.compile(r"^(?:(tcp|tls|ucx)://)?([A-Za-z0-9_.\-]{1,253}|\[[0-9A-Fa-f:.]{2,45}\]):(\d{1,5})$")
-_INPROC = re.compile(r"^inproc://[A-Za-z0-9_.\-]{1,253}(/\d{1,12}){1,3}$")  # an in-process LocalCluster
 
 
 def check_scheduler(scheduler: Any) -> None:
-    """Refuse a scheduler that is neither a local name, a ``host:port`` address nor a Client (ParseError)."""
-    if not isinstance(scheduler, str):
+    """Refuse a scheduler that is neither a local name, a ``tcp://``/``tls://`` address nor a Client
+    (ParseError)."""
+    if not isinstance(scheduler, str) or scheduler in LOCAL_SCHEDULERS:
         return
-    if scheduler in LOCAL_SCHEDULERS:
-        return
-    m = _ADDRESS.match(scheduler)
-    if _INPROC.match(scheduler):
-        return
-    if not m or not 0 < int(m.group(3)) < 65536:
-        shown = scheduler if len(scheduler) <= 60 else scheduler[:57] + "..."
-        raise ParseError(f"scheduler {shown!r}: expected one of {', '.join(LOCAL_SCHEDULERS)} or a dask "
-                         "scheduler address such as tcp://127.0.0.1:8786")
+    check_address(scheduler)
 
 
 def resolve_auto(scheduler: Any, samples: int) -> Any:
@@ -95,18 +85,15 @@ def session(scheduler: Any, workers: int | None = None) -> Iterator[Any]:
     check_scheduler(scheduler)
     if not isinstance(scheduler, str) or scheduler in POOLS:
         yield scheduler
-        return
-    cluster = None
-    if scheduler == "dask":
-        client, cluster = start_local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS))
+    elif scheduler == "dask":
+        with local_cluster(min(workers or os.cpu_count() or 1, MAX_WORKERS)) as client:
+            yield client
     else:
         client = connect(scheduler)
-    try:
-        yield client
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        try:
+            yield client
+        finally:
+            client.close()
 
 
 def run(fn: Callable, tasks: Iterable[tuple], scheduler: Any = "threads", workers: int | None = None
@@ -150,24 +137,35 @@ def _run(fn: Callable, tasks: Iterable[tuple], scheduler: Any, workers: int | No
                     done, pending = _wait(done_order, pending)
                     pending = set(pending)
                     for f in done:
-                        yield f.result()
+                        yield _result(f, client)
                 continue
             pending.add(submit(fn, *task))
             while len(pending) >= IN_FLIGHT * width:
                 done, pending = _wait(done_order, pending)
                 pending = set(pending)
                 for f in done:
-                    yield f.result()
+                    yield _result(f, client)
         while pending:
             done, pending = _wait(done_order, pending)
             pending = set(pending)
             for f in done:
-                yield f.result()
+                yield _result(f, client)
     finally:
         for f in pending:
             f.cancel()
         if isinstance(pool, cf.Executor):
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _result(future, client):
+    """The task's result; on a cluster, a failure of the cluster itself becomes one DenavitError line."""
+    try:
+        return future.result()
+    except Exception as exc:
+        failure = None if client is None else cluster_failure(exc)
+        if failure is None:
+            raise
+        raise failure from None
 
 
 class Progress:
