@@ -15,9 +15,27 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _truth_dh import (HERE, Arm, R, force_moment, frame_velocity, ik_ok, link, pi, qd_symbols,  # noqa: E402
-                       same, singular_set_ok, sp, t1, t2, t3, t4, t5, t6)
-from _truth_dh import c, np, s  # noqa: E402
+from _truth_dh import (
+    HERE,
+    Arm,
+    R,
+    c,
+    force_moment,
+    frame_velocity,
+    ik_ok,
+    link,
+    np,
+    pi,
+    s,
+    singular_set_ok,
+    sp,
+    t1,
+    t2,
+    t3,
+    t4,
+    t5,
+    t6,
+)
 
 FIXTURES: dict = {}
 
@@ -144,8 +162,8 @@ def f03():
     T04, J = arm.T(0), arm.jacobian()
     f = sp.Float
     case = {t1: pi / 6, t2: pi / 4, D3: r(12, 100), t4: pi / 2}
-    ikd3 = lambda tg, q: 0.30 - tg["pz"]                                       # noqa: E731
-    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 0.2125) / 0.21)  # noqa: E731
+    ikd3 = lambda tg, q: 0.30 - tg["pz"]
+    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 0.2125) / 0.21)
     return [
         R("correct", "T01", M([c1, -s1, 0, f(0.35) * c1], [s1, c1, 0, f(0.35) * s1], [0, 0, 1, f(0.40)], [0, 0, 0, 1]),
           arm.A(1)),
@@ -185,10 +203,10 @@ def f04():
     T03, J = arm.T(0), arm.jacobian()
     # the IK formulas are checked at H1 = 0.7, d2 = 0.25 (the report's symbols; any positive values would do)
     armn = Arm("std", [(0, -pi / 2, 0.7, t1), (0, pi / 2, 0.25, t2), (0, 0, D3, 0)], [("R", t1), ("R", t2), ("P", D3)])
-    r = lambda tg: math.sqrt(tg["px"] ** 2 + tg["py"] ** 2 - 0.25 ** 2)   # noqa: E731
-    ik1 = lambda tg, q: math.atan2(tg["py"], tg["px"]) - math.atan2(0.25, r(tg))   # noqa: E731
-    ikd3 = lambda tg, q: math.hypot(r(tg), tg["pz"] - 0.7)   # noqa: E731
-    ik2 = lambda tg, q: math.atan2(tg["pz"] - 0.7, r(tg))   # noqa: E731
+    r = lambda tg: math.sqrt(tg["px"] ** 2 + tg["py"] ** 2 - 0.25 ** 2)
+    ik1 = lambda tg, q: math.atan2(tg["py"], tg["px"]) - math.atan2(0.25, r(tg))
+    ikd3 = lambda tg, q: math.hypot(r(tg), tg["pz"] - 0.7)
+    ik2 = lambda tg, q: math.atan2(tg["pz"] - 0.7, r(tg))
     branch = {t2: 1, D3: 1}
     detv = J[:3, :].det()
     return [
@@ -304,7 +322,7 @@ def f07():
     m = sp.symbols("m1:4", positive=True)
     II = sp.symbols("I1:4", positive=True)
     g = sp.Symbol("g", positive=True)
-    pcs, vcs, K, V, Mq, G = planar_lagrange(3, L, Lc, m, II, g)
+    pcs, vcs, _, V, Mq, G = planar_lagrange(3, L, Lc, m, II, g)
     c1, s1, c2, c3 = c(t1), s(t1), c(t2), c(t3)
     c12, s12, c23, c123, s123 = c(t1 + t2), s(t1 + t2), c(t2 + t3), c(t1 + t2 + t3), s(t1 + t2 + t3)
     w1, w2, w3 = sp.symbols("qd1:4", real=True)
@@ -352,9 +370,9 @@ def f08():
     h = sp.sqrt(3) / 2
     half = sp.Rational(1, 2)
     Z = sp.zeros(3, 3)
-    ik2 = lambda tg, q: math.atan2(math.hypot(tg["r31"], tg["r32"]), tg["r33"])   # noqa: E731
-    ik1 = lambda tg, q: math.atan2(tg["r23"], tg["r13"])   # noqa: E731
-    ik3 = lambda tg, q: math.atan2(tg["r32"], tg["r31"])   # noqa: E731
+    ik2 = lambda tg, q: math.atan2(math.hypot(tg["r31"], tg["r32"]), tg["r33"])
+    ik1 = lambda tg, q: math.atan2(tg["r23"], tg["r13"])
+    ik3 = lambda tg, q: math.atan2(tg["r32"], tg["r31"])
     up = {t2: 1}
     return [
         R("correct", "1T2", M([c2, -s2, 0, 0], [0, 0, 1, 0], [-s2, -c2, 0, 0], [0, 0, 0, 1]), arm.A(2)),
@@ -446,7 +464,7 @@ def f10():
         return math.atan2(y, x)
 
     branch = {t2: 1, t3: 1}
-    atan_p = lambda tg, q: math.atan2(tg["py"], tg["px"])   # noqa: E731
+    atan_p = lambda tg, q: math.atan2(tg["py"], tg["px"])
 
     def wrist_only_incomplete():
         """J (6x6, numeric) is singular at an elbow-stretched pose with sin θ5 ≠ 0: the claimed set misses it."""
@@ -484,8 +502,8 @@ def f11():
     m1, m2, g = sp.symbols("m1 m2 g", positive=True)
     _, _, _, _, Mq, G = planar_lagrange(2, (L1, L2), (L1, L2), (m1, m2), (0, 0), g)   # point masses at the ends
     two = Arm("std", [(1, 0, 0, t1), (1, 0, 0, t2)], [("R", t1), ("R", t2)])
-    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 2) / 2)   # noqa: E731
-    ik1 = lambda tg, q: (math.atan(tg["py"] / tg["px"])   # noqa: E731
+    ik2 = lambda tg, q: math.acos((tg["px"] ** 2 + tg["py"] ** 2 - 2) / 2)
+    ik1 = lambda tg, q: (math.atan(tg["py"] / tg["px"])
                          - math.atan(math.sin(q["theta2"]) / (1 + math.cos(q["theta2"]))))
     D4, f = sp.Symbol("d4", real=True), sp.Float
     sc = Arm("mdh", [(0, 0, 0, t1), (f(0.35), 0, 0, t2), (f(0.3), 0, 0, t3), (0, pi, D4, 0)],

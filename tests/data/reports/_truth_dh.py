@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import random
 import re
-import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import sympy as sp
@@ -102,7 +102,7 @@ class Arm:
 
 
 def qd_symbols(arm: Arm) -> list:
-    return [sp.Symbol("qd%d" % k, real=True) for k in range(1, len(arm.q) + 1)]
+    return [sp.Symbol(f"qd{k}", real=True) for k in range(1, len(arm.q) + 1)]
 
 
 def frame_velocity(arm: Arm, k: int) -> tuple[sp.Matrix, sp.Matrix]:
@@ -227,7 +227,7 @@ def ik_ok(arm: Arm, joint: int, formula: Callable[[dict, dict], float], n: int =
             tgt.update(zip(("px", "py", "pz"), np.asarray(where(*args), dtype=float).ravel()))
         for i in range(3):
             for j in range(3):
-                tgt["r%d%d" % (i + 1, j + 1)] = Mn[i, j]
+                tgt[f"r{i + 1}{j + 1}"] = Mn[i, j]
         got = formula(tgt, {str(k): float(v) for k, v in qv.items()})
         want = float(qv[arm.q[joint - 1]])
         d = (got - want + 3.141592653589793) % 6.283185307179586 - 3.141592653589793
@@ -242,7 +242,7 @@ def planar_lagrange(n: int, L, Lc, m, I, g):
     """Planar nR arm in a vertical plane (gravity −y): centre of mass of link i at Lc_i along it, inertia I_i
     about it. Returns (p_c list, ṗ_c list, K, V, M, gravity vector) from K = Σ ½ mᵢ|ṗ_ci|² + ½ Iᵢ ωᵢ²."""
     q = T[:n]
-    qd = [sp.Symbol("qd%d" % k, real=True) for k in range(1, n + 1)]
+    qd = [sp.Symbol(f"qd{k}", real=True) for k in range(1, n + 1)]
     pcs, vcs = [], []
     K = 0
     for i in range(n):
