@@ -62,3 +62,52 @@ def test_a_long_entry_is_broken_at_its_plus_and_minus_and_reads_back_the_same():
     assert all(b.startswith(("+", "-")) for b in body[1:])  # every break is before a sign
     one_line = sp.pretty(M[0, 0], use_unicode=True, wrap_line=False)
     assert "⋅" in one_line and " ".join(body) == one_line
+
+
+# --- inverse kinematics says why ---------------------------------------------------------------------------------
+
+def _beyond(text):
+    m = re.search(r"out of reach: the target is ([\d.e+-]+) m beyond the arm's reach bound \(it is ([\d.e+-]+) m "
+                  r"from the chain's base point; no configuration reaches farther than ([\d.e+-]+) m from it\)", text)
+    assert m, text
+    return tuple(float(g) for g in m.groups())
+
+
+def test_out_of_reach_ik_says_how_far_beyond_the_reach_the_target_is(capsys):
+    import denavit
+
+    robot = denavit.load_robot("planar2r")
+    reach = sum(link.a for link in robot.links)  # a 2R arm reaches a1 + a2 from its base, stretched out (q2 = 0)
+    code, out, err = run(capsys, "ik", "planar2r", "--pose", "5,0,0,0,0,0")
+    assert code == 1 and len(err.strip().splitlines()) == 1
+    beyond, dist, bound = _beyond(out)
+    assert (beyond, dist, bound) == pytest.approx((5 - reach, 5, reach))
+    assert _beyond(err) == (beyond, dist, bound)
+
+
+def test_out_of_reach_puma_target_names_the_bound_and_reachable_ones_do_not(capsys, rng):
+    import numpy as np
+
+    import denavit
+
+    robot = denavit.load_robot("puma560")
+    code, out, _ = run(capsys, "ik", "puma560", "--pose", "3,0,0,0,0,0")
+    beyond, dist, bound = _beyond(out)
+    assert code == 1 and beyond == pytest.approx(dist - bound, abs=1e-3) and beyond > 0
+    # the bound is a bound: no configuration within the limits reaches past it (sampled), nor past 3 m
+    lo, hi = robot.q_limits.T
+    p = denavit.forward_kinematics(robot, rng.uniform(lo, hi, (20_000, 6)))[:, :3, 3]
+    assert np.max(np.linalg.norm(p - p.mean(axis=0), axis=1)) < 2 * bound and np.max(np.linalg.norm(p, axis=1)) < 3
+    code, out, err = run(capsys, "ik", "puma560", "--from-q", "0.1, 0.2, -0.3, 0.4, 0.5, 0.6")
+    assert code == 0 and "out of reach" not in out + err
+    code, out, err = run(capsys, "ik", "planar2r", "--pose", "0,0,0,0,0,0", "--method", "numeric")
+    assert "out of reach" not in out + err  # inside the reach (a folded arm reaches its base): no such claim
+
+
+def test_redundant_arm_analytic_refusal_names_lock(capsys):
+    code, out, err = run(capsys, "ik", "panda", "--pose", "0.3,0,0.5,0,0,0", "--method", "analytic")
+    assert code == 1 and out == "" and len(err.strip().splitlines()) == 1
+    assert "--lock" in err and "--lock q7=0" in err and "redundant" in err
+    # and the advice works: with q7 held, the closed forms answer (the README's command)
+    code, out, _ = run(capsys, "ik", "panda", "--from-q", "0.1, 0.2, 0.3, -1.4, 0.5, 1.6, 0.7", "--lock", "q7=0.7")
+    assert code == 0 and "q7 locked" in out

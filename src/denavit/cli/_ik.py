@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 
 import numpy as np
 
@@ -108,7 +109,10 @@ def _analytic(args, robot, T):
     from ..ik import analytic_ik
 
     locked = _locks(args, robot)
-    res = analytic_ik(robot, T, locked=locked)
+    try:
+        res = analytic_ik(robot, T, locked=locked)
+    except UnsupportedRobotError as e:
+        raise UnsupportedRobotError(_lock_hint(str(e), robot)) from None
     sols = res.solutions
     require_finite("ik", sols)
     data = {"method": "analytic", "structure": res.method, "controlled": res.controlled,
@@ -225,6 +229,33 @@ def _latex(e) -> str:
     return sp.latex(e)
 
 
+def _lock_hint(message: str, robot) -> str:
+    """A redundant arm's refusal, with the way to its closed forms the CLI offers: hold the extra joints with
+    --lock (docs/ik.md, "Redundant arms"), e.g. the Panda's q7."""
+    m = re.search(r"are redundant \(its Jacobian has rank (\d+) everywhere\)", message)
+    if m is None:
+        return message
+    extra = robot.dof - int(m.group(1))
+    held = " ".join(f"q{k}=0" for k in range(robot.dof - extra + 1, robot.dof + 1))
+    return (f"{message}; or hold {extra} joint{'s' * (extra > 1)} with --lock (e.g. --lock {held}) for every "
+            "closed-form solution of the others")
+
+
+def beyond_reach(robot, T) -> tuple[float, float, float] | None:
+    """How far the target's origin lies beyond the arm's reach, or None when it is within it.
+
+    The bound (:func:`denavit.chain.reach_ball`): with T = C0 J1(q1) C1 ⋯ Jn(qn) Cn, rotations keep lengths, so
+    the end-effector origin p stays within R = Σ_k |t(C_k)| (+ the prismatic travel) of c = t(C0) for every q.
+    Returns (|p − c| − R, |p − c|, R) when |p − c| > R.
+    """
+    from ..chain import reach_ball, screws_of
+
+    lim = robot.q_limits
+    centre, R = reach_ball(screws_of(robot), lim[:, 0], lim[:, 1])
+    dist = float(np.linalg.norm(np.asarray(T, dtype=float)[:3, 3] - centre))
+    return (dist - R, dist, R) if np.isfinite(R) and dist > R else None
+
+
 def cmd_ik(args: argparse.Namespace):
     robot = load(args)
     if args.derive:
@@ -250,6 +281,11 @@ def cmd_ik(args: argparse.Namespace):
     data, lines = (_analytic if method == "analytic" else _numeric)(args, robot, T)
     data = {"robot": robot.name, "angle_unit": "deg" if args.deg else "rad", "T": T, **data}
     text = "\n".join([f"{robot.name}: inverse kinematics of", "T =", matrix_text(T), ""] + lines)
+    if not data["success"] and (far := beyond_reach(robot, T)) is not None:
+        data["reason"] = (f"out of reach: the target is {far[0]:.4g} m beyond the arm's reach bound (it is "
+                          f"{far[1]:.4g} m from the chain's base point; no configuration reaches farther than "
+                          f"{far[2]:.4g} m from it)")
+        text += "\n" + data["reason"]
     if not data["success"]:
         emit(args, data, text)  # the result is printed, then the exit code says "no solution"
         raise _NoSolution("no solution" + (f" ({data.get('reason')})" if data.get("reason") else ""))
