@@ -111,3 +111,27 @@ def test_redundant_arm_analytic_refusal_names_lock(capsys):
     # and the advice works: with q7 held, the closed forms answer (the README's command)
     code, out, _ = run(capsys, "ik", "panda", "--from-q", "0.1, 0.2, 0.3, -1.4, 0.5, 1.6, 0.7", "--lock", "q7=0.7")
     assert code == 0 and "q7 locked" in out
+
+
+# --- names: did you mean, any letter case; the symbols known -----------------------------------------------------
+
+def test_unknown_robot_name_gets_did_you_mean_and_a_whole_short_line(capsys):
+    code, out, err = run(capsys, "fk", "puma650", "-q", "0")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "did you mean puma560" in err and " ... " not in err  # no list cut in the middle of a name
+    assert "denavit robots" in err
+    code, _, err = run(capsys, "fk", "qwertyuiop", "-q", "0")
+    assert code == 2 and "did you mean" not in err and " ... " not in err
+
+
+@pytest.mark.parametrize(("typed", "name"), [("UR5", "ur5"), ("Puma560", "puma560"), ("PANDA", "panda"),
+                                             ("Report000-6R", "coaxial-6r")])
+def test_catalogue_lookup_ignores_letter_case(typed, name):
+    import denavit
+
+    assert denavit.load_robot(typed) == denavit.load_robot(name)
+
+
+def test_unknown_symbol_in_joint_values_lists_only_what_is_known(capsys):
+    code, _, err = run(capsys, "fk", "puma560", "-q", "0, 0, 0, 0, 0, O")
+    assert code == 2 and "unknown symbol 'O' (known: pi)" in err and "none" not in err

@@ -152,9 +152,11 @@ def test_bad_files_name_the_place(tmp_path, text, message):
     assert "\n" not in str(info.value)
 
 
-def test_unknown_robot_lists_the_catalogue():
-    with pytest.raises(ParseError, match="built-in: .*puma560"):
+def test_unknown_robot_says_where_the_catalogue_is_listed():
+    with pytest.raises(ParseError, match=r"the \d+ built-in names: denavit robots, or denavit.catalogue_names\(\)"):
         load_robot("no-such-robot")
+    with pytest.raises(ParseError, match="did you mean scara or scara-rrrp"):
+        load_robot("scarra")
     with pytest.raises(ParseError, match="no such robot file"):
         load_robot("missing.yaml")
 

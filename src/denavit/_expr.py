@@ -261,7 +261,7 @@ def lookup(env: Mapping[str, Any], pi: Any) -> Callable[[str], Any]:
         if n == "pi":
             return pi
         if n not in env:
-            raise ParseError(f"unknown symbol {n!r} (known: pi, {', '.join(sorted(env)) or 'none'})")
+            raise ParseError(f"unknown symbol {n!r} (known: {', '.join(['pi', *sorted(env)])})")
         return env[n]
 
     return name

@@ -71,6 +71,21 @@ def catalogue_names() -> list[str]:
     return sorted(p.name[:-5] for p in _catalogue_dir().iterdir() if p.name.endswith(".yaml"))
 
 
+def catalogue_name(name: str) -> str:
+    """The built-in robot ``name`` stands for: itself, an old name (:data:`CATALOGUE_ALIASES`), or either in
+    other letter case (``"UR5"`` is ``ur5``).  Unknown: a ParseError with the closest names (difflib) and how to
+    list them all."""
+    import difflib
+
+    known = {n.lower(): n for n in catalogue_names()} | {a.lower(): n for a, n in CATALOGUE_ALIASES.items()}
+    if name.lower() in known:
+        return known[name.lower()]
+    close = difflib.get_close_matches(name.lower(), [n for n in known if n in known.values()], n=3, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(close)}?" if close else ""
+    raise ParseError(f"unknown robot {name!r}: not a file and not a built-in name{hint} (the {len(catalogue_names())} "
+                     "built-in names: denavit robots, or denavit.catalogue_names())")
+
+
 def load_robot(source: str | Path, **parameters: float) -> DHRobot:
     """Load a robot from a file path or a built-in name (see :func:`catalogue_names`).
 
@@ -95,11 +110,7 @@ def load_robot(source: str | Path, **parameters: float) -> DHRobot:
         data = _load_text(raw.decode("utf-8", errors="replace"), path.suffix.lower(), str(path))
         robot = robot_from_dict(_override(data, parameters, str(path)), where=str(path))
     else:
-        name = CATALOGUE_ALIASES.get(str(source), str(source))
-        if name not in catalogue_names():
-            raise ParseError(
-                f"unknown robot {name!r}: not a file and not a built-in name; built-in: {', '.join(catalogue_names())}"
-            )
+        name = catalogue_name(str(source))
         res = _catalogue_dir() / f"{name}.yaml"
         data = _load_text(res.read_text(encoding="utf-8"), ".yaml", f"catalogue:{name}")
         robot = robot_from_dict(_override(data, parameters, name), where=name)
