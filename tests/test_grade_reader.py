@@ -138,10 +138,11 @@ def test_singular_configurations_in_words_are_one_claim():
     assert [v for _, q, v in _verdicts(wrong) if q == "singularities"] == ["incorrect"]
 
 
-def test_definitions_and_givens_are_not_claims():
-    got = _verdicts(_report("$$T_0^2 = A_1 A_2$$", "$$\\tau = J^T F$$", "$$F = \\begin{bmatrix} 1 \\\\ 2 \\\\ 0 "
-                                                                    "\\end{bmatrix}$$"))
-    assert [v for *_, v in got] == ["not a claim", "not a claim", "not a claim"]
+def test_definitions_and_givens_are_not_claims_and_relations_are_judged():
+    got = _verdicts(_report("$$T_0^2 = A_1 A_2$$", "$$F = \\begin{bmatrix} 1 \\\\ 2 \\\\ 0 \\end{bmatrix}$$",
+                            "$$\\tau = J^T F$$", "$$\\tau = J F$$"))
+    assert [(q, v) for _, q, v in got] == [("end_effector", "not a claim"), ("given: wrench", "not a claim"),
+                                           ("relation", "correct"), ("relation", "incorrect")]
 
 
 def test_each_table_governs_its_own_section():

@@ -19,7 +19,7 @@ from ..tables import find_tables, import_table
 from ._document import Document, Heading
 from ._types import ArmInfo, GradedClaim
 
-__all__ = ["Arm", "Section", "sections_of", "arms_of", "GENERIC_LENGTHS"]
+__all__ = ["Arm", "Section", "arms_of", "compare_tables", "GENERIC_LENGTHS"]
 
 #: Values given to lengths a table names without a value (distinct, not round, so no two coincide).
 GENERIC_LENGTHS = (0.537, 0.419, 0.3271, 0.6143, 0.2789, 0.4657, 0.3917, 0.7129, 0.2473, 0.5861)
@@ -39,20 +39,6 @@ class Arm:
     robot: DHRobot | None
     info: ArmInfo
     problem: str = ""
-
-
-def sections_of(doc: Document) -> list[Section]:
-    """Top-level sections: each heading of the smallest level used starts one (the text before is section 0)."""
-    heads = [h for h in doc.items if isinstance(h, Heading)]
-    n = len(doc.lines)
-    if not heads:
-        return [Section(None, 1, n)]
-    top = min(h.level for h in heads)
-    starts = [h for h in heads if h.level == top]
-    out = [Section(None, 1, starts[0].line - 1)] if starts[0].line > 1 else []
-    for a, b in zip(starts, starts[1:] + [None]):
-        out.append(Section(a, a.line, (b.line - 1) if b else n))
-    return out
 
 
 def _dof_named(title: str) -> int | None:
@@ -95,37 +81,55 @@ def _table_arm(doc: Document, first: int, last: int, source: str, title: str, en
     return Arm(robot, info)
 
 
+def _extent(h: Heading, heads: list[Heading], n: int) -> int:
+    """The last line of the section heading ``h`` opens (until the next heading of its level or higher)."""
+    later = [g.line for g in heads if g.line > h.line and g.level <= h.level]
+    return (later[0] - 1) if later else n
+
+
 def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, DHRobot]) -> list[tuple[Section, Arm | None]]:
-    """The arm that governs each section (None: no arm for it)."""
-    sections = sections_of(doc)
-    tables = find_tables(list(doc.lines))
-    out: list[tuple[Section, Arm | None]] = []
-    current: Arm | None = None
+    """Spans of the report and the arm that governs each (None: no arm); the first span holding a line decides.
+
+    Each table governs from the heading just before it (the first table from the top of the report) to the span of
+    the next table; a section given with ``--arm`` takes that arm; a section whose heading names another number
+    of joints and holds no table of its own gets none.
+    """
+    n = len(doc.lines)
+    heads = [h for h in doc.items if isinstance(h, Heading)]
+    tables = [t for t in find_tables(list(doc.lines)) if t[2] is None]
+    base: list[tuple[int, Arm]] = []
     if robot is not None:
-        current = Arm(robot, ArmInfo(robot.name, "", 1, len(doc.lines), f"ROBOT {robot.name}",
-                                     robot.convention.value, robot.dof))
-    for sec in sections:
-        title = sec.heading.title if sec.heading else ""
-        key = sec.heading.key if sec.heading else ""
-        if key in given:
-            g = given[key]
-            out.append((sec, Arm(g, ArmInfo(g.name, title, sec.line, sec.end_line, f"--arm {key}={g.name}",
-                                            g.convention.value, g.dof))))
+        base.append((1, Arm(robot, ArmInfo(robot.name, "", 1, n, f"ROBOT {robot.name}", robot.convention.value,
+                                           robot.dof))))
+    else:
+        for i, (first, last, _) in enumerate(tables):
+            before = [h for h in heads if h.line < first]
+            start = before[-1].line if before and i > 0 else 1
+            if i > 0:
+                start = max(start, tables[i - 1][1] + 1)
+            title = before[-1].title if before else ""
+            base.append((start, _table_arm(doc, first, last, source, title, n)))
+    spans: list[tuple[Section, Arm | None]] = []
+    for h in heads:
+        end = _extent(h, heads, n)
+        if h.key in given:
+            g = given[h.key]
+            spans.append((Section(h, h.line, end), Arm(g, ArmInfo(g.name, h.title, h.line, end,
+                                                                    f"--arm {h.key}={g.name}", g.convention.value,
+                                                                    g.dof))))
             continue
-        inside = [t for t in tables if sec.line <= t[0] <= sec.end_line]
-        if robot is None:
-            for first, last, why in inside:
-                if why is None:
-                    current = _table_arm(doc, first, last, source, title, sec.end_line)
-        named = _dof_named(title)
+        current = next((arm for start, arm in reversed(base) if start <= h.line), None)
+        named = _dof_named(h.title)
+        has_table = any(h.line <= t[0] <= end for t in tables)
         if current is not None and current.robot is not None and named is not None and named != current.robot.dof \
-                and not inside:
-            out.append((sec, Arm(None, ArmInfo("", title, sec.line, sec.end_line, "none", "", 0),
-                                 f"this section is about a {named}-joint arm and has no DH table of its own "
-                                 f"(give one: --arm {key or 'SECTION'}=ROBOT)")))
-            continue
-        out.append((sec, current))
-    return out
+                and not has_table:
+            spans.append((Section(h, h.line, end), Arm(None, ArmInfo("", h.title, h.line, end, "none", "", 0),
+                          f"the section at line {h.line} is about a {named}-joint arm and has no DH table of its own "
+                          f"(give one: --arm {h.key or 'SECTION'}=ROBOT)")))
+    for k, (start, arm) in enumerate(base):
+        stop = base[k + 1][0] - 1 if k + 1 < len(base) else n
+        spans.append((Section(None, start, stop), arm))
+    return spans
 
 
 def compare_tables(doc: Document, robot: DHRobot, source: str) -> list[GradedClaim]:

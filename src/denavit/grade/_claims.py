@@ -8,18 +8,20 @@ configurations stated over several lines ("θ₃ = 0° … θ₃ = 180° … and
 
 from __future__ import annotations
 
+import itertools
 import re
 from dataclasses import dataclass, field
 from typing import Any
 
 from ._arms import Arm
+from ._prose import plain_prose, prose_case, prose_conditions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
                        rates_or_wrench, vector_entries)
 from ._document import Document, Heading, Math, Prose
 from ._lhs import read_symbol
 from ._names import Reading, joint_of, read_name
 from ._split import Equation, split_block
-from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, wrench_symbols
+from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
 __all__ = ["Pending", "walk"]
 
@@ -28,6 +30,9 @@ _IK_FUNCS = re.compile(r"atan|arctan|arccos|arcsin|\\cos\^\{?-1|\\sin\^\{?-1|\\t
 _TRIG_LHS = re.compile(r"^\\?(cos|sin|tan)\s*\(?\s*\\?(?:var)?(?:theta|q|Q)_\{?\d\}?\s*\)?$")
 _SINGULAR = re.compile(r"singular", re.I)
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
+_RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
+                       r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
+_SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
 _PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
@@ -50,6 +55,7 @@ class Pending:
     message: str = ""
     quantity: str = ""
     numeric_without_case: bool = False
+    not_a_claim_if_unreadable: bool = False
 
 
 class _Walker:
@@ -95,27 +101,59 @@ class _Walker:
     def run(self) -> list[Pending]:
         items = list(self.doc.items)
         k = 0
-        top = min((h.level for h in items if isinstance(h, Heading)), default=1)
+        levels = [h.level for h in items if isinstance(h, Heading)]
+        top = min(levels, default=1)
+        if levels.count(top) == 1 and len(set(levels)) > 1:  # a title above the sections
+            top = min(v for v in levels if v != top)
         while k < len(items):
             it = items[k]
             if isinstance(it, Heading):
                 self.flush()
                 self.ctx.singular = bool(_SINGULAR.search(it.title))
-                if it.level == top:
+                if it.level <= top:
                     self.ctx = Context(singular=self.ctx.singular)
                 elif _CASE.search(it.title):
                     self.ctx.q = None
             elif isinstance(it, Prose):
-                if _SINGULAR.search(it.text):
-                    self.ctx.singular = True
-                if _CASE.search(it.text):
-                    self.ctx.q, self.ctx.partial = None, {}
+                self.prose(it)
             elif isinstance(it, Math) and not self.in_table(it.line):
                 it, k = self._joined(items, k)
                 self.math(it)
             k += 1
         self.flush()
         return self.out
+
+    def prose(self, it: Prose) -> None:
+        """Words that set the scene (a case, singular configurations) or state singular values in plain text."""
+        plain = plain_prose(it.text)
+        if _SINGULAR.search(it.text):
+            self.ctx.singular = True
+        arm = self.arm_at(it.line)
+        robot = arm.robot if arm is not None else None
+        case = _CASE.search(it.text)
+        if case:
+            number = re.sub(r"\D", "", case.group(0))
+            self.ctx.q, self.ctx.partial = self.ctx.cases.get(number), {}
+            self.ctx.case_number = number
+            if robot is not None:
+                q = prose_case(plain, robot)
+                if q is not None:
+                    self.ctx.q = self.ctx.cases[number] = q
+        w = prose_wrench(plain)
+        if w is not None:
+            self.ctx.wrench = w
+        frame = re.search(r"\b(base|tool|gripper|end[- ]effector|world)\b[ -](?:frame|axes)", plain, re.I)
+        if frame and re.search(r"\b(?:force|wrench|F)\b", plain):
+            self.ctx.wrench_frame = "base" if frame.group(1).lower() in ("base", "world") else "tool"
+        det = re.search(r"determinant (?:is |of |equal to )?\$([^$=]{1,400})\$", it.text)
+        if det and robot is not None:
+            eq = Equation(it.line, it.line, det.group(1), ("\\det J", det.group(1)), "=")
+            self._det(eq, arm, det.group(1), None)
+        if self.ctx.singular and robot is not None:
+            for cond in prose_conditions(plain, robot):
+                eq = Equation(it.line, it.line, cond, (cond,), "=")
+                self.sing.append((eq, cond))
+                self.sing_arm = arm
 
     def _joined(self, items: list, k: int) -> tuple[Math, int]:
         """An equation split over consecutive display blocks (brackets left open) as one block."""
@@ -163,6 +201,9 @@ class _Walker:
             return
         if wrench_symbols(eq.text):
             self.ctx.wrench_texts.append(eq.text[:2000])
+        head = read_symbol(eq.parts[0])
+        if head is not None and head.det and eq.parts[-1].strip() == "0":
+            self.ctx.singular = True  # "det J = … = 0 ⇒ θ2 = 0, π": what follows are singular values
         if self.givens(eq, arm):
             return
         if self.ctx.singular and self.condition(eq, arm):
@@ -174,8 +215,11 @@ class _Walker:
         """A case's q, rates, a wrench: remembered, and the equation is "not a claim"."""
         robot = arm.robot if arm is not None else None
         lhs, last = eq.parts[0], eq.parts[-1]
-        if robot is not None and case_of(eq.parts, eq.text, robot):
-            self.ctx.q, self.ctx.partial = eq.text, {}
+        q = case_of(eq.parts, eq.text, robot) if robot is not None else None
+        if q is not None:
+            self.ctx.q, self.ctx.partial = q, {}
+            if self.ctx.case_number:
+                self.ctx.cases[self.ctx.case_number] = q
             self.note(eq, arm, "not a claim", "the configuration of this case (used for the numeric results "
                       "below)", "given: q")
             return True
@@ -243,9 +287,9 @@ class _Walker:
         rows = "planar" if arm.robot.dof <= 3 else None
         p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
                     quantity="det_jacobian")
-        p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in ("vx,vy", "linear", "planar",
-                                                                                   "vx,vy,vz", "wx,wy,wz")
-                        if r != rows]
+        names = ("vx", "vy", "vz", "wx", "wy", "wz")
+        subsets = [",".join(c) for c in itertools.combinations(names, arm.robot.dof)] if arm.robot.dof <= 6 else []
+        p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in subsets]
         if rows:
             claim["rows"] = rows
         self.out.append(p)
@@ -286,13 +330,20 @@ class _Walker:
                 self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
                           "the joint in terms of the target")
             return
-        reading = read_name(sym, robot, value) if sym is not None else None
+        reading = read_name(sym, robot, value) if sym is not None else _vector_reading(lhs, robot)
         if reading is not None and reading.spec.get("quantity") in _MATRIX_QUANTITIES and "\\begin" not in value \
                 and "[" not in value:
             self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "
                       "matrix)", reading.spec["quantity"])
             return
-        if reading is not None and _names_product(value):
+        if reading is not None and (_names_product(value) or _RELATION.fullmatch(value.replace(" ", ""))):
+            if reading.spec["quantity"] in ("torques", "twist", "jacobian"):
+                claim = {"quantity": "relation", "value": eq.text}
+                p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "a relation between the arm's quantities",
+                            quantity="relation")
+                p.not_a_claim_if_unreadable = True
+                self.out.append(p)
+                return
             self.note(eq, arm, "not a claim", "a definition: the product of other results", reading.spec["quantity"])
             return
         if reading is None:
@@ -300,7 +351,7 @@ class _Walker:
             name = _plain(lhs)
             if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
                     and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params \
-                    and "\\begin" not in value:
+                    and "\\begin" not in value and not _SHORTHAND.fullmatch(name):
                 self.ctx.define(name, value)
             self.note(eq, arm, "not a claim", f"not judged: {lhs[:60]} names no result denavit checks (a definition "
                       "or an intermediate step)")
@@ -308,6 +359,8 @@ class _Walker:
         self.out.append(self.claim(eq, arm, reading, value))
 
     def claim(self, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
+        if "\\begin" in value and matrices(value) is None:
+            value = scale_matrix(value) or value
         if "\\begin" in value:
             mats = matrices(value)
             expanded = expand_product(value) if mats is not None and len(mats) == 2 else None
@@ -374,8 +427,29 @@ class _Walker:
                 claim["wrench"] = "[" + ", ".join(WRENCH_NAMES) + "]"
         if claim["quantity"] == "torques":
             first, second = ("tool", "base") if self.ctx.propagation else ("base", "tool")
+            if self.ctx.wrench_frame:
+                first, second = self.ctx.wrench_frame, ("tool" if self.ctx.wrench_frame == "base" else "base")
             claim["frame"] = first
             p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+
+
+def _vector_reading(lhs: str, robot: Any) -> Reading | None:
+    """``[\\dot x; \\dot y; \\dot z]`` on the left: the twist rows those rates are (each read as a name)."""
+    entries = vector_entries(lhs) if lhs.strip().startswith("\\begin") else None
+    if not entries or len(entries) > 6:
+        return None
+    rows = []
+    for e in entries:
+        sym = read_symbol(e)
+        r = read_name(sym, robot) if sym is not None else None
+        k = r.spec.get("entry") if r is not None and r.spec.get("quantity") == "twist" else None
+        if not isinstance(k, int):
+            return None
+        rows.append(("vx", "vy", "vz", "wx", "wy", "wz")[k - 1])
+    if len(set(rows)) != len(rows):
+        return None
+    return Reading({"quantity": "twist", "rows": ",".join(rows)}, f"the end-effector velocity rows {', '.join(rows)}",
+                   needs=("q", "qd"))
 
 
 def _define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
@@ -413,7 +487,7 @@ def _names_product(value: str) -> bool:
 def _used_where(where: dict[str, str], value: str) -> dict[str, str]:
     """The definitions a value uses (and those they use), in the order they were made."""
     def uses(text: str, name: str) -> bool:
-        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z])", re.sub(r"\s+", " ", text)) is not None
+        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z_0-9])", re.sub(r"\s+", " ", text)) is not None
 
     need = {k for k in where if uses(value, k)}
     for _ in range(len(where)):

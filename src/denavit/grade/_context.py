@@ -42,6 +42,9 @@ class Context:
     singular: bool = False
     propagation: bool = False
     jacobian_frame: int | None = None
+    wrench_frame: str | None = None
+    cases: dict[str, str] = field(default_factory=dict)
+    case_number: str = ""
     wrench_texts: list[str] = field(default_factory=list)
 
     def define(self, name: str, value: str) -> None:
@@ -90,7 +93,7 @@ def _joint_tuple(lhs: str, dof: int) -> bool:
     if not m:
         return False
     items = [x for x in m.group(1).replace("\\right", "").split(",") if x]
-    return len(items) == dof and all(re.fullmatch(r"\\?(?:var)?(?:theta|q|Q|heta)_?\d", x) for x in items)
+    return len(items) == dof and all(re.fullmatch(r"\\?(?:var)?(?:theta|q|Q|heta|d)_?\d", x) for x in items)
 
 
 def case_of(parts: tuple[str, ...], text: str, robot: DHRobot) -> str | None:

@@ -61,6 +61,8 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
     details = v.to_json()
     if v.verdict == "correct" or v.verdict == "ambiguous":
         return v.verdict, v.message, "", details
+    if v.verdict == "unreadable" and p.not_a_claim_if_unreadable:
+        return "not a claim", "not judged: a relation in names the relation reader does not know", "", details
     if v.verdict == "unreadable":
         m = _UNKNOWN.search(v.message)
         name = m and (m.group(1) or m.group(2))
@@ -135,7 +137,7 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
     return GradedReport(source, text, fmt, tuple(seen.values()), tuple(graded), tuple(notes))
 
 
-def grade_report(path: str | Path, robot: DHRobot | None = None, arms: dict[str, Any] | None = None, *,
+def grade_report(path: str | Path, robot: DHRobot | str | None = None, arms: dict[str, Any] | None = None, *,
                  seed: int = 0) -> GradedReport:
     """Grade a student's report as written: every stated result judged in place.
 
@@ -165,4 +167,6 @@ def grade_report(path: str | Path, robot: DHRobot | None = None, arms: dict[str,
     except UnicodeDecodeError as exc:
         raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
     given = {str(k): (v if isinstance(v, DHRobot) else load_robot(str(v))) for k, v in (arms or {}).items()}
+    if robot is not None and not isinstance(robot, DHRobot):
+        robot = load_robot(str(robot))
     return grade_text(text, fmt, robot=robot, arms=given, source=where, seed=seed)

@@ -143,6 +143,8 @@ def _jacobian(sym: Symbol, robot: DHRobot) -> Reading | None:
             return None
         spec["frame"] = "tool"
         words.append("in tool axes (Je)")
+    elif sym.det and (sub in _LINEAR or sub in _ANGULAR):
+        words.append(f"(J_{sub}: the rows are found among the square blocks)")
     elif sub in _LINEAR and not sym.det:
         spec["rows"] = "linear"
         words.append("linear rows (J_v)")

@@ -72,6 +72,7 @@ def clean(text: str) -> str:
     """Alignment marks, equation numbers and spacing dropped; the mathematics kept."""
     text = re.sub(r"=\s+>", lambda _: " \\Rightarrow ", text)
     t = "".join(" " if text[k] == "&" and d == 0 else text[k] for k, d in _levels(text))
+    t = re.sub(r"\\label\{[^{}]{0,200}\}", " ", t)
     t = re.sub(r"\\(?:nonumber|notag|displaystyle|qquad|quad)(?![A-Za-z])|\\[,;!:]|(?<!\\)\\ ", " ", t)
     t = _EQNUM.sub(" ", t.strip())
     return re.sub(r"\s+", " ", t).strip().strip(",.;").strip()
@@ -105,6 +106,7 @@ def _unwrap(latex: str) -> str:
 def _pieces(row: str) -> list[str]:
     """A row split at arrows, at ``\\quad`` between equations and at a comma between equations."""
     row = re.sub(r"=\s+>", lambda _: " \\Rightarrow ", row)
+    row = re.sub(r"\\[,;:!]", " ", row)  # thin spaces, before the comma split
     row = _TEXT.sub(lambda m: " \\Rightarrow " if m.group(1).strip().lower() in ("or", "and", "or when", "and when")
                     else " ", row)
     out: list[str] = []

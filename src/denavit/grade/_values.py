@@ -13,7 +13,7 @@ import re
 from ._context import is_numeric, vector_entries
 from ._split import top_level_split
 
-__all__ = ["matrices", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES"]
+__all__ = ["matrices", "scale_matrix", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES"]
 
 _MAT = re.compile(r"\\begin\{([bBpv]?matrix)\}")
 #: The wrench's symbols, in the order (f, n), as the checker names them.
@@ -75,3 +75,19 @@ def wrench_symbols(*texts: str) -> list[str]:
     """The wrench symbols written in ``texts`` (``f_x``, ``F_y``, ``n_z`` …), in the checker's (f, n) order."""
     seen = {f"{m.group(1).lower()}_{m.group(2)}" for t in texts for m in _SYMBOL.finditer(t)}
     return [n for n in WRENCH_NAMES if n in seen]
+
+
+_SCALED = re.compile(r"^([^\\=]{0,0}(?:[^=]{1,200}?))\s*(\\begin\{([bBpv]?matrix)\}.*\\end\{\3\})\s*$", re.S)
+
+
+def scale_matrix(value: str) -> str | None:
+    """``g \\begin{bmatrix} a \\\\ b \\end{bmatrix}`` (a factor before one matrix) with the factor in every entry."""
+    m = _SCALED.match(value.strip())
+    if m is None or "\\begin" in m.group(1) or not m.group(1).strip():
+        return None
+    mats = matrices(m.group(2))
+    if mats is None or len(mats) != 1:
+        return None
+    factor = m.group(1).strip()
+    rows = [" & ".join(f"({factor})({c})" for c in r) for r in _cells(mats[0])]
+    return "\\begin{bmatrix} " + " \\\\ ".join(rows) + " \\end{bmatrix}"
