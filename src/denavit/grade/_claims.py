@@ -162,7 +162,7 @@ class _Walker:
             nxt = items[k + 1]
             if not isinstance(nxt, Math) or not nxt.display or nxt.line - it.end_line > 3:
                 break
-            head = nxt.latex.lstrip()
+            head = re.sub(r"^(?:\s|&|\\q?quad(?![A-Za-z])|\\[,;:!])+", "", nxt.latex)
             open_first = it.latex.count("(") > it.latex.count(")")
             closes_next = nxt.latex.count(")") > nxt.latex.count("(") or head[:1] in "+-*" or \
                 head.startswith("\\cdot")
