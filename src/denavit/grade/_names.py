@@ -277,6 +277,8 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         return _transform(sym, robot)
     if b == "J" or (sym.det and b == "J"):
         return _jacobian(sym, robot)
+    if b in ("P", "V", "U") and dynamic and not (sym.sub or sym.pre_sup or sym.dots):
+        return _energy(sym)
     if b in ("p", "P", "o", "O") and not sym.det:
         return _position(sym, robot)
     if b in ("x", "y", "z"):
