@@ -135,3 +135,95 @@ def test_catalogue_lookup_ignores_letter_case(typed, name):
 def test_unknown_symbol_in_joint_values_lists_only_what_is_known(capsys):
     code, _, err = run(capsys, "fk", "puma560", "-q", "0, 0, 0, 0, 0, O")
     assert code == 2 and "unknown symbol 'O' (known: pi)" in err and "none" not in err
+
+
+# --- import-urdf: the end link users expect, no rounding noise -----------------------------------------------------
+
+def _urdf(joints: list[tuple[str, str, str, str, str]]) -> str:
+    """A URDF of (joint name, type, parent, child, origin xyz / rpy attributes) joints; links from the joints."""
+    links = {j[2] for j in joints} | {j[3] for j in joints}
+    body = "".join(f'<link name="{n}"/>' for n in sorted(links))
+    for name, kind, parent, child, origin in joints:
+        extra = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>' if kind != "fixed" else ""
+        body += (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+                 f'<origin {origin}/>{extra}</joint>')
+    return f'<robot name="t">{body}</robot>'
+
+
+ARM = [("j1", "revolute", "base", "l1", 'xyz="0 0 0.3"'), ("j2", "revolute", "l1", "l2", 'xyz="0.4 0 0" rpy="1.57079632679 0 0"'),
+       ("j3", "revolute", "l2", "l3", 'xyz="0.3 0 0"')]
+
+
+def test_fixed_frames_of_the_last_link_do_not_compete_and_tool0_is_chosen(tmp_path):
+    from denavit.interop import import_urdf
+
+    res = import_urdf(_urdf(ARM + [("f1", "fixed", "l3", "ee_link", 'xyz="0.1 0 0"'),
+                                   ("f2", "fixed", "l3", "tool0", 'xyz="0 0 0.1"')]))
+    assert res.tip_link == "tool0" and res.robot.dof == 3
+    assert any(n.startswith("end link tool0 (chosen:") and "ee_link" in n and "--tip" in n for n in res.notes)
+
+
+def test_gripper_fingers_do_not_win_over_the_hand(tmp_path):
+    from denavit.interop import import_urdf
+
+    hand = [("h", "fixed", "l3", "hand", 'xyz="0 0 0.1"'), ("fl", "prismatic", "hand", "finger_l", 'xyz="0 0.02 0"'),
+            ("fr", "prismatic", "hand", "finger_r", 'xyz="0 -0.02 0"')]
+    res = import_urdf(_urdf(ARM + hand))
+    assert res.tip_link == "hand" and res.robot.dof == 3
+    assert any("branches there into finger_l, finger_r" in n for n in res.notes)
+
+
+def test_two_arms_on_a_torso_still_need_tip(tmp_path):
+    from denavit import ParseError
+    from denavit.interop import import_urdf
+
+    arms = [("t", "revolute", "base", "torso", 'xyz="0 0 0.5"')]
+    for side in "lr":
+        arms += [(f"{side}1", "revolute", "torso", f"{side}a", 'xyz="0 0.2 0"'),
+                 (f"{side}2", "revolute", f"{side}a", f"{side}b", 'xyz="0.3 0 0"')]
+    with pytest.raises(ParseError, match=r"choose the end link with --tip \(leaves: lb, rb\)"):
+        import_urdf(_urdf(arms))
+
+
+def _example_robot(rel):
+    from test_urdf_examples import _robots_dir
+
+    return str(_robots_dir() / rel)
+
+
+def test_example_robot_data_ur5_and_panda_import_without_tip(capsys, tmp_path):
+    path = _example_robot("ur_description/urdf/ur5_robot.urdf")
+    code, out, err = run(capsys, "import-urdf", path, "-o", str(tmp_path / "ur5.yaml"))
+    assert code == 0, err
+    assert "world -> tool0" in out and "note: end link tool0 (chosen:" in out
+    code, out, err = run(capsys, "import-urdf", _example_robot("panda_description/urdf/panda.urdf"))
+    assert code == 0, err
+    assert "panda_link0 -> panda_hand " in out and "note: end link panda_hand (chosen:" in out
+
+
+def test_urdf_rounded_right_angles_are_right_angles_in_the_table_and_the_file(capsys, tmp_path):
+    import numpy as np
+
+    import denavit
+
+    path = _example_robot("ur_description/urdf/ur5_robot.urdf")
+    assert "1.57079632679" in open(path).read()  # the file's pi/2, 4.9e-12 short
+    code, out, _ = run(capsys, "import-urdf", path, "-o", str(tmp_path / "ur5.yaml"))
+    written = (tmp_path / "ur5.yaml").read_text()
+    table = [line for line in out.splitlines() if " revolute " in line or line.startswith("tool:")]
+    assert code == 0 and len(table) == 6 and not any("e-1" in line for line in table), table  # no tool line either
+    assert [line.split()[5] for line in table] == ["q1", "q2", "q3", "q4", "q5", "q6"]
+    assert re.findall(r"theta: ([^,]*)", written) == ["q", "q", "q", "q", "q", "q + pi"] and "tool" not in written
+    robot = denavit.load_robot(str(tmp_path / "ur5.yaml"))
+    offsets = np.array([link.theta for link in robot.links] + [link.alpha for link in robot.links])
+    assert np.all(np.remainder(offsets, np.pi / 2) == 0)  # exactly multiples of pi/2
+    assert np.array_equal(robot.tool_matrix, np.eye(4))
+
+
+def test_snapping_leaves_real_offsets_alone():
+    import math
+
+    from denavit.interop._urdf_snap import snap_angle
+
+    assert snap_angle(1.57079632679) == math.pi / 2 and snap_angle(-3.14159265358) == -math.pi
+    assert snap_angle(4.9e-12) == 0.0 and snap_angle(1e-8) == 1e-8 and snap_angle(0.3) == 0.3

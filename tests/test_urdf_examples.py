@@ -72,7 +72,9 @@ def test_shipped_urdf_matches_pinocchio(arm, convention, rng):
     path = str(_robots_dir() / rel)
     result = import_urdf(path, base, tip, convention)
     robot = result.robot
-    assert result.position_error < 1e-12 and result.rotation_error < 1e-12
+    # 1e-10, not rounding alone: angles within 1e-9 of a multiple of pi/2 are taken as it (interop._urdf_snap;
+    # the UR files write pi/2 as 1.57079632679, 4.9e-12 short), so the model is that far from the file's numbers
+    assert result.position_error < 1e-10 and result.rotation_error < 1e-10
     model, data = _pin_chain(path, result.joint_names)
     assert model.nv == robot.dof
     vidx = [model.joints[model.getJointId(n)].idx_v for n in result.joint_names]
@@ -83,7 +85,7 @@ def test_shipped_urdf_matches_pinocchio(arm, convention, rng):
         v, a = np.zeros(model.nv), np.zeros(model.nv)
         v[vidx], a[vidx] = qd, qdd
         pin.framesForwardKinematics(model, data, x)
-        np.testing.assert_allclose(denavit.forward_kinematics(robot, q), data.oMf[fid].homogeneous, atol=1e-12)
+        np.testing.assert_allclose(denavit.forward_kinematics(robot, q), data.oMf[fid].homogeneous, atol=1e-10)
         if robot.has_dynamics:
             tau = pin.rnea(model, data, x, v, a)[vidx]
             np.testing.assert_allclose(denavit.rnea(robot, q, qd, qdd, friction=False), tau,

@@ -9,7 +9,7 @@ from ._urdf_in import (CHECK_SAMPLES, CHECK_TOL, INERTIA_CHOICES, URDF_GRAVITY, 
                        nearest_physical_inertia, urdf_chain_fk)
 from ._mjcf_out import MJCF_BALANCE_MARGIN, MJCF_MIN_INERTIA, MJCF_MIN_MASS, to_mjcf
 from ._urdf_out import to_urdf
-from ._urdf_read import MAX_NUMBER_CHARS, MAX_URDF_LINKS, chain_path, read_urdf
+from ._urdf_read import MAX_NUMBER_CHARS, MAX_URDF_LINKS, chain_path, default_tip, read_urdf
 from ._xacro import XACRO_CPU_SECONDS, XACRO_MEMORY_BYTES, XACRO_WALL_SECONDS
 from ._xml import MAX_XML_BYTES, MAX_XML_DEPTH, MAX_XML_ELEMENTS
 
@@ -24,6 +24,7 @@ __all__ = [
     "UrdfImport",
     "read_urdf",
     "chain_path",
+    "default_tip",
     "urdf_chain_fk",
     "PARALLEL_TOL",
     "INTERSECT_TOL",

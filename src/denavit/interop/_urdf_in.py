@@ -1,8 +1,8 @@
 """URDF in, DH out: the serial chain between two links of a URDF as a DH table, with base, tool and inertias.
 
-The axis geometry that gives the DH rows is :mod:`denavit.interop._urdf_axes` (its notes state the method);
-this module walks the chain, builds the robot, folds the inertias and checks the result against the URDF's FK.
-"""
+The axis geometry that gives the DH rows is :mod:`denavit.interop._urdf_axes` (its notes state the method); this
+module walks the chain, builds the robot (URDF rounding taken out: ``._urdf_snap``), folds the inertias and
+checks the result against the URDF's FK."""
 
 from __future__ import annotations
 
@@ -17,11 +17,11 @@ from ..model import MAX_JOINTS, Convention, DHLink, DHRobot, JointType, LinkIner
 from ..numeric import forward_kinematics, link_transforms
 from ._export import combine_inertia
 from ._urdf_axes import FAR_FOOT, dh_geometry
-from ._urdf_read import UrdfJoint, UrdfModel, chain_path, read_urdf, subtree_joints
+from ._urdf_read import UrdfJoint, UrdfModel, chain_path, default_tip, read_urdf, subtree_joints
+from ._urdf_snap import snap_angle, snap_pose
 
 __all__ = ["UrdfImport", "import_urdf", "from_urdf", "urdf_chain_fk", "tidy", "nearest_physical_inertia",
-           "INERTIA_CHOICES", "URDF_GRAVITY", "CHECK_SAMPLES", "CHECK_TOL",
-           "TIDY_DIGITS", "TIDY_ULPS"]
+           "INERTIA_CHOICES", "URDF_GRAVITY", "CHECK_SAMPLES", "CHECK_TOL", "TIDY_DIGITS", "TIDY_ULPS"]
 
 #: What :func:`import_urdf` does with the links' inertial data (``inertia=``; ``--fix-inertia``, ``--no-inertia``).
 INERTIA_CHOICES = ("check", "fix", "none")
@@ -110,7 +110,7 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         A URDF file, or URDF text (a string starting with ``<``).  Parsed as untrusted XML (no DTD, no
         entities, size and depth bounded); meshes are never read.
     base, tip : str, optional
-        Link names; default the URDF's root and its one leaf (a branching tree needs ``tip``).
+        Link names; default the URDF's root and :func:`~denavit.interop.default_tip`'s choice, said in the notes.
     convention : {"standard", "modified"}
     xacro : bool
         Expand a xacro document first (needs the optional ``xacrodoc``).  Xacro evaluates Python expressions:
@@ -136,13 +136,13 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
         Bad XML or URDF (naming file, element and line), a chain without moving joints, a ``floating``,
         ``planar`` or ``mimic`` joint on the chain.
     """
-    conv = Convention(convention) if convention in ("standard", "modified") else None
-    if conv is None:
+    if convention not in ("standard", "modified"):
         raise ParseError(f"convention {str(convention)[:40]!r}: choose one of standard, modified")
     if inertia not in INERTIA_CHOICES:
         raise ParseError(f"inertia {str(inertia)[:40]!r}: choose one of {', '.join(INERTIA_CHOICES)}")
-    model = read_urdf(source, xacro=xacro)
+    model, conv, given = read_urdf(source, xacro=xacro), Convention(convention), tip
     base, tip, path = chain_path(model, base, tip)
+    why = "" if given is not None else default_tip(model, base)[1]  # the choice, said in the notes
     moving = _moving_joints(model, path, base, tip)
     P, Z, T, link_pose, link_body = _chain_at_zero(path, base)
     scale = max(1.0, float(np.abs(P).max()), float(np.abs(T[:3, 3]).max()))
@@ -151,13 +151,13 @@ def import_urdf(source, base: str | None = None, tip: str | None = None, convent
     robot, gravity_notes = _gravity_in_base(robot, model, base)
     model, inertia_notes = _physical_inertials(model, inertia)
     robot, notes = _with_inertia(robot, model, path, link_pose, link_body, base, scale)
-    notes = gravity_notes + inertia_notes + notes
     pos, rot = _self_check(robot, path, rng)
     if pos > CHECK_TOL * scale or rot > CHECK_TOL:
         warnings.warn(f"{model.where}: the DH model differs from the URDF chain by up to {pos:.2g} m and "
                       f"{rot:.2g} in rotation at random configurations (nearly parallel axes?)", DenavitWarning,
                       stacklevel=2)
-    notes = _notes(path, moving, approximated) + notes
+    chosen = (f"end link {tip} (chosen: {why}; --tip chooses another)",) * bool(why)
+    notes = chosen + _notes(path, moving, approximated) + gravity_notes + inertia_notes + notes
     return UrdfImport(robot, base, tip, tuple(j.name for j in moving), tuple(cases), pos, rot, notes)
 
 
@@ -226,14 +226,15 @@ def _robot_rows(model: UrdfModel, conv: Convention, moving: list[UrdfJoint], the
         ak, alk = (a[k], alpha[k]) if conv is Convention.STANDARD else ((a[k - 1], alpha[k - 1]) if k else (0.0, 0.0))
         kind = JointType.PRISMATIC if j.kind == "prismatic" else JointType.REVOLUTE
         limits = j.limits if j.limits is None or j.limits[0] < j.limits[1] else None  # [0, 0]: no range given
-        links.append(DHLink(a=tidy(ak), alpha=alk, d=tidy(d[k]), theta=theta[k], joint=kind, q_limits=limits))
+        links.append(DHLink(a=tidy(ak), alpha=snap_angle(alk), d=tidy(d[k]), theta=snap_angle(theta[k]), joint=kind,
+                            q_limits=limits))
     names = ", ".join(j.name for j in moving)
-    robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=F0,
+    robot = DHRobot(name=model.name, links=tuple(links), convention=conv, base=snap_pose(F0),
                     description=f"imported from URDF; rows are the joints {names}"[:2000])
     Fn = link_transforms(robot, np.zeros(n))[-1]
     tool = np.linalg.solve(Fn, T_tip)
     tool[3] = (0.0, 0.0, 0.0, 1.0)
-    return robot.replace(tool=tool)
+    return robot.replace(tool=snap_pose(tool))
 
 
 #: Gravity of a URDF, in its root link's frame [m/s²] (URDF has no gravity element; ROS and simulators use -z).

@@ -20,8 +20,8 @@ from ..numeric import transform_from_xyz_rpy
 from ._xacro import expand_xacro
 from ._xml import Element, parse_xml, read_xml_source
 
-__all__ = ["UrdfInertial", "UrdfLink", "UrdfJoint", "UrdfModel", "read_urdf", "chain_path", "MOVING", "MAX_URDF_LINKS",
-           "MAX_NUMBER_CHARS"]
+__all__ = ["UrdfInertial", "UrdfLink", "UrdfJoint", "UrdfModel", "read_urdf", "chain_path", "default_tip", "MOVING",
+           "MAX_URDF_LINKS", "MAX_NUMBER_CHARS"]
 
 #: Joint types that move and can be a DH row; ``fixed`` folds into the geometry; ``floating`` and ``planar``
 #: (6 and 3 degrees of freedom) have no DH row and are refused on the chain.
@@ -288,26 +288,66 @@ def _moving_depth(model: UrdfModel, link: str, base: str) -> int:
     return count
 
 
-def _default_tip(model: UrdfModel, base: str) -> str:
+#: End links preferred, in this order, among frames fixed to the chain's last link (ROS-Industrial's tool0 is
+#: the flange frame; ee_link its older name); without one, the chain's last link itself is the end.
+PREFERRED_TIPS = ("tool0", "flange", "tcp", "ee_link")
+
+
+def _ancestors(model: UrdfModel, link: str, base: str) -> list[str]:
+    """Links from ``base`` down to ``link``, both included."""
+    up = [link]
+    while link != base:
+        link = model.parent_joint[link].parent
+        up.append(link)
+    return up[::-1]
+
+
+def default_tip(model: UrdfModel, base: str) -> tuple[str, str]:
+    """The end link below ``base`` when none is given, and the sentence saying why ("" for a lone leaf).
+
+    The leaf reached through the most moving joints; leaves hanging off by fixed joints (sensor and tool frames)
+    do not compete.  When several tie, the link where they branch (their last common link) is the end, if each
+    branch has fewer moving joints below it than the chain above it (a gripper's fingers below the hand, not
+    two arms on a torso): that link (the Panda's hand, not its fingers), or a leaf fixed to it with a usual end-frame
+    name (:data:`PREFERRED_TIPS`: the UR's ``tool0`` over ``ee_link``).  Otherwise ``--tip`` is needed and the
+    error lists the leaves.
+    """
     leaves = list(_leaves_below(model, base))
     if len(leaves) == 1:
-        return leaves[0]
+        return leaves[0], ""
     depth = {leaf: _moving_depth(model, leaf, base) for leaf in leaves}
     best = max(depth.values())
     top = [leaf for leaf in leaves if depth[leaf] == best]
     if len(top) == 1:
-        return top[0]
-    shown = ", ".join(x[:40] for x in top[:12]) + (" ..." if len(top) > 12 else "")
-    raise model.error(f"the tree branches below link {base[:60]!r} into {len(top)} chains of {best} moving joints; "
-                      f"choose the end link with --tip (leaves: {shown})")
+        return top[0], f"the leaf with the most moving joints ({best}; other leaves: {_names(set(leaves) - set(top))})"
+    lines = [_ancestors(model, leaf, base) for leaf in top]
+    k = 0  # lines[*][k] is the last link common to every tied leaf's line
+    while all(len(li) > k + 1 for li in lines) and len({li[k + 1] for li in lines}) == 1:
+        k += 1
+    fork = lines[0][k]
+    above = _moving_depth(model, fork, base)
+    if above == 0 or best - above >= above:
+        raise model.error(f"the tree branches below link {base[:60]!r} into {len(top)} chains of {best} moving "
+                          f"joints; choose the end link with --tip (leaves: {_names(top)})")
+    fixed = sorted(leaf for leaf in leaves if fork in _ancestors(model, leaf, base) and leaf != fork
+                   and _moving_depth(model, leaf, fork) == 0)
+    tip = next((name for name in PREFERRED_TIPS if name in fixed), fork)
+    if tip == fork:
+        return tip, (f"the {above}-joint chain branches there into {_names(top)}"
+                     + (f"; fixed to it: {_names(fixed)}" if fixed else ""))
+    return tip, (f"{_names(fixed)} {'are' if len(fixed) > 1 else 'is'} fixed to {fork}, the end of the {above}-joint "
+                 f"chain; {tip} is the usual name of the end frame")
+
+
+def _names(names) -> str:
+    names = sorted(names)
+    return ", ".join(x[:40] for x in names[:12]) + (" ..." if len(names) > 12 else "")
 
 
 def chain_path(model: UrdfModel, base: str | None = None, tip: str | None = None) -> tuple[str, str, list[UrdfJoint]]:
     """``(base, tip, joints)``: the joints from link ``base`` to link ``tip``, base first.
 
-    ``base`` defaults to the tree's root; ``tip`` to the leaf below ``base`` reached through the most moving
-    joints (sensor and tool frames hanging off by fixed joints do not compete); when two leaves tie (a gripper's
-    two fingers) ``tip`` is needed, and the error lists the leaves.
+    ``base`` defaults to the tree's root; ``tip`` to :func:`default_tip`'s choice.
     """
     for what, name in (("base", base), ("tip", tip)):
         if name is not None and name not in model.links:
@@ -320,7 +360,7 @@ def chain_path(model: UrdfModel, base: str | None = None, tip: str | None = None
                               "a URDF is one tree")
         base = roots[0]
     if tip is None:
-        tip = _default_tip(model, base)
+        tip = default_tip(model, base)[0]
     if tip == base:
         why = ("choose --tip below --base" if model.child_joints.get(base) else
                f"no link hangs below {base[:60]!r}; choose a --base nearer the root" if base in model.parent_joint
