@@ -227,3 +227,30 @@ def test_snapping_leaves_real_offsets_alone():
 
     assert snap_angle(1.57079632679) == math.pi / 2 and snap_angle(-3.14159265358) == -math.pi
     assert snap_angle(4.9e-12) == 0.0 and snap_angle(1e-8) == 1e-8 and snap_angle(0.3) == 0.3
+
+
+# --- workspace pictures: the axes end where the image does ------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["puma560", "planar3r", "stanford"])
+def test_occupancy_panels_do_not_run_past_their_image(name):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import denavit
+    from denavit.scale import occupancy
+    from denavit.viz import plot_occupancy
+
+    fig = plot_occupancy(occupancy(denavit.load_robot(name), 20_000, seed=0), name)
+    fig.canvas.draw()
+    panels = [ax for ax in fig.axes if ax.images]
+    assert len(panels) == (1 if name == "planar3r" else 3)
+    for ax in panels:
+        x0, x1, y0, y1 = ax.images[0].get_extent()
+        (a, b), (c, d) = ax.get_xlim(), ax.get_ylim()
+        tol = 1e-9 * (x1 - x0)
+        assert x0 - tol <= a < b <= x1 + tol and y0 - tol <= c < d <= y1 + tol, (ax.get_title(), (a, b, c, d),
+                                                                                  (x0, x1, y0, y1))
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -201,9 +201,11 @@ def _level_counts(occ) -> tuple[np.ndarray, float]:
     return c, h
 
 
-def _crop(ax, lo, hi, pad: float) -> None:
-    ax.set_xlim(lo[0] - pad, hi[0] + pad)
-    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+def _crop(ax, lo, hi, pad: float, extent) -> None:
+    """Limits around the occupied box ``lo``–``hi`` with a margin ``pad``, never past the image's ``extent``
+    (x0, x1, y0, y1): beyond it the axes showed a white band (issue 31)."""
+    ax.set_xlim(max(lo[0] - pad, extent[0]), min(hi[0] + pad, extent[1]))
+    ax.set_ylim(max(lo[1] - pad, extent[2]), min(hi[1] + pad, extent[3]))
 
 
 _DENSITY = "ln(1 + samples per cell): sampling density"
@@ -231,7 +233,7 @@ def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
                     "sampled cells (log count)")
         fig.colorbar(im, ax=ax, label=_DENSITY, shrink=0.8)
         ax.set_aspect("equal")
-        _crop(ax, lo_u, hi_u, 2 * h)
+        _crop(ax, lo_u, hi_u, 2 * h, (*span, *span))
         size = f"area {e.value:.4g} m² ∈ [{e.low:.4g}, {e.high:.4g}]"
     else:
         i0 = n // 2  # the centre plane holds the base of joint 1
@@ -241,10 +243,11 @@ def plot_occupancy(occ, title: str = "", figsize=(13.5, 4.6), dpi: int = 100):
         for k, (img, (a, b), name) in enumerate(panels):
             ax = fig.add_subplot(1, 3, k + 1)
             c = g.centre[[a, b]]
-            im = _image(ax, img, (c[0] + span[0], c[0] + span[1], c[1] + span[0], c[1] + span[1]),
-                        "xyz"[a] + " [m]", "xyz"[b] + " [m]", "viridis", name, vmax=float(dens.max()) or 1.0)
+            ext = (c[0] + span[0], c[0] + span[1], c[1] + span[0], c[1] + span[1])
+            im = _image(ax, img, ext, "xyz"[a] + " [m]", "xyz"[b] + " [m]", "viridis", name,
+                        vmax=float(dens.max()) or 1.0)
             ax.set_aspect("equal")
-            _crop(ax, c + lo_u[[a, b]], c + hi_u[[a, b]], 2 * h)
+            _crop(ax, c + lo_u[[a, b]], c + hi_u[[a, b]], 2 * h, ext)
         fig.colorbar(im, ax=fig.axes, label=_DENSITY, shrink=0.8)  # one scale (vmax) for the three panels
         size = f"volume {e.value:.4g} m³ ∈ [{e.low:.4g}, {e.high:.4g}]"
     fig.suptitle(f"{title} workspace — {size}{chr(10) if occ.planar else ' '}({e.resolution:.3g} m cells, "
