@@ -32,6 +32,7 @@ _SINGULAR = re.compile(r"singular", re.I)
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
+_NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
@@ -311,6 +312,8 @@ class _Walker:
     def result(self, eq: Equation, arm: Arm) -> None:
         robot = arm.robot
         lhs, value = eq.parts[0], eq.parts[-1]
+        if len(eq.parts) > 2 and _NAMED_RESULT.search(value) and "\\begin" not in value:
+            value = eq.parts[-2]  # "ν = [M][q̇] = {}^0J q̇": the value is the step before the restated relation
         sym = read_symbol(lhs)
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):

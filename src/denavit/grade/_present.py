@@ -21,7 +21,8 @@ def graded_text(report: GradedReport, *, show_all: bool = False) -> str:
     """
     s = report.summary()
     head = (f"{report.source}: {s['correct']} correct, {s['incorrect']} incorrect, {s['ambiguous']} ambiguous, "
-            f"{s['unreadable']} unreadable; {s['not a claim']} equations state no result")
+            f"{s['unreadable']} unreadable; {s['not a claim']} "
+            + ("equation states" if s["not a claim"] == 1 else "equations state") + " no result")
     lines = [head]
     for arm in report.arms:
         where = f" ({arm.section})" if arm.section else ""
