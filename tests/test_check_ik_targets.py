@@ -47,3 +47,22 @@ def test_a_genuine_target_is_still_judged():
     assert _verdict(T.tolist(), [[0.3, 0.9]]).verdict == "incorrect"
     # a pose written with four decimals is still a pose (its rotation is 1e-4 off orthonormal)
     assert _verdict(np.round(T, 4).tolist(), [q]).verdict != "unreadable"
+
+
+def test_a_target_written_with_few_decimals_is_checked_for_completeness(tmp_path):
+    """A pose rounded to 3 decimals is still a pose: an empty (or partial) solution list is judged against every
+    closed-form solution of the pose it rounds, not called correct because analytic_ik refused the rounded matrix."""
+    import numpy as np
+
+    import denavit
+    from denavit.check import check_claims
+
+    robot = denavit.load_robot("puma560")
+    T = np.round(denavit.forward_kinematics(robot, np.array([0.3, -0.4, 0.2, 0.5, 0.6, -0.7])), 3)
+    target = [[float(x) for x in row] for row in T]
+    empty = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": []}]).verdicts[0]
+    assert empty.verdict == "incorrect" and "missing" in empty.message
+    sols = denavit.analytic_ik(robot, denavit.forward_kinematics(robot, np.array([0.3, -0.4, 0.2, 0.5, 0.6, -0.7])))
+    one = [[round(float(x), 3) for x in sols.solutions[0]]]
+    partial = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": one}]).verdicts[0]
+    assert partial.verdict == "incorrect" and "missing" in partial.message

@@ -59,6 +59,16 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
     return out
 
 
+def _nearest_pose(T: np.ndarray) -> np.ndarray:
+    """T with its rotation block replaced by the nearest rotation (SVD): a target written with 3-4 decimals is the
+    pose it rounds, not a matrix analytic_ik refuses (rigid_target has already refused what is no pose at all)."""
+    U, _, Vt = np.linalg.svd(T[:3, :3])
+    out = np.array(T, dtype=float)
+    out[:3, :3] = U @ Vt
+    out[3] = (0.0, 0.0, 0.0, 1.0)
+    return out
+
+
 def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
     """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
     from ._engine import Verdict
@@ -75,9 +85,12 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
     rigid_target(T)  # a matrix that is no pose (bottom row 5 5 5 5) makes the claim unreadable, not judged
     claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
     try:
-        res = analytic_ik(robot, T)
+        res = analytic_ik(robot, _nearest_pose(T))
     except Exception:  # no closed form: each solution is still checked by FK
         res = None
+    if res is None and not claimed:
+        raise ParseError("an empty list of solutions cannot be checked: this arm has no closed form to show that "
+                         "the target is out of reach")
     rows = controlled_rows(res) if res is not None else list(range(6))
     entries, reach = [], []
     for k, (q, unit) in enumerate(claimed, start=1):
