@@ -234,3 +234,19 @@ def test_report_picture_file_name_is_made_of_safe_characters(tmp_path):
     pictures = [p.name for p in tmp_path.glob("*.png")]
     assert len(pictures) == 1 and re.fullmatch(r"r-[A-Za-z0-9_.-]+-arm\.png", pictures[0])
     assert f"\\includegraphics[width=0.7\\linewidth]{{{pictures[0]}}}" in (tmp_path / "r.tex").read_text()
+
+
+@pytest.mark.parametrize("cmd", [["fk", "-q", "0.1, 0.2"], ["jacobian", "-q", "0.1, 0.2"], ["show"],
+                                 ["dynamics", "-q", "0.1, 0.2", "--qd", "0, 0", "--qdd", "0, 0"]])
+def test_a_name_with_line_breaks_never_breaks_a_commands_output_lines(cmd, tmp_path, capsys):
+    """A robot named "evil\\nname: injected" prints on one line (as evil\\nname …), whatever the command."""
+    import denavit
+    from denavit.cli import main
+
+    path = tmp_path / "evil.yaml"
+    denavit.save_robot(denavit.load_robot("planar2r").replace(name="evil\nbase: injected\u2028x\r"), path)
+    assert main([cmd[0], str(path), *cmd[1:]]) == 0
+    out = capsys.readouterr().out
+    assert not any(line.startswith(("base: injected", "x")) for line in out.splitlines())
+    assert "\u2028" not in out and "\r" not in out
+    assert "evil\\nbase: injected\\u2028x\\r" in out

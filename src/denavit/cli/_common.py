@@ -193,7 +193,9 @@ def load(args: argparse.Namespace):
             overrides[k.strip()] = _expr.evaluate(_expr.parse(v))
         except ParseError as exc:
             raise ParseError(f"--param {k.strip()}: {exc}") from None
-    return load_robot(args.robot, **overrides)
+    robot = load_robot(args.robot, **overrides)
+    args.shown_names = [*getattr(args, "shown_names", []), robot.name]  # emit keeps each on one line
+    return robot
 
 
 def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = "q", check_limits: bool = True,
@@ -313,10 +315,17 @@ def matrix_text(M: np.ndarray, digits: int = 6, indent: str = "  ") -> str:
     return "\n".join(indent + "[ " + "  ".join(c.rjust(width) for c in row) + " ]" for row in cells)
 
 
+_LINE_BREAKS = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
+_LINE_BREAK_ESCAPES = {ord(c): c.encode("unicode_escape").decode("ascii") for c in _LINE_BREAKS}
+
+
 def emit(args: argparse.Namespace, data: Any, text: str) -> None:
     if getattr(args, "json", False):
         json.dump(to_json(data), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     elif text:
+        for name in getattr(args, "shown_names", []):
+            if any(ch in name for ch in _LINE_BREAKS):  # a robot name never breaks the output's lines
+                text = text.replace(name, name.translate(_LINE_BREAK_ESCAPES))
         text = terminal_text(text)  # a name's ESC or U+202E is shown as \x1b, \u202e: the terminal never obeys it
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
