@@ -83,7 +83,8 @@ def _rows(body: str) -> list[tuple[int, str]]:
     rows: list[tuple[int, str]] = []
     offset, start = 0, 0
     for piece in top_level_split(body, ("\\\\",)):
-        line_off = body.count("\n", 0, start)
+        lead = len(piece) - len(piece.lstrip())
+        line_off = body.count("\n", 0, start + lead)
         start += len(piece) + 2
         t = re.sub(r"^\s*(\[[^\]]{0,20}\])?", "", piece)  # \\[2pt] spacing
         s = t.replace("&", " ").replace("\\quad", " ").replace("\\qquad", " ").strip()
@@ -144,7 +145,7 @@ def split_block(latex: str, line: int, end_line: int) -> list[Equation]:
                 continue
             rel = "neq" if re.search(r"\\neq?(?![A-Za-z])|≠", t) and "=" not in t.replace("\\neq", "") else "="
             parts = tuple(p.strip() for p in top_level_split(t, ("=",)))
-            n_lines = piece.count("\n")
+            n_lines = piece.strip().count("\n")
             eqs.append(Equation(first, min(first + n_lines, end_line) if len(rows) > 1 else end_line, t, parts, rel))
     return eqs
 
