@@ -405,3 +405,30 @@ def test_checked_html_in_chromium_marks_sit_after_their_equations(browser, tmp_p
     page.close()
     assert problems == []
     assert requests and all(u == path.as_uri() or u.startswith("data:") for u in requests), requests
+
+
+@pytest.mark.browser
+def test_a_report_graded_by_the_cli_opens_in_chromium_with_every_mark(browser, tmp_path):
+    """End to end: `denavit check REPORT -o checked.html` on the example report, opened offline: no KaTeX error,
+    one mark per claim of the JSON (placed, with its verdict), a typeset correction under each incorrect one."""
+    import json as _json
+    import subprocess
+    import sys
+
+    report = Path(__file__).resolve().parents[1] / "examples" / "reports" / "planar2r-homework.md"
+    out = tmp_path / "checked.html"
+    res = subprocess.run([sys.executable, "-m", "denavit", "check", str(report), "-o", str(out), "--json"],
+                         capture_output=True, text=True, timeout=900)
+    assert res.returncode == 0, res.stderr
+    claims = _json.loads(res.stdout)["claims"]
+    assert any(c["verdict"] == "incorrect" for c in claims) and any(c["verdict"] == "correct" for c in claims)
+    page = browser.new_page(viewport={"width": 1280, "height": 900})
+    page.goto(out.as_uri())
+    page.wait_for_function("document.querySelectorAll('.katex').length > 0")
+    assert page.evaluate("document.querySelectorAll('.katex-error').length") == 0
+    marks = page.evaluate("""() => [...document.querySelectorAll('article.report .verdict[data-claim]')]
+        .map(m => [Number(m.dataset.claim), m.dataset.verdict, Number(m.dataset.line)])""")
+    assert sorted(marks) == sorted([k, c["verdict"], c["line"]] for k, c in enumerate(claims))
+    n_wrong = sum(c["verdict"] == "incorrect" for c in claims)
+    assert page.evaluate("document.querySelectorAll('article.report .correction .katex').length") >= n_wrong
+    page.close()

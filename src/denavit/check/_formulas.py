@@ -13,7 +13,7 @@ from ..errors import DenavitError, ParseError
 from ..model import DHRobot
 from ._points import wrench_nodes
 
-__all__ = ["expected_formula", "MAX_FORMULA_DOF_DYNAMICS", "MAX_FORMULA_DOF_STATICS"]
+__all__ = ["expected_formula", "MAX_FORMULA_DOF_DYNAMICS", "MAX_FORMULA_DOF_STATICS", "MAX_FORMULA_DOF_JACOBIAN"]
 
 
 def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | None:
@@ -23,6 +23,12 @@ def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | N
         return None
     if name in ("force", "moment"):
         return _expected_statics(robot, name, spec)
+    if name == "jacobian":
+        frame = spec.get("frame", "base")
+        if spec.get("column") is not None or spec.get("rows", "all") != "all" or spec.get("entry") is not None \
+                or not (frame in ("base", "tool")):
+            return None  # a part of J, or J in frame i: the numbers and hints say what differs
+        return _expected_jacobian(robot, str(frame))
     return _expected_formula(robot, name, *keys)
 
 
@@ -101,6 +107,29 @@ def _expected_formula(robot: DHRobot, name: str, index: int | None, frm: int | N
         else:
             return None
     except (KeyError, ValueError, IndexError, TypeError, DenavitError):
+        return None
+    if len(str(M)) > 20_000:
+        return None
+    M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
+    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+
+
+#: Most joints for which an incorrect J claim is given the correct formula (symbolic geometric Jacobian).
+MAX_FORMULA_DOF_JACOBIAN = 4
+
+
+@lru_cache(maxsize=16)
+def _expected_jacobian(robot: DHRobot, frame: str) -> str | None:
+    """J0 or Je from the symbolic engine (arms of up to MAX_FORMULA_DOF_JACOBIAN joints: seconds at most)."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    if robot.dof > MAX_FORMULA_DOF_JACOBIAN:
+        return None
+    try:
+        M = S.geometric_jacobian_sym(robot, frame=frame)
+    except (ValueError, TypeError, DenavitError):
         return None
     if len(str(M)) > 20_000:
         return None
