@@ -539,6 +539,8 @@ def f11():
 
 def main() -> int:
     from _truth_dh import expects
+    from _truth_more import FIXTURES as MORE  # fixtures 12-16
+    FIXTURES.update(MORE)
     failures = []
     names = sorted(p.name for p in HERE.iterdir()
                    if p.suffix in (".md", ".tex", ".txt") and not p.name.startswith(("_", "README")))
