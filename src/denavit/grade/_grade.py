@@ -16,7 +16,9 @@ from typing import Any
 from ..check import MAX_FILE_BYTES, check_claims
 from ..errors import DenavitError, ParseError
 from ..model import DHRobot
+from ..tables import find_tables
 from ._arms import arms_of, compare_tables
+from ._infer import infer_arms
 from ._claims import Pending, walk
 from ._document import read_document
 from ._types import ArmInfo, GradedClaim, GradedReport
@@ -110,9 +112,14 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
                arms: dict[str, DHRobot] | None = None, source: str = "<report>", seed: int = 0) -> GradedReport:
     """Grade the report ``text`` (see :func:`grade_report`)."""
     doc = read_document(text, fmt)
-    governed = arms_of(doc, source, robot, dict(arms or {}))
+    given = dict(arms or {})
+    inferred_notes: list[str] = []
+    if robot is None and not find_tables(list(doc.lines)):
+        inferred, inferred_notes = infer_arms(doc, source, seed)
+        given = {**inferred, **given}
+    governed = arms_of(doc, source, robot, given)
     pending, read_notes = walk(doc, governed)
-    notes = list(doc.notes) + read_notes
+    notes = list(doc.notes) + inferred_notes + read_notes
     if len(pending) > MAX_JUDGED:
         notes.append(f"only the first {MAX_JUDGED} equations were judged ({len(pending)} found)")
     graded = []

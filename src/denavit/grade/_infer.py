@@ -1,0 +1,105 @@
+"""An arm for a section that has no DH table (its table was a picture): a catalogue arm its own results fit.
+
+A person grading such a report reads the arm off the derivation; so does this, conservatively.  For every section
+no table, ROBOT or ``--arm`` governs, each catalogue arm with as many joints as the section writes is tried on the
+section's first :data:`SAMPLE` results (cheap kinds only: no singular sets or IK).  An arm is taken only when at
+least :data:`MIN_AGREEING` of them agree with it, a share of at least :data:`MIN_SHARE`, and no other arm comes
+within :data:`MARGIN` of it; the arm's notes then say it was recognised, not given, and ``--arm`` overrides it.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..check import check_claims
+from ..errors import DenavitError
+from ..io import catalogue_names, load_robot
+from ._arms import arms_of
+from ._claims import walk
+from ._document import Document, Heading, Math
+
+__all__ = ["infer_arms", "FIRST_SAMPLE", "SAMPLE", "MIN_AGREEING", "MIN_SHARE", "MARGIN", "MARGIN_LARGE"]
+
+#: Results of a section tried on each candidate arm first, and on the candidates still close after that.
+FIRST_SAMPLE = 5
+SAMPLE = 20
+#: Results that must agree with the arm taken.
+MIN_AGREEING = 4
+#: Share of the tried results that must agree with the arm taken.
+MIN_SHARE = 0.7
+#: How far ahead of the next candidate (share of agreeing results) the arm taken must be, after the first
+#: sample, and after the larger one (taken when the first left two candidates within MARGIN).
+MARGIN = 0.25
+MARGIN_LARGE = 0.1
+_SKIP = ("singularities", "ik_formula", "ik_solutions", "relation", "det_jacobian")
+_INDEX = re.compile(r"(?:\\(?:var)?theta|\bq|\bQ|(?<![A-Za-z\\])[cCsS]|\\dot\{?d\}?|\bd)\s*_\s*\{?\s*(\d{1,4})")
+
+
+def _joints_written(doc: Document, line: int, end: int) -> int:
+    """How many joints a section writes: the distinct joint numbers of its formulas."""
+    idx = {int(d) for it in doc.items if isinstance(it, Math) and line <= it.line <= end
+           for m in _INDEX.finditer(it.latex) for d in m.group(1)}
+    idx.discard(0)
+    return len(idx)
+
+
+def _score(doc: Document, source: str, key: str, robot, line: int, end: int, seed: int,
+           sample: int) -> tuple[int, int]:
+    """(agreeing, judged) of the section's first ``sample`` results with ``robot`` as its arm (an arm that fails
+    the first three is dropped early)."""
+    pending, _ = walk(doc, arms_of(doc, source, None, {key: robot}))
+    agree = judged = 0
+    for p in pending:
+        if not (line <= p.line <= end) or p.claim is None or p.claim.get("quantity") in _SKIP:
+            continue
+        try:
+            v = check_claims(robot, [dict(p.claim)], seed=seed).verdicts[0]
+        except DenavitError:
+            continue
+        if v.verdict in ("correct", "incorrect"):
+            judged += 1
+            agree += v.verdict == "correct"
+        if judged >= sample or (judged >= 3 and agree <= 1):
+            break
+    return agree, judged
+
+
+def infer_arms(doc: Document, source: str, seed: int = 0) -> tuple[dict[str, object], list[str]]:
+    """Arms recognised for the top-level sections of a report without tables, by section key, and notes."""
+    heads = [h for h in doc.items if isinstance(h, Heading)]
+    if not heads:
+        return {}, []
+    top = min(h.level for h in heads)
+    tops = [h for h in heads if h.level == top and h.key]
+    by_dof: dict[int, list] = {}
+    for name in catalogue_names():
+        r = load_robot(name)
+        by_dof.setdefault(r.dof, []).append(r)
+    found, notes = {}, []
+    for k, h in enumerate(tops):
+        end = tops[k + 1].line - 1 if k + 1 < len(tops) else len(doc.lines)
+        n = _joints_written(doc, h.line, end)
+        scores = []
+        for robot in by_dof.get(n, []):
+            agree, judged = _score(doc, source, h.key, robot, h.line, end, seed, FIRST_SAMPLE)
+            if judged:
+                scores.append((agree / judged, agree, judged, robot))
+        scores.sort(key=lambda s: (-s[0], -s[1]))
+        close = [sc for sc in scores if scores and scores[0][0] - sc[0] < MARGIN][:3]
+        if len(close) > 1:  # too close to call on a few results: the close ones on more of them
+            scores = []
+            for _, _, _, robot in close:
+                agree, judged = _score(doc, source, h.key, robot, h.line, end, seed, SAMPLE)
+                scores.append((agree / judged, agree, judged, robot))
+            scores.sort(key=lambda s: (-s[0], -s[1]))
+        if not scores:
+            continue
+        share, agree, judged, robot = scores[0]
+        runner = scores[1][0] if len(scores) > 1 else 0.0
+        margin = MARGIN_LARGE if len(close) > 1 else MARGIN
+        if agree >= MIN_AGREEING and share >= MIN_SHARE and share - runner >= margin:
+            found[h.key] = robot
+            notes.append(f"section {h.key!r} (line {h.line}) has no DH table: its results fit the catalogue arm "
+                         f"{robot.name} ({agree} of {judged} tried agree; the next arm {runner:.0%}); judged against it "
+                         f"(give --arm {h.key}=ROBOT to choose another)")
+    return found, notes
