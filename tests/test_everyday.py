@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import re
+import shutil
 
 import pytest
 
@@ -254,3 +256,94 @@ def test_occupancy_panels_do_not_run_past_their_image(name):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+# --- long formulas broken over lines -------------------------------------------------------------------------------
+
+def _report_argv(out):
+    from test_report import _readme_first_command
+
+    argv = _readme_first_command()  # the README's `denavit report puma560 ... -o report.html`
+    assert argv[:3] == ["denavit", "report", "puma560"]
+    return [a if a != "report.html" else str(out) for a in argv[1:]]
+
+
+@pytest.mark.browser
+def test_no_formula_of_the_readme_report_is_wider_than_its_column_in_chromium(tmp_path, capsys):
+    """Chromium at 1,280 px: every display formula fits the report's 960-px column (before: 29 of 153 wider,
+    up to 29,134 px), and KaTeX typesets all of them (the broken ones are `aligned` blocks)."""
+    from test_report import CHROMIUM, CI
+
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        pytest.skip("playwright is not installed")
+    if not shutil.which(CHROMIUM) and not os.path.exists(CHROMIUM):
+        if CI:
+            pytest.fail(f"no chromium at {CHROMIUM} under CI")
+        pytest.skip(f"no chromium at {CHROMIUM}")
+    out = tmp_path / "r.html"
+    assert main(_report_argv(out)) == 0
+    capsys.readouterr()
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, headless=True,
+                               args=["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"])
+        page = b.new_page(viewport={"width": 1280, "height": 900})
+        page.goto(out.as_uri())
+        page.wait_for_function("document.querySelectorAll('.katex').length > 0")
+        sizes = page.evaluate("""() => Array.from(document.querySelectorAll('.math-display')).map(el => {
+            const k = el.querySelector('.katex-display .katex-html');
+            return [el.scrollWidth, el.clientWidth, k ? k.scrollWidth : -1,
+                    (el.querySelector('annotation') || {}).textContent || ''];})""")
+        errors = page.evaluate("document.querySelectorAll('.katex-error').length")
+        b.close()
+    assert errors == 0 and len(sizes) > 100
+    assert {s[1] for s in sizes} == {960}  # the column (60rem) at this viewport
+    wide = [(s[0], s[3][:120]) for s in sizes if s[0] > s[1] or s[2] > s[1]]
+    assert wide == [], wide
+    assert sum("\\begin{aligned}" in s[3] for s in sizes) >= 20  # the long ones were broken, not dropped
+
+
+def test_broken_formulas_keep_every_term_and_break_only_before_a_sign():
+    import sympy as sp
+
+    from denavit.report import Equation, math_of
+
+    x = sp.symbols("x1:60")
+    expr = sum(x[i] * x[i + 1] * sp.cos(x[i + 2]) for i in range(50)) - 3 * x[0]
+    text = math_of(Equation("c_{1}", expr))
+    assert text.startswith("\\begin{aligned}c_{1} &= ") and text.endswith("\\end{aligned}")
+    rows = text[len("\\begin{aligned}"):-len("\\end{aligned}")].split(" \\\\ ")
+    assert len(rows) > 3 and all(r.startswith("&\\quad + ") or r.startswith("&\\quad - ") for r in rows[1:])
+    joined = " ".join([rows[0].split("&= ", 1)[1]] + [r[len("&\\quad "):] for r in rows[1:]])
+    assert joined == sp.latex(expr).replace("\\left(", "\\bigl(").replace("\\right)", "\\bigr)")
+    assert math_of(Equation("y", x[0] + x[1])) == "y = x_{1} + x_{2}"  # short ones unchanged
+
+
+def test_a_wide_matrix_is_written_entry_by_entry_under_the_names_of_its_left_side():
+    import sympy as sp
+
+    from denavit.report import Equation, math_of
+
+    x = sp.symbols("x1:40")
+    M = sp.Matrix(2, 2, [sum(x[k + i] * x[k + i + 1] for i in range(12)) for k in range(4)])
+    text = math_of(Equation("\\begin{bmatrix}m_{11} & m_{12}\\\\m_{21} & m_{22}\\end{bmatrix}", M))
+    labels = re.findall(r"(?:^|\\\\ )(m_{\d\d}) &= ", text.replace("\\begin{aligned}", ""))
+    assert labels == ["m_{11}", "m_{12}", "m_{21}", "m_{22}"]
+    text = math_of(Equation("J", M))
+    assert "\\left[J\\right]_{12} &= " in text
+
+
+@pytest.mark.skipif(shutil.which("pdflatex") is None, reason="no LaTeX engine")
+def test_pdf_report_has_no_overfull_formula(tmp_path, capsys):
+    import subprocess
+
+    out = tmp_path / "r.tex"
+    assert main([a if not a.endswith(".html") else str(out) for a in _report_argv(tmp_path / "r.html")]) == 0
+    capsys.readouterr()
+    run = subprocess.run(["pdflatex", "-interaction=nonstopmode", "r.tex"], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=600)
+    assert run.returncode == 0, run.stdout[-2000:]
+    over = [float(v) for v in re.findall(r"Overfull \\hbox \(([\d.]+)pt too wide\) in (?:paragraph|alignment)",
+                                         (tmp_path / "r.log").read_text(errors="replace"))]
+    assert max(over, default=0.0) < 10, over

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .. import _text
+from ._breaking import break_display
 from ._derivation import Derivation, Equation, Figure, Heading, Numbers, Section, Table, Text
 
 __all__ = ["render", "render_markdown", "render_latex", "render_html", "math_of", "number_text", "FORMATS",
@@ -45,17 +46,20 @@ def _matrix(values: np.ndarray, digits: int) -> str:
 
 
 def math_of(step: Equation | Numbers) -> str:
-    """The LaTeX of an equation or a numbers step (without delimiters)."""
+    """The LaTeX of an equation or a numbers step (without delimiters); one too wide for the page is an
+    ``aligned`` block broken at + and − (:func:`._breaking.break_display`)."""
+    note = f"\\text{{({_text_in_math(step.note)})}}" if step.note else ""
     if isinstance(step, Numbers):
         out = f"{step.lhs} \\approx {_matrix(step.values, step.digits)}"
     else:
         from ._sections import latex
 
+        broken = break_display(step.lhs, step.relation, step.expr, note, latex)  # too wide for one line
+        if broken is not None:
+            return broken
         rhs = step.expr if isinstance(step.expr, str) else latex(step.expr)
         out = f"{step.lhs} {step.relation} {rhs}"
-    if step.note:
-        out += f" \\qquad \\text{{({_text_in_math(step.note)})}}"
-    return out
+    return out + (f" \\qquad {note}" if note else "")
 
 
 def _text_in_math(s: str) -> str:
@@ -172,6 +176,7 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
         r"\usepackage[margin=2cm]{geometry}",
         r"\usepackage{amsmath,amssymb,graphicx,adjustbox}",
         r"\setcounter{MaxMatrixCols}{20}",
+        r"\allowdisplaybreaks",  # a formula broken over many lines may continue on the next page
         r"\sloppy",  # long identifiers (function names) move to the next line instead of into the margin
         r"\renewcommand{\arraystretch}{1.4}",
         rf"\title{{{_tex_plain(d.title)}}}",
@@ -193,8 +198,12 @@ def render_latex(d: Derivation, figure_prefix: str = "") -> tuple[str, dict[str,
             elif isinstance(step, Heading):
                 out += [rf"\subsection*{{{_tex_text(step.text)}}}", ""]
             elif isinstance(step, (Equation, Numbers)):
-                out += [r"\begin{center}\begin{adjustbox}{max width=\linewidth}$\displaystyle "
-                        + math_of(step) + r"$\end{adjustbox}\end{center}", ""]
+                m = math_of(step)
+                if m.startswith(r"\begin{aligned}"):  # broken over lines: align* may break across pages
+                    out += [r"\begin{align*}" + m[len(r"\begin{aligned}"):-len(r"\end{aligned}")] + r"\end{align*}", ""]
+                else:
+                    out += [r"\begin{center}\begin{adjustbox}{max width=\linewidth}$\displaystyle "
+                            + m + r"$\end{adjustbox}\end{center}", ""]
             elif isinstance(step, Table):
                 cell = (lambda c: f"${c}$") if step.math else _tex_text
                 out += [r"\begin{center}\small", r"\begin{adjustbox}{max width=\linewidth}",
