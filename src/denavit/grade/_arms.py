@@ -126,6 +126,7 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
             spans.append((Section(h, h.line, end), Arm(None, ArmInfo("", h.title, h.line, end, "none", "", 0),
                           f"the section at line {h.line} is about a {named}-joint arm and has no DH table of its own "
                           f"(give one: --arm {h.key or 'SECTION'}=ROBOT)")))
+    spans.sort(key=lambda s: s[0].end_line - s[0].line)  # the most specific section decides
     for k, (start, arm) in enumerate(base):
         stop = base[k + 1][0] - 1 if k + 1 < len(base) else n
         spans.append((Section(None, start, stop), arm))

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ._arms import Arm
-from ._prose import plain_prose, prose_case, prose_conditions, prose_wrench
+from ._prose import plain_prose, prose_case, prose_conditions, prose_definitions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
                        rates_or_wrench, vector_entries)
-from ._document import Document, Heading, Math, Prose
+from ._document import Document, Heading, Math, Prose, plain_names
 from ._lhs import read_symbol
 from ._names import Reading, joint_of, read_name
 from ._split import Equation, split_block
@@ -25,14 +25,15 @@ from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scal
 
 __all__ = ["Pending", "walk"]
 
-_IK_FUNCS = re.compile(r"atan|arctan|arccos|arcsin|\\cos\^\{?-1|\\sin\^\{?-1|\\tan\^\{?-1|acos|asin|\\sqrt|[pP]_\{?[xyz]"
+_IK_FUNCS = re.compile(r"atan|arctan|arccos|arcsin|sqrt|\\cos\^\{?-1|\\sin\^\{?-1|\\tan\^\{?-1|acos|asin|\\sqrt|[pP]_\{?[xyz]"
                        r"|r_\{?\d\d|[xyz]_[cw]|\\operatorname")
 _TRIG_LHS = re.compile(r"^\\?(cos|sin|tan)\s*\(?\s*\\?(?:var)?(?:theta|q|Q)_\{?\d\}?\s*\)?$")
-_SINGULAR = re.compile(r"singular", re.I)
+_SINGULAR = re.compile(r"singular|vanish|loses? rank|rank[- ]deficien|degenerat", re.I)
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
+_MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
@@ -140,6 +141,8 @@ class _Walker:
                 q = prose_case(plain, robot)
                 if q is not None:
                     self.ctx.q = self.ctx.cases[number] = q
+        for name, value in prose_definitions(plain_names(plain)):
+            self.ctx.define(name, value)
         w = prose_wrench(plain)
         if w is not None:
             self.ctx.wrench = w
@@ -151,6 +154,10 @@ class _Walker:
             eq = Equation(it.line, it.line, det.group(1), ("\\det J", det.group(1)), "=")
             self._det(eq, arm, det.group(1), None)
         if self.ctx.singular and robot is not None:
+            for m in _MORE_VALUES.finditer(it.text):  # "$\theta_2 = 0$ or $\pi$": π is θ2's too
+                cond = f"{m.group(1)} = {m.group(2)}"
+                self.sing.append((Equation(it.line, it.line, cond, (cond,), "="), cond))
+                self.sing_arm = arm
             for cond in prose_conditions(plain, robot):
                 eq = Equation(it.line, it.line, cond, (cond,), "=")
                 self.sing.append((eq, cond))
@@ -181,12 +188,28 @@ class _Walker:
         arm = self.arm_at(m.line)
         offset = self.offset_of(m.line, arm)
         latex = renumber(m.latex, offset, arm.robot.n_rows) if offset else m.latex
-        for eq in split_block(latex, m.line, m.end_line):
+        eqs = split_block(latex, m.line, m.end_line)
+        if len(eqs) == 1 and self._det_at_case(eqs[0], arm):
+            return
+        for eq in eqs:
             if len(eq.parts) < 2 or not eq.parts[0]:
                 continue
             if _PROPAGATION.search(eq.parts[0]):
                 self.ctx.propagation = True
             self.equation(eq, arm)
+
+    def _det_at_case(self, eq: Equation, arm: Arm | None) -> bool:
+        """``\\det J = 0`` alone, with a case in force: the claim that J is singular at that case."""
+        if arm is None or arm.robot is None or not self.ctx.q or len(eq.parts) != 2 or eq.parts[1].strip() != "0":
+            return False
+        sym = read_symbol(eq.parts[0])
+        if sym is None or not sym.det:
+            return False
+        self._det(eq, arm, "0", sym)
+        self.out[-1].claim["q"] = self.ctx.q
+        for alt, _ in self.out[-1].equivalent:
+            alt["q"] = self.ctx.q
+        return True
 
     def note(self, eq: Equation, arm: Arm | None, verdict: str, message: str, quantity: str = "") -> None:
         self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, verdict=verdict, message=message,
@@ -334,6 +357,9 @@ class _Walker:
                           "the joint in terms of the target")
             return
         reading = read_name(sym, robot, value) if sym is not None else _vector_reading(lhs, robot)
+        if reading is not None and reading.spec.get("quantity") == "det_jacobian":
+            self._det(eq, arm, value, sym)
+            return
         if reading is not None and reading.spec.get("quantity") in _MATRIX_QUANTITIES and "\\begin" not in value \
                 and "[" not in value:
             self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "

@@ -65,7 +65,7 @@ def has_joint_names(text: str) -> bool:
 
 def vector_entries(text: str) -> list[str] | None:
     """The entries of a column/row vector written as a matrix, ``(a, b, c)`` or ``[a, b, c]``."""
-    t = text.strip()
+    t = re.sub(r"\^\s*\{?\s*(?:T|\\top|\\intercal)\s*\}?\s*$", "", text.strip()).strip()
     m = _MATRIX.fullmatch(t)
     if m:
         body = m.group(2)
@@ -109,10 +109,13 @@ def case_of(parts: tuple[str, ...], text: str, robot: DHRobot) -> str | None:
 
 def joint_value(sym: Symbol, rhs: str, robot: DHRobot) -> tuple[int, str] | None:
     """``\\theta_2 = 90^\\circ``: (joint, value text) when the right side is one number."""
-    if sym.base not in JOINT_LETTERS or sym.dots or sym.pre_sup or sym.sup:
+    if sym.base not in JOINT_LETTERS + ("d",) or sym.dots or sym.pre_sup or sym.sup:
         return None
     k = sym.sub.strip("{} ")
     if not (k.isdigit() and 1 <= int(k) <= robot.dof) or not is_numeric(rhs) or "," in rhs:
+        return None
+    if sym.base == "d" and (robot.joint_types[int(k) - 1].value != "prismatic"
+                            or f"d{k}" in {n for n, _ in robot.parameters}):
         return None
     return int(k), rhs
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "MAX_BLOCK_LINES", "MAX_ITEMS"]
+__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "MAX_BLOCK_LINES", "MAX_ITEMS"]
 
 #: Longest display block (lines); a block left open longer than this is closed there.
 MAX_BLOCK_LINES = 400
@@ -81,6 +81,27 @@ def _key(title: str) -> str:
     if m:
         return m.group(1)
     return re.sub(r"[^a-z0-9]+", "-", title.lower()).strip("-")[:40]
+
+
+_PLAIN_EQ = re.compile(r"^\s*[A-Za-z\\][\w{}^\\,()]{0,40}\s*=\s*\S")
+_WORDS = re.compile(r"[A-Za-z]{3,}\s+[A-Za-z]{2,}\s+[A-Za-z]{2,}")
+
+
+_POINT = re.compile(r"\b([xyzp])([cw])\b")
+
+
+def plain_names(text: str) -> str:
+    """Plain-text names written without underscores: ``xc`` → ``x_c`` (the wrist centre's coordinates)."""
+    return _POINT.sub(r"\1_\2", text)
+
+
+def _plain_equation(line: str) -> bool:
+    """A plain-text report's line that is an equation (``theta1 = atan2(yc, xc) - …``), not a sentence."""
+    if "$" in line or "\\[" in line or len(line) > 2000 or not _PLAIN_EQ.match(line):
+        return False
+    rhs = line.split("=", 1)[1]
+    funcs = re.sub(r"\b(?:atan2|arctan|arccos|arcsin|sqrt|sin|cos|tan|pi)\b", " ", rhs)
+    return not _WORDS.search(funcs) and bool(re.search(r"[\d()_^*/+-]", rhs))
 
 
 def _strip_comments(line: str, in_comment: bool) -> tuple[str, bool]:
@@ -156,6 +177,9 @@ class _Scanner:
         return nxt
 
     def _pieces(self, line: str, n: int) -> int:
+        if self.fmt == "txt" and _plain_equation(line):
+            self.items.append(Math(n + 1, n + 1, plain_names(line.strip()), True))
+            return n + 1
         k, prose = 0, []
         while True:
             found = _next_open(line, k)

@@ -115,7 +115,7 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
     given = dict(arms or {})
     inferred_notes: list[str] = []
     if robot is None and not find_tables(list(doc.lines)):
-        inferred, inferred_notes = infer_arms(doc, source, seed)
+        inferred, inferred_notes = infer_arms(doc, source, seed, tuple(given))
         given = {**inferred, **given}
     governed = arms_of(doc, source, robot, given)
     pending, read_notes = walk(doc, governed)

@@ -64,12 +64,15 @@ def _score(doc: Document, source: str, key: str, robot, line: int, end: int, see
     return agree, judged
 
 
-def infer_arms(doc: Document, source: str, seed: int = 0) -> tuple[dict[str, object], list[str]]:
+def infer_arms(doc: Document, source: str, seed: int = 0, given: tuple[str, ...] = ()) -> tuple[dict[str, object], list[str]]:
     """Arms recognised for the top-level sections of a report without tables, by section key, and notes."""
     heads = [h for h in doc.items if isinstance(h, Heading)]
     if not heads:
         return {}, []
-    top = min(h.level for h in heads)
+    levels = [h.level for h in heads]
+    top = min(levels)
+    if levels.count(top) == 1 and len(set(levels)) > 1:  # a title above the sections
+        top = min(v for v in levels if v != top)
     tops = [h for h in heads if h.level == top and h.key]
     by_dof: dict[int, list] = {}
     for name in catalogue_names():
@@ -77,6 +80,8 @@ def infer_arms(doc: Document, source: str, seed: int = 0) -> tuple[dict[str, obj
         by_dof.setdefault(r.dof, []).append(r)
     found, notes = {}, []
     for k, h in enumerate(tops):
+        if h.key in given:
+            continue
         end = tops[k + 1].line - 1 if k + 1 < len(tops) else len(doc.lines)
         n = _joints_written(doc, h.line, end)
         scores = []

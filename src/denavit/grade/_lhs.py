@@ -102,6 +102,9 @@ def read_symbol(lhs: str) -> Symbol | None:
         g = _group(s, 0)
         if g is not None and s.startswith("{"):
             s = g[0] + s[g[1]:]
+    m = re.fullmatch(r"(theta|q|d|tau|omega)(\d{1,2})", s)
+    if m:  # plain text: theta1, q2, d3, tau1
+        return Symbol(m.group(1), sub=m.group(2))
     m = re.fullmatch(r"([TAR])(\d)(\d?)", s)
     if m:  # T01, T12, A1
         return Symbol(m.group(1), sub=m.group(2), sup=m.group(3))

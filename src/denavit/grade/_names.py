@@ -194,7 +194,7 @@ def _position(sym: Symbol, robot: DHRobot) -> Reading | None:
         if sym.dots:
             return Reading({"quantity": "twist", "rows": "linear"}, "the end-effector linear velocity", needs=("q", "qd"))
         return Reading({"quantity": "position"}, "the end-effector position", sure=sub != "", needs=("q",))
-    k = _digit(sub)
+    k = _digit(re.sub(r"(?i)org$", "", sub))
     if k is not None and not sym.dots and 0 <= k <= robot.n_rows:
         return Reading({"quantity": "origin", "index": k}, f"the origin of DH frame {k} (base axes)", needs=("q",))
     return None
@@ -283,6 +283,9 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         return _position(sym, robot)
     if b in ("x", "y", "z"):
         return _coordinate(sym, robot)
+    rate = _rate_row(sym, robot)
+    if rate is not None:
+        return rate
     if b in ("omega", "w", "v", "f", "n"):
         if not sym.pre_sup and b in ("omega", "v") and not sym.sub:
             rows = "angular" if b == "omega" else "linear"

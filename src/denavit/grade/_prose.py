@@ -10,11 +10,11 @@ import re
 
 from ..model import DHRobot
 
-__all__ = ["plain_prose", "prose_conditions", "prose_case", "prose_wrench"]
+__all__ = ["plain_prose", "prose_conditions", "prose_case", "prose_wrench", "prose_definitions"]
 
 _SUBSCRIPTS = str.maketrans("₀₁₂₃₄₅₆₇₈₉", "0123456789")
 _INLINE = re.compile(r"\$[^$]{0,2000}\$")
-_JOINT = r"(?:θ|ϑ|theta|q|Q)\s?_?\{?(\d)\}?"
+_JOINT = r"(?:θ|ϑ|theta|q|Q|(d))\s?_?\{?(\d)\}?"
 _CONDITION = re.compile(_JOINT + r"\s?=\s?((?:[-+]?\s?(?:\d+(?:\.\d+)?|π|pi)(?:\s?(?:°|deg|π|pi|/\s?\d))*"
                         r"(?:\s?(?:,|or|and)\s?)?){1,6})")
 _VALUE = re.compile(r"(?:θ|ϑ|theta|q|Q|d)\s?_?\{?(\d)\}?\s?=\s?(-?\d+(?:\.\d+)?)\s?(°|deg|rad|mm|cm|m)?")
@@ -35,8 +35,10 @@ def prose_conditions(plain: str, robot: DHRobot) -> list[str]:
     """Singular values of one joint written in words: ``q_2 = 0, \\pi`` for "θ₂ = 0 or π"."""
     out = []
     for m in _CONDITION.finditer(plain):
-        k = int(m.group(1))
-        value = _latex_value(m.group(2))
+        k = int(m.group(2))
+        value = _latex_value(m.group(3))
+        if m.group(1) and not (1 <= k <= robot.dof and robot.joint_types[k - 1].value == "prismatic"):
+            continue  # d_k is a joint only when joint k slides
         if 1 <= k <= robot.dof and value:
             out.append(f"q_{k} = {value}")
     return out
@@ -68,3 +70,16 @@ def prose_wrench(plain: str) -> str | None:
     if len(items) not in (3, 6) or not all(re.fullmatch(r"[-+]?\d+(?:\.\d+)?", x) for x in items):
         return None
     return "[" + ", ".join(items) + "]"
+
+
+_DEFINITION = re.compile(r"\b([a-zA-Z]_[a-z0-9]{1,2})\s?=\s?([A-Za-z0-9_^*/+\- ().]{3,120}?)(?=,\s|;|\.\s|\.$|$|\sand\s|\sis\s)")
+
+
+def prose_definitions(plain: str) -> list[tuple[str, str]]:
+    """Names a text defines in words: "the wrist centre is x_c = p_x - d_6 r_13, y_c = …" (formulas, not numbers)."""
+    out = []
+    for m in _DEFINITION.finditer(plain):
+        value = m.group(2).strip()
+        if re.search(r"[A-Za-z]", value) and re.search(r"[-+*/]", value):
+            out.append((m.group(1), value))
+    return out
