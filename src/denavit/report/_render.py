@@ -94,12 +94,16 @@ def _inputs_line(d: Derivation, esc: Any = str, name: Any = str) -> str:
     return esc("; ").join(parts)
 
 
-_MD_PUNCT = re.compile(r"([\\`*_{}\[\]()<>#+\-.!|$~&])")
+_MD_PUNCT = re.compile(r"([\\`*_{}\[\]<>#!|$~&])")
+_MD_LINE_START = re.compile(r"^(\s*)([-+>]|\d+[.)])")
 
 
 def _md_plain(s: str) -> str:
-    """User text (a robot's name) as plain Markdown: one line, every markup character backslash-escaped."""
-    return _MD_PUNCT.sub(r"\\\1", _text.visible(s))
+    """User text (a robot's name) as plain Markdown: one line, every character that can start markup inside a line
+    backslash-escaped, and a list or quote marker at its start too (``-``, ``+``, ``1.``); a hyphen inside a name
+    such as ``puma560-mdh`` stays as written."""
+    text = _MD_PUNCT.sub(r"\\\1", _text.visible(s))
+    return _MD_LINE_START.sub(lambda m: m.group(1) + m.group(2)[:-1] + "\\" + m.group(2)[-1], text)
 
 
 def _tex_plain(s: str) -> str:
