@@ -18,7 +18,7 @@ from ._arms import arms_of
 from ._claims import walk
 from ._document import Document, Heading, Math
 
-__all__ = ["infer_arms", "FIRST_SAMPLE", "SAMPLE", "MIN_AGREEING", "MIN_SHARE", "MARGIN", "MARGIN_LARGE"]
+__all__ = ["infer_arms", "FIRST_SAMPLE", "SAMPLE", "MIN_AGREEING", "MIN_SHARE", "MARGIN", "MARGIN_LARGE", "MIN_SHARE_LARGE"]
 
 #: Results of a section tried on each candidate arm first, and on the candidates still close after that.
 FIRST_SAMPLE = 5
@@ -31,6 +31,8 @@ MIN_SHARE = 0.7
 #: sample, and after the larger one (taken when the first left two candidates within MARGIN).
 MARGIN = 0.25
 MARGIN_LARGE = 0.1
+#: Share that must agree on the larger sample (a student's slips weigh more there; the margin still decides).
+MIN_SHARE_LARGE = 0.6
 _SKIP = ("singularities", "ik_formula", "ik_solutions", "relation", "det_jacobian")
 _INDEX = re.compile(r"(?:\\(?:var)?theta|\bq|\bQ|(?<![A-Za-z\\])[cCsS]|\\dot\{?d\}?|\bd)\s*_\s*\{?\s*(\d{1,4})")
 
@@ -101,8 +103,8 @@ def infer_arms(doc: Document, source: str, seed: int = 0, given: tuple[str, ...]
             continue
         share, agree, judged, robot = scores[0]
         runner = scores[1][0] if len(scores) > 1 else 0.0
-        margin = MARGIN_LARGE if len(close) > 1 else MARGIN
-        if agree >= MIN_AGREEING and share >= MIN_SHARE and share - runner >= margin:
+        margin, least = (MARGIN_LARGE, MIN_SHARE_LARGE) if len(close) > 1 else (MARGIN, MIN_SHARE)
+        if agree >= MIN_AGREEING and share >= least and share - runner >= margin:
             found[h.key] = robot
             notes.append(f"section {h.key!r} (line {h.line}) has no DH table: its results fit the catalogue arm "
                          f"{robot.name} ({agree} of {judged} tried agree; the next arm {runner:.0%}); judged against it "

@@ -85,9 +85,12 @@ def scale_matrix(value: str) -> str | None:
     m = _SCALED.match(value.strip())
     if m is None or "\\begin" in m.group(1) or not m.group(1).strip():
         return None
+    factor = m.group(1)
+    if re.search(r"[-+=]|\{\}|\\(?:times|cdot|left|right)|(?<![a-z\\])[A-Z](?![a-z])|\b[wvfn]_", factor):
+        return None  # "{}^1R^0 w_0 + [..]": a sum with other results, not a factor
     mats = matrices(m.group(2))
     if mats is None or len(mats) != 1:
         return None
-    factor = m.group(1).strip()
+    factor = factor.strip()
     rows = [" & ".join(f"({factor})({c})" for c in r) for r in _cells(mats[0])]
     return "\\begin{bmatrix} " + " \\\\ ".join(rows) + " \\end{bmatrix}"
