@@ -67,19 +67,30 @@ def test_dashboard_without_bokeh_is_one_line(tmp_path):
 
 # ---- the private cluster --------------------------------------------------------------------------------------
 
-def _refused(address: str, security) -> str:
-    """The exception type name of a Client that tries ``address`` with ``security`` (fails the test if it
-    connects or takes longer than CAP)."""
-    from distributed import Client
+_TRY_CLIENT = """
+import os, sys
+from distributed import Client, Security
+security = Security.temporary() if sys.argv[2] == "other-ca" else None
+try:
+    Client(sys.argv[1], security=security, timeout=float(sys.argv[3]), set_as_default=False)
+except Exception as exc:  # any refusal will do; its type is reported
+    print("REFUSED", type(exc).__name__, flush=True)
+    os._exit(0)  # no interpreter teardown: a half-made Client's __del__ can hang (distributed's LoopRunner)
+print("CONNECTED", flush=True)
+os._exit(0)
+"""
 
-    t0 = time.monotonic()
-    try:
-        client = Client(address, security=security, timeout=CAP / 2, set_as_default=False)
-    except Exception as exc:  # noqa: BLE001 - any refusal will do; the type is reported
-        assert time.monotonic() - t0 < CAP
-        return type(exc).__name__
-    client.close()
-    pytest.fail(f"a client without the cluster's credentials connected to {address}")
+
+def _refused(address: str, credentials: str) -> str:
+    """The exception type name of a Client that tries ``address`` with no credentials (``"none"``) or with those
+    of another temporary CA (``"other-ca"``), in a child process of its own (a refused Client left in this process
+    once deadlocked the next one's construction); fails the test if it connects or takes longer than CAP."""
+    res = subprocess.run([sys.executable, "-c", _TRY_CLIENT, address, credentials, str(CAP / 2)],
+                         capture_output=True, text=True, timeout=3 * CAP)
+    if "CONNECTED" in res.stdout:
+        pytest.fail(f"a client without the cluster's credentials connected to {address}")
+    assert res.stdout.startswith("REFUSED"), res.stdout + res.stderr[-2000:]
+    return res.stdout.split()[1]
 
 
 def _listening_ports(pid: int) -> set[int]:
@@ -101,9 +112,9 @@ def test_local_cluster_refuses_clients_without_its_credentials_and_serves_no_das
         cluster = client.cluster
         address = cluster.scheduler_address
         assert address.startswith("tls://127.0.0.1:"), address
-        _refused(address.replace("tls://", "tcp://"), None)  # plain TCP to the TLS port
-        _refused(address, None)  # TLS without a certificate
-        _refused(address, distributed.Security.temporary())  # a certificate of another (temporary) CA
+        _refused(address.replace("tls://", "tcp://"), "none")  # plain TCP to the TLS port
+        _refused(address, "none")  # TLS without a certificate
+        _refused(address, "other-ca")  # a certificate of another (temporary) CA
         with distributed.Client(address, security=cluster.security, timeout=CAP, set_as_default=False) as own:
             assert len(own.scheduler_info()["workers"]) == 1  # the credentials are what the refusals lacked
         # no dashboard: nothing listens on Dask's 8787, and the scheduler's HTTP server serves no page
