@@ -232,8 +232,7 @@ def cmd_check(args: argparse.Namespace):
 
 
 def _check_report(args: argparse.Namespace, path: Path):
-    from ..grade import grade_report, render_checked_html, render_checked_markdown
-    from ..grade._present import graded_text
+    from ..grade import grade_report, graded_text, render_checked_html, render_checked_markdown
 
     check_output(args, args.output, CHECKED_SUFFIXES)
     robot = load(args) if args.robot is not None else None

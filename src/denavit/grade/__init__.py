@@ -9,9 +9,10 @@ See ``docs/grading.md``.
 from __future__ import annotations
 
 from ._grade import MAX_GRADING_CPU, MAX_JUDGED, REPORT_SUFFIXES, grade_report, grade_text
+from ._present import graded_text
 from ._render import CHECKED_FORMATS, render_checked_html, render_checked_markdown, write_checked
 from ._types import VERDICTS, ArmInfo, GradedClaim, GradedReport
 
 __all__ = ["VERDICTS", "ArmInfo", "GradedClaim", "GradedReport", "grade_report", "grade_text", "REPORT_SUFFIXES",
-           "MAX_JUDGED", "MAX_GRADING_CPU",
+           "MAX_JUDGED", "MAX_GRADING_CPU", "graded_text",
            "render_checked_markdown", "render_checked_html", "write_checked", "CHECKED_FORMATS"]

@@ -20,6 +20,8 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, plain_names
 from ._lhs import read_symbol
 from ._names import Reading, joint_of, read_name
+from ._reading import (define_chain, joint_offset, names_product, plain_name, renumber, used_where,
+                       vector_reading)
 from ._split import Equation, split_block
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
@@ -341,13 +343,13 @@ class _Walker:
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
             lhs, value, sym = value, lhs, last  # "\arctan(P_y, P_x) = q_1"
-        if len(eq.parts) >= 2 and _define_chain(self.ctx, eq.parts, robot):
+        if len(eq.parts) >= 2 and define_chain(self.ctx, eq.parts, robot):
             self.note(eq, arm, "not a claim", "a name the derivation introduces")
             return
         if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
             if _IK_FUNCS.search(value) and len(eq.parts) == 2:
                 claim = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
-                used = _used_where(self.ctx.where, value)
+                used = used_where(self.ctx.where, value)
                 if used:
                     claim["where"] = used
                 self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, claim,
@@ -356,7 +358,7 @@ class _Walker:
                 self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
                           "the joint in terms of the target")
             return
-        reading = read_name(sym, robot, value) if sym is not None else _vector_reading(lhs, robot)
+        reading = read_name(sym, robot, value) if sym is not None else vector_reading(lhs, robot)
         if reading is not None and reading.spec.get("quantity") == "det_jacobian":
             self._det(eq, arm, value, sym)
             return
@@ -365,7 +367,7 @@ class _Walker:
             self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "
                       "matrix)", reading.spec["quantity"])
             return
-        if reading is not None and (_names_product(value) or _RELATION.fullmatch(value.replace(" ", ""))):
+        if reading is not None and (names_product(value) or _RELATION.fullmatch(value.replace(" ", ""))):
             if reading.spec["quantity"] in ("torques", "twist", "jacobian"):
                 claim = {"quantity": "relation", "value": eq.text}
                 p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "a relation between the arm's quantities",
@@ -377,7 +379,7 @@ class _Walker:
             return
         if reading is None:
             params = {k for k, _ in robot.parameters}
-            name = _plain(lhs)
+            name = plain_name(lhs)
             if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
                     and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params \
                     and "\\begin" not in value and not _SHORTHAND.fullmatch(name):
@@ -430,7 +432,7 @@ class _Walker:
                                for f in range(1, arm.robot.n_rows + 1)] + [({**claim, "frame": "tool"}, "Je")]
         if qty == "jacobian" and isinstance(claim.get("frame"), int):
             self.ctx.jacobian_frame = claim["frame"]
-        used = _used_where(self.ctx.where, value)
+        used = used_where(self.ctx.where, value)
         if used:
             claim["where"] = used
         if vec is not None and len(vec) == 2 and qty in ("position", "com_position", "com_velocity", "origin"):
@@ -460,98 +462,6 @@ class _Walker:
                 first, second = self.ctx.wrench_frame, ("tool" if self.ctx.wrench_frame == "base" else "base")
             claim["frame"] = first
             p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
-
-
-def _vector_reading(lhs: str, robot: Any) -> Reading | None:
-    """``[\\dot x; \\dot y; \\dot z]`` on the left: the twist rows those rates are (each read as a name)."""
-    entries = vector_entries(lhs) if lhs.strip().startswith("\\begin") else None
-    if not entries or len(entries) > 6:
-        return None
-    rows = []
-    for e in entries:
-        sym = read_symbol(e)
-        r = read_name(sym, robot) if sym is not None else None
-        k = r.spec.get("entry") if r is not None and r.spec.get("quantity") == "twist" else None
-        if not isinstance(k, int):
-            return None
-        rows.append(("vx", "vy", "vz", "wx", "wy", "wz")[k - 1])
-    if len(set(rows)) != len(rows):
-        return None
-    return Reading({"quantity": "twist", "rows": ",".join(rows)}, f"the end-effector velocity rows {', '.join(rows)}",
-                   needs=("q", "qd"))
-
-
-def _define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
-    """``d_4 = a_2 = k`` or ``k \\cos q_3 \\to \\{AA\\}``: a new name for a known one (remembered for later claims)."""
-    params = {k for k, _ in robot.parameters}
-    last = _plain(parts[-1]).strip("{}")
-    bare = re.fullmatch(r"\\?\{?([A-Za-z]{1,3}(?:_\{?\w{1,3}\}?)?)\\?\}?", last)
-    if bare is None or len(parts) < 3 and not parts[-1].strip().startswith("\\{"):
-        return False
-    name = bare.group(1)
-    if name.replace("_", "").replace("{", "").replace("}", "") in params or read_symbol(name) is None:
-        return False
-    sym = read_symbol(name)
-    if sym is None or sym.base in ("theta", "q", "Q", "x", "y", "z", "p", "P", "J", "T", "R", "A"):
-        return False
-    ctx.define(name, parts[-2])
-    return True
-
-
-_NAMED = re.compile(r"(?:\{\}\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?[A-Z]\s*"
-                    r"(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?")
-_FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times|left|right)|\.|[\s{}()]|\^\{?T\}?")
-
-
-def _names_product(value: str) -> bool:
-    """``T_0^1 T_1^2 ⋯``, ``{}^0T_1{}^1T_2``: a product of named transforms (a definition, not a value)."""
-    if len(value) > 400 or "\\begin" in value:
-        return False
-    value = re.sub(r"\^\s*\{?\s*(?:T|\\top|-1)\s*\}?", " ", value)
-    names = _NAMED.findall(value)
-    rest = _FILLER.sub("", _NAMED.sub("", value))
-    return len(names) >= 2 and not rest
-
-
-def _used_where(where: dict[str, str], value: str) -> dict[str, str]:
-    """The definitions a value uses (and those they use), in the order they were made."""
-    def uses(text: str, name: str) -> bool:
-        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z_0-9])", re.sub(r"\s+", " ", text)) is not None
-
-    need = {k for k in where if uses(value, k)}
-    for _ in range(len(where)):
-        more = {k for k in where for n in need if k not in need and uses(where[n], k)}
-        if not more:
-            break
-        need |= more
-    return {k: v for k, v in where.items() if k in need}
-
-
-def _plain(lhs: str) -> str:
-    return re.sub(r"\s+", "", lhs)
-
-
-_JOINT_INDEX = re.compile(r"(?:\\(?:var)?theta|\bq|\bQ|(?<![A-Za-z\\])[cCsS])\s*_\s*\{?\s*(\d{1,4})")
-_SUBSCRIPT = re.compile(r"(_\s*\{?\s*)(\d{1,4})(?!\.)")
-_LEFT_SUP = re.compile(r"(\{\}\s*\^\s*\{?\s*)(\d)")
-
-
-def joint_offset(texts: list[str], dof: int) -> int:
-    """The shift of a section's joint numbers: every index it writes lies in o+1 … o+dof, with o ≥ 1."""
-    idx = {int(d) for t in texts for m in _JOINT_INDEX.finditer(t) for d in m.group(1)}
-    if not idx or max(idx) <= dof:
-        return 0
-    lo = min(idx)
-    return lo - 1 if lo > 1 and max(idx) - lo < dof else 0
-
-
-def renumber(latex: str, offset: int, n_rows: int) -> str:
-    """Subscripts and left superscripts of a section written with shifted joint and frame numbers, shifted back."""
-    def shift(m: re.Match) -> str:
-        digits = "".join(str(int(d) - offset) if offset <= int(d) <= offset + n_rows else d for d in m.group(2))
-        return m.group(1) + digits
-
-    return _LEFT_SUP.sub(shift, _SUBSCRIPT.sub(shift, latex))
 
 
 def walk(doc: Document, arms: list) -> tuple[list[Pending], list[str]]:

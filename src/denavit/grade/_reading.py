@@ -1,0 +1,107 @@
+"""Reading names and values in a report's equations: what a derivation defines, renames, multiplies or renumbers.
+
+Moved from ``_claims.py`` (code unchanged, names made public for the walker).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from ._context import Context, vector_entries
+from ._lhs import read_symbol
+from ._names import Reading, read_name
+
+__all__ = ["vector_reading", "define_chain", "names_product", "used_where", "plain_name", "joint_offset", "renumber"]
+
+
+def vector_reading(lhs: str, robot: Any) -> Reading | None:
+    """``[\\dot x; \\dot y; \\dot z]`` on the left: the twist rows those rates are (each read as a name)."""
+    entries = vector_entries(lhs) if lhs.strip().startswith("\\begin") else None
+    if not entries or len(entries) > 6:
+        return None
+    rows = []
+    for e in entries:
+        sym = read_symbol(e)
+        r = read_name(sym, robot) if sym is not None else None
+        k = r.spec.get("entry") if r is not None and r.spec.get("quantity") == "twist" else None
+        if not isinstance(k, int):
+            return None
+        rows.append(("vx", "vy", "vz", "wx", "wy", "wz")[k - 1])
+    if len(set(rows)) != len(rows):
+        return None
+    return Reading({"quantity": "twist", "rows": ",".join(rows)}, f"the end-effector velocity rows {', '.join(rows)}",
+                   needs=("q", "qd"))
+
+
+def define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
+    """``d_4 = a_2 = k`` or ``k \\cos q_3 \\to \\{AA\\}``: a new name for a known one (remembered for later claims)."""
+    params = {k for k, _ in robot.parameters}
+    last = plain_name(parts[-1]).strip("{}")
+    bare = re.fullmatch(r"\\?\{?([A-Za-z]{1,3}(?:_\{?\w{1,3}\}?)?)\\?\}?", last)
+    if bare is None or len(parts) < 3 and not parts[-1].strip().startswith("\\{"):
+        return False
+    name = bare.group(1)
+    if name.replace("_", "").replace("{", "").replace("}", "") in params or read_symbol(name) is None:
+        return False
+    sym = read_symbol(name)
+    if sym is None or sym.base in ("theta", "q", "Q", "x", "y", "z", "p", "P", "J", "T", "R", "A"):
+        return False
+    ctx.define(name, parts[-2])
+    return True
+
+
+_NAMED = re.compile(r"(?:\{\}\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?[A-Z]\s*"
+                    r"(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?")
+_FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times|left|right)|\.|[\s{}()]|\^\{?T\}?")
+
+
+def names_product(value: str) -> bool:
+    """``T_0^1 T_1^2 ⋯``, ``{}^0T_1{}^1T_2``: a product of named transforms (a definition, not a value)."""
+    if len(value) > 400 or "\\begin" in value:
+        return False
+    value = re.sub(r"\^\s*\{?\s*(?:T|\\top|-1)\s*\}?", " ", value)
+    names = _NAMED.findall(value)
+    rest = _FILLER.sub("", _NAMED.sub("", value))
+    return len(names) >= 2 and not rest
+
+
+def used_where(where: dict[str, str], value: str) -> dict[str, str]:
+    """The definitions a value uses (and those they use), in the order they were made."""
+    def uses(text: str, name: str) -> bool:
+        return re.search(r"(?<![A-Za-z\\])" + re.escape(name) + r"(?![A-Za-z_0-9])", re.sub(r"\s+", " ", text)) is not None
+
+    need = {k for k in where if uses(value, k)}
+    for _ in range(len(where)):
+        more = {k for k in where for n in need if k not in need and uses(where[n], k)}
+        if not more:
+            break
+        need |= more
+    return {k: v for k, v in where.items() if k in need}
+
+
+def plain_name(lhs: str) -> str:
+    return re.sub(r"\s+", "", lhs)
+
+
+_JOINT_INDEX = re.compile(r"(?:\\(?:var)?theta|\bq|\bQ|(?<![A-Za-z\\])[cCsS])\s*_\s*\{?\s*(\d{1,4})")
+_SUBSCRIPT = re.compile(r"(_\s*\{?\s*)(\d{1,4})(?!\.)")
+_LEFT_SUP = re.compile(r"(\{\}\s*\^\s*\{?\s*)(\d)")
+
+
+def joint_offset(texts: list[str], dof: int) -> int:
+    """The shift of a section's joint numbers: every index it writes lies in o+1 … o+dof, with o ≥ 1."""
+    idx = {int(d) for t in texts for m in _JOINT_INDEX.finditer(t) for d in m.group(1)}
+    if not idx or max(idx) <= dof:
+        return 0
+    lo = min(idx)
+    return lo - 1 if lo > 1 and max(idx) - lo < dof else 0
+
+
+def renumber(latex: str, offset: int, n_rows: int) -> str:
+    """Subscripts and left superscripts of a section written with shifted joint and frame numbers, shifted back."""
+    def shift(m: re.Match) -> str:
+        digits = "".join(str(int(d) - offset) if offset <= int(d) <= offset + n_rows else d for d in m.group(2))
+        return m.group(1) + digits
+
+    return _LEFT_SUP.sub(shift, _SUBSCRIPT.sub(shift, latex))
