@@ -299,21 +299,27 @@ def _guard_numba(mod: types.ModuleType) -> None:
             value._cache = _GuardedCache(value._cache)
 
 
+def _own_entries(folder: Path) -> list[os.DirEntry]:
+    """The cache's own entries in ``folder`` and its ``__pycache__`` (other files are never listed)."""
+    found = []
+    for where in (folder, folder / "__pycache__"):
+        try:
+            found += [e for e in os.scandir(where) if ours(e.name)]
+        except OSError:
+            continue
+    return found
+
+
 def _usage(folder: Path) -> tuple[int, int]:
     """(files, bytes) of the cache's own entries in ``folder`` and its ``__pycache__``."""
     files = size = 0
-    for where in (folder, folder / "__pycache__"):
+    for entry in _own_entries(folder):
         try:
-            entries = [e for e in os.scandir(where) if ours(e.name)]
+            st = entry.stat(follow_symlinks=False)
         except OSError:
             continue
-        for entry in entries:
-            try:
-                st = entry.stat(follow_symlinks=False)
-            except OSError:
-                continue
-            files += 1
-            size += st.st_size if stat.S_ISREG(st.st_mode) else 0
+        files += 1
+        size += st.st_size if stat.S_ISREG(st.st_mode) else 0
     return files, size
 
 
@@ -330,13 +336,7 @@ def clear_cache() -> dict:
     them, leftovers.  Other files in the folder are left alone.  Returns :func:`cache_info` of what was removed."""
     with _LOCK:
         info = cache_info()
-        folder = Path(info["folder"])
-        for where in (folder, folder / "__pycache__"):
-            try:
-                entries = [e for e in os.scandir(where) if ours(e.name)]
-            except OSError:
-                continue
-            for entry in entries:
-                remove_entry(Path(entry.path))
+        for entry in _own_entries(Path(info["folder"])):
+            remove_entry(Path(entry.path))
         _LOADED.clear()
     return info
