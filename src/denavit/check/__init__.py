@@ -23,7 +23,7 @@ from ._resolve import robot_resolver
 
 __all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_text", "parse_math", "parse_matrix",
            "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_SIGN_CHOICES", "MAX_SINGULAR_SETS", "MAX_DETAILED",
-           "MAX_FILE_BYTES"]
+           "MAX_FILE_BYTES", "read_input_text"]
 
 #: Most claims in one file (a whole course report is a few hundred; 500 are judged in well under a minute).
 MAX_CLAIMS = 500
@@ -108,22 +108,29 @@ def _judge(robot: DHRobot, raw: Any, label: str, rng: np.random.Generator, deg: 
                        f"({type(exc).__name__}: {str(exc)[:200]}); please report this claim")
 
 
+def read_input_text(path: Path, what: str, encoding: str = "utf-8") -> str:
+    """The text of an input file (a claims file, a report), refused in one line when missing, not a regular file,
+    over :data:`MAX_FILE_BYTES` or not UTF-8."""
+    where = str(path)
+    if not path.exists():
+        raise ParseError(f"no such {what}: {where!r}")
+    if not path.is_file():
+        raise ParseError(f"the {what} {where!r} is not a regular file")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise ParseError(f"{what} too large (at most {MAX_FILE_BYTES} bytes)", where=where)
+    try:
+        return path.read_bytes().decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
+
+
 def check_file(robot: DHRobot, path: str | Path, *, seed: int = 0) -> CheckResult:
     """Read a YAML claims file (see ``docs/claims.md``) and judge its claims."""
     from ._yaml import load_claims_yaml
 
     path = Path(path)
     where = str(path)
-    if not path.exists():
-        raise ParseError(f"no such claims file: {where!r}")
-    if not path.is_file():
-        raise ParseError(f"the claims file {where!r} is not a regular file")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise ParseError(f"claims file too large (at most {MAX_FILE_BYTES} bytes)", where=where)
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
+    text = read_input_text(path, "claims file")
     data = load_claims_yaml(text, where)
     if isinstance(data, list):
         data = {"claims": data}

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..check import MAX_FILE_BYTES, check_claims
+from ..check import check_claims, read_input_text
 from ..errors import DenavitError, ParseError
 from ..model import DHRobot
 from ..tables import find_tables
@@ -165,14 +165,7 @@ def grade_report(path: str | Path, robot: DHRobot | str | None = None, arms: dic
     fmt = REPORT_SUFFIXES.get(path.suffix.lower())
     if fmt is None:
         raise ParseError(f"not a report: {where!r} (a report is .md, .markdown, .tex or .txt)")
-    if not path.is_file():
-        raise ParseError(f"no such report: {where!r}" if not path.exists() else f"{where!r} is not a regular file")
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise ParseError(f"report too large (at most {MAX_FILE_BYTES} bytes)", where=where)
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not UTF-8 text (byte {exc.start + 1})", where=where) from None
+    text = read_input_text(path, "report", "utf-8-sig")
     given = {str(k): (v if isinstance(v, DHRobot) else load_robot(str(v))) for k, v in (arms or {}).items()}
     if robot is not None and not isinstance(robot, DHRobot):
         robot = load_robot(str(robot))
