@@ -241,7 +241,7 @@ def _execute(modname: str, path: Path, code: types.CodeType) -> types.ModuleType
     mod.__file__ = str(path)
     sys.modules[modname] = mod
     try:
-        exec(code, mod.__dict__)  # noqa: S102 — the cache's own code, checked against its key and hash above
+        exec(code, mod.__dict__)  # noqa: S102  # safe: the cache's own generated code, checked against its key and hash above
     except BaseException:
         sys.modules.pop(modname, None)
         raise
