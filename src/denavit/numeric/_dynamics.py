@@ -136,7 +136,8 @@ def _crm(s: np.ndarray) -> np.ndarray:
     return np.concatenate([np.concatenate([Sw, Sv], -1), np.concatenate([Z, Sw], -1)], -2)
 
 
-def _gravity(robot: DHRobot, gravity) -> np.ndarray:
+def gravity_vector(robot: DHRobot, gravity) -> np.ndarray:
+    """Gravity [m/s²] in the world frame: ``gravity`` (3 finite numbers) or, when None, ``robot.gravity``."""
     g = np.asarray(robot.gravity if gravity is None else gravity, dtype=float)
     if g.shape != (3,):
         raise ModelError(f"gravity must have 3 components [m/s²], got shape {g.shape}")
@@ -183,7 +184,7 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
     q, qd, qdd = np.broadcast_arrays(
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(qdd, n, "qdd")
     )
-    g = _gravity(robot, gravity)
+    g = gravity_vector(robot, gravity)
     (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
     tau = to_array(rnea_kernel(plan(robot), qc, qdc, qddc, g.tolist()), batch, (n,))
     if friction:
@@ -285,7 +286,7 @@ def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool
     )
     if friction:
         tau = tau - friction_torques(robot, qd)
-    pl, g = plan(robot), _gravity(robot, gravity).tolist()
+    pl, g = plan(robot), gravity_vector(robot, gravity).tolist()
     (qc, batch), (qdc, _), (tc, _) = joint_columns(q), joint_columns(qd), joint_columns(tau)
     F = frames(pl, qc)
     bias = rnea_kernel(pl, qc, qdc, [0.0] * n, g, F)
@@ -314,5 +315,5 @@ def potential_energy(robot: DHRobot, q, *, gravity=None) -> np.ndarray:
     """Gravitational potential V = −Σ m gᵀ c (COMs in the world frame), shape (...) [J]."""
     q = as_joint_array(q, robot.dof)
     st = _State(robot, q)
-    g = _gravity(robot, gravity)
+    g = gravity_vector(robot, gravity)
     return -np.einsum("p,...pi,i->...", st.mass, st.com, g)
