@@ -24,6 +24,7 @@ from .numeric import end_effector_twist, force_propagation, joint_torques, manip
 from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 from .codegen import CompiledRobot, compile
+from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 
 __version__ = "0.1.0"
@@ -61,6 +62,9 @@ __all__ = [
     "forward_kinematics",
     "link_transforms",
     "geometric_jacobian",
+    "jacobian_dot",
+    "acceleration_bias",
+    "kinematic_hessian",
     "rnea",
     "mass_matrix",
     "coriolis_matrix",

@@ -11,6 +11,7 @@ from ._jacobians import (
     rpy_rate_matrix,
     zyz_rate_matrix,
 )
+from ._kin_derivatives import acceleration_bias, jacobian_dot, kinematic_hessian
 from ._propagation import (
     ForcePropagation,
     VelocityPropagation,
@@ -89,6 +90,9 @@ __all__ = [
     "jacobian_tool_from_base",
     "rpy_rate_matrix",
     "zyz_rate_matrix",
+    "jacobian_dot",
+    "acceleration_bias",
+    "kinematic_hessian",
     "ForcePropagation",
     "VelocityPropagation",
     "force_propagation",
