@@ -23,6 +23,7 @@ from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
+from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_derivatives
 from .codegen import CompiledRobot, compile
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
@@ -70,6 +71,9 @@ __all__ = [
     "coriolis_matrix",
     "gravity_torques",
     "forward_dynamics",
+    "rnea_derivatives",
+    "forward_dynamics_derivatives",
+    "gravity_derivatives",
     "simulate",
     "coriolis_vector",
     "friction_torques",

@@ -79,6 +79,16 @@ class Sym:
     def cos(self):
         return self.tape.unary("cos", self)
 
+    # what the dual numbers of denavit.numeric call on a value that is neither a float nor an array
+    def sign(self):
+        return self.tape.unary("sign", self)
+
+    def min(self, other):
+        return self.tape.binary("min", self, other)
+
+    def max(self, other):
+        return self.tape.binary("max", self, other)
+
     def __repr__(self) -> str:
         return f"Sym({self.tape.describe(self.i)})"
 

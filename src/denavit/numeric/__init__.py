@@ -53,7 +53,9 @@ from ._dynamics import (
     require_dynamics,
     rnea,
 )
-from ._dynamics import SINGULAR_TOL
+from ._dynamics import SINGULAR_TOL, gravity_vector
+from ._dyn_derivatives import forward_dynamics_derivatives, friction_coefficients, gravity_derivatives, rnea_derivatives
+from ._dual import Dual, dual_max, dual_min, dual_sign, seed_duals, tangent_matrix
 from ._dynamics_fast import ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
 from ._dynamics_fast import plan as dynamics_plan
 from ._simulate import SimulationResult, computed_torque_controller, pd_controller, simulate
@@ -133,6 +135,17 @@ __all__ = [
     "gravity_torques",
     "friction_torques",
     "forward_dynamics",
+    "rnea_derivatives",
+    "forward_dynamics_derivatives",
+    "gravity_derivatives",
+    "friction_coefficients",
+    "gravity_vector",
+    "Dual",
+    "seed_duals",
+    "tangent_matrix",
+    "dual_sign",
+    "dual_min",
+    "dual_max",
     "kinetic_energy",
     "potential_energy",
     "forward_kinematics",

@@ -1,0 +1,168 @@
+"""Dynamics derivatives (rnea_derivatives, forward_dynamics_derivatives, gravity_derivatives) against outside truth.
+
+Truth: Pinocchio's computeRNEADerivatives / computeABADerivatives / computeGeneralizedGravityDerivatives (an
+independent implementation of Carpentier & Mansard's recursive derivative algorithms) on the same arm built by
+denavit.peers.to_pinocchio, and fourth-order central differences of the public denavit.rnea /
+denavit.forward_dynamics.  Random arms: both conventions, prismatic joints, fixed rows (some carrying mass),
+base and tool, friction, motor inertia, gravity in an odd direction.  The error measure is
+max|A − B| / max|B| over a matrix (relative to its largest entry, floored at 1e-6 for a matrix that is
+zero in truth, like ∂τ/∂q̇ of a one-joint arm), required ≤ 1e-9.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit.peers import to_pinocchio
+from denavit import LinkInertia, ShapeError
+from denavit.errors import ModelError
+
+from _random_robots import random_robot
+
+REL = 1e-9
+
+
+def rel_err(a, b) -> float:
+    a, b = np.asarray(a), np.asarray(b)
+    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-6))
+
+
+def random_inertia(rng: np.random.Generator) -> LinkInertia:
+    """A physically valid rigid body (principal moments from a mass distribution, rotated), motor and friction."""
+    mass = rng.uniform(0.5, 3.0)
+    s = rng.uniform(0.01, 0.1, 3)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    I = Q @ np.diag([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) * mass @ Q.T
+    return LinkInertia(mass=mass, com=tuple(rng.uniform(-0.3, 0.3, 3)),
+                       inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
+                       motor_inertia=rng.uniform(0.0, 0.3), viscous=rng.uniform(0.0, 1.0), coulomb=rng.uniform(0.0, 1.0))
+
+
+def dynamic_arm(seed: int, fixed_mass: bool = True, n_rows: int | None = None):
+    """A random arm of tests/_random_robots with inertia on every joint row (and on fixed rows when
+    ``fixed_mass``: Pinocchio's conversion carries joint rows' inertia only), odd gravity."""
+    rng = np.random.default_rng(seed)
+    robot = random_robot(rng, n_rows=n_rows or int(rng.integers(2, 7)))
+    links = tuple(dataclasses.replace(link, inertia=random_inertia(rng)) if (link.is_joint or fixed_mass) else link
+                  for link in robot.links)
+    return robot.replace(links=links, gravity=tuple(rng.normal(size=3) * 5.0))
+
+
+def state(robot, seed: int, shape=()):
+    rng = np.random.default_rng(seed + 1000)
+    n = robot.dof
+    return (rng.uniform(-np.pi, np.pi, shape + (n,)), rng.uniform(-2, 2, shape + (n,)), rng.uniform(-3, 3, shape + (n,)))
+
+
+def central(f, x, h=1e-3):
+    """∂f/∂x by the fourth-order stencil (f(x−2h) − 8 f(x−h) + 8 f(x+h) − f(x+2h)) / 12h, columns per x_j."""
+    cols = []
+    for e in np.eye(x.shape[-1]) * h:
+        cols.append((f(x - 2 * e) - 8 * f(x - e) + 8 * f(x + e) - f(x + 2 * e)) / (12 * h))
+    return np.stack(cols, axis=-1)
+
+
+SEEDS = [3, 11, 29, 47]
+
+
+# --- against Pinocchio ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("seed", SEEDS)
+def test_rnea_derivatives_match_pinocchio(seed):
+    pin = pytest.importorskip("pinocchio")
+    robot = dynamic_arm(seed, fixed_mass=False)
+    model, data, _ = to_pinocchio(robot)
+    q, qd, qdd = state(robot, seed)
+    dq, dv, da = pin.computeRNEADerivatives(model, data, q, qd, qdd)
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd, friction=False)
+    assert rel_err(A, dq) <= REL and rel_err(B, dv) <= REL
+    fv = [link.inertia.viscous for link in robot.joints]
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd)  # friction: + diag(viscous) on ∂τ/∂q̇
+    assert rel_err(A, dq) <= REL and rel_err(B, dv + np.diag(fv)) <= REL
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_forward_dynamics_derivatives_match_pinocchio(seed):
+    pin = pytest.importorskip("pinocchio")
+    robot = dynamic_arm(seed, fixed_mass=False)
+    model, data, _ = to_pinocchio(robot)
+    q, qd, _ = state(robot, seed)
+    tau = np.random.default_rng(seed).uniform(-5, 5, robot.dof)
+    X, Y, Z = denavit.forward_dynamics_derivatives(robot, q, qd, tau, friction=False)
+    ddq, ddv, Minv = pin.computeABADerivatives(model, data, q, qd, tau)
+    assert rel_err(X, ddq) <= REL and rel_err(Y, ddv) <= REL and rel_err(Z, Minv) <= REL
+
+
+@pytest.mark.parametrize("seed", SEEDS[:2])
+def test_gravity_derivatives_match_pinocchio_and_are_symmetric(seed):
+    pin = pytest.importorskip("pinocchio")
+    robot = dynamic_arm(seed, fixed_mass=False)
+    model, data, _ = to_pinocchio(robot)
+    q = state(robot, seed)[0]
+    G = denavit.gravity_derivatives(robot, q)
+    assert rel_err(G, pin.computeGeneralizedGravityDerivatives(model, data, q)) <= REL
+    assert rel_err(G, G.T) <= REL  # ∂²V/∂q²
+
+
+def test_batched_matches_pinocchio_per_configuration():
+    pin = pytest.importorskip("pinocchio")
+    robot = dynamic_arm(5, fixed_mass=False)
+    model, data, _ = to_pinocchio(robot)
+    q, qd, qdd = state(robot, 5, (3, 2))
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd, friction=False)
+    X, Y, Z = denavit.forward_dynamics_derivatives(robot, q, qd, qdd, friction=False)  # qdd as torques
+    G = denavit.gravity_derivatives(robot, q)
+    assert A.shape == B.shape == X.shape == Z.shape == G.shape == (3, 2, robot.dof, robot.dof)
+    for i in np.ndindex(3, 2):
+        dq, dv, _ = pin.computeRNEADerivatives(model, data, q[i], qd[i], qdd[i])
+        assert rel_err(A[i], dq) <= REL and rel_err(B[i], dv) <= REL
+        ddq, ddv, Minv = pin.computeABADerivatives(model, data, q[i], qd[i], qdd[i])
+        assert rel_err(X[i], ddq) <= REL and rel_err(Y[i], ddv) <= REL and rel_err(Z[i], Minv) <= REL
+        assert rel_err(G[i], pin.computeGeneralizedGravityDerivatives(model, data, q[i])) <= REL
+
+
+# --- against central differences of the public functions (mass on fixed rows too, friction, motor inertia) ----
+@pytest.mark.parametrize("seed", SEEDS[:3])
+def test_rnea_derivatives_match_central_differences(seed):
+    robot = dynamic_arm(seed)
+    q, qd, qdd = state(robot, seed)
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd)
+    assert rel_err(A, central(lambda x: denavit.rnea(robot, x, qd, qdd), q)) <= REL
+    assert rel_err(B, central(lambda x: denavit.rnea(robot, q, x, qdd), qd)) <= REL
+
+
+@pytest.mark.parametrize("seed", SEEDS[:3])
+def test_forward_dynamics_derivatives_match_central_differences(seed):
+    robot = dynamic_arm(seed)
+    q, qd, _ = state(robot, seed)
+    tau = np.random.default_rng(seed).uniform(-5, 5, robot.dof)
+    fd = denavit.forward_dynamics
+    X, Y, Z = denavit.forward_dynamics_derivatives(robot, q, qd, tau)
+    assert rel_err(X, central(lambda x: fd(robot, x, qd, tau), q)) <= REL
+    assert rel_err(Y, central(lambda x: fd(robot, q, x, tau), qd)) <= REL
+    assert rel_err(Z, central(lambda x: fd(robot, q, qd, x), tau)) <= REL
+    assert rel_err(Z @ denavit.mass_matrix(robot, q), np.eye(robot.dof)) <= REL
+
+
+def test_gravity_keyword_and_friction_off():
+    robot = dynamic_arm(8)
+    q, qd, qdd = state(robot, 8)
+    g = np.array([1.5, -2.0, 0.7])
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd, gravity=g, friction=False)
+    assert rel_err(A, central(lambda x: denavit.rnea(robot, x, qd, qdd, gravity=g, friction=False), q)) <= REL
+    assert rel_err(B, central(lambda x: denavit.rnea(robot, q, x, qdd, gravity=g, friction=False), qd)) <= REL
+    G = denavit.gravity_derivatives(robot, q, gravity=g)
+    assert rel_err(G, central(lambda x: denavit.gravity_torques(robot, x, gravity=g), q)) <= REL
+
+
+def test_bad_input_is_a_clear_error():
+    robot = denavit.load_robot("puma560")
+    with pytest.raises(ShapeError, match="qd: expected shape"):
+        denavit.rnea_derivatives(robot, np.zeros(6), np.zeros(5), np.zeros(6))
+    with pytest.raises(ShapeError, match="non-finite"):
+        denavit.gravity_derivatives(robot, [0, 0, np.nan, 0, 0, 0])
+    with pytest.raises(ModelError, match="gravity must be finite"):
+        denavit.forward_dynamics_derivatives(robot, np.zeros(6), np.zeros(6), np.zeros(6), gravity=[0, 0, np.inf])
