@@ -16,7 +16,7 @@ from ..errors import ModelError
 from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
 from ._trace import Tape, sym_max, sym_min, sym_sign
 
-__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics"]
+__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns"]
 
 KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
                 "gravity", "coriolis", "forward_dynamics")
@@ -63,6 +63,30 @@ def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
+def jacobian_columns(chain, frames, end, tool: bool = False):
+    """The columns (v_k, w_k) of the geometric Jacobian, each a 3-tuple of components (traced values or floats).
+
+    Column k is [z × (p_e − o); z] for a revolute joint and [z; 0] for a prismatic one (Siciliano et al. 2009,
+    eq. 3.30), z and o the axis and origin of the frame carrying joint k (``frames`` from the walker, ``end`` the
+    end-effector pose); ``tool=True``: components along the end-effector axes (the rows of R_eᵀ), i.e. Je.
+    """
+    xe, ye, ze, pe = end
+    v_rows, w_rows = [], []
+    for k in range(chain.dof):
+        F = frames[chain.axis_frame[k]]
+        z, o = F[2], F[3]
+        if chain.revolute[k]:
+            v, w = _cross(z, tuple(pe[i] - o[i] for i in range(3))), z
+        else:
+            v, w = z, (0.0, 0.0, 0.0)
+        if tool:
+            v = tuple(sum((a[i] * v[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
+            w = tuple(sum((a[i] * w[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
+        v_rows.append(v)
+        w_rows.append(w)
+    return v_rows, w_rows
+
+
 def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> dict[str, KernelSpec]:
     """Trace the kernels ``names`` of ``robot`` (dynamics ones only when it carries inertial data);
     ``friction``: rnea and forward_dynamics include the joints' viscous and Coulomb friction."""
@@ -95,20 +119,7 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
         if name not in names:
             continue
         tape, q, frames, end = kinematics(name)
-        xe, ye, ze, pe = end
-        v_rows, w_rows = [], []
-        for k in range(n):
-            F = frames[chain.axis_frame[k]]
-            z, o = F[2], F[3]
-            if chain.revolute[k]:  # [z × (p_e − o); z]  (Siciliano et al. 2009, eq. 3.30)
-                v, w = _cross(z, tuple(pe[i] - o[i] for i in range(3))), z
-            else:  # [z; 0]
-                v, w = z, (0.0, 0.0, 0.0)
-            if name == "jacobiane":  # rows of R_eᵀ: components along the end-effector axes
-                v = tuple(sum((a[i] * v[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
-                w = tuple(sum((a[i] * w[i] for i in range(3)), 0.0) for a in (xe, ye, ze))
-            v_rows.append(v)
-            w_rows.append(w)
+        v_rows, w_rows = jacobian_columns(chain, frames, end, tool=name == "jacobiane")
         entries = [v_rows[k][r] for r in range(3) for k in range(n)] + [w_rows[k][r] for r in range(3)
                                                                          for k in range(n)]
         if name == "fk_jacobian0":  # the pose and J0 in one pass (what each IK iteration needs)
