@@ -160,3 +160,13 @@ def test_against_roboticstoolbox_hessian0_and_jacob0_dot():
         assert _rel(denavit.kinematic_hessian(robot, q), H.transpose(1, 2, 0)) < RTOL
         Jd = np.asarray(peer.jacob0_dot(expand_q(robot, q), expand_q(robot, qd)))[:, moving]
         assert _rel(denavit.jacobian_dot(robot, q, qd), Jd) < RTOL
+
+
+def test_threads_split_a_large_batch_with_the_same_result():
+    robot, _, _, rng = _arm(3, "standard")
+    Q, QD = random_q(rng, robot, (9000,)), rng.normal(size=(9000, robot.dof))  # ≥ 2 × MIN_ROWS: two blocks
+    one = denavit.jacobian_dot(robot, Q, QD, threads=1)
+    np.testing.assert_array_equal(denavit.jacobian_dot(robot, Q, QD, threads=2), one)
+    np.testing.assert_array_equal(one[4567], denavit.jacobian_dot(robot, Q[4567], QD[4567]))
+    with pytest.raises(ValueError, match="threads"):
+        denavit.kinematic_hessian(robot, Q[0], threads=0)

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._threads import resolve_threads, split_rows
 from .._validate import as_joint_array
 from ..errors import ShapeError
 from ..model import DHRobot, Frame
@@ -160,6 +161,29 @@ def _inputs(robot: DHRobot, q, qd):
         raise ShapeError(f"q {q.shape} and qd {qd.shape} do not broadcast together") from None
 
 
+def _evaluate(robot: DHRobot, frame: Frame, q: np.ndarray, qd, shape: tuple[int, ...], entries, threads):
+    """``entries(v, w, qd)`` → the C-ordered entries of one output of ``shape``, evaluated at q (..., n) (and qd):
+    one configuration in floats, a batch as (B,) components, its rows split over ``threads``
+    (:func:`denavit._threads.split_rows`)."""
+    resolve_threads(threads)  # a bad value is refused for one configuration too
+    n = robot.dof
+    batch = q.shape[:-1]
+    if not batch:
+        v, w = _columns(geometric_jacobian(robot, q, frame))
+        return _assemble(entries(v, w, None if qd is None else qd.tolist()), shape, ())
+    Q = q.reshape(-1, n)
+    QD = None if qd is None else qd.reshape(-1, n)
+    out = np.empty((Q.shape[0],) + shape)
+
+    def work(s: int, e: int) -> None:
+        if e > s:
+            v, w = _columns(geometric_jacobian(robot, Q[s:e], frame))
+            out[s:e] = _assemble(entries(v, w, None if QD is None else list(QD[s:e].T)), shape, (e - s,))
+
+    split_rows(Q.shape[0], work, threads)
+    return out.reshape(batch + shape)
+
+
 def jacobian_dot(robot: DHRobot, q, qd, frame: Frame | str = Frame.BASE, *, threads: int | None = None) -> np.ndarray:
     """Time derivative J̇ of the geometric Jacobian, shape (..., 6, n), rows (v, ω).
 
@@ -186,13 +210,13 @@ def jacobian_dot(robot: DHRobot, q, qd, frame: Frame | str = Frame.BASE, *, thre
     """
     frame = kin_frame(frame)
     q, qd = _inputs(robot, q, qd)
-    batch = q.shape[:-1]
-    v, w = _columns(geometric_jacobian(robot, q, frame))
-    qdc = qd.tolist() if not batch else list(qd.reshape(-1, robot.dof).T)
-    lin, ang = jacobian_dot_entries(v, w, qdc, frame is Frame.TOOL)
-    n = robot.dof
-    entries = [lin[j][r] for r in range(3) for j in range(n)] + [ang[j][r] for r in range(3) for j in range(n)]
-    return _assemble(entries, (6, n), batch)
+    n, tool = robot.dof, frame is Frame.TOOL
+
+    def entries(v, w, qd):
+        lin, ang = jacobian_dot_entries(v, w, qd, tool)
+        return [lin[j][r] for r in range(3) for j in range(n)] + [ang[j][r] for r in range(3) for j in range(n)]
+
+    return _evaluate(robot, frame, q, qd, (6, n), entries, threads)
 
 
 def acceleration_bias(robot: DHRobot, q, qd, frame: Frame | str = Frame.BASE, *,
@@ -213,10 +237,7 @@ def acceleration_bias(robot: DHRobot, q, qd, frame: Frame | str = Frame.BASE, *,
     """
     frame = kin_frame(frame)
     q, qd = _inputs(robot, q, qd)
-    batch = q.shape[:-1]
-    v, w = _columns(geometric_jacobian(robot, q, frame))
-    qdc = qd.tolist() if not batch else list(qd.reshape(-1, robot.dof).T)
-    return _assemble(list(bias_entries(v, w, qdc)), (6,), batch)
+    return _evaluate(robot, frame, q, qd, (6,), lambda v, w, qd: list(bias_entries(v, w, qd)), threads)
 
 
 def kinematic_hessian(robot: DHRobot, q, frame: Frame | str = Frame.BASE, *, threads: int | None = None) -> np.ndarray:
@@ -236,8 +257,10 @@ def kinematic_hessian(robot: DHRobot, q, frame: Frame | str = Frame.BASE, *, thr
     """
     frame = kin_frame(frame)
     q = as_joint_array(q, robot.dof)
-    v, w = _columns(geometric_jacobian(robot, q, frame))
-    H = hessian_entries(v, w, frame is Frame.TOOL)
-    n = robot.dof
-    entries = [H[j][k][r] for r in range(6) for j in range(n) for k in range(n)]
-    return _assemble(entries, (6, n, n), q.shape[:-1])
+    n, tool = robot.dof, frame is Frame.TOOL
+
+    def entries(v, w, _):
+        H = hessian_entries(v, w, tool)
+        return [H[j][k][r] for r in range(6) for j in range(n) for k in range(n)]
+
+    return _evaluate(robot, frame, q, None, (6, n, n), entries, threads)
