@@ -164,5 +164,29 @@ def test_bad_input_is_a_clear_error():
         denavit.rnea_derivatives(robot, np.zeros(6), np.zeros(5), np.zeros(6))
     with pytest.raises(ShapeError, match="non-finite"):
         denavit.gravity_derivatives(robot, [0, 0, np.nan, 0, 0, 0])
+    with pytest.raises(ShapeError, match="do not broadcast"):
+        denavit.forward_dynamics_derivatives(robot, np.zeros((2, 6)), np.zeros((3, 6)), np.zeros(6))
+    with pytest.raises(ValueError, match="threads must be"):
+        denavit.rnea_derivatives(robot, np.zeros(6), np.zeros(6), np.zeros(6), threads=0)
     with pytest.raises(ModelError, match="gravity must be finite"):
         denavit.forward_dynamics_derivatives(robot, np.zeros(6), np.zeros(6), np.zeros(6), gravity=[0, 0, np.inf])
+
+
+def test_a_batch_split_over_threads_gives_the_rows_of_the_unsplit_call():
+    from denavit._threads import MIN_ROWS
+
+    robot = dynamic_arm(29)
+    q = state(robot, 29, (2 * MIN_ROWS + 40,))[0]
+    one = denavit.gravity_derivatives(robot, q, threads=1)
+    two = denavit.gravity_derivatives(robot, q, threads=2)
+    assert np.array_equal(one, two)
+    assert rel_err(two[-1], denavit.gravity_derivatives(robot, q[-1])) <= REL
+
+
+def test_singular_mass_matrix_is_a_model_error():
+    from denavit import DHLink, DHRobot
+
+    point = LinkInertia(mass=1.0)  # a point mass on the axis of a one-joint arm: M = 0
+    robot = DHRobot(name="pointmass", links=(DHLink(a=0.0, alpha=0.0, d=0.0, inertia=point),))
+    with pytest.raises(ModelError, match="singular"):
+        denavit.forward_dynamics_derivatives(robot, [0.1], [0.0], [1.0])

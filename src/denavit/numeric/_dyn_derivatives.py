@@ -32,7 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._threads import resolve_threads, split_rows
 from .._validate import as_joint_array
+from ..errors import ShapeError
 from ..model import DHRobot
 from ._dual import dual_sign, seed_duals, tangent_matrix
 from ._dynamics import forward_dynamics, gravity_vector
@@ -49,8 +51,30 @@ def friction_coefficients(robot: DHRobot, friction: bool = True) -> tuple[list[f
 
 
 def _inputs(robot: DHRobot, arrays, names):
-    n = robot.dof
-    return np.broadcast_arrays(*(as_joint_array(a, n, nm) for a, nm in zip(arrays, names)))
+    arrays = [as_joint_array(a, robot.dof, nm) for a, nm in zip(arrays, names)]
+    try:
+        return np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = ", ".join(f"{nm} {a.shape}" for nm, a in zip(names, arrays))
+        raise ShapeError(f"inputs do not broadcast together: {shapes}") from None
+
+
+def _batched(arrays, shape: tuple[int, ...], compute, threads):
+    """``compute(*arrays)`` → output of ``shape`` per configuration: one configuration directly, a batch (..., n)
+    flattened and its rows split over ``threads`` (:func:`denavit._threads.split_rows`)."""
+    resolve_threads(threads)  # a bad value is refused for one configuration too
+    batch = arrays[0].shape[:-1]
+    if not batch:
+        return compute(*arrays)
+    flat = [a.reshape(-1, a.shape[-1]) for a in arrays]
+    out = np.empty((flat[0].shape[0],) + shape)
+
+    def work(s: int, e: int) -> None:
+        if e > s:
+            out[s:e] = compute(*[f[s:e] for f in flat])
+
+    split_rows(out.shape[0], work, threads)
+    return out.reshape(batch + shape)
 
 
 def _id_tangents(robot, qc, qdc, qddc, g, friction: bool, m: int):
@@ -75,7 +99,7 @@ def rnea_derivatives(robot: DHRobot, q, qd, qdd, *, friction: bool = True, gravi
     gravity : array_like, shape (3,), optional
         World gravity [m/s²]; default ``robot.gravity``.
     threads : int, optional
-        Split a batch over this many threads (default: all cores).
+        Split a batch over this many threads (default: every core; :mod:`denavit._threads`).
 
     Notes
     -----
@@ -86,8 +110,13 @@ def rnea_derivatives(robot: DHRobot, q, qd, qdd, *, friction: bool = True, gravi
     q, qd, qdd = _inputs(robot, (q, qd, qdd), ("q", "qd", "qdd"))
     g = gravity_vector(robot, gravity).tolist()
     n = robot.dof
-    (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
-    D = to_array(tangent_matrix(_id_tangents(robot, qc, qdc, qddc, g, friction, 2 * n), 2 * n), batch, (n, 2 * n))
+
+    def compute(q, qd, qdd):
+        (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
+        tau = _id_tangents(robot, qc, qdc, qddc, g, friction, 2 * n)
+        return to_array(tangent_matrix(tau, 2 * n), batch, (n, 2 * n))
+
+    D = _batched((q, qd, qdd), (n, 2 * n), compute, threads)
     return D[..., :n].copy(), D[..., n:].copy()
 
 
@@ -112,21 +141,30 @@ def forward_dynamics_derivatives(robot: DHRobot, q, qd, tau, *, friction: bool =
     RNEA on duals at the forward-dynamics q̈, then one LDLᵀ solve of M with the 3n tangents as right-hand sides.
     """
     q, qd, tau = _inputs(robot, (q, qd, tau), ("q", "qd", "tau"))
-    n = robot.dof
-    qdd = forward_dynamics(robot, q, qd, tau, gravity=gravity, friction=friction)  # raises where M is singular
-    g = gravity_vector(robot, gravity).tolist()
-    cols = [joint_columns(a) for a in (q, qd, qdd, tau)]
-    (qc, batch), (qdc, _), (qddc, _), (tc, _) = cols
-    m = 3 * n
-    residual = [t - i for t, i in zip(seed_duals(tc, 2 * n, m), _id_tangents(robot, qc, qdc, qddc, g, friction, m))]
-    pl = plan(robot)
-    x, _ = ldl_pivots_solve(mass_matrix_kernel(pl, qc, frames(pl, qc)), residual)
-    D = to_array(tangent_matrix(x, m), batch, (n, m))
+    n, m = robot.dof, 3 * robot.dof
+    gravity = gravity_vector(robot, gravity)
+    g, pl = gravity.tolist(), plan(robot)
+
+    def compute(q, qd, tau):
+        qdd = forward_dynamics(robot, q, qd, tau, gravity=gravity, friction=friction)  # raises where M is singular
+        (qc, batch), (qdc, _), (qddc, _), (tc, _) = (joint_columns(a) for a in (q, qd, qdd, tau))
+        ident = _id_tangents(robot, qc, qdc, qddc, g, friction, m)
+        residual = [t - i for t, i in zip(seed_duals(tc, 2 * n, m), ident)]  # τ − ID, tangents along (q, q̇, τ)
+        x, _ = ldl_pivots_solve(mass_matrix_kernel(pl, qc, frames(pl, qc)), residual)
+        return to_array(tangent_matrix(x, m), batch, (n, m))
+
+    D = _batched((q, qd, tau), (n, m), compute, threads)
     return D[..., :n].copy(), D[..., n:2 * n].copy(), D[..., 2 * n:].copy()
 
 
 def gravity_derivatives(robot: DHRobot, q, *, gravity=None, threads=None) -> np.ndarray:
     """∂g/∂q of the gravity torques :func:`denavit.gravity_torques`, shape (..., n, n), [output, input].
+
+    Parameters
+    ----------
+    q : array_like, shape (..., n)
+    gravity, threads
+        As :func:`rnea_derivatives`.
 
     Notes
     -----
@@ -135,7 +173,11 @@ def gravity_derivatives(robot: DHRobot, q, *, gravity=None, threads=None) -> np.
     q = as_joint_array(q, robot.dof)
     g = gravity_vector(robot, gravity).tolist()
     n = robot.dof
-    qc, batch = joint_columns(q)
     zero = [0.0] * n
-    tau = rnea_kernel(plan(robot), seed_duals(qc, 0, n), zero, zero, g)
-    return to_array(tangent_matrix(tau, n), batch, (n, n))
+
+    def compute(q):
+        qc, batch = joint_columns(q)
+        tau = rnea_kernel(plan(robot), seed_duals(qc, 0, n), zero, zero, g)
+        return to_array(tangent_matrix(tau, n), batch, (n, n))
+
+    return _batched((q,), (n, n), compute, threads)
