@@ -23,7 +23,7 @@ from ..chain import COMPONENTS, FLOATS, Chain, chain_of, walk
 from ..model import DHRobot
 
 __all__ = ["plan", "rnea_kernel", "mass_matrix_kernel", "ldl_pivots_solve", "ldl_solve", "joint_columns", "to_array",
-           "frames"]
+           "frames", "body_frames", "body_origins"]
 
 ZERO3 = (0.0, 0.0, 0.0)
 
@@ -37,6 +37,20 @@ class _Piece:
 
 
 @dataclass(frozen=True)
+class _Body:
+    """Body k's inertial parameters in the linear form: mass m, first moment h = m c and rotational inertia J,
+    both about O_k (the origin of joint k's frame, a point of its axis fixed in the body) in the axes of DH frame
+    ``frame`` (frame {r + 1} after the joint's row r).  ``to_joint``: rotation from the joint frame's axes to
+    those axes (vector components v_frame = to_joint · v_joint; the identity for modified DH)."""
+
+    frame: int
+    mass: float
+    h: tuple[float, float, float]
+    J: tuple[tuple[float, float, float], ...]
+    to_joint: tuple[tuple[float, float, float], ...]
+
+
+@dataclass(frozen=True)
 class _Plan:
     """Constants of a robot needed by the kernels (derived once per distinct robot value)."""
 
@@ -45,6 +59,8 @@ class _Plan:
     revolute: tuple[bool, ...]
     pieces: tuple[tuple[_Piece, ...], ...]  # per body (joint)
     armature: tuple[float, ...]
+    bodies: tuple[_Body, ...]  # per joint: the pieces summed into the linear form (the RNEA's input)
+    slide: tuple[bool, ...]  # per joint: O_k moves along the axis with q_k (a prismatic joint, standard DH)
 
 
 def plan(robot: DHRobot) -> _Plan:
@@ -72,7 +88,32 @@ def _make_plan(robot: DHRobot) -> _Plan:
         revolute=chain.revolute,
         pieces=tuple(tuple(p) for p in pieces),
         armature=tuple(link.inertia.motor_inertia if link.inertia else 0.0 for link in robot.joints),
+        bodies=tuple(_make_body(chain, k, pieces[k]) for k in range(robot.dof)),
+        slide=tuple(chain.standard and not rev for rev in chain.revolute),
     )
+
+
+def _make_body(chain: Chain, k: int, pieces) -> _Body:
+    """Body k's pieces summed about O_k in frame {r+1} axes (parallel-axis theorem; Khalil & Dombre 2002, §9.3).
+
+    Joint frame = frame {r+1} · D_r⁻¹ (standard DH: A_r = J(q) D_r) or frame {r+1} itself (modified), so O_k sits at
+    −R_Dᵀ p_D in frame {r+1} (standard) and the joint frame's axes are R_Dᵀ's columns there.
+    """
+    r = chain.joint_rows[k]
+    D = chain.row_constant(r) if chain.standard else np.eye(4)
+    origin = -D[:3, :3].T @ D[:3, 3]  # O_k in frame {r+1}
+    m, h, J = 0.0, np.zeros(3), np.zeros((3, 3))
+    for piece in pieces:
+        X = np.eye(4)  # frame {row+1} seen from frame {r+1}: the fixed rows in between
+        for i in range(r + 1, piece.row + 1):
+            X = X @ chain.row_constant(i)
+        c = X[:3, :3] @ np.array(piece.com) + X[:3, 3] - origin
+        m += piece.mass
+        h += piece.mass * c
+        J += X[:3, :3] @ np.array(piece.inertia) @ X[:3, :3].T + piece.mass * (c @ c * np.eye(3) - np.outer(c, c))
+    def tup(M):
+        return tuple(tuple(float(v) for v in row) for row in M)
+    return _Body(r + 1, float(m), tuple(float(v) for v in h), tup(J), tup(D[:3, :3].T))
 
 
 # --- 3-vector algebra on component tuples (floats or (B,) arrays) -------------------------------------
@@ -125,35 +166,92 @@ def frames(pl: _Plan, qcols) -> list[tuple]:
     return walk(pl.chain, qcols, FLOATS if isinstance(qcols[0], float) else COMPONENTS, frames=True)
 
 
-def _piece_world(piece: _Piece, F):
-    """World COM and the map v ↦ I_world v = R (I (Rᵀ v)) of a piece in frame F = (x, y, z, p)."""
-    x, y, z, p = F
-    c = _axpy(1.0, _combine(piece.com, (x, y, z)), p)
-    I = piece.inertia
-
-    def apply(v):
-        u = (_dot(x, v), _dot(y, v), _dot(z, v))  # Rᵀ v
-        Iu = [sum(I[i][j] * u[j] for j in range(3) if I[i][j] != 0.0) for i in range(3)]
-        return _axpy(Iu[0], x, _axpy(Iu[1], y, _scale(Iu[2], z)))
-
-    return c, apply
-
-
 # --- RNEA -----------------------------------------------------------------------------------------------
-def rnea_kernel(pl: _Plan, qc, qdc, qddc, g, F=None) -> list:
-    """τ per joint (floats or (B,) arrays, motor inertia included, no friction) — Craig eqs. 6.45–6.53.
+def _nonzero(v) -> bool:
+    """False only for a float 0 (parameters are floats for the robot, opaque values in the regressor)."""
+    return not (v.__class__ is float and v == 0.0)
 
-    ``F``: the frames of :func:`frames` when already computed for ``qc``.
+
+def body_origins(pl: _Plan, F, qc) -> list:
+    """World O_k per joint: the origin of joint k's frame, on its axis (the axis frame's origin, moved by q_k
+    along the axis for a prismatic joint of a standard-DH arm)."""
+    out = []
+    for k, i in enumerate(pl.axis_frame):
+        z, o = F[i][2], F[i][3]
+        out.append(_axpy(qc[k], z, o) if pl.slide[k] else o)
+    return out
+
+
+def body_frames(pl: _Plan) -> tuple:
+    """Per body: (frame index, m, h, J, armature) of the robot, the parameters :func:`rnea_kernel` uses."""
+    return tuple((b.frame, b.mass, b.h, b.J, a) for b, a in zip(pl.bodies, pl.armature))
+
+
+def _body_wrench(body, R, w, wd, acc):
+    """Force and moment about O_k of one body from its linear-form parameters (Khalil & Dombre 2002, eq. 9.44):
+
+    f = m a_O + ω̇ × h + ω × (ω × h),   n_O = J ω̇ + ω × (J ω) + h × a_O,
+
+    with h, J turned into world axes by R = (x, y, z) of the body's frame.
+    """
+    _, m, h, J, _ = body
+    x, y, z = R
+    f = _scale(m, acc) if _nonzero(m) else ZERO3
+    n = ZERO3
+    if any(_nonzero(c) for c in h):
+        hw = _combine_any(h, (x, y, z))
+        f = _add(f, _add(_cross(wd, hw), _cross(w, _cross(w, hw)))) if w is not ZERO3 else _add(f, _cross(wd, hw))
+        n = _cross(hw, acc)
+
+    def Jw(v):  # R (J (Rᵀ v))
+        u = (_dot(x, v), _dot(y, v), _dot(z, v))
+        Ju = [_sum_any([J[i][j] * u[j] for j in range(3) if _nonzero(J[i][j])]) for i in range(3)]
+        return _combine_any(Ju, (x, y, z))
+
+    if any(_nonzero(c) for row in J for c in row) and (wd is not ZERO3 or w is not ZERO3):
+        n = _add(n, Jw(wd))
+        if w is not ZERO3:
+            n = _add(n, _cross(w, Jw(w)))
+    return f, n
+
+
+def _sum_any(terms):
+    if not terms:
+        return 0.0
+    out = terms[0]
+    for t in terms[1:]:
+        out = out + t
+    return out
+
+
+def _combine_any(coefs, vecs):
+    """Σ c_i v_i with c_i floats or opaque values (terms with a float-zero c_i skipped)."""
+    out = None
+    for c, v in zip(coefs, vecs):
+        if _nonzero(c):
+            out = _scale(c, v) if out is None else _axpy(c, v, out)
+    return ZERO3 if out is None else out
+
+
+def rnea_kernel(pl: _Plan, qc, qdc, qddc, g, F=None, params=None) -> list:
+    """τ per joint (floats or (B,) arrays, motor inertia included, no friction) — Craig eqs. 6.45–6.53, with each
+    body's wrench from its parameters in the linear form (:func:`_body_wrench`), about O_k.
+
+    ``F``: the frames of :func:`frames` when already computed for ``qc``.  ``params``: per body
+    (frame, m, h, J, armature) in place of the robot's (:func:`body_frames`); τ is linear in them, which the
+    regressor uses (:mod:`denavit.numeric._regressor`).
     """
     F = frames(pl, qc) if F is None else F
+    params = body_frames(pl) if params is None else params
     n = len(pl.revolute)
-    axes = [(F[i][2], F[i][3]) for i in pl.axis_frame]
+    axes = [F[i][2] for i in pl.axis_frame]
+    origins = body_origins(pl, F, qc)
     w = wd = ZERO3
     acc = (-g[0], -g[1], -g[2])  # base accelerates at −g
-    ref = axes[0][1]
+    ref = origins[0]
     fs, ns = [], []
     for k in range(n):
-        z, o = axes[k]
+        z, o = axes[k], origins[k]
         r = _sub(o, ref)
         if w is not ZERO3:
             acc = _add(acc, _add(_cross(wd, r), _cross(w, _cross(w, r))))
@@ -164,25 +262,19 @@ def rnea_kernel(pl: _Plan, qc, qdc, qddc, g, F=None) -> list:
         else:
             acc = _add(acc, _axpy(2.0, _cross(w, qz), qzz))
         ref = o
-        f_k, n_k = ZERO3, ZERO3
-        for piece in pl.pieces[k]:
-            c, inertia = _piece_world(piece, F[piece.row + 1])
-            rc = _sub(c, o)
-            ac = _add(acc, _add(_cross(wd, rc), _cross(w, _cross(w, rc))))
-            f = _scale(piece.mass, ac)
-            N = _add(inertia(wd), _cross(w, inertia(w)))
-            f_k = _add(f_k, f)
-            n_k = _add(n_k, _add(N, _cross(rc, f)))
+        f_k, n_k = _body_wrench(params[k], F[params[k][0]][:3], w, wd, acc)
         fs.append(f_k)
         ns.append(n_k)
     tau = [0.0] * n
     f = m = ZERO3
     for k in range(n - 1, -1, -1):
-        z, o = axes[k]
+        z, o = axes[k], origins[k]
         if k < n - 1:
-            m = _add(m, _cross(_sub(axes[k + 1][1], o), f))  # moment moved from o_{k+1} to o_k
+            m = _add(m, _cross(_sub(origins[k + 1], o), f))  # moment moved from O_{k+1} to O_k
         f, m = _add(f, fs[k]), _add(m, ns[k])
-        tau[k] = _dot(z, m if pl.revolute[k] else f) + pl.armature[k] * qddc[k]
+        tau[k] = _dot(z, m if pl.revolute[k] else f)
+        if _nonzero(params[k][4]):
+            tau[k] = tau[k] + params[k][4] * qddc[k]
     return tau
 
 
