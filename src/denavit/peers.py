@@ -50,14 +50,16 @@ def to_pinocchio(robot: DHRobot):
     for k, r in enumerate(chain.joint_rows):
         jmodel = pin.JointModelRZ() if chain.revolute[k] else pin.JointModelPZ()
         parent = model.addJoint(parent, jmodel, pin.SE3(C[k][:3, :3].copy(), C[k][:3, 3].copy()), f"j{r}")
-        li = robot.links[r].inertia
-        if li is not None:
-            body_in_joint = np.eye(4)  # DH frame {r+1} seen from the axis frame
-            for i in range(chain.axis_frame[k], r + 1):
-                body_in_joint = body_in_joint @ chain.row_constant(i)
-            inertia = pin.Inertia(li.mass, np.array(li.com), li.inertia_matrix)
-            X = pin.SE3(body_in_joint[:3, :3].copy(), body_in_joint[:3, 3].copy())
-            model.appendBodyToJoint(parent, X.act(inertia), pin.SE3.Identity())
+        last = chain.joint_rows[k + 1] if k + 1 < chain.dof else robot.n_rows
+        body_in_joint = np.eye(4)  # DH frame {row+1} seen from the axis frame
+        for row in range(r, last):  # the joint's row and the fixed rows after it: pieces of one body
+            if row >= chain.axis_frame[k]:
+                body_in_joint = body_in_joint @ chain.row_constant(row)
+            li = robot.links[row].inertia
+            if li is not None:
+                inertia = pin.Inertia(li.mass, np.array(li.com), li.inertia_matrix)
+                X = pin.SE3(body_in_joint[:3, :3].copy(), body_in_joint[:3, 3].copy())
+                model.appendBodyToJoint(parent, X.act(inertia), pin.SE3.Identity())
     ee = C[-1]
     fid = model.addFrame(pin.Frame("ee", parent, 0, pin.SE3(ee[:3, :3].copy(), ee[:3, 3].copy()), pin.FrameType.OP_FRAME))
     model.gravity.linear = np.array(robot.gravity)
