@@ -5,12 +5,27 @@ No timing is asserted here (benchmarks/bench_threads.py measures the speed-up)."
 
 from __future__ import annotations
 
+import os
 import threading
+from dataclasses import replace
+from itertools import pairwise
 
 import numpy as np
 import pytest
+from test_dynamics_numeric import random_robot as random_dynamic_robot
 
-from denavit._threads import ALIGN, MIN_ROWS, available_cores, blocks, resolve_threads, run_batch, split_rows
+import denavit
+from denavit._threads import (
+    ALIGN,
+    MIN_ROWS,
+    available_cores,
+    blocks,
+    resolve_threads,
+    run_batch,
+    split_rows,
+)
+from denavit.codegen import numba_available
+from denavit.errors import ModelError, ShapeError
 
 
 # --- the helper --------------------------------------------------------------------------------------------
@@ -19,7 +34,7 @@ from denavit._threads import ALIGN, MIN_ROWS, available_cores, blocks, resolve_t
 def test_blocks_cover_the_rows_once_in_order(rows, threads):
     parts = blocks(rows, threads)
     assert parts[0][0] == 0 and parts[-1][1] == rows
-    assert all(a[1] == b[0] for a, b in zip(parts, parts[1:]))  # contiguous, in order, no overlap
+    assert all(a[1] == b[0] for a, b in pairwise(parts))  # contiguous, in order, no overlap
     assert len(parts) <= threads
     if len(parts) > 1:
         assert all(e - s >= MIN_ROWS - ALIGN for s, e in parts)
@@ -72,6 +87,15 @@ def test_first_exception_propagates_after_every_block_finished():
     assert sorted(done) == [s for s, _ in blocks(6 * MIN_ROWS, 3)[1:]]
 
 
+def test_exception_of_a_worker_block_reaches_the_caller():
+    def work(s, e):
+        if s > 0:
+            raise ArithmeticError(f"block at {s}")
+
+    with pytest.raises(ArithmeticError, match="block at"):
+        split_rows(4 * MIN_ROWS, work, threads=2)
+
+
 def test_nested_split_from_a_worker_runs_inline():
     inner = []
 
@@ -93,3 +117,123 @@ def test_run_batch_writes_each_block_of_the_output():
 
     run_batch(kernel, [x], [out], threads=3, extra=(2.0,))
     assert np.array_equal(out[:, 0], 2.0 * x.sum(axis=1)) and np.array_equal(out[:, 1], np.sin(x[:, 0]))
+
+
+# --- the batch functions -------------------------------------------------------------------------------------
+ODD = 2 * MIN_ROWS + 2 * ALIGN + 3  # two or three blocks, the last one short, not a multiple of the SIMD width
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory, monkeypatch):
+    """The kernel folder test_codegen uses (one per run, shared by xdist workers)."""
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(base / "kernels"))
+
+
+def _calls(robot, fast=None):
+    """name -> f(q, qd, qdd_or_tau, threads) for the plain functions, or the compiled object's methods."""
+    if fast is None:
+        d = denavit
+        return {"fk": lambda q, qd, a, t: d.forward_kinematics(robot, q, threads=t),
+                "frames": lambda q, qd, a, t: d.link_transforms(robot, q, threads=t),
+                "J0": lambda q, qd, a, t: d.geometric_jacobian(robot, q, threads=t),
+                "Je": lambda q, qd, a, t: d.geometric_jacobian(robot, q, "tool", threads=t),
+                "J1": lambda q, qd, a, t: d.geometric_jacobian(robot, q, 1, threads=t),
+                "rnea": lambda q, qd, a, t: d.rnea(robot, q, qd, a, threads=t),
+                "M": lambda q, qd, a, t: d.mass_matrix(robot, q, threads=t),
+                "g": lambda q, qd, a, t: d.gravity_torques(robot, q, threads=t),
+                "c": lambda q, qd, a, t: d.coriolis_vector(robot, q, qd, threads=t),
+                "FD": lambda q, qd, a, t: d.forward_dynamics(robot, q, qd, a, threads=t)}
+    f = fast
+    return {"fk": lambda q, qd, a, t: f.fk(q, threads=t), "frames": lambda q, qd, a, t: f.fk(q, True, threads=t),
+            "position": lambda q, qd, a, t: f.position(q, threads=t),
+            "J0": lambda q, qd, a, t: f.jacobian(q, threads=t), "Je": lambda q, qd, a, t: f.jacobian(q, "tool", threads=t),
+            "rnea": lambda q, qd, a, t: f.rnea(q, qd, a, threads=t), "M": lambda q, qd, a, t: f.mass_matrix(q, threads=t),
+            "g": lambda q, qd, a, t: f.gravity(q, threads=t), "c": lambda q, qd, a, t: f.coriolis(q, qd, threads=t),
+            "FD": lambda q, qd, a, t: f.forward_dynamics(q, qd, a, threads=t)}
+
+
+ROBOT = random_dynamic_robot(np.random.default_rng(25), n=3, friction=True)
+_NUMBA = pytest.mark.skipif(not numba_available(), reason="numba not installed")
+
+
+@pytest.fixture(scope="module", params=[None, "numpy", pytest.param("numba", marks=[pytest.mark.slow, _NUMBA])],
+                ids=["plain", "numpy", "numba"])
+def subject(request):
+    """The plain functions, and the compiled object on each backend (numba's ten kernels compile in ~20 s
+    on a busy machine: slow; test_numba_blocks_bit_for_bit covers its batch loop quickly)."""
+    return ROBOT, request.param
+
+
+@_NUMBA
+def test_numba_blocks_bit_for_bit():
+    """The SIMD batch loop (4 rows at once, the last lanes masked) gives each row the same bits whatever
+    block holds it, on block boundaries that are not multiples of 4 from the batch's end."""
+    fast = denavit.compile(ROBOT, backend="numba", kernels=("fk",))
+    q = np.random.default_rng(9).uniform(-3, 3, (ODD, ROBOT.dof))
+    ref = fast.fk(q, threads=1)
+    np.testing.assert_allclose(ref, denavit.forward_kinematics(ROBOT, q), rtol=0, atol=1e-12)
+    for t in (2, 3, None):
+        assert np.array_equal(fast.fk(q, threads=t), ref)
+    assert np.array_equal(fast.fk(q[:0], threads=2), np.zeros((0, 4, 4)))
+
+
+def _functions(subject):
+    robot, backend = subject
+    return _calls(robot, None if backend is None else denavit.compile(robot, backend=backend))
+
+
+def test_split_results_are_the_unsplit_ones_bit_for_bit(subject):
+    robot, _ = subject
+    rng = np.random.default_rng(7)
+    q, qd, a = (rng.uniform(-3, 3, (ODD, robot.dof)) for _ in range(3))
+    for name, f in _functions(subject).items():
+        whole = np.stack([f(q[k], qd[k], a[k], 1) for k in (0, ODD // 2, ODD - 1)])  # single calls: no batch code
+        ref = f(q, qd, a, 1)
+        np.testing.assert_allclose(ref[[0, ODD // 2, ODD - 1]], whole, rtol=1e-12, atol=1e-12, err_msg=name)
+        for t in (2, 3, None):
+            got = f(q, qd, a, t)
+            assert got.shape == ref.shape and np.array_equal(got, ref), (name, t)
+
+
+def test_batch_shapes_kept_and_empty_batches(subject):
+    robot, _ = subject
+    n = robot.dof
+    rng = np.random.default_rng(8)
+    q, qd, a = (rng.uniform(-3, 3, (2, MIN_ROWS + 1, n)) for _ in range(3))  # 2 x 4097: split, 3-D
+    for name, f in _functions(subject).items():
+        got = f(q, qd, a, 2)
+        flat = f(q.reshape(-1, n), qd.reshape(-1, n), a.reshape(-1, n), 1)
+        assert got.shape == (2, MIN_ROWS + 1) + flat.shape[1:], name
+        assert np.array_equal(got.reshape(flat.shape), flat), name
+        assert np.array_equal(f(q, qd[0], a[0, 0], 3), f(q, np.broadcast_to(qd[0], q.shape), np.broadcast_to(
+            a[0, 0], q.shape), 1)), name  # inputs broadcast before the split
+        empty = f(np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, n)), 2)
+        assert empty.shape == (0,) + flat.shape[1:], name
+
+
+def test_bad_shapes_and_bad_threads_refused(subject):
+    robot, _ = subject
+    n = robot.dof
+    for f in _functions(subject).values():
+        with pytest.raises(ShapeError):
+            f(np.zeros((3 * MIN_ROWS, n + 1)), np.zeros((3 * MIN_ROWS, n + 1)), np.zeros((3 * MIN_ROWS, n + 1)), 2)
+        with pytest.raises(ValueError, match="threads"):
+            f(np.zeros((5, n)), np.zeros((5, n)), np.zeros((5, n)), 0)
+    f = _functions(subject)["rnea"]
+    with pytest.raises(ValueError, match="broadcast"):  # batches that do not broadcast (ShapeError compiled)
+        f(np.zeros((3 * MIN_ROWS, n)), np.zeros((2, n)), np.zeros(n), 2)
+
+
+def test_singular_block_raises_in_the_caller():
+    rng = np.random.default_rng(3)
+    dyn = random_dynamic_robot(rng, n=3, fixed_rows=False, prismatic=False)
+    last = dyn.links[-1]
+    massless = replace(dyn, links=dyn.links[:-1] + (replace(last, inertia=None),))  # M singular everywhere
+    q = np.zeros((3 * MIN_ROWS, 3))
+    with pytest.raises(ModelError, match="singular"):
+        denavit.forward_dynamics(massless, q, q, q + 1.0, threads=3)
+    with pytest.raises(ModelError, match="singular"):
+        denavit.compile(massless, backend="numpy").forward_dynamics(q, q, q + 1.0, threads=3)

@@ -34,7 +34,9 @@ import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
-__all__ = ["ALIGN", "MIN_ROWS", "available_cores", "resolve_threads", "split_rows", "run_batch", "blocks"]
+import numpy as np
+
+__all__ = ["ALIGN", "MIN_ROWS", "available_cores", "blocks", "resolve_threads", "run_batch", "split_call", "split_rows"]
 
 #: Fewest rows a thread is given (a batch below 2 × MIN_ROWS runs inline).
 MIN_ROWS = 4096
@@ -130,3 +132,35 @@ def run_batch(kernel, inputs, outputs, threads=None, min_rows: int = MIN_ROWS, e
 
     split_rows(rows, work, threads, min_rows)
     return outputs
+
+
+def split_call(func, arrays, threads=None, min_rows: int = MIN_ROWS):
+    """``func(*arrays)`` computed block by block, or None when the batch is one block (the caller then
+    computes it whole, as it would without threads).
+
+    ``arrays`` are already checked and broadcast to one shape (..., k) (the trailing axis may differ between
+    them); ``func`` takes blocks of them, shaped (rows, k), and returns one array (rows,) + trailing.  The
+    blocks' results are joined into (...,) + trailing: exactly the array ``func`` returns for the whole batch
+    when each row's result depends on that row only.
+    """
+    if threads is not None:
+        resolve_threads(threads)  # refused even where it is not used (a single row)
+    batch = arrays[0].shape[:-1]
+    rows = 1
+    for s in batch:
+        rows *= s
+    if rows < 2 * min_rows:  # the common small call: no look at the cores
+        return None
+    parts = blocks(rows, threads, min_rows)
+    if len(parts) == 1:
+        return None
+    flat = [a.reshape(rows, a.shape[-1]) for a in arrays]
+    results: list = [None] * len(parts)
+    index = {start: k for k, (start, _) in enumerate(parts)}
+
+    def work(s: int, e: int) -> None:
+        results[index[s]] = func(*[x[s:e] for x in flat])
+
+    split_rows(rows, work, threads, min_rows)
+    out = np.concatenate(results, axis=0)
+    return out.reshape(batch + out.shape[1:])

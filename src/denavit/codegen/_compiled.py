@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._threads import resolve_threads, run_batch
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from ._cache import load_module, numba_available, robot_key
@@ -114,10 +115,12 @@ class CompiledRobot(IKMethods):
             raise ModelError(f"kernel {name!r} was not compiled (compile(robot, kernels=...) left it out)")
         return hit
 
-    def _call(self, name: str, inputs, labels):
-        """Any call: one configuration (every input (n,)) or a batch (inputs broadcast to (..., n))."""
+    def _call(self, name: str, inputs, labels, threads=None):
+        """Any call: one configuration (every input (n,)) or a batch (inputs broadcast to (..., n)), the batch's
+        rows split over ``threads`` threads (:mod:`denavit._threads`: None = every core) into one output."""
         kernel, shape = self._kernel(name)
         n = self.dof
+        resolve_threads(threads)  # a bad value is refused on every path, even where it is not used
         arrays = []
         for x, label in zip(inputs, labels):
             a = np.asarray(x, dtype=np.float64)
@@ -131,13 +134,13 @@ class CompiledRobot(IKMethods):
         flat, batch = _as_batch(arrays, n, labels)
         out = _empty((flat[0].shape[0],) + shape)
         if out.shape[0]:
-            getattr(self._m, f"{name}_n")(*flat, out)
+            run_batch(getattr(self._m, f"{name}_n"), flat, (out,), threads)  # the kernels release the GIL
         return out.reshape(batch + shape)
 
     # --- kinematics ---------------------------------------------------------------------------------------
     # Each method first tries the hot path: float64 ndarrays of shape (n,) go straight to the kernel with a
     # fresh output; anything else (lists, other dtypes, batches, wrong shapes) takes :meth:`_call`.
-    def fk(self, q, frames: bool = False) -> np.ndarray:
+    def fk(self, q, frames: bool = False, *, threads=None) -> np.ndarray:
         """End-effector pose T_w_e, shape (..., 4, 4) (as :func:`denavit.forward_kinematics`); with
         ``frames=True`` the world poses of the DH frames {0} … {N}, shape (..., N+1, 4, 4) (as
         :func:`denavit.link_transforms`, tool not applied)."""
@@ -145,18 +148,18 @@ class CompiledRobot(IKMethods):
             out = _empty(_SHAPE44)
             self._fk_1(q, out)
             return out
-        return self._call("frames" if frames else "fk", (q,), ("q",))
+        return self._call("frames" if frames else "fk", (q,), ("q",), threads)
 
-    def position(self, q) -> np.ndarray:
+    def position(self, q, *, threads=None) -> np.ndarray:
         """End-effector origin p_w_e, shape (..., 3): ``fk(q)[..., :3, 3]`` from a kernel that computes only
         what the origin needs (for workspace sampling)."""
         if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
             out = _empty(_SHAPE3)
             self._position_1(q, out)
             return out
-        return self._call("position", (q,), ("q",))
+        return self._call("position", (q,), ("q",), threads)
 
-    def jacobian(self, q, frame: Frame | str = "base") -> np.ndarray:
+    def jacobian(self, q, frame: Frame | str = "base", *, threads=None) -> np.ndarray:
         """Geometric Jacobian, shape (..., 6, n), rows (v, ω): ``base`` J0 or ``tool`` Je (as
         :func:`denavit.geometric_jacobian`)."""
         if frame == "base" or frame is Frame.BASE:
@@ -164,17 +167,17 @@ class CompiledRobot(IKMethods):
                 out = _empty(self._jshape)
                 self._jacobian0_1(q, out)
                 return out
-            return self._call("jacobian0", (q,), ("q",))
+            return self._call("jacobian0", (q,), ("q",), threads)
         if frame == "tool" or Frame(frame) is Frame.TOOL:
             if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
                 out = _empty(self._jshape)
                 self._jacobiane_1(q, out)
                 return out
-            return self._call("jacobiane", (q,), ("q",))
+            return self._call("jacobiane", (q,), ("q",), threads)
         raise ValueError(f"frame must be 'base' or 'tool', got {frame!r}")  # pragma: no cover (Frame raises)
 
     # --- dynamics -------------------------------------------------------------------------------------------
-    def rnea(self, q, qd, qdd) -> np.ndarray:
+    def rnea(self, q, qd, qdd, *, threads=None) -> np.ndarray:
         """Inverse dynamics τ = M q̈ + C q̇ + g + τ_f, shape (..., n) (as :func:`denavit.rnea` with the robot's
         gravity and friction)."""
         if (q.__class__ is _ndarray and qd.__class__ is _ndarray and qdd.__class__ is _ndarray
@@ -184,29 +187,29 @@ class CompiledRobot(IKMethods):
             out = _empty(self._vec)
             self._rnea_1(q, qd, qdd, out)
             return out
-        return self._call("rnea", (q, qd, qdd), ("q", "qd", "qdd"))
+        return self._call("rnea", (q, qd, qdd), ("q", "qd", "qdd"), threads)
 
-    def mass_matrix(self, q) -> np.ndarray:
+    def mass_matrix(self, q, *, threads=None) -> np.ndarray:
         """M(q), shape (..., n, n) (as :func:`denavit.mass_matrix`)."""
         if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
             out = _empty(self._mshape)
             self._mass_matrix_1(q, out)
             return out
-        return self._call("mass_matrix", (q,), ("q",))
+        return self._call("mass_matrix", (q,), ("q",), threads)
 
-    def gravity(self, q) -> np.ndarray:
+    def gravity(self, q, *, threads=None) -> np.ndarray:
         """g(q), shape (..., n) (as :func:`denavit.gravity_torques` with the robot's gravity)."""
         if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
             out = _empty(self._vec)
             self._gravity_1(q, out)
             return out
-        return self._call("gravity", (q,), ("q",))
+        return self._call("gravity", (q,), ("q",), threads)
 
-    def coriolis(self, q, qd) -> np.ndarray:
+    def coriolis(self, q, qd, *, threads=None) -> np.ndarray:
         """c(q, q̇) = C(q, q̇) q̇, shape (..., n) (as :func:`denavit.coriolis_vector`)."""
-        return self._call("coriolis", (q, qd), ("q", "qd"))
+        return self._call("coriolis", (q, qd), ("q", "qd"), threads)
 
-    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
+    def forward_dynamics(self, q, qd, tau, *, threads=None) -> np.ndarray:
         """q̈ = M⁻¹ (τ − c − g − τ_f), shape (..., n) (as :func:`denavit.forward_dynamics`); ModelError where
         M is singular."""
         if (q.__class__ is _ndarray and qd.__class__ is _ndarray and tau.__class__ is _ndarray
@@ -216,7 +219,7 @@ class CompiledRobot(IKMethods):
             r = _empty(self._fshape)
             self._forward_dynamics_1(q, qd, tau, r)
         else:
-            r = self._call("forward_dynamics", (q, qd, tau), ("q", "qd", "tau"))
+            r = self._call("forward_dynamics", (q, qd, tau), ("q", "qd", "tau"), threads)
         if r.ndim == 1:
             if not r[-1] > 0.0:
                 self._singular()
@@ -250,7 +253,10 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa
     CompiledRobot
         Methods ``fk(q, frames=False)``, ``jacobian(q, frame="base"|"tool")``, ``rnea(q, qd, qdd)``,
         ``mass_matrix(q)``, ``gravity(q)``, ``coriolis(q, qd)``, ``forward_dynamics(q, qd, tau)``, each
-        taking ``(n,)`` or ``(..., n)`` and returning what the plain function returns.
+        taking ``(n,)`` or ``(..., n)`` and returning what the plain function returns.  Each takes
+        ``threads=`` (default: every core): a batch's rows are split over that many threads (the kernels
+        release the GIL; :mod:`denavit._threads` has the rules: small batches run inline, results are those of
+        the unsplit call bit for bit).
 
     Notes
     -----

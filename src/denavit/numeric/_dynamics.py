@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._threads import split_call
 from .._validate import as_joint_array
 from ..errors import ModelError
 from ..model import DHRobot, JointType, inertial_rows
@@ -146,7 +147,7 @@ def gravity_vector(robot: DHRobot, gravity) -> np.ndarray:
     return g
 
 
-def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> np.ndarray:
+def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True, threads=None) -> np.ndarray:
     """Inverse dynamics τ = M(q) q̈ + C(q, q̇) q̇ + g(q) (+ τ_f) by the recursive Newton–Euler algorithm.
 
     Parameters
@@ -160,6 +161,9 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
         raises ModelError (it would turn every torque into NaN).
     friction : bool
         Add τ_f = viscous·q̇ + coulomb·sign(q̇).
+    threads : int, optional
+        Threads a batch's rows are split over (default every core; small batches run inline; the result is
+        the unsplit one bit for bit: :mod:`denavit._threads`).
 
     Returns
     -------
@@ -185,6 +189,9 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(qdd, n, "qdd")
     )
     g = gravity_vector(robot, gravity)
+    split = split_call(lambda *x: rnea(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, qdd), threads)
+    if split is not None:
+        return split
     (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
     tau = to_array(rnea_kernel(plan(robot), qc, qdc, qddc, g.tolist()), batch, (n,))
     if friction:
@@ -192,16 +199,19 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True) -> 
     return tau
 
 
-def mass_matrix(robot: DHRobot, q) -> np.ndarray:
+def mass_matrix(robot: DHRobot, q, *, threads=None) -> np.ndarray:
     """Joint-space inertia matrix M(q), shape (..., n, n), by the composite-rigid-body algorithm.
 
     Notes
     -----
     With S_k the spatial axis of joint k and I^C_k the spatial inertia of bodies k…n (world axes,
     world origin), :math:`M_{jk} = S_j^T I^C_k S_k` for j ≤ k (Featherstone 2008, eq. 6.8), plus the
-    motor inertia on the diagonal.
+    motor inertia on the diagonal.  ``threads``: as :func:`rnea`.
     """
     q = as_joint_array(q, robot.dof)
+    split = split_call(lambda x: mass_matrix(robot, x, threads=1), (q,), threads)
+    if split is not None:
+        return split
     qc, batch = joint_columns(q)
     return to_array(mass_matrix_kernel(plan(robot), qc), batch, (robot.dof, robot.dof))
 
@@ -256,20 +266,22 @@ def coriolis_matrix(robot: DHRobot, q, qd) -> np.ndarray:
     )
 
 
-def coriolis_vector(robot: DHRobot, q, qd) -> np.ndarray:
-    """The velocity term c(q, q̇) = C(q, q̇) q̇, shape (..., n), by the RNEA with q̈ = 0, g = 0."""
+def coriolis_vector(robot: DHRobot, q, qd, *, threads=None) -> np.ndarray:
+    """The velocity term c(q, q̇) = C(q, q̇) q̇, shape (..., n), by the RNEA with q̈ = 0, g = 0 (``threads``: as
+    :func:`rnea`)."""
     zero = np.zeros(np.shape(qd)[-1:])
-    return rnea(robot, q, qd, zero, gravity=np.zeros(3), friction=False)
+    return rnea(robot, q, qd, zero, gravity=np.zeros(3), friction=False, threads=threads)
 
 
-def gravity_torques(robot: DHRobot, q, *, gravity=None) -> np.ndarray:
-    """Gravity term g(q) = ∂V/∂q, shape (..., n) [N m or N] (RNEA at rest)."""
+def gravity_torques(robot: DHRobot, q, *, gravity=None, threads=None) -> np.ndarray:
+    """Gravity term g(q) = ∂V/∂q, shape (..., n) [N m or N] (RNEA at rest; ``threads``: as :func:`rnea`)."""
     q = as_joint_array(q, robot.dof)
     zero = np.zeros(robot.dof)
-    return rnea(robot, q, zero, zero, gravity=gravity, friction=False)
+    return rnea(robot, q, zero, zero, gravity=gravity, friction=False, threads=threads)
 
 
-def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool = True) -> np.ndarray:
+def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool = True,
+                     threads=None) -> np.ndarray:
     """Joint accelerations q̈ = M⁻¹ (τ − C q̇ − g − τ_f), shape (..., n).
 
     The bias C q̇ + g comes from the RNEA at q̈ = 0, M from the CRBA on the same frames, and the system is
@@ -279,14 +291,22 @@ def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool
     ----------
     q, qd, tau : array_like, shape (..., n)
         Positions, rates and applied joint torques/forces [N m, N]; broadcast together.
+    threads : int, optional
+        Threads a batch's rows are split over (default every core; small batches run inline; the result is
+        the unsplit one bit for bit: :mod:`denavit._threads`).
     """
     n = robot.dof
     q, qd, tau = np.broadcast_arrays(
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(tau, n, "tau")
     )
+    g = gravity_vector(robot, gravity)
+    split = split_call(lambda *x: forward_dynamics(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, tau),
+                       threads)
+    if split is not None:
+        return split
     if friction:
         tau = tau - friction_torques(robot, qd)
-    pl, g = plan(robot), gravity_vector(robot, gravity).tolist()
+    pl, g = plan(robot), g.tolist()
     (qc, batch), (qdc, _), (tc, _) = joint_columns(q), joint_columns(qd), joint_columns(tau)
     F = frames(pl, qc)
     bias = rnea_kernel(pl, qc, qdc, [0.0] * n, g, F)

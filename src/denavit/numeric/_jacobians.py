@@ -19,6 +19,7 @@ import warnings
 
 import numpy as np
 
+from .._threads import split_call
 from .._validate import as_joint_array
 from ..errors import ShapeError
 from ..chain import chain_of
@@ -72,7 +73,7 @@ def _frame_of(robot: DHRobot, frame: Frame | str | int) -> Frame | int:
                          f"{robot.n_rows}") from None
 
 
-def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE) -> np.ndarray:
+def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE, *, threads=None) -> np.ndarray:
     """Geometric Jacobian of the end-effector origin, shape (..., 6, n), rows (v, ω).
 
     Column i is [z_i × (p_e − o_i); z_i] for a revolute joint and [z_i; 0] for a prismatic one
@@ -87,6 +88,9 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE)
         (0 … N, the DH frames): ⁱJ = diag(R_0_iᵀ, R_0_iᵀ) J0, the same velocities in the axes of DH frame {i}
         (R_0_i its orientation in the world, ``base`` applied; Craig 2005, eq. 5.101).  The reference point is
         the end-effector origin in every case.
+    threads : int, optional
+        Threads a batch's rows are split over (default every core; small batches run inline; the result is
+        the unsplit one bit for bit: :mod:`denavit._threads`).
 
     Examples
     --------
@@ -100,9 +104,12 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE)
     """
     frame = _frame_of(robot, frame)
     q = as_joint_array(q, robot.dof)
+    split = split_call(lambda x: geometric_jacobian(robot, x, frame, threads=1), (q,), threads)
+    if split is not None:
+        return split
     if not isinstance(frame, Frame):
-        J0 = geometric_jacobian(robot, q, Frame.BASE)
-        return jacobian_tool_from_base(J0, link_transforms(robot, q)[..., frame, :, :])
+        J0 = geometric_jacobian(robot, q, Frame.BASE, threads=1)
+        return jacobian_tool_from_base(J0, link_transforms(robot, q, threads=1)[..., frame, :, :])
     if q.ndim > 1:
         return _geometric_jacobian_batch(robot, q, frame)
     frames = link_transforms(robot, q)  # (N+1, 4, 4)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._threads import split_call
 from .._validate import as_joint_array
 from ..chain import FLOATS, Batch, chain_of, pack, walk
 from ..model import DHRobot, JointType
@@ -65,7 +66,7 @@ def joint_axes_batch(robot: DHRobot, q: np.ndarray):
     return zs, os_, xe, ye, ze, pe, batch
 
 
-def link_transforms(robot: DHRobot, q) -> np.ndarray:
+def link_transforms(robot: DHRobot, q, *, threads=None) -> np.ndarray:
     """World poses of every DH frame {0} … {N}, shape (..., N+1, 4, 4).
 
     Index 0 is the base frame {0} (= ``robot.base``), index i the frame of row i (fixed rows
@@ -76,15 +77,21 @@ def link_transforms(robot: DHRobot, q) -> np.ndarray:
     robot : DHRobot
     q : array_like, shape (..., n)
         Joint values [rad for revolute, m for prismatic].
+    threads : int, optional
+        Threads a batch's rows are split over (default every core; small batches run inline; the result is
+        the unsplit one bit for bit: :mod:`denavit._threads`).
     """
     qa = as_joint_array(q, robot.dof)
+    split = split_call(lambda x: link_transforms(robot, x, threads=1), (qa,), threads)
+    if split is not None:
+        return split
     if qa.ndim == 1:
         return pack(walk(chain_of(robot), qa.tolist(), FLOATS, frames=True), None)
     frames, batch = _walk_batch(robot, qa, frames=True)
     return pack(frames, batch)
 
 
-def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
+def forward_kinematics(robot: DHRobot, q, *, threads=None) -> np.ndarray:
     """End-effector pose in the world frame, ``T_w_e = base @ A_1 ⋯ A_N @ tool``, shape (..., 4, 4).
 
     Parameters
@@ -92,6 +99,9 @@ def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
     robot : DHRobot
     q : array_like, shape (..., n)
         Joint values [rad for revolute, m for prismatic]; leading axes are batch axes.
+    threads : int, optional
+        Threads a batch's rows are split over (default every core; small batches run inline; the result is
+        the unsplit one bit for bit: :mod:`denavit._threads`).
 
     Examples
     --------
@@ -102,6 +112,9 @@ def forward_kinematics(robot: DHRobot, q) -> np.ndarray:
     (4, 4)
     """
     qa = as_joint_array(q, robot.dof)
+    split = split_call(lambda x: forward_kinematics(robot, x, threads=1), (qa,), threads)
+    if split is not None:
+        return split
     chain = chain_of(robot)
     if qa.ndim == 1:
         T = pack([walk(chain, qa.tolist(), FLOATS)], None)[0]
