@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import itertools
 import re
-from dataclasses import dataclass, field
 from typing import Any
 
 from ._arms import Arm
@@ -19,11 +18,12 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
                        rates_or_wrench, vector_entries)
 from ._document import Document, Heading, Math, Prose, plain_names
 from ._lhs import read_symbol
-from ._names import Reading, joint_of, read_name
+from ._names import joint_of, read_name
 from ._reading import (define_chain, joint_offset, names_product, plain_name, renumber, used_where,
                        vector_reading)
+from ._pending import Pending, build_claim
 from ._split import Equation, split_block
-from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
+from ._values import wrench_symbols
 
 __all__ = ["Pending", "walk"]
 
@@ -40,26 +40,6 @@ _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
 _PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
-
-
-@dataclass
-class Pending:
-    """One equation on its way to a verdict."""
-
-    line: int
-    end_line: int
-    latex: str
-    arm: Arm | None
-    claim: dict[str, Any] | None = None
-    understood: str = ""
-    alternatives: list[tuple[dict[str, Any], str]] = field(default_factory=list)
-    equivalent: list[tuple[dict[str, Any], str]] = field(default_factory=list)
-    sure: bool = True
-    verdict: str = ""
-    message: str = ""
-    quantity: str = ""
-    numeric_without_case: bool = False
-    not_a_claim_if_unreadable: bool = False
 
 
 class _Walker:
@@ -387,81 +367,7 @@ class _Walker:
             self.note(eq, arm, "not a claim", f"not judged: {lhs[:60]} names no result denavit checks (a definition "
                       "or an intermediate step)")
             return
-        self.out.append(self.claim(eq, arm, reading, value))
-
-    def claim(self, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
-        if "\\begin" in value and matrices(value) is None:
-            value = scale_matrix(value) or value
-        if "\\begin" in value:
-            mats = matrices(value)
-            expanded = expand_product(value) if mats is not None and len(mats) == 2 else None
-            if mats is None or len(mats) > 2 or (len(mats) == 2 and expanded is None):
-                return Pending(eq.line, eq.end_line, eq.text, arm, None, reading.understood, verdict="not a claim",
-                               message="not judged: a matrix expression (products, sums with other results), not "
-                               "one value; the result after it is judged", quantity=str(reading.spec.get("quantity")))
-            if expanded is not None:
-                value = expanded
-                if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
-                    reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
-        qty = str(reading.spec.get("quantity"))
-        vec = vector_entries(value)
-        spec = dict(reading.spec)
-        if qty in ("torques", "equations_of_motion") and "entry" in spec and vec and len(vec) == arm.robot.dof:
-            spec.pop("entry")  # "τ_2 = [2 entries]": the subscript is a label
-            reading = Reading(spec, "the joint torques τ (the subscript read as a label)", sure=False,
-                              needs=reading.needs)
-        claim: dict[str, Any] = {**spec, "value": value}
-        numeric = numeric_value(value)
-        p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure,
-                    quantity=qty)
-        p.alternatives = [({**alt, "value": value}, words) for alt, words in reading.alternatives]
-        if not has_joint_names(value) and self.ctx.q:
-            claim["q"] = self.ctx.q  # a value without joint variables, after a case: that case's value
-        elif numeric:
-            p.numeric_without_case = True
-        if "qd" in reading.needs and numeric and self.ctx.qd:
-            claim["qd"] = self.ctx.qd
-        if "wrench" in reading.needs:
-            self._wrench(p, claim, value, numeric)
-        if qty == "jacobian" and "frame" not in claim and self.ctx.jacobian_frame is not None:
-            claim["frame"] = self.ctx.jacobian_frame
-            p.understood += f" (in the axes of frame {self.ctx.jacobian_frame}, as the ⁱJ before it)"
-            p.alternatives.append(({**claim, "frame": "base"}, "J0, in base axes"))
-        elif qty == "jacobian" and "frame" not in claim:
-            p.alternatives += [({**claim, "frame": f}, f"ⁱJ in the axes of frame {f}")
-                               for f in range(1, arm.robot.n_rows + 1)] + [({**claim, "frame": "tool"}, "Je")]
-        if qty == "jacobian" and isinstance(claim.get("frame"), int):
-            self.ctx.jacobian_frame = claim["frame"]
-        used = used_where(self.ctx.where, value)
-        if used:
-            claim["where"] = used
-        if vec is not None and len(vec) == 2 and qty in ("position", "com_position", "com_velocity", "origin"):
-            flat = {**claim, "value": "[" + ", ".join(vec + ["0"]) + "]"}
-            p.equivalent.append((flat, "the (x, y) of a planar arm, z = 0"))
-        for alt, _ in p.alternatives + p.equivalent:
-            for key in ("q", "qd", "wrench", "where"):
-                if key in claim and key not in alt:
-                    alt[key] = claim[key]
-        return p
-
-    def _wrench(self, p: Pending, claim: dict[str, Any], value: str, numeric: bool) -> None:
-        """The wrench a τ, ⁱfᵢ or ⁱnᵢ claim is about: the stated numbers, or the symbols the section names."""
-        if numeric and self.ctx.wrench and claim["quantity"] == "torques":
-            claim["wrench"] = self.ctx.wrench
-        else:
-            names = wrench_symbols(value, *self.ctx.wrench_texts)
-            if names:
-                claim["wrench"] = "[" + ", ".join(n if n in names else "0" for n in WRENCH_NAMES) + "]"
-            elif numeric and self.ctx.wrench:
-                claim["wrench"] = self.ctx.wrench
-            else:
-                claim["wrench"] = "[" + ", ".join(WRENCH_NAMES) + "]"
-        if claim["quantity"] == "torques":
-            first, second = ("tool", "base") if self.ctx.propagation else ("base", "tool")
-            if self.ctx.wrench_frame:
-                first, second = self.ctx.wrench_frame, ("tool" if self.ctx.wrench_frame == "base" else "base")
-            claim["frame"] = first
-            p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+        self.out.append(build_claim(self.ctx, eq, arm, reading, value))
 
 
 def walk(doc: Document, arms: list) -> tuple[list[Pending], list[str]]:

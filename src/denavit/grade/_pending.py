@@ -1,0 +1,115 @@
+"""One equation's claim: the :class:`Pending` it becomes and the claim built from its reading and the context.
+
+Moved from ``_claims.py`` (code unchanged: the walker's ``claim``/``_wrench`` methods as functions of the context).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ._arms import Arm
+from ._context import Context, has_joint_names, vector_entries
+from ._names import Reading
+from ._reading import used_where
+from ._split import Equation
+from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
+
+__all__ = ["Pending", "build_claim"]
+
+
+@dataclass
+class Pending:
+    """One equation on its way to a verdict."""
+
+    line: int
+    end_line: int
+    latex: str
+    arm: Arm | None
+    claim: dict[str, Any] | None = None
+    understood: str = ""
+    alternatives: list[tuple[dict[str, Any], str]] = field(default_factory=list)
+    equivalent: list[tuple[dict[str, Any], str]] = field(default_factory=list)
+    sure: bool = True
+    verdict: str = ""
+    message: str = ""
+    quantity: str = ""
+    numeric_without_case: bool = False
+    not_a_claim_if_unreadable: bool = False
+
+
+def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
+    """The claim an equation makes under ``reading`` (with the case, rates, wrench and names ``ctx`` carries), and
+    the other readings of its left-hand side."""
+    if "\\begin" in value and matrices(value) is None:
+        value = scale_matrix(value) or value
+    if "\\begin" in value:
+        mats = matrices(value)
+        expanded = expand_product(value) if mats is not None and len(mats) == 2 else None
+        if mats is None or len(mats) > 2 or (len(mats) == 2 and expanded is None):
+            return Pending(eq.line, eq.end_line, eq.text, arm, None, reading.understood, verdict="not a claim",
+                           message="not judged: a matrix expression (products, sums with other results), not "
+                           "one value; the result after it is judged", quantity=str(reading.spec.get("quantity")))
+        if expanded is not None:
+            value = expanded
+            if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
+                reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
+    qty = str(reading.spec.get("quantity"))
+    vec = vector_entries(value)
+    spec = dict(reading.spec)
+    if qty in ("torques", "equations_of_motion") and "entry" in spec and vec and len(vec) == arm.robot.dof:
+        spec.pop("entry")  # "τ_2 = [2 entries]": the subscript is a label
+        reading = Reading(spec, "the joint torques τ (the subscript read as a label)", sure=False,
+                          needs=reading.needs)
+    claim: dict[str, Any] = {**spec, "value": value}
+    numeric = numeric_value(value)
+    p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure,
+                quantity=qty)
+    p.alternatives = [({**alt, "value": value}, words) for alt, words in reading.alternatives]
+    if not has_joint_names(value) and ctx.q:
+        claim["q"] = ctx.q  # a value without joint variables, after a case: that case's value
+    elif numeric:
+        p.numeric_without_case = True
+    if "qd" in reading.needs and numeric and ctx.qd:
+        claim["qd"] = ctx.qd
+    if "wrench" in reading.needs:
+        _wrench(ctx, p, claim, value, numeric)
+    if qty == "jacobian" and "frame" not in claim and ctx.jacobian_frame is not None:
+        claim["frame"] = ctx.jacobian_frame
+        p.understood += f" (in the axes of frame {ctx.jacobian_frame}, as the ⁱJ before it)"
+        p.alternatives.append(({**claim, "frame": "base"}, "J0, in base axes"))
+    elif qty == "jacobian" and "frame" not in claim:
+        p.alternatives += [({**claim, "frame": f}, f"ⁱJ in the axes of frame {f}")
+                           for f in range(1, arm.robot.n_rows + 1)] + [({**claim, "frame": "tool"}, "Je")]
+    if qty == "jacobian" and isinstance(claim.get("frame"), int):
+        ctx.jacobian_frame = claim["frame"]
+    used = used_where(ctx.where, value)
+    if used:
+        claim["where"] = used
+    if vec is not None and len(vec) == 2 and qty in ("position", "com_position", "com_velocity", "origin"):
+        flat = {**claim, "value": "[" + ", ".join(vec + ["0"]) + "]"}
+        p.equivalent.append((flat, "the (x, y) of a planar arm, z = 0"))
+    for alt, _ in p.alternatives + p.equivalent:
+        for key in ("q", "qd", "wrench", "where"):
+            if key in claim and key not in alt:
+                alt[key] = claim[key]
+    return p
+
+def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric: bool) -> None:
+    """The wrench a τ, ⁱfᵢ or ⁱnᵢ claim is about: the stated numbers, or the symbols the section names."""
+    if numeric and ctx.wrench and claim["quantity"] == "torques":
+        claim["wrench"] = ctx.wrench
+    else:
+        names = wrench_symbols(value, *ctx.wrench_texts)
+        if names:
+            claim["wrench"] = "[" + ", ".join(n if n in names else "0" for n in WRENCH_NAMES) + "]"
+        elif numeric and ctx.wrench:
+            claim["wrench"] = ctx.wrench
+        else:
+            claim["wrench"] = "[" + ", ".join(WRENCH_NAMES) + "]"
+    if claim["quantity"] == "torques":
+        first, second = ("tool", "base") if ctx.propagation else ("base", "tool")
+        if ctx.wrench_frame:
+            first, second = ctx.wrench_frame, ("tool" if ctx.wrench_frame == "base" else "base")
+        claim["frame"] = first
+        p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
