@@ -190,3 +190,36 @@ def test_singular_mass_matrix_is_a_model_error():
     robot = DHRobot(name="pointmass", links=(DHLink(a=0.0, alpha=0.0, d=0.0, inertia=point),))
     with pytest.raises(ModelError, match="singular"):
         denavit.forward_dynamics_derivatives(robot, [0.1], [0.0], [1.0])
+
+
+# --- the command line -------------------------------------------------------------------------------------------
+def test_cli_dynamics_derivatives_json_and_text(capsys):
+    from denavit.cli import main
+    import json
+
+    q, qd, qdd = np.array([0.1, 0.2, -0.3, 0.4, 0.5, 0.6]), np.array([1.0, -0.5, 0.3, 0.2, -1, 1]), np.array([0, 1.0, 0, 0, 0, 0])
+    # no q̇ at 0: the differences would straddle Coulomb friction's jump
+    argv = ["dynamics", "puma560", "-q", "0.1, 0.2, -0.3, 0.4, 0.5, 0.6", "--qd", "1,-0.5,0.3,0.2,-1,1", "--qdd", "0,1,0,0,0,0"]
+    assert main(argv + ["--derivatives", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    robot = denavit.load_robot("puma560")
+    assert rel_err(data["dtau_dq"], central(lambda x: denavit.rnea(robot, x, qd, qdd), q)) <= REL
+    assert rel_err(data["dtau_dqd"], central(lambda x: denavit.rnea(robot, q, x, qdd), qd)) <= REL
+    assert main(argv + ["--derivatives"]) == 0
+    text = capsys.readouterr().out
+    assert "dtau/dq [" in text and "dtau/dqd [" in text
+    assert main(argv) == 0
+    assert "dtau/dq" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["dynamics", "puma560", "--derivatives"], "--derivatives: give the joint values with -q"),
+    (["dynamics", "puma560", "-q", "1, 2", "--derivatives"], "q: expected 6 values"),
+    (["dynamics", "puma560", "-q", "0,0,0,0,0,0", "--qd", "nan,0,0,0,0,0", "--derivatives"], "qd"),
+])
+def test_cli_dynamics_derivatives_bad_input_is_one_line_exit_2(capsys, argv, message):
+    from denavit.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1

@@ -28,6 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--qd", metavar="QD", help="joint rates (default zeros)")
     p.add_argument("--qdd", metavar="QDD", help="joint accelerations (default zeros)")
     p.add_argument("--symbolic", action="store_true", help="the symbolic equations of motion")
+    p.add_argument("--derivatives", action="store_true",
+                   help="also dtau/dq and dtau/dqd at -q/--qd/--qdd (per rad or m; friction included)")
     p.add_argument("--method", choices=["lagrange", "newton-euler", "steps"], default="lagrange",
                    help="symbolic route: Lagrange in Jacobian form (fast), Newton-Euler, or the literal Lagrange steps")
     p.add_argument("--format", choices=["text", "latex", "markdown"], default="text", help="symbolic output format")
@@ -94,6 +96,8 @@ def cmd_dynamics(args: argparse.Namespace):
     require_dynamics(robot)
     data: dict = {"robot": robot.name}
     lines: list[str] = []
+    if args.derivatives and args.q is None:
+        raise ParseError("--derivatives: give the joint values with -q (and --qd, --qdd)")
     if args.q is not None:  # bad values fail now, not after the symbolic work
         joint_values(args, robot, args.q)
         _rates(args, robot, args.qd, "qd")
@@ -113,7 +117,7 @@ def cmd_dynamics(args: argparse.Namespace):
 
 
 def _numeric(robot, args):
-    from ..numeric import coriolis_matrix, friction_torques, gravity_torques, mass_matrix, rnea
+    from ..numeric import coriolis_matrix, friction_torques, gravity_torques, mass_matrix, rnea, rnea_derivatives
 
     q = joint_values(args, robot, args.q)
     qd = _rates(args, robot, args.qd, "qd")
@@ -132,6 +136,12 @@ def _numeric(robot, args):
              f"tau = M qdd + c + g + friction [N m / N]: [{vec(tau)}]"]
     data = {"q": show(q), "qd": show(qd), "qdd": show(qdd), "angle_unit": unit,
             "M": M, "C": C, "c": c, "g": g, "friction": f, "tau": tau}
+    if args.derivatives:
+        dq, dqd = rnea_derivatives(robot, q, qd, qdd)
+        require_finite("dynamics --derivatives", dq, dqd)
+        lines += ["dtau/dq [N m/rad, N/m; rows tau, columns q] =", matrix_text(dq),
+                  "dtau/dqd [N m s/rad, N s/m; rows tau, columns qd] =", matrix_text(dqd)]
+        data.update(dtau_dq=dq, dtau_dqd=dqd)
     return data, lines
 
 

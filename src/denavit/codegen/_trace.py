@@ -44,23 +44,32 @@ class Sym:
     def __init__(self, tape: "Tape", i: int) -> None:
         self.tape, self.i = tape, i
 
+    # another kind of number (a dual of denavit.numeric holding traced values) does the operation itself
     def __add__(self, other):
+        if not isinstance(other, _OPERANDS):
+            return NotImplemented
         return self.tape.add(self, other)
 
     __radd__ = __add__
 
     def __sub__(self, other):
+        if not isinstance(other, _OPERANDS):
+            return NotImplemented
         return self.tape.sub(self, other)
 
     def __rsub__(self, other):
         return self.tape.sub(other, self)
 
     def __mul__(self, other):
+        if not isinstance(other, _OPERANDS):
+            return NotImplemented
         return self.tape.mul(self, other)
 
     __rmul__ = __mul__
 
     def __truediv__(self, other):
+        if not isinstance(other, _OPERANDS):
+            return NotImplemented
         return self.tape.div(self, other)
 
     def __rtruediv__(self, other):
@@ -94,6 +103,9 @@ class Sym:
 
     def __bool__(self):
         raise TypeError("a traced value has no truth value: the algorithm branches on data, not on the arm")
+
+
+_OPERANDS = (Sym, int, float)
 
 
 def sym_sin(x):
