@@ -170,3 +170,58 @@ def test_threads_split_a_large_batch_with_the_same_result():
     np.testing.assert_array_equal(one[4567], denavit.jacobian_dot(robot, Q[4567], QD[4567]))
     with pytest.raises(ValueError, match="threads"):
         denavit.kinematic_hessian(robot, Q[0], threads=0)
+
+
+# --- command line ---------------------------------------------------------------------------------------------
+
+def _cli_json(capsys, *argv):
+    import json
+
+    from denavit.cli import main
+
+    code = main([*argv, "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return json.loads(out)
+
+
+@pytest.mark.parametrize("frame", ["base", "tool"])
+def test_cli_jacobian_dot_and_hessian_json(capsys, frame):
+    q, qd = np.array([0.1, 0.7, -0.4, 0.3, 1.1, -0.2]), np.array([0.5, -1.0, 2.0, 0.3, -0.7, 1.5])
+    data = _cli_json(capsys, "jacobian", "puma560", "-q", ",".join(str(float(x)) for x in q), "--dot", "--qd",
+                     ",".join(str(float(x)) for x in qd), "--hessian", "--frame", frame)
+    robot = denavit.load_robot("puma560")
+    H = denavit.kinematic_hessian(robot, q, frame)
+    assert data["frame"] == frame and np.array(data["H"]).shape == (6, 6, 6)
+    np.testing.assert_allclose(data["H"], H, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(data["Jdot"], H @ qd, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(data["Jdot_qd"], (H @ qd) @ qd, rtol=0, atol=1e-12)
+
+
+def test_cli_rates_in_degrees_and_text_labels(capsys):
+    from denavit.cli import main
+
+    rad = _cli_json(capsys, "jacobian", "planar2r", "-q", "0.3, 0.5", "--dot", "--qd", "1, -2")
+    deg = _cli_json(capsys, "jacobian", "planar2r", "-q", f"{float(np.degrees(0.3))}, {float(np.degrees(0.5))}",
+                    "--dot", "--qd", f"{float(np.degrees(1.0))}, {float(np.degrees(-2.0))}", "--deg")
+    np.testing.assert_allclose(deg["Jdot"], rad["Jdot"], rtol=1e-12, atol=1e-15)
+    assert main(["jacobian", "planar2r", "-q", "0.3, 0.5", "--hessian", "--frame", "tool"]) == 0
+    out = capsys.readouterr().out
+    assert "dJ/dq1 =" in out and "dJ/dq2 =" in out and "tool axes" in out and "wz" in out
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["-q", "0.3, 0.5", "--dot"], "--dot needs --qd"),
+    (["--hessian"], "give -q"),
+    (["-q", "0.3, 0.5", "--qd", "1, 2"], "--qd goes with --dot"),
+    (["-q", "0.3, 0.5", "--hessian", "--frame", "1"], "choose base or tool"),
+    (["-q", "0.3, 0.5", "--hessian", "--method", "propagation"], "does not go with --method"),
+    (["-q", "0.3, 0.5", "--dot", "--qd", "1, 2, 3"], "expected 2 values"),
+    (["-q", "0.3, 0.5", "--dot", "--qd", "1, 1e400"], "qd"),
+])
+def test_cli_bad_input_exits_2_with_one_line(capsys, argv, message):
+    from denavit.cli import main
+
+    code = main(["jacobian", "planar2r", *argv])
+    out, err = capsys.readouterr()
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err and message in err, err

@@ -14,6 +14,7 @@ from ..errors import ParseError
 from ..numeric import TWIST_ROWS as ROWS
 from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
                       require_symbolic_size)
+from ._kin_derivatives import add_kin_derivative_args, cmd_kin_derivatives, wants_kin_derivatives
 from ._shared import add_sym_format, q_out, q_text, sym_formatter
 
 REFERENCE = "end-effector origin (after the tool transform)"
@@ -32,6 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
     p.add_argument("--analytic", choices=["rpy", "zyz"], help="analytic Jacobian: rows (xdot, ydot, zdot, angle rates); numeric with -q, symbolic without")
     p.add_argument("--steps", action="store_true", help="with --method propagation: every omega_i and v_i (symbolic)")
+    add_kin_derivative_args(p)
     add_sym_format(p)
     p.set_defaults(handler=cmd_jacobian)
 
@@ -160,6 +162,8 @@ def cmd_jacobian(args: argparse.Namespace):
 
     robot = load(args)
     _check_frame(robot, args.frame)
+    if wants_kin_derivatives(args):
+        return cmd_kin_derivatives(args, robot)
     data: dict = {"robot": robot.name, "frame": args.frame, "method": args.method, "reference_point": REFERENCE,
                   "rows": list(ROWS)}
     lines: list[str] = []

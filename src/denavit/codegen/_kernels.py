@@ -16,7 +16,8 @@ from ..errors import ModelError
 from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
 from ._trace import Tape, sym_max, sym_min, sym_sign
 
-__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns"]
+__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns",
+           "end_effector"]
 
 KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
                 "gravity", "coriolis", "forward_dynamics")
@@ -63,6 +64,11 @@ def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
+def end_effector(chain, frames):
+    """The end-effector pose (tool applied) as column tuples, from the walker's frames {0} … {N}."""
+    return frames[-1] if chain.tool_identity else _with_tool(frames[-1], chain.tool.tolist())
+
+
 def jacobian_columns(chain, frames, end, tool: bool = False):
     """The columns (v_k, w_k) of the geometric Jacobian, each a 3-tuple of components (traced values or floats).
 
@@ -93,14 +99,12 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
     chain = chain_of(robot)
     n = chain.dof
     out: dict[str, KernelSpec] = {}
-    tool = chain.tool.tolist()
 
     def kinematics(name):
         tape = Tape()
         q = tape.inputs("q", n)
         frames = walk(chain, q, COMPONENTS, frames=True)
-        end = _with_tool(frames[-1], tool) if not chain.tool_identity else frames[-1]
-        return tape, q, frames, end
+        return tape, q, frames, end_effector(chain, frames)
 
     if "fk" in names:
         tape, q, frames, end = kinematics("fk")

@@ -11,7 +11,8 @@ from ._jacobians import (
     rpy_rate_matrix,
     zyz_rate_matrix,
 )
-from ._kin_derivatives import acceleration_bias, jacobian_dot, kinematic_hessian
+from ._kin_derivatives import (acceleration_bias, bias_entries, hessian_entries, jacobian_dot, jacobian_dot_entries,
+                               kinematic_hessian)
 from ._propagation import (
     ForcePropagation,
     VelocityPropagation,
@@ -95,6 +96,9 @@ __all__ = [
     "jacobian_dot",
     "acceleration_bias",
     "kinematic_hessian",
+    "jacobian_dot_entries",
+    "hessian_entries",
+    "bias_entries",
     "ForcePropagation",
     "VelocityPropagation",
     "force_propagation",

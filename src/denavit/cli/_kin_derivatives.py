@@ -1,0 +1,86 @@
+"""``denavit jacobian ... --dot --qd QD`` and ``--hessian``: J̇, J̇q̇ and ∂J/∂q at one configuration.
+
+Parses, calls :func:`denavit.jacobian_dot` / :func:`denavit.kinematic_hessian`, formats (text or the JSON keys
+``Jdot``, ``Jdot_qd``, ``H``).  Results are in SI units with radians (rad/s, m/s), whatever ``--deg`` says
+about the inputs.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import ParseError
+from ..numeric import TWIST_ROWS as ROWS
+from ._common import joint_values, matrix_text, numbers_text, require_finite
+from ._shared import q_out, q_text
+
+__all__ = ["add_kin_derivative_args", "wants_kin_derivatives", "cmd_kin_derivatives"]
+
+REFERENCE = "end-effector origin (after the tool transform)"
+
+
+def add_kin_derivative_args(p: argparse.ArgumentParser) -> None:
+    """--dot, --qd and --hessian on the ``jacobian`` subcommand."""
+    p.add_argument("--dot", action="store_true", help="the time derivative dJ/dt and dJ/dt qd at -q and --qd "
+                   "(--frame base or tool)")
+    p.add_argument("--qd", metavar="QD", help="joint rates for --dot [rad/s or m/s; deg/s with --deg]")
+    p.add_argument("--hessian", action="store_true", help="the kinematic Hessian dJ/dq at -q: per joint k the 6 x n "
+                   "matrix dJ/dq_k (--frame base or tool)")
+
+
+def wants_kin_derivatives(args: argparse.Namespace) -> bool:
+    """True when the call asks for J̇ or ∂J/∂q; a --qd without --dot is refused."""
+    if args.qd is not None and not args.dot:
+        raise ParseError("--qd goes with --dot (the joint rates of dJ/dt)")
+    return bool(args.dot or args.hessian)
+
+
+def _check(args: argparse.Namespace) -> None:
+    flags = "/".join(f for f, on in (("--dot", args.dot), ("--hessian", args.hessian)) if on)
+    if args.q is None:
+        raise ParseError(f"{flags} is numeric: give -q (and --qd for --dot)")
+    if args.dot and args.qd is None:
+        raise ParseError("--dot needs --qd, the joint rates")
+    if args.frame not in ("base", "tool"):
+        raise ParseError(f"{flags} --frame {args.frame}: choose base or tool")
+    for name, bad in (("--symbolic", args.symbolic), ("--analytic", args.analytic), ("--steps", args.steps),
+                      ("--method " + args.method, args.method != "geometric")):
+        if bad:
+            raise ParseError(f"{flags} does not go with {name} (closed forms on the geometric Jacobian, numeric)")
+
+
+def _labelled(M, labels=ROWS) -> str:
+    body = matrix_text(M).split("\n")
+    width = max(len(lab) for lab in labels)
+    return "\n".join(f"{lab:>{width}} {row}" for lab, row in zip(labels, body))
+
+
+def cmd_kin_derivatives(args: argparse.Namespace, robot):
+    """(data, text) for ``jacobian --dot`` / ``--hessian``."""
+    from .. import numeric as N
+
+    _check(args)
+    q = joint_values(args, robot, args.q)
+    axes = "base/world axes (d/dt J0)" if args.frame == "base" else "tool axes (d/dt Je)"
+    data: dict = {"robot": robot.name, "frame": args.frame, "reference_point": REFERENCE, "rows": list(ROWS),
+                  "q": q_out(args, robot, q)}
+    lines = [f"{robot.name}: kinematic derivatives at {q_text(args, robot, q)}",
+             f"rows (vx, vy, vz, wx, wy, wz); reference point: {REFERENCE}; SI units, radians"]
+    if args.dot:
+        qd = joint_values(args, robot, args.qd, what="qd", rates=True)
+        Jd = N.jacobian_dot(robot, q, qd, args.frame)
+        Jd_qd = Jd @ qd
+        require_finite("jacobian --dot", Jd)
+        data.update({"qd": q_out(args, robot, qd), "Jdot": Jd, "Jdot_qd": Jd_qd})
+        lines += ["", f"dJ/dt in {axes}, qd = [{numbers_text(qd)}] (rad/s or m/s):", _labelled(Jd),
+                  f"dJ/dt qd = [{numbers_text(Jd_qd)}]"]
+        if args.frame == "base":
+            lines.append("(the classical acceleration of the end-effector origin at qdd = 0)")
+    if args.hessian:
+        H = N.kinematic_hessian(robot, q, args.frame)
+        require_finite("jacobian --hessian", H)
+        data["H"] = H
+        lines += ["", f"kinematic Hessian H[:, j, k] = dJ[:, j]/dq_k in {axes.split(' (')[0]}:"]
+        for k in range(robot.dof):
+            lines += [f"dJ/dq{k + 1} =", _labelled(H[:, :, k])]
+    return data, "\n".join(lines)
