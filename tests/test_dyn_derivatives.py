@@ -42,13 +42,11 @@ def random_inertia(rng: np.random.Generator) -> LinkInertia:
                        motor_inertia=rng.uniform(0.0, 0.3), viscous=rng.uniform(0.0, 1.0), coulomb=rng.uniform(0.0, 1.0))
 
 
-def dynamic_arm(seed: int, fixed_mass: bool = True, n_rows: int | None = None):
-    """A random arm of tests/_random_robots with inertia on every joint row (and on fixed rows when
-    ``fixed_mass``: Pinocchio's conversion carries joint rows' inertia only), odd gravity."""
+def dynamic_arm(seed: int, n_rows: int | None = None):
+    """A random arm of tests/_random_robots with inertia on every row (fixed rows too), odd gravity."""
     rng = np.random.default_rng(seed)
     robot = random_robot(rng, n_rows=n_rows or int(rng.integers(2, 7)))
-    links = tuple(dataclasses.replace(link, inertia=random_inertia(rng)) if (link.is_joint or fixed_mass) else link
-                  for link in robot.links)
+    links = tuple(dataclasses.replace(link, inertia=random_inertia(rng)) for link in robot.links)
     return robot.replace(links=links, gravity=tuple(rng.normal(size=3) * 5.0))
 
 
@@ -73,7 +71,7 @@ SEEDS = [3, 11, 29, 47]
 @pytest.mark.parametrize("seed", SEEDS)
 def test_rnea_derivatives_match_pinocchio(seed):
     pin = pytest.importorskip("pinocchio")
-    robot = dynamic_arm(seed, fixed_mass=False)
+    robot = dynamic_arm(seed)
     model, data, _ = to_pinocchio(robot)
     q, qd, qdd = state(robot, seed)
     dq, dv, da = pin.computeRNEADerivatives(model, data, q, qd, qdd)
@@ -87,7 +85,7 @@ def test_rnea_derivatives_match_pinocchio(seed):
 @pytest.mark.parametrize("seed", SEEDS)
 def test_forward_dynamics_derivatives_match_pinocchio(seed):
     pin = pytest.importorskip("pinocchio")
-    robot = dynamic_arm(seed, fixed_mass=False)
+    robot = dynamic_arm(seed)
     model, data, _ = to_pinocchio(robot)
     q, qd, _ = state(robot, seed)
     tau = np.random.default_rng(seed).uniform(-5, 5, robot.dof)
@@ -99,7 +97,7 @@ def test_forward_dynamics_derivatives_match_pinocchio(seed):
 @pytest.mark.parametrize("seed", SEEDS[:2])
 def test_gravity_derivatives_match_pinocchio_and_are_symmetric(seed):
     pin = pytest.importorskip("pinocchio")
-    robot = dynamic_arm(seed, fixed_mass=False)
+    robot = dynamic_arm(seed)
     model, data, _ = to_pinocchio(robot)
     q = state(robot, seed)[0]
     G = denavit.gravity_derivatives(robot, q)
@@ -109,7 +107,7 @@ def test_gravity_derivatives_match_pinocchio_and_are_symmetric(seed):
 
 def test_batched_matches_pinocchio_per_configuration():
     pin = pytest.importorskip("pinocchio")
-    robot = dynamic_arm(5, fixed_mass=False)
+    robot = dynamic_arm(5)
     model, data, _ = to_pinocchio(robot)
     q, qd, qdd = state(robot, 5, (3, 2))
     A, B = denavit.rnea_derivatives(robot, q, qd, qdd, friction=False)
@@ -124,7 +122,7 @@ def test_batched_matches_pinocchio_per_configuration():
         assert rel_err(G[i], pin.computeGeneralizedGravityDerivatives(model, data, q[i])) <= REL
 
 
-# --- against central differences of the public functions (mass on fixed rows too, friction, motor inertia) ----
+# --- against central differences of the public functions (friction, motor inertia) ------------------------------
 @pytest.mark.parametrize("seed", SEEDS[:3])
 def test_rnea_derivatives_match_central_differences(seed):
     robot = dynamic_arm(seed)
