@@ -19,6 +19,7 @@ __all__ = [
     "zyz_from_rotation",
     "rotation_from_rpy",
     "rotation_from_zyz",
+    "rotation_log",
 ]
 
 
@@ -130,3 +131,31 @@ def zyz_from_rotation(R: np.ndarray) -> np.ndarray:
     psi_free = np.arctan2(R[..., 1, 0], np.where(R[..., 2, 2] > 0, R[..., 0, 0], -R[..., 0, 0]))
     psi = np.where(lock, psi_free, np.arctan2(R[..., 2, 1], -R[..., 2, 0]))
     return np.stack([phi, theta, psi], axis=-1)
+
+
+def rotation_log(R: np.ndarray) -> np.ndarray:
+    """Rotation vector θ·u of rotation matrices (..., 3, 3) → (..., 3), θ in [0, π].
+
+    Rodrigues inverted: sin θ [u]× = (R − Rᵀ)/2, cos θ = (tr R − 1)/2; near θ = π the axis is taken from the
+    symmetric part, u uᵀ = (R + Rᵀ)/2 − cos θ I) / (1 − cos θ) (Murray, Li & Sastry 1994, Sec. 2.2).
+    """
+    R = np.asarray(R, dtype=float)
+    tr = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
+    cos = np.clip((tr - 1.0) / 2.0, -1.0, 1.0)
+    theta = np.arccos(cos)
+    v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
+    sin = np.sin(theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        factor = np.where(theta < 1e-6, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(sin == 0, 1, sin)))
+    out = v * factor[..., None]
+    near_pi = cos < -0.9
+    if np.any(near_pi):
+        Rn, cn, vn, tn = R[near_pi], cos[near_pi], v[near_pi], theta[near_pi]
+        S = 0.5 * (Rn + np.swapaxes(Rn, -1, -2)) - cn[:, None, None] * np.eye(3)
+        S = S / (1.0 - cn)[:, None, None]  # u uᵀ
+        k = np.argmax(np.diagonal(S, axis1=-2, axis2=-1), axis=-1)
+        u = S[np.arange(len(k)), :, k]
+        u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+        sign = np.where(np.einsum("...i,...i->...", u, vn) < 0, -1.0, 1.0)
+        out[near_pi] = u * (sign * tn)[:, None]
+    return out
