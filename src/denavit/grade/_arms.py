@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ..errors import DenavitError
+from ..errors import DenavitError, ParseError
 from ..io import robot_from_dict
 from ..model import DHRobot
 from ..tables import find_tables, import_table
@@ -87,6 +87,17 @@ def _extent(h: Heading, heads: list[Heading], n: int) -> int:
     return (later[0] - 1) if later else n
 
 
+def _check_given(heads: list[Heading], given: dict[str, DHRobot]) -> None:
+    """Refuse an arm given for a section the report does not have (a typo was silently ignored, and the report
+    judged against its own table as if ``--arm`` had not been given)."""
+    keys = sorted(dict.fromkeys(h.key for h in heads if h.key), key=lambda k: (not k.isdigit(), len(k), k))
+    for key in given:
+        if key not in keys:
+            have = f"its sections: {', '.join(keys[:20])}" if keys else "it has no section headings"
+            raise ParseError(f"--arm {key[:40]}=...: the report has no section {key[:40]!r} ({have}; SECTION is a "
+                             "heading's number)")
+
+
 def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, DHRobot]) -> list[tuple[Section, Arm | None]]:
     """Spans of the report and the arm that governs each (None: no arm); the first span holding a line decides.
 
@@ -96,6 +107,7 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
     """
     n = len(doc.lines)
     heads = [h for h in doc.items if isinstance(h, Heading)]
+    _check_given(heads, given)
     tables = [t for t in find_tables(list(doc.lines)) if t[2] is None]
     base: list[tuple[int, Arm]] = []
     if robot is not None:
