@@ -225,3 +225,55 @@ def test_cli_bad_input_exits_2_with_one_line(capsys, argv, message):
     code = main(["jacobian", "planar2r", *argv])
     out, err = capsys.readouterr()
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err and message in err, err
+
+
+# --- analytic Jacobians --------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("representation", ["rpy", "zyz", "quaternion", "exp"])
+def test_analytic_jacobian_rates_match_differences_of_the_coordinates(representation):
+    """d/dt of the extracted coordinates along q(t) = q + t q̇ (five-point differences) equals Ja[3:] q̇, and the
+    position rows are J0's; configurations near a coordinate jump (the differences straddle it) are skipped."""
+    from denavit.numeric import analytic_jacobian, geometric_jacobian
+
+    checked = 0
+    for seed in range(10):
+        robot, q, qd, _ = _arm(300 + seed, None)
+        Ja, phi = analytic_jacobian(robot, q, representation)
+        steps = [analytic_jacobian(robot, q + s * qd, representation)[1] for s in (-2e-3, -1e-3, 1e-3, 2e-3)]
+        if max(np.abs(x - phi).max() for x in steps) > 0.1:  # wrapped angle, sign flip, θ = π
+            continue
+        fd = (steps[0] - 8 * steps[1] + 8 * steps[2] - steps[3]) / 12e-3
+        assert Ja.shape == (7 if representation == "quaternion" else 6, robot.dof)
+        np.testing.assert_array_equal(Ja[:3], geometric_jacobian(robot, q)[:3])
+        assert _rel(Ja[3:] @ qd, fd) < 1e-9
+        checked += 1
+    assert checked >= 7
+
+
+def test_analytic_jacobian_new_coordinates_batch_and_edge_cases():
+    from denavit.numeric import analytic_jacobian, exp_rate_matrix, quaternion_rate_matrix
+
+    robot, _, _, rng = _arm(11, "standard")
+    Q = random_q(rng, robot, (4, 3))
+    for rep in ("quaternion", "exp"):
+        Ja, phi = analytic_jacobian(robot, Q, rep)
+        np.testing.assert_allclose(Ja[2, 1], analytic_jacobian(robot, Q[2, 1], rep)[0], rtol=0, atol=1e-14)
+    quat = analytic_jacobian(robot, Q, "quaternion")[1]
+    np.testing.assert_allclose(np.linalg.norm(quat, axis=-1), 1.0, atol=1e-15)
+    assert (quat[..., 0] >= 0).all()
+    # Gᵀ G = I/4 (G's columns are orthogonal and of length 1/2 for a unit quaternion)
+    G = quaternion_rate_matrix(quat)
+    np.testing.assert_allclose(np.swapaxes(G, -1, -2) @ G, np.broadcast_to(np.eye(3) / 4, G.shape[:-2] + (3, 3)),
+                               atol=1e-15)
+    # the inverse of the left Jacobian J_l = I + (1 − cos θ)/θ² K + (θ − sin θ)/θ³ K² (its definition; series
+    # 1/2 − θ²/24, 1/6 − θ²/120 for small θ), on both sides of the series switch and up to θ = π
+    u = np.array([0.6, 0.0, 0.8])
+    for theta in (0.0, 0.99e-4, 1.01e-4, 0.3, 2.0, np.pi - 1e-9, np.pi):
+        r = u * theta
+        K = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+        a, b = ((0.5 - theta**2 / 24, 1 / 6 - theta**2 / 120) if theta < 1e-3 else
+                ((1 - np.cos(theta)) / theta**2, (theta - np.sin(theta)) / theta**3))
+        Jl = np.eye(3) + a * K + b * K @ K
+        np.testing.assert_allclose(exp_rate_matrix(r) @ Jl, np.eye(3), rtol=0, atol=1e-14)
+    with pytest.raises(ValueError, match="quaternion, exp"):
+        analytic_jacobian(robot, Q, "xyz")

@@ -10,6 +10,8 @@ from ._jacobians import (
     joint_axes,
     rpy_rate_matrix,
     zyz_rate_matrix,
+    quaternion_rate_matrix,
+    exp_rate_matrix,
 )
 from ._kin_derivatives import (acceleration_bias, bias_entries, hessian_entries, jacobian_dot, jacobian_dot_entries,
                                kinematic_hessian)
@@ -73,6 +75,7 @@ from ._transforms import (
     dh_transform,
     inverse_transform,
     rotation_from_rpy,
+    quaternion_from_rotation,
     rotation_from_zyz,
     rotation_log,
     rotx,
@@ -94,6 +97,8 @@ __all__ = [
     "jacobian_tool_from_base",
     "rpy_rate_matrix",
     "zyz_rate_matrix",
+    "quaternion_rate_matrix",
+    "exp_rate_matrix",
     "jacobian_dot",
     "acceleration_bias",
     "kinematic_hessian",
@@ -166,6 +171,7 @@ __all__ = [
     "rotation_from_rpy",
     "rotation_from_zyz",
     "rotation_log",
+    "quaternion_from_rotation",
     "rotx",
     "roty",
     "rotz",

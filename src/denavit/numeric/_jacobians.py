@@ -10,7 +10,7 @@ Three numeric routes that share nothing but the model:
 All use the end-effector origin (after ``tool``) as reference point. ``frame="base"`` gives J0 (world axes,
 ``base`` included), ``frame="tool"`` gives Je (end-effector axes); :func:`jacobian_tool_from_base` and
 :func:`jacobian_base_from_tool` convert between them. :func:`analytic_jacobian` maps joint rates to
-(ṗ, φ̇) with φ roll–pitch–yaw or ZYZ Euler angles.
+(ṗ, φ̇) with φ roll–pitch–yaw or ZYZ Euler angles, the unit quaternion or exponential coordinates.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from ..errors import ShapeError
 from ..chain import chain_of
 from ..model import Convention, DHRobot, Frame, JointType
 from ._kinematics import joint_axes_batch, joint_values_per_row, link_transforms
-from ._transforms import dh_transform, rpy_from_rotation, zyz_from_rotation
+from ._transforms import dh_transform, quaternion_from_rotation, rotation_log, rpy_from_rotation, zyz_from_rotation
 
 __all__ = [
     "geometric_jacobian",
@@ -36,11 +36,13 @@ __all__ = [
     "analytic_jacobian",
     "rpy_rate_matrix",
     "zyz_rate_matrix",
+    "quaternion_rate_matrix",
+    "exp_rate_matrix",
     "end_effector_twist",
     "REPRESENTATIONS",
 ]
 
-REPRESENTATIONS = ("rpy", "zyz")
+REPRESENTATIONS = ("rpy", "zyz", "quaternion", "exp")
 #: Below this |cos pitch| (RPY) or |sin θ| (ZYZ) the angle-rate map is treated as singular.
 REPRESENTATION_SINGULAR_TOL = 1e-9
 
@@ -262,25 +264,64 @@ def zyz_rate_matrix(zyz) -> np.ndarray:
                      np.stack([z + 1.0, z, ct], -1)], axis=-2)
 
 
-def analytic_jacobian(robot: DHRobot, q, representation: str = "rpy") -> tuple[np.ndarray, np.ndarray]:
-    """Analytic Jacobian Ja (..., 6, n) mapping q̇ to (ṗ, φ̇), and the angles φ (..., 3).
+def quaternion_rate_matrix(quat) -> np.ndarray:
+    """G (..., 4, 3) with d/dt (w, x, y, z) = G ω, ω in world axes: q̇ = ½ (0, ω) ⊗ q (Siciliano eq. 3.94's
+    counterpart for the world-axes ω; Sola 2017, "Quaternion kinematics for the error-state Kalman filter", eq. 199)."""
+    quat = np.asarray(quat, dtype=float)
+    w, x, y, z = quat[..., 0], quat[..., 1], quat[..., 2], quat[..., 3]
+    return 0.5 * np.stack([np.stack([-x, -y, -z], -1), np.stack([w, z, -y], -1),
+                           np.stack([-z, w, x], -1), np.stack([y, -x, w], -1)], axis=-2)
 
-    Ja = diag(I, E(φ)⁻¹) J0 (Siciliano eq. 3.66), φ the roll–pitch–yaw angles (``"rpy"``, R = Rz Ry Rx)
-    or ZYZ Euler angles (``"zyz"``) of the end effector in world axes, extracted as in
-    :func:`denavit.numeric.rpy_from_rotation` / :func:`zyz_from_rotation`. At a representation singularity
-    (cos pitch = 0, or sin θ = 0) the angle rows are not defined: a warning is issued and they are NaN.
+
+def exp_rate_matrix(r) -> np.ndarray:
+    """J_l⁻¹ (..., 3, 3) with ṙ = J_l⁻¹(r) ω for the rotation vector r = θu (R = exp([r]×), ω in world axes).
+
+    J_l⁻¹ = I − ½[r]× + (1 − (θ/2) cot(θ/2))/θ² [r]×² (the inverse left Jacobian of SO(3); Barfoot 2017, *State
+    Estimation for Robotics*, eq. 7.77b), finite for θ ∈ [0, π] (the range of :func:`rotation_log`); the
+    coefficient is its series 1/12 + θ²/720 below θ = 1e-4.
+    """
+    r = np.asarray(r, dtype=float)
+    theta = np.linalg.norm(r, axis=-1)
+    small = theta < 1e-4
+    t = np.where(small, 1.0, theta)
+    coef = np.where(small, 1.0 / 12.0 + theta**2 / 720.0, (1.0 - 0.5 * t / np.tan(0.5 * t)) / t**2)
+    z = np.zeros_like(theta)
+    K = np.stack([np.stack([z, -r[..., 2], r[..., 1]], -1), np.stack([r[..., 2], z, -r[..., 0]], -1),
+                  np.stack([-r[..., 1], r[..., 0], z], -1)], axis=-2)
+    return np.eye(3) - 0.5 * K + coef[..., None, None] * (K @ K)
+
+
+def analytic_jacobian(robot: DHRobot, q, representation: str = "rpy") -> tuple[np.ndarray, np.ndarray]:
+    """Analytic Jacobian Ja mapping q̇ to (ṗ, φ̇), and the orientation coordinates φ of the end effector.
+
+    Ja = diag(I, E(φ)⁻¹) J0 (Siciliano eq. 3.66), from the geometric Jacobian's angular rows ω = J0[3:] q̇:
+
+    * ``"rpy"``: roll–pitch–yaw (R = Rz Ry Rx), φ (..., 3), Ja (..., 6, n);
+    * ``"zyz"``: ZYZ Euler angles, φ (..., 3), Ja (..., 6, n);
+    * ``"quaternion"``: the unit quaternion (w, x, y, z), w ≥ 0 (:func:`quaternion_from_rotation`), φ (..., 4),
+      Ja (..., 7, n) with rows (ẋ, ẏ, ż, ẇ, ẋ_q, ẏ_q, ż_q) = (J0[:3], G(φ) J0[3:]) (:func:`quaternion_rate_matrix`);
+    * ``"exp"``: exponential coordinates (the rotation vector θu, θ ∈ [0, π], :func:`rotation_log`), φ (..., 3),
+      Ja (..., 6, n) = (J0[:3], J_l⁻¹(φ) J0[3:]) (:func:`exp_rate_matrix`).
+
+    φ is extracted as in :func:`denavit.numeric.rpy_from_rotation` / :func:`zyz_from_rotation`. At a representation
+    singularity of rpy or zyz (cos pitch = 0, or sin θ = 0) the angle rows are not defined: a warning is issued and
+    they are NaN; quaternion and exp rates are defined everywhere (the exp coordinates jump at θ = π).
     """
     if representation not in REPRESENTATIONS:
         raise ValueError(f"unknown representation {representation!r}; choose one of {', '.join(REPRESENTATIONS)}")
     frames = link_transforms(robot, q)
-    T = frames[..., -1, :, :] @ robot.tool_matrix
+    R = (frames[..., -1, :, :] @ robot.tool_matrix)[..., :3, :3]
     J0 = geometric_jacobian(robot, q, Frame.BASE)
+    if representation in ("quaternion", "exp"):
+        phi = quaternion_from_rotation(R) if representation == "quaternion" else rotation_log(R)
+        E_inv = quaternion_rate_matrix(phi) if representation == "quaternion" else exp_rate_matrix(phi)
+        return np.concatenate([J0[..., :3, :], E_inv @ J0[..., 3:, :]], axis=-2), phi
     if representation == "rpy":
-        phi = rpy_from_rotation(T[..., :3, :3])
+        phi = rpy_from_rotation(R)
         E = rpy_rate_matrix(phi)
         bad = np.abs(np.cos(phi[..., 1])) < REPRESENTATION_SINGULAR_TOL
     else:
-        phi = zyz_from_rotation(T[..., :3, :3])
+        phi = zyz_from_rotation(R)
         E = zyz_rate_matrix(phi)
         bad = np.abs(np.sin(phi[..., 1])) < REPRESENTATION_SINGULAR_TOL
     if np.any(bad):

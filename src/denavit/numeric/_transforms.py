@@ -20,6 +20,7 @@ __all__ = [
     "rotation_from_rpy",
     "rotation_from_zyz",
     "rotation_log",
+    "quaternion_from_rotation",
 ]
 
 
@@ -159,3 +160,24 @@ def rotation_log(R: np.ndarray) -> np.ndarray:
         sign = np.where(np.einsum("...i,...i->...", u, vn) < 0, -1.0, 1.0)
         out[near_pi] = u * (sign * tn)[:, None]
     return out
+
+
+def quaternion_from_rotation(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z), w ≥ 0, of rotation matrices (..., 3, 3) → (..., 4).
+
+    Shepperd's method (Shepperd 1978): of 4w², 4x², 4y², 4z² (1 ± the diagonal entries) the largest is the
+    pivot p, and the row of 4 p·(w, x, y, z) it gives is normalised; the sign is then chosen so that w ≥ 0.
+    """
+    R = np.asarray(R, dtype=float)
+    r00, r01, r02 = R[..., 0, 0], R[..., 0, 1], R[..., 0, 2]
+    r10, r11, r12 = R[..., 1, 0], R[..., 1, 1], R[..., 1, 2]
+    r20, r21, r22 = R[..., 2, 0], R[..., 2, 1], R[..., 2, 2]
+    rows = np.stack([  # row k: 4 q_k (w, x, y, z)
+        np.stack([1 + r00 + r11 + r22, r21 - r12, r02 - r20, r10 - r01], -1),
+        np.stack([r21 - r12, 1 + r00 - r11 - r22, r01 + r10, r02 + r20], -1),
+        np.stack([r02 - r20, r01 + r10, 1 - r00 + r11 - r22, r12 + r21], -1),
+        np.stack([r10 - r01, r02 + r20, r12 + r21, 1 - r00 - r11 + r22], -1)], -2)  # (..., 4, 4)
+    k = np.argmax(np.diagonal(rows, axis1=-2, axis2=-1), axis=-1)
+    quat = np.take_along_axis(rows, k[..., None, None], axis=-2)[..., 0, :]
+    quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+    return np.where(quat[..., :1] < 0, -quat, quat)
