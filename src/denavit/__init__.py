@@ -24,6 +24,7 @@ from .numeric import end_effector_twist, force_propagation, joint_torques, manip
 from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_derivatives
+from .numeric import BaseParameters, base_parameters, base_regressor, inertial_parameters, regressor
 from .codegen import CompiledRobot, compile
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
@@ -72,6 +73,11 @@ __all__ = [
     "gravity_torques",
     "forward_dynamics",
     "rnea_derivatives",
+    "regressor",
+    "base_parameters",
+    "base_regressor",
+    "inertial_parameters",
+    "BaseParameters",
     "forward_dynamics_derivatives",
     "gravity_derivatives",
     "simulate",

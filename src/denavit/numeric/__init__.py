@@ -60,6 +60,9 @@ from ._dynamics import SINGULAR_TOL, gravity_vector
 from ._dyn_derivatives import forward_dynamics_derivatives, friction_coefficients, gravity_derivatives, rnea_derivatives
 from ._dual import Dual, dual_max, dual_min, dual_sign, seed_duals, tangent_matrix
 from ._dynamics_fast import ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
+from ._regressor import (BODY_PARAMETERS, Linear, inertial_parameters, kinetic_energy_regressor, parameter_names,
+                         potential_energy_regressor, regressor, regressor_rows)
+from ._base_params import BASE_TOL, BaseParameters, base_parameters, base_regressor
 from ._dynamics_fast import plan as dynamics_plan
 from ._simulate import SimulationResult, computed_torque_controller, pd_controller, simulate
 from ._kinematics import forward_kinematics, link_transforms
@@ -128,6 +131,18 @@ __all__ = [
     "SINGULAR_TOL",
     "dynamics_plan",
     "rnea_kernel",
+    "BODY_PARAMETERS",
+    "Linear",
+    "inertial_parameters",
+    "kinetic_energy_regressor",
+    "parameter_names",
+    "potential_energy_regressor",
+    "regressor",
+    "regressor_rows",
+    "BASE_TOL",
+    "BaseParameters",
+    "base_parameters",
+    "base_regressor",
     "mass_matrix_kernel",
     "ldl_pivots_solve",
     "simulate",
