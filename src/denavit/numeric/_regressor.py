@@ -162,11 +162,12 @@ def _block_rows(value, n: int, batch: bool):
     return out
 
 
-def regressor_rows(pl, qc, qdc, qddc, g, unit, motor_inertia: bool = True) -> list:
+def regressor_rows(pl, qc, qdc, qddc, g, unit, motor_inertia: bool = True, F=None) -> list:
     """τ_j of :func:`~denavit.numeric._dynamics_fast.rnea_kernel` run on the unit parameters ``unit(i)`` (see
-    :func:`linear_parameters`): per joint, row j of Y's inertial (and motor-inertia) block in that algebra — a
-    (p,) or (p, B) array, a :class:`Linear`, or the float 0 when no parameter reaches joint j."""
-    return rnea_kernel(pl, qc, qdc, qddc, g, frames(pl, qc), linear_parameters(pl, unit, motor_inertia))
+    :func:`linear_parameters`): per joint, row j of Y's inertial (and motor-inertia) block as a :class:`Linear`
+    (or the float 0 when no parameter reaches joint j).  ``F``: the frames at ``qc`` when already walked."""
+    F = frames(pl, qc) if F is None else F
+    return rnea_kernel(pl, qc, qdc, qddc, g, F, linear_parameters(pl, unit, motor_inertia))
 
 
 #: Rows of a batch evaluated together by the plain regressor (the kernel's arrays are (p, rows)).
