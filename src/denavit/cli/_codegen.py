@@ -32,6 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into (made if absent)")
     p.add_argument("--prefix", help="C function / module name prefix (default: from the robot's name)")
+    p.add_argument("--kernels", metavar="NAMES", help="comma-separated kernel names, or 'all' (default: the built-in "
+                   "ones; 'all' adds the registered ones: derivatives, regressors)")
     add_no_clobber(p)
     p.set_defaults(handler=cmd_export)
 
@@ -80,8 +82,9 @@ def cmd_export(args: argparse.Namespace):
         raise ParseError(f"-o {args.output!r} is not a folder")
     if not folder.exists() and not folder.parent.is_dir():
         raise ParseError(f"-o {args.output!r}: its parent folder does not exist")
+    kernels = _kernel_names(args.kernels)
     robot = load(args)
-    files = export_sources(robot, args.lang, args.prefix)
+    files = export_sources(robot, args.lang, args.prefix, kernels)
     if folder.is_dir():  # each file replaced like -o FILE: a regular file, not an input, --no-clobber refuses
         for name in files:
             check_output(args, str(folder / name), ())
@@ -94,6 +97,21 @@ def cmd_export(args: argparse.Namespace):
             Path(tmp).write_text(text, encoding="utf-8")
     written = [str(folder / name) for name in files]
     return {"robot": robot.name, "lang": args.lang, "files": written}, "wrote " + ", ".join(written)
+
+
+def _kernel_names(text: str | None):
+    """--kernels: None (the built-in ones), "all", or a tuple of known names (ParseError naming the choices)."""
+    from ..codegen import KERNEL_NAMES, registered_kernels
+
+    if text is None or text.strip() == "all":
+        return None if text is None else "all"
+    names = tuple(x.strip() for x in text.split(",") if x.strip())
+    known = KERNEL_NAMES + tuple(registered_kernels())
+    unknown = [x for x in names if x not in known]
+    if unknown or not names:
+        raise ParseError(f"--kernels {text!r}: unknown {', '.join(unknown) or '(none given)'}; choose from "
+                         f"{', '.join(known)} or 'all'")
+    return names
 
 
 def _valid_prefix(text: str) -> bool:

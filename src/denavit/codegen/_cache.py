@@ -81,13 +81,16 @@ def _generator_digest() -> str:
     return _DIGEST[0]
 
 
-def robot_key(robot: DHRobot, backend: str, friction: bool, kernels) -> str:
+def robot_key(robot: DHRobot, backend: str, friction: bool, kernels, salt: str = "") -> str:
     """A digest of everything the kernels depend on: the DH rows, base, tool, gravity, inertial data, the
-    backend and options (exact float bits), and the generator's version.  Names and presentation are left out."""
+    backend and options (exact float bits), and the generator's version; ``salt`` adds what else shapes them (a
+    kernel group's name and the digest of the files tracing it).  Names and presentation are left out."""
     def h(x) -> str:
         return float(x).hex()
 
     parts = [_generator_digest(), backend, str(bool(friction)), ",".join(kernels), robot.convention.value]
+    if salt:
+        parts.append(salt)
     for link in robot.links:
         parts.append(" ".join([link.joint.value, h(link.a), h(link.alpha), h(link.d), h(link.theta)]))
         li = link.inertia

@@ -11,20 +11,21 @@ from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from ._cache import load_module, numba_available, robot_key
 from ._emit import NUMBA, NUMPY, python_module
-from ._kernels import DYNAMICS, KERNEL_NAMES, has_dynamics as _has_dynamics, trace_kernels
+from ._kernels import (BASE_GROUP, DYNAMICS, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
+                       registered_digest, registered_kernels, trace_kernels, trace_registered)
 from ._solvers import IKMethods
 
 __all__ = ["compile", "CompiledRobot"]
 
-def _as_batch(arrays, n: int, names):
-    """Broadcast the inputs to (..., n); return the 2-D contiguous (B, n) views and the batch shape."""
+def _as_batch(arrays, names):
+    """Broadcast the inputs' batch axes (..., k_i) together; return the 2-D contiguous (B, k_i) arrays and the
+    batch shape."""
     try:
-        arrays = np.broadcast_arrays(*arrays)
+        batch = np.broadcast_shapes(*[a.shape[:-1] for a in arrays])
     except ValueError:
         shapes = ", ".join(f"{nm} {a.shape}" for nm, a in zip(names, arrays))
         raise ShapeError(f"inputs do not broadcast together: {shapes}") from None
-    batch = arrays[0].shape[:-1]
-    flat = [np.ascontiguousarray(a.reshape(-1, n)) for a in arrays]
+    flat = [np.ascontiguousarray(np.broadcast_to(a, batch + a.shape[-1:]).reshape(-1, a.shape[-1])) for a in arrays]
     return flat, batch
 
 
@@ -34,24 +35,58 @@ _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.flo
 class CompiledRobot(IKMethods):
     """The generated kernels of one arm.  Made by :func:`compile`; see there."""
 
-    def __init__(self, robot: DHRobot, module, backend: str, names) -> None:
+    def __init__(self, robot: DHRobot, module, backend: str, names, friction: bool = True, only=None) -> None:
         self.robot = robot
         self.dof = n = robot.dof
         self.backend = backend
-        self.kernels = tuple(names)
+        self.friction = bool(friction)
+        self.kernels = ()  #: the kernels loaded so far (the base ones; a group's when first called)
         self._m = module
+        self._only = None if only is None else frozenset(only)  # compile(kernels=...): nothing else may load
+        self._groups = {BASE_GROUP: (module, tuple(names))}
         self._shapes = {"fk": (4, 4), "position": (3,), "frames": (len(robot.links) + 1, 4, 4), "jacobian0": (6, n),
                         "jacobiane": (6, n), "fk_jacobian0": (16 + 6 * n,), "rnea": (n,), "gravity": (n,), "coriolis": (n,),
                         "mass_matrix": (n, n), "forward_dynamics": (n + 1,)}
-        self._one = {name: (getattr(module, f"{name}_1"), self._shapes[name]) for name in names}
+        self._lengths: dict[str, tuple[int, ...]] = {}  # registered kernels: their inputs' lengths
+        self._one, self._many = {}, {}
         self._vec, self._jshape, self._mshape, self._fshape = (n,), (6, n), (n, n), (n + 1,)
         self._ik_constants = None
         self._elbow = None
+        for name in names:
+            self._bind(name, module)
         for name in self._shapes:  # bound kernels for the hot paths; a missing one raises the clear error
             if name not in self._one:
                 setattr(self, f"_{name}_1", self._missing(name))
-            else:
-                setattr(self, f"_{name}_1", self._first(name) if backend == NUMBA else self._one[name][0])
+
+    def _bind(self, name: str, module) -> None:
+        """Make kernel ``name`` of ``module`` callable: ``self._one``, ``self._many`` and ``self._<name>_1``."""
+        reg = registered_kernels().get(name)
+        if reg is not None:
+            self._shapes[name] = tuple(reg.shape(self.dof))
+            self._lengths[name] = tuple(k for _, k in reg.inputs(self.dof))
+        one = getattr(module, f"{name}_1")
+        self._one[name] = (one, self._shapes[name])
+        self._many[name] = getattr(module, f"{name}_n")
+        setattr(self, f"_{name}_1", self._first(name) if self.backend == NUMBA else one)
+        if name not in self.kernels:
+            self.kernels += (name,)
+
+    def _load_group(self, group: str) -> None:
+        """Compile the registered kernels of ``group`` for this arm, or load them from the disk cache (keyed by
+        the arm, the backend, friction, the group's kernels and the digest of the files tracing them)."""
+        names = group_kernels(group)
+        robot, backend, friction = self.robot, self.backend, self.friction
+        key = robot_key(robot, backend, friction, names, salt=f"group {group} {registered_digest(names)}")
+
+        def make_source() -> str:
+            specs = trace_registered(robot, names, friction)
+            return python_module(specs, backend, f"Kernels of a {robot.dof}-joint arm, group {group}.")
+
+        module = load_module(key, backend, make_source)
+        self._groups[group] = (module, names)
+        for name in names:  # absent from the module: its tracer refused this arm
+            if hasattr(module, f"{name}_1") and (self._only is None or name in self._only):
+                self._bind(name, module)
 
     @property
     def source(self) -> str:
@@ -75,10 +110,10 @@ class CompiledRobot(IKMethods):
         out = {}
         for name in self.kernels:
             kernel, shape = self._one[name]
-            k = {"rnea": 3, "forward_dynamics": 3, "coriolis": 2}.get(name, 1)
+            lengths = self._lengths.get(name) or (self.dof,) * {"rnea": 3, "forward_dynamics": 3, "coriolis": 2}.get(name, 1)
             t = time.perf_counter()
-            kernel(*[np.zeros(self.dof)] * k, _empty(shape))
-            getattr(self._m, f"{name}_n")(*[np.zeros((1, self.dof))] * k, _empty((1,) + shape))
+            kernel(*[np.zeros(k) for k in lengths], _empty(shape))
+            self._many[name](*[np.zeros((1, k)) for k in lengths], _empty((1,) + shape))
             out[name] = time.perf_counter() - t
         return out
 
@@ -109,10 +144,19 @@ class CompiledRobot(IKMethods):
     def _kernel(self, name: str):
         hit = self._one.get(name)
         if hit is None:
-            if name in DYNAMICS and not _has_dynamics(self.robot):
-                raise ModelError(f"robot {self.robot.name!r} has no inertial data: compiled dynamics need "
-                                 "'inertia: {mass, com, inertia}' on its joint rows")
-            raise ModelError(f"kernel {name!r} was not compiled (compile(robot, kernels=...) left it out)")
+            reg = registered_kernels().get(name)
+            if reg is None or reg.group == BASE_GROUP or (self._only is not None and name not in self._only):
+                if name in DYNAMICS and not _has_dynamics(self.robot):
+                    raise ModelError(f"robot {self.robot.name!r} has no inertial data: compiled dynamics need "
+                                     "'inertia: {mass, com, inertia}' on its joint rows")
+                raise ModelError(f"kernel {name!r} was not compiled (compile(robot, kernels=...) left it out)")
+            loaded = self._groups.get(reg.group)
+            if loaded is None or name not in loaded[1]:  # first call of the group (or a kernel registered since)
+                self._load_group(reg.group)
+            hit = self._one.get(name)
+            if hit is None:  # its tracer refused this arm: its own error says why
+                reg.trace(self.robot, self.friction)
+                raise ModelError(f"kernel {name!r} does not apply to robot {self.robot.name!r}")
         return hit
 
     def _call(self, name: str, inputs, labels, threads=None):
@@ -120,21 +164,23 @@ class CompiledRobot(IKMethods):
         rows split over ``threads`` threads (:mod:`denavit._threads`: None = every core) into one output."""
         kernel, shape = self._kernel(name)
         n = self.dof
+        lengths = self._lengths.get(name) or (n,) * len(labels)
         resolve_threads(threads)  # a bad value is refused on every path, even where it is not used
         arrays = []
-        for x, label in zip(inputs, labels):
+        for x, label, k in zip(inputs, labels, lengths):
             a = np.asarray(x, dtype=np.float64)
-            if a.ndim == 0 or a.shape[-1] != n:
-                raise ShapeError(f"{label}: expected shape (..., {n}) for a {n}-joint robot, got {a.shape}")
+            if a.ndim == 0 or a.shape[-1] != k:
+                joints = f" for a {n}-joint robot" if k == n else ""
+                raise ShapeError(f"{label}: expected shape (..., {k}){joints}, got {a.shape}")
             arrays.append(a)
         if all(a.ndim == 1 for a in arrays):
             out = _empty(shape)
             getattr(self, f"_{name}_1")(*[np.ascontiguousarray(a) for a in arrays], out)
             return out
-        flat, batch = _as_batch(arrays, n, labels)
+        flat, batch = _as_batch(arrays, labels)
         out = _empty((flat[0].shape[0],) + shape)
         if out.shape[0]:
-            run_batch(getattr(self._m, f"{name}_n"), flat, (out,), threads)  # the kernels release the GIL
+            run_batch(self._many[name], flat, (out,), threads)  # the kernels release the GIL
         return out.reshape(batch + shape)
 
     # --- kinematics ---------------------------------------------------------------------------------------
@@ -243,7 +289,9 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa
         ``numba`` (the ``fast`` extra: JIT-compiled machine code, cached on disk) is the default when
         numba is installed, else ``numpy`` (the same code run by numpy: vectorised over batches).
     kernels : iterable of str, optional
-        Which kernels to build (default all of ``KERNEL_NAMES`` the robot supports).
+        Which kernels to build now, and the only ones the object will have (built-in names, ``KERNEL_NAMES``, or
+        registered ones).  Default: every built-in kernel the robot supports now, and every registered kernel
+        (``register_kernel``) when first called (compiled then, or loaded from the disk cache, by group).
     friction : bool
         ``rnea`` and ``forward_dynamics`` include the joints' friction τ_f = viscous·q̇ + coulomb·sign(q̇), as the
         plain functions do by default (``friction=False`` there ⇔ ``compile(robot, friction=False)`` here).
@@ -274,19 +322,25 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa
         raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
     if backend == NUMBA and not numba_available():
         raise MissingDependencyError("backend='numba' needs numba: pip install 'denavit[fast]'")
-    wanted = KERNEL_NAMES if kernels is None else tuple(kernels)
-    unknown = [k for k in wanted if k not in KERNEL_NAMES]
+    reg = registered_kernels()
+    wanted = KERNEL_NAMES + group_kernels(BASE_GROUP) if kernels is None else tuple(kernels)
+    unknown = [k for k in wanted if k not in KERNEL_NAMES and k not in reg]
     if unknown:
-        raise ValueError(f"unknown kernels {unknown}; choose from {', '.join(KERNEL_NAMES)}")
+        raise ValueError(f"unknown kernels {unknown}; choose from {', '.join(KERNEL_NAMES + tuple(reg))}")
     if not _has_dynamics(robot):
         wanted = tuple(k for k in wanted if k not in DYNAMICS)
-    key = robot_key(robot, backend, friction, wanted)
+    base = tuple(k for k in wanted if k in KERNEL_NAMES or reg[k].group == BASE_GROUP)
+    added = tuple(k for k in base if k not in KERNEL_NAMES)
+    key = robot_key(robot, backend, friction, base, salt=f"registered {registered_digest(added)}" if added else "")
 
     def make_source() -> str:
-        specs = trace_kernels(robot, wanted, friction)
+        specs = trace_kernels(robot, base, friction)
+        specs.update(trace_registered(robot, added, friction))
         return python_module(specs, backend, f"Kernels of a {robot.dof}-joint arm.")  # no user text in code
 
     module = load_module(key, backend, make_source)
-    fast = CompiledRobot(robot, module, backend, wanted)
-    fast.friction = bool(friction)
+    fast = CompiledRobot(robot, module, backend, [k for k in base if k not in added or hasattr(module, f"{k}_1")], friction,
+                         None if kernels is None else wanted)
+    for group in dict.fromkeys(reg[k].group for k in wanted if k not in base):  # asked for by name: now
+        fast._load_group(group)
     return fast

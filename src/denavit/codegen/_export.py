@@ -6,7 +6,7 @@ import re
 
 from ..model import DHRobot
 from ._emit import NUMPY, c_sources, python_module
-from ._kernels import KERNEL_NAMES, trace_kernels
+from ._kernels import KERNEL_NAMES, registered_kernels, trace_kernels, trace_registered
 
 __all__ = ["export_sources", "default_prefix", "PREFIX_PATTERN", "LANGUAGES"]
 
@@ -20,17 +20,17 @@ _PY_API = '''
 N = {n}
 
 
-def _call(one, many, shape, *xs):
-    xs = np.broadcast_arrays(*[np.asarray(x, dtype=float) for x in xs])
-    for x in xs:
-        if x.ndim == 0 or x.shape[-1] != N:
-            raise ValueError(f"expected shape (..., {{N}}), got {{x.shape}}")
-    if xs[0].ndim == 1:
+def _call(one, many, shape, *xs, lengths=None):
+    xs = [np.asarray(x, dtype=float) for x in xs]
+    for x, k in zip(xs, lengths or [N] * len(xs)):
+        if x.ndim == 0 or x.shape[-1] != k:
+            raise ValueError(f"expected shape (..., {{k}}), got {{x.shape}}")
+    if all(x.ndim == 1 for x in xs):
         out = np.empty(shape)
         one(*xs, out)
         return out
-    batch = xs[0].shape[:-1]
-    flat = [np.ascontiguousarray(x.reshape(-1, N)) for x in xs]
+    batch = np.broadcast_shapes(*[x.shape[:-1] for x in xs])
+    flat = [np.ascontiguousarray(np.broadcast_to(x, batch + x.shape[-1:]).reshape(-1, x.shape[-1])) for x in xs]
     out = np.empty((flat[0].shape[0],) + shape)
     if out.shape[0]:
         many(*flat, out)
@@ -63,13 +63,21 @@ def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels
     ``lang="c"``: ``<prefix>.h`` and ``<prefix>.c`` — functions ``void <prefix>_<kernel>(const double q[n],
     ..., double out[k])`` writing row-major results, C99, libm only, no allocation.  ``lang="python"``:
     ``<prefix>.py``, needing only numpy, with ``fk(q)``, ``jacobian0(q)``, … on ``(n,)`` or ``(..., n)``.
+    ``kernels``: the built-in names (default all of ``KERNEL_NAMES`` the arm supports) and registered ones
+    (:func:`~denavit.codegen.register_kernel`; ``"all"`` for every built-in and registered kernel).
     """
     if lang not in LANGUAGES:
         raise ValueError(f"lang must be one of {', '.join(LANGUAGES)}, got {lang!r}")
     prefix = default_prefix(robot) if prefix is None else prefix
     if not PREFIX_PATTERN.fullmatch(prefix):
         raise ValueError(f"prefix {prefix!r}: expected a C identifier of at most 40 characters")
-    specs = trace_kernels(robot, KERNEL_NAMES if kernels is None else kernels)
+    reg = registered_kernels()
+    kernels = KERNEL_NAMES if kernels is None else (KERNEL_NAMES + tuple(reg) if kernels == "all" else tuple(kernels))
+    unknown = [k for k in kernels if k not in KERNEL_NAMES and k not in reg]
+    if unknown:
+        raise ValueError(f"unknown kernels {unknown}; choose from {', '.join(KERNEL_NAMES + tuple(reg))}")
+    specs = trace_kernels(robot, [k for k in kernels if k in KERNEL_NAMES])
+    specs.update(trace_registered(robot, [k for k in kernels if k in reg]))
     n = robot.dof
     title = f"Kernels of a {n}-joint arm ({robot.convention.value} DH), exported by denavit."
     if lang == "c":
@@ -83,6 +91,12 @@ def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels
         if name in specs:
             text += (f"\n\ndef {sig}:\n    \"\"\"{doc.format(rows=rows)}.\"\"\"\n"
                      f"    return _call({name}_1, {name}_n, {specs[name].shape!r}, {args})\n")
+    for name in (k for k in specs if k in reg):
+        spec = specs[name]
+        args = ", ".join(a for a, _ in spec.inputs)
+        text += (f"\n\ndef {name}({args}):\n    \"\"\"{spec.doc}, shape (...,) + {spec.shape!r}.\"\"\"\n"
+                 f"    return _call({name}_1, {name}_n, {spec.shape!r}, {args}, "
+                 f"lengths={[k for _, k in spec.inputs]!r})\n")
     if "forward_dynamics" in specs:
         text += (f"\n\ndef forward_dynamics(q, qd, tau):\n"
                  f"    \"\"\"qdd = M^-1 (tau - c - g - tau_f), shape (..., n); ValueError where M is singular.\"\"\"\n"

@@ -8,7 +8,12 @@ outputs each kernel has.
 
 from __future__ import annotations
 
+import hashlib
+import re
+import sys
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
 
 from ..chain import COMPONENTS, FLOATS, chain_of, walk
 from ..model import DHRobot
@@ -17,11 +22,16 @@ from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_
 from ._trace import Tape, sym_max, sym_min, sym_sign
 
 __all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns",
-           "end_effector"]
+           "end_effector", "register_kernel", "registered_kernels", "group_kernels", "trace_registered",
+           "registered_digest", "RegisteredKernel", "BASE_GROUP"]
 
 KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
                 "gravity", "coriolis", "forward_dynamics")
 DYNAMICS = frozenset({"rnea", "mass_matrix", "gravity", "coriolis", "forward_dynamics"})
+#: The group compiled by :func:`denavit.compile` itself; every other group is compiled (or loaded from the disk
+#: cache) on its first call.
+BASE_GROUP = "base"
+_IDENTIFIER = re.compile(r"[a-z][a-z0-9_]{0,39}")
 
 
 @dataclass(frozen=True)
@@ -237,3 +247,115 @@ def has_dynamics(robot: DHRobot) -> bool:
     except ModelError:
         return False
     return True
+
+
+# --- registered kernels: compiled by group, on first use ---------------------------------------------------------
+@dataclass(frozen=True)
+class RegisteredKernel:
+    """A kernel another module adds (see :func:`register_kernel`)."""
+
+    name: str
+    group: str
+    inputs: Callable[[int], tuple]
+    shape: Callable[[int], tuple]
+    doc: str
+    trace: Callable
+    source: str  #: the file defining ``trace`` (its bytes are part of the group's cache key)
+
+
+_REGISTRY: dict[str, RegisteredKernel] = {}
+
+
+def register_kernel(name: str, *, group: str, inputs, shape, doc: str, trace) -> RegisteredKernel:
+    """Add a kernel to every compiled arm: ``CompiledRobot._call(name, ...)`` and ``export_sources(kernels=...)``.
+
+    Parameters
+    ----------
+    name : str
+        Lower-case identifier (it becomes function names ``<name>_1`` / ``<name>_n`` and C ``<prefix>_<name>``).
+    group : str
+        Kernels of one group are compiled together, into one module cached on disk (keyed by robot, backend,
+        friction and group), on the first call of any of them; ``"base"`` ones by :func:`denavit.compile` itself.
+    inputs : callable
+        ``n -> ((label, length), ...)``, e.g. ``lambda n: (("q", n), ("qd", n))``.
+    shape : callable
+        ``n -> shape`` of one configuration's output.
+    doc : str
+        One line: what the output is.
+    trace : callable
+        ``(robot, friction) -> KernelSpec`` (traced on a :class:`~denavit.codegen.Tape`, as :func:`trace_kernels`
+        does); it raises :class:`~denavit.errors.ModelError` for an arm it does not apply to.
+    """
+    for what, value in (("name", name), ("group", group)):
+        if not isinstance(value, str) or not _IDENTIFIER.fullmatch(value):
+            raise ValueError(f"register_kernel: {what} {value!r} must be a lower-case identifier (at most 40)")
+    if name in KERNEL_NAMES:
+        raise ValueError(f"register_kernel: {name!r} is a built-in kernel")
+    if not _one_line(doc):
+        raise ValueError("register_kernel: doc is one line without quotes, backslashes or '*/'")
+    old = _REGISTRY.get(name)
+    module = sys.modules.get(getattr(trace, "__module__", ""), None)
+    source = getattr(module, "__file__", None) or ""
+    if old is not None and (old.source, old.group) != (source, group):
+        raise ValueError(f"register_kernel: {name!r} is already registered by {old.source or old.trace!r}")
+    entry = RegisteredKernel(name, group, inputs, shape, doc, trace, source)
+    _REGISTRY[name] = entry
+    return entry
+
+
+def _one_line(doc: str) -> bool:
+    """True for text that can sit in a generated docstring or C comment as is."""
+    return isinstance(doc, str) and not any(c in doc for c in ('"', "\\", "\n", "\r")) and "*/" not in doc
+
+
+def registered_kernels() -> dict[str, RegisteredKernel]:
+    """Every registered kernel by name, in registration order."""
+    return dict(_REGISTRY)
+
+
+def group_kernels(group: str) -> tuple[str, ...]:
+    """The names of the registered kernels of ``group``, in registration order."""
+    return tuple(name for name, e in _REGISTRY.items() if e.group == group)
+
+
+def trace_registered(robot: DHRobot, names, friction: bool = True) -> dict[str, KernelSpec]:
+    """The registered kernels ``names`` of ``robot``, traced; one that does not apply to this arm (its trace raises
+    :class:`~denavit.errors.ModelError`) is left out."""
+    n = robot.dof
+    out = {}
+    for name in names:
+        e = _REGISTRY[name]
+        try:
+            spec = e.trace(robot, friction)
+        except ModelError:
+            continue
+        want = (name, tuple(tuple(x) for x in e.inputs(n)), tuple(e.shape(n)))
+        got = (spec.name, tuple(tuple(x) for x in spec.inputs), tuple(spec.shape))
+        if not all(_IDENTIFIER.fullmatch(label) for label, _ in spec.inputs) or not _one_line(spec.doc):
+            raise RuntimeError(f"kernel {name!r}: input labels must be identifiers and doc one plain line")
+        if want != got:  # a bug of the registering module, not of the user's input
+            raise RuntimeError(f"kernel {name!r}: traced (name, inputs, shape) {got} != registered {want}")
+        count = 1
+        for s in spec.shape:
+            count *= s
+        if len(spec.outputs) != count:
+            raise RuntimeError(f"kernel {name!r}: {len(spec.outputs)} outputs for shape {spec.shape}")
+        out[name] = spec
+    return out
+
+
+_DIGESTS: dict[str, str] = {}
+
+
+def registered_digest(names) -> str:
+    """A digest of the files defining the kernels ``names`` (part of their cache key: an edited tracer never
+    reads a module generated by its former self)."""
+    h = hashlib.sha256()
+    for name in names:
+        e = _REGISTRY[name]
+        d = _DIGESTS.get(e.source)
+        if d is None:
+            data = Path(e.source).read_bytes() if e.source else repr(e.trace.__code__.co_code).encode()
+            d = _DIGESTS[e.source] = hashlib.sha256(data).hexdigest()
+        h.update(f"{name} {e.group} {d}\n".encode())
+    return h.hexdigest()[:16]

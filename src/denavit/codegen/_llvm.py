@@ -26,6 +26,7 @@ evaluation order, each operand either ``("n", j)`` (the value of step j), ``("c"
 
 from __future__ import annotations
 
+import inspect
 import math
 
 __all__ = ["kernel_intrinsic", "LANES"]
@@ -184,21 +185,16 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             return types.void(*args), lambda context, builder, sig, a: codegen(context, builder, sig, a, lanes)
         return make
 
-    # numba's @intrinsic needs a fixed signature: inputs + out (+ row)
+    # numba's @intrinsic needs a fixed signature (inputs + out (+ row)); *args alone is not lowered, so the
+    # signature numba reads (inspect's __signature__) names each argument
     def arity(k, lanes):
         t = typer(lanes)
-        if k == 2:
-            def kernel(typingctx, a0, a1):
-                return t(typingctx, a0, a1)
-        elif k == 3:
-            def kernel(typingctx, a0, a1, a2):
-                return t(typingctx, a0, a1, a2)
-        elif k == 4:
-            def kernel(typingctx, a0, a1, a2, a3):
-                return t(typingctx, a0, a1, a2, a3)
-        else:
-            def kernel(typingctx, a0, a1, a2, a3, a4):
-                return t(typingctx, a0, a1, a2, a3, a4)
+
+        def kernel(typingctx, *args):
+            return t(typingctx, *args)
+
+        P = inspect.Parameter
+        kernel.__signature__ = inspect.Signature([P(a, P.POSITIONAL_OR_KEYWORD) for a in ("typingctx", *(f"a{i}" for i in range(k)))])
         return intrinsic(kernel)
 
     return arity(n_inputs + 1, 0), arity(n_inputs + 2, LANES)
