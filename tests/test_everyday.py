@@ -110,6 +110,11 @@ def test_redundant_arm_analytic_refusal_names_lock(capsys):
     code, out, err = run(capsys, "ik", "panda", "--pose", "0.3,0,0.5,0,0,0", "--method", "analytic")
     assert code == 1 and out == "" and len(err.strip().splitlines()) == 1
     assert "--lock" in err and "--lock q7=0" in err and "redundant" in err
+    # whole: the advice was cut in the middle ("use the numerical ... w mask)") by the one-line limit; and the
+    # numeric solver needs no row mask on a 7-joint arm that controls the whole pose (rank 6)
+    assert " ... " not in err and "--method numeric for one solution" in err and "mask" not in err
+    code, out, _ = run(capsys, "ik", "panda", "--from-q", "0.1, 0.2, 0.3, -1.4, 0.5, 1.6, 0.7", "--method", "numeric")
+    assert code == 0
     # and the advice works: with q7 held, the closed forms answer (the README's command)
     code, out, _ = run(capsys, "ik", "panda", "--from-q", "0.1, 0.2, 0.3, -1.4, 0.5, 1.6, 0.7", "--lock", "q7=0.7")
     assert code == 0 and "q7 locked" in out

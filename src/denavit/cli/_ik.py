@@ -235,10 +235,15 @@ def _lock_hint(message: str, robot) -> str:
     m = re.search(r"are redundant \(its Jacobian has rank (\d+) everywhere\)", message)
     if m is None:
         return message
-    extra = robot.dof - int(m.group(1))
+    rank = int(m.group(1))
+    extra = robot.dof - rank
     held = " ".join(f"q{k}=0" for k in range(robot.dof - extra + 1, robot.dof + 1))
-    return (f"{message}; or hold {extra} joint{'s' * (extra > 1)} with --lock (e.g. --lock {held}) for every "
-            "closed-form solution of the others")
+    numeric = "--method numeric" + (" with a --mask" if rank < 6 else "")
+    # written whole (the library's message and this advice together ran past one_line's limit and were cut in
+    # the middle of the advice: "use the numerical ... w mask)")
+    return (f"{robot.name}: this {robot.dof}-joint arm is redundant (its Jacobian has rank {rank} everywhere), so "
+            f"a target is reached along a continuum: hold {extra} joint{'s' * (extra > 1)} with --lock (e.g. "
+            f"--lock {held}) for every closed-form solution of the others, or use {numeric} for one solution")
 
 
 def beyond_reach(robot, T) -> tuple[float, float, float] | None:

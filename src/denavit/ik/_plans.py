@@ -290,7 +290,8 @@ def make_plan(robot: DHRobot, closed_form: bool = True, general: bool = False) -
             raise UnsupportedRobotError(
                 f"{robot.name}: the joints of this {full.n}-joint {types} arm are redundant (its Jacobian has "
                 f"rank {rank} everywhere): every reachable target is reached along a continuum the closed forms "
-                "do not resolve; use the numerical solver (solve_ik / --method numeric, with a row mask)")
+                "do not resolve; use the numerical solver (solve_ik / --method numeric"
+                + (", with a row mask)" if rank < 6 else ")"))
         raise UnsupportedRobotError(
             f"{robot.name}: no closed-form inverse kinematics for this {full.n}-joint {types} structure "
             "(known: 6 joints with a spherical wrist, UR-type 6R with three parallel axes, any other 6R arm, "
