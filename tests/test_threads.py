@@ -237,3 +237,24 @@ def test_singular_block_raises_in_the_caller():
         denavit.forward_dynamics(massless, q, q, q + 1.0, threads=3)
     with pytest.raises(ModelError, match="singular"):
         denavit.compile(massless, backend="numpy").forward_dynamics(q, q, q + 1.0, threads=3)
+
+
+@_NUMBA
+@pytest.mark.slow
+def test_compiled_solve_ik_batch_independent_of_threads():
+    """Each target's random restarts come from its own stream: the answers (and iteration and restart counts)
+    of a split batch are those of the whole batch in one thread; the answers are judged by the plain FK."""
+    robot = denavit.load_robot("puma560")
+    fast = denavit.compile(robot)
+    lim = robot.q_limits
+    Q = np.random.default_rng(4).uniform(lim[:, 0], lim[:, 1], (203, robot.dof))
+    T = denavit.forward_kinematics(robot, Q).reshape(7, 29, 4, 4)
+    runs = [fast.solve_ik(T, rng=np.random.default_rng(5), threads=t) for t in (1, 2, 3)]
+    assert runs[0].q.shape == (7, 29, 6) and runs[0].success.shape == (7, 29)
+    assert runs[0].restarts.sum() > 0  # some targets needed random restarts: their streams are compared too
+    for r in runs[1:]:
+        for field in ("q", "success", "iterations", "restarts", "position_error", "orientation_error"):
+            assert np.array_equal(getattr(r, field), getattr(runs[0], field)), field
+    ok = runs[0].success
+    assert ok.mean() > 0.9
+    np.testing.assert_allclose(denavit.forward_kinematics(robot, runs[0].q[ok]), T[ok], atol=1e-8)

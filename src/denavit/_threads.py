@@ -102,6 +102,11 @@ def _mark_worker() -> None:
 def split_rows(rows: int, work, threads=None, min_rows: int = MIN_ROWS) -> None:
     """Call ``work(start, stop)`` once per block of :func:`blocks` (block 0 in this thread, the others on the
     pool), wait for all, and re-raise the first exception any raised."""
+    if rows < 2 * min_rows:  # one block whatever the cores: no look at them
+        if threads is not None:
+            resolve_threads(threads)
+        work(0, rows)
+        return
     parts = blocks(rows, threads, min_rows)
     if len(parts) == 1:
         work(0, rows)

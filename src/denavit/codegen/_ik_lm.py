@@ -108,12 +108,13 @@ def _ik_project(q, lo, hi, revolute, clip):
 
 
 @njit(cache=True, nogil=True)
-def ik_lm(T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, out_q, out_info):
+def ik_lm(T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, first, out_q, out_info):
     """LM for each target T[b] from q0[b], then from random q in [slo, shi]; out_info[b] = (success,
     position error, orientation error, iterations, restarts).  Attempts 0, 2, 4, ... keep q inside the limits
     at every step; the others iterate free and fold the result into the limits (a solution outside them is
-    often one turn or one clipped step away from one inside)."""
-    np.random.seed(seed)
+    often one turn or one clipped step away from one inside).  The random restarts of target b are drawn
+    from a generator seeded by (seed, first + b), first being the index of T[0] in the whole batch: a batch
+    split into blocks over threads gives every target the same draws as the whole batch in one call."""
     n = q0.shape[1]
     P = np.empty(16 + 6 * n)   # pose then J0, from the fused kernel
     Pn = np.empty(16 + 6 * n)
@@ -134,6 +135,8 @@ def ik_lm(T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts
             if attempt == 0:
                 q[:] = q0[b]
             else:
+                if attempt == 1:  # this target's own stream (numba's generator state is per thread)
+                    np.random.seed((seed + 1000003 * (first + b)) & 0x7FFFFFFF)
                 for k in range(n):
                     q[k] = slo[k] + (shi[k] - slo[k]) * np.random.random()
             clip = attempt % 2 == 0

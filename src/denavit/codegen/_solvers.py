@@ -6,6 +6,7 @@ import random as _random
 
 import numpy as np
 
+from .._threads import resolve_threads, split_rows
 from ..errors import ShapeError
 from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
@@ -19,6 +20,8 @@ __all__ = ["IKMethods"]
 
 _ndarray, _F64 = np.ndarray, np.dtype(np.float64)
 _NO_SEEDS = np.zeros((0, 1))
+#: Fewest targets a thread is given by a batch solve_ik (a target takes tens of microseconds: far more than an FK).
+IK_MIN_ROWS = 64
 _NO_FREE = ("",) * 8
 #: ``valid`` of a one-pose result with k solutions (all True), shared read-only arrays
 _ALL_VALID = tuple(np.ones(k, dtype=bool) for k in range(9))
@@ -31,14 +34,22 @@ class IKMethods:
 
     # --- inverse kinematics ------------------------------------------------------------------------------------
     def solve_ik(self, T, q0=None, *, mask="pose", tol: float | None = None, max_iterations: int | None = None,
-                 restarts: int | None = None, respect_limits: bool = True, rng: np.random.Generator | None = None):
+                 restarts: int | None = None, respect_limits: bool = True, rng: np.random.Generator | None = None,
+                 threads=None):
         """Numeric IK by Levenberg–Marquardt on the compiled FK and Jacobian: as :func:`denavit.solve_ik`
         (same arguments, same :class:`~denavit.IKResult`), each iteration in machine code.
 
         Targets the compiled search does not solve are handed to :func:`denavit.solve_ik` with the same
         arguments (its closed-form and bank rescues, and its diagnosis of *why* a target fails), so the
         answers are never worse than the plain function's.  The numpy backend always uses the plain function.
+
+        ``threads`` (default every core): a batch of targets is split over that many threads
+        (:mod:`denavit._threads`, blocks of at least ``IK_MIN_ROWS`` targets); each target's random restarts
+        come from its own stream, so the answers do not depend on ``threads``.  The plain function's rescues
+        run in the calling thread.
         """
+        if threads is not None:
+            resolve_threads(threads)  # refused before any work, for one target too
         tol = IK_TOL if tol is None else float(tol)
         max_iterations = IK_MAX_ITERATIONS if max_iterations is None else int(max_iterations)
         restarts = IK_RESTARTS if restarts is None else int(restarts)
@@ -84,8 +95,13 @@ class IKMethods:
         seed = _random.getrandbits(31) if rng is None else int(rng.bit_generator.random_raw() & 0x7FFFFFFF)
         q_out = np.empty((B, n))
         info = np.empty((B, 5))
-        self._m.ik_lm(Tf, Q0, lim.lo, lim.hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed,
-                      q_out, info)
+        lm = self._m.ik_lm
+
+        def block(s: int, e: int) -> None:  # targets s..e-1 (the kernel releases the GIL)
+            lm(Tf[s:e], Q0[s:e], lim.lo, lim.hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, s,
+               q_out[s:e], info[s:e])
+
+        split_rows(B, block, threads, IK_MIN_ROWS)
         if batch == () and info[0, 0] > 0.0:  # one target, solved: the lean path
             return IKResult(q_out[0], True, float(info[0, 1]), float(info[0, 2]), int(info[0, 3]), int(info[0, 4]),
                             "")
