@@ -277,3 +277,46 @@ def test_analytic_jacobian_new_coordinates_batch_and_edge_cases():
         np.testing.assert_allclose(exp_rate_matrix(r) @ Jl, np.eye(3), rtol=0, atol=1e-14)
     with pytest.raises(ValueError, match="quaternion, exp"):
         analytic_jacobian(robot, Q, "xyz")
+
+
+# --- compiled ----------------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def compiled_arms():
+    """Two arms compiled once: the Puma 560 (numba when installed: the machine-code entry points of the single
+    call) and a random modified-DH arm with a prismatic joint, a fixed row, base and tool (numpy backend: the same
+    generated code, without a second numba compile's CPU time)."""
+    rng = np.random.default_rng(17)
+    arm = random_robot(rng, "modified", n_rows=5)
+    while not {"prismatic", "fixed"} <= {link.joint.value for link in arm.links} or np.allclose(arm.tool_matrix, np.eye(4)):
+        arm = random_robot(rng, "modified", n_rows=5)
+    puma = denavit.load_robot("puma560")
+    return [(puma, denavit.compile(puma)), (arm, denavit.compile(arm, backend="numpy"))]
+
+
+def test_compiled_kernels_equal_the_plain_functions(compiled_arms):
+    rng = np.random.default_rng(5)
+    for robot, fast in compiled_arms:
+        q, qd = random_q(rng, robot), rng.normal(size=robot.dof)
+        Q, QD = random_q(rng, robot, (4, 3)), rng.normal(size=(3, robot.dof))
+        for frame in ("base", "tool"):
+            for method, args, batch in (("jacobian_dot", (q, qd), (Q, QD)), ("acceleration_bias", (q, qd), (Q, QD)),
+                                        ("kinematic_hessian", (q,), (Q,))):
+                plain = getattr(denavit, method)
+                assert _rel(getattr(fast, method)(*args, frame=frame), plain(robot, *args, frame=frame)) < 1e-13
+                got = getattr(fast, method)(*batch, frame=frame, threads=2)
+                assert _rel(got, plain(robot, *batch, frame=frame)) < 1e-13
+                assert got.shape == plain(robot, *batch, frame=frame).shape
+        assert _rel(fast.jacobian_dot(list(q), qd.tolist()), denavit.jacobian_dot(robot, q, qd)) < 1e-13
+
+
+def test_compiled_bad_input(compiled_arms):
+    robot, fast = compiled_arms[0]
+    with pytest.raises(ValueError, match="choose base or tool"):
+        fast.jacobian_dot(np.zeros(6), np.zeros(6), frame="world")
+    with pytest.raises(ShapeError, match="qd: expected shape"):
+        fast.acceleration_bias(np.zeros(6), np.zeros(5))
+    with pytest.raises(ValueError, match="threads"):
+        fast.kinematic_hessian(np.zeros((2, 6)), threads=0)
+    with pytest.raises(ValueError, match="threads"):
+        fast.jacobian_dot(np.zeros(6), np.zeros(6), threads=-1)

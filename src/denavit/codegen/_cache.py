@@ -67,7 +67,7 @@ def active_cache_dir() -> Path:
 #: chain walker, the dynamics kernels): a changed generator never reads a stale module.
 GENERATOR_VERSION = "2"  # 2: verified modules (key and hash line, checked-hash .pyc)
 _SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_ik_elbow.py", "codegen/_ik_finish.py", "codegen/_ik_parallel.py", "codegen/_ik_stanford.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
-            "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py")
+            "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py", "numeric/_kin_derivatives.py")
 _DIGEST: list[str] = []
 
 

@@ -16,10 +16,10 @@ from __future__ import annotations
 from ..chain import COMPONENTS, chain_of, walk
 from ..model import DHRobot
 from ..numeric import bias_entries, hessian_entries, jacobian_dot_entries
-from ._kernels import KernelSpec, end_effector, jacobian_columns
+from ._kernels import KernelSpec, end_effector, jacobian_columns, register_kernel
 from ._trace import Tape
 
-__all__ = ["GROUP", "KIN_KERNELS", "trace_kin_kernel", "register_kin_kernels"]
+__all__ = ["GROUP", "KIN_KERNELS", "trace_kin_kernel"]
 
 GROUP = "kinematic_derivatives"
 #: name → (doc, needs qd, tool axes)
@@ -66,9 +66,11 @@ def trace_kin_kernel(name: str, robot: DHRobot) -> KernelSpec:
     return KernelSpec(name, doc, _inputs(name, n), _shape(name, n), tuple(out), tape)
 
 
-def register_kin_kernels(register) -> None:
-    """Register every kernel of :data:`KIN_KERNELS` with ``register`` (:func:`register_kernel`'s signature)."""
+def _register() -> None:
     for name in KIN_KERNELS:
-        register(name, group=GROUP, inputs=lambda n, name=name: _inputs(name, n),
-                 shape=lambda n, name=name: _shape(name, n), doc=KIN_KERNELS[name][0],
-                 trace=lambda robot, friction, name=name: trace_kin_kernel(name, robot))
+        register_kernel(name, group=GROUP, inputs=lambda n, name=name: _inputs(name, n),
+                        shape=lambda n, name=name: _shape(name, n), doc=KIN_KERNELS[name][0],
+                        trace=lambda robot, friction, name=name: trace_kin_kernel(name, robot))
+
+
+_register()
