@@ -4,6 +4,11 @@
     python -m pytest -q -m "not slow" --durations=0 -p no:cacheprovider > durations.txt
     python scripts/slow_tests.py durations.txt            # adds the tests over 2 s to tests/slow_tests.txt
 
+or, better on a busy machine, from CPU seconds (tests/conftest.py writes them when ``DENAVIT_CPU_TIMES`` is set):
+
+    DENAVIT_CPU_TIMES=cpu.txt python -m pytest -q -m "not slow" -p no:cacheprovider
+    python scripts/slow_tests.py --cpu cpu.txt
+
 tests/conftest.py gives every test listed there the ``slow`` mark.  A test's time is the sum of its setup, call
 and teardown, in wall-clock seconds of the run the report comes from: on a busy machine that is more than its
 CPU time, so the list errs towards the quick subset being smaller.  Entries already listed stay (a test that
@@ -34,6 +39,19 @@ def slow_ids(report: str, threshold: float) -> set[str]:
     return {node for node, seconds in total.items() if seconds > threshold}
 
 
+def slow_ids_cpu(report: str, threshold: float) -> set[str]:
+    """Node ids whose CPU seconds (lines ``seconds node-id``, as tests/conftest.py writes them) exceed threshold."""
+    out = set()
+    for line in report.splitlines():
+        seconds, _, node = line.partition(" ")
+        try:
+            if node and float(seconds) > threshold:
+                out.add(node.strip())
+        except ValueError:
+            continue
+    return out
+
+
 def read_list(path: Path = LIST) -> set[str]:
     if not path.exists():
         return set()
@@ -43,10 +61,12 @@ def read_list(path: Path = LIST) -> set[str]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("report", type=Path, help="the output of pytest --durations=0")
+    ap.add_argument("report", type=Path, help="the output of pytest --durations=0 (or, with --cpu, of DENAVIT_CPU_TIMES)")
+    ap.add_argument("--cpu", action="store_true", help="the report is CPU seconds per test (DENAVIT_CPU_TIMES)")
     ap.add_argument("--threshold", type=float, default=2.0, help="seconds (default 2)")
     args = ap.parse_args(argv)
-    ids = read_list() | slow_ids(args.report.read_text(encoding="utf-8", errors="replace"), args.threshold)
+    read = slow_ids_cpu if args.cpu else slow_ids
+    ids = read_list() | read(args.report.read_text(encoding="utf-8", errors="replace"), args.threshold)
     LIST.write_text(HEADER + "".join(f"{node}\n" for node in sorted(ids)), encoding="utf-8")
     print(f"{len(ids)} tests listed in {LIST.relative_to(ROOT)}")
     return 0

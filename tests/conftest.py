@@ -92,3 +92,23 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.get_closest_marker("browser") is not None or item.nodeid in SLOW_TESTS:
             item.add_marker(slow)
+
+
+#: ``DENAVIT_CPU_TIMES=FILE``: append each test's CPU seconds (this process and the child processes it waited for,
+#: setup + call + teardown) to FILE, one ``seconds node-id`` a line — what a test costs on any machine, busy or
+#: not (wall-clock ``--durations`` grow with the load).  ``scripts/slow_tests.py --cpu FILE`` reads it.
+_CPU_TIMES = os.environ.get("DENAVIT_CPU_TIMES")
+
+if _CPU_TIMES:
+    import resource
+
+    def _cpu() -> float:
+        me, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+        return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_protocol(item, nextitem):
+        start = _cpu()
+        yield
+        with open(_CPU_TIMES, "a", encoding="utf-8") as f:
+            f.write(f"{_cpu() - start:.3f} {item.nodeid}\n")

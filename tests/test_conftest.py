@@ -45,3 +45,35 @@ def test_ci_fixture_is_the_flag(ci, request):
 def test_rng_fixture_is_seeded_per_test(rng, request):
     again = np.random.default_rng(sum(request.node.nodeid.encode()) + 16)
     assert rng.random() == again.random()
+
+
+def test_cpu_times_are_written_per_test_and_read_by_the_slow_list_script(tmp_path):
+    """DENAVIT_CPU_TIMES: each test's CPU seconds, a line each; a test burning CPU is over the threshold, an idle
+    sleeping one is not (CPU, not wall-clock: what a busy machine does not inflate)."""
+    import importlib.util
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parent
+    (tmp_path / "conftest.py").write_text((here / "conftest.py").read_text(encoding="utf-8"), encoding="utf-8")
+    (tmp_path / "slow_tests.txt").write_text("", encoding="utf-8")
+    (tmp_path / "_random_robots.py").write_text((here / "_random_robots.py").read_text(encoding="utf-8"),
+                                                encoding="utf-8")
+    (tmp_path / "test_two.py").write_text(
+        "import time\n"
+        "def test_burn():\n    t = time.process_time()\n    while time.process_time() - t < 0.6: pass\n"
+        "def test_sleep():\n    time.sleep(0.6)\n", encoding="utf-8")
+    out = tmp_path / "cpu.txt"
+    env = {**os.environ, "DENAVIT_CPU_TIMES": str(out)}
+    subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider",
+                    "--rootdir", str(tmp_path), "-o", "addopts=", str(tmp_path / "test_two.py")],
+                   cwd=tmp_path, env=env, check=True, capture_output=True, timeout=300)
+    lines = dict(reversed(line.split(" ", 1)) for line in out.read_text(encoding="utf-8").splitlines())
+    assert float(lines["test_two.py::test_burn"]) >= 0.5
+    assert float(lines["test_two.py::test_sleep"]) < 0.3
+    spec = importlib.util.spec_from_file_location("slow_tests", here.parent / "scripts" / "slow_tests.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    assert script.slow_ids_cpu(out.read_text(encoding="utf-8"), 0.4) == {"test_two.py::test_burn"}
