@@ -29,17 +29,26 @@ class KinDerivativeMethods:
     kin_group = GROUP
 
     def _kin2(self, name: str, q, qd, threads):
-        hit = self._one.get(name)
-        if (hit is not None and q.__class__ is _ndarray and qd.__class__ is _ndarray and q.dtype is _F64
-                and qd.dtype is _F64 and q.shape == self._vec and qd.shape == self._vec
-                and q.strides == qd.strides == _STRIDE and (threads is None or threads.__class__ is int and threads > 0)):
-            out = _empty(hit[1])
-            getattr(self, f"_{name}_1")(q, qd, out)
-            return out
+        """The single call's hot path when the kernel is loaded and q, q̇ are float64 (n,) arrays, else ``_call``."""
+        if (q.__class__ is _ndarray and qd.__class__ is _ndarray and q.dtype is _F64 and qd.dtype is _F64
+                and q.shape == self._vec and qd.shape == self._vec and q.strides == qd.strides == _STRIDE
+                and (threads is None or threads.__class__ is int and threads > 0)):
+            kernel = self.__dict__.get(f"_{name}_1")
+            if kernel is not None:
+                out = _empty(self._shapes[name])
+                kernel(q, qd, out)
+                return out
         return self._call(name, (q, qd), ("q", "qd"), threads)
 
     def jacobian_dot(self, q, qd, frame="base", *, threads=None) -> np.ndarray:
         """J̇, shape (..., 6, n): d/dt J0 (``base``) or d/dt Je (``tool``), as :func:`denavit.jacobian_dot`."""
+        if frame == "base" and q.__class__ is _ndarray and qd.__class__ is _ndarray and threads is None:
+            kernel = self.__dict__.get("_jacobian_dot0_1")  # the hot path, spelled out: no name built per call
+            if (kernel is not None and q.dtype is _F64 and qd.dtype is _F64 and q.shape == self._vec
+                    and qd.shape == self._vec and q.strides == qd.strides == _STRIDE):
+                out = _empty(self._jshape)
+                kernel(q, qd, out)
+                return out
         return self._kin2("jacobian_dot" + _suffix(frame), q, qd, threads)
 
     def acceleration_bias(self, q, qd, frame="base", *, threads=None) -> np.ndarray:
@@ -49,4 +58,12 @@ class KinDerivativeMethods:
 
     def kinematic_hessian(self, q, frame="base", *, threads=None) -> np.ndarray:
         """∂J/∂q, shape (..., 6, n, n) with ∂J[:, j]/∂q_k at [..., :, j, k], as :func:`denavit.kinematic_hessian`."""
-        return self._call("kinematic_hessian" + _suffix(frame), (q,), ("q",), threads)
+        name = "kinematic_hessian" + _suffix(frame)
+        if (q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE
+                and (threads is None or threads.__class__ is int and threads > 0)):
+            kernel = self.__dict__.get(f"_{name}_1")
+            if kernel is not None:
+                out = _empty(self._shapes[name])
+                kernel(q, out)
+                return out
+        return self._call(name, (q,), ("q",), threads)
