@@ -13,7 +13,9 @@ coriolis (and the derivative kernels where the compiled object has them):
           own throughput, without the page faults of a fresh output
 IK (LM): ``fast.solve_ik(T, threads=t)`` on ``--ik-targets`` targets (FK of random q inside the limits, no seeds).
 Plain (``denavit.forward_kinematics`` …, numpy): ``f(robot, q, …, threads=t)`` on ``--plain-batch`` rows.
-Times are the best of ``--repeat`` rounds, the thread counts taking turns within each round.
+Times are the best of ``--repeat`` rounds, the thread counts taking turns within each round.  ``CPU t/1`` is the
+process CPU time (all threads) of the t-thread call over the 1-thread call's: near 1.0, splitting adds no work, so
+on idle cores the speed-up is about t / that; on a loaded machine the wall-clock ratio falls below it.
 """
 
 from __future__ import annotations
@@ -22,11 +24,11 @@ import argparse
 import os
 import platform
 import sys
+import time
 
 import numpy as np
 
 import denavit
-from _peers import best_times
 from denavit._threads import available_cores, run_batch
 
 OPS = ("fk", "jacobian", "rnea", "mass_matrix", "forward_dynamics", "gravity", "coriolis")
@@ -38,6 +40,31 @@ ARGS = {"fk": 1, "jacobian": 1, "mass_matrix": 1, "gravity": 1, "coriolis": 2, "
 PLAIN = {"fk": denavit.forward_kinematics, "jacobian": denavit.geometric_jacobian, "rnea": denavit.rnea,
          "mass_matrix": denavit.mass_matrix, "forward_dynamics": denavit.forward_dynamics,
          "gravity": denavit.gravity_torques, "coriolis": denavit.coriolis_vector}
+
+
+def _busy() -> tuple[float, float]:
+    """(CPU seconds every process has used, CPU seconds this process has used) so far; the first is NaN where
+    /proc/stat is missing.  Their increments over a run give the cores the other processes kept busy."""
+    try:
+        with open("/proc/stat") as f:
+            fields = [float(x) for x in f.readline().split()[1:]]
+        total = (sum(fields) - fields[3] - fields[4]) / os.sysconf("SC_CLK_TCK")  # all but idle and iowait
+    except (OSError, ValueError, IndexError):
+        total = float("nan")
+    t = os.times()
+    return total, t.user + t.system
+
+
+def _times(fns, repeat: int) -> tuple[list[float], list[float]]:
+    """(best wall time, least process CPU time — every thread's) of one call of each of ``fns`` over ``repeat``
+    rounds, the functions taking turns within each round [s]."""
+    wall, cpu = [np.inf] * len(fns), [np.inf] * len(fns)
+    for _ in range(repeat):
+        for i, fn in enumerate(fns):
+            c0, t0 = time.process_time(), time.perf_counter()
+            fn()
+            wall[i], cpu[i] = min(wall[i], time.perf_counter() - t0), min(cpu[i], time.process_time() - c0)
+    return wall, cpu
 
 
 def _inputs(n: int, rows: int):
@@ -64,14 +91,14 @@ def _compiled_rows(robot, threads, rows, repeat, ik_targets):
         calls = [lambda t=t, m=method, a=args: m(*a, threads=t) for t in threads]
         if not _same([c() for c in calls]):
             sys.exit(f"{op}: split results differ from the unsplit call")
-        call = best_times(calls, repeat, 1)
+        call = _times(calls, repeat)
         kernel = None
         name = KERNEL.get(op, op)
         if hasattr(fast._m, f"{name}_n") and op in OPS:
             k = getattr(fast._m, f"{name}_n")
             o = np.empty((rows,) + fast._shapes[name])
             k(*[np.ascontiguousarray(a) for a in args], o)  # touch the output's pages once
-            kernel = best_times([lambda t=t, k=k, a=args, o=o: run_batch(k, a, (o,), t) for t in threads], repeat, 1)
+            kernel = _times([lambda t=t, k=k, a=args, o=o: run_batch(k, a, (o,), t) for t in threads], repeat)[0]
         out.append((op, call, kernel))
     if ik_targets:  # numeric IK on targets made by FK of q inside the limits, no seeds (restarts drawn)
         lim = robot.q_limits
@@ -80,7 +107,7 @@ def _compiled_rows(robot, threads, rows, repeat, ik_targets):
         calls = [lambda t=t: fast.solve_ik(T, rng=np.random.default_rng(2), threads=t) for t in threads]
         if not _same([c().q for c in calls]):
             sys.exit("solve_ik: split results differ from the unsplit call")
-        out.append(("solve_ik", best_times(calls, max(2, repeat // 2), 1), None, ik_targets))
+        out.append(("solve_ik", _times(calls, max(2, repeat // 2)), None, ik_targets))
     return fast.backend, out
 
 
@@ -92,22 +119,24 @@ def _plain_rows(robot, threads, rows, repeat):
         calls = [lambda t=t, f=f, a=args: f(robot, *a, threads=t) for t in threads]
         if not _same([c() for c in calls]):
             sys.exit(f"plain {op}: split results differ from the unsplit call")
-        out.append((op, best_times(calls, repeat, 1), None))
+        out.append((op, _times(calls, repeat), None))
     return out
 
 
 def _table(title, rows, threads, batch):
     head = " | ".join(f"{t} thr [ms]" for t in threads)
     ratio = " | ".join(f"1/{t}" for t in threads[1:])
+    cpu = " | ".join(f"CPU {t}/1" for t in threads[1:])
     print(f"\n{title}, batch {batch:,}\n")
-    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | kernel {ratio} |")
-    print("|---" * (2 + len(threads) + 2 * (len(threads) - 1)) + "|")
-    for op, call, kernel, *count in rows:
+    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | {cpu} | kernel {ratio} |")
+    print("|---" * (2 + len(threads) + 3 * (len(threads) - 1)) + "|")
+    for op, (call, cpu_s), kernel, *count in rows:
         times = " | ".join(f"{1e3 * c:.1f}" for c in call)
         n = count[0] if count else batch
         rc = " | ".join(f"{call[0] / c:.2f}" for c in call[1:])
+        rp = " | ".join(f"{c / cpu_s[0]:.2f}" for c in cpu_s[1:])
         rk = " | ".join(f"{kernel[0] / k:.2f}" for k in kernel[1:]) if kernel else " | ".join("–" for _ in call[1:])
-        print(f"| {LABEL[op]}{'' if n == batch else f' ({n:,})'} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rk} |")
+        print(f"| {LABEL[op]}{'' if n == batch else f' ({n:,})'} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {rk} |")
 
 
 def main(argv=None) -> None:
@@ -123,6 +152,7 @@ def main(argv=None) -> None:
     threads = [int(t) for t in a.threads.split(",")]
     print(f"{platform.processor() or platform.machine()}, {available_cores()} cores available, numpy {np.__version__}, "
           f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    start, wall = _busy(), time.perf_counter()
     for name in a.robots.split(","):
         robot = denavit.load_robot(name)
         backend, rows = _compiled_rows(robot, threads, int(a.batch), a.repeat, a.ik_targets)
@@ -130,7 +160,9 @@ def main(argv=None) -> None:
         if not a.no_plain:
             _table(f"{name}: plain numpy functions", _plain_rows(robot, threads, int(a.plain_batch), a.repeat),
                    threads, int(a.plain_batch))
-    print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    end, wall = _busy(), time.perf_counter() - wall
+    print(f"\nload average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}; other processes kept "
+          f"{((end[0] - start[0]) - (end[1] - start[1])) / wall:.2f} cores busy on average during the run")
 
 
 if __name__ == "__main__":

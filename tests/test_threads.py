@@ -180,6 +180,17 @@ def test_numba_blocks_bit_for_bit():
     assert np.array_equal(fast.fk(q[:0], threads=2), np.zeros((0, 4, 4)))
 
 
+
+@_NUMBA
+def test_generated_batch_loops_release_the_gil():
+    """What the threads rely on: every generated batch function and the IK batch solver are jitted with
+    nogil=True (read from numba's own options of the loaded module, not from the generator's text)."""
+    module = denavit.compile(ROBOT, backend="numba")._m  # numba compiles each function on its first call only
+    loops = [getattr(module, k) for k in dir(module) if k.endswith("_n") or k in ("ik_lm", "ik_check")]
+    assert {"fk_n", "rnea_n", "forward_dynamics_n", "ik_lm"} <= set(dir(module))
+    assert all(f.targetoptions.get("nogil") is True for f in loops)
+
+
 def _functions(subject):
     robot, backend = subject
     return _calls(robot, None if backend is None else denavit.compile(robot, backend=backend))
