@@ -221,3 +221,69 @@ def test_cli_dynamics_derivatives_bad_input_is_one_line_exit_2(capsys, argv, mes
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
+
+
+# --- compiled (the same code traced on the tape) ------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def compiled_arm():
+    """A random arm (prismatic joint, fixed rows, base/tool, friction, motor inertia, odd gravity), numpy backend."""
+    robot = dynamic_arm(29)
+    return robot, denavit.compile(robot, backend="numpy")
+
+
+def _compiled_matches_plain(robot, fast, friction=True):
+    q, qd, qdd = state(robot, 4)
+    for shape in ((), (3, 2)):
+        q, qd, qdd = state(robot, 4, shape)
+        pairs = list(zip(fast.rnea_derivatives(q, qd, qdd), denavit.rnea_derivatives(robot, q, qd, qdd, friction=friction)))
+        pairs += zip(fast.forward_dynamics_derivatives(q, qd, qdd),
+                     denavit.forward_dynamics_derivatives(robot, q, qd, qdd, friction=friction))
+        pairs.append((fast.gravity_derivatives(q), denavit.gravity_derivatives(robot, q)))
+        for a, b in pairs:
+            assert a.shape == shape + (robot.dof, robot.dof)
+            assert rel_err(a, b) <= REL
+
+
+def test_compiled_matches_plain_single_and_batched(compiled_arm):
+    robot, fast = compiled_arm
+    _compiled_matches_plain(robot, fast)
+    assert {"rnea_derivatives", "forward_dynamics_derivatives", "gravity_derivatives"} <= set(fast.kernels)
+
+
+def test_compiled_without_friction_and_bad_input(compiled_arm):
+    robot, _ = compiled_arm
+    _compiled_matches_plain(robot, denavit.compile(robot, backend="numpy", friction=False), friction=False)
+    fast = compiled_arm[1]
+    with pytest.raises(ShapeError, match="qd: expected shape"):
+        fast.rnea_derivatives(np.zeros(robot.dof), np.zeros(robot.dof + 1), np.zeros(robot.dof))
+    with pytest.raises(ValueError, match="threads must be"):
+        fast.gravity_derivatives(np.zeros((2, robot.dof)), threads=0)
+
+
+def test_compiled_singular_mass_matrix_is_a_model_error():
+    from denavit import DHLink, DHRobot
+
+    robot = DHRobot(name="pointmass", links=(DHLink(a=0.0, alpha=0.0, d=0.0, inertia=LinkInertia(mass=1.0)),))
+    fast = denavit.compile(robot, backend="numpy")
+    with pytest.raises(ModelError, match="singular"):
+        fast.forward_dynamics_derivatives(np.array([0.1]), np.array([0.0]), np.array([1.0]))
+
+
+@pytest.mark.slow
+def test_compiled_numba_matches_pinocchio():
+    pin = pytest.importorskip("pinocchio")
+    pytest.importorskip("numba")
+    robot = denavit.load_robot("puma560")
+    fast = denavit.compile(robot, backend="numba", friction=False)
+    model, data, _ = to_pinocchio(robot)
+    q, qd, qdd = state(robot, 6)
+    A, B = fast.rnea_derivatives(q, qd, qdd)
+    dq, dv, _ = pin.computeRNEADerivatives(model, data, q, qd, qdd)
+    assert rel_err(A, dq) <= REL and rel_err(B, dv) <= REL
+    for a, b in zip(fast.forward_dynamics_derivatives(q, qd, qdd), pin.computeABADerivatives(model, data, q, qd, qdd)):
+        assert rel_err(a, b) <= REL
+    Q = state(robot, 7, (4,))
+    A, B = fast.rnea_derivatives(*Q)
+    for i in range(4):
+        dq, dv, _ = pin.computeRNEADerivatives(model, data, Q[0][i], Q[1][i], Q[2][i])
+        assert rel_err(A[i], dq) <= REL and rel_err(B[i], dv) <= REL

@@ -20,11 +20,11 @@ from __future__ import annotations
 from ..chain import COMPONENTS, chain_of, walk
 from ..model import DHRobot
 from ..numeric import (SINGULAR_TOL, dual_sign, dynamics_plan, friction_coefficients, ldl_pivots_solve,
-                       mass_matrix_kernel, rnea_kernel, seed_duals, tangent_matrix)
-from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero
+                       mass_matrix_kernel, require_dynamics, rnea_kernel, seed_duals, tangent_matrix)
+from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero, register_kernel
 from ._trace import Tape, sym_max, sym_min
 
-__all__ = ["DERIVATIVE_KERNELS", "trace_rnea_derivatives", "trace_forward_dynamics_derivatives",
+__all__ = ["GROUP", "DERIVATIVE_KERNELS", "trace_rnea_derivatives", "trace_forward_dynamics_derivatives",
            "trace_gravity_derivatives"]
 
 
@@ -32,6 +32,7 @@ class _Setup:
     """What every dynamics-derivative kernel of an arm starts from."""
 
     def __init__(self, robot: DHRobot, friction: bool) -> None:
+        require_dynamics(robot)  # ModelError for an arm without inertial data: no kernel for it
         self.chain = chain_of(robot)
         self.n = robot.dof
         self.pl = dynamics_plan(robot)
@@ -105,10 +106,18 @@ def trace_forward_dynamics_derivatives(robot: DHRobot, friction: bool = True) ->
                       _blocks(tangent_matrix(x, m), n, 3) + (ok,), tape)
 
 
-#: name → (tracing function, input labels, output shape of n)
+GROUP = "dynamics_derivatives"
+
+#: name → (tracing function, input labels of n, output shape of n, one-line doc)
 DERIVATIVE_KERNELS = {
-    "rnea_derivatives": (trace_rnea_derivatives, lambda n: (("q", n), ("qd", n), ("qdd", n)), lambda n: (2, n, n)),
+    "rnea_derivatives": (trace_rnea_derivatives, lambda n: (("q", n), ("qd", n), ("qdd", n)), lambda n: (2, n, n),
+                         "[dtau/dq, dtau/dqd] of tau = M qdd + c + g + tau_f, each n x n [output, input]"),
     "forward_dynamics_derivatives": (trace_forward_dynamics_derivatives, lambda n: (("q", n), ("qd", n), ("tau", n)),
-                                     lambda n: (3 * n * n + 1,)),
-    "gravity_derivatives": (trace_gravity_derivatives, lambda n: (("q", n),), lambda n: (n, n)),
+                                     lambda n: (3 * n * n + 1,),
+                                     "[dqdd/dq, dqdd/dqd, M^-1] (3 n x n, C order), then an entry > 0 iff M is regular"),
+    "gravity_derivatives": (trace_gravity_derivatives, lambda n: (("q", n),), lambda n: (n, n),
+                            "dg/dq of the gravity torques, n x n [output, input]"),
 }
+
+for _name, (_trace_fn, _inputs, _shape, _doc) in DERIVATIVE_KERNELS.items():
+    register_kernel(_name, group=GROUP, inputs=_inputs, shape=_shape, doc=_doc, trace=_trace_fn)

@@ -1,0 +1,60 @@
+"""The dynamics-derivative half of :class:`denavit.codegen.CompiledRobot`: rnea_derivatives,
+forward_dynamics_derivatives and gravity_derivatives on the kernels of group ``dynamics_derivatives``
+(traced by :mod:`denavit.codegen._kernels_dyn`, compiled or loaded from the disk cache on the first call)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._kernels_dyn import GROUP
+
+__all__ = ["DynDerivativeMethods", "GROUP"]
+
+_ndarray, _F64, _empty, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (8,)
+
+
+class DynDerivativeMethods:
+    """Mixed into CompiledRobot, whose ``_call`` (any call, loading the group first) and hot-path kernels
+    ``_<name>_1`` (bound once the group is loaded) they use."""
+
+    def _single3(self, name: str, a, b, c, shape):
+        """The hot path for three (n,) float64 contiguous arrays once the kernel is bound, else None."""
+        kernel = self.__dict__.get(f"_{name}_1")
+        if (kernel is not None and a.__class__ is _ndarray and b.__class__ is _ndarray and c.__class__ is _ndarray
+                and a.dtype is _F64 and b.dtype is _F64 and c.dtype is _F64
+                and a.shape == b.shape == c.shape == self._vec and a.strides == b.strides == c.strides == _STRIDE):
+            out = _empty(shape)
+            kernel(a, b, c, out)
+            return out
+        return None
+
+    def rnea_derivatives(self, q, qd, qdd, *, threads=None):
+        """``(dtau_dq, dtau_dqd)``, each (..., n, n) [output, input] (as :func:`denavit.rnea_derivatives` with the
+        robot's gravity and the object's friction)."""
+        n = self.dof
+        out = self._single3("rnea_derivatives", q, qd, qdd, (2, n, n))
+        if out is None:
+            out = self._call("rnea_derivatives", (q, qd, qdd), ("q", "qd", "qdd"), threads)
+        return out[..., 0, :, :], out[..., 1, :, :]
+
+    def forward_dynamics_derivatives(self, q, qd, tau, *, threads=None):
+        """``(dqdd_dq, dqdd_dqd, dqdd_dtau)``, each (..., n, n); dqdd_dtau = M⁻¹ (as
+        :func:`denavit.forward_dynamics_derivatives`); ModelError where M is singular."""
+        n = self.dof
+        r = self._single3("forward_dynamics_derivatives", q, qd, tau, (3 * n * n + 1,))
+        if r is None:
+            r = self._call("forward_dynamics_derivatives", (q, qd, tau), ("q", "qd", "tau"), threads)
+        if not (r[..., -1] > 0.0).all():
+            self._singular()
+        D = r[..., :-1].reshape(r.shape[:-1] + (3, n, n))
+        return D[..., 0, :, :], D[..., 1, :, :], D[..., 2, :, :]
+
+    def gravity_derivatives(self, q, *, threads=None):
+        """∂g/∂q, (..., n, n) (as :func:`denavit.gravity_derivatives` with the robot's gravity)."""
+        kernel = self.__dict__.get("_gravity_derivatives_1")
+        if (kernel is not None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                and q.strides == _STRIDE):
+            out = _empty(self._mshape)
+            kernel(q, out)
+            return out
+        return self._call("gravity_derivatives", (q,), ("q",), threads)
