@@ -371,3 +371,17 @@ def test_an_arm_given_for_a_section_the_report_lacks_is_refused_naming_its_secti
     assert "no section '7'" in err and "1, 2, 3, 4" in err
     code, out, _ = run(capsys, "check", str(report), "--arm", "1=planar2r")  # a section it has: used
     assert code == 0 and "--arm 1=planar2r" in out
+
+
+def test_a_reports_arms_are_listed_in_the_order_of_its_sections():
+    """Sections given one arm each are listed top to bottom (they came out by the length of their sections:
+    report 004's eight arms as 6, 4, 2, 5, 1, 8, 3, 7 in the checked page)."""
+    from denavit.grade import grade_text
+    from denavit.io import load_robot
+
+    names = ["planar2r-mdh", "planar3r-mdh", "spherical-wrist", "articulated-rrr"]
+    body = [5, 1, 9, 3]  # lines of text per section: lengths that do not grow with the section number
+    text = "".join(f"## {k}. Exercise\n\n" + "Some words.\n\n" * n for k, n in enumerate(body, start=1))
+    report = grade_text(text, "md", arms={str(k): load_robot(name) for k, name in enumerate(names, start=1)})
+    assert [a.name for a in report.arms] == names
+    assert [a.line for a in report.arms] == sorted(a.line for a in report.arms)

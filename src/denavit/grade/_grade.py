@@ -141,7 +141,9 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
             notes.append(arm.problem)
     if not seen:
         notes.append("no DH table found in the report: give the arm (denavit check ROBOT REPORT)")
-    return GradedReport(source, text, fmt, tuple(seen.values()), tuple(graded), tuple(notes))
+    arms_in_order = tuple(sorted(seen.values(), key=lambda a: a.line))  # as the report runs (spans are ordered
+    # most specific first, which listed report 004's eight arms by the length of their sections)
+    return GradedReport(source, text, fmt, arms_in_order, tuple(graded), tuple(notes))
 
 
 def grade_report(path: str | Path, robot: DHRobot | str | None = None, arms: dict[str, Any] | None = None, *,
