@@ -148,6 +148,7 @@ def test_against_pinocchio(seed, convention):
         assert _rel(denavit.acceleration_bias(robot, q, qd, frame), a) < RTOL, frame
 
 
+@pytest.mark.slow  # importing roboticstoolbox takes seconds
 def test_against_roboticstoolbox_hessian0_and_jacob0_dot():
     pytest.importorskip("roboticstoolbox")
     from denavit.peers import expand_q, to_roboticstoolbox
@@ -320,3 +321,29 @@ def test_compiled_bad_input(compiled_arms):
         fast.kinematic_hessian(np.zeros((2, 6)), threads=0)
     with pytest.raises(ValueError, match="threads"):
         fast.jacobian_dot(np.zeros(6), np.zeros(6), threads=-1)
+
+
+def test_exported_python_and_c_carry_the_kernels(tmp_path):
+    import importlib.util
+    import shutil
+    import subprocess
+
+    from denavit.codegen import export_sources
+
+    robot, q, qd, rng = _arm(23, "standard")
+    names = ("jacobian_dot0", "acceleration_biase", "kinematic_hessiane")
+    (file, text), = export_sources(robot, "python", prefix="kin_kernels", kernels=names).items()
+    (tmp_path / file).write_text(text)
+    spec = importlib.util.spec_from_file_location("kin_kernels", tmp_path / file)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    Q = random_q(rng, robot, (3,))
+    assert _rel(mod.jacobian_dot0(q, qd), denavit.jacobian_dot(robot, q, qd)) < 1e-13
+    assert _rel(mod.acceleration_biase(q, qd), denavit.acceleration_bias(robot, q, qd, "tool")) < 1e-13
+    assert _rel(mod.kinematic_hessiane(Q), denavit.kinematic_hessian(robot, Q, "tool")) < 1e-13
+    files = export_sources(robot, "c", prefix="arm", kernels=names)
+    assert all(f"arm_{name}(" in files["arm.h"] for name in names)
+    if shutil.which("cc"):
+        for name, body in files.items():
+            (tmp_path / name).write_text(body)
+        subprocess.run(["cc", "-std=c99", "-c", str(tmp_path / "arm.c"), "-o", str(tmp_path / "arm.o")], check=True)
