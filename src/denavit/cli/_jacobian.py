@@ -14,7 +14,7 @@ from ..errors import ParseError
 from ..numeric import TWIST_ROWS as ROWS
 from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
                       require_symbolic_size)
-from ._kin_derivatives import add_kin_derivative_args, cmd_kin_derivatives, wants_kin_derivatives
+from ._kin_derivatives import add_kin_derivative_args, analytic_numeric, cmd_kin_derivatives, wants_kin_derivatives
 from ._shared import add_sym_format, q_out, q_text, sym_formatter
 
 REFERENCE = "end-effector origin (after the tool transform)"
@@ -186,15 +186,7 @@ def cmd_jacobian(args: argparse.Namespace):
         q = joint_values(args, robot, args.q)
         data["q"] = q_out(args, robot, q)
         if args.analytic:
-            Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
-            require_finite("jacobian", phi)  # rate rows are NaN at a representation singularity (warned)
-            names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
-            conv = np.degrees(phi) if args.deg else phi
-            data.update({"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)})
-            lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {q_text(args, robot, q)}",
-                      f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
-                      f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
-                      f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
+            data.update(analytic_numeric(args, robot, q, lines))
         else:
             route = {"geometric": N.geometric_jacobian, "differentiation": N.differentiation_jacobian,
                      "propagation": N.propagation_jacobian}[args.method]

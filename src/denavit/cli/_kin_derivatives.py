@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import argparse
 
+import numpy as np
+
 from ..errors import ParseError
 from ..numeric import TWIST_ROWS as ROWS
 from ._common import joint_values, matrix_text, numbers_text, require_finite
 from ._shared import q_out, q_text
 
-__all__ = ["add_kin_derivative_args", "wants_kin_derivatives", "cmd_kin_derivatives"]
+__all__ = ["add_kin_derivative_args", "wants_kin_derivatives", "cmd_kin_derivatives", "analytic_numeric"]
 
 REFERENCE = "end-effector origin (after the tool transform)"
 
@@ -47,6 +49,22 @@ def _check(args: argparse.Namespace) -> None:
                       ("--method " + args.method, args.method != "geometric")):
         if bad:
             raise ParseError(f"{flags} does not go with {name} (closed forms on the geometric Jacobian, numeric)")
+
+
+def analytic_numeric(args: argparse.Namespace, robot, q, lines: list[str]) -> dict:
+    """``jacobian -q Q --analytic REP``: Ja and the angles at q; the text lines appended to ``lines``, the JSON
+    entries returned."""
+    from .. import numeric as N
+
+    Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
+    require_finite("jacobian", phi)  # rate rows are NaN at a representation singularity (warned)
+    names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
+    conv = np.degrees(phi) if args.deg else phi
+    lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {q_text(args, robot, q)}",
+              f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
+              f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
+              f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
+    return {"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)}
 
 
 def _labelled(M, labels=ROWS) -> str:
