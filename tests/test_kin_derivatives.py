@@ -347,3 +347,20 @@ def test_exported_python_and_c_carry_the_kernels(tmp_path):
         for name, body in files.items():
             (tmp_path / name).write_text(body)
         subprocess.run(["cc", "-std=c99", "-c", str(tmp_path / "arm.c"), "-o", str(tmp_path / "arm.o")], check=True)
+
+
+@pytest.mark.parametrize("representation, rows", [("quaternion", 7), ("exp", 6)])
+def test_cli_analytic_quaternion_and_exp(capsys, representation, rows):
+    from denavit.cli import main
+    from denavit.numeric import analytic_jacobian
+
+    q = "0.1, -0.6, -0.9, 0.2, 0.7, -0.3"
+    data = _cli_json(capsys, "jacobian", "puma560", "-q", q, "--analytic", representation, "--deg")
+    Ja, phi = analytic_jacobian(denavit.load_robot("puma560"), np.radians([0.1, -0.6, -0.9, 0.2, 0.7, -0.3]),
+                                representation)
+    assert np.array(data["Ja"]).shape == (rows, 6) and len(data["analytic_rows"]) == rows
+    np.testing.assert_allclose(data["Ja"], Ja, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(data["angles"], phi, rtol=0, atol=1e-15)  # not converted to degrees
+    assert main(["jacobian", "puma560", "--analytic", representation]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is numeric: give -q" in err

@@ -14,7 +14,8 @@ from ..errors import ParseError
 from ..numeric import TWIST_ROWS as ROWS
 from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
                       require_symbolic_size)
-from ._kin_derivatives import add_kin_derivative_args, analytic_numeric, cmd_kin_derivatives, wants_kin_derivatives
+from ._kin_derivatives import (add_kin_derivative_args, analytic_numeric, check_analytic_symbolic, cmd_kin_derivatives,
+                               wants_kin_derivatives)
 from ._shared import add_sym_format, q_out, q_text, sym_formatter
 
 REFERENCE = "end-effector origin (after the tool transform)"
@@ -31,7 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=["geometric", "differentiation", "propagation"], default="geometric",
                    help="route: joint axes of the frames, differentiation of FK, or Craig's velocity propagation")
     p.add_argument("--symbolic", action="store_true", help="the formulas (the default when -q is not given)")
-    p.add_argument("--analytic", choices=["rpy", "zyz"], help="analytic Jacobian: rows (xdot, ydot, zdot, angle rates); numeric with -q, symbolic without")
+    p.add_argument("--analytic", choices=["rpy", "zyz", "quaternion", "exp"], help="analytic Jacobian: rows (xdot, ydot, "
+                   "zdot, rates of the orientation coordinates); numeric with -q, symbolic without (rpy, zyz)")
     p.add_argument("--steps", action="store_true", help="with --method propagation: every omega_i and v_i (symbolic)")
     add_kin_derivative_args(p)
     add_sym_format(p)
@@ -170,6 +172,7 @@ def cmd_jacobian(args: argparse.Namespace):
     if args.q is not None:  # a bad -q fails now, not after the symbolic work
         joint_values(args, robot, args.q)
     if args.symbolic or args.q is None:
+        check_analytic_symbolic(args)
         sdata, lines = _symbolic_jacobian(robot, args)
         data.update(sdata)
         if args.analytic:

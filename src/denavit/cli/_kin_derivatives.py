@@ -16,7 +16,8 @@ from ..numeric import TWIST_ROWS as ROWS
 from ._common import joint_values, matrix_text, numbers_text, require_finite
 from ._shared import q_out, q_text
 
-__all__ = ["add_kin_derivative_args", "wants_kin_derivatives", "cmd_kin_derivatives", "analytic_numeric"]
+__all__ = ["add_kin_derivative_args", "wants_kin_derivatives", "cmd_kin_derivatives", "analytic_numeric",
+           "check_analytic_symbolic"]
 
 REFERENCE = "end-effector origin (after the tool transform)"
 
@@ -51,19 +52,34 @@ def _check(args: argparse.Namespace) -> None:
             raise ParseError(f"{flags} does not go with {name} (closed forms on the geometric Jacobian, numeric)")
 
 
+#: rows of the analytic Jacobian after (x, y, z), per representation; angles in degrees with --deg
+COORDINATES = {"rpy": ("roll", "pitch", "yaw"), "zyz": ("phi", "theta", "psi"), "quaternion": ("qw", "qx", "qy", "qz"),
+               "exp": ("rx", "ry", "rz")}
+
+
+def check_analytic_symbolic(args: argparse.Namespace) -> None:
+    """The symbolic analytic Jacobian exists for rpy and zyz only."""
+    if args.analytic in ("quaternion", "exp"):
+        raise ParseError(f"--analytic {args.analytic} is numeric: give -q (without --symbolic); formulas exist for rpy "
+                         "and zyz")
+
+
 def analytic_numeric(args: argparse.Namespace, robot, q, lines: list[str]) -> dict:
-    """``jacobian -q Q --analytic REP``: Ja and the angles at q; the text lines appended to ``lines``, the JSON
-    entries returned."""
+    """``jacobian -q Q --analytic REP``: Ja and the coordinates at q; the text lines appended to ``lines``, the
+    JSON entries returned.  Euler angles are in degrees with --deg; quaternion and rotation vector as computed."""
     from .. import numeric as N
 
     Ja, phi = N.analytic_jacobian(robot, q, args.analytic)
     require_finite("jacobian", phi)  # rate rows are NaN at a representation singularity (warned)
-    names = ("x", "y", "z") + (("roll", "pitch", "yaw") if args.analytic == "rpy" else ("phi", "theta", "psi"))
-    conv = np.degrees(phi) if args.deg else phi
+    names = ("x", "y", "z") + COORDINATES[args.analytic]
+    euler = args.analytic in ("rpy", "zyz")
+    conv = np.degrees(phi) if args.deg and euler else phi
+    unit = "" if args.analytic == "quaternion" else f" ({'deg' if args.deg and euler else 'rad'})"
+    what = "angles" if euler else "quaternion (w, x, y, z)" if args.analytic == "quaternion" else "rotation vector"
     lines += ["" if lines else "", f"{robot.name}: analytic Jacobian ({args.analytic}) at {q_text(args, robot, q)}",
               f"rows (xdot, ydot, zdot, {', '.join(n + 'dot' for n in names[3:])}) in base/world axes",
-              f"angles: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))} "
-              f"({'deg' if args.deg else 'rad'})", _labelled(Ja, names)]
+              f"{what}: {', '.join(f'{n} = {t}' for n, t in zip(names[3:], numbers_text(conv).split(', ')))}{unit}",
+              _labelled(Ja, names)]
     return {"Ja": Ja, "representation": args.analytic, "angles": conv, "analytic_rows": list(names)}
 
 
