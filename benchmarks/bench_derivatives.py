@@ -7,8 +7,9 @@ Timed operations, for Puma 560 (6 DOF, standard DH) and Panda (7 DOF, modified D
 RNEA has none), motor inertia included (Pinocchio's armature):
   RNEA derivatives  ∂τ/∂q, ∂τ/∂q̇   denavit: compile(robot).rnea_derivatives;  pin.computeRNEADerivatives
   ABA derivatives   ∂q̈/∂q, ∂q̈/∂q̇, M⁻¹  denavit: compile(robot).forward_dynamics_derivatives;  pin.computeABADerivatives
-Single call: one configuration from Python, best of `repeat` rounds of the mean of `number` calls, the two libraries
-taking turns within each round (benchmarks/_peers.best_times), so load on a shared machine reaches both alike.
+Single call: one configuration from Python, best of `repeat` rounds of the mean CPU time (time.process_time: time
+spent descheduled on a loaded machine does not count) of `number` calls, the two libraries taking turns within each
+round, so load on a shared machine reaches both alike.
 Batch: `batch` configurations in one call of the compiled object on one thread (rows per second).
 """
 
@@ -16,13 +17,26 @@ from __future__ import annotations
 
 import argparse
 import platform
+import time
 
 import numpy as np
 
 import denavit
-from _peers import best_times, to_pinocchio
+from _peers import to_pinocchio
 
 ROBOTS = ("puma560", "panda")
+
+
+def cpu_best_times(fns, repeat: int, number: int) -> list[float]:
+    """As _peers.best_times, in CPU seconds of this process per call."""
+    best = [np.inf] * len(fns)
+    for _ in range(repeat):
+        for i, fn in enumerate(fns):
+            t0 = time.process_time()
+            for _ in range(number):
+                fn()
+            best[i] = min(best[i], (time.process_time() - t0) / number)
+    return best
 
 
 def _check(fast, model, data, q, qd, qdd, tau):
@@ -49,14 +63,16 @@ def rows(repeat: int, number: int, batch: int):
         q, qd, qdd = (rng.uniform(-1, 1, robot.dof) for _ in range(3))
         tau = denavit.rnea(robot, q, qd, qdd, friction=False)
         fast.rnea_derivatives(q, qd, qdd)  # compiles the group (or loads it from the disk cache)
+        fast.forward_dynamics_derivatives(q, qd, tau)
         _check(fast, model, data, q, qd, qdd, tau)
-        ours_r, pin_r, ours_a, pin_a = best_times([
+        ours_r, pin_r, ours_a, pin_a = cpu_best_times([
             lambda: fast.rnea_derivatives(q, qd, qdd), lambda: pin.computeRNEADerivatives(model, data, q, qd, qdd),
             lambda: fast.forward_dynamics_derivatives(q, qd, tau),
             lambda: pin.computeABADerivatives(model, data, q, qd, tau)], repeat, number)
         Q = rng.uniform(-1, 1, (batch, robot.dof))
         QD, QDD = rng.uniform(-1, 1, (2, batch, robot.dof))
-        (b,) = best_times([lambda: fast.rnea_derivatives(Q, QD, QDD, threads=1)], max(1, repeat // 2), 1)
+        fast.rnea_derivatives(Q[:8], QD[:8], QDD[:8])  # the batch kernel compiles (or loads) before it is timed
+        (b,) = cpu_best_times([lambda: fast.rnea_derivatives(Q, QD, QDD, threads=1)], max(1, repeat // 2), 1)
         out.append((name, "RNEA derivatives", ours_r, pin_r, batch / b))
         out.append((name, "ABA derivatives", ours_a, pin_a, None))
     return out, pin.__version__

@@ -33,8 +33,9 @@ class DynDerivativeMethods:
         robot's gravity and the object's friction)."""
         n = self.dof
         out = self._single3("rnea_derivatives", q, qd, qdd, (2, n, n))
-        if out is None:
-            out = self._call("rnea_derivatives", (q, qd, qdd), ("q", "qd", "qdd"), threads)
+        if out is not None:
+            return out[0], out[1]
+        out = self._call("rnea_derivatives", (q, qd, qdd), ("q", "qd", "qdd"), threads)
         return out[..., 0, :, :], out[..., 1, :, :]
 
     def forward_dynamics_derivatives(self, q, qd, tau, *, threads=None):
@@ -44,10 +45,15 @@ class DynDerivativeMethods:
         r = self._single3("forward_dynamics_derivatives", q, qd, tau, (3 * n * n + 1,))
         if r is None:
             r = self._call("forward_dynamics_derivatives", (q, qd, tau), ("q", "qd", "tau"), threads)
-        if not (r[..., -1] > 0.0).all():
+        if r.ndim > 1:
+            if not (r[..., -1] > 0.0).all():
+                self._singular()
+            D = r[..., :-1].reshape(r.shape[:-1] + (3, n, n))
+            return D[..., 0, :, :], D[..., 1, :, :], D[..., 2, :, :]
+        if not r[-1] > 0.0:
             self._singular()
-        D = r[..., :-1].reshape(r.shape[:-1] + (3, n, n))
-        return D[..., 0, :, :], D[..., 1, :, :], D[..., 2, :, :]
+        D = r[:-1].reshape(3, n, n)
+        return D[0], D[1], D[2]
 
     def gravity_derivatives(self, q, *, threads=None):
         """∂g/∂q, (..., n, n) (as :func:`denavit.gravity_derivatives` with the robot's gravity)."""
