@@ -359,13 +359,9 @@ def test_pdf_report_has_no_overfull_formula(tmp_path, capsys):
 def test_an_arm_given_for_a_section_the_report_lacks_is_refused_naming_its_sections(capsys, tmp_path):
     """``--arm 7=planar2r`` on a report of sections 1-4 was silently ignored (the report judged against its own
     table, as if --arm had not been given); a typo in SECTION must say so."""
-    from pathlib import Path
-
     report = tmp_path / "hw.md"
-    report.write_text((Path(__file__).parents[1] / "examples" / "reports" / "planar2r-homework.md")
-                      .read_text(encoding="utf-8"), encoding="utf-8")
-    headings = re.findall(r"^#+ (\d+)\. ", report.read_text(encoding="utf-8"), re.M)
-    assert headings == ["1", "2", "3", "4"]  # the sections the message must offer
+    report.write_text("# Homework\n\n" + "".join(f"## {k}. Part {k}\n\nWords.\n\n" for k in range(1, 5)),
+                      encoding="utf-8")
     code, out, err = run(capsys, "check", str(report), "--arm", "7=planar2r")
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert "no section '7'" in err and "1, 2, 3, 4" in err
