@@ -107,6 +107,30 @@ def test_nested_split_from_a_worker_runs_inline():
     assert inner == [(0, 10 * MIN_ROWS)]
 
 
+def _split_in_child(conn):
+    seen = []
+    split_rows(4 * MIN_ROWS, lambda s, e: seen.append(s), threads=2)
+    conn.send(sorted(seen))
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork on this platform")
+def test_a_forked_child_makes_its_own_pool():
+    """A child forked after the pool started has the pool object but none of its threads: it must not queue
+    blocks there (they would never run)."""
+    import multiprocessing
+
+    split_rows(4 * MIN_ROWS, lambda s, e: None, threads=2)  # the pool exists, with its threads
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe()
+    p = ctx.Process(target=_split_in_child, args=(child,))
+    p.start()
+    got = parent.recv() if parent.poll(60) else None
+    p.join(10)
+    if p.is_alive():  # pragma: no cover (the failure this test is for)
+        p.kill()
+    assert got == [s for s, _ in blocks(4 * MIN_ROWS, 2)]
+
+
 def test_run_batch_writes_each_block_of_the_output():
     x = np.random.default_rng(1).normal(size=(3 * MIN_ROWS + 11, 3))
     out = np.full((len(x), 2), np.nan)

@@ -45,7 +45,7 @@ ALIGN = 8
 
 _local = threading.local()
 _lock = threading.Lock()
-_pool: list = [None, 0]  # the executor and its number of workers
+_pool: list = [None, 0, 0]  # the executor, its number of workers, the process id that made it
 
 
 def available_cores() -> int:
@@ -86,12 +86,14 @@ def blocks(rows: int, threads=None, min_rows: int = MIN_ROWS) -> list[tuple[int,
 
 def _executor(workers: int) -> ThreadPoolExecutor:
     with _lock:
-        if _pool[1] < workers:  # grown, never shrunk; the old pool is dropped (not shut down: a caller may
-            # still be submitting to it), and its idle threads end once it is garbage-collected
+        # a forked child inherits the pool object but not its threads (work queued there would never run):
+        # it makes its own
+        if _pool[1] < workers or _pool[2] != os.getpid():  # grown, never shrunk; the old pool is dropped (not
+            # shut down: a caller may still be submitting to it), its idle threads end once it is collected
             workers = max(workers, available_cores() - 1)
             _pool[0] = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="denavit",
                                           initializer=_mark_worker)
-            _pool[1] = workers
+            _pool[1], _pool[2] = workers, os.getpid()
         return _pool[0]
 
 
