@@ -15,25 +15,18 @@ _ndarray, _F64, _empty, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (8
 
 class DynDerivativeMethods:
     """Mixed into CompiledRobot, whose ``_call`` (any call, loading the group first) and hot-path kernels
-    ``_<name>_1`` (bound once the group is loaded) they use."""
-
-    def _single3(self, name: str, a, b, c, shape):
-        """The hot path for three (n,) float64 contiguous arrays once the kernel is bound, else None."""
-        kernel = self.__dict__.get(f"_{name}_1")
-        if (kernel is not None and a.__class__ is _ndarray and b.__class__ is _ndarray and c.__class__ is _ndarray
-                and a.dtype is _F64 and b.dtype is _F64 and c.dtype is _F64
-                and a.shape == b.shape == c.shape == self._vec and a.strides == b.strides == c.strides == _STRIDE):
-            out = _empty(shape)
-            kernel(a, b, c, out)
-            return out
-        return None
+    ``_<name>_1`` (bound once the group is loaded) they use.  The hot path (three (n,) float64 contiguous arrays,
+    kernel bound) is spelled out in each method: a helper call and a name built per call cost a microsecond."""
 
     def rnea_derivatives(self, q, qd, qdd, *, threads=None):
         """``(dtau_dq, dtau_dqd)``, each (..., n, n) [output, input] (as :func:`denavit.rnea_derivatives` with the
         robot's gravity and the object's friction)."""
-        n = self.dof
-        out = self._single3("rnea_derivatives", q, qd, qdd, (2, n, n))
-        if out is not None:
+        kernel = self.__dict__.get("_rnea_derivatives_1")
+        if (kernel is not None and q.__class__ is _ndarray and qd.__class__ is _ndarray and qdd.__class__ is _ndarray
+                and q.dtype is _F64 and qd.dtype is _F64 and qdd.dtype is _F64
+                and q.shape == qd.shape == qdd.shape == self._vec and q.strides == qd.strides == qdd.strides == _STRIDE):
+            out = _empty(self._shapes["rnea_derivatives"])
+            kernel(q, qd, qdd, out)
             return out[0], out[1]
         out = self._call("rnea_derivatives", (q, qd, qdd), ("q", "qd", "qdd"), threads)
         return out[..., 0, :, :], out[..., 1, :, :]
@@ -42,8 +35,13 @@ class DynDerivativeMethods:
         """``(dqdd_dq, dqdd_dqd, dqdd_dtau)``, each (..., n, n); dqdd_dtau = M⁻¹ (as
         :func:`denavit.forward_dynamics_derivatives`); ModelError where M is singular."""
         n = self.dof
-        r = self._single3("forward_dynamics_derivatives", q, qd, tau, (3 * n * n + 1,))
-        if r is None:
+        kernel = self.__dict__.get("_forward_dynamics_derivatives_1")
+        if (kernel is not None and q.__class__ is _ndarray and qd.__class__ is _ndarray and tau.__class__ is _ndarray
+                and q.dtype is _F64 and qd.dtype is _F64 and tau.dtype is _F64
+                and q.shape == qd.shape == tau.shape == self._vec and q.strides == qd.strides == tau.strides == _STRIDE):
+            r = _empty(self._shapes["forward_dynamics_derivatives"])
+            kernel(q, qd, tau, r)
+        else:
             r = self._call("forward_dynamics_derivatives", (q, qd, tau), ("q", "qd", "tau"), threads)
         if r.ndim > 1:
             if not (r[..., -1] > 0.0).all():
