@@ -184,27 +184,35 @@ def analytic_rows(name: str, n_targets: int):
 RTB_TOL = 5e-19
 
 COLD = """
-import time, numpy as np
-t0 = time.perf_counter()
+import json, time, numpy as np
 import numba  # the numba import itself is not part of the compile time
 import denavit
 robot = denavit.load_robot({name!r})
-t1 = time.perf_counter()
-fast = denavit.compile(robot)
-times = fast.warm()
-print(time.perf_counter() - t1, t1 - t0)
+q = np.zeros(robot.dof)
+marks = [(time.perf_counter(), time.process_time())]
+fast = denavit.compile(robot)  # from the cache: the module only, no kernel loaded
+marks.append((time.perf_counter(), time.process_time()))
+fast.fk(q)  # the first kernel: numba's own start-up (its typing and target registries) and fk_1
+marks.append((time.perf_counter(), time.process_time()))
+fast.jacobian(q)  # another kernel's first call: that kernel alone
+marks.append((time.perf_counter(), time.process_time()))
+fast.warm()  # every other kernel, single and batch
+marks.append((time.perf_counter(), time.process_time()))
+print(json.dumps([[b[0] - a[0], b[1] - a[1]] for a, b in zip(marks, marks[1:])]))
 """
 
 
 def compile_rows(name: str):
+    """Two fresh processes on an empty cache folder: the first compiles (cold), the second loads.  Each stage as
+    (wall, CPU) seconds: compile(), the first kernel call, a second kernel's first call, warm() of the rest."""
+    import json
+
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "DENAVIT_CACHE_DIR": cache}
-        runs = []
-        for _ in range(2):
-            out = subprocess.run([sys.executable, "-c", COLD.format(name=name)], env=env, capture_output=True,
-                                 text=True, check=True).stdout.split()
-            runs.append((float(out[0]), float(out[1])))
-    return name, runs[0][0], runs[1][0], runs[0][1]
+        runs = [json.loads(subprocess.run([sys.executable, "-c", COLD.format(name=name)], env=env,
+                                          capture_output=True, text=True, check=True).stdout) for _ in range(2)]
+    cold = [sum(x[i] for x in runs[0]) for i in (0, 1)]
+    return name, cold, runs[1]
 
 
 def main() -> None:
@@ -213,38 +221,68 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--number", type=int, default=5000)
     ap.add_argument("--targets", type=int, default=1000, help="IK targets per arm")
+    ap.add_argument("--parts", default="single,batch,ik,analytic,compile",
+                    help="comma-separated tables to run (default all): single, batch, ik, analytic, compile")
     args = ap.parse_args()
+    parts = set(args.parts.split(","))
     import numba
     import pinocchio as pin
 
     print(f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, "
           f"Pinocchio {pin.__version__}, load average {os.getloadavg()[0]:.1f}\n")
+    if "single" in parts:
+        single_table(args.repeat, args.number)
+    if "batch" in parts:
+        batch_table(args.batch, args.repeat)
+    if "ik" in parts:
+        ik_table(args.targets)
+    if "analytic" in parts:
+        analytic_table(args.targets)
+    if "compile" in parts:
+        compile_table()
+
+
+def single_table(repeat: int, number: int) -> None:
     print("| robot | op | denavit.compile [µs] | Pinocchio [µs] | ratio | plain denavit [µs] |")
     print("|---|---|---:|---:|---:|---:|")
     for name in ROBOTS:
-        for r in single_rows(name, args.repeat, args.number):
+        for r in single_rows(name, repeat, number):
             print(f"| {r[0]} | {r[1]} | {r[2]:.2f} | {r[3]:.2f} | {r[4]:.2f} | {r[5]:.1f} |")
+
+
+def batch_table(batch: int, repeat: int) -> None:
     print(f"\n| robot | op | numba [configs/s] | numpy backend [configs/s] | roboticstoolbox batched C [configs/s] |")
     print("|---|---|---:|---:|---:|")
     for name in ROBOTS:
-        for r in batch_rows(name, args.batch, max(3, args.repeat // 2)):
+        for r in batch_rows(name, batch, max(3, repeat // 2)):
             peer = f"{r[4] / 1e6:.2f} M" if r[4] else "—"
             print(f"| {r[0]} | {r[1]} | {r[2] / 1e6:.2f} M | {r[3] / 1e6:.2f} M | {peer} |")
+
+
+def ik_table(targets: int) -> None:
     print("\n| robot | IK solver | median / solve [µs] | mean / solve [µs] | success (1e-8, in limits) |")
     print("|---|---|---:|---:|---:|")
     for name in ("puma560", "ur5", "panda"):
-        for r in ik_rows(name, args.targets):
+        for r in ik_rows(name, targets):
             print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {100 * r[4]:.1f} % |")
+
+
+def analytic_table(targets: int) -> None:
     print("\n| robot | analytic IK, one pose per call | median [µs] | p95 [µs] | solutions / pose |")
     print("|---|---|---:|---:|---:|")
     for name in ("puma560", "ur5", "stanford"):  # elbow + spherical wrist; UR class (axes 2-4 parallel); R R P
-        for r in analytic_rows(name, args.targets):
+        for r in analytic_rows(name, targets):
             print(f"| {r[0]} | {r[1]} | {r[2]:.1f} | {r[3]:.1f} | {r[4]:.2f} |")
-    print("\n| robot | compile, empty cache [s] | compile, from the cache [s] | numba + denavit import [s] |")
-    print("|---|---:|---:|---:|")
+
+
+def compile_table() -> None:
+    print("\n| robot | cold: compile + every kernel [s] (CPU) | from the cache: compile() [ms] (CPU) | first kernel "
+          "call [ms] (CPU) | a second kernel's first call [ms] (CPU) | every other kernel [ms] (CPU) |")
+    print("|---|---:|---:|---:|---:|---:|")
     for name in ROBOTS:
-        r = compile_rows(name)
-        print(f"| {r[0]} | {r[1]:.2f} | {r[2]:.3f} | {r[3]:.2f} |")
+        r, cold, warm = compile_rows(name)
+        cells = " | ".join(f"{1e3 * w:.0f} ({1e3 * c:.0f})" for w, c in warm)
+        print(f"| {r} | {cold[0]:.2f} ({cold[1]:.2f}) | {cells} |")
 
 
 if __name__ == "__main__":

@@ -42,6 +42,7 @@ __all__ = [
     "cache_dir",
     "cache_info",
     "clear_cache",
+    "guard_cache",
     "load_module",
     "numba_available",
     "robot_key",
@@ -300,6 +301,12 @@ def _guard_numba(mod: types.ModuleType) -> None:
     for value in vars(mod).values():
         if isinstance(value, Dispatcher) and hasattr(getattr(value, "_cache", None), "load_overload"):
             value._cache = _GuardedCache(value._cache)
+
+
+def guard_cache(compiled) -> None:
+    """Put a :class:`_GuardedCache` in front of the disk cache of one numba object made later (a ``CFunc``)."""
+    if hasattr(getattr(compiled, "_cache", None), "load_overload"):
+        compiled._cache = _GuardedCache(compiled._cache)
 
 
 def _own_entries(folder: Path) -> list[os.DirEntry]:

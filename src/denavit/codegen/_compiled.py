@@ -9,7 +9,8 @@ import numpy as np
 from .._threads import resolve_threads, run_batch
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
-from ._cache import load_module, numba_available, robot_key
+from . import _fastcall
+from ._cache import guard_cache, load_module, numba_available, robot_key
 from ._emit import NUMBA, NUMPY, python_module
 from ._kernels import (BASE_GROUP, DYNAMICS, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
                        registered_digest, registered_kernels, trace_kernels, trace_registered)
@@ -31,6 +32,10 @@ def _as_batch(arrays, names):
     return flat, batch
 
 
+#: kernels whose single call a built-in function takes over (the method it stands in for), and their inputs' count
+_BUILTIN_METHODS = {"fk": "fk", "position": "position", "jacobian0": "jacobian", "rnea": "rnea",
+                    "mass_matrix": "mass_matrix", "gravity": "gravity", "coriolis": "coriolis"}
+_ARITY = {"rnea": 3, "coriolis": 2, "forward_dynamics": 3}
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
 
@@ -54,6 +59,7 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods):
         self._vec, self._jshape, self._mshape, self._fshape = (n,), (6, n), (n, n), (n + 1,)
         self._ik_constants = None
         self._elbow = None
+        self._keep: list = []  # what the built-in methods need alive (see _builtin)
         for name in names:
             self._bind(name, module)
         for name in self._shapes:  # bound kernels for the hot paths; a missing one raises the clear error
@@ -133,8 +139,24 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods):
                 if all(getattr(t, "layout", "C") == "C" for t in sig):
                     setattr(self, f"_{name}_1", result.entry_point)
                     break
+            if name in _BUILTIN_METHODS:
+                self._builtin(name, _BUILTIN_METHODS[name])
 
         return first
+
+    def _builtin(self, name: str, method: str) -> None:
+        """Put kernel ``name``'s CPython built-in (:mod:`denavit.codegen._fastcall`) on this object in place of
+        ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on; every
+        other call goes to the method itself.  Nothing changes when the built-in cannot be made here."""
+        lengths = (self.dof,) * _ARITY.get(name, 1)
+        try:
+            made = _fastcall.install(self._groups[BASE_GROUP][0], name, lengths, self._shapes[name],
+                                     getattr(type(self), method).__get__(self), guard_cache)
+        except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
+            made = None
+        if made is not None:
+            setattr(self, method, made[0])
+            self._keep.append(made[1])
 
     def _missing(self, name: str):
         def kernel(*args):

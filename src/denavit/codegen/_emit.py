@@ -117,7 +117,11 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
             "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",
             f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {spec.shape}."""',
             # LANES rows per call (the last call masks the lanes past the end)
-            f"    for b in range(0, {first}.shape[0], {LANES}):", f"        _{k}_rows({args}, out, b)", "", ""])
+            f"    for b in range(0, {first}.shape[0], {LANES}):", f"        _{k}_rows({args}, out, b)", "", "",
+            # compiled as a cfunc on first use, with _{k}_entry made then (see denavit.codegen._fastcall)
+            f"def {k}_entry(self, args, nargs, kwnames):",
+            f'    """{spec.doc}: the CPython fast-call entry of one configuration."""',
+            f"    return _{k}_entry(self, args, nargs, kwnames)", "", ""])
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:

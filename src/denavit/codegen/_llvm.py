@@ -72,24 +72,6 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
             inside = [builder.icmp_signed("<", builder.add(args[-1], ir.Constant(i64, j)), n_rows)
                       for j in range(lanes)]
             rows = [builder.select(inside[j], builder.add(args[-1], ir.Constant(i64, j)), last) for j in range(lanes)]
-        module = builder.module
-        vty = ir.VectorType(dbl, lanes) if lanes else dbl
-        sincos = cgutils.get_or_insert_function(
-            module, ir.FunctionType(ir.VoidType(), [dbl, dbl.as_pointer(), dbl.as_pointer()]), "sincos")
-        fns = {name: _intrinsic(module, name, vty, 2) for name in ("minnum", "maxnum")}
-        both: dict = {}
-        inputs: dict = {}
-        values: list = []
-
-        constants: dict = {}
-
-        def const(x: float):
-            key = (x, math.copysign(1.0, x))  # −0.0 == 0.0 as a key; its sign still matters
-            c = constants.get(key)
-            if c is None:
-                c = constants[key] = ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
-            return c
-
         # each array's data pointer (as bytes) and strides, read once here (before any conditional block):
         # an element's address is data + Σ index·stride; numba's get_item_pointer would re-read them per element
         i8p = ir.IntType(8).as_pointer()
@@ -119,54 +101,15 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
                 b = bases[(arg, id(row))] = base(arg, row)
             return at(b, inner(arg, index))
 
-        def operand(ref):
-            kind = ref[0]
-            if kind == "n":
-                return values[ref[1]]
-            if kind == "c":
-                return const(ref[1])
-            key = (ref[1], ref[2])
-            v = inputs.get(key)
-            if v is None:
-                k = [ref[2]]
-                if lanes:
-                    v = ir.Constant(vty, ir.Undefined)
-                    for j, row in enumerate(rows):
-                        v = builder.insert_element(v, builder.load(item(ref[1], k, row)), ir.Constant(i64, j))
-                else:
-                    v = builder.load(item(ref[1], k, rows[0] if batched else None))
-                inputs[key] = v
+        def load(arg, k):
+            if not lanes:
+                return builder.load(item(arg, [k], rows[0] if batched else None))
+            v = ir.Constant(ir.VectorType(dbl, lanes), ir.Undefined)
+            for j, row in enumerate(rows):
+                v = builder.insert_element(v, builder.load(item(arg, [k], row)), ir.Constant(i64, j))
             return v
 
-        one, zero, minus = const(1.0), const(0.0), const(-1.0)
-        for op, a, b in steps:
-            A = operand(a)
-            if op == "add":
-                v = builder.fadd(A, operand(b))
-            elif op == "sub":
-                v = builder.fsub(A, operand(b))
-            elif op == "mul":
-                v = builder.fmul(A, operand(b))
-            elif op == "div":
-                v = builder.fdiv(A, operand(b))
-            elif op == "neg":
-                v = builder.fneg(A)
-            elif op in ("sin", "cos"):
-                pair = both.get(repr(a))
-                if pair is None:
-                    pair = _poly_sincos(builder, A, lanes, sincos, const)
-                    both[repr(a)] = pair
-                v = pair[0] if op == "sin" else pair[1]
-            elif op == "sign":  # 1, −1 or 0 (NaN stays NaN through the multiplications it feeds)
-                v = builder.select(builder.fcmp_ordered(">", A, zero), one,
-                                   builder.select(builder.fcmp_ordered("<", A, zero), minus, zero))
-            elif op == "min":
-                v = builder.call(fns["minnum"], [A, operand(b)])
-            elif op == "max":
-                v = builder.call(fns["maxnum"], [A, operand(b)])
-            else:  # pragma: no cover - the tape has no other operations
-                raise ValueError(f"unknown operation {op!r}")
-            values.append(v)
+        operand = emit_steps(builder, steps, lanes, load)
         if not lanes:
             row_base = base(n_inputs, rows[0])
             for index, ref in outputs:
@@ -198,6 +141,75 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
         return intrinsic(kernel)
 
     return arity(n_inputs + 1, 0), arity(n_inputs + 2, LANES)
+
+
+def emit_steps(builder, steps: tuple, lanes: int, load):
+    """Emit the program ``steps`` at the builder (on doubles, or ``<lanes x double>`` vectors); ``load(arg, k)`` gives
+    element k of input ``arg`` (called once per element used, in the main flow).  Returns ``operand(ref)``: the value
+    of a step, a constant or an input, for the outputs."""
+    from llvmlite import ir
+    from numba.core import cgutils
+
+    dbl = ir.DoubleType()
+    module = builder.module
+    vty = ir.VectorType(dbl, lanes) if lanes else dbl
+    sincos = cgutils.get_or_insert_function(
+        module, ir.FunctionType(ir.VoidType(), [dbl, dbl.as_pointer(), dbl.as_pointer()]), "sincos")
+    fns = {name: _intrinsic(module, name, vty, 2) for name in ("minnum", "maxnum")}
+    both: dict = {}
+    inputs: dict = {}
+    values: list = []
+    constants: dict = {}
+
+    def const(x: float):
+        key = (x, math.copysign(1.0, x))  # −0.0 == 0.0 as a key; its sign still matters
+        c = constants.get(key)
+        if c is None:
+            c = constants[key] = ir.Constant(vty, [x] * lanes) if lanes else ir.Constant(dbl, x)
+        return c
+
+    def operand(ref):
+        kind = ref[0]
+        if kind == "n":
+            return values[ref[1]]
+        if kind == "c":
+            return const(ref[1])
+        key = (ref[1], ref[2])
+        v = inputs.get(key)
+        if v is None:
+            v = inputs[key] = load(ref[1], ref[2])
+        return v
+
+    one, zero, minus = const(1.0), const(0.0), const(-1.0)
+    for op, a, b in steps:
+        A = operand(a)
+        if op == "add":
+            v = builder.fadd(A, operand(b))
+        elif op == "sub":
+            v = builder.fsub(A, operand(b))
+        elif op == "mul":
+            v = builder.fmul(A, operand(b))
+        elif op == "div":
+            v = builder.fdiv(A, operand(b))
+        elif op == "neg":
+            v = builder.fneg(A)
+        elif op in ("sin", "cos"):
+            pair = both.get(repr(a))
+            if pair is None:
+                pair = _poly_sincos(builder, A, lanes, sincos, const)
+                both[repr(a)] = pair
+            v = pair[0] if op == "sin" else pair[1]
+        elif op == "sign":  # 1, −1 or 0 (NaN stays NaN through the multiplications it feeds)
+            v = builder.select(builder.fcmp_ordered(">", A, zero), one,
+                               builder.select(builder.fcmp_ordered("<", A, zero), minus, zero))
+        elif op == "min":
+            v = builder.call(fns["minnum"], [A, operand(b)])
+        elif op == "max":
+            v = builder.call(fns["maxnum"], [A, operand(b)])
+        else:  # pragma: no cover - the tape has no other operations
+            raise ValueError(f"unknown operation {op!r}")
+        values.append(v)
+    return operand
 
 
 def _intrinsic(module, name: str, ty, n_args: int):
