@@ -407,3 +407,16 @@ def test_a_reports_arms_are_listed_in_the_order_of_its_sections():
     report = grade_text(text, "md", arms={str(k): load_robot(name) for k, name in enumerate(names, start=1)})
     assert [a.name for a in report.arms] == names
     assert [a.line for a in report.arms] == sorted(a.line for a in report.arms)
+
+
+def test_the_readme_names_every_extra_the_package_defines():
+    """README's "Install options" named 4 of the 10 extras of pyproject.toml (no `fast`, `scale`, `xacro`, ...),
+    while the docs and error messages send the reader to them."""
+    from pathlib import Path
+
+    tomllib = pytest.importorskip("tomllib")
+    root = Path(__file__).parents[1]
+    extras = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["project"]["optional-dependencies"]
+    readme = (root / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("## Install options"):]
+    assert len(extras) >= 5 and [e for e in extras if f"`{e}`" not in section] == []
