@@ -78,7 +78,7 @@ def test_rnea_derivatives_match_pinocchio(seed):
     robot = dynamic_arm(seed)
     model, data, _ = to_pinocchio(robot)
     q, qd, qdd = state(robot, seed)
-    dq, dv, da = pin.computeRNEADerivatives(model, data, q, qd, qdd)
+    dq, dv, _ = pin.computeRNEADerivatives(model, data, q, qd, qdd)
     A, B = denavit.rnea_derivatives(robot, q, qd, qdd, friction=False)
     assert rel_err(A, dq) <= REL and rel_err(B, dv) <= REL
     fv = [link.inertia.viscous for link in robot.joints]
