@@ -327,3 +327,28 @@ def test_compiled_numba_matches_pinocchio():
     for i in range(4):
         dq, dv, _ = pin.computeRNEADerivatives(model, data, Q[0][i], Q[1][i], Q[2][i])
         assert rel_err(A[i], dq) <= REL and rel_err(B[i], dv) <= REL
+
+
+def test_exported_python_has_the_derivative_kernels(tmp_path):
+    """`denavit export --lang python --kernels ...`: the numpy-only module computes what the plain functions do."""
+    import importlib.util
+
+    from denavit.codegen import export_sources
+
+    robot = dynamic_arm(5)
+    names = ["rnea_derivatives", "forward_dynamics_derivatives", "gravity_derivatives"]
+    (tmp_path / "arm.py").write_text(export_sources(robot, "python", "arm", kernels=names)["arm.py"], encoding="utf-8")
+    spec = importlib.util.spec_from_file_location("arm", tmp_path / "arm.py")
+    arm = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(arm)
+    q, qd, qdd = state(robot, 5, (3,))
+    D = arm.rnea_derivatives(q, qd, qdd)  # (3, 2, n, n)
+    A, B = denavit.rnea_derivatives(robot, q, qd, qdd)
+    assert rel_err(D[:, 0], A) <= REL and rel_err(D[:, 1], B) <= REL
+    assert rel_err(arm.gravity_derivatives(q), denavit.gravity_derivatives(robot, q)) <= REL
+    n = robot.dof
+    r = arm.forward_dynamics_derivatives(q, qd, qdd)  # (3, 3 n² + 1): the blocks, then the regularity flag
+    assert (r[:, -1] > 0).all()
+    X = r[:, :-1].reshape(3, 3, n, n)
+    for k, ref in enumerate(denavit.forward_dynamics_derivatives(robot, q, qd, qdd)):
+        assert rel_err(X[:, k], ref) <= REL
