@@ -29,6 +29,7 @@ straight-line program.
 from __future__ import annotations
 
 import math
+from numbers import Real
 
 __all__ = ["Sym", "Tape", "sym_sin", "sym_cos", "sym_sign", "sym_min", "sym_max"]
 
@@ -46,14 +47,14 @@ class Sym:
 
     # another kind of number (a dual of denavit.numeric holding traced values) does the operation itself
     def __add__(self, other):
-        if not isinstance(other, _OPERANDS):
+        if not isinstance(other, _OPERANDS) and not isinstance(other, Real):
             return NotImplemented
         return self.tape.add(self, other)
 
     __radd__ = __add__
 
     def __sub__(self, other):
-        if not isinstance(other, _OPERANDS):
+        if not isinstance(other, _OPERANDS) and not isinstance(other, Real):
             return NotImplemented
         return self.tape.sub(self, other)
 
@@ -61,14 +62,14 @@ class Sym:
         return self.tape.sub(other, self)
 
     def __mul__(self, other):
-        if not isinstance(other, _OPERANDS):
+        if not isinstance(other, _OPERANDS) and not isinstance(other, Real):
             return NotImplemented
         return self.tape.mul(self, other)
 
     __rmul__ = __mul__
 
     def __truediv__(self, other):
-        if not isinstance(other, _OPERANDS):
+        if not isinstance(other, _OPERANDS) and not isinstance(other, Real):
             return NotImplemented
         return self.tape.div(self, other)
 
