@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -11,7 +12,8 @@ import numpy as np
 from ..errors import ModelError
 from ..model import DHRobot
 from ._refine import Refinement, check_factor, pilot_blocks, plan_refinement, refined_levels, refinement
-from ._sampler import BLOCK, Grid, Job, make_job, positions_block, run_task
+from ._sampler import BLOCK, CompiledPositionFK, Grid, Job, default_fk, make_job, positions_block, run_task
+from ._sink import close_sink, open_sink, sink_of
 from ._schedule import POOLS, Progress, resolve_auto, run
 from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
 
@@ -154,6 +156,15 @@ def _tasks(samples: int, chunk: int, start: int = 0, stop: int | None = None):
         first += per
 
 
+def _where(scheduler: Any, samples: int, fk: Callable | None, robot: DHRobot) -> Any:
+    """``"auto"``: threads when the tasks run the fused kernel (the default FK from COMPILED_FROM samples with
+    numba: no GIL held, no counts handed over), else :func:`resolve_auto`'s choice."""
+    if isinstance(scheduler, str) and scheduler == "auto" and fk is None:
+        if type(default_fk(robot, samples)) is CompiledPositionFK:
+            return "threads"
+    return resolve_auto(scheduler, samples)
+
+
 def _check_sizes(samples: int, chunk: int) -> None:
     if isinstance(samples, bool) or int(samples) != samples or not 1 <= samples <= MAX_SAMPLES:
         raise ModelError(f"samples must be a whole number from 1 to {MAX_SAMPLES:.0e}, got {samples}")
@@ -211,7 +222,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     """
     _check_sizes(samples, DEFAULT_CHUNK if chunk is None else chunk)
     refine = check_factor(refine)
-    scheduler = resolve_auto(scheduler, samples)
+    scheduler = _where(scheduler, samples, fk, robot)
     if chunk is None:
         chunk = DEFAULT_CHUNK if isinstance(scheduler, str) and scheduler in POOLS else CLUSTER_CHUNK
     seed = new_seed() if seed is None else int(seed)
@@ -224,6 +235,10 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     lo, hi, reach = np.full(3, np.inf), np.full(3, -np.inf), 0.0
     blocks = -(-job.samples // BLOCK)
     pilot = pilot_blocks(blocks) if refine != 0 and (refine is not None or resolution is None) else 0
+    in_process = isinstance(scheduler, str) and scheduler in ("threads", "synchronous")
+    sink = open_sink(counts, workers or os.cpu_count() or 1, pilot > 0) if job.fused and in_process else None
+    if sink is not None:
+        job = dataclasses.replace(job, sink=sink)
     state = {"job": job, "fine": None}
 
     def tasks():
@@ -232,11 +247,15 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
             return
         yield from ((job, f, c) for f, c in _tasks(job.samples, chunk, 0, pilot))
         yield None  # barrier: every pilot result is merged into counts before the plan is made
+        if sink is not None:
+            sink_of(sink).flush()
         ref = plan_refinement(counts, refine, pilot)
         if ref is not None:
             state["job"] = dataclasses.replace(job, refine=ref)
             small = job.samples - pilot * BLOCK < 2**32  # no sub-cell count can overflow uint32
             state["fine"] = np.zeros(ref.cells.size * ref.factor**g.dim, dtype=np.uint32 if small else np.uint64)
+            if sink is not None:
+                sink_of(sink).flush(state["fine"])
         yield from ((state["job"], f, c) for f, c in _tasks(job.samples, chunk, pilot, blocks))
 
     bar = Progress(int(samples), "samples", progress)
@@ -247,8 +266,12 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
                 state["fine"][fidx] += fcnt
             lo, hi, reach = np.minimum(lo, bmin), np.maximum(hi, bmax), max(reach, r)
             bar.update(m)
+        if sink is not None:
+            sink_of(sink).flush(state["fine"])
     finally:
         bar.close()
+        if sink is not None:
+            close_sink(sink)
     ref = state["job"].refine
     fine = None if ref is None else state["fine"].reshape(ref.cells.size, -1)
     best, levels = _estimate(counts, g, ref, fine)

@@ -162,6 +162,8 @@ class Job:
     grid: Grid
     base_origin: np.ndarray  # (3,)
     refine: Refinement | None = None  # sub-cell counts in these cells (blocks after the pilot)
+    fused: bool = False  # tasks run the fused kernel (``_fused``: same numbers as fk, a CompiledPositionFK)
+    sink: str | None = None  # the run's accumulators in the driver's process (``_sink``), for in-process tasks
 
 
 def _draw(job: Job, block: int, q: np.ndarray) -> np.ndarray:
@@ -218,8 +220,14 @@ def _cells(job: Job, P: np.ndarray, flat: np.ndarray, T: np.ndarray | None = Non
     np.subtract(P, g.centre, out=D)
     if g.dim == 3 and np.array_equal(g.basis, np.eye(3)):
         U = D  # (m, dim)
-    else:
-        U = np.matmul(D, g.basis.T, out=_scratch.get("U", (m, g.dim), np.float64))
+    else:  # u_a = (d0·b_a0 + d1·b_a1) + d2·b_a2, in this order (as the fused kernel; BLAS may fuse or reorder)
+        U = _scratch.get("U", (m, g.dim), np.float64)
+        e = _scratch.get("e", (m,), np.float64)
+        for a in range(g.dim):
+            np.multiply(D[:, 0], g.basis[a, 0], out=U[:, a])
+            for j in (1, 2):
+                np.multiply(D[:, j], g.basis[a, j], out=e)
+                U[:, a] += e
     c = _scratch.get("c", (m,), np.int32)
     flat[:] = 0
     for a in range(g.dim):
@@ -270,7 +278,14 @@ def _distance_max(P: np.ndarray, origin: np.ndarray) -> float:
 
 def run_task(job: Job, first: int, count: int) -> tuple:
     """Blocks first … first+count−1: sorted flat cell indices, their counts, bounds (3,), (3,), reach, samples,
-    and — when ``job.refine`` is set — sorted sub-cell indices and their counts (else empty arrays)."""
+    and — when ``job.refine`` is set — sorted sub-cell indices and their counts (else empty arrays).
+
+    With ``job.fused`` the fused kernel computes the same (``_sink.run_fused``; cells unsorted, and none at all
+    when ``job.sink`` holds them in this process)."""
+    if job.fused:
+        from ._sink import run_fused
+
+        return run_fused(job, first, count)
     total = min((first + count) * BLOCK, job.samples) - first * BLOCK
     flat = _scratch.get("flat", (total,), np.int32)
     fine = _scratch.get("fine", (total,), np.int64) if job.refine is not None else None
@@ -355,4 +370,11 @@ def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, 
             raise ModelError(f"resolution {h:g} m leaves {cells:.3g} cells along the {2 * R:.4g} m reach box (at "
                              f"least {MIN_CELLS}): use a resolution of at most {2 * R / MIN_CELLS:.3g} m")
         side, levels = math.ceil(cells), 1
-    return Job(fk, limits, seed, samples, Grid(centre, basis, h, side, levels), base_origin)
+    return Job(fk, limits, seed, samples, Grid(centre, basis, h, side, levels), base_origin,
+               fused=type(fk) is CompiledPositionFK and _has_numba())
+
+
+def _has_numba() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("numba") is not None

@@ -1,0 +1,203 @@
+"""Where fused tasks count: dense per-task accumulators, merged by the driver (no hand-off per sample).
+
+In this process (``threads`` and ``synchronous`` schedulers) a run opens a :class:`Sink`: a pool of dense
+``uint32`` accumulators of the grid's size (and of the refined sub-cells').  A task takes one, counts into it
+with the GIL released (``_fused``), gives it back and returns no counts at all; the driver adds the
+accumulators into its ``uint64`` counts at the pilot's barrier and at the end (``flush``).  An accumulator is
+also flushed before its samples could pass 2³² − 1 (no cell can overflow).  At most ``cap`` accumulators exist
+(ACC_BUDGET bytes; a task waits for a free one), so memory does not grow with the workers beyond that.
+
+In another process (a process pool, a cluster) a task counts into a zeroed per-thread accumulator and records
+the first hit of each cell; it returns those cells and their counts (as the numpy route does after its sort)
+and zeroes them again.
+
+Integer sums commute, so the counts are those of the numpy route for any tasks, workers and accumulators.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+
+import numpy as np
+
+from ..errors import DenavitError, ModelError
+from ._refine import REFINE_CELLS, slot_map
+
+__all__ = ["ACC_BUDGET", "Sink", "open_sink", "close_sink", "run_fused", "task_memory"]
+
+#: Most bytes of accumulators a run keeps in this process (at least one accumulator is always made).
+ACC_BUDGET = 2**29
+#: Most samples an accumulator takes between flushes (its uint32 cells cannot overflow).
+_MOST = 2**32 - 1
+
+_sinks: dict = {}
+_sinks_lock = threading.Lock()
+_tokens = itertools.count()
+_E32, _E64, _EU64 = np.empty(0, np.int32), np.empty(0, np.int64), np.empty(0, np.uint64)
+
+
+class _Accumulator:
+    def __init__(self, cells: int) -> None:
+        self.counts = np.zeros(cells, dtype=np.uint32)
+        self.fine: np.ndarray | None = None
+        self.tally = 0  # samples since the last flush
+
+
+class Sink:
+    """The accumulators of one run in this process, and the driver's arrays they are flushed into."""
+
+    def __init__(self, counts: np.ndarray, workers: int, refinable: bool) -> None:
+        self.counts, self.fine = counts.reshape(-1), None
+        per = 4 * self.counts.size + (4 * REFINE_CELLS if refinable else 0)
+        self.cap = max(1, min(workers, ACC_BUDGET // per))
+        self.all: list[_Accumulator] = []
+        self.free: list[_Accumulator] = []
+        self.cond = threading.Condition()
+
+    def acquire(self, samples: int, fine_size: int) -> _Accumulator:
+        """A free accumulator (made while fewer than ``cap`` exist, else waited for) with room for
+        ``samples`` more and, when ``fine_size``, sub-cell counts of that size."""
+        with self.cond:
+            while not self.free and len(self.all) >= self.cap:
+                self.cond.wait()
+            if self.free:
+                acc = self.free.pop()
+            else:
+                acc = _Accumulator(self.counts.size)
+                self.all.append(acc)
+            if acc.tally + samples > _MOST:
+                self._flush_one(acc)
+        if fine_size and (acc.fine is None or acc.fine.size != fine_size):
+            acc.fine = np.zeros(fine_size, dtype=np.uint32)
+        acc.tally += samples
+        return acc
+
+    def release(self, acc: _Accumulator) -> None:
+        with self.cond:
+            self.free.append(acc)
+            self.cond.notify()
+
+    def _flush_one(self, acc: _Accumulator) -> None:
+        np.add(self.counts, acc.counts, out=self.counts)
+        acc.counts[:] = 0
+        if acc.fine is not None and self.fine is not None:
+            np.add(self.fine, acc.fine, out=self.fine, casting="unsafe")  # uint32 + uint32 into uint32 or uint64
+            acc.fine[:] = 0
+        acc.tally = 0
+
+    def flush(self, fine: np.ndarray | None = None) -> None:
+        """Add every accumulator into the driver's counts (and into ``fine``, the sub-cell counts, once they
+        exist); called when no task runs (a barrier, the end)."""
+        with self.cond:
+            if fine is not None:
+                self.fine = fine
+            for acc in self.all:
+                self._flush_one(acc)
+
+
+def open_sink(counts: np.ndarray, workers: int, refinable: bool) -> str:
+    """Register a :class:`Sink` flushing into ``counts``; its token travels with the run's tasks."""
+    token = f"sink-{next(_tokens)}"
+    with _sinks_lock:
+        _sinks[token] = Sink(counts, workers, refinable)
+    return token
+
+
+def sink_of(token: str) -> Sink:
+    return _sinks[token]
+
+
+def close_sink(token: str) -> None:
+    with _sinks_lock:
+        _sinks.pop(token, None)
+
+
+class _Work(threading.local):
+    """Per-thread arrays kept from task to task: zeroed accumulators of tasks run away from their driver
+    (``dense``; zeroed again after each task) and scratch (``get``; contents undefined)."""
+
+    def dense(self, name: str, size: int) -> np.ndarray:
+        a = self.__dict__.get(name)
+        if a is None or a.size != size:
+            a = self.__dict__[name] = np.zeros(size, dtype=np.uint32)
+        return a
+
+    def get(self, name: str, shape: tuple, dtype) -> np.ndarray:
+        a = self.__dict__.get(name)
+        size = int(np.prod(shape))
+        if a is None or a.size < size or a.dtype != dtype:
+            a = self.__dict__[name] = np.empty(size, dtype=dtype)
+        return a[:size].reshape(shape)
+
+
+_work = _Work()
+
+
+def task_memory(job, count: int) -> int:
+    """Bytes a fused task allocates beyond the accumulators: keys, sizes, scratch rows and — away from the
+    driver — the first-hit buffers (4 + 8 bytes per sample with sub-cells).  Independent of ``job.samples``."""
+    from ._fused import SUB_ROWS
+    from ._sampler import BLOCK
+
+    n = len(job.limits)
+    touched = 0 if job.sink else (4 + (8 if job.refine is not None else 0)) * count * BLOCK
+    return 24 * count + SUB_ROWS * 8 * (n + 3) + touched
+
+
+def run_fused(job, first: int, count: int) -> tuple:
+    """What :func:`denavit.scale._sampler.run_task` returns for blocks first … first+count−1, from the fused
+    kernel; into the run's sink when ``job.sink`` names one in this process (then no cells are returned)."""
+    from ._fused import SUB_ROWS, block_keys, fused_kernel
+    from ._sampler import BLOCK
+
+    g, ref, n = job.grid, job.refine, len(job.limits)
+    sizes = np.array([min(BLOCK, job.samples - b * BLOCK) for b in range(first, first + count)], dtype=np.int64)
+    total = int(sizes.sum())
+    lo = np.ascontiguousarray(job.limits[:, 0])
+    span = job.limits[:, 1] - job.limits[:, 0]
+    grid = np.array([*g.centre, g.lo, g.resolution, ref.factor if ref is not None else 0], dtype=float)
+    ident = bool(g.dim == 3 and np.array_equal(g.basis, np.eye(3)))
+    words, prefix = slot_map(ref, g.side**g.dim) if ref is not None else (_EU64, _E64)
+    fine_size = 0 if ref is None else ref.cells.size * ref.factor**g.dim
+    stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
+    args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), ident,
+            g.side, job.base_origin)
+    scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (SUB_ROWS, 3), np.float64),
+               _work.get("fcells", (SUB_ROWS,), np.int64), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
+               stats)
+    kernel = fused_kernel(job.fk.robot)
+    sink = _sinks.get(job.sink) if job.sink else None
+    if sink is not None:
+        acc = sink.acquire(total, fine_size)
+        try:
+            _, _, status = kernel(*args, acc.counts, _E32, words, prefix,
+                                  acc.fine if fine_size else _work.dense("none", 0), _E64, *scratch)
+        finally:
+            sink.release(acc)
+        _check(status)
+        empty = np.empty(0, np.int32)
+        return empty, empty.astype(np.uint32), stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, _E64, _E32.astype(
+            np.uint32)
+    acc, fine = _work.dense("cells", g.side**g.dim), _work.dense("fine", fine_size)
+    touched = _work.get("ftouch", (total,), np.int32)
+    ftouched = _work.get("fftouch", (total if fine_size else 0,), np.int64)
+    nt = nft = 0
+    try:
+        nt, nft, status = kernel(*args, acc, touched, words, prefix, fine, ftouched, *scratch)
+        idx, fidx = touched[:nt].copy(), ftouched[:nft].copy()
+        cnt, fcnt = acc[idx], fine[fidx]
+    finally:
+        acc[touched[:nt]] = 0  # nt is 0 if the kernel raised: a failed run is not resumed
+        fine[ftouched[:nft]] = 0
+    _check(status)
+    return idx, cnt, stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, fidx, fcnt
+
+
+def _check(status: int) -> None:
+    from ._fused import NON_FINITE
+
+    if status == NON_FINITE:
+        raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
+    if status:
+        raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")

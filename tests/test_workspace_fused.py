@@ -1,0 +1,175 @@
+"""The fused workspace task (denavit.scale._fused / _sink) against the numpy route.
+
+Oracles: numpy's own ``Philox`` generator (the fused kernel's random words), the numpy route of
+``run_task`` (numpy's Philox, the compiled position kernel's batch call, numpy cell arithmetic and a sort) on
+random arms, and the same run on other chunk sizes, workers, accumulators and schedulers (identical counts).
+Memory: tracemalloc peaks (not wall clock) and the accumulators' budget arithmetic.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit import JointType
+from denavit.scale import BLOCK, CompiledPositionFK, occupancy
+
+from _random_robots import random_robot
+
+pytest.importorskip("numba")
+
+from denavit.scale import _fused, _sink  # noqa: E402  (numba needed)
+from denavit.scale._refine import plan_refinement  # noqa: E402
+from denavit.scale._sampler import make_job, run_task  # noqa: E402
+
+
+class NumpyRoute(CompiledPositionFK):
+    """The same compiled kernel, but not the exact class: tasks take the numpy route."""
+
+
+def _limited(robot):
+    """The arm with limits on its prismatic rows (a workspace needs them)."""
+    links = tuple(dataclasses.replace(link, q_limits=(-0.4, 0.7)) if link.joint is JointType.PRISMATIC else link
+                  for link in robot.links)
+    return robot.replace(links=links)
+
+
+def _sorted(idx, cnt):
+    order = np.argsort(idx, kind="stable")
+    return np.asarray(idx)[order].astype(np.int64), np.asarray(cnt)[order].astype(np.int64)
+
+
+def _same_task(a, b):
+    for (ia, ca), (ib, cb) in (((a[0], a[1]), (b[0], b[1])), ((a[6], a[7]), (b[6], b[7]))):
+        ia, ca = _sorted(ia, ca)
+        ib, cb = _sorted(ib, cb)
+        assert np.array_equal(ia, ib) and np.array_equal(ca, cb)
+    assert np.array_equal(a[2], b[2]) and np.array_equal(a[3], b[3])  # bounds, bit for bit
+    assert a[4] == b[4] and a[5] == b[5]  # reach, samples
+
+
+def _same(a, b):
+    assert np.array_equal(a.counts, b.counts)
+    assert np.array_equal(a.bounds_min, b.bounds_min) and np.array_equal(a.bounds_max, b.bounds_max)
+    assert a.reach == b.reach and a.estimate == b.estimate
+    assert (a.fine is None) == (b.fine is None)
+    if a.fine is not None:
+        assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
+
+
+def test_random_words_are_numpys_philox_across_calls():
+    """Rows drawn in pieces (starting mid-way through a 4-word Philox output) are numpy's Generator.random."""
+    for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6)):
+        key = _fused.block_keys(seed, block, 1)[0]
+        ref = np.random.Generator(np.random.Philox(np.random.SeedSequence(seed, spawn_key=(block,)))).random((41, n))
+        lo, span = np.linspace(-1, 1, n), np.linspace(0.5, 3, n)
+        q = np.empty((41, n))
+        j = _fused._draw(q[:3], 3, 0, key[0], key[1], lo, span)
+        assert j == 3 * n
+        assert _fused._draw(q[3:], 38, j, key[0], key[1], lo, span) == 41 * n
+        assert np.array_equal(q, ref * (span) + lo)  # lo + u·span, as numpy's route computes it
+
+
+def test_fused_tasks_equal_the_numpy_route_on_random_arms():
+    rng = np.random.default_rng(11)
+    for _ in range(2):
+        robot = _limited(random_robot(rng))
+        job = make_job(robot, 3 * BLOCK + 777, None, int(rng.integers(2**40)), CompiledPositionFK(robot))
+        assert job.fused
+        numpy_job = dataclasses.replace(job, fused=False)
+        ref = run_task(numpy_job, 0, 4)
+        _same_task(run_task(job, 0, 4), ref)  # away from a sink: sparse counts from the first-hit list
+        _same_task(run_task(job, 1, 2), run_task(numpy_job, 1, 2))
+        counts = np.zeros(job.grid.shape, np.uint64)
+        counts.reshape(-1)[ref[0]] += ref[1]
+        plan = plan_refinement(counts, 4, 1)
+        if plan is not None:  # sub-cells too
+            a, b = run_task(dataclasses.replace(job, refine=plan), 1, 3), run_task(
+                dataclasses.replace(numpy_job, refine=plan), 1, 3)
+            assert a[6].size > 0
+            _same_task(a, b)
+
+
+def test_tilted_plane_cells_are_the_numpy_routes():
+    """A planar arm whose plane is no coordinate plane: the projection onto the plane's basis in one order."""
+    robot = denavit.load_robot("planar2r")
+    tilt = np.eye(4)
+    tilt[:3, :3] = np.array([[1, 0, 0], [0, 0.6, -0.8], [0, 0.8, 0.6]])
+    robot = robot.replace(base=tilt)
+    job = make_job(robot, 2 * BLOCK, None, 5, CompiledPositionFK(robot))
+    assert job.grid.dim == 2 and not np.all(np.isin(job.grid.basis, (0.0, 1.0, -1.0)))
+    _same_task(run_task(job, 0, 2), run_task(dataclasses.replace(job, fused=False), 0, 2))
+
+
+def test_identical_for_chunks_workers_accumulators_and_routes(monkeypatch):
+    robot = denavit.load_robot("stanford")
+    n = 5 * BLOCK + 999
+    args = dict(resolution=0.1, seed=42, refine=4)
+    ref = occupancy(robot, n, scheduler="synchronous", chunk=BLOCK, fk=NumpyRoute(robot), **args)
+    assert ref.refinement is not None and ref.fine.sum() > 0
+    fk = CompiledPositionFK(robot)
+    _same(ref, occupancy(robot, n, scheduler="synchronous", chunk=2 * BLOCK, fk=fk, **args))
+    _same(ref, occupancy(robot, n, scheduler="threads", workers=2, chunk=BLOCK, fk=fk, **args))
+    monkeypatch.setattr(_sink, "_MOST", BLOCK + 1)  # an accumulator flushed before nearly every task
+    monkeypatch.setattr(_sink, "ACC_BUDGET", 1)  # one accumulator for three threads
+    _same(ref, occupancy(robot, n, scheduler="threads", workers=3, chunk=BLOCK, fk=fk, **args))
+
+
+@pytest.mark.slow
+def test_identical_on_a_process_pool_with_the_fused_kernel():
+    robot = denavit.load_robot("puma560")
+    n = 4 * BLOCK + 5
+    ref = occupancy(robot, n, 0.05, seed=8, scheduler="synchronous", fk=NumpyRoute(robot), refine=2)
+    _same(ref, occupancy(robot, n, 0.05, seed=8, scheduler="processes", workers=2, chunk=BLOCK,
+                         fk=CompiledPositionFK(robot), refine=2))
+
+
+def test_auto_runs_fused_tasks_on_threads():
+    from denavit.scale._occupancy import _where
+    from denavit.scale._sampler import COMPILED_FROM
+
+    robot = denavit.load_robot("planar2r")
+    assert _where("auto", COMPILED_FROM, None, robot) == "threads"
+    assert _where("auto", 10**8, NumpyRoute(robot), robot) == "processes"  # another FK: the old rule
+    assert _where("processes", 10**8, None, robot) == "processes"
+
+
+def test_accumulators_stay_within_their_budget():
+    for cells, refinable in ((256**3, True), (2048**2, True), (2048**2, False), (8**3, False)):
+        sink = _sink.Sink(np.zeros(cells, np.uint64), 64, refinable)
+        per = 4 * cells + (4 * 2**25 if refinable else 0)
+        assert sink.cap == 1 or sink.cap * per <= _sink.ACC_BUDGET
+        assert sink.cap <= 64
+
+
+def test_memory_does_not_grow_with_the_samples():
+    """Peak traced allocations (numpy's included) of a run in this process: the same for 4 and 24 blocks, and
+    within the grid-sized arrays (driver counts, one accumulator, the estimate's levels) plus scratch."""
+    robot = denavit.load_robot("planar2r")
+    fk = CompiledPositionFK(robot)
+    occupancy(robot, BLOCK, 0.01, seed=1, scheduler="synchronous", fk=fk)  # kernels compiled or loaded first
+    peaks = []
+    for n in (4 * BLOCK, 24 * BLOCK):
+        tracemalloc.start()
+        ws = occupancy(robot, n, 0.01, seed=1, scheduler="synchronous", fk=fk, refine=0)
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    cells = ws.counts.size
+    assert peaks[1] <= peaks[0] + 2**20, peaks
+    assert peaks[1] <= (8 + 4 + 8) * cells + 16 * 2**20, (peaks, cells)
+    job = make_job(robot, 10**9, None, 1, fk)
+    sink_job = dataclasses.replace(job, sink="run")
+    assert _sink.task_memory(sink_job, 4) == _sink.task_memory(dataclasses.replace(sink_job, samples=BLOCK), 4)
+    assert _sink.task_memory(sink_job, 64) < 2**16  # a task in the driver's process holds no sample-sized array
+
+
+def test_progress_line_of_a_fused_run(capsys):
+    robot = denavit.load_robot("planar2r")
+    occupancy(robot, 3 * BLOCK, seed=0, scheduler="threads", workers=2, chunk=BLOCK, progress=True,
+              fk=CompiledPositionFK(robot))
+    err = capsys.readouterr().err
+    assert "100.0%" in err and "samples/s" in err and "ETA" in err and err.endswith("\n")
