@@ -1,7 +1,11 @@
 """Workspace and reachability at scale (denavit.scale): throughput, memory and the volume interval vs samples.
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
-              [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--markdown FILE]
+              [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--kernel-ratio 1e8] [--markdown FILE]
+``--kernel-ratio N`` compares, in one process, the bare compiled position kernel (``compile(robot).position`` on
+a batch of 2²⁰ configurations, one thread) with the whole pipeline (``occupancy`` of N samples on the threads
+scheduler: random numbers, FK, cells, counts, merge, volume), both per CPU-second (so per core, whatever else
+the machine runs) and per wall second.
 Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows
 only) of this process and of the largest finished worker process, the peak PSS of the whole process tree
 during the run (sampled every 0.5 s; shared library pages split between the processes), the 1-minute load
@@ -141,6 +145,39 @@ def run_cluster(robot, n, repeat: int = 1) -> list[str]:
     return lines
 
 
+def kernel_ratio(robot, n: int, workers) -> list[str]:
+    """Bare position kernel vs the pipeline, same process; throughput per CPU-second and per wall second."""
+    from denavit.scale import CompiledPositionFK, sampling_limits
+
+    c = denavit.compile(robot, kernels=["position"])
+    lim = sampling_limits(robot)
+    Q = lim[:, 0] + np.random.default_rng(0).random((2**20, robot.dof)) * (lim[:, 1] - lim[:, 0])
+    c.position(Q)
+    occupancy(robot, 8 * 65536, seed=2, scheduler="threads", workers=workers, fk=CompiledPositionFK(robot))  # warm
+    rows = ["| what | samples | wall [s] | CPU [s] | samples/s (wall) | samples per CPU-second (per core) | load |",
+            "|---|---:|---:|---:|---:|---:|---:|"]
+    figures = {}
+    for what in ("kernel", "pipeline", "kernel"):
+        t, cpu = time.perf_counter(), time.process_time()
+        if what == "kernel":
+            m = len(Q)
+            for _ in range(8):
+                c.position(Q)
+            m *= 8
+        else:
+            m = n
+            occupancy(robot, n, seed=1, scheduler="threads", workers=workers, progress=None)
+        wall, cpu = time.perf_counter() - t, time.process_time() - cpu
+        figures.setdefault(what, []).append(m / cpu)
+        rows.append(f"| {what} | {m:.3g} | {wall:.2f} | {cpu:.2f} | {m / wall:.3g} | {m / cpu:.3g} | "
+                    f"{os.getloadavg()[0]:.1f} |")
+        print(rows[-1], flush=True)
+    k, p = max(figures["kernel"]), figures["pipeline"][0]
+    rows.append(f"\npipeline ÷ kernel per core: {p / k:.2f} ({robot.name}, {workers or os.cpu_count()} threads)")
+    print(rows[-1], flush=True)
+    return rows
+
+
 def run_reach(robot, spec: str, scheduler, workers) -> str:
     h, k = spec.split("x")
     t0 = time.perf_counter()
@@ -161,12 +198,15 @@ def main() -> None:
     ap.add_argument("--cluster", action="store_true")
     ap.add_argument("--repeat", type=int, default=1, help="cluster comparison: runs of each, alternating (medians)")
     ap.add_argument("--reach", help="e.g. 0.05x100: resolution [m] x orientations")
+    ap.add_argument("--kernel-ratio", type=float, help="pipeline of this many samples vs the bare kernel")
     ap.add_argument("--markdown")
     a = ap.parse_args()
     robot = denavit.load_robot(a.robot)
     lines = [f"{a.robot}, scheduler {a.scheduler}, workers {a.workers or os.cpu_count()}, "
              f"load average {os.getloadavg()[0]:.2f}", ""]
-    lines += run_samples(robot, [int(float(x)) for x in a.samples.split(",")], a.scheduler, a.workers)
+    if a.kernel_ratio:
+        lines += kernel_ratio(robot, int(a.kernel_ratio), a.workers)
+    lines += run_samples(robot, [int(float(x)) for x in a.samples.split(",") if x], a.scheduler, a.workers)
     if a.cluster:
         more = run_cluster(robot, int(float(a.samples.split(",")[-1])), a.repeat)
         print("\n".join(more), flush=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import tracemalloc
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -61,17 +62,28 @@ def _same(a, b):
         assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
 
 
-def test_random_words_are_numpys_philox_across_calls():
-    """Rows drawn in pieces (starting mid-way through a 4-word Philox output) are numpy's Generator.random."""
-    for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6)):
+def test_random_values_are_the_halves_of_numpys_philox_words_across_calls():
+    """Rows drawn in pieces (starting mid-way through a Philox output) are lo + (h·2⁻³²)·span, h the 32-bit
+    halves (low first) of numpy's raw Philox words, and the numpy route's rows too."""
+    from denavit.scale._sampler import _draw
+
+    assert np.little_endian  # the halves below are read through a uint32 view
+    for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6), (9, 1, 1)):
         key = _fused.block_keys(seed, block, 1)[0]
-        ref = np.random.Generator(np.random.Philox(np.random.SeedSequence(seed, spawn_key=(block,)))).random((41, n))
-        lo, span = np.linspace(-1, 1, n), np.linspace(0.5, 3, n)
+        raw = np.random.Philox(np.random.SeedSequence(seed, spawn_key=(block,))).random_raw(41 * n)
+        h = raw.view(np.uint32)[:41 * n].reshape(41, n).astype(float)
+        lo, hi = np.linspace(-1, 1, n), np.linspace(0.5, 3, n) + 1.0
+        span = hi - lo  # as the numpy route computes it
+        ref = h * 2.0**-32 * span + lo
         q = np.empty((41, n))
-        j = _fused._draw(q[:3], 3, 0, key[0], key[1], lo, span)
+        buf = np.empty(41 * n, np.uint64)
+        j = _fused._draw(q[:3], 3, 0, key[0], key[1], lo, span, buf)
         assert j == 3 * n
-        assert _fused._draw(q[3:], 38, j, key[0], key[1], lo, span) == 41 * n
-        assert np.array_equal(q, ref * (span) + lo)  # lo + u·span, as numpy's route computes it
+        assert _fused._draw(q[3:], 38, j, key[0], key[1], lo, span, buf) == 41 * n
+        assert np.array_equal(q, ref)
+        job = SimpleNamespace(entropy=seed, limits=np.stack([lo, hi], axis=1))
+        assert np.array_equal(_draw(job, block, np.empty((41, n))), ref)
+        assert 0 <= h.min() and h.max() < 2**32 and len(np.unique(h)) > 40 * n  # 32 random bits each
 
 
 def test_fused_tasks_equal_the_numpy_route_on_random_arms():

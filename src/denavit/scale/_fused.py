@@ -112,8 +112,8 @@ def _mulhilo_intrinsic():
 
 _mulhilo = _mulhilo_intrinsic()
 _M0, _M1, _W0, _W1 = np.uint64(_M0), np.uint64(_M1), np.uint64(_W0), np.uint64(_W1)
-_Z, _S11, _ONE, _LOW6 = np.uint64(0), np.uint64(11), np.uint64(1), np.uint64(63)
-_SCALE = 1.0 / 9007199254740992.0  # 2⁻⁵³
+_Z, _S32, _ONE, _LOW6, _LOW32 = np.uint64(0), np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
+_HALF = 2.0**-32
 
 
 @njit(nogil=True, cache=True)
@@ -131,21 +131,35 @@ def _philox(c0, k0, k1):
 
 
 @njit(nogil=True, cache=True)
-def _draw(q, r, j, k0, k1, lo, span):
-    """Rows 0 … r−1 of q (C-contiguous; joint values lo + u·span) from words j, j+1 … of the block's stream;
-    returns the next word's index.  Word j is word j mod 4 of Philox(j div 4 + 1); u = (word >> 11)·2⁻⁵³ (the
-    shifted word is below 2⁵³: converted exactly, as a signed integer)."""
+def _draw(q, r, j, k0, k1, lo, span, buf):
+    """Rows 0 … r−1 of q (C-contiguous) from values j, j+1 … of the block's stream; returns the next value's
+    index.  Value v is the low (v even) or high (v odd) 32-bit half h of word v div 2, word w is word w mod 4 of
+    Philox(w div 4 + 1); the joint value is lo + (h·2⁻³²)·span (as ``_sampler._draw``).  ``buf``: scratch of at
+    least r·n/2 + 8 words (the Philox outputs, then converted in one straight loop)."""
     n = q.shape[1]
-    flat = q.reshape(-1)[:r * n]
     end = j + r * n
-    i, a = 0, 0  # flat index and its column
-    while j < end:
-        w = _philox(np.uint64(j // 4 + 1), k0, k1)
-        for s in range(j & 3, min(4, end - (j & ~3))):
-            flat[i] = np.int64(w[s] >> _S11) * _SCALE * span[a] + lo[a]
-            i += 1
-            a = 0 if a + 1 == n else a + 1
-        j = (j & ~3) + 4
+    c0, c1 = (j >> 1) >> 2, ((end - 1) >> 1) >> 2  # the Philox counters (minus one) these values come from
+    for c in range(c0, c1 + 1):
+        w0, w1, w2, w3 = _philox(np.uint64(c + 1), k0, k1)
+        o = 4 * (c - c0)
+        buf[o], buf[o + 1], buf[o + 2], buf[o + 3] = w0, w1, w2, w3
+    flat = q.reshape(-1)
+    m = r * n
+    if j & 1:  # a start in the middle of a word (not reached by run: blocks start at 0, steps are even)
+        for v in range(m):
+            w = j + v - 8 * c0
+            flat[v] = np.int64((buf[w >> 1] >> (_S32 * np.uint64(w & 1))) & _LOW32) * _HALF
+    else:
+        off = (j >> 1) - 4 * c0
+        for p in range(m // 2):  # both halves of each word
+            w = buf[off + p]
+            flat[2 * p] = np.int64(w & _LOW32) * _HALF
+            flat[2 * p + 1] = np.int64(w >> _S32) * _HALF
+        if m & 1:
+            flat[m - 1] = np.int64(buf[off + m // 2] & _LOW32) * _HALF
+    for i in range(r):
+        for a in range(n):
+            flat[i * n + a] = flat[i * n + a] * span[a] + lo[a]
     return end
 
 
@@ -158,49 +172,65 @@ def _popcount(x):
 
 
 @njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats):
-    """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²), cell (cells[:r]) and sub-cell (subs[:r], −1 outside the refined cells) of the
-    origins P[:r]; returns a status.  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
-    dim = basis.shape[0]
-    cx, cy, cz, glo, h, k = grid[0], grid[1], grid[2], grid[3], grid[4], int(grid[5])
-    x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
+def _coordinates(P, r, grid, basis, ident, origin, T, R2):
+    """T[a, i] = (u_a − lo)/h, u = (p_i − centre) in the grid's basis (u_a = (d0·b_a0 + d1·b_a1) + d2·b_a2 unless
+    the basis is the identity), and R2[i] = |p_i − origin|² ((dx² + dy²) + dz²), for i < r: straight loops with
+    no branches (vectorised)."""
+    cx, cy, cz, glo, inv = grid[0], grid[1], grid[2], grid[3], grid[4]
     ox, oy, oz = origin[0], origin[1], origin[2]
-    status = 0
-    t = np.empty(3)
+    for i in range(r):
+        dx, dy, dz = P[i, 0] - ox, P[i, 1] - oy, P[i, 2] - oz
+        R2[i] = dx * dx + dy * dy + dz * dz
+    if ident:
+        for i in range(r):
+            T[0, i] = (P[i, 0] - cx - glo) * inv
+            T[1, i] = (P[i, 1] - cy - glo) * inv
+            T[2, i] = (P[i, 2] - cz - glo) * inv
+        return
+    for a in range(basis.shape[0]):
+        b0, b1, b2 = basis[a, 0], basis[a, 1], basis[a, 2]
+        for i in range(r):
+            T[a, i] = ((P[i, 0] - cx) * b0 + (P[i, 1] - cy) * b1 + (P[i, 2] - cz) * b2 - glo) * inv
+
+
+@njit(nogil=True, cache=True)
+def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2):
+    """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
+    is taken at the end), cell (cells[:r]) and sub-cell (subs[:r], −1 outside the refined cells) of the origins
+    P[:r]; returns a status.  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
+    dim, k = basis.shape[0], int(grid[5])
+    _coordinates(P, r, grid, basis, ident, origin, T, R2)
+    x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
     for i in range(r):
         x, y, z = P[i, 0], P[i, 1], P[i, 2]
-        if not (np.isfinite(x) and np.isfinite(y) and np.isfinite(z)):
-            status = 1
-            break
         x0, y0, z0, x1, y1, z1 = min(x0, x), min(y0, y), min(z0, z), max(x1, x), max(y1, y), max(z1, z)
-        dx, dy, dz = x - ox, y - oy, z - oz
-        reach = max(reach, dx * dx + dy * dy + dz * dz)  # squared: sqrt is monotone, taken at the end
-        d0, d1, d2 = x - cx, y - cy, z - cz
+        reach = max(reach, R2[i])
+    stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6] = x0, y0, z0, x1, y1, z1, reach
+    bad = False
+    for i in range(r):
         flat = 0
         for a in range(dim):
-            if ident:
-                u = d0 if a == 0 else (d1 if a == 1 else d2)
-            else:
-                u = d0 * basis[a, 0] + d1 * basis[a, 1] + d2 * basis[a, 2]
-            t[a] = (u - glo) / h
-            f = np.floor(t[a])
-            if f < 0 or f >= side:
-                status = 2
+            f = np.floor(T[a, i])
+            bad |= not (f >= 0 and f < side)  # NaN fails too
             flat = flat * side + int(f)
-        if status:
-            break
         cells[i] = flat
-        if words.size:
+    if bad:
+        for i in range(r):
+            if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
+                return 1
+        return 2
+    if words.size:
+        for i in range(r):
+            flat = cells[i]
             word = words[flat >> 6]
             b = np.uint64(flat) & _LOW6
             idx = -1
             if (word >> b) & _ONE:
                 idx = prefix[flat >> 6] + np.int64(_popcount(word & ((_ONE << b) - _ONE)))
                 for a in range(dim):
-                    idx = idx * k + int(np.floor(t[a] * k) - k * np.floor(t[a]))
+                    idx = idx * k + int(np.floor(T[a, i] * k) - k * np.floor(T[a, i]))
             subs[i] = idx
-    stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6] = x0, y0, z0, x1, y1, z1, reach
-    return status
+    return 0
 
 
 @njit(nogil=True, cache=True)
@@ -234,16 +264,18 @@ def _build(rows):
     def run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, words, prefix, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
+        buf = np.empty(q.shape[0] * q.shape[1] // 2 + 8, dtype=np.uint64)
+        T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
         for blk in range(keys.shape[0]):
             k0, k1 = keys[blk, 0], keys[blk, 1]
             j = 0
             for s in range(0, sizes[blk], q.shape[0]):
                 r = min(q.shape[0], sizes[blk] - s)
                 qs, Ps = q[:r], P[:r]
-                j = _draw(qs, r, j, k0, k1, lo, span)
+                j = _draw(qs, r, j, k0, k1, lo, span, buf)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
-                status = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats)
+                status = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2)
                 if status:
                     return nt, nft, status
                 nt = _add(cells, r, acc, touched, nt)

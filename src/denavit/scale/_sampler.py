@@ -36,6 +36,8 @@ FINE_CELLS = {3: 256, 2: 2048}
 MAX_CELLS = 2**24
 #: Coarsest level kept: at least this many cells along a side.
 MIN_CELLS = 8
+#: 2⁻³²: a 32-bit random half-word as a number in [0, 1).
+HALF_WORD = 2.0**-32
 #: Runs of at least this many samples use the compiled position kernel by default (when numba is installed).
 COMPILED_FROM = 2_000_000
 
@@ -167,12 +169,20 @@ class Job:
 
 
 def _draw(job: Job, block: int, q: np.ndarray) -> np.ndarray:
-    """Fill q (m, n) with the joint values of random block ``block`` (its first m samples); return q."""
-    rng = np.random.Generator(np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))))
-    lo, hi = job.limits[:, 0], job.limits[:, 1]
-    rng.random(out=q)  # a prefix of the block's stream
-    q *= hi - lo
-    q += lo  # = lo + r·(hi − lo), in place
+    """Fill q (m, n) (C-contiguous) with the joint values of random block ``block`` (its first m samples).
+
+    Value v of the block (row-major: sample v div n, joint v mod n) is u = h·2⁻³², h the low (v even) or high
+    (v odd) 32 bits of word v div 2 of ``numpy.random.Philox`` keyed by ``SeedSequence(entropy,
+    spawn_key=(block,))``; the joint value is lo + u·(hi − lo).  (32 bits a joint value: steps of 2⁻³² of its
+    range, half the random words 53-bit doubles would take.)"""
+    m, n = q.shape
+    words = np.random.Philox(np.random.SeedSequence(job.entropy, spawn_key=(block,))).random_raw(-(-m * n // 2))
+    flat = q.reshape(-1)
+    flat[0::2] = words[:(m * n + 1) // 2] & np.uint64(0xFFFFFFFF)  # exact: below 2³²
+    flat[1::2] = words[:m * n // 2] >> np.uint64(32)
+    q *= HALF_WORD
+    q *= job.limits[:, 1] - job.limits[:, 0]
+    q += job.limits[:, 0]  # = lo + u·(hi − lo), in place
     return q
 
 
@@ -233,11 +243,11 @@ def _cells(job: Job, P: np.ndarray, flat: np.ndarray, T: np.ndarray | None = Non
     for a in range(g.dim):
         t = _scratch.get("t", (m,), np.float64)
         np.subtract(U[:, a], g.lo, out=t)
-        t /= g.resolution
+        t *= 1.0 / g.resolution  # the reciprocal once (the fused kernel too): a multiplication per sample
         if T is not None:
             T[a] = t
         np.floor(t, out=t)
-        if t.min() < 0 or t.max() >= g.side:
+        if not (t.min() >= 0 and t.max() < g.side):  # NaN fails too
             raise DenavitError("a sample fell outside the reach bound (internal error in the sampler's grid)")
         c[:] = t  # < MAX_CELLS = 2^24: int32 sorts faster than int64
         flat *= g.side

@@ -156,7 +156,7 @@ def run_fused(job, first: int, count: int) -> tuple:
     total = int(sizes.sum())
     lo = np.ascontiguousarray(job.limits[:, 0])
     span = job.limits[:, 1] - job.limits[:, 0]
-    grid = np.array([*g.centre, g.lo, g.resolution, ref.factor if ref is not None else 0], dtype=float)
+    grid = np.array([*g.centre, g.lo, 1.0 / g.resolution, ref.factor if ref is not None else 0], dtype=float)
     ident = bool(g.dim == 3 and np.array_equal(g.basis, np.eye(3)))
     words, prefix = slot_map(ref, g.side**g.dim) if ref is not None else (_EU64, _E64)
     fine_size = 0 if ref is None else ref.cells.size * ref.factor**g.dim
