@@ -3,7 +3,7 @@
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
               [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--kernel-ratio 1e8] [--markdown FILE]
 ``--kernel-ratio N`` compares, in one process, the bare compiled position kernel (``compile(robot).position`` on
-a batch of 2²⁰ configurations, one thread) with the whole pipeline (``occupancy`` of N samples on the threads
+a batch of 65 536 configurations, one thread) with the whole pipeline (``occupancy`` of N samples on the threads
 scheduler: random numbers, FK, cells, counts, merge, volume), both per CPU-second (so per core, whatever else
 the machine runs) and per wall second.
 Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows
@@ -146,28 +146,34 @@ def run_cluster(robot, n, repeat: int = 1) -> list[str]:
 
 
 def kernel_ratio(robot, n: int, workers) -> list[str]:
-    """Bare position kernel vs the pipeline, same process; throughput per CPU-second and per wall second."""
+    """Bare position kernel vs the pipeline, same process: throughput per CPU-second (per core, whatever else
+    the machine runs) and per wall second.  The kernel: ``compile(robot).position`` on one block of 65 536
+    configurations within the limits, 64 calls a round, best of 3 rounds, one thread."""
     from denavit.scale import CompiledPositionFK, sampling_limits
 
     c = denavit.compile(robot, kernels=["position"])
     lim = sampling_limits(robot)
-    Q = lim[:, 0] + np.random.default_rng(0).random((2**20, robot.dof)) * (lim[:, 1] - lim[:, 0])
+    Q = lim[:, 0] + np.random.default_rng(0).random((65536, robot.dof)) * (lim[:, 1] - lim[:, 0])
     c.position(Q)
     occupancy(robot, 8 * 65536, seed=2, scheduler="threads", workers=workers, fk=CompiledPositionFK(robot))  # warm
     rows = ["| what | samples | wall [s] | CPU [s] | samples/s (wall) | samples per CPU-second (per core) | load |",
             "|---|---:|---:|---:|---:|---:|---:|"]
     figures = {}
     for what in ("kernel", "pipeline", "kernel"):
-        t, cpu = time.perf_counter(), time.process_time()
-        if what == "kernel":
-            m = len(Q)
-            for _ in range(8):
-                c.position(Q)
-            m *= 8
-        else:
-            m = n
-            occupancy(robot, n, seed=1, scheduler="threads", workers=workers, progress=None)
-        wall, cpu = time.perf_counter() - t, time.process_time() - cpu
+        best = None
+        for _ in range(3 if what == "kernel" else 1):
+            t, cpu = time.perf_counter(), time.process_time()
+            if what == "kernel":
+                m = 64 * len(Q)
+                for _ in range(64):
+                    c.position(Q)
+            else:
+                m = n
+                occupancy(robot, n, seed=1, scheduler="threads", workers=workers, progress=None)
+            wall, cpu = time.perf_counter() - t, time.process_time() - cpu
+            if best is None or cpu < best[1]:
+                best = (wall, cpu)
+        wall, cpu = best
         figures.setdefault(what, []).append(m / cpu)
         rows.append(f"| {what} | {m:.3g} | {wall:.2f} | {cpu:.2f} | {m / wall:.3g} | {m / cpu:.3g} | "
                     f"{os.getloadavg()[0]:.1f} |")

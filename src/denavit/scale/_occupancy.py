@@ -13,7 +13,7 @@ from ..errors import ModelError
 from ..model import DHRobot
 from ._refine import Refinement, check_factor, pilot_blocks, plan_refinement, refined_levels, refinement
 from ._sampler import BLOCK, CompiledPositionFK, Grid, Job, default_fk, make_job, positions_block, run_task
-from ._sink import close_sink, open_sink, sink_of
+from ._sink import NoSink, open_sink
 from ._schedule import POOLS, Progress, resolve_auto, run
 from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
 
@@ -165,6 +165,13 @@ def _where(scheduler: Any, samples: int, fk: Callable | None, robot: DHRobot) ->
     return resolve_auto(scheduler, samples)
 
 
+def _sink_for(job: Job, counts: np.ndarray, scheduler: Any, workers: int | None, pilot: int):
+    """The run's accumulators in this process when its tasks are fused and run here (threads, synchronous)."""
+    if job.fused and isinstance(scheduler, str) and scheduler in ("threads", "synchronous"):
+        return open_sink(counts, workers or os.cpu_count() or 1, pilot > 0)
+    return NoSink()
+
+
 def _check_sizes(samples: int, chunk: int) -> None:
     if isinstance(samples, bool) or int(samples) != samples or not 1 <= samples <= MAX_SAMPLES:
         raise ModelError(f"samples must be a whole number from 1 to {MAX_SAMPLES:.0e}, got {samples}")
@@ -188,7 +195,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     seed : int, optional
         Seed of the counter-based random stream; ``None`` draws one (returned in the result).
     scheduler : {"auto", "threads", "processes", "synchronous"}, str address or distributed.Client
-        Where the tasks run; ``"auto"``: processes from AUTO_PROCESSES_FROM samples on, threads below;
+        Where the tasks run; ``"auto"``: threads when the tasks run the fused kernel (the default FK from
+        COMPILED_FROM samples with numba), else processes from AUTO_PROCESSES_FROM samples on, threads below;
         ``"tcp://host:8786"`` connects to a dask.distributed scheduler.
     workers : int, optional
         Local pool size (default: the CPU count).
@@ -235,10 +243,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
     lo, hi, reach = np.full(3, np.inf), np.full(3, -np.inf), 0.0
     blocks = -(-job.samples // BLOCK)
     pilot = pilot_blocks(blocks) if refine != 0 and (refine is not None or resolution is None) else 0
-    in_process = isinstance(scheduler, str) and scheduler in ("threads", "synchronous")
-    sink = open_sink(counts, workers or os.cpu_count() or 1, pilot > 0) if job.fused and in_process else None
-    if sink is not None:
-        job = dataclasses.replace(job, sink=sink)
+    sink = _sink_for(job, counts, scheduler, workers, pilot)
+    job = dataclasses.replace(job, sink=sink.token)
     state = {"job": job, "fine": None}
 
     def tasks():
@@ -247,15 +253,13 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
             return
         yield from ((job, f, c) for f, c in _tasks(job.samples, chunk, 0, pilot))
         yield None  # barrier: every pilot result is merged into counts before the plan is made
-        if sink is not None:
-            sink_of(sink).flush()
+        sink.flush()
         ref = plan_refinement(counts, refine, pilot)
         if ref is not None:
             state["job"] = dataclasses.replace(job, refine=ref)
             small = job.samples - pilot * BLOCK < 2**32  # no sub-cell count can overflow uint32
             state["fine"] = np.zeros(ref.cells.size * ref.factor**g.dim, dtype=np.uint32 if small else np.uint64)
-            if sink is not None:
-                sink_of(sink).flush(state["fine"])
+            sink.flush(state["fine"])
         yield from ((state["job"], f, c) for f, c in _tasks(job.samples, chunk, pilot, blocks))
 
     bar = Progress(int(samples), "samples", progress)
@@ -266,12 +270,10 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
                 state["fine"][fidx] += fcnt
             lo, hi, reach = np.minimum(lo, bmin), np.maximum(hi, bmax), max(reach, r)
             bar.update(m)
-        if sink is not None:
-            sink_of(sink).flush(state["fine"])
+        sink.flush(state["fine"])
     finally:
         bar.close()
-        if sink is not None:
-            close_sink(sink)
+        sink.close()
     ref = state["job"].refine
     fine = None if ref is None else state["fine"].reshape(ref.cells.size, -1)
     best, levels = _estimate(counts, g, ref, fine)

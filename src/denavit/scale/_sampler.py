@@ -1,10 +1,12 @@
 """Streaming workspace sampler: counter-based random blocks → FK → voxel counts.
 
-The unit of randomness is the *block* of :data:`BLOCK` samples: block ``b`` draws its joint values from
-``numpy.random.Philox`` seeded by ``SeedSequence(seed, spawn_key=(b,))``, so sample ``i`` is the same number
-whichever task, worker or chunk size computes it.  A *task* is any run of whole blocks; tasks return sparse
-voxel counts (sorted cell index, count) that the driver adds into one grid.  Integer sums commute, so the
-counts, bounds and reach are bit-identical for any number of workers and any chunk size.
+The unit of randomness is the *block* of :data:`BLOCK` samples: block ``b`` draws its joint values from the
+raw words of ``numpy.random.Philox`` keyed by ``SeedSequence(seed, spawn_key=(b,))`` (two 32-bit joint values a
+word), so sample ``i`` is the same number whichever task, worker or chunk size computes it.  A *task* is any
+run of whole blocks; tasks return sparse voxel counts (sorted cell index, count) that the driver adds into one
+grid.  Integer sums commute, so the counts, bounds and reach are bit-identical for any number of workers and
+any chunk size.  This module is the numpy route; with the compiled position kernel tasks run the fused kernel
+of ``_fused`` instead (one pass, no GIL), which computes the same numbers.
 """
 
 from __future__ import annotations

@@ -24,10 +24,10 @@ import numpy as np
 from ..errors import DenavitError, ModelError
 from ._refine import REFINE_CELLS, slot_map
 
-__all__ = ["ACC_BUDGET", "Sink", "open_sink", "close_sink", "run_fused", "task_memory"]
+__all__ = ["ACC_BUDGET", "Sink", "NoSink", "open_sink", "close_sink", "run_fused", "task_memory"]
 
 #: Most bytes of accumulators a run keeps in this process (at least one accumulator is always made).
-ACC_BUDGET = 2**29
+ACC_BUDGET = 3 * 2**27
 #: Most samples an accumulator takes between flushes (its uint32 cells cannot overflow).
 _MOST = 2**32 - 1
 
@@ -86,6 +86,9 @@ class Sink:
             acc.fine[:] = 0
         acc.tally = 0
 
+    def close(self) -> None:
+        close_sink(self.token)
+
     def flush(self, fine: np.ndarray | None = None) -> None:
         """Add every accumulator into the driver's counts (and into ``fine``, the sub-cell counts, once they
         exist); called when no task runs (a barrier, the end)."""
@@ -96,16 +99,26 @@ class Sink:
                 self._flush_one(acc)
 
 
-def open_sink(counts: np.ndarray, workers: int, refinable: bool) -> str:
-    """Register a :class:`Sink` flushing into ``counts``; its token travels with the run's tasks."""
-    token = f"sink-{next(_tokens)}"
+class NoSink:
+    """A run without a sink (its tasks return their counts): the same calls, doing nothing."""
+
+    token = None
+
+    def flush(self, fine: np.ndarray | None = None) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def open_sink(counts: np.ndarray, workers: int, refinable: bool) -> Sink:
+    """A registered :class:`Sink` flushing into ``counts``; its ``token`` travels with the run's tasks and
+    ``close()`` forgets it."""
+    sink = Sink(counts, workers, refinable)
+    sink.token = f"sink-{next(_tokens)}"
     with _sinks_lock:
-        _sinks[token] = Sink(counts, workers, refinable)
-    return token
-
-
-def sink_of(token: str) -> Sink:
-    return _sinks[token]
+        _sinks[sink.token] = sink
+    return sink
 
 
 def close_sink(token: str) -> None:
