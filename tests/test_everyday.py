@@ -420,3 +420,26 @@ def test_the_readme_names_every_extra_the_package_defines():
     readme = (root / "README.md").read_text(encoding="utf-8")
     section = readme[readme.index("## Install options"):]
     assert len(extras) >= 5 and [e for e in extras if f"`{e}`" not in section] == []
+
+
+# --- a mistyped command, option or choice -----------------------------------------------------------------------
+
+def test_a_mistyped_command_gets_did_you_mean_and_no_list_cut_in_a_name(capsys):
+    """`denavit jacobain` listed the 26 commands cut in the middle by the one-line limit ('jacobian' ... ,
+    'dynamics': velocity, statics and singularities lost) and offered no nearest name."""
+    code, out, err = run(capsys, "jacobain", "puma560")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "did you mean jacobian?" in err and " ... " not in err and "denavit --help" in err
+    code, _, err = run(capsys, "ik", "puma560", "--method", "analitic", "--from-q", "0,0,0,0,0,0")
+    assert code == 2 and "did you mean analytic?" in err and "choose from auto, analytic, numeric" in err
+
+
+def test_a_mistyped_option_is_reported_by_its_command_with_the_nearest_option(capsys):
+    """`denavit fk puma560 --frams` said `denavit: error: unrecognized arguments: --frams` (the top parser's
+    name and help, no hint)."""
+    code, out, err = run(capsys, "fk", "puma560", "--frams")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith("denavit fk: error: unrecognized arguments: --frams (did you mean --frames?)")
+    assert "denavit fk --help" in err
+    code, _, err = run(capsys, "fk", "puma560", "--zzzzzz")
+    assert code == 2 and "did you mean" not in err and err.startswith("denavit fk: error: unrecognized")

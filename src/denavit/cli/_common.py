@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import difflib
 import json
 import re
 import sys
@@ -54,6 +55,33 @@ class OneLineParser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')", file=sys.stderr)
         raise SystemExit(2)
+
+    def _check_value(self, action, value):  # type: ignore[override]
+        # a mistyped choice gets the nearest one; a long list (the 26 commands) is left to --help, not cut by
+        # one_line in the middle of a name
+        if action.choices is not None and value not in action.choices:
+            names = [str(c) for c in action.choices]
+            near = difflib.get_close_matches(str(value), names, n=1, cutoff=0.6)
+            listed = ", ".join(names)
+            said = ([f"did you mean {near[0]}?"] if near else []) + ([f"choose from {listed}"] if len(listed) <= 120
+                                                                     else [])
+            raise argparse.ArgumentError(action, f"invalid choice: {str(value)[:40]!r}"
+                                         + (f" ({' '.join(said)})" if said else ""))
+        super()._check_value(action, value)
+
+    def parse_args(self, args=None, namespace=None):  # type: ignore[override]
+        # an unknown option is reported by the subcommand it was given to, with the nearest option of that one
+        # (argparse left it to the top parser: "denavit: error: unrecognized arguments: --frams")
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            subs = [a for a in self._actions if isinstance(a, argparse._SubParsersAction)]
+            name = getattr(parsed, subs[0].dest, None) if subs else None
+            target = subs[0].choices.get(name, self) if name else self
+            options = [o for o in target._option_string_actions if o.startswith("--")]
+            near = [m for e in extras if e.startswith("-")
+                    for m in difflib.get_close_matches(e.split("=")[0], options, n=1, cutoff=0.6)]
+            target.error(f"unrecognized arguments: {' '.join(extras)}" + (f" (did you mean {near[0]}?)" if near else ""))
+        return parsed
 
 
 MAX_MESSAGE = 300
