@@ -22,6 +22,7 @@ from denavit._threads import (
     blocks,
     resolve_threads,
     run_batch,
+    split_call,
     split_rows,
 )
 from denavit.codegen import numba_available
@@ -143,6 +144,35 @@ def test_run_batch_writes_each_block_of_the_output():
     assert np.array_equal(out[:, 0], 2.0 * x.sum(axis=1)) and np.array_equal(out[:, 1], np.sin(x[:, 0]))
 
 
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+@pytest.mark.parametrize("chunk", [None, 1000, 4099])
+def test_split_call_joins_blocks_and_pieces_in_order(threads, chunk):
+    x = np.random.default_rng(2).normal(size=(3, 4 * MIN_ROWS + 5, 2))
+    y = np.random.default_rng(3).normal(size=(3, 4 * MIN_ROWS + 5, 4))
+    calls = []
+
+    def func(a, b):
+        calls.append(len(a))
+        return np.stack([a.sum(axis=1), np.sin(b[:, 0]), b[:, 1] * a[:, 0]], axis=1)[:, :, None] * [1.0, 2.0]
+
+    whole = func(x.reshape(-1, 2), y.reshape(-1, 4)).reshape(3, -1, 3, 2)
+    calls.clear()
+    got = split_call(func, (x, y), threads, chunk=chunk)
+    if threads == 1 and chunk is None:
+        assert got is None and calls == []  # one block, no pieces: the caller computes it whole
+        return
+    assert got.shape == whole.shape and np.array_equal(got, whole)
+    assert sum(calls) == x.shape[0] * x.shape[1] and max(calls) <= (chunk or len(x.reshape(-1, 2)))
+
+
+def test_split_call_small_batches_are_left_to_the_caller():
+    assert split_call(lambda a: a, (np.zeros((MIN_ROWS, 2)),), 4, chunk=None) is None
+    assert split_call(lambda a: a, (np.zeros(2),), 4) is None
+    with pytest.raises(ValueError, match="threads"):
+        split_call(lambda a: a, (np.zeros(2),), 0)
+
+
 # --- the batch functions -------------------------------------------------------------------------------------
 ODD = 2 * MIN_ROWS + 2 * ALIGN + 3  # two or three blocks, the last one short, not a multiple of the SIMD width
 
@@ -231,6 +261,21 @@ def test_split_results_are_the_unsplit_ones_bit_for_bit(subject):
         for t in (2, 3, None):
             got = f(q, qd, a, t)
             assert got.shape == ref.shape and np.array_equal(got, ref), (name, t)
+
+
+def test_plain_pieces_are_the_whole_batch_bit_for_bit(monkeypatch):
+    """The plain functions cut a batch into NUMPY_CHUNK-row pieces even on one thread: the same bits as one
+    pass over the whole batch (NUMPY_CHUNK made larger than the batch)."""
+    import denavit._threads as threads_module
+
+    rng = np.random.default_rng(11)
+    q, qd, a = (rng.uniform(-3, 3, (2 * threads_module.NUMPY_CHUNK + 17, ROBOT.dof)) for _ in range(3))
+    calls = _calls(ROBOT)
+    pieces = {name: f(q, qd, a, 1) for name, f in calls.items()}
+    monkeypatch.setattr(threads_module, "NUMPY_CHUNK", 10**9)
+    for name, f in calls.items():
+        whole = f(q, qd, a, 1)
+        assert np.array_equal(pieces[name], whole), name
 
 
 def test_batch_shapes_kept_and_empty_batches(subject):

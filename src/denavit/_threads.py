@@ -18,6 +18,8 @@ Rules (the same for every caller):
 - Results are bitwise those of the unsplit call: each row's arithmetic does not depend on which block holds it.
 - The first exception raised by any block is re-raised in the caller, after every block has finished (no
   block is left writing into the output when the call returns).
+- The plain numpy functions (:func:`split_call`) also cut each thread's block into pieces of NUMPY_CHUNK rows,
+  run one after another: numpy's temporaries then stay in the CPU cache (less work per row, threads or not).
 - A call made from inside a worker (a batched function calling another) runs inline: workers never wait for
   workers, so the pool cannot deadlock.
 
@@ -36,12 +38,16 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["ALIGN", "MIN_ROWS", "available_cores", "blocks", "resolve_threads", "run_batch", "split_call", "split_rows"]
+__all__ = ["ALIGN", "MIN_ROWS", "NUMPY_CHUNK", "available_cores", "blocks", "resolve_threads", "run_batch", "split_call", "split_rows"]
 
 #: Fewest rows a thread is given (a batch below 2 × MIN_ROWS runs inline).
 MIN_ROWS = 4096
 #: Block boundaries fall on multiples of this many rows.
 ALIGN = 8
+#: Rows per piece of a plain numpy function's batch (:func:`split_call`): its temporaries, a few dozen arrays of
+#: this many doubles, then stay in the CPU cache.  Measured on Puma 560 and Panda (10⁵ rows, one thread, process
+#: CPU time): one pass over the whole batch took 1.1–1.2× (FK), 1.05× (J), 1.4–1.6× (RNEA, M, FD, g, c) the pieces'.
+NUMPY_CHUNK = 16384
 
 _local = threading.local()
 _lock = threading.Lock()
@@ -141,14 +147,16 @@ def run_batch(kernel, inputs, outputs, threads=None, min_rows: int = MIN_ROWS, e
     return outputs
 
 
-def split_call(func, arrays, threads=None, min_rows: int = MIN_ROWS):
-    """``func(*arrays)`` computed block by block, or None when the batch is one block (the caller then
-    computes it whole, as it would without threads).
+def split_call(func, arrays, threads=None, min_rows: int = MIN_ROWS, chunk: int | None = -1):
+    """``func(*arrays)`` computed block by block, or None when the batch is small enough to be computed whole
+    (the caller then does, as it would without threads).
 
     ``arrays`` are already checked and broadcast to one shape (..., k) (the trailing axis may differ between
-    them); ``func`` takes blocks of them, shaped (rows, k), and returns one array (rows,) + trailing.  The
-    blocks' results are joined into (...,) + trailing: exactly the array ``func`` returns for the whole batch
-    when each row's result depends on that row only.
+    them); ``func`` takes pieces of them, shaped (rows, k), and returns one array (rows,) + trailing.  The rows
+    are cut into the blocks of :func:`blocks` (one per thread), and each block, in its thread, into pieces of
+    at most ``chunk`` rows (default :data:`NUMPY_CHUNK`; None: no pieces) run one after another.  The pieces' results are joined into
+    (...,) + trailing: exactly the array ``func`` returns for the whole batch when each row's result depends on
+    that row only.
     """
     if threads is not None:
         resolve_threads(threads)  # refused even where it is not used (a single row)
@@ -156,18 +164,21 @@ def split_call(func, arrays, threads=None, min_rows: int = MIN_ROWS):
     rows = 1
     for s in batch:
         rows *= s
-    if rows < 2 * min_rows:  # the common small call: no look at the cores
+    if chunk == -1:
+        chunk = NUMPY_CHUNK
+    piece = rows if chunk is None else max(1, int(chunk))
+    if rows < 2 * min_rows and rows <= piece:  # the common small call: no look at the cores
         return None
     parts = blocks(rows, threads, min_rows)
-    if len(parts) == 1:
+    if len(parts) == 1 and rows <= piece:
         return None
     flat = [a.reshape(rows, a.shape[-1]) for a in arrays]
-    results: list = [None] * len(parts)
-    index = {start: k for k, (start, _) in enumerate(parts)}
+    results: dict = {}
 
     def work(s: int, e: int) -> None:
-        results[index[s]] = func(*[x[s:e] for x in flat])
+        for a in range(s, e, piece):
+            results[a] = func(*[x[a:min(e, a + piece)] for x in flat])
 
     split_rows(rows, work, threads, min_rows)
-    out = np.concatenate(results, axis=0)
+    out = np.concatenate([results[a] for a in sorted(results)], axis=0)
     return out.reshape(batch + out.shape[1:])
