@@ -162,3 +162,62 @@ def test_bad_input_is_one_clear_error():
         base_parameters(robot, samples=1)
     with pytest.raises(ValueError, match="tol"):
         base_parameters(robot, tol=2.0)
+
+
+# --- symbolic grouping rules against the numeric base parameters ------------------------------------------
+
+
+@pytest.mark.parametrize("case", ["puma560", "stanford", "scara", "planar2r", 0, 5, 8])
+def test_symbolic_rules_span_the_numeric_base_parameters(case):
+    from denavit.symbolic import base_parameters_sym, compare_base_parameters
+
+    robot = denavit.load_robot(case) if isinstance(case, str) else random_arm(case)
+    sym = base_parameters_sym(robot)
+    base = base_parameters(robot)
+    assert len(sym.kept) == base.rank
+    assert compare_base_parameters(robot, sym, base) == (True, True)
+
+
+def test_symbolic_rules_of_the_puma_are_khalils():
+    """Khalil & Dombre 2002, §14.4 (Stäubli RX-90 / PUMA structure, modified DH there; the same grouping in the
+    joint frames here): ZZR1 collects YY2, YY3 and the masses beyond joint 2 at their distances from axis 1."""
+    from denavit.symbolic import base_parameters_sym
+
+    sym = base_parameters_sym(denavit.load_robot("puma560"))
+    rules = {name: str(e) for name, e in sym.rules}
+    assert rules["XX6R"] == "XX6 - YY6"
+    assert rules["ZZ5R"] == "YY6 + ZZ5"
+    assert rules["MX2R"] == "M3*a2 + M4*a2 + M5*a2 + M6*a2 + MX2"
+    assert rules["ZZ1R"].startswith("IA1 + M3*a2**2") and "YY2 + YY3 + ZZ1" in rules["ZZ1R"]
+    assert {"XX1", "XY1", "XZ1", "YZ1", "MX1", "MY1"} == set(sym.no_effect)  # axis 1 along gravity
+
+
+# --- command line -------------------------------------------------------------------------------------------
+
+
+def test_cli_regressor_prints_counts_rules_values_and_y(capsys):
+    import json
+
+    from denavit.cli import main
+
+    assert main(["regressor", "planar2r", "--json", "-q", "0.3, 0.5", "--qd", "1, 2", "--qdd", "0, 1"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    robot = denavit.load_robot("planar2r")
+    assert data["n_standard"] == 26 and data["n_base"] == len(data["values"]) == 11
+    Y = np.array(data["Y"])
+    np.testing.assert_allclose(Y @ inertial_parameters(robot), denavit.rnea(robot, [0.3, 0.5], [1, 2], [0, 1]),
+                               atol=1e-9)
+    assert main(["regressor", "puma560", "--symbolic"]) == 0
+    out = capsys.readouterr().out
+    assert "52 base parameters" in out and "XX6R = XX6 - YY6" in out and "the same span and values" in out
+
+
+@pytest.mark.parametrize("argv", [["regressor", "puma560", "-q", "1, 2"], ["regressor", "puma560", "--tol", "5"],
+                                  ["regressor", "puma560", "--qd", "1,2,3,4,5,6"],
+                                  ["regressor", "puma560", "-q", "0,0,0,0,0,0", "--qdd", "1,x,3,4,5,6"]])
+def test_cli_regressor_bad_input_is_one_line_exit_2(argv, capsys):
+    from denavit.cli import main
+
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("denavit regressor: error:")

@@ -11,6 +11,7 @@ from ._dynamics_format import format_dynamics
 from ._dynamics_trig import fourier_form
 from ._dynamics_types import DynamicsTerms
 from ._regressor import PARAMETER_NAMES, regressor_sym
+from ._base_params import SymbolicBaseParameters, base_parameters_sym, compare_base_parameters
 from ._recursive import HAND_FORM_MAX_DOF, RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
 from ._newton_euler import NewtonEulerSteps, newton_euler_dynamics
@@ -55,6 +56,9 @@ __all__ = [
     "fourier_form",
     "PARAMETER_NAMES",
     "regressor_sym",
+    "SymbolicBaseParameters",
+    "base_parameters_sym",
+    "compare_base_parameters",
     "RecursiveDynamics",
     "format_recursive",
     "HAND_FORM_MAX_DOF",
