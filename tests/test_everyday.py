@@ -443,3 +443,30 @@ def test_a_mistyped_option_is_reported_by_its_command_with_the_nearest_option(ca
     assert "denavit fk --help" in err
     code, _, err = run(capsys, "fk", "puma560", "--zzzzzz")
     assert code == 2 and "did you mean" not in err and err.startswith("denavit fk: error: unrecognized")
+
+
+# --- the report's friction in decimals, as M, c, g ---------------------------------------------------------------
+
+_ARM4 = """name: arm4
+convention: standard
+joints:
+  - {a: 0.5, alpha: 0, d: 0, theta: q, inertia: {mass: 1, com: [0, 0, 0], inertia: [0.005, 0.005, 0.01, 0, 0, 0],
+     viscous: 5.801821768, coulomb: 25.9836065}}
+""" + "".join(f"  - {{a: 0.{k}, alpha: 0, d: 0, theta: q, inertia: {{mass: 1, com: [0, 0, 0], "
+              f"inertia: [0.005, 0.005, 0.01, 0, 0, 0]}}}}\n" for k in (4, 3, 2))
+
+
+@pytest.mark.slow  # a symbolic 4-joint derivation: about 3 s
+def test_report_friction_is_written_in_decimals_like_the_rest_of_the_dynamics(tmp_path):
+    """The README's puma560 report wrote tau_f as 725227721 qd1 / 125000000 + 51967213 sign(qd1) / 2000000 (the
+    exact decimals the symbolic engine keeps) beside M, c, g in decimals; the file says 5.801821768, 25.9836065."""
+    import denavit
+    from denavit.report import derive
+
+    path = tmp_path / "arm4.yaml"
+    path.write_text(_ARM4, encoding="utf-8")
+    d = derive(denavit.load_robot(str(path)), topics=["dynamics"])
+    (tau_f,) = [st for st in d.section("dynamics").steps if getattr(st, "lhs", "") == "\\tau_f(\\dot q)"]
+    text = str(tau_f.expr)
+    assert "5.80182 \\dot{q}_{1}" in text and "25.9836 \\operatorname{sign}" in text, text
+    assert "\\frac" not in text and "125000000" not in text

@@ -165,7 +165,7 @@ def _hand_form(ctx: Context, steps: list, found) -> Any:
         if ctx.too_long(e):
             steps.append(Text(f"(${lhs}$ is too long to print usefully.)"))
             return
-        e = e.xreplace({r: sp.Float(r, 6) for r in e.atoms(sp.Rational) if r.q > 12})  # 0.0202, not 2527/125000
+        e = _decimals(e)
         e = shorthand(e, ctx.syms.q, collapse=False)
         steps.append(Equation(lhs, sp.latex(e, symbol_names=_dot_names(e, robot.dof)), shorthand=True))
 
@@ -177,9 +177,15 @@ def _hand_form(ctx: Context, steps: list, found) -> Any:
         entry(f"c_{{{k + 1}}}", t.c[k])
     for k in range(n):
         entry(f"g_{{{k + 1}}}", t.g[k])
-    if any(e != 0 for e in t.friction):
-        steps.append(_eq(ctx, "\\tau_f(\\dot q)", t.friction))
+    if any(e != 0 for e in t.friction):  # decimals as in M, c, g (was 725227721/125000000 for the file's 5.801821768)
+        steps.append(_eq(ctx, "\\tau_f(\\dot q)", t.friction.applyfunc(_decimals)))
     return t
+
+
+def _decimals(e: Any) -> Any:
+    """The exact decimals the symbolic engine keeps (so that terms cancel) shown as decimals: 0.0202, not
+    2527/125000 (six significant digits; small fractions such as 5/4 stay)."""
+    return e.xreplace({r: sp.Float(r, 6) for r in e.atoms(sp.Rational) if r.q > 12})
 
 
 def _recursive_form(ctx: Context, steps: list, found) -> None:
