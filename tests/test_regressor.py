@@ -221,3 +221,21 @@ def test_cli_regressor_bad_input_is_one_line_exit_2(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("denavit regressor: error:")
+
+
+# --- compiled kernel ----------------------------------------------------------------------------------------
+
+
+def test_compiled_regressor_equals_plain_single_batched_and_threaded():
+    robot = random_arm(5)  # modified DH, a prismatic joint, fixed rows with inertia, odd gravity
+    compiled = denavit.compile(robot)
+    rng = np.random.default_rng(11)
+    q, qd, qdd = random_state(rng, robot)
+    Y = compiled.regressor(q, qd, qdd)
+    assert Y.shape == (robot.dof, 13 * robot.dof)
+    np.testing.assert_allclose(Y, regressor(robot, q, qd, qdd), rtol=0, atol=1e-11)
+    Q, QD, QDD = random_state(rng, robot, (3, 4))
+    YB = compiled.regressor(Q, QD, QDD, threads=2)
+    np.testing.assert_allclose(YB, regressor(robot, Q, QD, QDD), rtol=0, atol=1e-11)
+    tau = denavit.rnea(robot, Q, QD, QDD)
+    np.testing.assert_allclose(YB @ inertial_parameters(robot), tau, rtol=0, atol=1e-10 * np.abs(tau).max())

@@ -15,6 +15,7 @@ from ._emit import NUMBA, NUMPY, python_module
 from ._kernels import (BASE_GROUP, DYNAMICS, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
                        registered_digest, registered_kernels, trace_kernels, trace_registered)
 from ._compiled_dyn import DynDerivativeMethods
+from ._compiled_reg import RegressorMethods
 from ._compiled_kin import KinDerivativeMethods
 from ._solvers import IKMethods
 
@@ -39,7 +40,7 @@ _ARITY = {"rnea": 3, "coriolis": 2, "forward_dynamics": 3}
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
 
-class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods):
+class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, RegressorMethods):
     """The generated kernels of one arm.  Made by :func:`compile`; see there."""
 
     def __init__(self, robot: DHRobot, module, backend: str, names, friction: bool = True, only=None) -> None:

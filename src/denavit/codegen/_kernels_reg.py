@@ -13,20 +13,18 @@ from __future__ import annotations
 from ..chain import COMPONENTS, chain_of, walk
 from ..model import DHRobot
 from ..numeric import Linear, dynamics_plan, parameter_names, regressor_rows
-from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero
+from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero, register_kernel
 from ._trace import Tape, sym_sign
 
-__all__ = ["trace_regressor", "regressor_width"]
+__all__ = ["trace_regressor", "GROUP"]
 
-
-def regressor_width(robot: DHRobot, friction: bool = True) -> int:
-    """p, the number of columns of the compiled regressor (friction columns when compiled with friction)."""
-    return len(parameter_names(robot, friction=friction, motor_inertia=True))
+GROUP = "regressor"
 
 
 def trace_regressor(robot: DHRobot, friction: bool = True) -> KernelSpec:
-    """Y(q, q̇, q̈), output (n, p): the columns of :func:`denavit.numeric.regressor` (``friction=friction``,
-    ``motor_inertia=True``)."""
+    """Y(q, q̇, q̈), output (n, 13 n): the columns of :func:`denavit.numeric.regressor` with its defaults (friction
+    and motor-inertia columns always: they hold q̇, sign q̇ and q̈, whatever the robot's friction values and the
+    compiled object's ``friction`` setting, which ``τ = Y π`` leaves to π)."""
     chain = chain_of(robot)
     n = robot.dof
     pl = dynamics_plan(robot)
@@ -36,15 +34,19 @@ def trace_regressor(robot: DHRobot, friction: bool = True) -> KernelSpec:
     g = _gravity_seen_at_zero(chain, q, [float(v) for v in robot.gravity])
     rows = regressor_rows(pl, q0, qd, qdd, g, lambda i: Linear({i: 1.0}), True,
                           walk(chain, q0, COMPONENTS, frames=True))
-    p = regressor_width(robot, friction)
+    p = len(parameter_names(robot))
     out = []
     for j, tau in enumerate(rows):
         row = [0.0] * p
         if isinstance(tau, Linear):
             for i, c in tau.terms.items():
                 row[i if i < 10 * n else p - n + (i - 10 * n)] = c  # motor inertia: the last n columns
-        if friction:
-            row[10 * n + j], row[11 * n + j] = qd[j], sym_sign(qd[j])
+        row[10 * n + j], row[11 * n + j] = qd[j], sym_sign(qd[j])
         out.extend(row)
     return KernelSpec("regressor", "Y(q, qd, qdd) with tau = Y pi (pi: denavit.inertial_parameters)",
                       (("q", n), ("qd", n), ("qdd", n)), (n, p), tuple(out), tape)
+
+
+register_kernel("regressor", group=GROUP, inputs=lambda n: (("q", n), ("qd", n), ("qdd", n)),
+                shape=lambda n: (n, 13 * n), doc="Y(q, qd, qdd) with tau = Y pi (pi: denavit.inertial_parameters)",
+                trace=trace_regressor)
