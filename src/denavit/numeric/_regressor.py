@@ -213,19 +213,22 @@ def regressor(robot: DHRobot, q, qd, qdd, *, friction: bool = True, motor_inerti
     batch = q.shape[:-1]
     flat = [x.reshape(-1, n) for x in (q, qd, qdd)]
     out = np.zeros((flat[0].shape[0], n, p))
-    unit = _block_unit(True)
-
-    def work(s: int, e: int) -> None:
-        for a in range(s, e, _BLOCK):
-            b = min(e, a + _BLOCK)
-            rows = regressor_rows(pl, *[joint_columns(x[a:b])[0] for x in flat], g, unit, False)
-            for j, row in enumerate(rows):
-                for k, c in (_block_rows(row, n, True) or {}).items():
-                    out[a:b, j, 10 * k: 10 * k + 10] = c
-            out[a:b] = _finish(out[a:b], flat[1][a:b], flat[2][a:b], n, friction, motor_inertia)
-
-    split_rows(out.shape[0], work, threads, min_rows=256)
+    split_rows(out.shape[0], lambda s, e: _fill(out, pl, flat, g, s, e, friction, motor_inertia), threads,
+               min_rows=256)
     return out.reshape(batch + (n, p))
+
+
+def _fill(out, pl, flat, g, s: int, e: int, friction: bool, motor_inertia: bool) -> None:
+    """Rows s:e of a batch's Y, in blocks of :data:`_BLOCK` rows (the kernel's arrays are (10, rows))."""
+    n = out.shape[1]
+    unit = _block_unit(True)
+    for a in range(s, e, _BLOCK):
+        b = min(e, a + _BLOCK)
+        rows = regressor_rows(pl, *[joint_columns(x[a:b])[0] for x in flat], g, unit, False)
+        for j, row in enumerate(rows):
+            for k, c in (_block_rows(row, n, True) or {}).items():
+                out[a:b, j, 10 * k: 10 * k + 10] = c
+        out[a:b] = _finish(out[a:b], flat[1][a:b], flat[2][a:b], n, friction, motor_inertia)
 
 
 def _finish(out, qd, qdd, n: int, friction: bool, motor_inertia: bool) -> np.ndarray:
