@@ -18,7 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_q(p, required=False)
     p.add_argument("--qd", metavar="QD", help="joint rates for Y (default zeros)")
     p.add_argument("--qdd", metavar="QDD", help="joint accelerations for Y (default zeros)")
-    p.add_argument("--tol", type=bounded_float(0.0, 0.1, open_low=True), default=None, metavar="TOL",
+    p.add_argument("--tol", type=bounded_float(1e-15, 0.1), default=None, metavar="TOL",
                    help="rank tolerance of the base parameters, relative (default 1e-8)")
     p.add_argument("--no-friction", action="store_true", help="leave out the friction parameters FV, FC")
     p.add_argument("--no-motor-inertia", action="store_true", help="leave out the motor inertias IA")

@@ -23,6 +23,8 @@ __all__ = ["BaseParameters", "base_parameters", "base_regressor", "BASE_TOL"]
 #: Rank tolerance of :func:`base_parameters`: a column counts as independent of the ones before it when its
 #: distance to their span exceeds BASE_TOL × its norm (after scaling every column of W to unit norm).
 BASE_TOL = 1e-8
+#: The smallest tolerance accepted: below it the rounding of float64 columns would count as independent.
+MIN_TOL = 1e-15
 
 
 @dataclass(frozen=True)
@@ -120,8 +122,8 @@ def _base_parameters_cached(robot, friction, motor_inertia, tol, samples) -> Bas
 
 
 def _base_parameters(robot, friction, motor_inertia, tol, samples, rng) -> BaseParameters:
-    if not (tol > 0 and tol < 1):
-        raise ValueError(f"tol must be in (0, 1), got {tol!r}")
+    if not (MIN_TOL <= tol < 1):
+        raise ValueError(f"tol must be in [{MIN_TOL:g}, 1), got {tol!r} (below, float64 rounding counts as rank)")
     names = parameter_names(robot, friction=friction, motor_inertia=motor_inertia)
     p, n = len(names), robot.dof
     samples = int(samples) if samples is not None else max(50, -(-3 * p // n))
