@@ -196,8 +196,8 @@ def _coordinates(P, r, grid, basis, ident, origin, T, R2):
 @njit(nogil=True, cache=True)
 def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2):
     """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
-    is taken at the end), cell (cells[:r]) and sub-cell (subs[:r], −1 outside the refined cells) of the origins
-    P[:r]; returns a status.  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
+    is taken at the end), cells (cells[:r]) and the sub-cells of those in refined cells (subs[:ns], in order) of
+    the origins P[:r]; returns (status, ns).  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
     dim, k = basis.shape[0], int(grid[5])
     _coordinates(P, r, grid, basis, ident, origin, T, R2)
     x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
@@ -217,40 +217,37 @@ def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, s
     if bad:
         for i in range(r):
             if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
-                return 1
-        return 2
-    if words.size:
+                return 1, 0
+        return 2, 0
+    ns = 0
+    if words.size:  # branch-free: every sample's index is written, only those in refined cells are kept
         for i in range(r):
             flat = cells[i]
             word = words[flat >> 6]
             b = np.uint64(flat) & _LOW6
-            idx = -1
-            if (word >> b) & _ONE:
-                idx = prefix[flat >> 6] + np.int64(_popcount(word & ((_ONE << b) - _ONE)))
-                for a in range(dim):
-                    idx = idx * k + int(np.floor(T[a, i] * k) - k * np.floor(T[a, i]))
-            subs[i] = idx
-    return 0
+            idx = prefix[flat >> 6] + np.int64(_popcount(word & ((_ONE << b) - _ONE)))
+            for a in range(dim):
+                idx = idx * k + int(np.floor(T[a, i] * k) - k * np.floor(T[a, i]))
+            subs[ns] = idx
+            ns += np.int64((word >> b) & _ONE)
+    return 0, ns
 
 
 @njit(nogil=True, cache=True)
 def _add(cells, r, acc, touched, nt):
-    """acc[cells[i]] += 1 for i < r (cells ≥ 0); the first hit of each cell appended to touched (when it has
-    room: a buffer of the task's size, or none); returns the new length of touched.  A loop of its own: its
-    increments are independent, so the cache misses of a large grid overlap."""
+    """acc[cells[i]] += 1 for i < r; the first hit of each cell appended to touched (when it has room: a buffer
+    of the task's size, or none); returns the new length of touched.  A loop of its own: its increments are
+    independent, so the cache misses of a large grid overlap."""
     if touched.size:
         for i in range(r):
             c = cells[i]
-            if c >= 0:
-                if acc[c] == 0:
-                    touched[nt] = c
-                    nt += 1
-                acc[c] += 1
+            if acc[c] == 0:
+                touched[nt] = c
+                nt += 1
+            acc[c] += 1
     else:
         for i in range(r):
-            c = cells[i]
-            if c >= 0:
-                acc[c] += 1
+            acc[cells[i]] += 1
     return nt
 
 
@@ -275,12 +272,12 @@ def _build(rows):
                 j = _draw(qs, r, j, k0, k1, lo, span, buf)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
-                status = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2)
+                status, ns = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T,
+                                    R2)
                 if status:
                     return nt, nft, status
                 nt = _add(cells, r, acc, touched, nt)
-                if words.size:
-                    nft = _add(subs, r, fine, ftouched, nft)
+                nft = _add(subs, ns, fine, ftouched, nft)
         return nt, nft, 0
 
     return run
