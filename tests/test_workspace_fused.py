@@ -14,18 +14,17 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _random_robots import random_robot
 
 import denavit
 from denavit import JointType
 from denavit.scale import BLOCK, CompiledPositionFK, occupancy
 
-from _random_robots import random_robot
-
 pytest.importorskip("numba")
 
-from denavit.scale import _fused, _sink  # noqa: E402  (numba needed)
-from denavit.scale._refine import plan_refinement  # noqa: E402
-from denavit.scale._sampler import make_job, run_task  # noqa: E402
+from denavit.scale import _fused, _sink
+from denavit.scale._refine import plan_refinement
+from denavit.scale._sampler import make_job, run_task
 
 
 class NumpyRoute(CompiledPositionFK):
@@ -120,7 +119,7 @@ def test_tilted_plane_cells_are_the_numpy_routes():
 def test_identical_for_chunks_workers_accumulators_and_routes(monkeypatch):
     robot = denavit.load_robot("stanford")
     n = 5 * BLOCK + 999
-    args = dict(resolution=0.1, seed=42, refine=4)
+    args = {"resolution": 0.1, "seed": 42, "refine": 4}
     ref = occupancy(robot, n, scheduler="synchronous", chunk=BLOCK, fk=NumpyRoute(robot), **args)
     assert ref.refinement is not None and ref.fine.sum() > 0
     fk = CompiledPositionFK(robot)

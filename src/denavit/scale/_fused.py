@@ -26,7 +26,7 @@ import threading
 import numpy as np
 from numba import njit
 
-__all__ = ["fused_kernel", "block_keys", "SUB_ROWS", "OK", "NON_FINITE", "OUTSIDE"]
+__all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel"]
 
 #: Rows drawn, positioned and counted per step (their joint values and origins stay in the L1 cache).
 SUB_ROWS = 256

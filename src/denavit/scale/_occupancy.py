@@ -159,9 +159,9 @@ def _tasks(samples: int, chunk: int, start: int = 0, stop: int | None = None):
 def _where(scheduler: Any, samples: int, fk: Callable | None, robot: DHRobot) -> Any:
     """``"auto"``: threads when the tasks run the fused kernel (the default FK from COMPILED_FROM samples with
     numba: no GIL held, no counts handed over), else :func:`resolve_auto`'s choice."""
-    if isinstance(scheduler, str) and scheduler == "auto" and fk is None:
-        if type(default_fk(robot, samples)) is CompiledPositionFK:
-            return "threads"
+    if isinstance(scheduler, str) and scheduler == "auto" and fk is None and (
+            type(default_fk(robot, samples)) is CompiledPositionFK):
+        return "threads"
     return resolve_auto(scheduler, samples)
 
 

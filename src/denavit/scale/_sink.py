@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import DenavitError, ModelError
 from ._refine import REFINE_CELLS, slot_map
 
-__all__ = ["ACC_BUDGET", "Sink", "NoSink", "open_sink", "close_sink", "run_fused", "task_memory"]
+__all__ = ["ACC_BUDGET", "NoSink", "Sink", "close_sink", "open_sink", "run_fused", "task_memory"]
 
 #: Most bytes of accumulators a run keeps in this process (at least one accumulator is always made).
 ACC_BUDGET = 3 * 2**27
@@ -35,6 +35,7 @@ _sinks: dict = {}
 _sinks_lock = threading.Lock()
 _tokens = itertools.count()
 _E32, _E64, _EU64 = np.empty(0, np.int32), np.empty(0, np.int64), np.empty(0, np.uint64)
+_NONE = np.empty(0, np.uint32)  # no counts (read-only use: nothing is ever written to it)
 
 
 class _Accumulator:
@@ -182,17 +183,28 @@ def run_fused(job, first: int, count: int) -> tuple:
     kernel = fused_kernel(job.fk.robot)
     sink = _sinks.get(job.sink) if job.sink else None
     if sink is not None:
-        acc = sink.acquire(total, fine_size)
-        try:
-            _, _, status = kernel(*args, acc.counts, _E32, words, prefix,
-                                  acc.fine if fine_size else _work.dense("none", 0), _E64, *scratch)
-        finally:
-            sink.release(acc)
-        _check(status)
-        empty = np.empty(0, np.int32)
-        return empty, empty.astype(np.uint32), stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, _E64, _E32.astype(
-            np.uint32)
-    acc, fine = _work.dense("cells", g.side**g.dim), _work.dense("fine", fine_size)
+        idx, cnt, fidx, fcnt = _into_sink(kernel, args, scratch, sink, total, words, prefix, fine_size)
+    else:
+        idx, cnt, fidx, fcnt = _sparse(kernel, args, scratch, g.side**g.dim, total, words, prefix, fine_size)
+    return idx, cnt, stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, fidx, fcnt
+
+
+def _into_sink(kernel, args, scratch, sink: Sink, total: int, words, prefix, fine_size: int) -> tuple:
+    """Count into a free accumulator of the run's sink; no cells returned (empty arrays)."""
+    acc = sink.acquire(total, fine_size)
+    try:
+        _, _, status = kernel(*args, acc.counts, _E32, words, prefix, acc.fine if fine_size else _NONE, _E64,
+                              *scratch)
+    finally:
+        sink.release(acc)
+    _check(status)
+    return _E32, _NONE, _E64, _NONE
+
+
+def _sparse(kernel, args, scratch, cells: int, total: int, words, prefix, fine_size: int) -> tuple:
+    """Count into this thread's zeroed accumulators; return the cells hit and their counts (and the sub-cells'),
+    and zero those cells again."""
+    acc, fine = _work.dense("cells", cells), _work.dense("fine", fine_size)
     touched = _work.get("ftouch", (total,), np.int32)
     ftouched = _work.get("fftouch", (total if fine_size else 0,), np.int64)
     nt = nft = 0
@@ -201,10 +213,10 @@ def run_fused(job, first: int, count: int) -> tuple:
         idx, fidx = touched[:nt].copy(), ftouched[:nft].copy()
         cnt, fcnt = acc[idx], fine[fidx]
     finally:
-        acc[touched[:nt]] = 0  # nt is 0 if the kernel raised: a failed run is not resumed
+        acc[touched[:nt]] = 0  # the kernel reports errors by status, with nt and nft counted so far
         fine[ftouched[:nft]] = 0
     _check(status)
-    return idx, cnt, stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, fidx, fcnt
+    return idx, cnt, fidx, fcnt
 
 
 def _check(status: int) -> None:
