@@ -184,3 +184,16 @@ def test_progress_line_of_a_fused_run(capsys):
               fk=CompiledPositionFK(robot))
     err = capsys.readouterr().err
     assert "100.0%" in err and "samples/s" in err and "ETA" in err and err.endswith("\n")
+
+
+def test_a_process_without_numba_takes_the_numpy_route(monkeypatch):
+    """A fused job reaching a worker without numba is counted by the numpy route: the same numbers."""
+    import denavit.scale._sampler as sampler
+
+    robot = denavit.load_robot("planar2r")
+    job = make_job(robot, 2 * BLOCK, None, 3, CompiledPositionFK(robot))
+    fused = run_task(job, 0, 2)
+    monkeypatch.setattr(sampler, "_has_numba", lambda: False)
+    numpy_route = run_task(job, 0, 2)
+    assert np.all(np.diff(numpy_route[0]) > 0)  # the numpy route's sorted cells (the fused ones are not)
+    _same_task(fused, numpy_route)

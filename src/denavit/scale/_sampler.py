@@ -294,7 +294,7 @@ def run_task(job: Job, first: int, count: int) -> tuple:
 
     With ``job.fused`` the fused kernel computes the same (``_sink.run_fused``; cells unsorted, and none at all
     when ``job.sink`` holds them in this process)."""
-    if job.fused:
+    if job.fused and _has_numba():  # a cluster worker without numba takes the numpy route: the same numbers
         from ._sink import run_fused
 
         return run_fused(job, first, count)
@@ -387,6 +387,10 @@ def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, 
 
 
 def _has_numba() -> bool:
+    import sys
+
+    if "numba" in sys.modules:
+        return True
     import importlib.util
 
     return importlib.util.find_spec("numba") is not None
