@@ -118,7 +118,7 @@ def _analytic_task(robot, grid, cells, rot):
     valid = np.asarray(res.valid)  # (B, K, S)
     w = np.zeros(valid.shape)
     if valid.any():
-        w[valid] = manipulability(geometric_jacobian(robot, res.solutions[valid]))
+        w[valid] = manipulability(geometric_jacobian(robot, res.solutions[valid], threads=1))
     reached = valid.any(axis=-1)  # (B, K)
     best = w.max(axis=-1)  # (B, K)
     return cells, reached.mean(axis=-1), _mean_reached(best, reached)
@@ -138,7 +138,7 @@ def _numeric_task(robot, grid, cells, rot, seed):
             r = solve_ik(robot, T[i, k], restarts=NUMERIC_RESTARTS, rng=rng)
             if r.success:
                 reached[i, k] = True
-                best[i, k] = float(manipulability(geometric_jacobian(robot, r.q)))
+                best[i, k] = float(manipulability(geometric_jacobian(robot, r.q, threads=1)))
     return cells, reached.mean(axis=-1), _mean_reached(best, reached)
 
 

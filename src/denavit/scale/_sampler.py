@@ -86,7 +86,7 @@ class PositionFK:
     def __call__(self, q: np.ndarray) -> np.ndarray:
         from ..numeric import forward_kinematics
 
-        return forward_kinematics(self.robot, q)[:, :3, 3]
+        return forward_kinematics(self.robot, q, threads=1)[:, :3, 3]  # the scheduler runs the tasks in parallel
 
 
 class CompiledPositionFK:
@@ -107,7 +107,7 @@ class CompiledPositionFK:
             from ..codegen import compile as compile_robot
 
             self._kernel = compile_robot(self.robot, kernels=["position"]).position
-        return self._kernel(np.ascontiguousarray(q, dtype=float))
+        return self._kernel(np.ascontiguousarray(q, dtype=float), threads=1)  # one task, one thread
 
 
 def default_fk(robot: DHRobot, samples: int) -> Callable:
