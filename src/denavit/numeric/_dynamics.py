@@ -189,7 +189,8 @@ def rnea(robot: DHRobot, q, qd, qdd, *, gravity=None, friction: bool = True, thr
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(qdd, n, "qdd")
     )
     g = gravity_vector(robot, gravity)
-    split = split_call(lambda *x: rnea(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, qdd), threads)
+    split = None if q.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda *x: rnea(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, qdd), threads)
     if split is not None:
         return split
     (qc, batch), (qdc, _), (qddc, _) = joint_columns(q), joint_columns(qd), joint_columns(qdd)
@@ -209,7 +210,8 @@ def mass_matrix(robot: DHRobot, q, *, threads=None) -> np.ndarray:
     motor inertia on the diagonal.  ``threads``: as :func:`rnea`.
     """
     q = as_joint_array(q, robot.dof)
-    split = split_call(lambda x: mass_matrix(robot, x, threads=1), (q,), threads)
+    split = None if q.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda x: mass_matrix(robot, x, threads=1), (q,), threads)
     if split is not None:
         return split
     qc, batch = joint_columns(q)
@@ -300,8 +302,8 @@ def forward_dynamics(robot: DHRobot, q, qd, tau, *, gravity=None, friction: bool
         as_joint_array(q, n), as_joint_array(qd, n, "qd"), as_joint_array(tau, n, "tau")
     )
     g = gravity_vector(robot, gravity)
-    split = split_call(lambda *x: forward_dynamics(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, tau),
-                       threads)
+    split = None if q.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda *x: forward_dynamics(robot, *x, gravity=g, friction=friction, threads=1), (q, qd, tau), threads)
     if split is not None:
         return split
     if friction:

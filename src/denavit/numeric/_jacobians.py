@@ -106,7 +106,8 @@ def geometric_jacobian(robot: DHRobot, q, frame: Frame | str | int = Frame.BASE,
     """
     frame = _frame_of(robot, frame)
     q = as_joint_array(q, robot.dof)
-    split = split_call(lambda x: geometric_jacobian(robot, x, frame, threads=1), (q,), threads)
+    split = None if q.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda x: geometric_jacobian(robot, x, frame, threads=1), (q,), threads)
     if split is not None:
         return split
     if not isinstance(frame, Frame):

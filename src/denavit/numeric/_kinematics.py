@@ -82,7 +82,8 @@ def link_transforms(robot: DHRobot, q, *, threads=None) -> np.ndarray:
         the unsplit one bit for bit: :mod:`denavit._threads`).
     """
     qa = as_joint_array(q, robot.dof)
-    split = split_call(lambda x: link_transforms(robot, x, threads=1), (qa,), threads)
+    split = None if qa.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda x: link_transforms(robot, x, threads=1), (qa,), threads)
     if split is not None:
         return split
     if qa.ndim == 1:
@@ -112,7 +113,8 @@ def forward_kinematics(robot: DHRobot, q, *, threads=None) -> np.ndarray:
     (4, 4)
     """
     qa = as_joint_array(q, robot.dof)
-    split = split_call(lambda x: forward_kinematics(robot, x, threads=1), (qa,), threads)
+    split = None if qa.ndim == 1 and threads is None else split_call(  # one configuration: inline
+        lambda x: forward_kinematics(robot, x, threads=1), (qa,), threads)
     if split is not None:
         return split
     chain = chain_of(robot)
