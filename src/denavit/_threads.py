@@ -24,10 +24,12 @@ Rules (the same for every caller):
   workers, so the pool cannot deadlock.
 
 Oversubscription: the compiled kernels are serial (numba's ``parallel=True``/``prange`` is not used, so
-numba's own threading layer never starts), and numpy's batched small-matrix products do not use the BLAS
-thread pool, so ``threads=T`` keeps T cores busy, not more.  If you run denavit next to other multi-threaded
-code (a numba ``parallel=True`` function of your own, a multi-threaded BLAS on large matrices, Dask workers),
-give each a share: ``threads=`` here, ``numba.set_num_threads`` / ``OMP_NUM_THREADS`` there.
+numba's own threading layer never starts), and numpy's products of small (4×4, 6×n) matrices stay below the
+size at which a threaded BLAS starts its own threads, so ``threads=T`` keeps T cores busy, not more.  Work that
+is already parallel calls with ``threads=1``: the workspace and reachability tasks (:mod:`denavit.scale`) do,
+since Dask runs the tasks side by side.  Next to other multi-threaded code (a numba ``parallel=True`` function of
+your own, a threaded BLAS on large matrices) give each a share: ``threads=`` here, ``numba.set_num_threads`` /
+``OMP_NUM_THREADS`` there.
 """
 
 from __future__ import annotations
@@ -38,7 +40,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["ALIGN", "MIN_ROWS", "NUMPY_CHUNK", "available_cores", "blocks", "resolve_threads", "run_batch", "split_call", "split_rows"]
+__all__ = ["ALIGN", "MIN_ROWS", "NUMPY_CHUNK", "available_cores", "blocks", "resolve_threads", "run_batch",
+           "split_call", "split_rows"]
 
 #: Fewest rows a thread is given (a batch below 2 × MIN_ROWS runs inline).
 MIN_ROWS = 4096
