@@ -104,3 +104,14 @@ def test_report_friction_is_written_in_decimals_like_the_rest_of_the_dynamics(tm
     text = str(tau_f.expr)
     assert "5.80182 \\dot{q}_{1}" in text and "25.9836 \\operatorname{sign}" in text, text
     assert "\\frac" not in text and "125000000" not in text
+
+
+def test_a_name_in_q_of_an_arm_without_poses_gets_the_values_error(capsys, tmp_path):
+    """`-q "O"` on a one-joint arm without named poses said `'O' is neither 1 joint values nor a named pose of p
+    (its poses: none)`: a pose cannot be meant there, and the value's own error names the unknown symbol."""
+    arm = tmp_path / "p.yaml"
+    arm.write_text("name: p\nconvention: standard\njoints:\n  - {a: 0.5, alpha: 0, d: 0, theta: q}\n", encoding="utf-8")
+    code, out, err = run(capsys, "fk", str(arm), "-q", "O")
+    assert code == 2 and out == "" and "unknown symbol 'O' (known: pi)" in err and "pose" not in err
+    code, _, err = run(capsys, "fk", "puma560", "-q", "qx")  # an arm with poses: the pose names are offered
+    assert code == 2 and "neither 6 joint values nor a named pose" in err and "qz, qr, qs, qn" in err

@@ -245,10 +245,10 @@ def joint_values(args: argparse.Namespace, robot, text: str | None, what: str = 
                 vals = np.where(revolute, parse_values(text, robot.dof, what=what, deg=True), vals)
         except ParseError:
             name = text.strip()
-            if not rates and name.isidentifier() and len(name) <= 40:
-                known = ", ".join(p for p, _ in robot.poses) or "none"
-                raise ParseError(f"{what}: {name!r} is neither {robot.dof} joint values nor a named pose of "
-                                 f"{robot.name} (its poses: {known})") from None
+            if not rates and name.isidentifier() and len(name) <= 40 and robot.poses:  # else: the value's error
+                known = ", ".join(p for p, _ in robot.poses)
+                raise ParseError(f"{what}: {name!r} is neither {robot.dof} joint value{'s' * (robot.dof != 1)} nor "
+                                 f"a named pose of {robot.name} (its poses: {known})") from None
             raise
     if check_limits and not rates and not getattr(args, "ignore_limits", False):
         lim = robot.q_limits
