@@ -7,7 +7,8 @@ to agree with denavit on the numbers it is timed on.
 
 Single call: one configuration, best of 3·`repeat` rounds of `number` calls, denavit and Pinocchio taking turns
 within each round, each returning what a user gets:
-  FK     denavit fast.fk(q) → 4×4 array; Pinocchio framesForwardKinematics + data.oMf[tool] (an SE3)
+  FK     denavit fast.fk(q) → 4×4 array; Pinocchio framesForwardKinematics + data.oMf[tool] (an SE3); and against
+         Pinocchio's bare forwardKinematics(model, data, q) (joint placements only, nothing returned: issue 25's yardstick)
   J      fast.jacobian(q) (J0); Pinocchio computeFrameJacobian(..., LOCAL_WORLD_ALIGNED) (includes its FK)
   RNEA   fast.rnea(q, qd, qdd); pin.rnea      M  fast.mass_matrix(q); pin.crba (upper triangle only)
   FD     fast.forward_dynamics(q, qd, tau); pin.aba
@@ -50,6 +51,8 @@ def single_rows(name: str, repeat: int, number: int):
 
     ops = [
         ("FK", lambda: fast.fk(q), pin_fk, lambda a, b: np.allclose(a, b.homogeneous, atol=1e-10)),
+        ("FK vs bare forwardKinematics", lambda: fast.fk(q), lambda: pin.forwardKinematics(model, data, q),
+         lambda a, b: np.allclose(a, pin.updateFramePlacement(model, data, fid).homogeneous, atol=1e-10)),
         ("J", lambda: fast.jacobian(q), lambda: pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED),
          lambda a, b: np.allclose(a, b, atol=1e-10)),
         ("RNEA", lambda: fast.rnea(q, qd, qdd), lambda: pin.rnea(model, data, q, qd, qdd),
@@ -59,7 +62,8 @@ def single_rows(name: str, repeat: int, number: int):
         ("FD", lambda: fast.forward_dynamics(q, qd, tau), lambda: pin.aba(model, data, q, qd, tau),
          lambda a, b: np.allclose(a, b, atol=1e-8)),
     ]
-    plain = {"FK": lambda: denavit.forward_kinematics(robot, q), "J": lambda: denavit.geometric_jacobian(robot, q),
+    plain = {"FK": lambda: denavit.forward_kinematics(robot, q),
+             "FK vs bare forwardKinematics": lambda: denavit.forward_kinematics(robot, q), "J": lambda: denavit.geometric_jacobian(robot, q),
              "RNEA": lambda: denavit.rnea(robot, q, qd, qdd, friction=False), "M": lambda: denavit.mass_matrix(robot, q),
              "FD": lambda: denavit.forward_dynamics(robot, q, qd, tau, friction=False)}
     rows = []
