@@ -115,3 +115,19 @@ def test_a_name_in_q_of_an_arm_without_poses_gets_the_values_error(capsys, tmp_p
     assert code == 2 and out == "" and "unknown symbol 'O' (known: pi)" in err and "pose" not in err
     code, _, err = run(capsys, "fk", "puma560", "-q", "qx")  # an arm with poses: the pose names are offered
     assert code == 2 and "neither 6 joint values nor a named pose" in err and "qz, qr, qs, qn" in err
+
+
+def test_the_correction_of_a_jacobian_read_as_three_rows_shows_those_rows(capsys, tmp_path):
+    """The homework's 3-row J (rows vx, vy, ωz) with a slip was corrected by the whole 6-row J0, three rows of
+    zeros the student never wrote among them; the correction is now in the rows the claim was read as."""
+    claims = tmp_path / "j.yaml"
+    claims.write_text("claims:\n  - quantity: jacobian\n    value: |\n"
+                      "      \\begin{bmatrix} -L_1 s_1 - L_2 s_{12} & -L_2 s_{12} \\\\ L_1 c_1 + L_2 c_{12} & L_1 c_{12}"
+                      " \\\\ 1 & 1 \\end{bmatrix}\n", encoding="utf-8")
+    code, out, _ = run(capsys, "check", "planar2r", str(claims))
+    assert code == 0 and "INCORRECT" in out and "read as the rows (vx, vy, ωz)" in out
+    (fix,) = [line.split("(LaTeX): ", 1)[1] for line in out.splitlines() if "correct formula (LaTeX)" in line]
+    rows = fix.removeprefix("\\begin{bmatrix}").removesuffix("\\end{bmatrix}").split("\\\\")
+    # Spong's planar 2R, rows (vx, vy, ωz): [-L1 S1 - L2 S12, -L2 S12; L1 C1 + L2 C12, L2 C12; 1, 1]
+    assert len(rows) == 3 and rows[2].replace(" ", "") == "1&1", fix
+    assert rows[1].replace(" ", "").endswith("&C_{12}L_{2}"), fix

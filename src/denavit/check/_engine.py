@@ -126,10 +126,11 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         v = _compare(robot, cid, q2, spec, shape_to(cells, t2.shape[1:]), points, t2, rng, False)
         if v.verdict == "correct":
             return replace(v, message=f"{v.message}, read as {label}")
-        verdicts.append((len(v.entries), label, q2, t2))
-    _, label, q2, t2 = min(verdicts, key=lambda x: x[0])
-    v = _compare(robot, cid, q2, spec, shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
-    others = "; ".join(lb for _, lb, _, _ in verdicts if lb != label)
+        verdicts.append((len(v.entries), label, q2, t2, getattr(fn, "rows", None)))
+    _, label, q2, t2, rows = min(verdicts, key=lambda x: x[0])
+    spec_read = {**spec, "_rows": rows} if rows else spec  # the correct formula shown in the rows read
+    v = _compare(robot, cid, q2, spec_read, shape_to(cells, t2.shape[1:]), points, t2, rng, detail)
+    others = "; ".join(lb for _, lb, *_ in verdicts if lb != label)
     return replace(v, message=f"{v.message}, read as {label}" + (f" (also wrong read as {others})" if others else ""))
 
 

@@ -28,7 +28,7 @@ def expected_formula(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | N
         if spec.get("column") is not None or spec.get("rows", "all") != "all" or spec.get("entry") is not None \
                 or not (frame in ("base", "tool")):
             return None  # a part of J, or J in frame i: the numbers and hints say what differs
-        return _expected_jacobian(robot, str(frame))
+        return _expected_jacobian(robot, str(frame), spec.get("_rows"))
     return _expected_formula(robot, name, *keys)
 
 
@@ -119,8 +119,9 @@ MAX_FORMULA_DOF_JACOBIAN = 4
 
 
 @lru_cache(maxsize=16)
-def _expected_jacobian(robot: DHRobot, frame: str) -> str | None:
-    """J0 or Je from the symbolic engine (arms of up to MAX_FORMULA_DOF_JACOBIAN joints: seconds at most)."""
+def _expected_jacobian(robot: DHRobot, frame: str, rows: tuple[int, ...] | None = None) -> str | None:
+    """J0 or Je from the symbolic engine (arms of up to MAX_FORMULA_DOF_JACOBIAN joints: seconds at most); only
+    ``rows`` (indices into (vx, vy, vz, ωx, ωy, ωz)) when the claim was read as those rows."""
     import sympy as sp
 
     from .. import symbolic as S
@@ -134,6 +135,8 @@ def _expected_jacobian(robot: DHRobot, frame: str) -> str | None:
     if len(str(M)) > 20_000:
         return None
     M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
+    if rows:
+        M = M.extract(list(rows), list(range(M.shape[1])))
     return sp.latex(M, mat_str="bmatrix", mat_delim="")
 
 

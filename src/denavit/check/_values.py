@@ -129,14 +129,22 @@ def shape_readings(qty, spec: dict[str, Any], shape: tuple[int, ...], cells: lis
         if width_ok and m in (2, 3):
             sets = [(0, 1, 2), (0, 1, 5), (3, 4, 5)] if m == 3 else [(0, 1)]
             for rows in sets:
-                out.append((f"the rows ({', '.join(_ROW_NAMES[i] for i in rows)})",
-                            lambda t, rows=rows: t[list(rows)]))
+                out.append((f"the rows ({', '.join(_ROW_NAMES[i] for i in rows)})", _take_rows(rows)))
     if not out:
         r, c = len(cells), len(cells[0])
         what = {"jacobian": " (rows v, ω; one column per joint)", "twist": " (v, ω)",
                 "torques": " (one per joint)"}.get(qty.name, "")
         raise ShapeMismatch(f"expected {_describe(shape)}{what}, got a {r}×{c} value")
     return out
+
+
+def _take_rows(rows: tuple[int, ...]):
+    """The reading "these rows of the 6-row quantity"; ``.rows`` tells the correct formula which rows to show."""
+    def take(t):
+        return t[list(rows)]
+
+    take.rows = rows  # type: ignore[attr-defined]
+    return take
 
 
 def no_names(ident) -> tuple:
