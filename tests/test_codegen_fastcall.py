@@ -24,9 +24,11 @@ def puma(tmp_path_factory):
     mp = pytest.MonkeyPatch()
     mp.setenv("DENAVIT_CACHE_DIR", str(tmp_path_factory.mktemp("kernels")))
     robot = denavit.load_robot("puma560")
-    fast = denavit.compile(robot, kernels=["fk", "frames", "jacobian0", "jacobiane", "rnea", "mass_matrix"])
+    fast = denavit.compile(robot, kernels=["fk", "frames", "jacobian0", "jacobiane", "rnea", "mass_matrix",
+                                           "forward_dynamics"])
     q = np.zeros(6)
     fast.fk(q), fast.jacobian(q), fast.rnea(q, q, q), fast.mass_matrix(q)  # first calls: the built-ins appear
+    fast.forward_dynamics(q, q, q)
     yield robot, fast
     mp.undo()
 
@@ -34,7 +36,7 @@ def puma(tmp_path_factory):
 def test_single_calls_become_builtins_with_the_same_numbers(puma, rng):
     robot, fast = puma
     assert all(type(getattr(fast, m)).__name__ == "builtin_function_or_method"
-               for m in ("fk", "jacobian", "rnea", "mass_matrix"))
+               for m in ("fk", "jacobian", "rnea", "mass_matrix", "forward_dynamics"))
     for q, qd, qdd in rng.uniform(-3, 3, (20, 3, 6)):
         T = fast.fk(q)
         assert T.shape == (4, 4) and T.dtype == np.float64 and T.flags.c_contiguous and T.flags.writeable
@@ -43,6 +45,10 @@ def test_single_calls_become_builtins_with_the_same_numbers(puma, rng):
         np.testing.assert_allclose(fast.jacobian(q), denavit.geometric_jacobian(robot, q), atol=1e-13)
         np.testing.assert_allclose(fast.rnea(q, qd, qdd), denavit.rnea(robot, q, qd, qdd), rtol=1e-12, atol=1e-11)
         np.testing.assert_allclose(fast.mass_matrix(q), denavit.mass_matrix(robot, q), rtol=1e-12, atol=1e-12)
+        acc = fast.forward_dynamics(q, qd, qdd)  # qdd stands for τ here
+        assert acc.shape == (6,)
+        np.testing.assert_array_equal(acc, fast.forward_dynamics(q[None], qd[None], qdd[None])[0])
+        np.testing.assert_allclose(acc, denavit.forward_dynamics(robot, q, qd, qdd), rtol=1e-9, atol=1e-9)
     assert fast.fk(q) is not fast.fk(q)  # a fresh array each call
 
 
@@ -86,3 +92,20 @@ def test_no_references_leak(puma, rng):
         fast.rnea(q, q, q)
     assert sys.getrefcount(q) == before
     assert sys.getrefcount(fast.fk(q)) == 2  # the call's result, referenced only by getrefcount's argument
+
+
+def test_forward_dynamics_where_m_is_singular_raises_through_the_method(tmp_path, monkeypatch):
+    """The built-in hands a call whose regularity flag is not > 0 to the method, which raises."""
+    from dataclasses import replace
+
+    from denavit.errors import ModelError
+
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path))
+    robot = denavit.load_robot("planar2r")
+    massless = replace(robot, links=robot.links[:-1] + (replace(robot.links[-1], inertia=None),))
+    fast = denavit.compile(massless, kernels=["forward_dynamics"])
+    with pytest.raises(ModelError, match="singular"):
+        fast.forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2))  # the first call: the method itself
+    assert type(fast.forward_dynamics).__name__ == "builtin_function_or_method"
+    with pytest.raises(ModelError, match="singular"):
+        fast.forward_dynamics(np.zeros(2), np.zeros(2), np.ones(2))

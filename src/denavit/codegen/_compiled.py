@@ -35,7 +35,8 @@ def _as_batch(arrays, names):
 
 #: kernels whose single call a built-in function takes over (the method it stands in for), and their inputs' count
 _BUILTIN_METHODS = {"fk": "fk", "position": "position", "jacobian0": "jacobian", "rnea": "rnea",
-                    "mass_matrix": "mass_matrix", "gravity": "gravity", "coriolis": "coriolis"}
+                    "mass_matrix": "mass_matrix", "gravity": "gravity", "coriolis": "coriolis",
+                    "forward_dynamics": "forward_dynamics"}
 _ARITY = {"rnea": 3, "coriolis": 2, "forward_dynamics": 3}
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
@@ -150,9 +151,11 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
         ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on; every
         other call goes to the method itself.  Nothing changes when the built-in cannot be made here."""
         lengths = (self.dof,) * _ARITY.get(name, 1)
+        flagged = name == "forward_dynamics"  # its last entry: M regular; the method raises where it is not
+        shape = (self.dof,) if flagged else self._shapes[name]
         try:
-            made = _fastcall.install(self._groups[BASE_GROUP][0], name, lengths, self._shapes[name],
-                                     getattr(type(self), method).__get__(self), guard_cache)
+            made = _fastcall.install(self._groups[BASE_GROUP][0], name, lengths, shape,
+                                     getattr(type(self), method).__get__(self), guard_cache, flagged)
         except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
             made = None
         if made is not None:

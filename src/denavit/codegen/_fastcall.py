@@ -88,9 +88,11 @@ def _setup() -> bool:
     return True
 
 
-def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple):
-    """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the result's
-    allocation and the program (see the module's docstring)."""
+def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple, flagged: bool = False):
+    """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the program
+    and the result (see the module's docstring).  ``flagged``: the kernel's last output is a flag that must be > 0
+    (forward dynamics: M regular); the result is the outputs before it, and a call whose flag is not > 0 goes to
+    the Python method (which raises the error)."""
     from llvmlite import ir
     from numba.core import cgutils, types
     from numba.extending import intrinsic
@@ -135,6 +137,20 @@ def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple):
                 builder.icmp_signed("==", field(obj, _OFF_ND, i32), ir.Constant(i32, 1))))
             require(builder.icmp_signed("==", builder.load(field(obj, _OFF_DIMS, i64.as_pointer())), ir.Constant(i64, k)))
             arrays.append((field(obj, _OFF_DATA, ptr), builder.load(field(obj, _OFF_STRIDES, i64.as_pointer()))))
+        def load(arg, k):
+            data, stride = arrays[arg]
+            return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(i64, k), stride)]),
+                                                dbl.as_pointer()))
+
+        operand = emit_steps(builder, steps, 0, load)
+        flat = {}
+        for index, ref in outputs:
+            f = 0
+            for i, s in zip(index, (size + 1,) if flagged else shape):
+                f = f * s + i
+            flat[f] = ref
+        if flagged:
+            require(builder.fcmp_ordered(">", operand(flat.pop(size)), ir.Constant(dbl, 0.0)))
         new_ty = ir.FunctionType(ptr, [ptr, i32, i64.as_pointer(), i32, ptr, ptr, i32, i32, ptr])
         new = builder.bitcast(extern("denavit_pyarray_new"), new_ty.as_pointer())
         dims = cgutils.alloca_once(builder, i64, size=len(shape))
@@ -149,20 +165,7 @@ def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple):
         incoming.append((null, builder.block))
         builder.cbranch(failed, done, compute)
         builder.position_at_end(compute)
-
-        def load(arg, k):
-            data, stride = arrays[arg]
-            return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(i64, k), stride)]),
-                                                dbl.as_pointer()))
-
-        operand = emit_steps(builder, steps, 0, load)
         data = builder.bitcast(field(out, _OFF_DATA, ptr), dbl.as_pointer())
-        flat = {}
-        for index, ref in outputs:
-            f = 0
-            for i, s in zip(index, shape):
-                f = f * s + i
-            flat[f] = ref
         for f, ref in flat.items():
             builder.store(operand(ref), builder.gep(data, [ir.Constant(i64, f)]))
         incoming.append((out, builder.block))
@@ -186,10 +189,10 @@ def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple):
     return entry
 
 
-def install(module, name: str, lengths: tuple, shape: tuple, method, guard):
+def install(module, name: str, lengths: tuple, shape: tuple, method, guard, flagged: bool = False):
     """``(function, keep)``: the built-in function of kernel ``name`` of the generated ``module``, calling ``method``
     (the Python method, bound) for everything it does not handle itself, and what must live as long as it; None
-    when this process cannot have one.  ``guard(cfunc)``
+    when this process cannot have one.  ``shape``: the result's (``flagged``: see :func:`entry_intrinsic`).  ``guard(cfunc)``
     puts the disk cache's guard in front of numba's cache before anything is loaded."""
     py_func = getattr(module, f"{name}{ENTRY_SUFFIX}", None)
     if py_func is None or not _setup():
@@ -199,7 +202,7 @@ def install(module, name: str, lengths: tuple, shape: tuple, method, guard):
 
     setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(tuple(lengths), tuple(shape),
                                                           getattr(module, f"_{name}_steps"),
-                                                          getattr(module, f"_{name}_outputs")))
+                                                          getattr(module, f"_{name}_outputs"), flagged))
     sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
     cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
     cf.enable_caching()
