@@ -36,6 +36,7 @@ _PYARRAY_NEW_SLOT = 93  # numpy/__multiarray_api.h: PyArray_New, stable since nu
 _OFF_TYPE, _OFF_DATA, _OFF_ND, _OFF_DIMS, _OFF_STRIDES, _OFF_DESCR = 8, 16, 24, 32, 40, 56
 _SYMBOLS = ("denavit_ndarray_type", "denavit_float64_descr", "denavit_pyarray_new", "denavit_vectorcall")
 _STATE: dict = {}
+_CFUNCS: dict = {}  # (generated module's name, kernel) -> its compiled CFunc, for every object of that module
 
 
 class _MethodDef(ctypes.Structure):
@@ -200,14 +201,17 @@ def install(module, name: str, lengths: tuple, shape: tuple, method, guard, flag
     from numba.core import sigutils, types
     from numba.core.ccallback import CFunc
 
-    setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(tuple(lengths), tuple(shape),
-                                                          getattr(module, f"_{name}_steps"),
-                                                          getattr(module, f"_{name}_outputs"), flagged))
-    sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
-    cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
-    cf.enable_caching()
-    guard(cf)
-    cf.compile()
+    cf = _CFUNCS.get((module.__name__, name))  # one per generated module and kernel, whatever the objects
+    if cf is None:
+        setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(tuple(lengths), tuple(shape),
+                                                              getattr(module, f"_{name}_steps"),
+                                                              getattr(module, f"_{name}_outputs"), flagged))
+        sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
+        cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
+        cf.enable_caching()
+        guard(cf)
+        cf.compile()
+        _CFUNCS[(module.__name__, name)] = cf
     doc = (method.__doc__ or "").encode("utf-8", "replace")
     definition = _MethodDef(name.encode(), cf.address, _METH_FASTCALL_KEYWORDS, doc)
     make = ctypes.pythonapi.PyCFunction_NewEx
