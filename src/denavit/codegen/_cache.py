@@ -46,6 +46,7 @@ __all__ = [
     "load_module",
     "numba_available",
     "robot_key",
+    "generator_sources",
 ]
 
 _LOCK = threading.Lock()
@@ -64,20 +65,28 @@ def active_cache_dir() -> Path:
     return choose_folder().folder
 
 
-#: Part of every cache key, with a digest of the sources that shape the generated code (the generator, the
-#: chain walker, the dynamics kernels): a changed generator never reads a stale module.
+#: Part of every cache key, with a digest of the sources that shape the generated code: every module of the
+#: generator (codegen/), the chain walker (chain/) and the numeric kernels the tracer runs (numeric/: the RNEA,
+#: the dual numbers, the kinematic derivatives, the regressor, ...).  All of them, not a hand-kept list: a list
+#: missed the modules new kernel groups trace through, and an upgrade that changed one would have read a stale
+#: module.  A changed generator never reads a stale module.
 GENERATOR_VERSION = "2"  # 2: verified modules (key and hash line, checked-hash .pyc)
-_SOURCES = ("codegen/_emit.py", "codegen/_ik_lm.py", "codegen/_ik_elbow.py", "codegen/_ik_finish.py", "codegen/_ik_parallel.py", "codegen/_ik_stanford.py", "codegen/_llvm.py", "codegen/_kernels.py", "codegen/_trace.py",
-            "chain/_chain.py", "chain/_walk.py", "numeric/_dynamics_fast.py", "numeric/_kin_derivatives.py")
+_SOURCE_PACKAGES = ("codegen", "chain", "numeric")
 _DIGEST: list[str] = []
+
+
+def generator_sources() -> list[str]:
+    """The package files (paths relative to the package) whose text is part of every cache key."""
+    root = Path(__file__).resolve().parent.parent
+    return sorted(p.relative_to(root).as_posix() for pkg in _SOURCE_PACKAGES for p in (root / pkg).glob("*.py"))
 
 
 def _generator_digest() -> str:
     if not _DIGEST:
         root = Path(__file__).resolve().parent.parent
         h = hashlib.sha256(GENERATOR_VERSION.encode())
-        for rel in _SOURCES:
-            h.update((root / rel).read_bytes())
+        for rel in generator_sources():
+            h.update(rel.encode() + b"\0" + (root / rel).read_bytes())
         _DIGEST.append(h.hexdigest()[:16])
     return _DIGEST[0]
 
