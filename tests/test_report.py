@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import re
@@ -25,6 +26,17 @@ ALL = dn.catalogue_names()
 FEW = ["report000-6r", "puma560", "report004-4-rrp", "planar2r"]
 
 
+@functools.lru_cache(maxsize=None)
+def _derived(name):
+    """The full report of catalogue arm ``name`` at its rest pose, q̇ = 0.5 and one wrench: one derivation per arm
+    and test process, rendered by every test that only needs some report of that arm (it is data; renderers do
+    not change it)."""
+    robot = dn.load_robot(name)
+    if robot.name != name:  # an old alias: one cache entry per arm
+        return _derived(robot.name)
+    return derive(robot, qd=[0.5] * robot.dof, wrench=[1, 2, 3, 0.1, 0.2, 0.3])
+
+
 def _case_inputs(robot, rng):
     lo, hi = robot.q_limits.T
     lo, hi = np.maximum(lo, -np.pi), np.minimum(hi, np.pi)
@@ -43,8 +55,7 @@ def _equations(sec, lhs):
 @pytest.mark.parametrize("name", ALL)
 @pytest.mark.slow
 def test_report_every_arm_renders_markdown(name):
-    robot = dn.load_robot(name)
-    d = derive(robot, qd=[0.5] * robot.dof, wrench=[1, 2, 3, 0.1, 0.2, 0.3])
+    d = _derived(name)
     text, _ = render(d, "md")
     assert text.startswith(f"# Kinematics and dynamics of {name}")
     for sec in d.sections:
@@ -59,8 +70,7 @@ def test_report_every_arm_renders_markdown(name):
 @pytest.mark.parametrize("fmt", ["html", "tex"])
 @pytest.mark.slow
 def test_report_renders_html_and_latex(name, fmt, tmp_path):
-    robot = dn.load_robot(name)
-    d = derive(robot, qd=[1] * robot.dof, wrench=[0, 0, -10, 0, 0, 0])
+    d = _derived(name)
     out = tmp_path / f"r.{fmt}"
     written = write_report(d, out)
     text = out.read_text()
@@ -179,8 +189,7 @@ def test_report_every_formula_is_valid_katex(tmp_path):
         "strict:false,maxSize:20});}catch(e){bad.push([s.slice(0,120),String(e).slice(0,160)]);}}"
         "console.log(JSON.stringify(bad));")
     for name in ["report000-6r", "report004-4-rrp", "puma560", "report000-planar3r"]:
-        robot = dn.load_robot(name)
-        text, _ = render(derive(robot, qd=[1] * robot.dof, wrench=[1, 0, 0, 0, 0, 1]), "html")
+        text, _ = render(_derived(name), "html")
         items = [(unescape(m.group(2)), m.group(1) == "display")
                  for m in re.finditer(r'<(?:div|span) class="math-(display|inline)">(.*?)</(?:div|span)>', text, re.S)]
         assert len(items) > 20
