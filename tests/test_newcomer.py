@@ -131,3 +131,23 @@ def test_the_correction_of_a_jacobian_read_as_three_rows_shows_those_rows(capsys
     # Spong's planar 2R, rows (vx, vy, ωz): [-L1 S1 - L2 S12, -L2 S12; L1 C1 + L2 C12, L2 C12; 1, 1]
     assert len(rows) == 3 and rows[2].replace(" ", "") == "1&1", fix
     assert rows[1].replace(" ", "").endswith("&C_{12}L_{2}"), fix
+
+
+def test_symbolic_equations_of_motion_fit_the_terminal_and_read_back_the_same(capsys, monkeypatch):
+    """`dynamics planar3r --symbolic` wrote c[1] on one 228-column line; now every line fits 80 columns, broken
+    before a top-level + or − and aligned under the expression, and re-joined it is the unwrapped text (the JSON's
+    symbolic_text, which stays whole)."""
+    import json
+    import re
+
+    from denavit.cli import main
+
+    monkeypatch.setenv("COLUMNS", "80")
+    assert main(["dynamics", "planar3r", "--symbolic"]) == 0
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines()) <= 80
+    assert main(["dynamics", "planar3r", "--symbolic", "--json"]) == 0
+    whole = json.loads(capsys.readouterr().out)["symbolic_text"]
+    assert max(len(line) for line in whole.splitlines()) > 80  # the case this is about
+    joined = re.sub(r"\n {4,}(?=[+-] )", " ", out)
+    assert whole in joined

@@ -160,7 +160,8 @@ def _symbolic(robot, args):
         data = {"form": "recursive", "definitions": {str(k): v for k, v, _ in rd.definitions},
                 "M_symbolic": rd.M, "c_symbolic": rd.c, "g_symbolic": rd.g, "symbolic_text": text,
                 "format": args.format, "method": args.method, "seconds": round(elapsed, 3)}
-        return data, [f"{robot.name}: equations of motion ({args.method}, recursive form, {elapsed:.2f} s)", text]
+        return data, [f"{robot.name}: equations of motion ({args.method}, recursive form, {elapsed:.2f} s)",
+                      _fitted(text, args)]
     kw = dict(simplify=args.simplify, numeric=args.numeric_params, progress=None if args.json else _progress_printer())
     if args.method == "newton-euler":
         terms = S.newton_euler_dynamics(robot, **kw).terms
@@ -178,7 +179,14 @@ def _symbolic(robot, args):
     if args.coriolis and terms.C is not None:
         data["C_symbolic"] = terms.C
     data["M_latex"] = sp.latex(terms.M)
-    return data, [f"{robot.name}: equations of motion ({args.method}, {elapsed:.2f} s)", text]
+    return data, [f"{robot.name}: equations of motion ({args.method}, {elapsed:.2f} s)", _fitted(text, args)]
+
+
+def _fitted(text: str, args) -> str:
+    """Text equations broken to the terminal's width (LaTeX and Markdown are for other programs: kept whole)."""
+    from ..display import equations_text
+
+    return equations_text(text) if args.format == "text" else text
 
 
 def cmd_simulate(args: argparse.Namespace):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 import shutil
 
-__all__ = ["terminal_width", "matrix_text"]
+__all__ = ["terminal_width", "matrix_text", "equations_text"]
 
 #: Narrowest width written to: below it, a labelled entry would have no room left.
 MIN_WIDTH = 40
@@ -78,4 +78,32 @@ def matrix_text(M, width: int | None = None) -> str:
             else:  # a 2-D entry (fractions, powers) or a long one: under its label
                 out.append(label.rstrip())
                 out += ["    " + line for line in _entry_lines(M[i, j], width - 4)]
+    return "\n".join(out)
+
+
+def equations_text(text: str, width: int | None = None) -> str:
+    """Lines of ``name = expression`` text fitted to ``width`` columns (default: the terminal's): a longer line is
+    broken before the top-level ``+`` and ``-`` of its right-hand side, the continuation lines aligned under the
+    expression's start, as a textbook aligns a long sum.  Lines without `` = ``, and lines that fit, are kept.
+
+    >>> print(equations_text("c[1] = a*b + c*(d + e) - f*g", width=40))
+    c[1] = a*b + c*(d + e) - f*g
+    >>> print(equations_text("c[1] = aaaa*bbbb + cccc*(d + e) - ffff*gggg + hhhh*iiii", width=40))
+    c[1] = aaaa*bbbb + cccc*(d + e)
+           - ffff*gggg + hhhh*iiii
+    """
+    width = terminal_width() if width is None else max(MIN_WIDTH, int(width))
+    out = []
+    for line in text.split("\n"):
+        head, sep, rhs = line.partition(" = ")
+        if len(line) <= width or not sep:
+            out.append(line)
+            continue
+        pad = len(head) + len(sep)
+        if pad > width // 2:  # a long left-hand side: continue under a fixed indent instead
+            pad = 4
+        pieces = _break_sum(rhs, max(MIN_WIDTH // 2, width - pad))
+        pieces = [pieces[0]] + [p[2:] if p.startswith("  ") else p for p in pieces[1:]]
+        out.append(head + sep + pieces[0])
+        out += [" " * pad + p for p in pieces[1:]]
     return "\n".join(out)
