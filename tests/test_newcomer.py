@@ -151,3 +151,25 @@ def test_symbolic_equations_of_motion_fit_the_terminal_and_read_back_the_same(ca
     assert max(len(line) for line in whole.splitlines()) > 80  # the case this is about
     joined = re.sub(r"\n {4,}(?=[+-] )", " ", out)
     assert whole in joined
+
+
+def test_singularities_prose_fits_the_terminal_and_reads_back_the_same(capsys, monkeypatch):
+    """`singularities puma560` wrote its notes on lines up to 154 columns; its prose now fits 80 columns (the
+    determinant, a formula, is sympy's picture and is not broken), and re-joined it says what the JSON says."""
+    import json
+    import re
+
+    from denavit.cli import main
+
+    monkeypatch.setenv("COLUMNS", "80")
+    assert main(["singularities", "puma560"]) == 0
+    out = capsys.readouterr().out
+    prose = [line for line in out.splitlines() if "⋅" not in line and "⎡" not in line and "⎢" not in line
+             and "⎣" not in line]
+    assert max(len(line) for line in prose) <= 80
+    assert main(["singularities", "puma560", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    joined = re.sub(r"\n +", " ", out)
+    assert len(f"matrix: {data['matrix_note']}") > 80 and f"matrix: {data['matrix_note']}" in joined
+    for cond in data["conditions"]:
+        assert f"kind: {cond['kind']} — {cond['explanation']}" in joined

@@ -55,11 +55,18 @@ def _condition_lines(cond, robot, args, fmt) -> list[str]:
                              for v, ok in zip(s.values, s.in_limits))
             expr = f"{s.expression} = " if s.expression is not None and not s.expression.is_number else ""
             parts.setdefault(s.variable, []).append(expr + vals)
-        lines.append("    → " + "; ".join(f"{var} = {', '.join(vals)}" for var, vals in parts.items()))
+        lines.append(_prose("    → " + "; ".join(f"{var} = {', '.join(vals)}" for var, vals in parts.items()), args))
     else:
         lines.append("    (kept as an equation: no closed form in one variable)")
-    lines.append(f"    kind: {cond.kind} — {cond.explanation}")
+    lines.append(_prose(f"    kind: {cond.kind} — {cond.explanation}", args))
     return lines
+
+
+def _prose(line: str, args) -> str:
+    """A prose line fitted to the terminal (Markdown output is left to its renderer)."""
+    from ..display import prose_text
+
+    return line if args.markdown else prose_text(line)
 
 
 def _measures(robot, args, rows_idx) -> tuple[dict, list[str]]:
@@ -111,7 +118,8 @@ def cmd_singularities(args: argparse.Namespace):
     rows_idx = [ROWS.index(r) for r in res.rows]  # the task rows analysed (an arm of < 6 joints: its own)
     fmt = sym_formatter(args, S.joint_symbols(robot.dof).q)
     det_text = fmt(res.determinant)
-    lines = [f"{robot.name}: singularities", f"matrix: {res.matrix_note}", f"measure: {res.measure}"]
+    lines = [f"{robot.name}: singularities", _prose(f"matrix: {res.matrix_note}", args),
+             _prose(f"measure: {res.measure}", args)]
     if args.markdown:
         lines = [f"## {robot.name}: singularities", "", f"matrix: {res.matrix_note}", "", f"measure: {res.measure}", ""]
     lines += ["matrix =", fmt(res.matrix), f"{res.measure} =", det_text]
@@ -126,10 +134,10 @@ def cmd_singularities(args: argparse.Namespace):
     elif "minors" in res.measure:
         # Non-square J: a common factor of all minors is sufficient for a rank loss, not necessary. Without
         # one, singular configurations (if any) are where all minors vanish together: not solved here.
-        lines += ["", "no common factor of the minors: any singular configuration lies where ALL the minors vanish "
-                  "together, which is not solved symbolically here (redundant arms, e.g. 7 joints, do have such "
-                  "configurations); check a configuration with -q (rank, smallest singular value), or pick a "
-                  "square sub-Jacobian with --rows"]
+        lines += ["", _prose("no common factor of the minors: any singular configuration lies where ALL the minors "
+                             "vanish together, which is not solved symbolically here (redundant arms, e.g. 7 joints, "
+                             "do have such configurations); check a configuration with -q (rank, smallest singular "
+                             "value), or pick a square sub-Jacobian with --rows", args)]
     else:
         lines += ["", "no singular configuration: the determinant never vanishes"]
     data = {"robot": robot.name, "rows": list(res.rows), "frame": args.frame, "matrix_note": res.matrix_note,

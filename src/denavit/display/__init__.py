@@ -5,7 +5,7 @@ Results stay data; this package only turns them into text.  It needs numpy only,
 symbolic (sympy is then already loaded) and for the optional picture of the arm (matplotlib, when installed).
 """
 
-from ._matrix import equations_text, matrix_text, terminal_width
+from ._matrix import equations_text, matrix_text, prose_text, terminal_width
 from ._results import (
     MAX_HTML_ROWS,
     derivation_markdown,
@@ -33,4 +33,5 @@ __all__ = [
     "matrix_text",
     "terminal_width",
     "equations_text",
+    "prose_text",
 ]

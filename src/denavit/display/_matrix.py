@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import os
 import shutil
+import textwrap
 
-__all__ = ["terminal_width", "matrix_text", "equations_text"]
+__all__ = ["terminal_width", "matrix_text", "equations_text", "prose_text"]
 
 #: Narrowest width written to: below it, a labelled entry would have no room left.
 MIN_WIDTH = 40
@@ -107,3 +108,19 @@ def equations_text(text: str, width: int | None = None) -> str:
         out.append(head + sep + pieces[0])
         out += [" " * pad + p for p in pieces[1:]]
     return "\n".join(out)
+
+
+def prose_text(line: str, width: int | None = None) -> str:
+    """A line of prose fitted to ``width`` columns (default: the terminal's) at spaces, continuation lines indented
+    two more than the line; words are never cut (a single longer word keeps its line).
+
+    >>> print(prose_text("    kind: elbow — joint 3 stretches the arm out or folds it back", width=40))
+        kind: elbow — joint 3 stretches the
+          arm out or folds it back
+    """
+    width = terminal_width() if width is None else max(MIN_WIDTH, int(width))
+    if len(line) <= width:
+        return line
+    lead = line[:len(line) - len(line.lstrip())]
+    return "\n".join(textwrap.wrap(line.strip(), width, initial_indent=lead, subsequent_indent=lead + "  ",
+                                    break_long_words=False, break_on_hyphens=False))
