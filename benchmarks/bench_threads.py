@@ -147,6 +147,7 @@ def main(argv=None) -> None:
     p.add_argument("--threads", default="1,2")
     p.add_argument("--repeat", type=int, default=5)
     p.add_argument("--no-plain", action="store_true")
+    p.add_argument("--no-compiled", action="store_true")
     p.add_argument("--ik-targets", type=int, default=2000, help="numeric IK batch (0: none)")
     a = p.parse_args(argv)
     threads = [int(t) for t in a.threads.split(",")]
@@ -155,8 +156,9 @@ def main(argv=None) -> None:
     start, wall = _busy(), time.perf_counter()
     for name in a.robots.split(","):
         robot = denavit.load_robot(name)
-        backend, rows = _compiled_rows(robot, threads, int(a.batch), a.repeat, a.ik_targets)
-        _table(f"{name}: compiled ({backend})", rows, threads, int(a.batch))
+        if not a.no_compiled:
+            backend, rows = _compiled_rows(robot, threads, int(a.batch), a.repeat, a.ik_targets)
+            _table(f"{name}: compiled ({backend})", rows, threads, int(a.batch))
         if not a.no_plain:
             _table(f"{name}: plain numpy functions", _plain_rows(robot, threads, int(a.plain_batch), a.repeat),
                    threads, int(a.plain_batch))
