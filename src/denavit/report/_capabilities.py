@@ -24,9 +24,9 @@ __all__ = ["section_singularities", "section_figures", "capability", "arm_pictur
 
 
 def arm_picture_name(robot_name: str) -> str:
-    """The file name of a report's picture of the arm: ``<name>-arm.png`` with every character of the robot's name
+    r"""The file name of a report's picture of the arm: ``<name>-arm.png`` with every character of the robot's name
     other than letters, digits, ``_``, ``.`` and ``-`` written ``_`` (the name is free text; the file name lands in
-    ``\\includegraphics{...}`` and ``![...](...)``, where ``}``, ``)``, ``/`` or a newline would be syntax).
+    ``\includegraphics{...}`` and ``![...](...)``, where ``}``, ``)``, ``/`` or a newline would be syntax).
 
     >>> arm_picture_name("UR5e"), arm_picture_name("x}\\input{/etc/passwd")
     ('UR5e-arm.png', 'x__input__etc_passwd-arm.png')

@@ -197,7 +197,7 @@ def base_parameters_sym(robot: DHRobot, *, friction: bool = True, motor_inertia:
     >>> from denavit.symbolic import base_parameters_sym
     >>> b = base_parameters_sym(denavit.load_robot("planar2r"), friction=False, motor_inertia=False)
     >>> b.kept
-    ('MX1', 'MY1', 'ZZ1', 'MX2', 'MY2', 'XX2', 'XY2', 'XZ2', 'YZ2', 'ZZ2')
+    ('MX1', 'MY1', 'ZZ1', 'MX2', 'MY2', 'ZZ2')
     """
     names = parameter_names(robot, friction=friction, motor_inertia=motor_inertia)
     P = {name: sp.Symbol(name, real=True) for name in names}
