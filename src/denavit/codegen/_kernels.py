@@ -23,7 +23,7 @@ from ._trace import Tape, sym_max, sym_min, sym_sign
 
 __all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns",
            "end_effector", "register_kernel", "registered_kernels", "group_kernels", "trace_registered",
-           "registered_digest", "RegisteredKernel", "BASE_GROUP"]
+           "registered_digest", "RegisteredKernel", "BASE_GROUP", "first_joint_at_zero", "gravity_seen_at_zero"]
 
 KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
                 "gravity", "coriolis", "forward_dynamics")
@@ -160,38 +160,38 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
     if "rnea" in names:
         tape = Tape()
         q, qd, qdd = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("qdd", n)
-        q0 = _first_joint_at_zero(q)
-        tau = rnea_kernel(pl, q0, qd, qdd, _gravity_seen_at_zero(chain, q, g), at(q0))
+        q0 = first_joint_at_zero(q)
+        tau = rnea_kernel(pl, q0, qd, qdd, gravity_seen_at_zero(chain, q, g), at(q0))
         tau = [t + f for t, f in zip(tau, friction(qd))]
         out["rnea"] = KernelSpec("rnea", "tau = M(q) qdd + C(q, qd) qd + g(q) + tau_f (friction)",
                                  (("q", n), ("qd", n), ("qdd", n)), (n,), tuple(tau), tape)
     if "gravity" in names:
         tape = Tape()
         q = tape.inputs("q", n)
-        q0, zero = _first_joint_at_zero(q), [0.0] * n
+        q0, zero = first_joint_at_zero(q), [0.0] * n
         out["gravity"] = KernelSpec("gravity", "g(q), the gravity torques", (("q", n),), (n,),
-                                    tuple(rnea_kernel(pl, q0, zero, zero, _gravity_seen_at_zero(chain, q, g), at(q0))),
+                                    tuple(rnea_kernel(pl, q0, zero, zero, gravity_seen_at_zero(chain, q, g), at(q0))),
                                     tape)
     if "coriolis" in names:
         tape = Tape()
         q, qd = tape.inputs("q", n), tape.inputs("qd", n)
-        q0 = _first_joint_at_zero(q)
+        q0 = first_joint_at_zero(q)
         c = rnea_kernel(pl, q0, qd, [0.0] * n, [0.0, 0.0, 0.0], at(q0))
         out["coriolis"] = KernelSpec("coriolis", "c(q, qd) = C(q, qd) qd, the velocity torques",
                                      (("q", n), ("qd", n)), (n,), tuple(c), tape)
     if "mass_matrix" in names:
         tape = Tape()
         q = tape.inputs("q", n)
-        q0 = _first_joint_at_zero(q)
+        q0 = first_joint_at_zero(q)
         M = mass_matrix_kernel(pl, q0, at(q0))
         out["mass_matrix"] = KernelSpec("mass_matrix", "M(q), the joint-space inertia matrix", (("q", n),),
                                         (n, n), tuple(e for row in M for e in row), tape)
     if "forward_dynamics" in names:
         tape = Tape()
         q, qd, tau = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("tau", n)
-        q0 = _first_joint_at_zero(q)
+        q0 = first_joint_at_zero(q)
         frames = at(q0)
-        bias = rnea_kernel(pl, q0, qd, [0.0] * n, _gravity_seen_at_zero(chain, q, g), frames)
+        bias = rnea_kernel(pl, q0, qd, [0.0] * n, gravity_seen_at_zero(chain, q, g), frames)
         M = mass_matrix_kernel(pl, q0, frames)
         rhs = [t - f - b for t, f, b in zip(tau, friction(qd), bias)]
         try:
@@ -208,7 +208,7 @@ def trace_kernels(robot: DHRobot, names=KERNEL_NAMES, friction: bool = True) -> 
     return out
 
 
-def _first_joint_at_zero(q) -> list:
+def first_joint_at_zero(q) -> list:
     """q with joint 1 at 0: the dynamics kernels' configuration.
 
     Joint 1 moves everything after it rigidly (a rotation about, or a translation along, a fixed line), and
@@ -219,7 +219,7 @@ def _first_joint_at_zero(q) -> list:
     return [0.0] + list(q[1:])
 
 
-def _gravity_seen_at_zero(chain, q, g) -> list:
+def gravity_seen_at_zero(chain, q, g) -> list:
     """Gravity as the arm at q1 = 0 feels it: Rᵀ g, with R the rotation of joint 1 by q1 about its axis u.
 
     The arm at q is the arm at q1 = 0 moved rigidly by joint 1; in gravity g it needs the torques the unmoved

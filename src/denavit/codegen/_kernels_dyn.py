@@ -21,7 +21,7 @@ from ..chain import COMPONENTS, chain_of, walk
 from ..model import DHRobot
 from ..numeric import (SINGULAR_TOL, dual_sign, dynamics_plan, friction_coefficients, ldl_pivots_solve,
                        mass_matrix_kernel, require_dynamics, rnea_kernel, seed_duals, tangent_matrix)
-from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero, register_kernel
+from ._kernels import KernelSpec, first_joint_at_zero, gravity_seen_at_zero, register_kernel
 from ._trace import Tape, sym_max, sym_min
 
 __all__ = ["GROUP", "DERIVATIVE_KERNELS", "trace_rnea_derivatives", "trace_forward_dynamics_derivatives",
@@ -41,8 +41,8 @@ class _Setup:
 
     def inverse_dynamics(self, q, qd, qdd):
         """τ = ID(q, q̇, q̈) + τ_f in any algebra (traced values, or duals of them), with joint 1 at 0."""
-        q0 = _first_joint_at_zero(q)
-        tau = rnea_kernel(self.pl, q0, qd, qdd, _gravity_seen_at_zero(self.chain, q, self.g),
+        q0 = first_joint_at_zero(q)
+        tau = rnea_kernel(self.pl, q0, qd, qdd, gravity_seen_at_zero(self.chain, q, self.g),
                           walk(self.chain, q0, COMPONENTS, frames=True))
         return [t + self.fv[k] * qd[k] + self.fc[k] * dual_sign(qd[k]) for k, t in enumerate(tau)]
 
@@ -85,7 +85,7 @@ def trace_forward_dynamics_derivatives(robot: DHRobot, friction: bool = True) ->
     n, m = s.n, 3 * s.n
     tape = Tape()
     q, qd, tau = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("tau", n)
-    q0 = _first_joint_at_zero(q)
+    q0 = first_joint_at_zero(q)
     M = mass_matrix_kernel(s.pl, q0, walk(s.chain, q0, COMPONENTS, frames=True))
     bias = s.inverse_dynamics(q, qd, [0.0] * n)  # c + g + τ_f
     try:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from ..chain import COMPONENTS, chain_of, walk
 from ..model import DHRobot
 from ..numeric import Linear, dynamics_plan, parameter_names, regressor_rows
-from ._kernels import KernelSpec, _first_joint_at_zero, _gravity_seen_at_zero, register_kernel
+from ._kernels import KernelSpec, first_joint_at_zero, gravity_seen_at_zero, register_kernel
 from ._trace import Tape, sym_sign
 
 __all__ = ["trace_regressor", "GROUP"]
@@ -30,8 +30,8 @@ def trace_regressor(robot: DHRobot, friction: bool = True) -> KernelSpec:
     pl = dynamics_plan(robot)
     tape = Tape()
     q, qd, qdd = tape.inputs("q", n), tape.inputs("qd", n), tape.inputs("qdd", n)
-    q0 = _first_joint_at_zero(q)
-    g = _gravity_seen_at_zero(chain, q, [float(v) for v in robot.gravity])
+    q0 = first_joint_at_zero(q)
+    g = gravity_seen_at_zero(chain, q, [float(v) for v in robot.gravity])
     rows = regressor_rows(pl, q0, qd, qdd, g, lambda i: Linear({i: 1.0}), True,
                           walk(chain, q0, COMPONENTS, frames=True))
     p = len(parameter_names(robot))
