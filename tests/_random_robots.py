@@ -1,10 +1,11 @@
-"""Random DH robots for property tests (both conventions, prismatic joints, offsets, fixed rows)."""
+"""Random DH robots for property tests (both conventions, prismatic joints, offsets, fixed rows), and random
+physical inertial data for them."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from denavit import Convention, DHLink, DHRobot, JointType
+from denavit import Convention, DHLink, DHRobot, JointType, LinkInertia
 from denavit.numeric import transform_from_xyz_rpy
 
 
@@ -33,3 +34,17 @@ def random_robot(rng: np.random.Generator, convention: str | None = None, n_rows
 
 def random_q(rng: np.random.Generator, robot: DHRobot, shape: tuple[int, ...] = ()) -> np.ndarray:
     return rng.uniform(-np.pi, np.pi, shape + (robot.dof,))
+
+
+def random_inertia(rng: np.random.Generator, motor: bool = True, friction: bool = True) -> LinkInertia:
+    """A physically valid rigid body: principal moments of a random mass distribution (second moments s along the
+    principal axes, so the triangle inequality holds), turned by a random rotation; motor inertia and viscous and
+    Coulomb friction drawn when asked."""
+    mass = rng.uniform(0.5, 3.0)
+    s = rng.uniform(0.01, 0.1, 3)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    I = Q @ np.diag([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) * mass @ Q.T
+    return LinkInertia(mass=mass, com=tuple(rng.uniform(-0.3, 0.3, 3)),
+                       inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
+                       motor_inertia=rng.uniform(0, 0.5) if motor else 0.0,
+                       viscous=rng.uniform(0, 1) if friction else 0.0, coulomb=rng.uniform(0, 1) if friction else 0.0)

@@ -24,7 +24,7 @@ from denavit.errors import ModelError
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from _random_robots import random_robot
+from _random_robots import random_inertia, random_robot
 
 REL = 1e-9
 
@@ -32,17 +32,6 @@ REL = 1e-9
 def rel_err(a, b) -> float:
     a, b = np.asarray(a), np.asarray(b)
     return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-3))
-
-
-def random_inertia(rng: np.random.Generator) -> LinkInertia:
-    """A physically valid rigid body (principal moments from a mass distribution, rotated), motor and friction."""
-    mass = rng.uniform(0.5, 3.0)
-    s = rng.uniform(0.01, 0.1, 3)
-    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    I = Q @ np.diag([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) * mass @ Q.T
-    return LinkInertia(mass=mass, com=tuple(rng.uniform(-0.3, 0.3, 3)),
-                       inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
-                       motor_inertia=rng.uniform(0.0, 0.3), viscous=rng.uniform(0.0, 1.0), coulomb=rng.uniform(0.0, 1.0))
 
 
 def dynamic_arm(seed: int, n_rows: int | None = None):

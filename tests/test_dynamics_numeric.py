@@ -25,6 +25,7 @@ from denavit.numeric import (
     rnea,
 )
 
+from _random_robots import random_inertia
 from conftest import REDUCED
 
 N_RANDOM = 3 if REDUCED else 8
@@ -41,20 +42,6 @@ def _rotation(rng: np.random.Generator) -> np.ndarray:
     return Q if np.linalg.det(Q) > 0 else -Q
 
 
-def random_inertia(rng: np.random.Generator, motor: bool = False, friction: bool = False) -> LinkInertia:
-    """A physically valid inertia: principal moments from a random mass distribution, rotated."""
-    mass = rng.uniform(0.5, 3.0)
-    s = rng.uniform(0.01, 0.1, 3)  # second moments along principal axes
-    R = _rotation(rng)
-    I = R @ np.diag([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) * mass @ R.T
-    return LinkInertia(
-        mass=mass, com=tuple(rng.uniform(-0.3, 0.3, 3)),
-        inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
-        motor_inertia=rng.uniform(0, 0.5) if motor else 0.0,
-        viscous=rng.uniform(0, 1) if friction else 0.0, coulomb=rng.uniform(0, 1) if friction else 0.0,
-    )
-
-
 def random_robot(rng: np.random.Generator, n: int | None = None, convention: str | None = None,
                  prismatic: bool = True, fixed_rows: bool = True, motor: bool = False,
                  friction: bool = False) -> DHRobot:
@@ -63,7 +50,7 @@ def random_robot(rng: np.random.Generator, n: int | None = None, convention: str
     links = []
     for k in range(n):
         if fixed_rows and rng.random() < 0.3:  # a fixed row, sometimes with its own inertia
-            inertia = random_inertia(rng) if rng.random() < 0.5 else None
+            inertia = random_inertia(rng, motor=False, friction=False) if rng.random() < 0.5 else None
             links.append(DHLink(a=rng.uniform(-0.5, 0.5), alpha=rng.uniform(-np.pi, np.pi), d=rng.uniform(-0.3, 0.3),
                                 theta=rng.uniform(-np.pi, np.pi), joint=JointType.FIXED, inertia=inertia))
         joint = JointType.PRISMATIC if prismatic and k > 0 and rng.random() < 0.3 else JointType.REVOLUTE

@@ -19,22 +19,11 @@ from denavit.numeric import (base_parameters, base_regressor, inertial_parameter
                              kinetic_energy_regressor, parameter_names, potential_energy, potential_energy_regressor,
                              regressor)
 
+from _random_robots import random_inertia
 from _random_robots import random_robot as random_kinematics
 from conftest import REDUCED
 
 SEEDS = range(4 if REDUCED else 10)
-
-
-def _inertia(rng, motor=True, friction=True) -> LinkInertia:
-    """A physically valid inertia (principal moments of a random mass distribution, rotated)."""
-    mass = rng.uniform(0.5, 3.0)
-    s = rng.uniform(0.01, 0.1, 3)
-    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    I = Q @ np.diag([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) * mass @ Q.T
-    return LinkInertia(mass=mass, com=tuple(rng.uniform(-0.3, 0.3, 3)),
-                       inertia=(I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]),
-                       motor_inertia=rng.uniform(0, 0.5) if motor else 0.0,
-                       viscous=rng.uniform(0, 1) if friction else 0.0, coulomb=rng.uniform(0, 1) if friction else 0.0)
 
 
 def random_arm(seed: int) -> DHRobot:
@@ -43,7 +32,7 @@ def random_arm(seed: int) -> DHRobot:
     rng = np.random.default_rng(seed)
     robot = random_kinematics(rng)
     links = tuple(DHLink(a=l.a, alpha=l.alpha, d=l.d, theta=l.theta, joint=l.joint,
-                         inertia=_inertia(rng) if rng.random() < 0.85 else None) for l in robot.links)
+                         inertia=random_inertia(rng) if rng.random() < 0.85 else None) for l in robot.links)
     return robot.replace(links=links, gravity=tuple(rng.normal(size=3) * 4))
 
 
