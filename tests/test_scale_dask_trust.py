@@ -283,3 +283,20 @@ def test_guard_ends_a_process_whose_parent_is_killed(route):
         proc.kill()
         proc.wait(CAP)
     assert _none_survive([child]) == []
+
+
+def test_sigterm_reaching_the_caller_outside_the_cluster_block_is_still_143_and_silent(monkeypatch, capsys):
+    """SIGTERM can land while the main thread is in the caller's frame (occupancy merging a result) rather than in
+    the generator holding the cluster: the Terminated then reaches the command line, which exits 143 and prints
+    nothing (it printed 'denavit: interrupted' and exited 130, as for Ctrl-C, in about a third of the runs)."""
+    import denavit.scale
+    from denavit.cli import main
+    from denavit.errors import Terminated
+
+    def terminated(*args, **kwargs):
+        raise Terminated
+
+    monkeypatch.setattr(denavit.scale, "occupancy", terminated)
+    assert main(["workspace", "planar2r", "--samples", "1000"]) == 128 + signal.SIGTERM
+    out, err = capsys.readouterr()
+    assert (out, err) == ("", "")

@@ -14,6 +14,7 @@ __all__ = [
     "UnsupportedRobotError",
     "MissingDependencyError",
     "DenavitWarning",
+    "Terminated",
 ]
 
 
@@ -46,6 +47,12 @@ class UnsupportedRobotError(DenavitError):
 
 class MissingDependencyError(DenavitError, ImportError):
     """An optional dependency is missing; the message names the extra to install."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived while denavit ran a local Dask cluster: raised in the main thread so that every cleanup
+    (the cluster's close first) runs as the stack unwinds, like Ctrl-C's KeyboardInterrupt.  The command line
+    exits with status 128 + SIGTERM = 143 and prints nothing, as a process killed by SIGTERM would."""
 
 
 class DenavitWarning(UserWarning):

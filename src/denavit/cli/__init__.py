@@ -10,13 +10,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
 import warnings
 from typing import Sequence
 
 import numpy as np
 
-from ..errors import DenavitError, MissingDependencyError, ModelError, ParseError, ShapeError
+from ..errors import DenavitError, MissingDependencyError, ModelError, ParseError, ShapeError, Terminated
 from ._common import OneLineParser, emit, one_line
 
 __all__ = ["main", "build_parser"]
@@ -72,6 +73,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail(args.command, one_line(exc), 1)
     except DenavitError as exc:
         return _fail(args.command, one_line(exc), 1)
+    except Terminated:  # SIGTERM during a local cluster, caught outside the block that exits 143 itself
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("denavit: interrupted", file=sys.stderr)
         return 130

@@ -21,7 +21,7 @@ import signal
 import threading
 from typing import Iterator
 
-from ..errors import DenavitError, MissingDependencyError, ParseError
+from ..errors import DenavitError, MissingDependencyError, ParseError, Terminated
 
 __all__ = ["CONNECT_TIMEOUT", "GUARD", "LOCAL_CLUSTER_CONFIG", "SCHEMES", "check_address", "cluster_failure",
            "connect", "local_cluster", "start_local_cluster"]
@@ -175,19 +175,17 @@ def cluster_failure(exc: BaseException) -> DenavitError | None:
     return DenavitError(f"the Dask cluster failed: {why} ({type(exc).__name__})")
 
 
-class _Terminated(KeyboardInterrupt):
-    """Raised in the main thread by SIGTERM while a local cluster runs, so it unwinds through every cleanup."""
-
-
 def _raise_terminated(signum, frame):
-    raise _Terminated
+    raise Terminated
 
 
 @contextlib.contextmanager
 def _terminate_cleanly() -> Iterator[None]:
-    """While inside: SIGTERM (when its disposition is the default) raises _Terminated in the main thread; once
-    the cleanups ran, the process exits with status 128 + SIGTERM = 143 (``SystemExit``, so the exit handlers
-    run too: multiprocessing's release the cluster's semaphores, and its resource tracker stays silent)."""
+    """While inside: SIGTERM (when its disposition is the default) raises :class:`denavit.errors.Terminated` in the
+    main thread; once the cleanups ran, the process exits with status 128 + SIGTERM = 143 (``SystemExit``, so the
+    exit handlers run too: multiprocessing's release the cluster's semaphores, and its resource tracker stays
+    silent).  The signal may land in a frame outside this block — the caller consuming a generator that holds
+    the cluster, say — and then reaches the caller as ``Terminated``; the command line exits 143 for it too."""
     if threading.current_thread() is not threading.main_thread() or \
             signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
         yield
@@ -195,7 +193,7 @@ def _terminate_cleanly() -> Iterator[None]:
     signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         yield
-    except _Terminated:
+    except Terminated:
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         raise SystemExit(128 + signal.SIGTERM) from None
     finally:
