@@ -26,6 +26,7 @@ from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_ma
 from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_derivatives
 from .numeric import BaseParameters, base_parameters, base_regressor, inertial_parameters, regressor
 from .codegen import CompiledRobot, compile
+from .calibration import Measurements, read_measurements, write_measurements
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 
@@ -97,5 +98,8 @@ __all__ = [
     "solve_ik",
     "compile",
     "CompiledRobot",
+    "Measurements",
+    "read_measurements",
+    "write_measurements",
     "__version__",
 ]
