@@ -36,7 +36,16 @@ def _as_batch(arrays, names):
 #: kernels whose single call a built-in function takes over (the method it stands in for), and their inputs' count
 _BUILTIN_METHODS = {"fk": "fk", "position": "position", "jacobian0": "jacobian", "rnea": "rnea",
                     "mass_matrix": "mass_matrix", "gravity": "gravity", "coriolis": "coriolis",
-                    "forward_dynamics": "forward_dynamics"}
+                    "forward_dynamics": "forward_dynamics", "rnea_derivatives": "rnea_derivatives",
+                    "forward_dynamics_derivatives": "forward_dynamics_derivatives",
+                    "gravity_derivatives": "gravity_derivatives", "jacobian_dot0": "jacobian_dot",
+                    "acceleration_bias0": "acceleration_bias", "kinematic_hessian0": "kinematic_hessian",
+                    "regressor": "regressor"}
+#: the built-in's result, when not one array of the kernel's shape: (its arrays' shapes of n, kernel's last entry
+#: a flag that must be > 0)
+_BUILTIN_RESULTS = {"forward_dynamics": (lambda n: ((n,),), True),
+                    "rnea_derivatives": (lambda n: ((n, n),) * 2, False),
+                    "forward_dynamics_derivatives": (lambda n: ((n, n),) * 3, True)}
 _ARITY = {"rnea": 3, "coriolis": 2, "forward_dynamics": 3}
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
@@ -148,14 +157,16 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
 
     def _builtin(self, name: str, method: str) -> None:
         """Put kernel ``name``'s CPython built-in (:mod:`denavit.codegen._fastcall`) on this object in place of
-        ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on; every
-        other call goes to the method itself.  Nothing changes when the built-in cannot be made here."""
-        lengths = (self.dof,) * _ARITY.get(name, 1)
-        flagged = name == "forward_dynamics"  # its last entry: M regular; the method raises where it is not
-        shape = (self.dof,) if flagged else self._shapes[name]
+        ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on (a
+        tuple of fresh arrays where the method returns a tuple); every other call goes to the method itself.
+        Nothing changes when the built-in cannot be made here."""
+        n, reg = self.dof, registered_kernels().get(name)
+        lengths = self._lengths.get(name) or (n,) * _ARITY.get(name, 1)
+        blocks, flagged = _BUILTIN_RESULTS.get(name, (lambda n: (self._shapes[name],), False))
         try:
-            made = _fastcall.install(self._groups[BASE_GROUP][0], name, lengths, shape,
-                                     getattr(type(self), method).__get__(self), guard_cache, flagged)
+            made = _fastcall.install(self._groups[reg.group if reg else BASE_GROUP][0], name, lengths,
+                                     self._shapes[name], blocks(n), getattr(type(self), method).__get__(self),
+                                     guard_cache, flagged)
         except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
             made = None
         if made is not None:

@@ -9,6 +9,10 @@ METH_KEYWORDS), which
 1. checks each argument in machine code: exactly ``numpy.ndarray`` (not a subclass), the float64 dtype object,
    one dimension of the kernel input's length (any stride: elements are read at ``data + k·stride``);
 2. allocates the result with numpy's own ``PyArray_New`` (C API slot 93) and writes the program's outputs into it;
+   a kernel with several results (``rnea_derivatives``: ∂τ/∂q and ∂τ/∂q̇) returns a tuple of fresh arrays, made by
+   ``PyTuple_New`` and filled by ``PyTuple_SetItem`` (which steals each array's only reference), so the caller
+   owns one tuple holding the only references to its arrays; if an allocation fails, the tuple is released
+   (``Py_DecRef`` frees the arrays already in it) and NULL returned with numpy's MemoryError set;
 3. hands every other call — keywords, other types, other shapes, batches — unchanged to ``self``, the Python
    method, which does what it always did.
 
@@ -34,7 +38,8 @@ _NPY_DOUBLE = 12
 _PYARRAY_NEW_SLOT = 93  # numpy/__multiarray_api.h: PyArray_New, stable since numpy 1.0
 #: PyArrayObject_fields (numpy/ndarraytypes.h) after PyObject_HEAD: data, nd, dimensions, strides, base, descr
 _OFF_TYPE, _OFF_DATA, _OFF_ND, _OFF_DIMS, _OFF_STRIDES, _OFF_DESCR = 8, 16, 24, 32, 40, 56
-_SYMBOLS = ("denavit_ndarray_type", "denavit_float64_descr", "denavit_pyarray_new", "denavit_vectorcall")
+_SYMBOLS = ("denavit_ndarray_type", "denavit_float64_descr", "denavit_pyarray_new", "denavit_vectorcall",
+            "denavit_tuple_new", "denavit_tuple_setitem", "denavit_decref")
 _STATE: dict = {}
 _CFUNCS: dict = {}  # (generated module's name, kernel) -> its compiled CFunc, for every object of that module
 
@@ -79,9 +84,10 @@ def _setup() -> bool:
                 or word(word(base + _OFF_DIMS) + 8) != 5 or word(word(base + _OFF_STRIDES)) != 40
                 or word(base + _OFF_DESCR) != id(np.dtype(np.float64)) or id(a.dtype) != id(np.dtype(np.float64))):
             return False
-        vectorcall = ctypes.cast(api.PyObject_Vectorcall, ctypes.c_void_p).value
-        for name, addr in zip(_SYMBOLS, (id(np.ndarray), id(np.dtype(np.float64)), table[_PYARRAY_NEW_SLOT],
-                                         vectorcall)):
+        functions = [ctypes.cast(getattr(api, f), ctypes.c_void_p).value
+                     for f in ("PyObject_Vectorcall", "PyTuple_New", "PyTuple_SetItem", "Py_DecRef")]
+        for name, addr in zip(_SYMBOLS, [id(np.ndarray), id(np.dtype(np.float64)), table[_PYARRAY_NEW_SLOT]]
+                              + functions):
             ll.add_symbol(name, addr)
         _STATE["ok"] = True
     except (AttributeError, ImportError, OSError, ValueError, TypeError):
@@ -89,99 +95,174 @@ def _setup() -> bool:
     return True
 
 
-def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple, flagged: bool = False):
+def _flat_outputs(outputs: tuple, kernel_shape: tuple) -> dict:
+    """The program's outputs by flat (C-order) index in the kernel's output shape: {index: operand}."""
+    flat = {}
+    for index, ref in outputs:
+        f = 0
+        for i, s in zip(index, kernel_shape):
+            f = f * s + i
+        flat[f] = ref
+    return flat
+
+
+class _Emitter:
+    """The IR of one fast-call entry, in the function being lowered: its checks branch to ``fallback``, and every
+    way out joins at ``done`` (a phi of the returned object)."""
+
+    def __init__(self, builder):
+        from llvmlite import ir
+
+        self.ir, self.b = ir, builder
+        self.i32, self.i64 = ir.IntType(32), ir.IntType(64)
+        self.ptr = ir.IntType(8).as_pointer()
+        self.null = ir.Constant(self.ptr, None)
+        fn = builder.function
+        self.fallback, self.done = fn.append_basic_block("dv_fallback"), fn.append_basic_block("dv_done")
+        self.incoming: list = []
+
+    def extern(self, name):
+        module, ir = self.b.module, self.ir
+        g = module.globals.get(name) or ir.GlobalVariable(module, ir.IntType(8), name)
+        return self.b.bitcast(g, self.ptr)
+
+    def call(self, name, ret, args, types):
+        fty = self.ir.FunctionType(ret, types)
+        return self.b.call(self.b.bitcast(self.extern(name), fty.as_pointer()), args)
+
+    def require(self, ok, otherwise=None):
+        nxt = self.b.function.append_basic_block("dv_ok")
+        self.b.cbranch(ok, nxt, otherwise or self.fallback)
+        self.b.position_at_end(nxt)
+
+    def field(self, obj, offset, ty):
+        b = self.b
+        return b.load(b.bitcast(b.gep(obj, [self.ir.Constant(self.i64, offset)]), ty.as_pointer()))
+
+    def new_array(self, shape):
+        """``PyArray_New(&PyArray_Type, nd, dims, NPY_DOUBLE, NULL, NULL, 0, 0, NULL)``: a fresh C-contiguous
+        float64 array (a new reference), or NULL with the error set."""
+        from numba.core import cgutils
+
+        ir, i32, i64, ptr, null = self.ir, self.i32, self.i64, self.ptr, self.null
+        dims = cgutils.alloca_once(self.b, i64, size=len(shape))
+        for j, s in enumerate(shape):
+            self.b.store(ir.Constant(i64, s), self.b.gep(dims, [ir.Constant(i32, j)]))
+        return self.call("denavit_pyarray_new", ptr, [
+            self.extern("denavit_ndarray_type"), ir.Constant(i32, len(shape)), dims, ir.Constant(i32, _NPY_DOUBLE),
+            null, null, ir.Constant(i32, 0), ir.Constant(i32, 0), null],
+            [ptr, i32, i64.as_pointer(), i32, ptr, ptr, i32, i32, ptr])
+
+    def results(self, blocks):
+        """(object returned, data pointer of each block): one array, or a tuple of ``len(blocks)`` arrays.  A
+        failed allocation returns NULL (the tuple, when made, released with the arrays already in it)."""
+        ir, b, ptr, i64 = self.ir, self.b, self.ptr, self.i64
+        fail = b.function.append_basic_block("dv_nomemory")
+        if len(blocks) == 1:
+            out = self.new_array(blocks[0])
+            self.require(b.icmp_unsigned("!=", out, self.null), fail)
+            arrays, result = [out], out
+        else:
+            result = self.call("denavit_tuple_new", ptr, [ir.Constant(i64, len(blocks))], [i64])
+            self.require(b.icmp_unsigned("!=", result, self.null), fail)
+            release = b.function.append_basic_block("dv_release")
+            arrays = []
+            for j, shape in enumerate(blocks):
+                out = self.new_array(shape)
+                self.require(b.icmp_unsigned("!=", out, self.null), release)
+                self.call("denavit_tuple_setitem", self.i32, [result, ir.Constant(i64, j), out], [ptr, i64, ptr])
+                arrays.append(out)
+            here = b.block
+            b.position_at_end(release)  # Py_DecRef(tuple): frees it and the arrays it holds (NULL slots skipped)
+            self.call("denavit_decref", ir.VoidType(), [result], [ptr])
+            b.branch(fail)
+            b.position_at_end(here)
+        here = b.block
+        b.position_at_end(fail)
+        self.incoming.append((self.null, fail))
+        b.branch(self.done)
+        b.position_at_end(here)
+        return result, [b.bitcast(self.field(a, _OFF_DATA, ptr), ir.DoubleType().as_pointer()) for a in arrays]
+
+    def finish(self, result, argv):
+        """Return ``result`` from here; lower the fallback (the bound method, called with the same arguments)."""
+        b, ptr = self.b, self.ptr
+        self.incoming.append((result, b.block))
+        b.branch(self.done)
+        b.position_at_end(self.fallback)
+        this, args, nargs, kwnames = argv
+        again = self.call("denavit_vectorcall", ptr, [this, args, nargs, kwnames], [ptr, ptr.as_pointer(), self.i64, ptr])
+        self.incoming.append((again, b.block))
+        b.branch(self.done)
+        b.position_at_end(self.done)
+        phi = b.phi(ptr)
+        for value, block in self.incoming:
+            phi.add_incoming(value, block)
+        return phi
+
+
+def _checked_arrays(e: _Emitter, argv, nargs, kwnames, lengths: tuple) -> list:
+    """Branch to the fallback unless the call is exactly ``f(a_0, …, a_{k-1})`` with each a_j an ndarray (not a
+    subclass) of the float64 dtype object, one dimension of length ``lengths[j]``; (data, stride) of each."""
+    b, ir, i64, ptr = e.b, e.ir, e.i64, e.ptr
+    e.require(b.and_(b.icmp_unsigned("==", kwnames, e.null), b.icmp_signed("==", nargs, ir.Constant(i64, len(lengths)))))
+    arrays = []
+    for j, k in enumerate(lengths):
+        obj = b.load(b.gep(argv, [ir.Constant(i64, j)]))
+        e.require(b.icmp_unsigned("==", e.field(obj, _OFF_TYPE, ptr), e.extern("denavit_ndarray_type")))
+        e.require(b.and_(  # an ndarray: its fields can be read
+            b.icmp_unsigned("==", e.field(obj, _OFF_DESCR, ptr), e.extern("denavit_float64_descr")),
+            b.icmp_signed("==", e.field(obj, _OFF_ND, e.i32), ir.Constant(e.i32, 1))))
+        e.require(b.icmp_signed("==", b.load(e.field(obj, _OFF_DIMS, i64.as_pointer())), ir.Constant(i64, k)))
+        arrays.append((e.field(obj, _OFF_DATA, ptr), b.load(e.field(obj, _OFF_STRIDES, i64.as_pointer()))))
+    return arrays
+
+
+def entry_intrinsic(lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: tuple, outputs: tuple,
+                    flagged: bool = False):
     """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the program
-    and the result (see the module's docstring).  ``flagged``: the kernel's last output is a flag that must be > 0
-    (forward dynamics: M regular); the result is the outputs before it, and a call whose flag is not > 0 goes to
-    the Python method (which raises the error)."""
+    and the result (see the module's docstring).  The kernel's outputs (shape ``kernel_shape``, C order) fill the
+    result ``blocks`` (shapes) in turn: one block is returned as an array, several as a tuple of arrays.
+    ``flagged``: the output after the blocks is a flag that must be > 0 (forward dynamics: M regular); a call whose
+    flag is not > 0 releases its result and goes to the Python method (which raises the error)."""
     from llvmlite import ir
-    from numba.core import cgutils, types
+    from numba.core import types
     from numba.extending import intrinsic
 
     from ._llvm import emit_steps
 
-    i8, i32, i64, dbl = ir.IntType(8), ir.IntType(32), ir.IntType(64), ir.DoubleType()
-    ptr = i8.as_pointer()
-    size = 1
-    for s in shape:
-        size *= s
+    sizes = [int(np.prod(s, dtype=np.int64)) for s in blocks]
+    flat = _flat_outputs(outputs, kernel_shape)
 
     def codegen(context, builder, sig, args):
-        this, argv, nargs, kwnames = args
-        module = builder.module
+        e = _Emitter(builder)
+        argv = builder.bitcast(args[1], e.ptr.as_pointer())
+        arrays = _checked_arrays(e, argv, args[2], args[3], lengths)
 
-        def extern(name):
-            g = module.globals.get(name) or ir.GlobalVariable(module, i8, name)
-            return builder.bitcast(g, ptr)
-
-        fn = builder.function
-        fallback, done = fn.append_basic_block("dv_fallback"), fn.append_basic_block("dv_done")
-        incoming = []
-
-        def require(ok):
-            nxt = fn.append_basic_block("dv_ok")
-            builder.cbranch(ok, nxt, fallback)
-            builder.position_at_end(nxt)
-
-        def field(obj, offset, ty):
-            return builder.load(builder.bitcast(builder.gep(obj, [ir.Constant(i64, offset)]), ty.as_pointer()))
-
-        argv = builder.bitcast(argv, ptr.as_pointer())
-        require(builder.and_(builder.icmp_unsigned("==", kwnames, ir.Constant(ptr, None)),
-                             builder.icmp_signed("==", nargs, ir.Constant(i64, len(lengths)))))
-        arrays = []
-        for j, k in enumerate(lengths):
-            obj = builder.load(builder.gep(argv, [ir.Constant(i64, j)]))
-            require(builder.icmp_unsigned("==", field(obj, _OFF_TYPE, ptr), extern("denavit_ndarray_type")))
-            require(builder.and_(  # an ndarray: its fields can be read
-                builder.icmp_unsigned("==", field(obj, _OFF_DESCR, ptr), extern("denavit_float64_descr")),
-                builder.icmp_signed("==", field(obj, _OFF_ND, i32), ir.Constant(i32, 1))))
-            require(builder.icmp_signed("==", builder.load(field(obj, _OFF_DIMS, i64.as_pointer())), ir.Constant(i64, k)))
-            arrays.append((field(obj, _OFF_DATA, ptr), builder.load(field(obj, _OFF_STRIDES, i64.as_pointer()))))
         def load(arg, k):
             data, stride = arrays[arg]
-            return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(i64, k), stride)]),
-                                                dbl.as_pointer()))
+            return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(e.i64, k), stride)]),
+                                                ir.DoubleType().as_pointer()))
 
+        # allocated first, so the program's values go to memory as they are made (not held across the calls)
+        result, data = e.results(blocks)
         operand = emit_steps(builder, steps, 0, load)
-        flat = {}
-        for index, ref in outputs:
-            f = 0
-            for i, s in zip(index, (size + 1,) if flagged else shape):
-                f = f * s + i
-            flat[f] = ref
-        if flagged:
-            require(builder.fcmp_ordered(">", operand(flat.pop(size)), ir.Constant(dbl, 0.0)))
-        new_ty = ir.FunctionType(ptr, [ptr, i32, i64.as_pointer(), i32, ptr, ptr, i32, i32, ptr])
-        new = builder.bitcast(extern("denavit_pyarray_new"), new_ty.as_pointer())
-        dims = cgutils.alloca_once(builder, i64, size=len(shape))
-        for j, s in enumerate(shape):
-            builder.store(ir.Constant(i64, s), builder.gep(dims, [ir.Constant(i32, j)]))
-        null = ir.Constant(ptr, None)
-        out = builder.call(new, [extern("denavit_ndarray_type"), ir.Constant(i32, len(shape)), dims,
-                                 ir.Constant(i32, _NPY_DOUBLE), null, null, ir.Constant(i32, 0), ir.Constant(i32, 0),
-                                 null])
-        failed = builder.icmp_unsigned("==", out, null)
-        compute = fn.append_basic_block("dv_compute")
-        incoming.append((null, builder.block))
-        builder.cbranch(failed, done, compute)
-        builder.position_at_end(compute)
-        data = builder.bitcast(field(out, _OFF_DATA, ptr), dbl.as_pointer())
-        for f, ref in flat.items():
-            builder.store(operand(ref), builder.gep(data, [ir.Constant(i64, f)]))
-        incoming.append((out, builder.block))
-        builder.branch(done)
-        builder.position_at_end(fallback)
-        call_ty = ir.FunctionType(ptr, [ptr, ptr.as_pointer(), i64, ptr])
-        again = builder.call(builder.bitcast(extern("denavit_vectorcall"), call_ty.as_pointer()),
-                             [this, argv, nargs, kwnames])
-        incoming.append((again, builder.block))
-        builder.branch(done)
-        builder.position_at_end(done)
-        result = builder.phi(ptr)
-        for value, block in incoming:
-            result.add_incoming(value, block)
-        return result
+        flag = flat.pop(sum(sizes)) if flagged else None
+        start = 0
+        for block, size in enumerate(sizes):
+            for f in range(start, start + size):
+                if f in flat:
+                    builder.store(operand(flat[f]), builder.gep(data[block], [ir.Constant(e.i64, f - start)]))
+            start += size
+        if flagged:  # not > 0: the result is released and the method raises the error
+            discard = builder.function.append_basic_block("dv_discard")
+            e.require(builder.fcmp_ordered(">", operand(flag), ir.Constant(ir.DoubleType(), 0.0)), discard)
+            here = builder.block
+            builder.position_at_end(discard)
+            e.call("denavit_decref", ir.VoidType(), [result], [e.ptr])
+            builder.branch(e.fallback)
+            builder.position_at_end(here)
+        return e.finish(result, (args[0], argv, args[2], args[3]))
 
     @intrinsic
     def entry(typingctx, this, argv, nargs, kwnames):
@@ -190,11 +271,13 @@ def entry_intrinsic(lengths: tuple, shape: tuple, steps: tuple, outputs: tuple, 
     return entry
 
 
-def install(module, name: str, lengths: tuple, shape: tuple, method, guard, flagged: bool = False):
+def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tuple, method, guard,
+            flagged: bool = False):
     """``(function, keep)``: the built-in function of kernel ``name`` of the generated ``module``, calling ``method``
     (the Python method, bound) for everything it does not handle itself, and what must live as long as it; None
-    when this process cannot have one.  ``shape``: the result's (``flagged``: see :func:`entry_intrinsic`).  ``guard(cfunc)``
-    puts the disk cache's guard in front of numba's cache before anything is loaded."""
+    when this process cannot have one.  ``kernel_shape``: the kernel's output; ``blocks``: the result's arrays
+    (``flagged``: see :func:`entry_intrinsic`).  ``guard(cfunc)`` puts the disk cache's guard in front of numba's
+    cache before anything is loaded."""
     py_func = getattr(module, f"{name}{ENTRY_SUFFIX}", None)
     if py_func is None or not _setup():
         return None
@@ -203,9 +286,9 @@ def install(module, name: str, lengths: tuple, shape: tuple, method, guard, flag
 
     cf = _CFUNCS.get((module.__name__, name))  # one per generated module and kernel, whatever the objects
     if cf is None:
-        setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(tuple(lengths), tuple(shape),
-                                                              getattr(module, f"_{name}_steps"),
-                                                              getattr(module, f"_{name}_outputs"), flagged))
+        setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(
+            tuple(lengths), tuple(kernel_shape), tuple(map(tuple, blocks)), getattr(module, f"_{name}_steps"),
+            getattr(module, f"_{name}_outputs"), flagged))
         sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
         cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
         cf.enable_caching()
@@ -213,7 +296,7 @@ def install(module, name: str, lengths: tuple, shape: tuple, method, guard, flag
         cf.compile()
         _CFUNCS[(module.__name__, name)] = cf
     doc = (method.__doc__ or "").encode("utf-8", "replace")
-    definition = _MethodDef(name.encode(), cf.address, _METH_FASTCALL_KEYWORDS, doc)
+    definition = _MethodDef(method.__name__.encode(), cf.address, _METH_FASTCALL_KEYWORDS, doc)
     make = ctypes.pythonapi.PyCFunction_NewEx
     make.restype, make.argtypes = ctypes.py_object, [ctypes.POINTER(_MethodDef), ctypes.py_object, ctypes.py_object]
     builtin = make(ctypes.byref(definition), method, None)
