@@ -16,9 +16,9 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from _random_robots import random_inertia, random_robot
 
 import denavit
-from _random_robots import random_inertia, random_robot
 from denavit.codegen import CompiledRobot, numba_available
 from denavit.errors import ModelError, ShapeError
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from .errors import ShapeError
 
-__all__ = ["as_joint_array", "as_transform", "as_vector"]
+__all__ = ["as_joint_array", "as_transform", "as_vector", "checked_out"]
 
 
 def as_joint_array(q: Any, n: int, name: str = "q") -> np.ndarray:
@@ -41,3 +41,18 @@ def as_transform(T: Any, name: str = "T") -> np.ndarray:
     if err > 1e-6:
         raise ShapeError(f"{name}: rotation part is not orthonormal (error {err:.2g})")
     return arr
+
+
+def checked_out(out: Any, shape: tuple[int, ...], name: str = "out") -> np.ndarray:
+    """``out`` when it can take a result of ``shape`` in place: a writeable, C-contiguous float64 ndarray of exactly
+    that shape (no broadcasting, no casting); ShapeError naming what was expected and what was given otherwise."""
+    if (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == shape and out.flags.c_contiguous
+            and out.flags.writeable):
+        return out
+    if not isinstance(out, np.ndarray):
+        got = type(out).__name__
+    else:
+        flaws = [w for w, bad in (("not C-contiguous", not out.flags.c_contiguous),
+                                  ("read-only", not out.flags.writeable)) if bad]
+        got = f"{out.dtype} array of shape {out.shape}" + "".join(f", {w}" for w in flaws)
+    raise ShapeError(f"{name}: expected a writeable C-contiguous float64 array of shape {shape}, got {got}")

@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .._threads import resolve_threads, run_batch
+from .._validate import checked_out
 from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from . import _fastcall
@@ -198,9 +199,10 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
                 raise ModelError(f"kernel {name!r} does not apply to robot {self.robot.name!r}")
         return hit
 
-    def _call(self, name: str, inputs, labels, threads=None):
+    def _call(self, name: str, inputs, labels, threads=None, out=None):
         """Any call: one configuration (every input (n,)) or a batch (inputs broadcast to (..., n)), the batch's
-        rows split over ``threads`` threads (:mod:`denavit._threads`: None = every core) into one output."""
+        rows split over ``threads`` threads (:mod:`denavit._threads`: None = every core) into one output: a fresh
+        array, or ``out`` (checked: writeable C-contiguous float64 of the result's shape; returned)."""
         kernel, shape = self._kernel(name)
         n = self.dof
         lengths = self._lengths.get(name) or (n,) * len(labels)
@@ -213,86 +215,97 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
                 raise ShapeError(f"{label}: expected shape (..., {k}){joints}, got {a.shape}")
             arrays.append(a)
         if all(a.ndim == 1 for a in arrays):
-            out = _empty(shape)
-            getattr(self, f"_{name}_1")(*[np.ascontiguousarray(a) for a in arrays], out)
-            return out
+            result = _empty(shape) if out is None else checked_out(out, shape)
+            getattr(self, f"_{name}_1")(*[np.array(a) if out is not None and np.may_share_memory(a, out)
+                                          else np.ascontiguousarray(a) for a in arrays], result)
+            return result
         flat, batch = _as_batch(arrays, labels)
-        out = _empty((flat[0].shape[0],) + shape)
-        if out.shape[0]:
-            run_batch(self._many[name], flat, (out,), threads)  # the kernels release the GIL
-        return out.reshape(batch + shape)
+        if out is None:
+            result = _empty((flat[0].shape[0],) + shape)
+        else:  # rows of a C-contiguous array: a view; an input overlapping it is copied first, as numpy's ufuncs do
+            result = checked_out(out, batch + shape).reshape((flat[0].shape[0],) + shape)
+            flat = [a.copy() if np.may_share_memory(a, out) else a for a in flat]
+        if result.shape[0]:
+            run_batch(self._many[name], flat, (result,), threads)  # the kernels release the GIL
+        return result.reshape(batch + shape) if out is None else out
 
     # --- kinematics ---------------------------------------------------------------------------------------
     # Each method first tries the hot path: float64 ndarrays of shape (n,) go straight to the kernel with a
     # fresh output; anything else (lists, other dtypes, batches, wrong shapes) takes :meth:`_call`.
-    def fk(self, q, frames: bool = False, *, threads=None) -> np.ndarray:
+    def fk(self, q, frames: bool = False, *, threads=None, out=None) -> np.ndarray:
         """End-effector pose T_w_e, shape (..., 4, 4) (as :func:`denavit.forward_kinematics`); with
         ``frames=True`` the world poses of the DH frames {0} … {N}, shape (..., N+1, 4, 4) (as
         :func:`denavit.link_transforms`, tool not applied)."""
-        if not frames and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+        if (out is None and not frames and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                and q.strides == _STRIDE):
             out = _empty(_SHAPE44)
             self._fk_1(q, out)
             return out
-        return self._call("frames" if frames else "fk", (q,), ("q",), threads)
+        return self._call("frames" if frames else "fk", (q,), ("q",), threads, out)
 
-    def position(self, q, *, threads=None) -> np.ndarray:
+    def position(self, q, *, threads=None, out=None) -> np.ndarray:
         """End-effector origin p_w_e, shape (..., 3): ``fk(q)[..., :3, 3]`` from a kernel that computes only
         what the origin needs (for workspace sampling)."""
-        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+        if (out is None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                and q.strides == _STRIDE):
             out = _empty(_SHAPE3)
             self._position_1(q, out)
             return out
-        return self._call("position", (q,), ("q",), threads)
+        return self._call("position", (q,), ("q",), threads, out)
 
-    def jacobian(self, q, frame: Frame | str = "base", *, threads=None) -> np.ndarray:
+    def jacobian(self, q, frame: Frame | str = "base", *, threads=None, out=None) -> np.ndarray:
         """Geometric Jacobian, shape (..., 6, n), rows (v, ω): ``base`` J0 or ``tool`` Je (as
         :func:`denavit.geometric_jacobian`)."""
         if frame == "base" or frame is Frame.BASE:
-            if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            if (out is None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                    and q.strides == _STRIDE):
                 out = _empty(self._jshape)
                 self._jacobian0_1(q, out)
                 return out
-            return self._call("jacobian0", (q,), ("q",), threads)
+            return self._call("jacobian0", (q,), ("q",), threads, out)
         if frame == "tool" or Frame(frame) is Frame.TOOL:
-            if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+            if (out is None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                    and q.strides == _STRIDE):
                 out = _empty(self._jshape)
                 self._jacobiane_1(q, out)
                 return out
-            return self._call("jacobiane", (q,), ("q",), threads)
+            return self._call("jacobiane", (q,), ("q",), threads, out)
         raise ValueError(f"frame must be 'base' or 'tool', got {frame!r}")  # pragma: no cover (Frame raises)
 
     # --- dynamics -------------------------------------------------------------------------------------------
-    def rnea(self, q, qd, qdd, *, threads=None) -> np.ndarray:
+    def rnea(self, q, qd, qdd, *, threads=None, out=None) -> np.ndarray:
         """Inverse dynamics τ = M q̈ + C q̇ + g + τ_f, shape (..., n) (as :func:`denavit.rnea` with the robot's
         gravity and friction)."""
-        if (q.__class__ is _ndarray and qd.__class__ is _ndarray and qdd.__class__ is _ndarray
+        if (out is None and q.__class__ is _ndarray and qd.__class__ is _ndarray and qdd.__class__ is _ndarray
                 and q.dtype is _F64 and qd.dtype is _F64 and qdd.dtype is _F64
                 and q.shape == self._vec and qd.shape == self._vec and qdd.shape == self._vec
                 and q.strides == qd.strides == qdd.strides == _STRIDE):
             out = _empty(self._vec)
             self._rnea_1(q, qd, qdd, out)
             return out
-        return self._call("rnea", (q, qd, qdd), ("q", "qd", "qdd"), threads)
+        return self._call("rnea", (q, qd, qdd), ("q", "qd", "qdd"), threads, out)
 
-    def mass_matrix(self, q, *, threads=None) -> np.ndarray:
+    def mass_matrix(self, q, *, threads=None, out=None) -> np.ndarray:
         """M(q), shape (..., n, n) (as :func:`denavit.mass_matrix`)."""
-        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+        if (out is None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                and q.strides == _STRIDE):
             out = _empty(self._mshape)
             self._mass_matrix_1(q, out)
             return out
-        return self._call("mass_matrix", (q,), ("q",), threads)
+        return self._call("mass_matrix", (q,), ("q",), threads, out)
 
-    def gravity(self, q, *, threads=None) -> np.ndarray:
+    def gravity(self, q, *, threads=None, out=None) -> np.ndarray:
         """g(q), shape (..., n) (as :func:`denavit.gravity_torques` with the robot's gravity)."""
-        if q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec and q.strides == _STRIDE:
+        if (out is None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+                and q.strides == _STRIDE):
             out = _empty(self._vec)
             self._gravity_1(q, out)
             return out
-        return self._call("gravity", (q,), ("q",), threads)
+        return self._call("gravity", (q,), ("q",), threads, out)
 
-    def coriolis(self, q, qd, *, threads=None) -> np.ndarray:
+    def coriolis(self, q, qd, *, threads=None, out=None) -> np.ndarray:
         """c(q, q̇) = C(q, q̇) q̇, shape (..., n) (as :func:`denavit.coriolis_vector`)."""
-        return self._call("coriolis", (q, qd), ("q", "qd"), threads)
+        return self._call("coriolis", (q, qd), ("q", "qd"), threads, out)
 
     def forward_dynamics(self, q, qd, tau, *, threads=None) -> np.ndarray:
         """q̈ = M⁻¹ (τ − c − g − τ_f), shape (..., n) (as :func:`denavit.forward_dynamics`); ModelError where
@@ -343,7 +356,8 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa
         taking ``(n,)`` or ``(..., n)`` and returning what the plain function returns.  Each takes
         ``threads=`` (default: every core): a batch's rows are split over that many threads (the kernels
         release the GIL; :mod:`denavit._threads` has the rules: small batches run inline, results are those of
-        the unsplit call bit for bit).
+        the unsplit call bit for bit).  All but ``forward_dynamics`` take ``out=``: the caller's writeable
+        C-contiguous float64 array of the result's shape, written and returned (ShapeError if it is not one).
 
     Notes
     -----

@@ -191,7 +191,8 @@ class _Emitter:
         b.branch(self.done)
         b.position_at_end(self.fallback)
         this, args, nargs, kwnames = argv
-        again = self.call("denavit_vectorcall", ptr, [this, args, nargs, kwnames], [ptr, ptr.as_pointer(), self.i64, ptr])
+        again = self.call("denavit_vectorcall", ptr, [this, args, nargs, kwnames],
+                          [ptr, ptr.as_pointer(), self.i64, ptr])
         self.incoming.append((again, b.block))
         b.branch(self.done)
         b.position_at_end(self.done)
@@ -205,7 +206,8 @@ def _checked_arrays(e: _Emitter, argv, nargs, kwnames, lengths: tuple) -> list:
     """Branch to the fallback unless the call is exactly ``f(a_0, …, a_{k-1})`` with each a_j an ndarray (not a
     subclass) of the float64 dtype object, one dimension of length ``lengths[j]``; (data, stride) of each."""
     b, ir, i64, ptr = e.b, e.ir, e.i64, e.ptr
-    e.require(b.and_(b.icmp_unsigned("==", kwnames, e.null), b.icmp_signed("==", nargs, ir.Constant(i64, len(lengths)))))
+    e.require(b.and_(b.icmp_unsigned("==", kwnames, e.null),
+                     b.icmp_signed("==", nargs, ir.Constant(i64, len(lengths)))))
     arrays = []
     for j, k in enumerate(lengths):
         obj = b.load(b.gep(argv, [ir.Constant(i64, j)]))
