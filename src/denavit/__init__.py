@@ -27,6 +27,7 @@ from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_der
 from .numeric import BaseParameters, base_parameters, base_regressor, inertial_parameters, regressor
 from .codegen import CompiledRobot, compile
 from .calibration import Measurements, read_measurements, write_measurements
+from .calibration import CalibrationResult, calibrate
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 
@@ -101,5 +102,7 @@ __all__ = [
     "Measurements",
     "read_measurements",
     "write_measurements",
+    "calibrate",
+    "CalibrationResult",
     "__version__",
 ]

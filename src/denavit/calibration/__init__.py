@@ -1,9 +1,15 @@
 """Calibration and identification: the arm's DH parameters and inertial parameters fitted to measurements.
 
+- :func:`calibrate`: kinematic calibration, the DH table, base and tool fitted to measured poses or positions.
+- :func:`error_model`: the arm as elementary motions with an unknown correction each, its pose and
+  identification Jacobian (what :func:`calibrate` fits).
 - :func:`read_measurements` / :func:`write_measurements`: the measurement CSV files (joint readings, poses,
   positions, torques) shared by every command of this package.
 """
 
 from ._measurements import Measurements, read_measurements, write_measurements
+from ._kinematic_model import ErrorModel, error_model
+from ._kinematic import CalibrationResult, ParameterEstimate, ResidualStats, WorstPose, calibrate
 
-__all__ = ["Measurements", "read_measurements", "write_measurements"]
+__all__ = ["Measurements", "read_measurements", "write_measurements", "calibrate", "CalibrationResult",
+           "ParameterEstimate", "ResidualStats", "WorstPose", "ErrorModel", "error_model"]
