@@ -9,6 +9,8 @@ Compiled (``denavit.compile(robot)``, numba backend when installed), for FK, J0,
 coriolis (and the derivative kernels where the compiled object has them):
   call    ``fast.<op>(q, …, threads=t)``: the whole call, a fresh (B, …) output each time (its pages are first
           touched by the kernel, in the threads)
+  out=    ``fast.<op>(q, …, threads=t, out=o)``: the whole call into the caller's output, reused across calls
+          (every op but FD)
   kernel  ``denavit._threads.run_batch`` of the batch kernel into one output reused across calls: the kernel's
           own throughput, without the page faults of a fresh output
 IK (LM): ``fast.solve_ik(T, threads=t)`` on ``--ik-targets`` targets (FK of random q inside the limits, no seeds).
@@ -99,7 +101,11 @@ def _compiled_rows(robot, threads, rows, repeat, ik_targets):
             o = np.empty((rows,) + fast._shapes[name])
             k(*[np.ascontiguousarray(a) for a in args], o)  # touch the output's pages once
             kernel = _times([lambda t=t, k=k, a=args, o=o: run_batch(k, a, (o,), t) for t in threads], repeat)[0]
-        out.append((op, call, kernel))
+        reuse = None
+        if op in OPS and op != "forward_dynamics":
+            o = np.empty_like(calls[0]())  # its pages touched once, here
+            reuse = _times([lambda t=t, m=method, a=args, o=o: m(*a, threads=t, out=o) for t in threads], repeat)[0]
+        out.append((op, call, kernel, reuse))
     if ik_targets:  # numeric IK on targets made by FK of q inside the limits, no seeds (restarts drawn)
         lim = robot.q_limits
         Q = np.random.default_rng(1).uniform(lim[:, 0], lim[:, 1], (ik_targets, robot.dof))
@@ -107,7 +113,7 @@ def _compiled_rows(robot, threads, rows, repeat, ik_targets):
         calls = [lambda t=t: fast.solve_ik(T, rng=np.random.default_rng(2), threads=t) for t in threads]
         if not _same([c().q for c in calls]):
             sys.exit("solve_ik: split results differ from the unsplit call")
-        out.append(("solve_ik", _times(calls, max(2, repeat // 2)), None, ik_targets))
+        out.append(("solve_ik", _times(calls, max(2, repeat // 2)), None, None, ik_targets))
     return fast.backend, out
 
 
@@ -119,7 +125,7 @@ def _plain_rows(robot, threads, rows, repeat):
         calls = [lambda t=t, f=f, a=args: f(robot, *a, threads=t) for t in threads]
         if not _same([c() for c in calls]):
             sys.exit(f"plain {op}: split results differ from the unsplit call")
-        out.append((op, _times(calls, repeat), None))
+        out.append((op, _times(calls, repeat), None, None))
     return out
 
 
@@ -128,15 +134,17 @@ def _table(title, rows, threads, batch):
     ratio = " | ".join(f"1/{t}" for t in threads[1:])
     cpu = " | ".join(f"CPU {t}/1" for t in threads[1:])
     print(f"\n{title}, batch {batch:,}\n")
-    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | {cpu} | kernel {ratio} |")
-    print("|---" * (2 + len(threads) + 3 * (len(threads) - 1)) + "|")
-    for op, (call, cpu_s), kernel, *count in rows:
+    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | {cpu} | out= {ratio} | kernel {ratio} |")
+    print("|---" * (2 + len(threads) + 4 * (len(threads) - 1)) + "|")
+    for op, (call, cpu_s), kernel, reuse, *count in rows:
         times = " | ".join(f"{1e3 * c:.1f}" for c in call)
         n = count[0] if count else batch
         rc = " | ".join(f"{call[0] / c:.2f}" for c in call[1:])
         rp = " | ".join(f"{c / cpu_s[0]:.2f}" for c in cpu_s[1:])
         rk = " | ".join(f"{kernel[0] / k:.2f}" for k in kernel[1:]) if kernel else " | ".join("–" for _ in call[1:])
-        print(f"| {LABEL[op]}{'' if n == batch else f' ({n:,})'} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {rk} |")
+        ro = " | ".join(f"{reuse[0] / k:.2f}" for k in reuse[1:]) if reuse else " | ".join("–" for _ in call[1:])
+        label = f"{LABEL[op]}{'' if n == batch else f' ({n:,})'}"
+        print(f"| {label} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {ro} | {rk} |")
 
 
 def main(argv=None) -> None:
