@@ -80,6 +80,7 @@ def check_against_truth(nominal, true, q, rng, result):
     return z
 
 
+@pytest.mark.slow  # about 1-1.6 CPU-s each; the three together are half the quick subset's budget
 @pytest.mark.parametrize("name, rank", [("puma560", 30), ("ur5", 30), ("panda", 34)])
 def test_done_when_catalogue_arm_calibrated_to_noise_level(name, rank):
     rng = np.random.default_rng(2026)
@@ -130,6 +131,39 @@ def test_nearly_parallel_axes_misalignment_of_005_deg_identified():
     plain = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), parallel_tolerance=0.0)
     assert "beta2" not in [p.name for p in plain.parameters]
     assert result.after.rotation_rms <= 1.5 * math.sqrt(3) * SIGMA_R < plain.after.rotation_rms / 1.5
+
+
+@pytest.mark.parametrize("name", ["stanford", "scara", "cylindrical-rpp", "puma560-mdh", "jaco2-6dof", "lift-prrr"])
+def test_noise_free_poses_give_the_true_arm_with_everetts_count(name):
+    """Prismatic joints, both conventions, β rows (SCARA: three parallel axes): the calibrated file's FK is the
+    true arm's at fresh joint values, with 4R + 2P + 6 parameters identified (Everett, Driels & Mooring 1987)."""
+    rng = np.random.default_rng(3)
+    nominal = denavit.load_robot(name)
+    true = perturbed(nominal, rng)
+    q = joint_samples(nominal, rng, 40)
+    result = calibrate(nominal, q, measured(true, q, rng, noise=False), robust="none")
+    revolute = sum(t is JointType.REVOLUTE for t in nominal.joint_types)
+    assert result.rank == 4 * revolute + 2 * (nominal.dof - revolute) + 6
+    q_new = joint_samples(nominal, rng, 10)
+    np.testing.assert_allclose(denavit.forward_kinematics(result.robot, q_new), denavit.forward_kinematics(true, q_new),
+                               atol=1e-8)
+
+
+def test_gross_outlier_is_downweighted_and_named_as_the_worst_pose():
+    rng = np.random.default_rng(21)
+    nominal = denavit.load_robot("puma560")
+    true = perturbed(nominal, rng)
+    q = joint_samples(nominal, rng, 50)
+    T = measured(true, q, rng)
+    clean = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R))
+    T[17, :3, 3] += [0.01, 0.0, 0.0]  # one pose 1 cm off (a tracker that lost its target)
+    labels = np.arange(50) + 100
+    huber = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), labels=labels)
+    plain = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), robust="none")
+    assert huber.worst[0].label == 117 and huber.worst[0].position_error > 0.009
+    shift = lambda r: max(abs(r.parameter(n).estimate - clean.parameter(n).estimate) / clean.parameter(n).sigma  # noqa: E731
+                          for n in clean.identified)
+    assert shift(huber) < 1.0 < 3.0 < shift(plain)  # least squares is dragged by many sigma, Huber is not
 
 
 def test_joint_never_moved_names_what_cannot_be_identified():
