@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,23 @@ def _as_batch(arrays, names):
         raise ShapeError(f"inputs do not broadcast together: {shapes}") from None
     flat = [np.ascontiguousarray(np.broadcast_to(a, batch + a.shape[-1:]).reshape(-1, a.shape[-1])) for a in arrays]
     return flat, batch
+
+
+def _group_batch(kernel, sel: int, arity: int):
+    """Kernel ``sel`` of a generated module's ``group_n`` as ``f(*inputs, out)``, the form of ``<name>_n``: inputs
+    (B, k) (missing ones filled with the first), ``out`` (B,) + shape seen as (B, size)."""
+    def many(*arrays):
+        *inputs, out = arrays
+        inputs += [inputs[0]] * (arity - len(inputs))
+        rows, size = out.shape[0], math.prod(out.shape[1:])
+        if out.flags.c_contiguous:
+            kernel(sel, *inputs, out.reshape(rows, size))
+            return
+        flat = _empty((rows, size))  # not a view of out (a caller's strided array): filled, then copied
+        kernel(sel, *inputs, flat)
+        out[...] = flat.reshape(out.shape)
+
+    return many
 
 
 #: kernels whose single call a built-in function takes over (the method it stands in for), and their inputs' count
@@ -86,7 +104,9 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
             self._lengths[name] = tuple(k for _, k in reg.inputs(self.dof))
         one = getattr(module, f"{name}_1")
         self._one[name] = (one, self._shapes[name])
-        self._many[name] = getattr(module, f"{name}_n")
+        group = getattr(module, "GROUP", ())  # numba: every batch kernel of the module in one compiled function
+        self._many[name] = (_group_batch(module.group_n, group.index(name), module.GROUP_ARITY) if name in group
+                            else getattr(module, f"{name}_n"))
         setattr(self, f"_{name}_1", self._first(name) if self.backend == NUMBA else one)
         if name not in self.kernels:
             self.kernels += (name,)

@@ -112,9 +112,9 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
     k = spec.name
     return ([f"_{k}_steps = ("] + steps + [")", f"_{k}_outputs = ("] + outs + [")",
             f"_{k}, _{k}_rows = kernel_intrinsic({len(spec.inputs)}, _{k}_steps, _{k}_outputs)", "", "",
-            "@njit(cache=True, nogil=True)", f"def {k}_1({args}, out):",
+            "@njit(cache=True, nogil=True, no_cfunc_wrapper=True)", f"def {k}_1({args}, out):",
             f'    """{spec.doc}: one configuration, out {spec.shape}."""', f"    _{k}({args}, out)", "", "",
-            "@njit(cache=True, nogil=True)", f"def {k}_n({args}, out):",
+            "@njit(cache=True, nogil=True, no_cfunc_wrapper=True)", f"def {k}_n({args}, out):",
             f'    """{spec.doc}: a batch, inputs (B, k), out (B,) + {spec.shape}."""',
             # LANES rows per call (the last call masks the lanes past the end)
             f"    for b in range(0, {first}.shape[0], {LANES}):", f"        _{k}_rows({args}, out, b)", "", "",
@@ -122,6 +122,20 @@ def _numba_kernel(spec: KernelSpec) -> list[str]:
             f"def {k}_entry(self, args, nargs, kwnames):",
             f'    """{spec.doc}: the CPython fast-call entry of one configuration."""',
             f"    return _{k}_entry(self, args, nargs, kwnames)", "", ""])
+
+
+def _numba_group(specs: dict[str, KernelSpec]) -> list[str]:
+    """``group_n(sel, a_0, …, a_{m-1}, out)``: the batch form of every kernel of the module in one compiled function
+    (kernel ``GROUP[sel]``; inputs (B, k), fewer than m inputs: the first repeated; ``out`` (B, size)).  numba
+    spends about 0.1 s of fixed cost on each function it compiles: one for all the batches of a group."""
+    arity = max(len(spec.inputs) for spec in specs.values())
+    names = list(specs)
+    programs = [f"    ({len(specs[k].inputs)}, _{k}_steps, _{k}_outputs, {specs[k].shape!r})," for k in names]
+    args = ", ".join(f"a{i}" for i in range(arity))
+    return ([f"GROUP = {tuple(names)!r}", f"GROUP_ARITY = {arity}", f"_group_1, _group_rows = group_intrinsic({arity}, ("] + programs + ["))", "", "",
+             "@njit(cache=True, nogil=True, no_cfunc_wrapper=True)", f"def group_n(sel, {args}, out):",
+             '    """Kernel GROUP[sel] on a batch: inputs (B, k), out (B, size)."""',
+             f"    for b in range(0, a0.shape[0], {LANES}):", f"        _group_rows(sel, {args}, out, b)", "", ""])
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:
@@ -217,13 +231,15 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
             f"Backend: {backend}.  Each kernel has <name>_1(inputs..., out) for one configuration and <name>_n(inputs..., out) for",
             'batches (inputs shaped (B, k), out (B,) + shape)."""', "", "import math", "", "import numpy as np"]
     if backend == NUMBA:
-        head += ["from numba import njit", "", "from denavit.codegen import kernel_intrinsic", "", ""]
+        head += ["from numba import njit", "", "from denavit.codegen._llvm import group_intrinsic, kernel_intrinsic", "", ""]
     else:
         head += ["", "CHUNK = 8192  # configurations per pass: the live arrays stay in cache", "", "",
                  "def _sign(x):", "    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)", "", ""]
     body: list[str] = []
     for spec in specs.values():
         body += _numba_kernel(spec) if backend == NUMBA else _python_kernel(spec)
+    if backend == NUMBA and specs:
+        body += _numba_group(specs)
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
         from ._ik_elbow import IK_ELBOW_SOURCE
         from ._ik_finish import IK_FINISH_SOURCE

@@ -8,6 +8,11 @@ llvmlite's IR builder, and the generated module wraps it in two tiny ``@njit(cac
 configuration, a batch loop).  LLVM then optimises the block as usual, numba caches the machine code on disk
 like any jitted function, and the Python-level cost is one builder call per instruction.
 
+The batch forms of all the kernels of one generated module are one compiled function (:func:`group_intrinsic`:
+a switch on the kernel's number around their programs): numba's fixed cost per compiled function — its
+pipeline, the CPython wrapper, a module of its own through LLVM, about 0.1 s — is then paid once per group, not
+once per kernel.
+
 No fast-math flags are set: no reassociation and no fused multiply-adds, so the numbers are those of the
 numpy backend, operation for operation.
 
@@ -29,7 +34,7 @@ from __future__ import annotations
 import inspect
 import math
 
-__all__ = ["kernel_intrinsic", "LANES"]
+__all__ = ["kernel_intrinsic", "group_intrinsic", "LANES"]
 
 #: rows computed at once by a batch kernel's SIMD form (4 doubles: one AVX2 register).
 LANES = 4
@@ -54,74 +59,55 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
     are computed at once, in SIMD, with no array views per row (a batch loop does no reference counting);
     lanes past the last row (B mod LANES at the end of a batch) compute a copy of the last row and store
     nothing."""
-    from llvmlite import ir
-    from numba.core import cgutils, types
-    from numba.extending import intrinsic
-
-    dbl = ir.DoubleType()
-    i64 = ir.IntType(64)
 
     def codegen(context, builder, sig, args, lanes):
-        batched = bool(lanes)
-        arrays = [context.make_array(ty)(context, builder, val)
-                  for ty, val in zip(sig.args[:n_inputs + 1], args[:n_inputs + 1])]
-        rows = [None]
-        if lanes:  # rows b … b + lanes − 1; past the batch's end a lane reads the last row and stores nothing
-            n_rows = cgutils.unpack_tuple(builder, arrays[0].shape)[0]
-            last = builder.sub(n_rows, ir.Constant(i64, 1))
-            inside = [builder.icmp_signed("<", builder.add(args[-1], ir.Constant(i64, j)), n_rows)
-                      for j in range(lanes)]
-            rows = [builder.select(inside[j], builder.add(args[-1], ir.Constant(i64, j)), last) for j in range(lanes)]
-        # each array's data pointer (as bytes) and strides, read once here (before any conditional block):
-        # an element's address is data + Σ index·stride; numba's get_item_pointer would re-read them per element
-        i8p = ir.IntType(8).as_pointer()
-        layout = [(builder.bitcast(arr.data, i8p), cgutils.unpack_tuple(builder, arr.strides)) for arr in arrays]
-
-        def inner(arg, index):
-            """Σ index_k·stride_k over an element's own dimensions (not the batch row), or None for 0."""
-            offset = None
-            for i, stride in zip(index, layout[arg][1][1:] if batched else layout[arg][1]):
-                if i:
-                    term = builder.mul(ir.Constant(i64, i), stride)
-                    offset = term if offset is None else builder.add(offset, term)
-            return offset
-
-        def base(arg, row):
-            data, strides = layout[arg]
-            return builder.gep(data, [builder.mul(row, strides[0])]) if batched else data
-
-        def at(base_ptr, offset):
-            return builder.bitcast(base_ptr if offset is None else builder.gep(base_ptr, [offset]), dbl.as_pointer())
-
-        bases: dict = {}  # (input, row) -> the row's address: inputs are read in the main flow only
-
-        def item(arg, index, row):
-            b = bases.get((arg, id(row)))
-            if b is None:
-                b = bases[(arg, id(row))] = base(arg, row)
-            return at(b, inner(arg, index))
-
-        def load(arg, k):
-            if not lanes:
-                return builder.load(item(arg, [k], rows[0] if batched else None))
-            v = ir.Constant(ir.VectorType(dbl, lanes), ir.Undefined)
-            for j, row in enumerate(rows):
-                v = builder.insert_element(v, builder.load(item(arg, [k], row)), ir.Constant(i64, j))
-            return v
-
-        operand = emit_steps(builder, steps, lanes, load)
-        if not lanes:
-            row_base = base(n_inputs, rows[0])
-            for index, ref in outputs:
-                builder.store(operand(ref), at(row_base, inner(n_inputs, index)))
-            return context.get_dummy_value()
-        results = [(inner(n_inputs, index), operand(ref)) for index, ref in outputs]
-        for j, row in enumerate(rows):
-            with cgutils.if_likely(builder, inside[j]):
-                row_base = base(n_inputs, row)
-                for offset, v in results:
-                    builder.store(builder.extract_element(v, ir.Constant(i64, j)), at(row_base, offset))
+        k = n_inputs + 1
+        _program(context, builder, sig.args[:k], args[:k], args[-1] if lanes else None, steps, outputs, lanes)
         return context.get_dummy_value()
+
+    return _intrinsics(n_inputs + 1, codegen)
+
+
+def group_intrinsic(arity: int, programs: tuple):
+    """Two numba intrinsics running program ``sel`` of ``programs`` — one compiled function for a whole group of
+    kernels (numba's fixed cost, ~0.1 s per compiled function, paid once).
+
+    ``programs``: ``(n_inputs, steps, outputs, shape)`` per kernel (``outputs`` indexed by ``shape``, as
+    :func:`kernel_intrinsic`'s).  ``f(sel, in_0, …, in_{arity-1}, out)``: vectors, ``out`` flat; ``f_rows(sel, in_0, …, out, b)``: (B, k)
+    inputs and a (B, m) ``out``, rows ``b … b + LANES − 1`` as :func:`kernel_intrinsic`'s.  A kernel of fewer
+    inputs ignores the last ones; an unknown ``sel`` does nothing."""
+    from llvmlite import ir
+
+    def flat(index, shape):
+        f = 0
+        for i, size in zip(index, shape):
+            f = f * size + i
+        return (f,)
+
+    programs = tuple((k, steps, tuple((flat(index, shape), ref) for index, ref in outputs))
+                     for k, steps, outputs, shape in programs)
+
+    def codegen(context, builder, sig, args, lanes):
+        sel, out_at = args[0], 1 + arity
+        done = builder.append_basic_block("dv_done")
+        switch = builder.switch(sel, done)
+        for j, (k, steps, outputs) in enumerate(programs):
+            block = builder.append_basic_block(f"dv_kernel{j}")
+            switch.add_case(ir.Constant(sel.type, j), block)
+            builder.position_at_end(block)
+            tys, vals = sig.args[1:1 + k] + (sig.args[out_at],), args[1:1 + k] + (args[out_at],)
+            _program(context, builder, tys, vals, args[-1] if lanes else None, steps, outputs, lanes)
+            builder.branch(done)
+        builder.position_at_end(done)
+        return context.get_dummy_value()
+
+    return _intrinsics(arity + 2, codegen)
+
+
+def _intrinsics(n_args: int, codegen):
+    """The pair of numba intrinsics (one configuration: ``n_args`` arguments; SIMD rows: one more, the row)."""
+    from numba.core import types
+    from numba.extending import intrinsic
 
     def typer(lanes):
         def make(typingctx, *args):
@@ -140,7 +126,84 @@ def kernel_intrinsic(n_inputs: int, steps: tuple, outputs: tuple):
         kernel.__signature__ = inspect.Signature([P(a, P.POSITIONAL_OR_KEYWORD) for a in ("typingctx", *(f"a{i}" for i in range(k)))])
         return intrinsic(kernel)
 
-    return arity(n_inputs + 1, 0), arity(n_inputs + 2, LANES)
+    return arity(n_args, 0), arity(n_args + 1, LANES)
+
+
+class _Addresses:
+    """Element addresses of numba arrays: each array's data pointer (as bytes) and strides, read once at the start
+    (before any conditional block); an element's address is data + Σ index·stride (numba's get_item_pointer would
+    re-read them per element).  ``batched``: the first dimension is the batch row."""
+
+    def __init__(self, builder, arrays, batched: bool) -> None:
+        from llvmlite import ir
+        from numba.core import cgutils
+
+        self.b, self.batched, self.ir = builder, batched, ir
+        self.i64, self.dptr = ir.IntType(64), ir.DoubleType().as_pointer()
+        i8p = ir.IntType(8).as_pointer()
+        self.layout = [(builder.bitcast(a.data, i8p), cgutils.unpack_tuple(builder, a.strides)) for a in arrays]
+        self.bases: dict = {}  # (input, row) -> the row's address: inputs are read in the main flow only
+
+    def inner(self, arg, index):
+        """Σ index_k·stride_k over an element's own dimensions (not the batch row), or None for 0."""
+        offset = None
+        for i, stride in zip(index, self.layout[arg][1][1:] if self.batched else self.layout[arg][1]):
+            if i:
+                term = self.b.mul(self.ir.Constant(self.i64, i), stride)
+                offset = term if offset is None else self.b.add(offset, term)
+        return offset
+
+    def base(self, arg, r):
+        data, strides = self.layout[arg]
+        return self.b.gep(data, [self.b.mul(r, strides[0])]) if self.batched else data
+
+    def at(self, base_ptr, offset):
+        return self.b.bitcast(base_ptr if offset is None else self.b.gep(base_ptr, [offset]), self.dptr)
+
+    def item(self, arg, index, r):
+        key = (arg, id(r))
+        if key not in self.bases:
+            self.bases[key] = self.base(arg, r)
+        return self.at(self.bases[key], self.inner(arg, index))
+
+
+def _program(context, builder, tys, vals, row, steps: tuple, outputs: tuple, lanes: int) -> None:
+    """Emit one program at the builder: ``tys``/``vals`` the input arrays then ``out`` (numba types and values),
+    ``row`` the first batch row (``lanes`` > 0: SIMD over LANES rows) or None (one configuration)."""
+    from llvmlite import ir
+    from numba.core import cgutils
+
+    dbl, i64 = ir.DoubleType(), ir.IntType(64)
+    n_inputs = len(vals) - 1
+    arrays = [context.make_array(ty)(context, builder, val) for ty, val in zip(tys, vals)]
+    rows = [None]
+    if lanes:  # rows b … b + lanes − 1; past the batch's end a lane reads the last row and stores nothing
+        n_rows = cgutils.unpack_tuple(builder, arrays[0].shape)[0]
+        last = builder.sub(n_rows, ir.Constant(i64, 1))
+        inside = [builder.icmp_signed("<", builder.add(row, ir.Constant(i64, j)), n_rows) for j in range(lanes)]
+        rows = [builder.select(inside[j], builder.add(row, ir.Constant(i64, j)), last) for j in range(lanes)]
+    A = _Addresses(builder, arrays, bool(lanes))
+
+    def load(arg, k):
+        if not lanes:
+            return builder.load(A.item(arg, [k], rows[0]))
+        v = ir.Constant(ir.VectorType(dbl, lanes), ir.Undefined)
+        for j, r in enumerate(rows):
+            v = builder.insert_element(v, builder.load(A.item(arg, [k], r)), ir.Constant(i64, j))
+        return v
+
+    operand = emit_steps(builder, steps, lanes, load)
+    if not lanes:
+        row_base = A.base(n_inputs, rows[0])
+        for index, ref in outputs:
+            builder.store(operand(ref), A.at(row_base, A.inner(n_inputs, index)))
+        return
+    results = [(A.inner(n_inputs, index), operand(ref)) for index, ref in outputs]
+    for j, r in enumerate(rows):
+        with cgutils.if_likely(builder, inside[j]):
+            row_base = A.base(n_inputs, r)
+            for offset, v in results:
+                builder.store(builder.extract_element(v, ir.Constant(i64, j)), A.at(row_base, offset))
 
 
 def emit_steps(builder, steps: tuple, lanes: int, load):
