@@ -45,7 +45,9 @@ def test_calibrate_prints_report_and_writes_a_robot_that_matches_the_truth(tmp_p
     cal = denavit.load_robot(str(out))
     assert cal.name == "puma560" and cal.has_dynamics  # names, inertia, limits kept
     np.testing.assert_array_equal(cal.q_limits, denavit.load_robot("puma560").q_limits)
-    assert out.read_text().startswith("# Kinematics calibrated by denavit calibrate")
+    head = out.read_text().splitlines()
+    assert head[0].startswith("# Source: P. Corke")  # the catalogue file's leading comments are kept
+    assert any(line.startswith("# Kinematics calibrated by denavit calibrate from") for line in head[:15])
     q = np.random.default_rng(9).uniform(-1, 1, (10, 6))
     p_true = denavit.forward_kinematics(true, q)[:, :3, 3]
     err = np.abs(denavit.forward_kinematics(cal, q)[:, :3, 3] - p_true).max()
@@ -85,3 +87,16 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, args, fragment):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and fragment in err, err
     assert not list(tmp_path.glob("*.png")) and not list(tmp_path.glob(".denavit-*"))
+
+
+def test_calibrated_file_keeps_plain_leading_comments_only(tmp_path, capsys):
+    data, out = tmp_path / "poses.csv", tmp_path / "cal.yaml"
+    _simulate(data, m=20)
+    text = denavit.dump_robot(denavit.load_robot("puma560")).replace("# puma560: written by denavit\n", "")
+    robot = tmp_path / "arm.yaml"
+    robot.write_text("# bench arm 7, serial 1234\n#\tmeasured 2026\n# \u202ered\n" + text, encoding="utf-8")
+    assert main(["calibrate", str(robot), str(data), "-o", str(out), "--holdout", "0"]) == 0
+    lines = out.read_text(encoding="utf-8").splitlines()
+    assert lines[:2] == ["# bench arm 7, serial 1234", "#\tmeasured 2026"]
+    assert not any("\u202e" in line for line in lines)  # a bidi override is never copied
+    assert denavit.load_robot(str(out)).dof == 6

@@ -66,20 +66,35 @@ def cmd_calibrate(args: argparse.Namespace):
     return _json(result, args, m.notes), _text(result, args, list(m.notes))
 
 
+def _source_text(robot_arg: str) -> str:
+    """The robot file's text (a YAML file named, or the catalogue's file of a built-in name), else ""."""
+    from importlib import resources
+
+    from ..io import catalogue_name
+
+    if os.path.isfile(robot_arg):
+        if Path(robot_arg).suffix.lower() not in (".yaml", ".yml"):
+            return ""
+        with open(robot_arg, encoding="utf-8", errors="replace") as fh:
+            return fh.read(256_000)
+    try:
+        entry = resources.files("denavit") / "data" / "robots" / f"{catalogue_name(robot_arg)}.yaml"
+        return entry.read_text(encoding="utf-8")
+    except (ParseError, OSError):
+        return ""
+
+
 def source_comments(robot_arg: str) -> list[str]:
-    """The leading ``#`` lines of the robot file (none for a catalogue name), each kept only when it is one plain
-    comment line (no character YAML or a terminal would read as a line break or control)."""
+    """The leading ``#`` lines of the robot file (YAML, or the catalogue's), each kept only when it is one plain
+    comment line (no character YAML or a terminal would read as a line break or a control; tabs allowed)."""
     from .._text import has_unsafe
 
-    if not os.path.isfile(robot_arg) or Path(robot_arg).suffix.lower() not in (".yaml", ".yml"):
-        return []
     out = []
-    with open(robot_arg, encoding="utf-8", errors="replace") as fh:
-        for line in fh.read(256_000).splitlines()[:MAX_COMMENT_LINES]:
-            if not line.startswith("#"):
-                break
-            if not has_unsafe(line):
-                out.append(line)
+    for line in _source_text(robot_arg).splitlines()[:MAX_COMMENT_LINES]:
+        if not line.startswith("#"):
+            break
+        if not has_unsafe(line, keep="\t"):
+            out.append(line)
     return out
 
 
