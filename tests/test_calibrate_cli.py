@@ -100,3 +100,19 @@ def test_calibrated_file_keeps_plain_leading_comments_only(tmp_path, capsys):
     assert lines[:2] == ["# bench arm 7, serial 1234", "#\tmeasured 2026"]
     assert not any("\u202e" in line for line in lines)  # a bidi override is never copied
     assert denavit.load_robot(str(out)).dof == 6
+
+
+def test_millimetres_and_a_json_robot_file(tmp_path, capsys):
+    data, out = tmp_path / "poses.csv", tmp_path / "cal.json"
+    true, q = _simulate(tmp_path / "m.csv", kind="position")
+    m = denavit.read_measurements(tmp_path / "m.csv", true)
+    denavit.write_measurements(data, {"q": m.q, "x": m.position[:, 0] * 1e3, "y": m.position[:, 1] * 1e3,
+                                      "z": m.position[:, 2] * 1e3})  # the same positions in millimetres
+    assert main(["calibrate", "puma560", str(data), "--mm", "--noise-pos", "0.05", "--holdout", "0", "-o",
+                 str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "a2 " in text and " mm" in text
+    cal = denavit.load_robot(str(out))
+    q_new = np.random.default_rng(2).uniform(-1, 1, (10, 6))
+    err = np.abs(denavit.forward_kinematics(cal, q_new)[:, :3, 3] - denavit.forward_kinematics(true, q_new)[:, :3, 3])
+    assert err.max() < 2e-4  # metres: --mm read the file's millimetres

@@ -32,8 +32,8 @@ __all__ = ["calibrate", "CalibrationResult", "ParameterEstimate", "ResidualStats
 ROBUST_LOSSES = ("huber", "cauchy", "none")
 #: Levenberg–Marquardt iterations at most.
 MAX_ITERATIONS = 100
-#: Poses at most (memory: the Jacobian holds 6 · poses · unknowns numbers).
-MAX_POSES = 200_000
+#: Poses at most (memory: the Jacobian holds 6 · poses · unknowns numbers, about 100 MB for a 7-joint arm).
+MAX_POSES = 50_000
 _WORST = 5
 _PASSES = 3
 
