@@ -28,7 +28,7 @@ import denavit
 from denavit import DHLink, JointType, ShapeError, calibrate
 from denavit.calibration import error_model
 
-from conftest import robots
+from conftest import REDUCED, robots
 
 SIGMA_P = 1e-4  # m, per axis
 SIGMA_R = math.radians(0.01)  # rad, per axis
@@ -197,7 +197,7 @@ def test_position_data_holds_the_tool_orientation():
     assert result.after.position_rms <= 1.5 * math.sqrt(3) * SIGMA_P
 
 
-@settings(max_examples=15)
+@settings(max_examples=6 if REDUCED else 15)
 @given(robots(), st.integers(0, 2**32 - 1))
 def test_identification_jacobian_matches_finite_differences(robot, seed):
     rng = np.random.default_rng(seed)
@@ -218,7 +218,7 @@ def test_identification_jacobian_matches_finite_differences(robot, seed):
         np.testing.assert_allclose(J[:, 3:, k], dphi, atol=1e-7, err_msg=model.parameters[k].name)
 
 
-@settings(max_examples=15)
+@settings(max_examples=6 if REDUCED else 15)
 @given(robots(), st.integers(0, 2**32 - 1))
 def test_error_model_and_calibrated_robot_agree_with_library_kinematics(robot, seed):
     """Zero corrections: the library's FK; random corrections (β included): the written robot's FK."""

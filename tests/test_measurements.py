@@ -16,6 +16,8 @@ from hypothesis import strategies as st
 import denavit
 from denavit import ParseError, ShapeError, read_measurements, write_measurements
 
+from conftest import REDUCED
+
 PUMA = denavit.load_robot("puma560")
 STANFORD = denavit.load_robot("stanford")  # joint 3 prismatic
 
@@ -146,7 +148,7 @@ def test_write_refuses_bad_columns(tmp_path):
 finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False, allow_subnormal=False)
 
 
-@settings(max_examples=25)
+@settings(max_examples=10 if REDUCED else 25)
 @given(st.integers(1, 8).flatmap(lambda m: st.tuples(
     st.lists(st.lists(finite, min_size=6, max_size=6), min_size=m, max_size=m),
     st.lists(st.lists(finite, min_size=3, max_size=3), min_size=m, max_size=m),
