@@ -30,6 +30,7 @@ from .calibration import Measurements, read_measurements, write_measurements
 from .calibration import CalibrationResult, calibrate
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
+from .calibration import excitation_trajectory
 
 __version__ = "0.1.0"
 
@@ -104,5 +105,6 @@ __all__ = [
     "write_measurements",
     "calibrate",
     "CalibrationResult",
+    "excitation_trajectory",
     "__version__",
 ]

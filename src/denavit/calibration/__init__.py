@@ -5,11 +5,15 @@
   identification Jacobian (what :func:`calibrate` fits).
 - :func:`read_measurements` / :func:`write_measurements`: the measurement CSV files (joint readings, poses,
   positions, torques) shared by every command of this package.
+- :func:`excitation_trajectory`: a finite-Fourier-series trajectory within the joint limits that makes the base
+  regressor well conditioned (what to run on the arm before :func:`identify`).
 """
 
 from ._measurements import Measurements, read_measurements, write_measurements
 from ._kinematic_model import ErrorModel, error_model
 from ._kinematic import CalibrationResult, ParameterEstimate, ResidualStats, WorstPose, calibrate
+from ._excite import ExcitationTrajectory, excitation_trajectory, fourier_series
 
 __all__ = ["Measurements", "read_measurements", "write_measurements", "calibrate", "CalibrationResult",
-           "ParameterEstimate", "ResidualStats", "WorstPose", "ErrorModel", "error_model"]
+           "ParameterEstimate", "ResidualStats", "WorstPose", "ErrorModel", "error_model",
+           "ExcitationTrajectory", "excitation_trajectory", "fourier_series"]
