@@ -23,6 +23,7 @@ from ..model import DHRobot
 from ..numeric import rotation_log
 from ._kinematic_model import PARALLEL_TOLERANCE, ErrorModel, error_model
 from ._kinematic_observe import RANK_TOLERANCE, observability
+from ._kinematic_register import REGISTERED_NOTE, registered_start
 from ._kinematic_robot import calibrated_robot
 
 __all__ = ["calibrate", "CalibrationResult", "ParameterEstimate", "ResidualStats", "WorstPose", "ROBUST_LOSSES",
@@ -333,23 +334,27 @@ def calibrate(robot: DHRobot, q, measured, kind: str = "pose", *, noise: tuple[f
     q, p, R = _checked(robot, q, measured, kind, noise, robust, holdout)
     labels = np.arange(1, len(q) + 1) if labels is None else np.asarray(labels, dtype=int)
     fit, out = _split(len(q), holdout, seed)
-    model = error_model(robot, parallel_tolerance)
+    start = registered_start(robot, q[fit], p[fit]) if base else robot
+    model = error_model(start, parallel_tolerance)
     R_fit = None if R is None else R[fit]
     obs, problem, solution = _fit(model, q[fit], p[fit], R_fit, noise, (base, tool), (robust, robust_scale),
                                   rank_tol, max_iterations)
     x_full = problem.full(solution[0])
     params, s2, cov = _estimates(model, obs, solution, x_full)
-    before, after, worst = _fitted_report(model, x_full, q[fit], p[fit], R_fit, labels[fit], noise)
+    nominal = model if start is robot else error_model(robot, parallel_tolerance)
+    before = _stats(nominal, np.zeros_like(x_full), q[fit], p[fit], R_fit)[0]
+    after, worst = _fitted_report(model, x_full, q[fit], p[fit], R_fit, labels[fit], noise)
     held_out = [None, None]
     if len(out):
         R_out = None if R is None else R[out]
-        held_out = [_stats(model, xv, q[out], p[out], R_out)[0] for xv in (np.zeros_like(x_full), x_full)]
+        held_out = [_stats(m_, x_, q[out], p[out], R_out)[0] for m_, x_ in ((nominal, 0 * x_full), (model, x_full))]
     note = f"kinematics calibrated from {len(fit)} measured {kind}s"
     iterations, converged = solution[4], solution[5]
+    notes = _notes(q[fit], model, converged) + (() if start is robot else (REGISTERED_NOTE,))
     return CalibrationResult(
-        calibrated_robot(robot, model, x_full, note), robot, kind, tuple(float(v) for v in noise), params, obs.rank,
+        calibrated_robot(start, model, x_full, note), robot, kind, tuple(float(v) for v in noise), params, obs.rank,
         obs.condition_number, before, after, held_out[0], held_out[1], worst, iterations, converged, s2, cov,
-        tuple(r + 1 for r in model.beta_rows), _notes(q[fit], model, converged))
+        tuple(r + 1 for r in model.beta_rows), notes)
 
 
 def _estimates(model: ErrorModel, obs, solution, x_full: np.ndarray):
@@ -365,13 +370,12 @@ def _estimates(model: ErrorModel, obs, solution, x_full: np.ndarray):
 
 
 def _fitted_report(model: ErrorModel, x_full: np.ndarray, q, p, R, labels, noise):
-    """Residuals before and after on the fitted measurements, and the worst poses (largest error in noise units)."""
-    before, _, _ = _stats(model, np.zeros_like(x_full), q, p, R)
+    """Residuals after calibration on the fitted measurements, and the worst poses (largest error in noise units)."""
     after, ep, er = _stats(model, x_full, q, p, R)
     score = ep / noise[0] + (0.0 if er is None else er / noise[1])
     worst = tuple(WorstPose(int(labels[i]), float(ep[i]), None if er is None else float(er[i]))
                   for i in np.argsort(-score)[:_WORST])
-    return before, after, worst
+    return after, worst
 
 
 def _notes(q: np.ndarray, model: ErrorModel, converged: bool) -> tuple[str, ...]:
