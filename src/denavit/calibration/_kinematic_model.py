@@ -11,8 +11,9 @@ current frame):
 B and T the nominal base and tool, the joint value added to θ (revolute) or d (prismatic), and each parameter the
 nominal value plus its correction.  The extra rotation β about the row's y axis is added to rows whose consecutive
 joint axes are nearly parallel (the classical DH singularity of calibration: there a small tilt of the next axis
-would move the common normal, and d, by kilometres); such a row's d is then held (it moves the arm exactly as the
-next row's d while the axes are parallel).
+would move the common normal, and d, by kilometres); such a row's d is then held (while the axes are parallel it
+moves the arm exactly as the d of the other row on them: the next row's in the standard convention, the previous
+row's in the modified one).
 
 Identification Jacobian (no finite differences): a parameter of an elementary motion about (along) the unit axis
 e of the frame F it acts in moves the end effector by the twist (Veitschegger & Wu 1986; Mooring, Roth & Driels,
@@ -156,8 +157,8 @@ def _row_ops(robot: DHRobot, r: int, joint: int, beta: bool, params: list[Parame
 
     def op(field: str, kind: str, axis: int, value: float) -> Op:
         name = f"{field}{n}" + ("_offset" if field == offset else "")
-        held = "parallel axes: the row's d moves the arm as the next d does (its Hayati beta is estimated instead)" \
-            if beta and field == "d" else ""
+        held = ("parallel axes: moves the arm as the d of the other row on these axes does (Hayati beta estimated "
+                "instead)") if beta and field == "d" else ""
         unit = "m" if kind == "t" else "rad"
         params.append(Parameter(name, r, field, value, unit, held))
         moving = joint if field == offset else -1
