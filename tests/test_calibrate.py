@@ -169,7 +169,8 @@ def test_measurements_in_a_far_instrument_frame_register_the_base_first():
     assert np.abs(err).max() < 3e-4
 
 
-def test_gross_outlier_is_downweighted_and_named_as_the_worst_pose():
+@pytest.mark.parametrize("robust", ["huber", "cauchy"])
+def test_gross_outlier_is_downweighted_and_named_as_the_worst_pose(robust):
     rng = np.random.default_rng(21)
     nominal = denavit.load_robot("puma560")
     true = perturbed(nominal, rng)
@@ -178,12 +179,26 @@ def test_gross_outlier_is_downweighted_and_named_as_the_worst_pose():
     clean = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R))
     T[17, :3, 3] += [0.01, 0.0, 0.0]  # one pose 1 cm off (a tracker that lost its target)
     labels = np.arange(50) + 100
-    huber = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), labels=labels)
+    huber = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), labels=labels, robust=robust)
     plain = calibrate(nominal, q, T, noise=(SIGMA_P, SIGMA_R), robust="none")
     assert huber.worst[0].label == 117 and huber.worst[0].position_error > 0.009
     shift = lambda r: max(abs(r.parameter(n).estimate - clean.parameter(n).estimate) / clean.parameter(n).sigma  # noqa: E731
                           for n in clean.identified)
     assert shift(huber) < 1.0 < 3.0 < shift(plain)  # least squares is dragged by many sigma, Huber is not
+
+
+def test_base_and_tool_can_be_kept_as_they_are():
+    rng = np.random.default_rng(12)
+    nominal = denavit.load_robot("ur5")
+    true = perturbed(nominal, rng).replace(base=nominal.base, tool=nominal.tool)  # only the DH rows are off
+    q = joint_samples(nominal, rng, 40)
+    result = calibrate(nominal, q, measured(true, q, rng), noise=(SIGMA_P, SIGMA_R), base=False, tool=False)
+    for name in ("base_x", "base_rz", "tool_y", "tool_rx"):
+        assert name in result.held and result.parameter(name).reason == f"not calibrated ({name[:4]}=False)"
+    np.testing.assert_array_equal(result.robot.base_matrix, nominal.base_matrix)
+    np.testing.assert_array_equal(result.robot.tool_matrix, nominal.tool_matrix)
+    assert result.rank == 4 * 6  # every row's four (beta for d in rows 2, 3): no base or tool to confuse them with
+    assert result.after.position_rms <= 1.5 * math.sqrt(3) * SIGMA_P
 
 
 def test_joint_never_moved_names_what_cannot_be_identified():
