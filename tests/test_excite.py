@@ -22,7 +22,7 @@ from denavit.numeric import base_parameters, base_regressor
 
 ROBOTS = ("puma560", "panda")
 #: A cheap design (the default budget is 2 starts x 10 iterations of 5 harmonics): enough to test the contract.
-CHEAP = {"harmonics": 3, "starts": 1, "max_iterations": 5, "instants": 20, "samples": 400}
+CHEAP = {"harmonics": 3, "starts": 1, "max_iterations": 4, "instants": 16, "samples": 400}
 
 
 @pytest.fixture(scope="module", params=ROBOTS)
@@ -98,12 +98,14 @@ def test_excite_lowers_the_condition_number_with_full_rank(designed):
 def test_excite_cli_writes_a_csv_that_reads_back(tmp_path, capsys):
     path = tmp_path / "traj.csv"
     code = main(["excite", "puma560", "-o", str(path), "--harmonics", "2", "--starts", "1", "--iterations", "3",
-                 "--period", "4", "--rate", "25", "--seed", "5", "--json"])
+                 "--period", "4", "--rate", "25", "--seed", "5", "--center", "--json"])
     out = capsys.readouterr().out
     assert code == 0
     data = json.loads(out)
     assert data["samples"] == 100 and data["cond"] < data["cond_initial"] and data["rank"] == data["n_base"] == 52
     assert data["at_rest"] is False and len(data["active"]["qd"]) == 6
+    lim = denavit.load_robot("puma560").q_limits  # --center: q0 in the middle of the limits (symmetric margin)
+    np.testing.assert_allclose(data["q0"], lim.mean(axis=1), atol=1e-9)
     m = denavit.read_measurements(path, denavit.load_robot("puma560"))
     assert m.t.shape == (100,) and m.q.shape == m.qd.shape == m.qdd.shape == (100, 6) and m.tau is None
     with open(path, newline="") as fh:  # the header, read by the csv module

@@ -160,7 +160,7 @@ def _limits(robot: DHRobot, margin: float, q_limits, qd_max, qdd_max):
 
 
 class _Problem:
-    """log cond(W_b(x)) and its gradient, W_b stacked at ``instants``; the last stack kept for the gradient."""
+    """log cond(W_b(x)) and its gradient, W_b stacked at ``instants`` (the last few values kept by x)."""
 
     def __init__(self, robot, base, instants, H, w):
         self.robot, self.base, self.n, self.H = robot, base, robot.dof, H
@@ -218,7 +218,7 @@ def _gram(W: np.ndarray) -> np.ndarray:
 def excitation_trajectory(robot: DHRobot, *, harmonics: int = 5, base_freq: float = 0.1, duration: float | None = None,
                           samples: int | None = None, margin: float = 0.05, q_limits=None, qd_max=None, qdd_max=None,
                           friction: bool = True, motor_inertia: bool = True, seed: int | None = 0, starts: int = 2,
-                          max_iterations: int = 10, instants: int | None = None,
+                          max_iterations: int = 10, instants: int | None = None, center: bool = False,
                           progress=None) -> ExcitationTrajectory:
     """A finite-Fourier-series trajectory within the limits that minimises cond(W_b) (module notes).
 
@@ -250,6 +250,9 @@ def excitation_trajectory(robot: DHRobot, *, harmonics: int = 5, base_freq: floa
         iteration stacks the regressor at ``instants`` × (1 + 3n) states once, plus its line search).
     instants : int, optional
         Instants where W_b is stacked (default max(50, ⌈3 r / n⌉), r base parameters, n joints).
+    center : bool
+        Hold each offset q_i0 at the middle of its position window (by default q_i0 starts there and is optimised
+        with the other coefficients).
     progress : callable(str), optional
         Called at each start and each SLSQP iteration.
 
@@ -289,7 +292,8 @@ def excitation_trajectory(robot: DHRobot, *, harmonics: int = 5, base_freq: floa
         first = f0 if first is None else first
         if progress is not None:
             progress(f"start {start + 1}/{starts}: cond {np.exp(f0):.4g}")
-        nit, message, x = _solve(problem, x0, C, d, max_iterations, progress, f"start {start + 1}/{starts}")
+        nit, message, x = _solve(problem, x0, (C, d, window.mean(axis=1) if center else None), max_iterations,
+                                 progress, f"start {start + 1}/{starts}")
         iterations += nit
         x = within_limits(x, span, H, w, window, qd_lim, qdd_lim)
         f = problem.log_cond(x)
@@ -299,11 +303,17 @@ def excitation_trajectory(robot: DHRobot, *, harmonics: int = 5, base_freq: floa
                    iterations, starts)
 
 
-def _solve(problem: _Problem, x0, C, d, max_iterations: int, progress, label: str):
-    """SLSQP from x0; returns (iterations, message, x): x the iterate of least cond among those within the limits
-    to 1e-3 of each limit (SLSQP's iterates may step outside, and its last is not always its best)."""
+def _solve(problem: _Problem, x0, constraints, max_iterations: int, progress, label: str):
+    """SLSQP from x0 under C x + d ≥ 0 (and q_i0 = mid_i when ``mid`` is given); returns (iterations, message, x):
+    x the iterate of least cond among those within the limits to FEASIBLE_TOL of each limit (SLSQP's iterates
+    may step outside, and its last is not always its best)."""
     from scipy.optimize import minimize
 
+    C, d, mid = constraints
+    bounds = None
+    if mid is not None:
+        k = x0.size // mid.size
+        bounds = [(mid[i // k], mid[i // k]) if i % k == 0 else (None, None) for i in range(x0.size)]
     best = [problem.log_cond(x0), x0]
     count = [0]
 
@@ -315,7 +325,7 @@ def _solve(problem: _Problem, x0, C, d, max_iterations: int, progress, label: st
         if progress is not None:
             progress(f"{label}, iteration {count[0]}: cond {np.exp(f):.4g}")
 
-    res = minimize(problem.log_cond, x0, jac=problem.gradient, method="SLSQP", callback=visit,
+    res = minimize(problem.log_cond, x0, jac=problem.gradient, method="SLSQP", callback=visit, bounds=bounds,
                    constraints=[{"type": "ineq", "fun": lambda x: C @ x + d, "jac": lambda x: C}],
                    options={"maxiter": max_iterations, "ftol": 1e-6})
     return int(res.nit), str(res.message), best[1]

@@ -45,6 +45,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="SLSQP iterations per start (default 10)")
     p.add_argument("--margin", type=bounded_float(0.0, 0.49), default=0.05, metavar="F",
                    help="each side of the position limits moved in by this fraction of the range (default 0.05)")
+    p.add_argument("--center", action="store_true",
+                   help="hold each joint's offset q0 at the middle of its position window (else optimised)")
     p.add_argument("--qd-max", metavar="QD", help="velocity limits: one value or one per joint (rad/s, deg/s "
                                                   "with --deg, m/s; default 1 rad/s, 0.25 m/s)")
     p.add_argument("--qdd-max", metavar="QDD", help="acceleration limits, likewise (default 4 rad/s^2, 1 m/s^2)")
@@ -70,7 +72,7 @@ def cmd_excite(args: argparse.Namespace):
                                 samples=samples, margin=args.margin, qd_max=rates[0], qdd_max=rates[1],
                                 friction=not args.no_friction, motor_inertia=not args.no_motor_inertia,
                                 seed=args.seed, starts=args.starts, max_iterations=args.iterations,
-                                progress=_progress(args))
+                                center=args.center, progress=_progress(args))
     scale = _scale(args, robot)
     if args.output is not None:
         write_measurements(args.output, {"t": res.t, "q": res.q * scale, "qd": res.qd * scale,
