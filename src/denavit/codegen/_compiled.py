@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +12,7 @@ from ..errors import MissingDependencyError, ModelError, ShapeError
 from ..model import DHRobot, Frame
 from . import _fastcall
 from ._cache import guard_cache, load_module, numba_available, robot_key
-from ._emit import NUMBA, NUMPY, python_module
+from ._emit import NUMBA, NUMPY, group_batch, python_module
 from ._kernels import (BASE_GROUP, DYNAMICS, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
                        registered_digest, registered_kernels, trace_kernels, trace_registered)
 from ._compiled_dyn import DynDerivativeMethods
@@ -35,23 +34,6 @@ def _as_batch(arrays, names):
     return flat, batch
 
 
-def _group_batch(kernel, sel: int, arity: int):
-    """Kernel ``sel`` of a generated module's ``group_n`` as ``f(*inputs, out)``, the form of ``<name>_n``: inputs
-    (B, k) (missing ones filled with the first), ``out`` (B,) + shape seen as (B, size)."""
-    def many(*arrays):
-        *inputs, out = arrays
-        inputs += [inputs[0]] * (arity - len(inputs))
-        rows, size = out.shape[0], math.prod(out.shape[1:])
-        if out.flags.c_contiguous:
-            kernel(sel, *inputs, out.reshape(rows, size))
-            return
-        flat = _empty((rows, size))  # not a view of out (a caller's strided array): filled, then copied
-        kernel(sel, *inputs, flat)
-        out[...] = flat.reshape(out.shape)
-
-    return many
-
-
 #: kernels whose single call a built-in function takes over (the method it stands in for), and their inputs' count
 _BUILTIN_METHODS = {"fk": "fk", "position": "position", "jacobian0": "jacobian", "rnea": "rnea",
                     "mass_matrix": "mass_matrix", "gravity": "gravity", "coriolis": "coriolis",
@@ -65,6 +47,9 @@ _BUILTIN_METHODS = {"fk": "fk", "position": "position", "jacobian0": "jacobian",
 _BUILTIN_RESULTS = {"forward_dynamics": (lambda n: ((n,),), True),
                     "rnea_derivatives": (lambda n: ((n, n),) * 2, False),
                     "forward_dynamics_derivatives": (lambda n: ((n, n),) * 3, True)}
+#: base kernels whose built-in returns one array: their first call goes through it (see CompiledRobot._first)
+_BASE_BUILTINS = frozenset({"fk", "position", "jacobian0", "rnea", "mass_matrix", "gravity", "coriolis",
+                            "forward_dynamics"})
 _ARITY = {"rnea": 3, "coriolis": 2, "forward_dynamics": 3}
 _ndarray, _F64, _empty, _SHAPE44, _SHAPE3, _STRIDE = np.ndarray, np.dtype(np.float64), np.empty, (4, 4), (3,), (8,)
 
@@ -104,9 +89,7 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
             self._lengths[name] = tuple(k for _, k in reg.inputs(self.dof))
         one = getattr(module, f"{name}_1")
         self._one[name] = (one, self._shapes[name])
-        group = getattr(module, "GROUP", ())  # numba: every batch kernel of the module in one compiled function
-        self._many[name] = (_group_batch(module.group_n, group.index(name), module.GROUP_ARITY) if name in group
-                            else getattr(module, f"{name}_n"))
+        self._many[name] = group_batch(module, name) or getattr(module, f"{name}_n")
         setattr(self, f"_{name}_1", self._first(name) if self.backend == NUMBA else one)
         if name not in self.kernels:
             self.kernels += (name,)
@@ -144,15 +127,18 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
 
     def warm(self) -> dict[str, float]:
         """Run every kernel once, single and batch (this compiles it, or loads it from the disk cache);
-        return the seconds each took."""
+        return the seconds each took (the first batch call compiles the batch forms of the whole group)."""
         import time
 
         out = {}
         for name in self.kernels:
-            kernel, shape = self._one[name]
+            _, shape = self._one[name]
             lengths = self._lengths.get(name) or (self.dof,) * {"rnea": 3, "forward_dynamics": 3, "coriolis": 2}.get(name, 1)
             t = time.perf_counter()
-            kernel(*[np.zeros(k) for k in lengths], _empty(shape))
+            try:  # the single call as the methods make it (a base kernel's built-in, if it has one)
+                getattr(self, f"_{name}_1")(*[np.zeros(k) for k in lengths], _empty(shape))
+            except ModelError:  # forward dynamics of an arm whose M is singular at q = 0: compiled all the same
+                pass
             self._many[name](*[np.zeros((1, k)) for k in lengths], _empty((1,) + shape))
             out[name] = time.perf_counter() - t
         return out
@@ -162,25 +148,47 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
 
         A numba dispatcher spends a few hundred nanoseconds per call choosing the compiled version from the
         argument types; the hot paths already know them (float64, C-contiguous, fresh output), so they call
-        the entry point of that version directly."""
+        the entry point of that version directly.  A base kernel with a built-in (:meth:`_builtin`) answers its
+        first call through the built-in, and compiles its own one-configuration function only when a call the
+        built-in hands back needs it (keywords, lists, ...): a cold ``compile`` + ``warm`` builds one program less
+        per kernel."""
         dispatcher = self._one[name][0]
 
-        def first(*args):
+        def compiled(*args):
             dispatcher(*args)
             for sig, result in dispatcher.overloads.items():
                 if all(getattr(t, "layout", "C") == "C" for t in sig):
                     setattr(self, f"_{name}_1", result.entry_point)
                     break
+
+        def first(*args):
+            compiled(*args)
             if name in _BUILTIN_METHODS:
                 self._builtin(name, _BUILTIN_METHODS[name])
 
-        return first
+        if name not in _BASE_BUILTINS:
+            return first
 
-    def _builtin(self, name: str, method: str) -> None:
+        def first_builtin(*args):
+            setattr(self, f"_{name}_1", compiled)  # what the method runs when the built-in hands a call back
+            builtin = self._builtin(name, _BUILTIN_METHODS[name])
+            if builtin is None:
+                compiled(*args)
+                return
+            *inputs, out = args
+            if name == "forward_dynamics":  # q̈ only where M is regular (flag > 0); else the method raises
+                out[:-1] = builtin(*inputs)
+                out[-1] = 1.0
+            else:
+                out[...] = builtin(*inputs)
+
+        return first_builtin
+
+    def _builtin(self, name: str, method: str):
         """Put kernel ``name``'s CPython built-in (:mod:`denavit.codegen._fastcall`) on this object in place of
         ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on (a
         tuple of fresh arrays where the method returns a tuple); every other call goes to the method itself.
-        Nothing changes when the built-in cannot be made here."""
+        Nothing changes when the built-in cannot be made here (None is returned; else the built-in)."""
         n, reg = self.dof, registered_kernels().get(name)
         lengths = self._lengths.get(name) or (n,) * _ARITY.get(name, 1)
         blocks, flagged = _BUILTIN_RESULTS.get(name, (lambda n: (self._shapes[name],), False))
@@ -190,9 +198,11 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
                                      guard_cache, flagged)
         except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
             made = None
-        if made is not None:
-            setattr(self, method, made[0])
-            self._keep.append(made[1])
+        if made is None:
+            return None
+        setattr(self, method, made[0])
+        self._keep.append(made[1])
+        return made[0]
 
     def _missing(self, name: str):
         def kernel(*args):

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ._kernels import KernelSpec
 from ._llvm import LANES
 
-__all__ = ["python_module", "c_sources", "NUMBA", "NUMPY"]
+__all__ = ["python_module", "c_sources", "group_batch", "NUMBA", "NUMPY"]
 
 NUMBA, NUMPY = "numba", "numpy"
 
@@ -136,6 +138,29 @@ def _numba_group(specs: dict[str, KernelSpec]) -> list[str]:
              "@njit(cache=True, nogil=True, no_cfunc_wrapper=True)", f"def group_n(sel, {args}, out):",
              '    """Kernel GROUP[sel] on a batch: inputs (B, k), out (B, size)."""',
              f"    for b in range(0, a0.shape[0], {LANES}):", f"        _group_rows(sel, {args}, out, b)", "", ""])
+
+
+def group_batch(module, name: str):
+    """Kernel ``name`` of a generated module's ``group_n`` as ``f(*inputs, out)``, the form of ``<name>_n``: inputs
+    (B, k) (missing ones filled with the first), ``out`` (B,) + shape seen as (B, size); None when the module has
+    no group holding it (the numpy backend)."""
+    group = getattr(module, "GROUP", ())
+    if name not in group:
+        return None
+    kernel, sel, arity = module.group_n, group.index(name), module.GROUP_ARITY
+
+    def many(*arrays):
+        *inputs, out = arrays
+        inputs += [inputs[0]] * (arity - len(inputs))
+        rows, size = out.shape[0], math.prod(out.shape[1:])
+        if out.flags.c_contiguous:
+            kernel(sel, *inputs, out.reshape(rows, size))
+            return
+        flat = np.empty((rows, size))  # not a view of out (a strided array): filled, then copied
+        kernel(sel, *inputs, flat)
+        out[...] = flat.reshape(out.shape)
+
+    return many
 
 
 def _python_kernel(spec: KernelSpec) -> list[str]:
