@@ -74,7 +74,7 @@ class WorstPose:
     rotation_error: float | None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class CalibrationResult:
     """What :func:`calibrate` found.  ``robot`` is the calibrated arm (a :class:`~denavit.DHRobot`)."""
 

@@ -43,7 +43,7 @@ CORRECTION_AXES = (("x", "t", 0), ("y", "t", 1), ("z", "t", 2), ("rx", "r", 0), 
 _X, _Y, _Z = 0, 1, 2
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class Op:
     """One elementary motion: rotation ("r") or translation ("t") along ``axis`` (0, 1, 2 = x, y, z) of the current
     frame by ``value`` + (joint value of ``joint`` when ≥ 0) + (correction ``param`` when ≥ 0); or, with
@@ -71,7 +71,7 @@ class Parameter:
     held: str = ""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class ErrorModel:
     """The arm's elementary motions and unknowns (see the module notes)."""
 

@@ -28,7 +28,7 @@ _TERMS = 3
 _SHOWN = 1e-3
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class Observability:
     """Which unknowns are identified (indices into the candidates), which are held and why."""
 

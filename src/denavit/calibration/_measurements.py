@@ -43,7 +43,7 @@ _QUATERNION = ("qw", "qx", "qy", "qz")
 _SHOWN = 40  # characters of a user's field shown in a message
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class Measurements:
     """The columns of a measurement file, in SI units and radians; ``None`` where a group is absent.
 
