@@ -172,3 +172,28 @@ def test_excite_refuses_bad_arguments():
         excitation_trajectory(robot, qdd_max=0)
     with pytest.raises(denavit.ModelError, match="joint 2"):
         excitation_trajectory(robot, q_limits=[[-1, 1], [0.5, 0.5]])
+
+
+def test_excite_reports_progress_per_start_and_iteration():
+    seen = []
+    res = excitation_trajectory(denavit.load_robot("planar2r"), harmonics=1, starts=2, max_iterations=3, seed=2,
+                                progress=seen.append)
+    starts = [s for s in seen if "iteration" not in s]
+    assert [s.split(":")[0] for s in starts] == ["start 1/2", "start 2/2"]
+    assert float(starts[0].split("cond ")[1]) == pytest.approx(res.cond_initial, rel=1e-3)
+    assert len(seen) - len(starts) == res.iterations  # one line per SLSQP iteration
+
+
+@pytest.mark.parametrize("duration", [4.0, 15.0])
+def test_excite_durations_other_than_a_period(duration):
+    # shorter: the limits are imposed (and hold) on [0, duration] only; longer: the period repeats
+    res = excitation_trajectory(denavit.load_robot("planar2r"), harmonics=2, starts=1, max_iterations=3,
+                                duration=duration, samples=int(duration * 20), seed=4)
+    assert res.t[-1] == pytest.approx(duration - 0.05)
+    t = np.linspace(0.0, min(duration, res.period), 5000)
+    q, qd, qdd = series(res, t)
+    assert np.all(q >= res.q_limits[:, 0] - 1e-12) and np.all(q <= res.q_limits[:, 1] + 1e-12)
+    assert np.all(np.abs(qd) <= res.qd_max + 1e-12) and np.all(np.abs(qdd) <= res.qdd_max + 1e-12)
+    if duration > res.period:
+        later = res.t >= res.period
+        np.testing.assert_allclose(res.q[later], res.q[: later.sum()], atol=1e-9)
