@@ -166,3 +166,19 @@ def test_write_then_read_round_trip(tmp_path_factory, data):
     np.testing.assert_allclose(m.quaternion, quat, rtol=0, atol=1e-15)
     assert m.notes and "'note'" in m.notes[0]
     np.testing.assert_array_equal(m.lines, np.arange(len(q)) + 4)  # two comment lines and the header first
+
+
+@settings(max_examples=15 if REDUCED else 60)
+@given(st.lists(st.text(alphabet=st.sampled_from(list("q1234567xyzwtau,.-+e#\"' \t\r\x00\u2028nfi")), max_size=40),
+                max_size=6),
+       st.binary(max_size=20))
+def test_any_text_is_read_or_refused_with_one_line(tmp_path_factory, lines, tail):
+    """Random header and rows (and random bytes at the end): a Measurements or one ParseError line, nothing else."""
+    path = tmp_path_factory.mktemp("hostile") / "m.csv"
+    path.write_bytes(("\n".join([HEADER6 + ",x,y,z", *lines]) + "\n").encode("utf-8") + tail)
+    try:
+        m = read_measurements(path, PUMA)
+    except ParseError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith(str(path))
+    else:
+        assert m.q.shape[1] == 6 and np.all(np.isfinite(m.q)) and np.all(np.isfinite(m.position))
