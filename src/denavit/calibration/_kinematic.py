@@ -312,13 +312,16 @@ def calibrate(robot: DHRobot, q, measured, kind: str = "pose", *, noise: tuple[f
     robust : {"huber", "cauchy", "none"}
         Robust loss, with ``robust_scale`` its scale k in noise units.
     holdout : float
-        Fraction of the measurements left out of the fit (chosen by ``seed``) to validate the calibrated model.
+        Fraction of the measurements left out of the fit to validate the calibrated model; ``seed`` chooses them
+        (a permutation by ``numpy.random.default_rng(seed)``, the last ``1 - holdout`` of it fitted).
     labels : array_like of int, optional
         A label per measurement (file lines) for the worst-pose report; 1-based indices otherwise.
     parallel_tolerance : float
         Consecutive joint axes within this angle of parallel get a Hayati β [rad].
     rank_tol : float
         Identifiability threshold (see :mod:`denavit.calibration._kinematic_observe`).
+    max_iterations : int
+        Levenberg–Marquardt iterations at most (per pass; ``converged`` says whether it stopped earlier).
 
     Returns
     -------
