@@ -31,6 +31,7 @@ from .calibration import CalibrationResult, calibrate
 from .numeric import acceleration_bias, jacobian_dot, kinematic_hessian
 from .numeric import coriolis_vector, friction_torques, kinetic_energy, mass_matrix_derivatives, potential_energy
 from .calibration import excitation_trajectory
+from .calibration import Identification, identify
 
 __version__ = "0.1.0"
 
@@ -106,5 +107,7 @@ __all__ = [
     "calibrate",
     "CalibrationResult",
     "excitation_trajectory",
+    "identify",
+    "Identification",
     "__version__",
 ]
