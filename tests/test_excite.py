@@ -176,7 +176,7 @@ def test_excite_refuses_bad_arguments():
 
 def test_excite_reports_progress_per_start_and_iteration():
     seen = []
-    res = excitation_trajectory(denavit.load_robot("planar2r"), harmonics=1, starts=2, max_iterations=3, seed=2,
+    res = excitation_trajectory(denavit.load_robot("planar2r"), harmonics=2, starts=2, max_iterations=3, seed=2,
                                 progress=seen.append)
     starts = [s for s in seen if "iteration" not in s]
     assert [s.split(":")[0] for s in starts] == ["start 1/2", "start 2/2"]

@@ -56,6 +56,7 @@ FD_STEP = 1e-6  # step of the regressor's differences in q and q̇ [rad, rad/s]
 GRID_PER_HARMONIC = 8  # constraint instants per period and harmonic (ω_H h = 2π/8 between them)
 ACTIVE_TOL = 1e-3  # a limit counts as active when used to within this fraction
 TINY = 1e-300
+RANK_TOL = 1e-10  # relative singular-value threshold of the reported rank
 FEASIBLE_TOL = 1e-3  # an SLSQP iterate counts as within the limits to this fraction of each
 
 
@@ -77,11 +78,13 @@ class ExcitationTrajectory:
     q, qd, qdd : ndarray, shape (k, n)
         The series and its exact derivatives at ``t``.
     cond_initial, cond : float
-        cond(W_b) at ``instants`` of the first start's random trajectory and of the result.
+        cond(W_b) = σ_max/σ_min (SVD) at ``instants`` of the first start's random trajectory and of the result;
+        inf when σ_min = 0.
     instants : ndarray, shape (m,)
         Where the regressor is stacked for the condition number.
     rank, n_base : int
-        Rank of W_b at ``instants`` (tolerance 1e-10 relative) and the number of base parameters.
+        Rank of W_b at ``instants`` (singular values above RANK_TOL = 1e-10 of the largest) and the number of base
+        parameters: rank < n_base says the trajectory leaves some base parameters unidentifiable.
     q_limits : ndarray, shape (n, 2)
         The position window used (the robot's limits shrunk by the margin).
     qd_max, qdd_max : ndarray, shape (n,)
@@ -289,7 +292,7 @@ def excitation_trajectory(robot: DHRobot, *, harmonics: int = 5, base_freq: floa
     for start in range(starts):
         x0 = feasible_start(rng, grid, H, w, window, qd_lim, qdd_lim)
         f0 = problem.log_cond(x0)
-        first = f0 if first is None else first
+        first = x0 if first is None else first
         if progress is not None:
             progress(f"start {start + 1}/{starts}: cond {np.exp(f0):.4g}")
         nit, message, x = _solve(problem, x0, (C, d, window.mean(axis=1) if center else None), max_iterations,
@@ -333,7 +336,7 @@ def _solve(problem: _Problem, x0, constraints, max_iterations: int, progress, la
 
 def _result(robot, problem, best, first, limits, base_freq, duration, samples, span, iterations, starts):
     window, qd_lim, qdd_lim = limits
-    f, x, message = best
+    _, x, message = best
     n, H = robot.dof, problem.H
     X = x.reshape(n, 2 * H + 1)
     t = np.arange(samples) * (duration / samples)
@@ -343,14 +346,20 @@ def _result(robot, problem, best, first, limits, base_freq, duration, samples, s
     mid, half = window.mean(axis=1), (window[:, 1] - window[:, 0]) / 2
     usage = np.column_stack([np.abs(fq - mid).max(axis=0) / half, np.abs(fqd).max(axis=0) / qd_lim,
                              np.abs(fqdd).max(axis=0) / qdd_lim])
-    W = base_regressor(robot, *problem.states(x), problem.base, threads=1).reshape(-1, problem.base.rank)
-    lam = np.linalg.eigvalsh(_gram(W))
-    rank = int(np.sum(lam > 1e-20 * lam[-1]))  # σ > 1e-10 σ_max
+    (cond0, _), (cond, rank) = (_cond_rank(problem, v) for v in (first, x))
     return ExcitationTrajectory(robot.name, float(base_freq), X[:, 0].copy(), X[:, 1:H + 1].copy(),
-                                X[:, H + 1:].copy(), t, q, qd, qdd, float(np.exp(first)), float(np.exp(f)),
+                                X[:, H + 1:].copy(), t, q, qd, qdd, cond0, cond,
                                 problem.instants, rank, problem.base.rank, window,
                                 qd_lim, qdd_lim, usage, usage >= 1 - ACTIVE_TOL, iterations, problem.evaluations,
                                 starts, message)
+
+
+def _cond_rank(problem: _Problem, x) -> tuple[float, int]:
+    """cond(W_b) = σ_max/σ_min by SVD (inf when σ_min = 0; the optimiser's Gram matrix squares it and floors it)
+    and the rank: the σ > RANK_TOL σ_max."""
+    W = base_regressor(problem.robot, *problem.states(x), problem.base, threads=1).reshape(-1, problem.base.rank)
+    s = np.linalg.svd(W, compute_uv=False)
+    return (float(s[0] / s[-1]) if s[-1] > 0 else float("inf")), int(np.sum(s > RANK_TOL * s[0]))
 
 
 def _whole(value, name: str, lo: int, hi: int) -> int:

@@ -139,6 +139,10 @@ def _report(args, robot, res, scale):
         lines.append(f"  {j + 1:<5}  [{number_text(lo):>10}, {number_text(hi):>10}]  {use[0]}  "
                      f"{number_text(res.qd_max[j] * scale[j]):>9}  {use[1]}  {number_text(res.qdd_max[j] * scale[j]):>9}"
                      f"  {use[2]}")
+    if res.rank < res.n_base:
+        lines.append(f"the trajectory excites only {res.rank} of the {res.n_base} base parameters: the others cannot "
+                     "be identified from it (a longer --period, higher --qd-max or --qdd-max, more --iterations or "
+                     "--starts)")
     lines.append("a periodic series: q and its rates join smoothly from one period to the next, but the motion "
                  "does not start or end at rest (qd(0) is not 0): ramp in from rest on a real arm")
     data = {"robot": robot.name, "output": args.output, "harmonics": res.harmonics, "base_freq": res.base_freq,
