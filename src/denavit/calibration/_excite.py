@@ -60,7 +60,7 @@ RANK_TOL = 1e-10  # relative singular-value threshold of the reported rank
 FEASIBLE_TOL = 1e-3  # an SLSQP iterate counts as within the limits to this fraction of each
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class ExcitationTrajectory:
     """A designed excitation trajectory (data only; :func:`excitation_trajectory` makes it).
 
