@@ -7,6 +7,7 @@ writes by hand: cos(q2 + q3), not cos q2 cos q3 − sin q2 sin q3), and ``"full"
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Callable
 
 import sympy as sp
@@ -87,7 +88,19 @@ def shorthand(e: sp.Expr, q, style: str = "C", collapse: bool = True) -> sp.Expr
     >>> shorthand(sp.cos(q1) * sp.cos(q2) - sp.sin(q1) * sp.sin(q2) + sp.sin(q2), joint_symbols(2))
     C12 + S2
     """
-    qs = {s: i + 1 for i, s in enumerate(_joint_variables(q))}
+    qs = _joint_variables(q)
+    try:
+        hash(e)
+    except TypeError:  # not a sympy expression: the same work, not remembered
+        return _shorthand.__wrapped__(e, qs, style, collapse)
+    return _shorthand(e, qs, style, collapse)
+
+
+@lru_cache(maxsize=4096)
+def _shorthand(e: sp.Expr, q: tuple[sp.Symbol, ...], style: str, collapse: bool) -> sp.Expr:
+    """:func:`shorthand` of a hashable ``e``, remembered: a pure function of its arguments, and its TR10i pass
+    costs seconds on a 6-joint arm's force propagation, which every report of that arm shows again."""
+    qs = {s: i + 1 for i, s in enumerate(q)}
     if collapse and isinstance(e, sp.Basic) and e.has(sp.sin, sp.cos):
         terms = sp.Add.make_args(sp.expand(e))
         if any(isinstance(t, sp.Mul) and len(t.atoms(sp.sin, sp.cos)) > 1 for t in terms) and not (
