@@ -10,7 +10,7 @@ coriolis (and the derivative kernels where the compiled object has them):
   call    ``fast.<op>(q, …, threads=t)``: the whole call, a fresh (B, …) output each time (its pages are first
           touched by the kernel, in the threads)
   out=    ``fast.<op>(q, …, threads=t, out=o)``: the whole call into the caller's output, reused across calls
-          (every op but FD)
+          (every op but FD), with its own ``CPU t/1``
   kernel  ``denavit._threads.run_batch`` of the batch kernel into one output reused across calls: the kernel's
           own throughput, without the page faults of a fresh output
 IK (LM): ``fast.solve_ik(T, threads=t)`` on ``--ik-targets`` targets (FK of random q inside the limits, no seeds).
@@ -104,7 +104,7 @@ def _compiled_rows(robot, threads, rows, repeat, ik_targets):
         reuse = None
         if op in OPS and op != "forward_dynamics":
             o = np.empty_like(calls[0]())  # its pages touched once, here
-            reuse = _times([lambda t=t, m=method, a=args, o=o: m(*a, threads=t, out=o) for t in threads], repeat)[0]
+            reuse = _times([lambda t=t, m=method, a=args, o=o: m(*a, threads=t, out=o) for t in threads], repeat)
         out.append((op, call, kernel, reuse))
     if ik_targets:  # numeric IK on targets made by FK of q inside the limits, no seeds (restarts drawn)
         lim = robot.q_limits
@@ -134,17 +134,19 @@ def _table(title, rows, threads, batch):
     ratio = " | ".join(f"1/{t}" for t in threads[1:])
     cpu = " | ".join(f"CPU {t}/1" for t in threads[1:])
     print(f"\n{title}, batch {batch:,}\n")
-    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | {cpu} | out= {ratio} | kernel {ratio} |")
-    print("|---" * (2 + len(threads) + 4 * (len(threads) - 1)) + "|")
+    print(f"| op | {head} | 1 thr [M rows/s] | call {ratio} | {cpu} | out= {ratio} | out= {cpu} | kernel {ratio} |")
+    print("|---" * (2 + len(threads) + 5 * (len(threads) - 1)) + "|")
     for op, (call, cpu_s), kernel, reuse, *count in rows:
         times = " | ".join(f"{1e3 * c:.1f}" for c in call)
         n = count[0] if count else batch
         rc = " | ".join(f"{call[0] / c:.2f}" for c in call[1:])
         rp = " | ".join(f"{c / cpu_s[0]:.2f}" for c in cpu_s[1:])
         rk = " | ".join(f"{kernel[0] / k:.2f}" for k in kernel[1:]) if kernel else " | ".join("–" for _ in call[1:])
-        ro = " | ".join(f"{reuse[0] / k:.2f}" for k in reuse[1:]) if reuse else " | ".join("–" for _ in call[1:])
+        dash = " | ".join("–" for _ in call[1:])
+        ro = " | ".join(f"{reuse[0][0] / k:.2f}" for k in reuse[0][1:]) if reuse else dash
+        ru = " | ".join(f"{k / reuse[1][0]:.2f}" for k in reuse[1][1:]) if reuse else dash
         label = f"{LABEL[op]}{'' if n == batch else f' ({n:,})'}"
-        print(f"| {label} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {ro} | {rk} |")
+        print(f"| {label} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {ro} | {ru} | {rk} |")
 
 
 def main(argv=None) -> None:
