@@ -144,3 +144,21 @@ def test_singular_mass_matrix_raises_through_the_builtin():
     for _ in range(3):
         with pytest.raises(ModelError, match="singular"):
             fast.forward_dynamics_derivatives(np.zeros(2), np.zeros(2), np.ones(2))
+
+
+@pytest.mark.parametrize("shape", [(), (2, 3)])
+def test_out_on_the_one_array_calls(arm, rng, shape):
+    """gravity_derivatives, jacobian_dot (both frames), acceleration_bias, kinematic_hessian and regressor write into
+    ``out=`` and return it; the values are those of the call without it; a wrong out is one ShapeError."""
+    _, fast = arm
+    q, qd, qdd = rng.uniform(-2, 2, (3,) + shape + (3,))
+    for name, args, kw in (("gravity_derivatives", (q,), {}), ("jacobian_dot", (q, qd), {}),
+                           ("jacobian_dot", (q, qd), {"frame": "tool"}), ("acceleration_bias", (q, qd), {}),
+                           ("kinematic_hessian", (q,), {}), ("regressor", (q, qd, qdd), {})):
+        call = getattr(fast, name)
+        want = call(*args, **kw)
+        out = np.full(want.shape, np.nan)
+        assert call(*args, **kw, out=out) is out, name
+        np.testing.assert_array_equal(out, want)
+        with pytest.raises(ShapeError, match=r"^out: expected a writeable C-contiguous float64 array of shape"):
+            call(*args, **kw, out=np.zeros(want.shape + (1,)))

@@ -53,12 +53,13 @@ class DynDerivativeMethods:
         D = r[:-1].reshape(3, n, n)
         return D[0], D[1], D[2]
 
-    def gravity_derivatives(self, q, *, threads=None):
-        """∂g/∂q, (..., n, n) (as :func:`denavit.gravity_derivatives` with the robot's gravity)."""
+    def gravity_derivatives(self, q, *, threads=None, out=None):
+        """∂g/∂q, (..., n, n) (as :func:`denavit.gravity_derivatives` with the robot's gravity); ``out=`` the
+        caller's array to write and return (as the compiled object's other one-array calls)."""
         kernel = self.__dict__.get("_gravity_derivatives_1")
-        if (kernel is not None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
+        if (out is None and kernel is not None and q.__class__ is _ndarray and q.dtype is _F64 and q.shape == self._vec
                 and q.strides == _STRIDE):
-            out = _empty(self._mshape)
-            kernel(q, out)
-            return out
-        return self._call("gravity_derivatives", (q,), ("q",), threads)
+            res = _empty(self._mshape)
+            kernel(q, res)
+            return res
+        return self._call("gravity_derivatives", (q,), ("q",), threads, out)
