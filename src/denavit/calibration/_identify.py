@@ -27,7 +27,7 @@ from .._validate import as_joint_array
 from ..model import DHRobot
 from ..numeric import BaseParameters, base_parameters, base_regressor
 
-__all__ = ["Identification", "identify", "RANK_TOL", "NULL_TOL", "METHODS"]
+__all__ = ["METHODS", "NULL_TOL", "RANK_TOL", "Identification", "identify"]
 
 #: Relative singular-value threshold of the stacked, column-scaled base regressor: below it, a direction of π_b
 #: is not seen by the data (the singular values come from the Gram matrix: float64 resolves them to ~1e-8).
@@ -118,7 +118,8 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     qd, qdd : array_like, shape (N, n), optional
         Joint rates and accelerations; when both are omitted they are estimated from ``q`` and ``t`` by the
         zero-phase filter of :func:`~denavit.calibration._identify_filter.differentiate` (Butterworth low-pass run
-        forwards and backwards, then central differences) — and the SAME filter is applied to ``tau``.
+        forwards and backwards, then central differences) — and the SAME filter is applied to ``tau`` and to every
+        column of the regressor (parallel filtering); the first and last samples are dropped.
     tau : array_like, shape (N, n)
         Measured joint torques [N m] (forces [N] for prismatic joints).
     t : array_like, shape (N,), optional
@@ -140,19 +141,13 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     q, qd, qdd, tau, filtered = _inputs(robot, q, qd, qdd, tau, t, filter)
     base = base_parameters(robot, friction=friction, motor_inertia=motor_inertia)
-    N, n = q.shape
-    W = base_regressor(robot, q, qd, qdd, base, threads=threads).reshape(N * n, base.rank)  # (N n, r)
-    y = tau.reshape(N * n)
-    sol = _least_squares(W, y, np.ones(N * n))
-    residual = (y - W @ sol.x).reshape(N, n)
-    noise = _joint_noise(residual, W.reshape(N, n, -1), sol.ident)
-    if method == "wls":
-        sol = _least_squares(W, y, np.tile(1.0 / noise, N))
-        residual = (y - W @ sol.x).reshape(N, n)
-        s2 = 1.0
-    else:
-        s2 = float(residual.ravel() @ residual.ravel()) / max(N * n - sol.rank, 1)
-    cov, info = sol.cov * s2, sol.info / s2
+    W = base_regressor(robot, q, qd, qdd, base, threads=threads)  # (N, n, r)
+    if filtered is not None:  # the same filter on τ and on every column of W; the ends dropped
+        smooth, keep, filtered = filtered
+        W, tau = smooth(W)[keep], smooth(tau)[keep]
+    N, n = tau.shape
+    W = W.reshape(N * n, base.rank)  # (N n, r)
+    sol, residual, noise, cov, info = _fit(W, tau.reshape(N * n), N, n, method)
     est, std, cov = _mask(sol.x, cov, sol.ident)
     with np.errstate(divide="ignore", invalid="ignore"):
         rel = 100.0 * std / np.abs(est)
@@ -168,9 +163,24 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     return result
 
 
+def _fit(W: np.ndarray, y: np.ndarray, N: int, n: int, method: str):
+    """OLS, then (``wls``) the rows of joint j weighted by 1/σ_j of the OLS residuals: (solution, residual (N, n),
+    σ_j, Cov, information) — module notes."""
+    sol = _least_squares(W, y, np.ones(N * n))
+    residual = (y - W @ sol.x).reshape(N, n)
+    noise = _joint_noise(residual, W.reshape(N, n, -1), sol.ident)
+    if method == "wls":
+        sol = _least_squares(W, y, np.tile(1.0 / noise, N))
+        residual = (y - W @ sol.x).reshape(N, n)
+        s2 = 1.0
+    else:
+        s2 = float(residual.ravel() @ residual.ravel()) / max(N * n - sol.rank, 1)
+    return sol, residual, noise, sol.cov * s2, sol.info / s2
+
+
 def _inputs(robot, q, qd, qdd, tau, t, cutoff):
-    """Checked (N, n) arrays q, q̇, q̈, τ (q̇, q̈ and a filtered τ from the filter when not given) and the filter's
-    description (None when not used)."""
+    """Checked (N, n) arrays q, q̇, q̈, τ (q̇, q̈ from the filter when not given) and the filter as (smooth, kept
+    samples, description), or None when not used."""
     n = robot.dof
     q = as_joint_array(q, n, "q")
     if tau is None:
@@ -185,8 +195,8 @@ def _inputs(robot, q, qd, qdd, tau, t, cutoff):
             raise ValueError("qd and qdd not given: the sample times t are needed to estimate them from q")
         from ._identify_filter import differentiate
 
-        q, qd, qdd, tau, _, text = differentiate(t, q, tau, cutoff)
-        return q, qd, qdd, tau, text
+        q, qd, qdd, smooth, keep, text = differentiate(t, q, cutoff)
+        return q, qd, qdd, tau, (smooth, keep, text)
     if cutoff is not None:
         raise ValueError("filter= applies only when qd and qdd are estimated from q and t (none was given)")
     qd, qdd = as_joint_array(qd, n, "qd"), as_joint_array(qdd, n, "qdd")

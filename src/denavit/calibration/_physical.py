@@ -34,16 +34,26 @@ from ..chain import chain_of
 from ..model import DHRobot, LinkInertia
 from ..numeric import dynamics_plan, inertial_parameters
 
-__all__ = ["PhysicalEstimate", "physical_parameters", "robot_with_parameters", "pseudo_inertia",
-           "PRIOR_WEIGHT", "REALISABLE_TOL"]
+__all__ = [
+    "PRIOR_WEIGHT",
+    "REALISABLE_TOL",
+    "PhysicalEstimate",
+    "physical_parameters",
+    "pseudo_inertia",
+    "robot_with_parameters",
+]
 
 #: Weight λ of the pull toward the robot's own parameters, against the data's χ² (one unit per σ²).
-PRIOR_WEIGHT = 1e-2
+PRIOR_WEIGHT = 1e-4
 #: The unconstrained estimate counts as realisable when the consistent fit is within this Mahalanobis distance.
 REALISABLE_TOL = 0.1
 #: Smallest eigenvalue of a body's normalised pseudo-inertia in the prior (and the start): a catalogue body on the
 #: boundary (a massless link, a thin rod) is moved inside, so the prior never pulls toward the boundary.
 PRIOR_FLOOR = 1e-2
+#: Largest ratio of the data term's curvature to the prior's in the fit (in u = π / s): above it the data term is
+#: scaled down to it (its minimiser is unchanged where the estimate is realisable; the distance reported is
+#: always in the identification's own σ).
+MAX_RATIO = 1e14
 #: Barrier method: factor of t per round, duality-gap target (σ² units of the data term), Newton decrement
 #: target and bound on the Newton steps.
 MU = 20.0
@@ -151,6 +161,9 @@ def physical_parameters(robot: DHRobot, identification, *, prior_weight: float =
     w, Q = np.linalg.eigh(identification.information)
     R = np.sqrt(np.clip(w, 0.0, None))[:, None] * Q.T  # F = Rᵀ R
     K, xhat, lam = base.combination, identification.solution, np.sqrt(prior_weight)
+    data = np.linalg.norm(R @ K * scale, 2) ** 2 / prior_weight  # data's curvature over the prior's (u = π / s)
+    if data > MAX_RATIO:  # nearly noise-free data: the Newton system would be singular in float64
+        R = R * np.sqrt(MAX_RATIO / data)
     M = np.vstack([R @ K, lam * np.diag(1.0 / scale)]) * scale  # residual M u − c in u = π / s
     c = np.concatenate([R @ xhat, lam * nominal / scale])
     u, steps, success = _barrier(M, c, nominal / scale, scale, n, max_newton)
@@ -189,7 +202,7 @@ def _barrier(M, c, u0, scale, n: int, max_newton: int):
         while steps < max_newton:
             g, H = _barrier_terms(u, A, n)
             grad = t * 2 * M.T @ (M @ u - c) + g
-            du = -np.linalg.solve(t * H_f + H, grad)
+            du = _newton_step(t * H_f + H, grad)
             steps += 1
             dec = -float(grad @ du)
             if dec / 2 <= NEWTON_TOL:
@@ -198,6 +211,19 @@ def _barrier(M, c, u0, scale, n: int, max_newton: int):
         if m_c / t < GAP or steps >= max_newton:
             return u, steps, steps < max_newton
         t *= MU
+
+
+def _newton_step(A: np.ndarray, grad: np.ndarray) -> np.ndarray:
+    """−A⁻¹ grad, A symmetric positive (semi)definite, solved with Jacobi scaling D⁻¹ A D⁻¹ (the data and the
+    barrier weigh the variables on very different scales), by Cholesky, or least squares where that fails."""
+    d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+    As = A / np.outer(d, d)
+    try:
+        L = np.linalg.cholesky(As)
+        y = np.linalg.solve(L.T, np.linalg.solve(L, grad / d))
+    except np.linalg.LinAlgError:
+        y = np.linalg.lstsq(As, grad / d, rcond=None)[0]
+    return -y / d
 
 
 def _barrier_terms(u, A, n: int):

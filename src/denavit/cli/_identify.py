@@ -73,11 +73,11 @@ def _robot_text(result, args) -> str:
         return dump_robot(robot, "json")
     ph = result.physical
     head = source_comments(args.robot) + [
-        f"# Inertia, friction and motor inertia identified by denavit identify from {visible(args.file)}: "
-        f"{result.samples} samples, {result.method.upper()}, {result.rank} of {len(result.names)} base parameters "
-        "identified; a physically consistent full set" + ("" if ph.realisable else
-                                                          f" (the estimate itself was not realisable: "
-                                                          f"distance {ph.distance:.3g} sigma)"),
+        (f"# Inertia, friction and motor inertia identified by denavit identify from {visible(args.file)}: "
+         f"{result.samples} samples, {result.method.upper()}, {result.rank} of {len(result.names)} base parameters "
+         "identified; a physically consistent full set" + ("" if ph.realisable else
+                                                           f" (the estimate itself was not realisable: "
+                                                           f"distance {ph.distance:.3g} sigma)")),
         "# Fixed rows after a joint lost their own inertia (merged into the joint's row); names and limits kept."]
     return "\n".join(head) + "\n" + dump_robot(robot)
 
@@ -94,10 +94,10 @@ def _verdict(result) -> str:
 
 
 def _text(result, robot, args, notes) -> str:
-    lines = [f"{robot.name}: dynamic identification from {args.file} ({result.samples} samples, "
-             f"{result.method.upper()})",
-             f"{len(result.names)} base parameters, rank of the data {result.rank}, condition number of the "
-             f"stacked base regressor {number_text(result.condition_number, 4)}"]
+    lines = [(f"{robot.name}: dynamic identification from {args.file} ({result.samples} samples, "
+              f"{result.method.upper()})"),
+             (f"{len(result.names)} base parameters, rank of the data {result.rank}, condition number of the "
+              f"stacked base regressor {number_text(result.condition_number, 4)}")]
     lines += [f"note: {n}" for n in notes]
     if result.filter:
         lines.append(f"qd, qdd: {result.filter}")
