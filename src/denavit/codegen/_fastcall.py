@@ -223,10 +223,9 @@ def _checked_arrays(e: _Emitter, argv, nargs, kwnames, lengths: tuple) -> list:
 def entry_intrinsic(lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: tuple, outputs: tuple,
                     flagged: bool = False):
     """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the program
-    and the result (see the module's docstring).  The kernel's outputs (shape ``kernel_shape``, C order) fill the
-    result ``blocks`` (shapes) in turn: one block is returned as an array, several as a tuple of arrays.
-    ``flagged``: the output after the blocks is a flag that must be > 0 (forward dynamics: M regular); a call whose
-    flag is not > 0 releases its result and goes to the Python method (which raises the error)."""
+    and the result (module docstring).  The kernel's outputs (``kernel_shape``, C order) fill the result ``blocks``
+    in turn: one block is returned as an array, several as a tuple.  ``flagged``: the output after the blocks must
+    be > 0 (forward dynamics: M regular), else the result is released and the Python method called (it raises)."""
     from llvmlite import ir
     from numba.core import types
     from numba.extending import intrinsic
