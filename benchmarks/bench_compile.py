@@ -1,6 +1,7 @@
 """Generated kernels (denavit.compile) against Pinocchio and roboticstoolbox, in one run.
 
 Run:  python benchmarks/bench_compile.py [--batch 200000] [--repeat 7] [--number 5000]
+      python benchmarks/bench_compile.py --cold 3     (only the cold compile's CPU time, three fresh processes per arm)
 Prints Markdown tables: single calls (µs, ratio to Pinocchio), batched throughput on one core (configurations/s),
 and compile times (cold: an empty cache; warm: a new process reading the cache).  Every library is first checked
 to agree with denavit on the numbers it is timed on.
@@ -206,6 +207,31 @@ print(json.dumps([[b[0] - a[0], b[1] - a[1]] for a, b in zip(marks, marks[1:])])
 """
 
 
+COLD_ONLY = """
+import json, time
+import numba  # numba's import is not part of the compile time (numba's start-up on the first kernel call is)
+import denavit
+robot = denavit.load_robot({name!r})
+t = time.process_time()
+fast = denavit.compile(robot)
+fast.warm()  # every base kernel: its single call (the built-in where it has one) and its batch form
+print(json.dumps(time.process_time() - t))
+"""
+
+
+def cold_rows(name: str, runs: int):
+    """CPU seconds of ``compile(robot)`` + ``warm()`` in a fresh process on an empty cache folder, ``runs`` times."""
+    import json
+
+    times = []
+    for _ in range(runs):
+        with tempfile.TemporaryDirectory() as cache:
+            env = {**os.environ, "DENAVIT_CACHE_DIR": cache}
+            times.append(json.loads(subprocess.run([sys.executable, "-c", COLD_ONLY.format(name=name)], env=env,
+                                                   capture_output=True, text=True, check=True).stdout))
+    return name, times
+
+
 def compile_rows(name: str):
     """Two fresh processes on an empty cache folder: the first compiles (cold), the second loads.  Each stage as
     (wall, CPU) seconds: compile(), the first kernel call, a second kernel's first call, warm() of the rest."""
@@ -227,7 +253,17 @@ def main() -> None:
     ap.add_argument("--targets", type=int, default=1000, help="IK targets per arm")
     ap.add_argument("--parts", default="single,batch,ik,analytic,compile",
                     help="comma-separated tables to run (default all): single, batch, ik, analytic, compile")
+    ap.add_argument("--cold", type=int, default=0, metavar="RUNS",
+                    help="only the cold compile: CPU time of compile() + warm() on an empty cache, RUNS fresh processes "
+                         "per arm (CPU time: it holds on a loaded machine where wall time does not)")
     args = ap.parse_args()
+    if args.cold:
+        print(f"load average {os.getloadavg()[0]:.1f}\n")
+        print("| robot | cold compile() + warm(), CPU [s] per run | min–max |\n|---|---|---|")
+        for name in ROBOTS:
+            r, times = cold_rows(name, args.cold)
+            print(f"| {r} | {', '.join(f'{t:.2f}' for t in times)} | {min(times):.2f}–{max(times):.2f} |")
+        return
     parts = set(args.parts.split(","))
     import numba
     import pinocchio as pin

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ._kernels import KernelSpec
 from ._llvm import LANES
 
@@ -142,8 +140,8 @@ def _numba_group(specs: dict[str, KernelSpec]) -> list[str]:
 
 def group_batch(module, name: str):
     """Kernel ``name`` of a generated module's ``group_n`` as ``f(*inputs, out)``, the form of ``<name>_n``: inputs
-    (B, k) (missing ones filled with the first), ``out`` (B,) + shape seen as (B, size); None when the module has
-    no group holding it (the numpy backend)."""
+    (B, k) (missing ones filled with the first), ``out`` (B,) + shape, C-contiguous (a fresh array or a checked
+    ``out=``), seen as (B, size); None when the module has no group holding it (the numpy backend)."""
     group = getattr(module, "GROUP", ())
     if name not in group:
         return None
@@ -151,14 +149,13 @@ def group_batch(module, name: str):
 
     def many(*arrays):
         *inputs, out = arrays
+        inputs = [x.view() for x in inputs]
+        for x in inputs:  # read-only, as broadcast inputs are: one signature (numba types mutability) for all
+            x.flags.writeable = False
         inputs += [inputs[0]] * (arity - len(inputs))
-        rows, size = out.shape[0], math.prod(out.shape[1:])
-        if out.flags.c_contiguous:
-            kernel(sel, *inputs, out.reshape(rows, size))
-            return
-        flat = np.empty((rows, size))  # not a view of out (a strided array): filled, then copied
+        flat = out.view()
+        flat.shape = (out.shape[0], math.prod(out.shape[1:]))  # raises rather than copy: out is C-contiguous
         kernel(sel, *inputs, flat)
-        out[...] = flat.reshape(out.shape)
 
     return many
 

@@ -1,0 +1,64 @@
+"""What a cold compile builds: the batch forms of a generated module in one numba function, and the single call of a
+kernel with a built-in answered by the built-in (its own njit function compiled only when a call needs it).
+
+Counts of compiled overloads, not times: the point is which programs get compiled.  Results are checked against the
+plain numpy functions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit.codegen import numba_available
+
+pytestmark = pytest.mark.skipif(not numba_available(), reason="numba not installed")
+
+
+@pytest.fixture
+def fresh(tmp_path, monkeypatch):
+    """A planar 2R arm nobody else compiles (its own gravity: its own generated module), on an empty cache."""
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path / "kernels"))
+    robot = replace(denavit.load_robot("planar2r"), gravity=(0.3, -9.7, 0.1))
+    return robot, denavit.compile(robot)
+
+
+def overloads(dispatcher) -> int:
+    return len(dispatcher.overloads)
+
+
+def test_single_calls_go_through_the_builtin_without_the_njit_single(fresh, rng):
+    robot, fast = fresh
+    q, qd, qdd = (rng.uniform(-1, 1, 2) for _ in range(3))
+    np.testing.assert_allclose(fast.fk(q), denavit.forward_kinematics(robot, q), atol=1e-12)
+    np.testing.assert_allclose(fast.rnea(q, qd, qdd), denavit.rnea(robot, q, qd, qdd), atol=1e-12)
+    tau = denavit.rnea(robot, q, qd, qdd)
+    np.testing.assert_allclose(fast.forward_dynamics(q, qd, tau), qdd, atol=1e-9)
+    assert type(fast.fk).__name__ == "builtin_function_or_method"
+    m = fast._m
+    assert (overloads(m.fk_1), overloads(m.rnea_1), overloads(m.forward_dynamics_1)) == (0, 0, 0)
+    # a call the built-in hands back (a keyword) compiles the kernel's own single form, once, and is right
+    np.testing.assert_allclose(fast.fk(q, frames=False), denavit.forward_kinematics(robot, q), atol=1e-12)
+    np.testing.assert_allclose(fast.fk(list(q)), denavit.forward_kinematics(robot, q), atol=1e-12)
+    assert overloads(m.fk_1) == 1
+
+
+def test_batches_of_every_kernel_share_one_compiled_function(fresh, rng):
+    robot, fast = fresh
+    seconds = fast.warm()
+    assert set(seconds) == set(fast.kernels)
+    m = fast._m
+    assert overloads(m.group_n) == 1
+    assert all(overloads(getattr(m, f"{k}_n")) == 0 for k in fast.kernels)
+    Q, QD, QDD = (rng.uniform(-1, 1, (5, 2)) for _ in range(3))
+    np.testing.assert_allclose(fast.fk(Q), denavit.forward_kinematics(robot, Q), atol=1e-12)
+    np.testing.assert_allclose(fast.fk(Q, frames=True), denavit.link_transforms(robot, Q), atol=1e-12)
+    np.testing.assert_allclose(fast.jacobian(Q, "tool"), denavit.geometric_jacobian(robot, Q, frame="tool"),
+                               atol=1e-12)
+    np.testing.assert_allclose(fast.rnea(Q, QD, QDD), denavit.rnea(robot, Q, QD, QDD), atol=1e-12)
+    np.testing.assert_allclose(fast.coriolis(Q, QD), denavit.coriolis_vector(robot, Q, QD), atol=1e-12)
+    np.testing.assert_allclose(fast.mass_matrix(Q), denavit.mass_matrix(robot, Q), atol=1e-12)
+    assert overloads(m.group_n) == 1
