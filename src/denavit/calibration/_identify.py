@@ -7,7 +7,8 @@ y = W π_b + ε, W = [Y_b(1); …; Y_b(N)] (N·n × r), solved by least squares 
 
 - OLS: π̂ = W⁺ y, one noise level σ² = ‖y − W π̂‖² / (N·n − r), Cov(π̂) = σ² (WᵀW)⁻¹;
 - WLS (Gautier & Poignet 2001): σ_j² = ‖ρ_j‖² / (N − r_j) per joint j from the OLS residuals ρ_j (r_j: the base
-  parameters reaching joint j), each row of joint j divided by σ_j, then OLS again: Cov(π̂) = (Wᵀ Σ⁻¹ W)⁻¹.
+  parameters reaching joint j), each row of joint j divided by σ_j, then OLS again: Cov(π̂) = (Wᵀ Σ⁻¹ W)⁻¹; σ_j
+  re-estimated once from these residuals and the fit repeated (:data:`WLS_PASSES`).
 
 Observability is that of the data, not only of the structure: W's columns are scaled to unit norm and the rank
 is the number of singular values above :data:`RANK_TOL` × the largest.  A base parameter is *identifiable from
@@ -38,6 +39,9 @@ BLOCK = 4096
 #: basis) is below NULL_TOL.
 NULL_TOL = 1e-6
 METHODS = ("ols", "wls")
+#: WLS fits: σ_j from the OLS residuals, then once more from the first WLS's (OLS misfits the joints of small
+#: torques, whose σ_j it overestimates).
+WLS_PASSES = 2
 
 
 @dataclass(frozen=True)
@@ -60,7 +64,7 @@ class Identification:
     unidentifiable : tuple of str
         Base parameters these data cannot determine (no number is given for them).
     noise : ndarray, shape (n,)
-        Per-joint noise σ_j estimated from the OLS residuals [N m or N].
+        Per-joint noise σ_j estimated from the residuals of the final fit [N m or N].
     residual_rms : ndarray, shape (n,)
         RMS of τ − Y_b π̂_b per joint, of the returned estimate.
     condition_number : float
@@ -164,14 +168,16 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
 
 
 def _fit(W: np.ndarray, y: np.ndarray, N: int, n: int, method: str):
-    """OLS, then (``wls``) the rows of joint j weighted by 1/σ_j of the OLS residuals: (solution, residual (N, n),
-    σ_j, Cov, information) — module notes."""
+    """OLS, then (``wls``) the rows of joint j weighted by 1/σ_j of the previous fit's residuals, twice:
+    (solution, residual (N, n), σ_j, Cov, information) — module notes."""
     sol = _least_squares(W, y, np.ones(N * n))
     residual = (y - W @ sol.x).reshape(N, n)
     noise = _joint_noise(residual, W.reshape(N, n, -1), sol.ident)
     if method == "wls":
-        sol = _least_squares(W, y, np.tile(1.0 / noise, N))
-        residual = (y - W @ sol.x).reshape(N, n)
+        for _ in range(WLS_PASSES):  # σ_j from the previous fit's residuals (OLS, then the first WLS)
+            sol = _least_squares(W, y, np.tile(1.0 / noise, N))
+            residual = (y - W @ sol.x).reshape(N, n)
+            noise = _joint_noise(residual, W.reshape(N, n, -1), sol.ident)
         s2 = 1.0
     else:
         s2 = float(residual.ravel() @ residual.ravel()) / max(N * n - sol.rank, 1)

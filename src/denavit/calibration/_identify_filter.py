@@ -89,5 +89,5 @@ def differentiate(t, q: np.ndarray, cutoff: float | None = None, order: int = FI
     keep = slice(edge, N - edge, every)
     text = (f"q filtered by a zero-phase Butterworth low-pass (order {order}, forwards and backwards, cut-off "
             f"{fc:g} Hz, sampling {fs:g} Hz), qd and qdd by central differences, tau and the regressor filtered "
-            f"alike; {edge} samples dropped at each end, every {every}th kept (decimation)")
+            f"alike; {edge} samples dropped at each end, then one in {every} kept (decimation)")
     return qf, qd, qdd, smooth, keep, text

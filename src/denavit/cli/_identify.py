@@ -101,7 +101,7 @@ def _text(result, robot, args, notes) -> str:
     lines += [f"note: {n}" for n in notes]
     if result.filter:
         lines.append(f"qd, qdd: {result.filter}")
-    lines.append("noise per joint, from the OLS residuals [N m or N]: " + ", ".join(number_text(v, 4)
+    lines.append("noise per joint, estimated from the residuals [N m or N]: " + ", ".join(number_text(v, 4)
                                                                                 for v in result.noise))
     lines.append("residual RMS per joint [N m or N]: " + ", ".join(number_text(v, 4) for v in result.residual_rms))
     lines.append("base parameters: estimate +- sigma (relative sigma) [kg, kg m, kg m^2, N m s, N m]:")
@@ -113,7 +113,8 @@ def _text(result, robot, args, notes) -> str:
     if result.unidentifiable:
         lines.append("not identifiable from these data (no value given): " + ", ".join(result.unidentifiable))
     if result.rules:
-        lines.append("grouping: " + "; ".join(result.rules))
+        lines.append("grouping of the base parameters:")
+        lines += [f"  {rule}" for rule in result.rules]
     lines.append(_verdict(result))
     if args.output:
         lines.append(f"wrote {args.output}")
