@@ -107,7 +107,7 @@ class Identification:
     physical: object | None = None
 
 
-def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: str = "ols", friction: bool = True,
+def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: str = "wls", friction: bool = True,
              motor_inertia: bool = True, filter: float | None = None, physical: bool = True,
              threads: int | None = None) -> Identification:
     """The base inertial parameters of ``robot`` from torques ``tau`` measured along the motion ``q``.
@@ -115,8 +115,7 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     Parameters
     ----------
     robot : DHRobot
-        The arm (its kinematics is trusted; its inertial values are only the nominal ones the physically
-        consistent fit is pulled towards).
+        The arm: its kinematics is trusted, its inertia is only the prior of the physically consistent fit.
     q : array_like, shape (N, n)
         Joint positions [rad or m] at N samples.
     qd, qdd : array_like, shape (N, n), optional
@@ -127,13 +126,13 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     tau : array_like, shape (N, n)
         Measured joint torques [N m] (forces [N] for prismatic joints).
     t : array_like, shape (N,), optional
-        Sample times [s] (constant rate), required when q̇, q̈ are estimated.
-    method : {"ols", "wls"}
-        Ordinary, or weighted by the per-joint noise estimated from the OLS residuals (module notes).
+        Sample times [s] (constant rate), required when q̇, q̈ are estimated.  ``threads``: for the regressor.
+    method : {"wls", "ols"}
+        Weighted by the per-joint noise estimated from the residuals (default), or ordinary (module notes).
     friction, motor_inertia : bool
         Model viscous + Coulomb friction (FV, FC) and motor inertia (IA) as :func:`denavit.regressor` does.
     filter : float, optional
-        Cut-off [Hz] of the filter (default min(10 Hz, f_s / 5)); only with ``t`` and no q̇, q̈.
+        Cut-off [Hz] of the filter (default min(10 Hz, f_s / 5)), with ``t`` and no q̇, q̈ only.
     physical : bool
         Also fit the physically consistent full parameter set (``physical`` of the result).
 
@@ -152,19 +151,24 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     N, n = tau.shape
     W = W.reshape(N * n, base.rank)  # (N n, r)
     sol, residual, noise, cov, info = _fit(W, tau.reshape(N * n), N, n, method)
-    est, std, cov = _mask(sol.x, cov, sol.ident)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = 100.0 * std / np.abs(est)
-    sv = sol.singular
-    cond = float(sv[0] / sv[-1]) if sol.rank == base.rank and sv[-1] > 0 else float("inf")
-    result = Identification(method, base.base_names, base.rules, est, std, rel, cov, sol.ident,
-                            tuple(nm for nm, ok in zip(base.base_names, sol.ident) if not ok), noise,
-                            np.sqrt(np.mean(residual ** 2, axis=0)), cond, sol.rank, N, filtered, sol.x, info, base)
+    result = _result(method, base, sol, cov, info, noise, residual, N, filtered)
     if physical:
         from ._physical import physical_parameters
 
         result = dataclasses.replace(result, physical=physical_parameters(robot, result))
     return result
+
+
+def _result(method, base, sol, cov, info, noise, residual, N: int, filtered) -> Identification:
+    """The :class:`Identification` of a fit (NaN where unidentifiable, relative σ, the condition number)."""
+    est, std, cov = _mask(sol.x, cov, sol.ident)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = 100.0 * std / np.abs(est)
+    sv = sol.singular
+    cond = float(sv[0] / sv[-1]) if sol.rank == base.rank and sv[-1] > 0 else float("inf")
+    return Identification(method, base.base_names, base.rules, est, std, rel, cov, sol.ident,
+                          tuple(nm for nm, ok in zip(base.base_names, sol.ident) if not ok), noise,
+                          np.sqrt(np.mean(residual ** 2, axis=0)), cond, sol.rank, N, filtered, sol.x, info, base)
 
 
 def _fit(W: np.ndarray, y: np.ndarray, N: int, n: int, method: str):

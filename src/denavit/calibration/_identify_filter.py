@@ -52,22 +52,8 @@ def differentiate(t, q: np.ndarray, cutoff: float | None = None, order: int = FI
     """
     from scipy.signal import butter, sosfiltfilt
 
-    t = np.asarray(t, dtype=float)
     N = q.shape[0]
-    if t.ndim != 1 or t.shape[0] != N:
-        raise ValueError(f"t: expected shape ({N},) (one time per sample), got {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise ValueError("t has non-finite values (NaN or inf)")
-    dt = np.diff(t)
-    if N < 3 or not np.all(dt > 0):
-        k = int(np.argmax(dt <= 0)) + 1 if N >= 3 else 0
-        raise ValueError("t must be strictly increasing with at least 3 samples"
-                         + (f" (sample {k + 1}: t = {t[k]:.9g} after {t[k - 1]:.9g})" if N >= 3 else f", got {N}"))
-    step = float(np.mean(dt))
-    jitter = float(np.max(np.abs(dt - step)) / step)
-    if jitter > MAX_JITTER:
-        raise ValueError(f"t: the sampling interval varies by {100 * jitter:.3g} % (at most {100 * MAX_JITTER:g} % "
-                         "is accepted: resample at a constant rate, or give qd and qdd)")
+    step = _step(t, N)
     fs = 1.0 / step
     fc = min(DEFAULT_CUTOFF, fs / 5) if cutoff is None else float(cutoff)
     if not (0 < fc < fs / 2):
@@ -91,3 +77,23 @@ def differentiate(t, q: np.ndarray, cutoff: float | None = None, order: int = FI
             f"{fc:g} Hz, sampling {fs:g} Hz), qd and qdd by central differences, tau and the regressor filtered "
             f"alike; {edge} samples dropped at each end, then one in {every} kept (decimation)")
     return qf, qd, qdd, smooth, keep, text
+
+
+def _step(t, N: int) -> float:
+    """The sampling interval of ``t`` (N,), checked: finite, strictly increasing, uniform within MAX_JITTER."""
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.shape[0] != N:
+        raise ValueError(f"t: expected shape ({N},) (one time per sample), got {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise ValueError("t has non-finite values (NaN or inf)")
+    dt = np.diff(t)
+    if N < 3 or not np.all(dt > 0):
+        k = int(np.argmax(dt <= 0)) + 1 if N >= 3 else 0
+        raise ValueError("t must be strictly increasing with at least 3 samples"
+                         + (f" (sample {k + 1}: t = {t[k]:.9g} after {t[k - 1]:.9g})" if N >= 3 else f", got {N}"))
+    step = float(np.mean(dt))
+    jitter = float(np.max(np.abs(dt - step)) / step)
+    if jitter > MAX_JITTER:
+        raise ValueError(f"t: the sampling interval varies by {100 * jitter:.3g} % (at most {100 * MAX_JITTER:g} % "
+                         "is accepted: resample at a constant rate, or give qd and qdd)")
+    return step
