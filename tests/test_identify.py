@@ -239,6 +239,13 @@ def test_identify_refuses_bad_arguments_with_one_clear_message(kwargs, match):
         identify(robot, q, **args)
 
 
+def test_too_few_samples_to_estimate_the_noise_are_refused():
+    robot = denavit.load_robot("planar2r")
+    q = np.full((1, 2), 0.3)
+    with pytest.raises(ValueError, match="no degree of freedom is left"):
+        identify(robot, q, q, q, tau=q)
+
+
 def test_uneven_sampling_is_refused():
     robot = denavit.load_robot("planar2r")
     t = np.cumsum(np.r_[0, np.full(199, 0.01)])

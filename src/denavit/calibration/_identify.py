@@ -175,6 +175,9 @@ def _fit(W: np.ndarray, y: np.ndarray, N: int, n: int, method: str):
     """OLS, then (``wls``) the rows of joint j weighted by 1/σ_j of the previous fit's residuals, twice:
     (solution, residual (N, n), σ_j, Cov, information) — module notes."""
     sol = _least_squares(W, y, np.ones(N * n))
+    if N * n <= sol.rank:
+        raise ValueError(f"{N} sample{'s' * (N != 1)} of {n} torques fit the {sol.rank} parameters they determine "
+                         "exactly: no degree of freedom is left to estimate the noise and σ (record more samples)")
     residual = (y - W @ sol.x).reshape(N, n)
     noise = _joint_noise(residual, W.reshape(N, n, -1), sol.ident)
     if method == "wls":
