@@ -135,7 +135,7 @@ def _numba_group(specs: dict[str, KernelSpec]) -> list[str]:
     return ([f"GROUP = {tuple(names)!r}", f"GROUP_ARITY = {arity}", f"_group_1, _group_rows = group_intrinsic({arity}, ("] + programs + ["))", "", "",
              "@njit(cache=True, nogil=True, no_cfunc_wrapper=True)", f"def group_n(sel, {args}, out):",
              '    """Kernel GROUP[sel] on a batch: inputs (B, k), out (B, size)."""',
-             f"    for b in range(0, a0.shape[0], {LANES}):", f"        _group_rows(sel, {args}, out, b)", "", ""])
+             f"    _group_rows(sel, {args}, out)", "", ""])
 
 
 def group_batch(module, name: str):

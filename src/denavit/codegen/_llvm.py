@@ -73,10 +73,13 @@ def group_intrinsic(arity: int, programs: tuple):
     kernels (numba's fixed cost, ~0.1 s per compiled function, paid once).
 
     ``programs``: ``(n_inputs, steps, outputs, shape)`` per kernel (``outputs`` indexed by ``shape``, as
-    :func:`kernel_intrinsic`'s).  ``f(sel, in_0, …, in_{arity-1}, out)``: vectors, ``out`` flat; ``f_rows(sel, in_0, …, out, b)``: (B, k)
-    inputs and a (B, m) ``out``, rows ``b … b + LANES − 1`` as :func:`kernel_intrinsic`'s.  A kernel of fewer
-    inputs ignores the last ones; an unknown ``sel`` does nothing."""
+    :func:`kernel_intrinsic`'s).  ``f(sel, in_0, …, in_{arity-1}, out)``: vectors, ``out`` flat; ``f_batch(sel,
+    in_0, …, out)``: (B, k) inputs and a (B, m) ``out``, the whole batch LANES rows at a time as
+    :func:`kernel_intrinsic`'s rows.  Each kernel has its own loop over the rows (the switch is outside the loops:
+    one loop holding every kernel would keep every kernel's loop-invariant addresses live, and spill).  A kernel
+    of fewer inputs ignores the last ones; an unknown ``sel`` does nothing."""
     from llvmlite import ir
+    from numba.core import cgutils
 
     def flat(index, shape):
         f = 0
@@ -96,16 +99,22 @@ def group_intrinsic(arity: int, programs: tuple):
             switch.add_case(ir.Constant(sel.type, j), block)
             builder.position_at_end(block)
             tys, vals = sig.args[1:1 + k] + (sig.args[out_at],), args[1:1 + k] + (args[out_at],)
-            _program(context, builder, tys, vals, args[-1] if lanes else None, steps, outputs, lanes)
+            if not lanes:
+                _program(context, builder, tys, vals, None, steps, outputs, 0)
+            else:
+                n_rows = cgutils.unpack_tuple(builder, context.make_array(tys[0])(context, builder, vals[0]).shape)[0]
+                i64 = ir.IntType(64)
+                with cgutils.for_range_slice(builder, ir.Constant(i64, 0), n_rows, ir.Constant(i64, lanes)) as (row, _):
+                    _program(context, builder, tys, vals, row, steps, outputs, lanes)
             builder.branch(done)
         builder.position_at_end(done)
         return context.get_dummy_value()
 
-    return _intrinsics(arity + 2, codegen)
+    return _intrinsics(arity + 2, codegen, rows=False)
 
 
-def _intrinsics(n_args: int, codegen):
-    """The pair of numba intrinsics (one configuration: ``n_args`` arguments; SIMD rows: one more, the row)."""
+def _intrinsics(n_args: int, codegen, rows: bool = True):
+    """The pair of numba intrinsics (one configuration: ``n_args`` arguments; SIMD: one more, the row, if ``rows``)."""
     from numba.core import types
     from numba.extending import intrinsic
 
@@ -126,7 +135,7 @@ def _intrinsics(n_args: int, codegen):
         kernel.__signature__ = inspect.Signature([P(a, P.POSITIONAL_OR_KEYWORD) for a in ("typingctx", *(f"a{i}" for i in range(k)))])
         return intrinsic(kernel)
 
-    return arity(n_args, 0), arity(n_args + 1, LANES)
+    return arity(n_args, 0), arity(n_args + rows, LANES)
 
 
 class _Addresses:
