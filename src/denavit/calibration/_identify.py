@@ -33,6 +33,8 @@ __all__ = ["METHODS", "NULL_TOL", "RANK_TOL", "Identification", "identify"]
 #: Relative singular-value threshold of the stacked, column-scaled base regressor: below it, a direction of π_b
 #: is not seen by the data (the singular values come from the Gram matrix: float64 resolves them to ~1e-8).
 RANK_TOL = 1e-6
+#: Largest stacked regressor W (N · n · r doubles) identify builds: 2 GB (10⁶ samples of a 6-joint arm need 2.5).
+MAX_REGRESSOR_BYTES = 2e9
 #: Rows of W summed at once into the Gram matrices.
 BLOCK = 4096
 #: A base parameter is identifiable from the data when the norm of its components along W's null space (unit
@@ -140,10 +142,9 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     -------
     Identification
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    q, qd, qdd, tau, filtered = _inputs(robot, q, qd, qdd, tau, t, filter)
+    q, qd, qdd, tau, filtered = _inputs(robot, q, qd, qdd, tau, t, filter, method)
     base = base_parameters(robot, friction=friction, motor_inertia=motor_inertia)
+    _check_size(q.shape[0], 8.0 * q.size * base.rank)
     W = base_regressor(robot, q, qd, qdd, base, threads=threads)  # (N, n, r)
     if filtered is not None:  # the same filter on τ and on every column of W; the ends dropped
         smooth, keep, filtered = filtered
@@ -157,6 +158,12 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
 
         result = dataclasses.replace(result, physical=physical_parameters(robot, result))
     return result
+
+
+def _check_size(N: int, size: float) -> None:
+    if size > MAX_REGRESSOR_BYTES:
+        raise ValueError(f"{N} samples: their stacked regressor would take {size / 1e9:.3g} GB (at most "
+                         f"{MAX_REGRESSOR_BYTES / 1e9:g} GB); decimate the data (every k-th sample)")
 
 
 def _result(method, base, sol, cov, info, noise, residual, N: int, filtered) -> Identification:
@@ -191,9 +198,11 @@ def _fit(W: np.ndarray, y: np.ndarray, N: int, n: int, method: str):
     return sol, residual, noise, sol.cov * s2, sol.info / s2
 
 
-def _inputs(robot, q, qd, qdd, tau, t, cutoff):
+def _inputs(robot, q, qd, qdd, tau, t, cutoff, method: str):
     """Checked (N, n) arrays q, q̇, q̈, τ (q̇, q̈ from the filter when not given) and the filter as (smooth, kept
     samples, description), or None when not used."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     n = robot.dof
     q = as_joint_array(q, n, "q")
     if tau is None:
