@@ -77,3 +77,30 @@ def test_cpu_times_are_written_per_test_and_read_by_the_slow_list_script(tmp_pat
     script = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(script)
     assert script.slow_ids_cpu(out.read_text(encoding="utf-8"), 0.4) == {"test_two.py::test_burn"}
+
+
+def test_numeric_function_equals_lambdify_on_random_formulas():
+    """tests/_evaluate.numeric_function (the DAG evaluator test_symbolic_dynamics uses for the Panda's formulas)
+    gives lambdify's values on random expressions that share sub-expressions, and refuses what it cannot do."""
+    import pytest
+    import sympy as sp
+
+    from _evaluate import numeric_function
+
+    rng = np.random.default_rng(5)
+    x, y, z = sp.symbols("x y z", real=True)
+    for _ in range(30):
+        pool = [x, y, z, sp.Rational(int(rng.integers(-9, 9)), int(rng.integers(1, 9))), sp.Float(rng.normal())]
+        for _ in range(12):  # each new node reuses earlier ones: a DAG
+            a, b = (pool[int(k)] for k in rng.integers(0, len(pool), 2))
+            op = int(rng.integers(0, 6))
+            pool.append([a + b, a * b, a - 3 * b, sp.sin(a) * b, sp.cos(a + b), a**2 + b**3][op])
+        M = sp.Matrix(2, 2, pool[-4:])
+        point = rng.uniform(-2, 2, 3)
+        (got,) = numeric_function([x, y, z], [M])(*point)
+        want = np.array(sp.lambdify([x, y, z], M, "numpy")(*point), dtype=float)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    with pytest.raises(TypeError, match="no rule for"):
+        numeric_function([x], [sp.Matrix([sp.besselj(0, x)])])(1.0)
+    with pytest.raises(KeyError, match="no value for symbol y"):
+        numeric_function([x], [sp.Matrix([x * y])])(1.0)

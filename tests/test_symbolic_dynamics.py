@@ -18,18 +18,21 @@ from denavit import numeric as N
 from denavit.model import LinkInertia
 from denavit.symbolic import format_dynamics, joint_symbols, lagrangian_dynamics, parameter_symbols
 
+from _evaluate import numeric_function
 from test_jacobians import make_robot
 
 ARMS = ["planar2r", "planar3r", "planar3r-lagrange"] + [pytest.param(n, marks=pytest.mark.slow)
                                                         for n in ("puma560", "puma560-mdh", "ur5")]
 
 
-@functools.lru_cache(maxsize=2)  # the Panda's two tests share one lambdify of its ~1 MB of formulas
+@functools.lru_cache(maxsize=2)  # the Panda's two checks share one evaluator of its ~2.6 MB of formulas
 def _functions(robot, t):
+    """M, c, g (and C) as functions of q, q̇ (each distinct sub-expression evaluated once: tests/_evaluate.py;
+    lambdify spent ~30 CPU seconds printing the Panda's)."""
     js = joint_symbols(robot.dof)
     syms = list(js.q) + list(js.qd) + list(parameter_symbols(robot).values())
     mats = [t.M, t.c, t.g] + ([t.C] if t.C is not None else [])
-    f = sp.lambdify(syms, mats, "numpy")
+    f = numeric_function(syms, mats)
     values = list(robot.parameter_values.values())
     return lambda q, qd: [np.array(x, dtype=float) for x in f(*q, *qd, *values)]
 
@@ -62,8 +65,8 @@ def test_catalogue_arms_match_the_numeric_engine(name):
 
 @pytest.mark.slow
 def test_panda_matches_the_numeric_engine():
-    """The Panda's hand form (~1 MB of formulas: one lambdify, shared) against the numeric engine and, when it is
-    installed, Pinocchio (the Pinocchio test's Panda case, here so that the formulas are compiled once)."""
+    """The Panda's hand form (~2.6 MB of formulas: one evaluator, shared) against the numeric engine and, when it is
+    installed, Pinocchio (the Pinocchio test's Panda case, here so that the formulas are prepared once)."""
     robot = denavit.load_robot("panda")
     t = lagrangian_dynamics(robot, coriolis=False)
     _check_against_numeric(robot, t, np.random.default_rng(81), count=2)
@@ -237,11 +240,11 @@ def _check_regressor(robot, rng, count=3):
     Y, pi = regressor_sym(robot)
     js = joint_symbols(robot.dof)
     assert Y.shape == (robot.dof, len(pi)) and not (Y.free_symbols & set(pi))  # linear: π is not left in Y
-    f = sp.lambdify(list(js.q) + list(js.qd) + list(js.qdd) + list(parameter_symbols(robot).values()), Y, "numpy")
+    f = numeric_function(list(js.q) + list(js.qd) + list(js.qdd) + list(parameter_symbols(robot).values()), [Y])
     p = _standard_parameters(robot)
     for _ in range(count):
         q, qd, qdd = (rng.uniform(-2, 2, robot.dof) for _ in range(3))
-        Yv = np.array(f(*q, *qd, *qdd, *robot.parameter_values.values()), dtype=float)
+        (Yv,) = f(*q, *qd, *qdd, *robot.parameter_values.values())
         np.testing.assert_allclose(Yv @ p, N.rnea(robot, q, qd, qdd, friction=False), atol=1e-9)
 
 
