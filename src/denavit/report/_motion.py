@@ -9,6 +9,8 @@ force propagation (Craig eq. 5.80-5.82), when the numeric engine provides it.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 import sympy as sp
 
@@ -28,18 +30,26 @@ def jacobian_sym(ctx: Context) -> sp.ImmutableMatrix:
     cached = getattr(ctx, "_J_sym", None)
     if cached is not None:
         return cached
-    p_e = sp.ImmutableMatrix(ctx.fk_sym[:3, 3])
+    J = _jacobian_from_axes(sp.ImmutableMatrix(ctx.fk_sym[:3, 3]), tuple(ctx.joint_frames_sym),
+                            tuple(ctx.robot.joint_types), ctx.simplify)
+    ctx._J_sym = J  # type: ignore[attr-defined]
+    return J
+
+
+@lru_cache(maxsize=64)
+def _jacobian_from_axes(p_e: sp.ImmutableMatrix, axes: tuple, types: tuple, simplify: str) -> sp.ImmutableMatrix:
+    """Columns [z_i × (p_e − p_i); z_i] (revolute) or [z_i; 0] (prismatic), simplified: a pure function of its
+    arguments, remembered (every report of an arm derives the same J0, and its trigsimp pass costs a second)."""
     cols = []
-    for (z, p), jt in zip(ctx.joint_frames_sym, ctx.robot.joint_types):
+    for (z, p), jt in zip(axes, types):
         if jt is JointType.REVOLUTE:
             v = z.cross(p_e - p)
             cols.append(list(v) + list(z))
         else:
             cols.append(list(z) + [0, 0, 0])
-    J = S.simplify_matrix(sp.Matrix(cols).T, ctx.simplify)
-    if ctx.simplify != "none":
+    J = S.simplify_matrix(sp.Matrix(cols).T, simplify)
+    if simplify != "none":
         J = J.applyfunc(_pythagoras)
-    ctx._J_sym = J  # type: ignore[attr-defined]
     return J
 
 
@@ -96,11 +106,16 @@ def _position_derivatives(ctx: Context) -> tuple:
     cached = getattr(ctx, "_dT_sym", None)
     if cached is not None:
         return cached
-    T = ctx.fk_sym
-    dT = tuple(sp.ImmutableMatrix(T.diff(qi)) for qi in ctx.q_syms)
-    dp = tuple(S.simplify_matrix(sp.ImmutableMatrix(d[:3, 3]), ctx.simplify) for d in dT)
-    ctx._dT_sym = (dp, dT)  # type: ignore[attr-defined]
+    ctx._dT_sym = _derivatives_of(ctx.fk_sym, tuple(ctx.q_syms), ctx.simplify)  # type: ignore[attr-defined]
     return ctx._dT_sym
+
+
+@lru_cache(maxsize=64)
+def _derivatives_of(T: sp.ImmutableMatrix, q: tuple, simplify: str) -> tuple:
+    """(∂p/∂q_i simplified, ∂T/∂q_i) of T(q): a pure function of its arguments, remembered."""
+    dT = tuple(sp.ImmutableMatrix(T.diff(qi)) for qi in q)
+    dp = tuple(S.simplify_matrix(sp.ImmutableMatrix(d[:3, 3]), simplify) for d in dT)
+    return dp, dT
 
 
 def _differentiation_steps(ctx: Context) -> list:
