@@ -13,7 +13,7 @@ from ..model import DHRobot, Frame
 from . import _fastcall
 from ._cache import guard_cache, load_module, numba_available, robot_key
 from ._emit import NUMBA, NUMPY, group_batch, python_module
-from ._kernels import (BASE_GROUP, DYNAMICS, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
+from ._kernels import (BASE_GROUP, DYNAMICS, INTERNAL, KERNEL_NAMES, group_kernels, has_dynamics as _has_dynamics,
                        registered_digest, registered_kernels, trace_kernels, trace_registered)
 from ._compiled_dyn import DynDerivativeMethods
 from ._compiled_reg import RegressorMethods
@@ -127,11 +127,14 @@ class CompiledRobot(IKMethods, KinDerivativeMethods, DynDerivativeMethods, Regre
 
     def warm(self) -> dict[str, float]:
         """Run every kernel once, single and batch (this compiles it, or loads it from the disk cache);
-        return the seconds each took (the first batch call compiles the batch forms of the whole group)."""
+        return the seconds each took (the first batch call compiles the batch forms of the whole group).  The IK
+        solvers' own kernel (``fk_jacobian0``) is compiled with them, on their first use."""
         import time
 
         out = {}
         for name in self.kernels:
+            if name in INTERNAL:  # the IK solvers' kernel: compiled with them
+                continue
             _, shape = self._one[name]
             lengths = self._lengths.get(name) or (self.dof,) * {"rnea": 3, "forward_dynamics": 3, "coriolis": 2}.get(name, 1)
             t = time.perf_counter()

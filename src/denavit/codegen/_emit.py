@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ._kernels import KernelSpec
+from ._kernels import INTERNAL, KernelSpec
 from ._llvm import LANES
 
 __all__ = ["python_module", "c_sources", "group_batch", "NUMBA", "NUMPY"]
@@ -128,8 +128,10 @@ def _numba_group(specs: dict[str, KernelSpec]) -> list[str]:
     """``group_n(sel, a_0, …, a_{m-1}, out)``: the batch form of every kernel of the module in one compiled function
     (kernel ``GROUP[sel]``; inputs (B, k), fewer than m inputs: the first repeated; ``out`` (B, size)).  numba
     spends about 0.1 s of fixed cost on each function it compiles: one for all the batches of a group."""
-    arity = max(len(spec.inputs) for spec in specs.values())
-    names = list(specs)
+    names = [k for k in specs if k not in INTERNAL]
+    if not names:
+        return []
+    arity = max(len(specs[k].inputs) for k in names)
     programs = [f"    ({len(specs[k].inputs)}, _{k}_steps, _{k}_outputs, {specs[k].shape!r})," for k in names]
     args = ", ".join(f"a{i}" for i in range(arity))
     return ([f"GROUP = {tuple(names)!r}", f"GROUP_ARITY = {arity}", f"_group_1, _group_rows = group_intrinsic({arity}, ("] + programs + ["))", "", "",
@@ -260,7 +262,7 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     body: list[str] = []
     for spec in specs.values():
         body += _numba_kernel(spec) if backend == NUMBA else _python_kernel(spec)
-    if backend == NUMBA and specs:
+    if backend == NUMBA:
         body += _numba_group(specs)
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
         from ._ik_elbow import IK_ELBOW_SOURCE

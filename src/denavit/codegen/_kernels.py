@@ -21,13 +21,16 @@ from ..errors import ModelError
 from ..numeric import SINGULAR_TOL, require_dynamics, dynamics_plan, ldl_pivots_solve, mass_matrix_kernel, rnea_kernel
 from ._trace import Tape, sym_max, sym_min, sym_sign
 
-__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "has_dynamics", "jacobian_columns",
+__all__ = ["KernelSpec", "trace_kernels", "KERNEL_NAMES", "DYNAMICS", "INTERNAL", "has_dynamics", "jacobian_columns",
            "end_effector", "register_kernel", "registered_kernels", "group_kernels", "trace_registered",
            "registered_digest", "RegisteredKernel", "BASE_GROUP", "first_joint_at_zero", "gravity_seen_at_zero"]
 
 KERNEL_NAMES = ("fk", "position", "frames", "jacobian0", "jacobiane", "fk_jacobian0", "rnea", "mass_matrix",
                 "gravity", "coriolis", "forward_dynamics")
 DYNAMICS = frozenset({"rnea", "mass_matrix", "gravity", "coriolis", "forward_dynamics"})
+#: Kernels no method calls directly: the IK solvers' (compiled with them, on their first use; not by ``warm()``, and
+#: not in the module's batch group).
+INTERNAL = frozenset({"fk_jacobian0"})
 #: The group compiled by :func:`denavit.compile` itself; every other group is compiled (or loaded from the disk
 #: cache) on its first call.
 BASE_GROUP = "base"
