@@ -22,6 +22,7 @@ from .interop import from_urdf, to_mjcf, to_urdf
 from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
+from .ik import PathResult, PathTrajectory, cartesian_line, ik_path
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_derivatives
 from .numeric import BaseParameters, base_parameters, base_regressor, inertial_parameters, regressor
@@ -99,6 +100,10 @@ __all__ = [
     "IKResult",
     "analytic_ik",
     "solve_ik",
+    "ik_path",
+    "cartesian_line",
+    "PathResult",
+    "PathTrajectory",
     "compile",
     "CompiledRobot",
     "Measurements",

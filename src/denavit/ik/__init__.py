@@ -9,11 +9,16 @@ numeric engine (:mod:`denavit.numeric`) for forward kinematics and Jacobians; no
 """
 
 from ._analytic import AnalyticIKResult, analytic_ik, ik_plan, ik_structure
+from ._path import PathResult, PathTrajectory, cartesian_line, ik_path
 from ._numeric import MAX_ITERATIONS, RESTARTS, TOL, solve_ik
 from ._residual import IKResult, JointLimits, characteristic_length, pose_error, rotation_log, row_mask
 
 __all__ = [
     "AnalyticIKResult",
+    "ik_path",
+    "cartesian_line",
+    "PathResult",
+    "PathTrajectory",
     "analytic_ik",
     "ik_structure",
     "ik_plan",
