@@ -137,7 +137,7 @@ def _records(text: str, path: str):
         raise ParseError(f"not valid CSV ({exc})", where=f"{path}:{reader.line_num}") from None
 
 
-def _columns(header: list[str], robot: DHRobot, where: str) -> tuple[dict[str, int], list[str]]:
+def _columns(header: list[str], robot: DHRobot, where: str, joints: bool = True) -> tuple[dict[str, int], list[str]]:
     """Column index of each known name, and the ignored names; refuses duplicates and incomplete groups."""
     n = robot.dof
     known = {"t", *_POSITION, *_QUATERNION}
@@ -162,7 +162,7 @@ def _columns(header: list[str], robot: DHRobot, where: str) -> tuple[dict[str, i
     groups += [_POSITION, _QUATERNION]
     for group in groups:
         missing = [c for c in group if c not in index]
-        if missing and (group is groups[0] or len(missing) < len(group)):
+        if missing and ((group is groups[0] and joints) or len(missing) < len(group)):
             raise ParseError(f"column {missing[0]!r} missing (the group {' '.join(group)} needs every column)",
                              where=where)
     if _QUATERNION[0] in index and _POSITION[0] not in index:
@@ -200,7 +200,7 @@ def _parse_rows(records, header: list[str], index: Mapping[str, int], path: str)
 
 
 def read_measurements(path: str | os.PathLike, robot: DHRobot, *, angle_unit: str = "rad", length_unit: str = "m",
-                      torque_scale: float = 1.0) -> Measurements:
+                      torque_scale: float = 1.0, require_joints: bool = True) -> Measurements:
     """Read a measurement CSV file for ``robot`` (see the module notes for the columns).
 
     Parameters
@@ -215,6 +215,8 @@ def read_measurements(path: str | os.PathLike, robot: DHRobot, *, angle_unit: st
         Unit of prismatic joint readings (and rates) and of the positions x y z.
     torque_scale : float
         Factor from the file's torque unit to N·m / N (e.g. 1e-3 for N·mm).
+    require_joints : bool
+        False for files of poses alone (``denavit ik --path``): without q columns, ``q`` has shape (m, 0).
 
     Returns
     -------
@@ -239,7 +241,7 @@ def read_measurements(path: str | os.PathLike, robot: DHRobot, *, angle_unit: st
         line, header = next(records)
     except StopIteration:
         raise ParseError("no header line (expected column names such as q1, q2, ..., x, y, z)", where=path) from None
-    index, ignored = _columns(header, robot, f"{path}:{line}")
+    index, ignored = _columns(header, robot, f"{path}:{line}", require_joints)
     values, lines = _parse_rows(records, header, index, path)
     if not len(lines):
         raise ParseError("no data rows after the header", where=f"{path}:{line}")
@@ -275,7 +277,8 @@ def _assemble(col: Mapping[str, np.ndarray], robot: DHRobot, lines: np.ndarray, 
         shown = ", ".join(_short(c) for c in ignored[:10]) + (f" and {len(ignored) - 10} more" if len(ignored) > 10
                                                                 else "")
         notes = (f"{path}: ignored column{'s' * (len(ignored) > 1)} {shown}",)
-    return Measurements(q=group("q", unit), t=col.get("t"), qd=group("qd", unit), qdd=group("qdd", unit),
+    q = group("q", unit)
+    return Measurements(q=np.zeros((len(lines), 0)) if q is None else q, t=col.get("t"), qd=group("qd", unit), qdd=group("qdd", unit),
                         position=position, quaternion=quat, tau=group("tau", torque), lines=lines, notes=notes,
                         source=path)
 
