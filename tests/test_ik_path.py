@@ -200,3 +200,30 @@ def test_bad_input_is_refused_with_one_line():
         denavit.ik_path(robot, np.eye(4)[None], hold="q9")
     with pytest.raises(ValueError, match="step"):
         denavit.cartesian_line(np.eye(4), np.eye(4), step=0.0)
+
+
+def test_cli_line_and_path_file(tmp_path, capsys):
+    import json
+
+    from denavit.cli import main
+
+    q0 = "0.3,-1.2,1.4,-0.6,1.1,0.4"
+    assert main(["ik", "ur5", "--line", "0.4,0.1,0.3,0,3.1,0", "0.4,0.2,0.3,0,3.1,0", "--step", "0.05", "--q0", q0,
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    (traj,) = out["trajectories"]
+    assert traj["status"] == "complete" and len(traj["q"]) == 3
+    robot = denavit.load_robot("ur5")
+    T = denavit.forward_kinematics(robot, np.array(traj["q"][-1]))
+    np.testing.assert_allclose(T[:3, 3], [0.4, 0.2, 0.3], atol=1e-8)
+    # the same poses from a CSV file (quaternion of roll 0, pitch 3.1, yaw 0: w = cos 1.55, y = sin 1.55), then a
+    # pose far out of reach: exit code 1, the stop named
+    w, y = np.cos(1.55), np.sin(1.55)
+    f = tmp_path / "poses.csv"
+    f.write_text(f"x,y,z,qw,qx,qy,qz\n0.4,0.1,0.3,{w},0,{y},0\n0.4,0.2,0.3,{w},0,{y},0\n3,3,3,1,0,0,0\n")
+    assert main(["ik", "ur5", "--path", str(f), "--q0", q0]) == 1
+    text = capsys.readouterr().out
+    assert "stops before pose 2: workspace boundary" in text
+    f.write_text("x,y,z\n1,2,3\n")
+    assert main(["ik", "ur5", "--path", str(f)]) == 2
+    assert "--path needs the columns x y z qw qx qy qz" in capsys.readouterr().err

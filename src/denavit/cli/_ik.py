@@ -8,6 +8,7 @@ import re
 import numpy as np
 
 from ..errors import DenavitError, ParseError, UnsupportedRobotError
+from ._ik_path import add_path_arguments, cmd_ik_path
 from ._common import (add_common, bounded_int, check_values, emit, joint_values, load, matrix_text, numbers_text,
                       positive_float, require_finite)
 
@@ -24,6 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="target position [m] and roll-pitch-yaw R = Rz(yaw) Ry(pitch) Rx(roll) [rad or --deg]")
     target.add_argument("--T", dest="T", metavar="T11,...,T44", help="target pose as 16 numbers, row by row")
     target.add_argument("--from-q", dest="from_q", metavar="Q", help="target = the pose of the arm at these joint values")
+    add_path_arguments(target, p)
     p.add_argument("--method", choices=["auto", "analytic", "numeric"], default="auto",
                    help="closed form (all solutions), numerical LM, or auto: closed form when the arm has one")
     p.add_argument("--all", action="store_true",
@@ -265,8 +267,11 @@ def cmd_ik(args: argparse.Namespace):
     robot = load(args)
     if args.derive:
         return _derive(args, robot)
+    if args.path is not None or args.line is not None:
+        return cmd_ik_path(args, robot)
     if args.pose is None and args.T is None and args.from_q is None:
-        raise ParseError("give a target: --pose, --T or --from-q (or --derive for the symbolic derivation)")
+        raise ParseError("give a target: --pose, --T or --from-q, a path: --path or --line (or --derive for the "
+                         "symbolic derivation)")
     if args.latex:
         raise ParseError("--latex goes with --derive")
     T = _target(args, robot)
