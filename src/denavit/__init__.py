@@ -23,6 +23,7 @@ from .numeric import forward_kinematics, geometric_jacobian, link_transforms
 from .numeric import end_effector_twist, force_propagation, joint_torques, manipulability, velocity_propagation
 from .ik import AnalyticIKResult, IKResult, analytic_ik, solve_ik
 from .ik import PathResult, PathTrajectory, cartesian_line, ik_path
+from .ik import FreeJointSweep, free_joint_sweep
 from .numeric import coriolis_matrix, forward_dynamics, gravity_torques, mass_matrix, rnea, simulate
 from .numeric import forward_dynamics_derivatives, gravity_derivatives, rnea_derivatives
 from .numeric import BaseParameters, base_parameters, base_regressor, inertial_parameters, regressor
@@ -104,6 +105,8 @@ __all__ = [
     "cartesian_line",
     "PathResult",
     "PathTrajectory",
+    "free_joint_sweep",
+    "FreeJointSweep",
     "compile",
     "CompiledRobot",
     "Measurements",

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import DenavitError, ParseError, UnsupportedRobotError
 from ._ik_path import add_path_arguments, cmd_ik_path
+from . import _ik_sweep
 from ._common import (add_common, bounded_int, check_values, emit, joint_values, load, matrix_text, numbers_text,
                       positive_float, require_finite)
 
@@ -42,6 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--lock", metavar="qN=V[,qM=W]", action="append",
                    help="analytic: hold these joints at these values and solve the others (redundant arms, e.g. "
                         "panda --lock q7=0.5); repeatable")
+    _ik_sweep.add_arguments(p)  # --free (= --lock), --sweep, --samples
     p.add_argument("--derive", action="store_true",
                    help="print the symbolic derivation of the closed form (spherical-wrist 6-joint and planar 2R/3R "
                         "arms) instead of solving a target")
@@ -89,10 +91,11 @@ def _locks(args, robot) -> dict[str, float] | None:
     from ..io import parse_values
     from ..model import JointType
 
-    if not args.lock:
+    items = (args.lock or []) + (args.free or [])  # --free is --lock under issue 30's name
+    if not items:
         return None
     out = {}
-    for item in ",".join(args.lock).split(","):  # linear: split and strip, no backtracking regex
+    for item in ",".join(items).split(","):  # linear: split and strip, no backtracking regex
         name, eq, value = item.partition("=")
         name, value = name.strip(), value.strip()
         digits = name[1:]
@@ -276,6 +279,13 @@ def cmd_ik(args: argparse.Namespace):
         raise ParseError("--latex goes with --derive")
     T = _target(args, robot)
     method = args.method
+    _ik_sweep.check(args)
+    if args.sweep:
+        data, lines = _ik_sweep.cmd_sweep(args, robot, T)
+        data = {"robot": robot.name, "angle_unit": "deg" if args.deg else "rad", "T": T, **data}
+        return data, "\n".join([f"{robot.name}: inverse kinematics of", "T =", matrix_text(T), ""] + lines)
+    if args.free:
+        method = "analytic"
     if args.lock and method == "numeric":
         raise ParseError("--lock goes with the analytic solver (--method analytic or auto)")
     if args.lock:

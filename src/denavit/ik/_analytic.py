@@ -123,7 +123,8 @@ def _dedupe(robot: DHRobot, q: np.ndarray, keep: np.ndarray, T: np.ndarray | Non
     return keep
 
 
-def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> AnalyticIKResult:
+def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None, *,
+                free: dict[str, float] | None = None) -> AnalyticIKResult:
     """All inverse-kinematics solutions in closed form, each verified by FK, within the joint limits.
 
     The structure is recognised from the DH table (either convention, offsets, fixed rows, base and tool
@@ -143,6 +144,9 @@ def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> An
     locked : dict, optional
         Joint names (``"q1"`` … ``"qN"``, numbered as in the DH table) and the values they are held at
         [rad, m]; they are returned unchanged in every solution.
+    free : dict, optional
+        The same as ``locked`` under issue 30's name (the held joint is the free parameter of a redundant arm's
+        self-motion): ``free={"q7": 0.3}``; give one of the two.
 
     Returns
     -------
@@ -164,6 +168,12 @@ def analytic_ik(robot: DHRobot, T, locked: dict[str, float] | None = None) -> An
     (True, True)
     """
     T = as_transform(T, "T")
+    if free is not None:  # one code path: free= is locked= under another name
+        if locked is not None:
+            from ..errors import ModelError
+
+            raise ModelError("analytic_ik: give locked= or free= (the same thing), not both")
+        locked = free
     plan = None if locked else _plan(robot, True)
     # targets far beyond the reach (1e300 m, say) overflow on the way to "no solution"; every candidate is
     # verified by FK, so those intermediate infinities are no news to the caller

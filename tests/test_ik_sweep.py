@@ -1,0 +1,217 @@
+"""Redundant arms by one held joint: analytic_ik(free=) and free_joint_sweep, checked against a dense numeric search.
+
+Truth comes from routes the code under test does not use: the held arm is built here from the DH rows (the held
+joint's value added to its θ, the row made fixed) and searched by Levenberg–Marquardt from many random seeds;
+every claimed solution is checked by forward kinematics of the full arm against the target and against the limits.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import denavit
+from denavit import (
+    analytic_ik,
+    forward_kinematics,
+    free_joint_sweep,
+    load_robot,
+    solve_ik,
+)
+from denavit.cli import main
+from denavit.errors import ModelError
+from denavit.ik import default_free_joint
+from denavit.model import JointType
+
+SEEDS = 120  # LM starts per pose of the dense search (2-8 solutions within the limits; each found ~20-60 times)
+SAME = 1e-6  # two joint vectors within this (max over joints, angles modulo 2π) are one solution
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return load_robot("panda")
+
+
+def _poses(robot, n, seed):
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(*robot.q_limits.T, (n, robot.dof))
+    return q, forward_kinematics(robot, q)
+
+
+def _held_arm(robot, k, v):
+    """The arm with joint k turned into a fixed row at v (revolute: v added to the row's θ)."""
+    rows = [i for i, link in enumerate(robot.links) if link.joint is not JointType.FIXED]
+    link = robot.links[rows[k]]
+    assert link.joint is JointType.REVOLUTE
+    links = list(robot.links)
+    links[rows[k]] = replace(link, theta=link.theta + v, joint=JointType.FIXED, q_limits=None)
+    return replace(robot, links=tuple(links), poses=())
+
+
+def _wrapped(d):
+    return np.abs(d - 2 * np.pi * np.rint(d / (2 * np.pi)))
+
+
+def _gap(a, b):
+    """(A,) distance of each row of a to its nearest row of b (max over joints, angles modulo 2π)."""
+    if len(b) == 0:
+        return np.full(len(a), np.inf)
+    return _wrapped(a[:, None, :] - b[None, :, :]).max(axis=-1).min(axis=-1)
+
+
+def _check_solutions(robot, T, q):
+    """Every row of q reproduces T (full-arm FK, computed here) and lies within the limits."""
+    q = np.asarray(q).reshape(-1, robot.dof)
+    F = forward_kinematics(robot, q)
+    assert np.abs(F - T).max(initial=0.0) < 1e-8
+    lim = robot.q_limits
+    assert np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
+
+
+def _dense(robot, T, k, v, rng):
+    """Every solution the numeric search finds with joint k held at v: (m, n) rows, joint k inserted."""
+    held = _held_arm(robot, k, v)
+    seeds = rng.uniform(*held.q_limits.T, (SEEDS, held.dof))
+    res = solve_ik(held, np.broadcast_to(T, (SEEDS, 4, 4)), seeds, restarts=0, rng=rng)
+    return np.insert(res.q[res.success], k, v, axis=1)
+
+
+def test_free_is_locked(panda):
+    q, T = _poses(panda, 1, 0)
+    a = analytic_ik(panda, T[0], free={"q7": q[0, 6]})
+    b = analytic_ik(panda, T[0], locked={"q7": q[0, 6]})
+    assert np.array_equal(a.solutions, b.solutions) and a.method == b.method
+    assert np.min(_gap(q[:1], a.solutions)) < 1e-9
+    with pytest.raises(ModelError, match="not both"):
+        analytic_ik(panda, T[0], locked={"q7": 0.1}, free={"q7": 0.1})
+
+
+@pytest.mark.parametrize("joint, n", [(6, 6), (2, 2)])
+def test_free_joint_solutions_are_complete(panda, joint, n):
+    """Held q7 (closed form) at 6 random poses and q3 (general 6R route) at 2 (more under slow): the dense search finds no
+    solution the analytic set lacks, and the generating configuration is in it."""
+    rng = np.random.default_rng(10 + joint)
+    q, T = _poses(panda, n, 20 + joint)
+    found = 0
+    for qi, Ti in zip(q, T):
+        res = analytic_ik(panda, Ti, free={f"q{joint + 1}": qi[joint]})
+        _check_solutions(panda, Ti, res.solutions)
+        assert np.all(res.solutions[:, joint] == qi[joint])
+        assert _gap(qi[None], res.solutions)[0] < 1e-8
+        numeric = _dense(panda, Ti, joint, qi[joint], rng)
+        _check_solutions(panda, Ti, numeric)
+        assert np.all(_gap(numeric, res.solutions) < SAME), "the dense search found a solution analytic_ik missed"
+        found += len(numeric)
+    assert found > n  # the search did run
+
+
+def test_default_free_joint_is_a_closed_form_choice(panda):
+    assert default_free_joint(panda) == "q7"
+    _, T = _poses(panda, 1, 3)
+    assert not analytic_ik(panda, T[0], free={"q7": 0.0}).method.startswith("general")
+    assert analytic_ik(panda, T[0], free={"q3": 0.0}).method.startswith("general")
+
+
+def _sweep_checks(robot, T, q, sweep, rng):
+    k = int(sweep.joint[1:]) - 1
+    assert any(a - 1e-12 <= q[k] <= b + 1e-12 for a, b in sweep.intervals), "the generating value is feasible"
+    for b in sweep.branches:  # every listed solution: FK matches T, within the limits, held value as listed
+        _check_solutions(robot, T, b.q)
+        assert np.array_equal(b.q[:, k], b.values) and b.interval == (b.values[0], b.values[-1])
+    for a, b in sweep.intervals:  # confirmed inside, by the one-value route (not the sweep's batch)
+        for t in np.r_[a, b, rng.uniform(a, b, 2)]:
+            res = analytic_ik(robot, T, free={sweep.joint: t})
+            assert res.count >= 1
+            _check_solutions(robot, T, res.solutions)
+    for (a0, b0), (a1, b1) in zip(sweep.intervals[:-1], sweep.intervals[1:]):  # gaps: the dense search agrees
+        if a1 - b0 > 1e-3:
+            t = 0.5 * (b0 + a1)
+            assert len(_dense(robot, T, k, t, rng)) == 0, f"a solution at {sweep.joint} = {t} in a gap"
+    inside = [np.any([(a <= v <= b) for a, b in sweep.intervals]) for v in sweep.values]
+    assert np.array_equal(np.array(inside), sweep.counts > 0)
+
+
+def test_sweep_intervals_confirmed(panda):
+    rng = np.random.default_rng(5)
+    q, T = _poses(panda, 2, 6)
+    for qi, Ti in zip(q, T):
+        sweep = free_joint_sweep(panda, Ti, "q7", samples=48, tol=1e-5)
+        assert sweep.tol == 1e-5 and len(sweep.values) == 48
+        _sweep_checks(panda, Ti, qi, sweep, rng)
+        # the batch route (targets moved by X(v)) against the one-value route at a few samples
+        for i in rng.choice(48, 4, replace=False):
+            res = analytic_ik(panda, Ti, free={"q7": sweep.values[i]})
+            assert res.count == sweep.counts[i]
+
+
+@pytest.mark.slow
+def test_sweep_intervals_confirmed_many(panda):
+    rng = np.random.default_rng(7)
+    q, T = _poses(panda, 3, 8)
+    for j, (qi, Ti) in enumerate(zip(q, T)):
+        _sweep_checks(panda, Ti, qi, free_joint_sweep(panda, Ti, "q1" if j == 2 else "q7", samples=64), rng)
+
+
+@pytest.mark.slow
+def test_free_joint_solutions_are_complete_many(panda):
+    rng = np.random.default_rng(11)
+    q, T = _poses(panda, 24, 12)
+    for j, (qi, Ti) in enumerate(zip(q, T)):
+        k = (4, 5, 6, 3, 0)[j % 5]
+        res = analytic_ik(panda, Ti, free={f"q{k + 1}": qi[k]})
+        _check_solutions(panda, Ti, res.solutions)
+        assert np.all(_gap(_dense(panda, Ti, k, qi[k], rng), res.solutions) < SAME)
+
+
+def test_sweep_refuses_bad_input(panda):
+    T = forward_kinematics(panda, panda.q_limits.mean(axis=1))
+    for kwargs, match in [({"joint": "q8"}, "not a joint"), ({"joint": "x"}, "not a joint"),
+                          ({"samples": 1}, "samples"), ({"tol": -1.0}, "tol")]:
+        with pytest.raises(ModelError, match=match):
+            free_joint_sweep(panda, T, **kwargs)
+    with pytest.raises(ModelError, match="one target"):
+        free_joint_sweep(panda, np.stack([T, T]), "q7")
+
+
+def _run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_cli_free_and_sweep(capsys, panda):
+    qs = "0.2,-0.3,0.1,-2.0,0.3,1.6,0.5"
+    code, out, err = _run(capsys, "ik", "panda", "--from-q", qs, "--free", "q7=0.5", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["locked"] == {"q7": 0.5}
+    assert np.min(_gap(np.array([[0.2, -0.3, 0.1, -2.0, 0.3, 1.6, 0.5]]), np.array(data["solutions"]))) < 1e-9
+    code, out, err = _run(capsys, "ik", "panda", "--from-q", qs, "--free", "q7", "--sweep", "--samples", "32", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["joint"] == "q7" and data["samples"] == 32
+    assert any(a <= 0.5 <= b for a, b in data["intervals"])
+    T = np.array(data["T"])
+    for b in data["branches"]:
+        _check_solutions(panda, T, np.array(b["solutions"]))
+    code, out, err = _run(capsys, "ik", "panda", "--from-q", qs, "--sweep", "--samples", "32")
+    assert code == 0, err
+    assert "q7 swept over" in out and "feasible q7" in out and "branch(es)" in out
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--free", "q9", "--sweep"], "not a joint"), (["--samples", "5"], "goes with --sweep"),
+    (["--free", "q7", "--free", "q6", "--sweep"], "one --free"), (["--sweep", "--lock", "q7=0"], "--sweep goes"),
+    (["--free", "q7=0", "--method", "numeric"], "analytic"), (["--free", "q7=abc"], "q7"),
+    (["--sweep", "--samples", "1"], "")])
+def test_cli_refuses_bad_input(capsys, argv, match):
+    code, _, err = _run(capsys, "ik", "panda", "--from-q", "0,0,0,-1,0,1,0", *argv)
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert match in err
+
+
+def test_public_names():
+    assert denavit.free_joint_sweep is free_joint_sweep and "free_joint_sweep" in denavit.__all__
