@@ -74,11 +74,18 @@ def _run_random(name, count, seed):
     robot = denavit.load_robot(name)
     rng = np.random.default_rng(seed)
     done = stopped = 0
+    free = np.arange(6)  # panda: q7 held (the default), the first six joints move
     for q, poses in _random_lines(robot, rng, count):
         res = denavit.ik_path(robot, poses, q)
         (traj,) = res.trajectories
         np.testing.assert_allclose(traj.q[0], q, atol=1e-7)  # the start continues q0 itself
-        _check_trajectory(robot, poses, traj)
+        _check_trajectory(robot, poses, traj, free=free)
+        if robot.dof == 7:
+            assert np.all(traj.q[:, 6] == q[6]), "the held joint moved"
+            if traj.status == "stopped":
+                assert traj.reason.endswith(f"(q7 held at {q[6]:.6g})")
+                stopped += 1
+                continue
         if traj.status == "complete":
             done += 1
             assert traj.reached == len(poses) - 1 and traj.s[-1] == len(poses) - 1
@@ -95,15 +102,27 @@ def _run_random(name, count, seed):
     assert done >= count // 4, (done, stopped)  # (the Puma's mid-range q3 is a stretched elbow: many stop)
 
 
-@pytest.mark.parametrize("name", ["puma560", "ur5"])
-def test_random_lines_are_continuous_and_reproduce_every_pose(name):
-    _run_random(name, 12, 1)
+@pytest.mark.parametrize("name, count", [("puma560", 12), ("ur5", 12), ("panda", 6)])
+def test_random_lines_are_continuous_and_reproduce_every_pose(name, count):
+    _run_random(name, count, 1)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["puma560", "ur5"])
-def test_200_random_lines_per_arm(name):
-    _run_random(name, 200, 2)
+@pytest.mark.parametrize("name, count", [("puma560", 200), ("ur5", 200), ("panda", 100)])
+def test_many_random_lines_per_arm(name, count):
+    _run_random(name, count, 2)
+
+
+def test_joint_limit_is_named_at_the_pose_past_it():
+    """Poses of a joint-space line on which q1 runs from 2.4 to 3.1 rad: the Puma's q1 limit (±160°) lies
+    between samples 7 (2.75) and 8 (2.80), known from the limits, not from the follower."""
+    robot = denavit.load_robot("puma560")
+    qa = np.array([2.4, 0.4, -0.5, 0.3, 0.8, 0.2])
+    qs = qa + np.linspace(0, 1, 15)[:, None] * (np.array([3.1, 0.4, -0.5, 0.3, 0.8, 0.2]) - qa)
+    first_out = int(np.argmax(qs[:, 0] > robot.q_limits[0, 1]))
+    (traj,) = denavit.ik_path(robot, denavit.forward_kinematics(robot, qs), qa).trajectories
+    assert traj.stop_index == first_out == 8 and traj.reason.startswith("joint limit"), traj.reason
+    np.testing.assert_allclose(traj.q, qs[:first_out], atol=1e-8)  # it followed the generating q until then
 
 
 def _puma_wrist_line(count):

@@ -287,7 +287,8 @@ def _follow(ctx: _Context, poses: np.ndarray, cands, q_start: np.ndarray, label:
         qs += [x for _, x in samples]
         ss += [i - 1 + t for t, _ in samples]
         if why is not None:
-            return PathTrajectory(np.array(qs), np.array(ss), i - 1, label, "stopped", i, f"{why[0]}: {why[1]}")
+            held = "".join(f" ({k} held at {v:.6g})" for k, v in (ctx.locked or {}).items())
+            return PathTrajectory(np.array(qs), np.array(ss), i - 1, label, "stopped", i, f"{why[0]}: {why[1]}{held}")
     return PathTrajectory(np.array(qs), np.array(ss), len(poses) - 1, label, "complete", None, "")
 
 
