@@ -11,6 +11,7 @@ Degrees are converted to radians in these modules (and on the command line) and 
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
@@ -182,6 +183,22 @@ def with_parameters(robot: DHRobot, **values: float) -> DHRobot:
         An unknown parameter name (the message lists the robot's parameters), a value that is not a finite
         number, or a new value that puts a field out of range.
     """
+    if not all(type(v) in (float, int) for v in values.values()):  # anything else: checked below, not remembered
+        return _with_parameters(robot, values)
+    # the key tells apart what == does not: the robot's angle unit (compare=False), -0.0 and 0.0, 1 and 1.0
+    return _with_parameters_remembered(robot, robot.angle_unit,
+                                       tuple((k, type(v), repr(v), v) for k, v in values.items()))
+
+
+@lru_cache(maxsize=1024)
+def _with_parameters_remembered(robot: DHRobot, unit: str, values: tuple) -> DHRobot:
+    """:func:`with_parameters` for plain numbers, remembered: a pure function of a frozen robot and the values (the
+    claim checker's "a wrong parameter value" hint builds the same robots on the same grid for every incorrect
+    claim of an arm)."""
+    return _with_parameters(robot, {k: v for k, _, _, v in values})
+
+
+def _with_parameters(robot: DHRobot, values: dict) -> DHRobot:
     params = robot.parameter_values
     for k, v in values.items():
         if k not in params:
