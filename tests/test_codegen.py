@@ -256,10 +256,10 @@ def test_numba_kernels_are_cached_on_disk_for_the_next_process(tmp_path):
     script = textwrap.dedent("""
         import numpy as np, denavit
         fast = denavit.compile(denavit.load_robot("planar3r"))
-        fast.fk(np.zeros(3)); fast.jacobian(np.zeros((2, 3)))
+        fast.fk(np.zeros(3), frames=True); fast.jacobian(np.zeros((2, 3)))  # a numba single; the batch group
         m = fast._m
-        hits = m.fk_1.stats.cache_hits.values() and sum(m.fk_1.stats.cache_hits.values())
-        misses = sum(m.fk_1.stats.cache_misses.values()) + sum(m.jacobian0_n.stats.cache_misses.values())
+        hits = sum(m.frames_1.stats.cache_hits.values()) + sum(m.group_n.stats.cache_hits.values())
+        misses = sum(m.frames_1.stats.cache_misses.values()) + sum(m.group_n.stats.cache_misses.values())
         print(fast.backend, hits, misses)
     """)
     env = {**os.environ, "DENAVIT_CACHE_DIR": str(tmp_path)}
