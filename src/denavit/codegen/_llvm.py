@@ -338,12 +338,36 @@ def _poly_sincos(builder, x, lanes: int, sincos, const):
     any_big = (builder.icmp_unsigned("!=", builder.bitcast(big, ir.IntType(lanes)), ir.Constant(ir.IntType(lanes), 0))
                if lanes else big)
     with cgutils.if_unlikely(builder, any_big):
-        s_ptr, c_ptr = cgutils.alloca_once(builder, dbl), cgutils.alloca_once(builder, dbl)
-        if not lanes:
-            builder.call(sincos, [x, s_out, c_out])
-        for j in range(lanes):
-            lane = ir.Constant(i64, j)
-            builder.call(sincos, [builder.extract_element(x, lane), s_ptr, c_ptr])
-            builder.store(builder.insert_element(builder.load(s_out), builder.load(s_ptr), lane), s_out)
-            builder.store(builder.insert_element(builder.load(c_out), builder.load(c_ptr), lane), c_out)
+        builder.call(_lanes_sincos(module, sincos, lanes) if lanes else sincos, [x, s_out, c_out])
     return builder.load(s_out), builder.load(c_out)
+
+
+def _lanes_sincos(module, sincos, lanes: int):
+    """``void f(<lanes x double> x, <lanes x double>* s, <lanes x double>* c)``: libm's sincos lane by lane, one
+    internal function per module (called where an angle is out of the polynomial's range: written once, not at
+    every sine of every batch program, which LLVM would optimise each time)."""
+    from llvmlite import ir
+    from numba.core import cgutils
+
+    name = f"denavit_lanes_sincos_{lanes}"
+    fn = module.globals.get(name)
+    if fn is not None:
+        return fn
+    dbl, i64 = ir.DoubleType(), ir.IntType(64)
+    vty = ir.VectorType(dbl, lanes)
+    fn = ir.Function(module, ir.FunctionType(ir.VoidType(), [vty, vty.as_pointer(), vty.as_pointer()]), name=name)
+    fn.linkage = "internal"
+    fn.attributes.add("noinline")
+    fn.attributes.add("cold")
+    b = ir.IRBuilder(fn.append_basic_block("entry"))
+    x, s_out, c_out = fn.args
+    s_ptr, c_ptr = cgutils.alloca_once(b, dbl), cgutils.alloca_once(b, dbl)
+    s_v, c_v = ir.Constant(vty, ir.Undefined), ir.Constant(vty, ir.Undefined)
+    for j in range(lanes):
+        lane = ir.Constant(i64, j)
+        b.call(sincos, [b.extract_element(x, lane), s_ptr, c_ptr])
+        s_v, c_v = b.insert_element(s_v, b.load(s_ptr), lane), b.insert_element(c_v, b.load(c_ptr), lane)
+    b.store(s_v, s_out)
+    b.store(c_v, c_out)
+    b.ret_void()
+    return fn
