@@ -43,7 +43,7 @@ __all__ = ["PathTrajectory", "PathResult", "ik_path", "cartesian_line", "SINGULA
            "STEP_FACTOR"]
 
 #: σ_min/σ_max of the scaled Jacobian below which a configuration counts as singular (the branch ends there).
-SINGULAR_RTOL = 1e-3
+SINGULAR_RTOL = 1e-4
 #: Most halvings of one Cartesian segment (so at most 2**MAX_HALVINGS − 1 inserted poses per segment).
 MAX_HALVINGS = 8
 #: A step may be this many times what J⁺·Δx implies.
@@ -73,6 +73,9 @@ class PathTrajectory:
     reason : str
         ``""``, or why: ``"singularity"``, ``"joint limit"``, ``"workspace boundary"``, ``"step bound"``, with
         details after a colon.
+    labels : tuple of str (k,)
+        The branch label of each sample: ``branch`` throughout, except where a label's test changes sign away
+        from any singular set (see :func:`_switch`): the configuration continues, its label changes.
     """
 
     q: np.ndarray
@@ -82,6 +85,7 @@ class PathTrajectory:
     status: str
     stop_index: int | None
     reason: str
+    labels: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -246,22 +250,47 @@ def _step(ctx: _Context, q, label, Ta, Tb, cand):
 
 
 def _segment(ctx, q, label, Ta, Tb, cand, depth=0):
-    """Samples [(t, q)] (t in (0, 1]) from q at Ta to Tb, halving where a step is too large; and why it stopped
-    (None, or (kind, detail))."""
+    """Samples [(t, q, label)] (t in (0, 1]) from q at Ta to Tb, halving where a step is too large; and why it
+    stopped (None, or (kind, detail))."""
     q_new, kind, detail = _step(ctx, q, label, Ta, Tb, cand)
     if kind is None:
-        return [(1.0, q_new)], None
+        return [(1.0, q_new, label)], None
     if kind not in ("continuity", "max step"):
         return [], (kind, detail)
     if depth >= MAX_HALVINGS:
-        return [], _verdict(ctx, q, label, Tb, kind, detail, cand)
+        switch = _switch(ctx, q, label, Ta, Tb, cand) if kind == "continuity" else None
+        return ([(1.0, *switch)], None) if switch else ([], _verdict(ctx, q, label, Tb, kind, detail, cand))
     Tm = _interpolate(Ta, Tb, np.array(0.5))
     left, why = _segment(ctx, q, label, Ta, Tm, None, depth + 1)
-    left = [(0.5 * t, x) for t, x in left]
+    left = [(0.5 * t, x, b) for t, x, b in left]
     if why is not None:
         return left, why
-    right, why = _segment(ctx, left[-1][1], label, Tm, Tb, cand, depth + 1)
-    return left + [(0.5 + 0.5 * t, x) for t, x in right], why
+    right, why = _segment(ctx, left[-1][1], left[-1][2], Tm, Tb, cand, depth + 1)
+    return left + [(0.5 + 0.5 * t, x, b) for t, x, b in right], why
+
+
+def _switch(ctx, q, label, Ta, Tb, cand):
+    """After every halving: a solution of another label that continues q within the step bound, when no singular
+    configuration lies between them — a label's test changing sign away from a singular set (the labels are
+    tests of q, docs/ik.md), not a branch ending.  σ_min/σ_max is checked at 9 points of the joint-space step:
+    a true crossing of a singular set (the Puma's q5 = 0) passes through it.  (q_new, label) or None."""
+    if not ctx.analytic:
+        return None
+    sols, labels = ctx.solve(Tb) if cand is None else cand
+    other = [k for k, b in enumerate(labels) if b != label]
+    if not other:
+        return None
+    d = ctx.diff(sols[other], q)
+    step = np.max(np.abs(d), axis=1)
+    k = int(np.argmin(step))
+    if step[k] > ctx.bound(q, Ta, Tb) or (ctx.max_step is not None and step[k] > ctx.max_step):
+        return None
+    if min(ctx.sigma_ratio(q + t * d[k]) for t in np.linspace(0.0, 1.0, 9)) < SINGULAR_RTOL:
+        return None
+    q_new = q + d[k]
+    if not np.all((q_new >= ctx.lo - 1e-12) & (q_new <= ctx.hi + 1e-12)):
+        q_new = sols[other][k]
+    return q_new, labels[other[k]]
 
 
 def _verdict(ctx, q, label, Tb, kind, detail, cand):
@@ -281,15 +310,17 @@ def _verdict(ctx, q, label, Tb, kind, detail, cand):
 
 def _follow(ctx: _Context, poses: np.ndarray, cands, q_start: np.ndarray, label: str) -> PathTrajectory:
     """The trajectory from q_start (a solution of pose 0) along every following pose, until the branch ends."""
-    qs, ss = [q_start], [0.0]  # the start is a solution even when singular: the steps away from it are judged
+    qs, ss, ls = [q_start], [0.0], [label]  # the start is a solution even when singular: steps away are judged
     for i in range(1, len(poses)):
-        samples, why = _segment(ctx, qs[-1], label, poses[i - 1], poses[i], cands[i])
-        qs += [x for _, x in samples]
-        ss += [i - 1 + t for t, _ in samples]
+        samples, why = _segment(ctx, qs[-1], ls[-1], poses[i - 1], poses[i], cands[i])
+        qs += [x for _, x, _ in samples]
+        ss += [i - 1 + t for t, _, _ in samples]
+        ls += [b for _, _, b in samples]
         if why is not None:
             held = "".join(f" ({k} held at {v:.6g})" for k, v in (ctx.locked or {}).items())
-            return PathTrajectory(np.array(qs), np.array(ss), i - 1, label, "stopped", i, f"{why[0]}: {why[1]}{held}")
-    return PathTrajectory(np.array(qs), np.array(ss), len(poses) - 1, label, "complete", None, "")
+            return PathTrajectory(np.array(qs), np.array(ss), i - 1, label, "stopped", i, f"{why[0]}: {why[1]}{held}",
+                                  tuple(ls))
+    return PathTrajectory(np.array(qs), np.array(ss), len(poses) - 1, label, "complete", None, "", tuple(ls))
 
 
 def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step: float | None = None) -> PathResult:
@@ -353,6 +384,6 @@ def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step
         out = np.size(analytic_ik(robot, T[0], locked=ctx.locked).outside_limits) if ctx.analytic else 0
         why = ("joint limit: pose 0 has solutions only outside the joint limits" if out else
                "workspace boundary: no solution at pose 0")
-        empty = PathTrajectory(np.zeros((0, robot.dof)), np.zeros(0), -1, "", "stopped", 0, why)
+        empty = PathTrajectory(np.zeros((0, robot.dof)), np.zeros(0), -1, "", "stopped", 0, why, ())
         return PathResult((empty,), T, held)
     return PathResult(tuple(_follow(ctx, T, cands, s, b) for s, b in zip(sols, labels)), T, held)
