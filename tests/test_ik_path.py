@@ -209,6 +209,20 @@ def test_panda_holds_the_chosen_joint():
     _check_trajectory(robot, poses, traj, free=np.arange(6))
 
 
+def test_panda_nearest_moves_every_joint_and_stays_continuous():
+    """redundancy="nearest": LM from the previous q at every pose, all seven joints free."""
+    robot = denavit.load_robot("panda")
+    rng = np.random.default_rng(3)
+    moved = 0
+    for q, poses in _random_lines(robot, rng, 4):
+        (traj,) = denavit.ik_path(robot, poses, q, redundancy="nearest").trajectories
+        assert traj.status == "complete" or traj.reason.split(":")[0] in (
+            "singularity", "joint limit", "workspace boundary", "no convergence"), traj.reason
+        _check_trajectory(robot, poses, traj)
+        moved += np.ptp(traj.q[:, 6]) > 1e-6
+    assert moved  # the self-motion is used (q7 not held)
+
+
 def test_bad_input_is_refused_with_one_line():
     robot = denavit.load_robot("puma560")
     with pytest.raises(ValueError, match="poses"):
@@ -217,6 +231,8 @@ def test_bad_input_is_refused_with_one_line():
         denavit.ik_path(robot, np.eye(4)[None], max_step=-1.0)
     with pytest.raises(ValueError, match="hold"):
         denavit.ik_path(robot, np.eye(4)[None], hold="q9")
+    with pytest.raises(ValueError, match="redundancy"):
+        denavit.ik_path(robot, np.eye(4)[None], redundancy="free")
     with pytest.raises(ValueError, match="step"):
         denavit.cartesian_line(np.eye(4), np.eye(4), step=0.0)
 

@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import DenavitError, ParseError
 from ._common import check_values, emit, joint_values, numbers_text, positive_float
 
-__all__ = ["add_path_arguments", "cmd_ik_path", "MAX_LINE_POSES"]
+__all__ = ["MAX_LINE_POSES", "add_path_arguments", "cmd_ik_path"]
 
 #: Most poses a --line may be cut into (--step small against the line's length is refused).
 MAX_LINE_POSES = 100_000
@@ -30,6 +30,9 @@ def add_path_arguments(target: argparse._MutuallyExclusiveGroup, p: argparse.Arg
                    help="--path/--line: largest joint step [rad, m]; poses are inserted to respect it")
     p.add_argument("--hold", metavar="qN", help="--path/--line, redundant arms: the joint held at --q0's value "
                                                 "(default the last)")
+    p.add_argument("--redundancy", choices=["hold", "nearest"], default="hold",
+                   help="--path/--line, redundant arms: hold one joint (closed form for the rest), or nearest: the "
+                        "numeric solver from the previous q at every pose")
 
 
 def _line_pose(args, text: str):
@@ -71,9 +74,9 @@ def cmd_ik_path(args: argparse.Namespace, robot):
     q0 = None if args.q0 is None else joint_values(args, robot, args.q0, what="--q0")
     if args.hold is not None and q0 is None:
         raise ParseError("--hold needs --q0 (the held joint keeps its value)")
-    res = ik_path(robot, poses, q0, hold=args.hold, max_step=args.max_step)
+    res = ik_path(robot, poses, q0, hold=args.hold, max_step=args.max_step, redundancy=args.redundancy)
     rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-    unit = lambda q: np.where(rev, np.degrees(q), q) if args.deg else q  # noqa: E731
+    unit = lambda q: np.where(rev, np.degrees(q), q) if args.deg else q
     trajs = [{"branch": t.branch, "status": t.status, "reached": t.reached, "stop_index": t.stop_index,
               "reason": t.reason, "s": t.s, "q": unit(t.q)} for t in res.trajectories]
     data = {"robot": robot.name, "angle_unit": "deg" if args.deg else "rad", "poses": len(poses),

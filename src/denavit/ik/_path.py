@@ -19,10 +19,12 @@ one, or a continuum) the numeric solver is seeded at the previous q without rest
 - ``"joint limit"``: the pose has solutions only outside the joint limits, or the nearest continuation lies
   outside them;
 - ``"workspace boundary"``: no solution at all, even outside the limits;
-- ``"step bound"``: ``max_step`` cannot be met after every halving.
+- ``"step bound"``: ``max_step`` cannot be met after every halving;
+- ``"no convergence"`` (numeric route only): the solver seeded at the previous q ran out of iterations.
 
 Redundant arms (more than 6 joints) hold one joint (``hold``, default the last one) at q0's value — the
-null-space motion chosen is "that joint does not move"; the other joints follow the rules above.
+null-space motion chosen is "that joint does not move"; the other joints follow the rules above.  With
+``redundancy="nearest"`` every pose is solved numerically from the previous q instead (least joint motion).
 """
 
 from __future__ import annotations
@@ -39,8 +41,15 @@ from ._analytic import analytic_ik
 from ._numeric import solve_ik
 from ._residual import characteristic_length, pose_error
 
-__all__ = ["PathTrajectory", "PathResult", "ik_path", "cartesian_line", "SINGULAR_RTOL", "MAX_HALVINGS",
-           "STEP_FACTOR"]
+__all__ = [
+    "MAX_HALVINGS",
+    "SINGULAR_RTOL",
+    "STEP_FACTOR",
+    "PathResult",
+    "PathTrajectory",
+    "cartesian_line",
+    "ik_path",
+]
 
 #: σ_min/σ_max of the scaled Jacobian below which a configuration counts as singular (the branch ends there).
 SINGULAR_RTOL = 1e-4
@@ -154,15 +163,20 @@ def cartesian_line(T_start, T_end, step: float = 0.01, angle_step: float = 0.05)
 class _Context:
     """The arm, its held joint and how one pose is solved (read-only after construction)."""
 
-    def __init__(self, robot: DHRobot, q0, hold: str | None, max_step: float | None):
+    def __init__(self, robot: DHRobot, q0, hold: str | None, max_step: float | None, redundancy: str = "hold"):
         n = robot.dof
         self.robot, self.n, self.max_step = robot, n, max_step
         self.rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
         self.L = characteristic_length(robot)
         self.lo, self.hi = robot.q_limits[:, 0], robot.q_limits[:, 1]
+        if redundancy not in ("hold", "nearest"):
+            raise ModelError(f"redundancy: {redundancy!r}; choose 'hold' or 'nearest'")
+        self.locked, self.free = None, np.arange(n)
+        if redundancy == "nearest" and hold is None and n > 6:  # LM from the previous q: no closed form
+            self.analytic = False
+            return
         if hold is None and n > 6:
             hold = f"q{n}"
-        self.locked, self.free = None, np.arange(n)
         if hold is not None:
             k = int(hold[1:]) - 1 if hold[:1] == "q" and hold[1:].isdigit() else -1
             if not 0 <= k < n:
@@ -208,8 +222,9 @@ class _Context:
         return STEP_FACTOR * float(np.max(np.abs(dq), initial=0.0)) + _STEP_ATOL
 
     def numeric(self, q: np.ndarray, T: np.ndarray):
+        """LM seeded at q, no restarts: (the solution continued from q, "") or (None, solve_ik's reason)."""
         res = solve_ik(self.robot, T, q, restarts=0, tol=_FK_TOL)
-        return q + self.diff(res.q, q) if res.success else None
+        return (q + self.diff(res.q, q), "") if res.success else (None, str(res.reason))
 
 
 def _step(ctx: _Context, q, label, Ta, Tb, cand):
@@ -235,9 +250,10 @@ def _step(ctx: _Context, q, label, Ta, Tb, cand):
             if not same:
                 return None, "continuity", "the branch has no solution here"
     else:
-        q_new = ctx.numeric(q, Tb)
-        if q_new is None:
-            return None, "workspace boundary", "the numeric solver seeded at the previous q found no solution"
+        q_new, why = ctx.numeric(q, Tb)
+        if q_new is None:  # solve_ik's reasons: "limits" (a solution only outside them), "unreachable", "iterations"
+            kind = {"limits": "joint limit", "unreachable": "workspace boundary"}.get(why, "no convergence")
+            return None, kind, f"the numeric solver seeded at the previous q found no solution ({why})"
         step = float(np.max(np.abs(ctx.diff(q_new, q)), initial=0.0))
     if step > bound:
         return None, "continuity", f"step {step:.3g} > {bound:.3g} = {STEP_FACTOR:g}·|J⁺Δx|"
@@ -323,7 +339,8 @@ def _follow(ctx: _Context, poses: np.ndarray, cands, q_start: np.ndarray, label:
     return PathTrajectory(np.array(qs), np.array(ss), len(poses) - 1, label, "complete", None, "", tuple(ls))
 
 
-def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step: float | None = None) -> PathResult:
+def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step: float | None = None,
+            redundancy: str = "hold") -> PathResult:
     """Joint trajectories along a sequence of poses, each staying on one IK branch (module notes: the rules).
 
     Parameters
@@ -337,6 +354,11 @@ def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step
     hold : str, optional
         Redundant arms: the joint held at q0's value (default the last joint; the middle of its limits when q0
         is None).  The held joint never moves: that is the null-space motion chosen.
+    redundancy : {"hold", "nearest"}
+        Redundant arms: ``"hold"`` one joint (above), every closed-form solution of the rest; ``"nearest"``: the
+        numeric solver (Levenberg–Marquardt, no restarts) seeded at the previous q for every pose — its damped
+        least-squares steps are the least joint motion that reduces the pose error, so the self-motion is not
+        driven and the trajectory stays near the previous q (one trajectory, no labels).
     max_step : float, optional
         Largest joint step between samples [rad, m]; segments are halved (poses inserted) to respect it, at
         most :data:`MAX_HALVINGS` times, else the trajectory stops with ``"step bound"``.
@@ -367,19 +389,10 @@ def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step
         q0 = as_joint_array(q0, robot.dof, "q0")
         if q0.ndim != 1:
             raise ModelError(f"q0: expected one configuration of shape ({robot.dof},), got {q0.shape}")
-    ctx = _Context(robot, q0, hold, max_step)
+    ctx = _Context(robot, q0, hold, max_step, redundancy)
     cands = ctx.solve(T)
     held = next(iter(ctx.locked), "") if ctx.locked else ""
-    sols, labels = cands[0]
-    if not ctx.analytic:
-        start = ctx.numeric(np.zeros(robot.dof) if q0 is None else q0, T[0])
-        sols, labels = (np.zeros((0, robot.dof)), ()) if start is None else (start[None], ("",))
-    if q0 is not None and len(sols):
-        d = ctx.diff(sols, q0)
-        k = int(np.argmin(np.max(np.abs(d), axis=1)))
-        start = q0 + d[k]  # q0's own turn of each angle when that stays within the limits
-        inside = np.all((start >= ctx.lo - 1e-12) & (start <= ctx.hi + 1e-12))
-        sols, labels = (start if inside else sols[k])[None], labels[k:k + 1]
+    sols, labels = _starts(ctx, T[0], cands[0], q0)
     if not len(sols):
         out = np.size(analytic_ik(robot, T[0], locked=ctx.locked).outside_limits) if ctx.analytic else 0
         why = ("joint limit: pose 0 has solutions only outside the joint limits" if out else
@@ -387,3 +400,19 @@ def ik_path(robot: DHRobot, poses, q0=None, *, hold: str | None = None, max_step
         empty = PathTrajectory(np.zeros((0, robot.dof)), np.zeros(0), -1, "", "stopped", 0, why, ())
         return PathResult((empty,), T, held)
     return PathResult(tuple(_follow(ctx, T, cands, s, b) for s, b in zip(sols, labels)), T, held)
+
+
+def _starts(ctx: _Context, T0: np.ndarray, cand, q0):
+    """Where the trajectories start: pose 0's solution nearest to q0 (q0's own turn of each angle when that stays
+    within the limits), or every solution of pose 0; the numeric route: LM from q0 (or zero)."""
+    sols, labels = cand
+    if not ctx.analytic:
+        start = ctx.numeric(np.zeros(ctx.n) if q0 is None else q0, T0)[0]
+        sols, labels = (np.zeros((0, ctx.n)), ()) if start is None else (start[None], ("",))
+    if q0 is not None and len(sols):
+        d = ctx.diff(sols, q0)
+        k = int(np.argmin(np.max(np.abs(d), axis=1)))
+        start = q0 + d[k]
+        inside = np.all((start >= ctx.lo - 1e-12) & (start <= ctx.hi + 1e-12))
+        sols, labels = (start if inside else sols[k])[None], labels[k:k + 1]
+    return sols, labels
