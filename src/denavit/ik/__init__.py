@@ -11,7 +11,8 @@ numeric engine (:mod:`denavit.numeric`) for forward kinematics and Jacobians; no
 """
 
 from ._analytic import AnalyticIKResult, analytic_ik, ik_plan, ik_structure
-from ._path import PathResult, PathTrajectory, cartesian_line, ik_path
+from ._line import cartesian_line
+from ._path import PathResult, PathTrajectory, ik_path
 from ._numeric import MAX_ITERATIONS, RESTARTS, TOL, solve_ik
 from ._sweep import SAMPLES, SWEEP_TOL, FreeJointSweep, SweepBranch, default_free_joint, free_joint_sweep
 from ._residual import IKResult, JointLimits, characteristic_length, pose_error, rotation_log, row_mask
