@@ -57,6 +57,8 @@ def compile_planar(backend="numpy"):
     _cache._LOADED.clear()
     fast = denavit.compile(denavit.load_robot("planar2r"), backend=backend, kernels=["fk"])
     np.testing.assert_allclose(fast.fk(Q)[:2, 3], planar_xy(Q), atol=1e-14)
+    # a keyword call: numba's fk_1 (the first call went through fk's built-in, which hands this one back)
+    np.testing.assert_allclose(fast.fk(Q, frames=False)[:2, 3], planar_xy(Q), atol=1e-14)
     return fast
 
 

@@ -126,8 +126,8 @@ SCRIPT = textwrap.dedent("""
     one = fast._call("toy_qq", (np.array([3.0, 4.0]),), ("q",))[0]
     many = fast._call("toy_qq", (np.array([[1.0, 2.0], [2.0, 2.0], [0.0, 1.0], [1.0, 1.0], [3.0, 0.0]]),), ("q",))
     m = fast._groups["toys"][0]
-    hits = sum(m.toy_qq_1.stats.cache_hits.values()) + sum(m.toy_qq_n.stats.cache_hits.values())
-    misses = sum(m.toy_qq_1.stats.cache_misses.values()) + sum(m.toy_qq_n.stats.cache_misses.values())
+    hits = sum(m.toy_qq_1.stats.cache_hits.values()) + sum(m.group_n.stats.cache_hits.values())
+    misses = sum(m.toy_qq_1.stats.cache_misses.values()) + sum(m.group_n.stats.cache_misses.values())
     print(fast.backend, before, one, many[:, 0].tolist(), hits, misses)
 """)
 
@@ -143,5 +143,5 @@ def test_numba_group_compiled_on_first_call_and_loaded_by_the_next_process(tmp_p
         assert rest.startswith("[5.0, 8.0, 1.0, 2.0, 9.0]")
     hits1, misses1 = map(int, runs[0][4].split()[-2:])
     hits2, misses2 = map(int, runs[1][4].split()[-2:])
-    assert misses1 == 2 and hits1 == 0  # compiled: the single and the batch function
+    assert misses1 == 2 and hits1 == 0  # compiled: the single and the group's batch function
     assert hits2 == 2 and misses2 == 0  # the second process loads both from the disk cache
