@@ -148,9 +148,11 @@ def test_puma_wrist_singularity_is_named_where_it_is_crossed(count, where):
     assert np.all(traj.q[:, 4] > 0)  # the branch (wrist noflip) kept to the end
 
 
-def test_line_beyond_reach_stops_at_the_workspace_boundary():
-    robot = denavit.load_robot("ur5")
-    q = np.array([0.3, -1.2, 1.4, -0.6, 1.1, 0.4])
+@pytest.mark.parametrize("name, q", [("ur5", [0.3, -1.2, 1.4, -0.6, 1.1, 0.4]),
+                                     ("puma560", [0.1, 0.4, -0.5, 0.3, 0.8, 0.2])])
+def test_line_beyond_reach_stops_at_the_workspace_boundary(name, q):
+    robot = denavit.load_robot(name)
+    q = np.array(q)
     Ta = denavit.forward_kinematics(robot, q)
     Tb = Ta.copy()
     Tb[:3, 3] += 1.5 * Ta[:3, 3] / np.linalg.norm(Ta[:3, 3])  # straight out, far past the reach
@@ -262,3 +264,22 @@ def test_cli_line_and_path_file(tmp_path, capsys):
     f.write_text("x,y,z\n1,2,3\n")
     assert main(["ik", "ur5", "--path", str(f)]) == 2
     assert "--path needs the columns x y z qw qx qy qz" in capsys.readouterr().err
+
+
+def test_cli_max_step_and_degrees(capsys):
+    import json
+
+    from denavit.cli import main
+
+    args = ["ik", "puma560", "--line", "0.4,0.1,0.6,0,90,0", "0.45,0.2,0.6,0,90,0", "--step", "0.05", "--deg"]
+    assert main(args + ["--max-step", "1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    robot = denavit.load_robot("puma560")
+    for traj in out["trajectories"]:
+        q = np.radians(np.array(traj["q"]))  # --deg: every Puma joint is revolute
+        assert np.abs(np.diff(q, axis=0)).max() <= np.radians(1) + 1e-12
+        T = denavit.forward_kinematics(robot, q[-1])
+        np.testing.assert_allclose(T[:3, 3], [0.45, 0.2, 0.6], atol=1e-8)
+        np.testing.assert_allclose(T[:3, 2], [1, 0, 0], atol=1e-8)  # pitch 90°: the tool z axis along +x
+    assert main(args + ["--hold", "q6"]) == 2
+    assert "--hold needs --q0" in capsys.readouterr().err

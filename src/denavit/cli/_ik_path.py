@@ -27,7 +27,8 @@ def add_path_arguments(target: argparse._MutuallyExclusiveGroup, p: argparse.Arg
     p.add_argument("--q0", metavar="Q", help="--path/--line: continue this configuration's branch (default: one "
                                              "trajectory per solution of the first pose)")
     p.add_argument("--max-step", dest="max_step", type=positive_float,
-                   help="--path/--line: largest joint step [rad, m]; poses are inserted to respect it")
+                   help="--path/--line: largest joint step [rad (deg with --deg), m]; poses are inserted to "
+                        "respect it")
     p.add_argument("--hold", metavar="qN", help="--path/--line, redundant arms: the joint held at --q0's value "
                                                 "(default the last)")
     p.add_argument("--redundancy", choices=["hold", "nearest"], default="hold",
@@ -74,7 +75,8 @@ def cmd_ik_path(args: argparse.Namespace, robot):
     q0 = None if args.q0 is None else joint_values(args, robot, args.q0, what="--q0")
     if args.hold is not None and q0 is None:
         raise ParseError("--hold needs --q0 (the held joint keeps its value)")
-    res = ik_path(robot, poses, q0, hold=args.hold, max_step=args.max_step, redundancy=args.redundancy)
+    max_step = np.radians(args.max_step) if args.deg and args.max_step is not None else args.max_step
+    res = ik_path(robot, poses, q0, hold=args.hold, max_step=max_step, redundancy=args.redundancy)
     rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
     unit = lambda q: np.where(rev, np.degrees(q), q) if args.deg else q
     trajs = [{"branch": t.branch, "status": t.status, "reached": t.reached, "stop_index": t.stop_index,
