@@ -306,14 +306,16 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
         keep = np.r_[True, np.diff(vs) > 0]  # a refined end equal to its sample is not listed twice
         branches.append(SweepBranch(str(b["label"]), (float(vs[0]), float(vs[-1])), vs[keep], qs[keep]))
     branches.sort(key=lambda b: (b.interval, b.label))
-    return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches), _union(b.interval for b in branches),
-                          float(tol), held.method)
+    return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
+                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method)
 
 
-def _union(intervals) -> tuple[tuple[float, float], ...]:
+def _union(intervals, gap: float) -> tuple[tuple[float, float], ...]:
+    """Sorted union; pieces less than ``gap`` apart are one (a branch split where its joints jump leaves its two
+    refined ends up to 2·tol apart with solutions in between: a gap that narrow is not resolved)."""
     out: list[list[float]] = []
     for a, b in sorted(intervals):
-        if out and a <= out[-1][1]:
+        if out and a <= out[-1][1] + gap:
             out[-1][1] = max(out[-1][1], b)
         else:
             out.append([a, b])
