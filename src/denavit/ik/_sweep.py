@@ -283,7 +283,14 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     values = np.linspace(lo, hi, int(samples))
     q, labels = held.solve(values)
     counts = (~np.isnan(q).any(axis=-1)).sum(axis=-1)
-    raw = _branches(robot, values, q, labels)
+    branches = _assemble(robot, held, values, _branches(robot, values, q, labels), tol)
+    branches.sort(key=lambda b: (b.interval, b.label))
+    return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
+                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method)
+
+
+def _assemble(robot: DHRobot, held: _Held, values: np.ndarray, raw: list[dict], tol: float) -> list[SweepBranch]:
+    """The linked samples as SweepBranch values, each end inside the range refined by bisection (all at once)."""
     ends = []  # (inside, outside, q, label) for every end strictly inside the range
     for b in raw:
         i0, i1 = b["idx"][0], b["idx"][-1]
@@ -305,9 +312,7 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
         vs, qs = np.array(vs), np.array(qs)
         keep = np.r_[True, np.diff(vs) > 0]  # a refined end equal to its sample is not listed twice
         branches.append(SweepBranch(str(b["label"]), (float(vs[0]), float(vs[-1])), vs[keep], qs[keep]))
-    branches.sort(key=lambda b: (b.interval, b.label))
-    return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
-                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method)
+    return branches
 
 
 def _union(intervals, gap: float) -> tuple[tuple[float, float], ...]:
