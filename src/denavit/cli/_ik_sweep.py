@@ -60,7 +60,8 @@ def cmd_sweep(args, robot, T):
     from ..model import JointType
 
     joint = sweep_joint(args, robot)
-    res = free_joint_sweep(robot, T, joint, samples=args.samples or SAMPLES)
+    samples = args.samples or SAMPLES
+    res = free_joint_sweep(robot, T, joint, samples=samples)
     k = int(res.joint[1:]) - 1
     deg = args.deg and robot.joint_types[k] is JointType.REVOLUTE
     unit = (lambda v: float(np.degrees(v))) if deg else float
@@ -68,12 +69,12 @@ def cmd_sweep(args, robot, T):
              if args.deg else np.asarray(q))
     fmt = lambda v: number_text(unit(v), 6)
     data = {"method": "analytic sweep", "structure": res.method, "joint": res.joint,
-            "limits": [unit(v) for v in res.limits], "samples": len(res.values), "tol": unit(res.tol),
+            "limits": [unit(v) for v in res.limits], "samples": samples, "evaluated": len(res.values), "tol": unit(res.tol),
             "intervals": [[unit(a), unit(b)] for a, b in res.intervals], "success": bool(res.intervals),
             "branches": [{"label": b.label, "interval": [unit(v) for v in b.interval], "values": [unit(v) for v in b.values],
                           "solutions": qunit(b.q)} for b in res.branches]}
     span = lambda ab: f"[{fmt(ab[0])}, {fmt(ab[1])}]"
-    lines = [(f"{res.joint} swept over {span(res.limits)} ({len(res.values)} samples, ends to {number_text(unit(res.tol), 3)}; "
+    lines = [(f"{res.joint} swept over {span(res.limits)} ({samples} samples + {len(res.values) - samples} near branch ends, ends to {number_text(unit(res.tol), 3)}; "
              f"held arm: {res.method})"),
              f"feasible {res.joint} (a solution within every joint limit): "
              + (", ".join(span(ab) for ab in res.intervals) if res.intervals else "none"),

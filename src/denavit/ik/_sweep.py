@@ -27,6 +27,7 @@ from ..numeric import forward_kinematics
 from ._analytic import analytic_ik
 
 __all__ = [
+    "DENSIFY",
     "LINK_RADIUS",
     "SAMPLES",
     "SWEEP_TOL",
@@ -38,6 +39,7 @@ __all__ = [
 
 SAMPLES = 256  #: default number of samples of the held joint over its limits
 SWEEP_TOL = 1e-6  #: default bisection tolerance on the branch ends [rad, m]
+DENSIFY = 8  #: a sample step where a branch starts or ends is cut into this many (once)
 LINK_RADIUS = 0.5  #: largest joint change (max over joints, angles modulo 2π) that links two samples' solutions
 
 
@@ -74,7 +76,8 @@ class FreeJointSweep:
     limits : (float, float)
         Its limit range, the swept range.
     values : ndarray, shape (S,)
-        The samples of the held joint.
+        The samples of the held joint: ``samples`` evenly spaced, plus DENSIFY − 1 more in each step where a
+        branch starts or ends.
     counts : ndarray of int, shape (S,)
         Solutions within the limits at each sample.
     branches : tuple of SweepBranch
@@ -280,13 +283,35 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     if not (np.isfinite(tol) and tol > 0):
         raise ModelError(f"free_joint_sweep: tol must be a positive number, got {tol!r}")
     held = _Held(robot, T, k)
-    values = np.linspace(lo, hi, int(samples))
-    q, labels = held.solve(values)
+    values, q, _, raw = _densified(robot, held, np.linspace(lo, hi, int(samples)))
     counts = (~np.isnan(q).any(axis=-1)).sum(axis=-1)
-    branches = _assemble(robot, held, values, _branches(robot, values, q, labels), tol)
+    branches = _assemble(robot, held, values, raw, tol)
     branches.sort(key=lambda b: (b.interval, b.label))
     return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
                           _union((b.interval for b in branches), 2 * tol), float(tol), held.method)
+
+
+def _densified(robot: DHRobot, held: _Held, values: np.ndarray):
+    """Solve at the samples, link; then, once, each sample step where a branch starts or ends gets DENSIFY − 1
+    more samples (a branch living between two samples, next to a fold or a limit, is found there) and the whole
+    set is linked again.  Returns values (S',), q (S', K, n), labels (S', K) and the linked branches."""
+    q, labels = held.solve(values)
+    raw = _branches(robot, values, q, labels)
+    last = len(values) - 1
+    steps = sorted({b["idx"][-1] for b in raw if b["idx"][-1] < last} | {b["idx"][0] - 1 for b in raw if b["idx"][0] > 0})
+    if not steps:
+        return values, q, labels, raw
+    frac = np.arange(1, DENSIFY) / DENSIFY
+    extra = (values[steps, None] + (values[np.array(steps) + 1, None] - values[steps, None]) * frac).ravel()
+    q2, l2 = held.solve(extra)
+    K = max(q.shape[1], q2.shape[1])
+    pad = lambda a, fill: np.concatenate(
+        [a, np.full(a.shape[:1] + (K - a.shape[1],) + a.shape[2:], fill, dtype=a.dtype)], axis=1)
+    order = np.argsort(np.r_[values, extra], kind="stable")
+    values = np.r_[values, extra][order]
+    q = np.concatenate([pad(q, np.nan), pad(q2, np.nan)])[order]
+    labels = np.concatenate([pad(labels, ""), pad(l2, "")])[order]
+    return values, q, labels, _branches(robot, values, q, labels)
 
 
 def _assemble(robot: DHRobot, held: _Held, values: np.ndarray, raw: list[dict], tol: float) -> list[SweepBranch]:
