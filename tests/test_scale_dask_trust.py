@@ -300,3 +300,61 @@ def test_sigterm_reaching_the_caller_outside_the_cluster_block_is_still_143_and_
     assert main(["workspace", "planar2r", "--samples", "1000"]) == 128 + signal.SIGTERM
     out, err = capsys.readouterr()
     assert (out, err) == ("", "")
+
+
+class _Part:
+    """A stand-in for a Client or a cluster: ``close`` records its call, then blocks, fails or returns."""
+
+    def __init__(self, log, name, behaviour="return"):
+        self.log, self.name, self.behaviour = log, name, behaviour
+        self.release = threading.Event()
+
+    def close(self):
+        self.log.append(self.name)
+        if self.behaviour == "block":
+            self.release.wait()
+        elif self.behaviour == "fail":
+            raise RuntimeError("close failed")
+
+
+def test_closing_the_cluster_is_bounded_and_ordered():
+    """close_within closes the Client, then the cluster; a close that fails does not stop the next one or
+    replace the outcome; one that never returns is left behind after the bound (the run ends anyway)."""
+    from denavit.scale._cluster import close_within
+
+    log: list = []
+    assert close_within(10.0, _Part(log, "client", "fail"), _Part(log, "cluster")) is True
+    assert log == ["client", "cluster"]
+
+    log.clear()
+    stuck = _Part(log, "client", "block")
+    start = time.process_time()
+    assert close_within(0.2, stuck, _Part(log, "cluster")) is False
+    assert log == ["client"]  # the cluster's close waits behind the stuck one, in the helper thread
+    assert time.process_time() - start < 1.0  # a wait, not a spin
+    stuck.release.set()
+
+
+def test_local_cluster_ends_even_when_the_close_hangs(monkeypatch):
+    """The run's own exception (here Ctrl-C) leaves local_cluster within CLOSE_TIMEOUT though the close hangs."""
+    import denavit.scale._cluster as cluster_module
+
+    log: list = []
+    client, cluster = _Part(log, "client", "block"), _Part(log, "cluster")
+    monkeypatch.setattr(cluster_module, "start_local_cluster", lambda workers, dashboard: (client, cluster))
+    monkeypatch.setattr(cluster_module, "CLOSE_TIMEOUT", 0.2)
+    outcome: list = []
+
+    def run():
+        try:
+            with cluster_module.local_cluster(2):
+                raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            outcome.append(exc)
+
+    runner = threading.Thread(target=run, daemon=True)  # not the main thread: SIGTERM handling stays off
+    runner.start()
+    runner.join(30.0)  # 150x the bound: only a close that is not bounded gets here
+    assert not runner.is_alive(), "local_cluster waited for a close that never returns"
+    assert len(outcome) == 1 and log == ["client"]
+    client.release.set()

@@ -23,8 +23,8 @@ from typing import Iterator
 
 from ..errors import DenavitError, MissingDependencyError, ParseError, Terminated
 
-__all__ = ["CONNECT_TIMEOUT", "GUARD", "LOCAL_CLUSTER_CONFIG", "SCHEMES", "check_address", "cluster_failure",
-           "connect", "local_cluster", "start_local_cluster"]
+__all__ = ["CLOSE_TIMEOUT", "CONNECT_TIMEOUT", "GUARD", "LOCAL_CLUSTER_CONFIG", "SCHEMES", "check_address",
+           "close_within", "cluster_failure", "connect", "local_cluster", "start_local_cluster"]
 
 #: Dask settings of the LocalCluster that ``scheduler="dask"`` starts (single-threaded worker processes): the
 #: workers' statistical profiler (a stack sample every 10 ms) and 0.1–0.5 s monitors cost an idle worker ~4 % of
@@ -40,6 +40,10 @@ LOCAL_CLUSTER_CONFIG = {
 }
 #: Seconds to wait for a dask.distributed scheduler to answer.
 CONNECT_TIMEOUT = 10.0
+#: Seconds the Client's and the LocalCluster's close may take in all when a run ends.  It takes 1-5 s (up to load
+#: 11 on 2 cores); once, in a full test run at load ~10, a close after Ctrl-C had not returned after 60 s, so the
+#: wait is bounded: past it the run ends without it (the worker processes die with this process, see ``_guard``).
+CLOSE_TIMEOUT = 20.0
 #: Address schemes accepted for a scheduler of the user's (``inproc://`` and ``ucx://`` are refused).
 SCHEMES = ("tcp", "tls")
 #: The worker preload that ties each worker process to this one (module name, imported in the worker).
@@ -132,9 +136,7 @@ def start_local_cluster(workers: int, dashboard: bool = False):
         _release_signals(held)  # a Ctrl-C or SIGTERM held during the start is raised here
     except BaseException:
         _release_signals(held)
-        for part in (client, cluster):
-            if part is not None:
-                part.close()
+        close_within(CLOSE_TIMEOUT, *(part for part in (client, cluster) if part is not None))
         raise
     return client, cluster
 
@@ -151,8 +153,26 @@ def local_cluster(workers: int | None = None, *, dashboard: bool = False) -> Ite
         try:
             yield client
         finally:
-            client.close()
-            cluster.close()
+            close_within(CLOSE_TIMEOUT, client, cluster)
+
+
+def close_within(seconds: float, *parts) -> bool:
+    """Close each of ``parts`` (a Client, its cluster) in turn, in a helper thread, waiting at most ``seconds``
+    in all; True when every close returned.  A close that does not return in time is left behind (daemon thread):
+    the run ends anyway, and the worker processes die with this process (``_guard``).  An error while closing is
+    not the run's result and is dropped."""
+
+    def close_all():
+        for part in parts:
+            try:
+                part.close()
+            except Exception:  # noqa: BLE001 - a failing close must not replace the run's own outcome
+                pass
+
+    closer = threading.Thread(target=close_all, name="denavit-close-cluster", daemon=True)
+    closer.start()
+    closer.join(seconds)
+    return not closer.is_alive()
 
 
 def cluster_failure(exc: BaseException) -> DenavitError | None:
