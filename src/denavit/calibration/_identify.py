@@ -68,7 +68,9 @@ class Identification:
     noise : ndarray, shape (n,)
         Per-joint noise σ_j estimated from the residuals of the final fit [N m or N].
     residual_rms : ndarray, shape (n,)
-        RMS of τ − Y_b π̂_b per joint, of the returned estimate.
+        RMS of τ − Y_b π̂_b per joint, of the returned estimate ("after").
+    nominal_residual_rms : ndarray, shape (n,)
+        RMS of τ − Y_b π_b(robot) per joint: the arm's own parameters on the same (filtered) data ("before").
     condition_number : float
         σ_max / σ_min of the stacked base regressor W (unscaled, unweighted); inf when the data leave a direction
         of π_b unseen.
@@ -107,6 +109,7 @@ class Identification:
     information: np.ndarray
     base: BaseParameters
     physical: object | None = None
+    nominal_residual_rms: np.ndarray | None = None
 
 
 def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: str = "wls", friction: bool = True,
@@ -153,6 +156,8 @@ def identify(robot: DHRobot, q, qd=None, qdd=None, tau=None, *, t=None, method: 
     W = W.reshape(N * n, base.rank)  # (N n, r)
     sol, residual, noise, cov, info = _fit(W, tau.reshape(N * n), N, n, method)
     result = _result(method, base, sol, cov, info, noise, residual, N, filtered)
+    before = tau - (W @ base.values).reshape(N, n)  # the arm as given, on the same samples
+    result = dataclasses.replace(result, nominal_residual_rms=np.sqrt(np.mean(before ** 2, axis=0)))
     if physical:
         from ._physical import physical_parameters
 

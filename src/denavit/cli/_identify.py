@@ -103,7 +103,10 @@ def _text(result, robot, args, notes) -> str:
         lines.append(f"qd, qdd: {result.filter}")
     lines.append("noise per joint, estimated from the residuals [N m or N]: " + ", ".join(number_text(v, 4)
                                                                                 for v in result.noise))
-    lines.append("residual RMS per joint [N m or N]: " + ", ".join(number_text(v, 4) for v in result.residual_rms))
+    lines.append("residual RMS per joint [N m or N], the arm as given: " + ", ".join(
+        number_text(v, 4) for v in result.nominal_residual_rms))
+    lines.append("residual RMS per joint [N m or N], identified:       " + ", ".join(
+        number_text(v, 4) for v in result.residual_rms))
     lines.append("base parameters: estimate +- sigma (relative sigma) [kg, kg m, kg m^2, N m s, N m]:")
     width = max(len(nm) for nm in result.names)
     for nm, est, sd, rel, ok in zip(result.names, result.estimate, result.std, result.relative_std,
@@ -127,7 +130,7 @@ def _json(result, args, notes) -> dict:
             "names": list(result.names), "rules": list(result.rules), "estimate": result.estimate, "std": result.std,
             "relative_std": result.relative_std, "identifiable": result.identifiable.tolist(),
             "unidentifiable": list(result.unidentifiable), "noise": result.noise,
-            "residual_rms": result.residual_rms, "condition_number": result.condition_number,
+            "residual_rms": result.residual_rms, "residual_rms_nominal": result.nominal_residual_rms, "condition_number": result.condition_number,
             "rank": result.rank, "filter": result.filter, "notes": list(notes),
             "physical": {"realisable": ph.realisable, "distance": ph.distance, "deviation": ph.deviation,
                          "names": list(ph.names), "parameters": ph.parameters, "converged": ph.success},
