@@ -13,8 +13,9 @@ from ._compiled import CompiledRobot, compile
 from ._export import LANGUAGES, PREFIX_PATTERN, default_prefix, export_sources
 from ._kernels import KERNEL_NAMES, KernelSpec, register_kernel, registered_kernels, trace_kernels
 from ._llvm import kernel_intrinsic
+from ._tensor import TensorRobot
 from ._trace import Sym, Tape
 
-__all__ = ["compile", "CompiledRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir",
+__all__ = ["compile", "CompiledRobot", "TensorRobot", "export_sources", "default_prefix", "LANGUAGES", "PREFIX_PATTERN", "cache_dir",
            "active_cache_dir", "cache_info", "clear_cache", "numba_available", "robot_key", "KERNEL_NAMES", "KernelSpec",
            "register_kernel", "registered_kernels", "trace_kernels", "Sym", "Tape", "kernel_intrinsic", "numeric_function"]

@@ -20,6 +20,7 @@ from ._compiled_dyn import DynDerivativeMethods
 from ._compiled_reg import RegressorMethods
 from ._compiled_kin import KinDerivativeMethods
 from ._solvers import IKMethods
+from ._tensor import FRAMEWORKS, TensorRobot, compile_tensor
 
 __all__ = ["compile", "CompiledRobot"]
 
@@ -265,15 +266,18 @@ class CompiledRobot(BaseMethods, IKMethods, KinDerivativeMethods, DynDerivativeM
 
 
 def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa: A001
-            friction: bool = True) -> CompiledRobot:
+            friction: bool = True) -> CompiledRobot | TensorRobot:
     """Generated kernels of ``robot``: FK, Jacobians and dynamics as straight-line code for this arm.
 
     Parameters
     ----------
     robot : DHRobot
-    backend : {"numba", "numpy"}, optional
+    backend : {"numba", "numpy", "torch", "jax"}, optional
         ``numba`` (the ``fast`` extra: JIT-compiled machine code, cached on disk) is the default when
-        numba is installed, else ``numpy`` (the same code run by numpy: vectorised over batches).
+        numba is installed, else ``numpy`` (the same code run by numpy: vectorised over batches).  ``torch`` and
+        ``jax`` (extras of those names) give a :class:`~denavit.codegen.TensorRobot`: the same programs on the
+        framework's tensors, differentiable and jit-compatible, with the base methods below (no ``threads``,
+        ``out`` or registered kernels; forward dynamics by the framework's linear solve).
     kernels : iterable of str, optional
         Which kernels to build now, and the only ones the object will have (built-in names, ``KERNEL_NAMES``, or
         registered ones).  Default: every built-in kernel the robot supports now, and every registered kernel
@@ -305,8 +309,10 @@ def compile(robot: DHRobot, *, backend: str | None = None, kernels=None,  # noqa
         raise TypeError(f"compile expects a DHRobot, got {type(robot).__name__}")
     if backend is None:
         backend = NUMBA if numba_available() else NUMPY
+    if backend in FRAMEWORKS:
+        return compile_tensor(robot, backend, kernels, friction)
     if backend not in (NUMBA, NUMPY):
-        raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+        raise ValueError(f"backend must be 'numba', 'numpy', 'torch' or 'jax', got {backend!r}")
     if backend == NUMBA and not numba_available():
         raise MissingDependencyError("backend='numba' needs numba: pip install 'denavit[fast]'")
     reg = registered_kernels()

@@ -12,7 +12,7 @@ import math
 from ._kernels import INTERNAL, KernelSpec
 from ._llvm import LANES
 
-__all__ = ["python_module", "c_sources", "group_batch", "NUMBA", "NUMPY"]
+__all__ = ["python_module", "c_sources", "group_batch", "vector_statements", "NUMBA", "NUMPY"]
 
 NUMBA, NUMPY = "numba", "numpy"
 
@@ -37,27 +37,28 @@ class _Names:
         return f"v{x}"
 
 
-_PY_FUNCS = {  # op → (scalar/numba form, numpy vector form)
-    "sin": ("math.sin({a})", "np.sin({a})"),
-    "cos": ("math.cos({a})", "np.cos({a})"),
-    "sign": ("_sign({a})", "np.sign({a})"),
-    "min": ("min({a}, {b})", "np.minimum({a}, {b})"),
-    "max": ("max({a}, {b})", "np.maximum({a}, {b})"),
+_PY_FUNCS = {  # op → (scalar/numba form, vector form in namespace {ns}: numpy, torch or jax.numpy)
+    "sin": ("math.sin({a})", "{ns}.sin({a})"),
+    "cos": ("math.cos({a})", "{ns}.cos({a})"),
+    "sign": ("_sign({a})", "{ns}.sign({a})"),
+    "min": ("min({a}, {b})", "{ns}.minimum({a}, {b})"),
+    "max": ("max({a}, {b})", "{ns}.maximum({a}, {b})"),
 }
 _C_FUNCS = {"sin": "sin({a})", "cos": "cos({a})", "sign": "(double)(({a} > 0.0) - ({a} < 0.0))",
             "min": "fmin({a}, {b})", "max": "fmax({a}, {b})"}
 _INFIX = {"add": "+", "sub": "-", "mul": "*", "div": "/"}
 
 
-def _expression(op: str, A: str, B: str | None, lang: str, vector: bool) -> str:
-    """The right-hand side of one operation on the operands' texts, in C or Python (scalar or numpy)."""
+def _expression(op: str, A: str, B: str | None, lang: str, vector: bool, ns: str = "np") -> str:
+    """The right-hand side of one operation on the operands' texts, in C or Python (scalar, or vector in the array
+    namespace ``ns``)."""
     if op in _INFIX:
         return f"{A} {_INFIX[op]} {B}"
     if op == "neg":
         return f"-{A}"
     if lang == "c":
         return _C_FUNCS[op].format(a=A, b=B)
-    return _PY_FUNCS[op][1 if vector else 0].format(a=A, b=B)
+    return _PY_FUNCS[op][1 if vector else 0].format(a=A, b=B, ns=ns)
 
 
 def _statements(spec: KernelSpec, lang: str, vector: bool = False) -> list[str]:
@@ -187,7 +188,7 @@ def _python_kernel(spec: KernelSpec) -> list[str]:
         if any(x == a for x, _ in used):
             L.append(f"{pad}{a}T = np.ascontiguousarray({a}[s:e].T)")
     L += [f"{pad}{a}_{k} = {a}T[{k}]" for a, k in used]
-    body, reg = _vector_statements(spec)
+    body, reg = vector_statements(spec)
     L += [pad + x for x in body]
     for f, o in enumerate(spec.outputs):
         value = name(o) if isinstance(o, (int, float)) else reg[o.i]
@@ -196,9 +197,11 @@ def _python_kernel(spec: KernelSpec) -> list[str]:
     return L
 
 
-def _vector_statements(spec: KernelSpec) -> tuple[list[str], dict[int, str]]:
+def vector_statements(spec: KernelSpec, ns: str = "np") -> tuple[list[str], dict[int, str]]:
     """The program on arrays, each result in a register ``r<k>`` reused once its value is dead (a linear
-    scan over the straight-line code): a batch keeps tens of arrays alive, not one per operation."""
+    scan over the straight-line code): a batch keeps tens of arrays alive, not one per operation.  ``ns``: the
+    array namespace (``np``; ``xp`` for torch or jax.numpy, whose sin, cos, sign, minimum, maximum are numpy's);
+    each register is rebound, never written in place, so autograd and tracing JITs follow it."""
     tape = spec.tape
     prog = tape.program(spec.outputs)
     last: dict[int, float] = {}
@@ -224,7 +227,7 @@ def _vector_statements(spec: KernelSpec) -> tuple[list[str], dict[int, str]]:
         def ref(x):
             return _const(x, "py") if isinstance(x, float) else reg[x]
 
-        expr = _expression(op, ref(a), ref(b) if b is not None else None, "py", True)
+        expr = _expression(op, ref(a), ref(b) if b is not None else None, "py", True, ns)
         for x in {a, b}:
             if isinstance(x, int) and last.get(x) == pos and tape.ops[x][0] != "input":
                 free.append(reg[x])
