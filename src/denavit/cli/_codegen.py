@@ -27,9 +27,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--deg", action="store_true", help="accepted like every command's --deg (the cache has no angles)")
     p.set_defaults(handler=cmd_cache)
 
-    p = sub.add_parser("export", help="write an arm's kernels as standalone C99 or numpy-only Python source")
+    p = sub.add_parser("export", help="write an arm's kernels as standalone C99, numpy, PyTorch or JAX source")
     add_common(p, angles=False)
-    p.add_argument("--lang", required=True, choices=["c", "python"], help="c: PREFIX.h + PREFIX.c; python: PREFIX.py")
+    p.add_argument("--lang", required=True, choices=["c", "python", "torch", "jax"],
+                   help="c: PREFIX.h + PREFIX.c; python: PREFIX.py (numpy); torch, jax: PREFIX.py (that framework only)")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write into (made if absent)")
     p.add_argument("--prefix", help="C function / module name prefix (default: from the robot's name)")
     p.add_argument("--kernels", metavar="NAMES", help="comma-separated kernel names, or 'all' (default: the built-in "

@@ -1,4 +1,5 @@
-"""Standalone source of an arm's kernels: C99 (header + source, libm only) or a numpy-only Python module."""
+"""Standalone source of an arm's kernels: C99 (header + source, libm only), a numpy-only Python module, or a
+module needing only PyTorch or JAX."""
 
 from __future__ import annotations
 
@@ -6,11 +7,12 @@ import re
 
 from ..model import DHRobot
 from ._emit import NUMPY, c_sources, python_module
-from ._kernels import KERNEL_NAMES, registered_kernels, trace_kernels, trace_registered
+from ._kernels import INTERNAL, KERNEL_NAMES, registered_kernels, trace_kernels, trace_registered
+from ._tensor_emit import FRAMEWORKS, tensor_module
 
 __all__ = ["export_sources", "default_prefix", "PREFIX_PATTERN", "LANGUAGES"]
 
-LANGUAGES = ("c", "python")
+LANGUAGES = ("c", "python") + FRAMEWORKS
 #: A prefix becomes C identifiers and file names: letters, digits, underscores, at most 40, not a digit first.
 PREFIX_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,39}")
 
@@ -63,6 +65,9 @@ def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels
     ``lang="c"``: ``<prefix>.h`` and ``<prefix>.c`` — functions ``void <prefix>_<kernel>(const double q[n],
     ..., double out[k])`` writing row-major results, C99, libm only, no allocation.  ``lang="python"``:
     ``<prefix>.py``, needing only numpy, with ``fk(q)``, ``jacobian0(q)``, … on ``(n,)`` or ``(..., n)``.
+    ``lang="torch"`` / ``"jax"``: ``<prefix>.py`` needing only that framework, one function per kernel on the
+    framework's tensors (``fk(q)``, ``jacobian0(q)``, ``rnea(q, qd, qdd)``, ``forward_dynamics(q, qd, tau)`` by
+    its linear solve, …), differentiable and jit-compatible (:mod:`denavit.codegen._tensor_emit`).
     ``kernels``: the built-in names (default all of ``KERNEL_NAMES`` the arm supports) and registered ones
     (:func:`~denavit.codegen.register_kernel`; ``"all"`` for every built-in and registered kernel).
     """
@@ -80,6 +85,11 @@ def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels
     specs.update(trace_registered(robot, [k for k in kernels if k in reg]))
     n = robot.dof
     title = f"Kernels of a {n}-joint arm ({robot.convention.value} DH), exported by denavit."
+    if lang in FRAMEWORKS:  # forward dynamics by the framework's solve of M: rnea and mass_matrix instead
+        if "forward_dynamics" in specs:
+            specs.update(trace_kernels(robot, [k for k in ("rnea", "mass_matrix") if k not in specs]))
+        specs = {k: v for k, v in specs.items() if k not in INTERNAL and k != "forward_dynamics"}
+        return {f"{prefix}.py": tensor_module(specs, lang, title + _tensor_usage(prefix, n, lang))}
     if lang == "c":
         usage = _c_usage(prefix, n, "rnea" in specs)
         header, source = c_sources(specs, prefix, title + usage)
@@ -118,6 +128,13 @@ def _c_usage(prefix: str, n: int, dynamics: bool) -> str:
                   f"    {prefix}_forward_dynamics(q, qd, tau, a);  (qdd in a[0..{n - 1}]; a[{n}] > 0 iff M is regular)"]
     lines += [f"Build: cc -std=c99 -O2 -c {prefix}.c && link with -lm."]
     return "\n".join(lines)
+
+
+def _tensor_usage(prefix: str, n: int, lang: str) -> str:
+    make = "torch.rand(1000, {n}, dtype=torch.float64)" if lang == "torch" else "jax.numpy.ones((1000, {n}))"
+    imports = "torch" if lang == "torch" else "jax"
+    return "\n".join(["", "", "Usage:", f"    import {imports}, {prefix}", f"    q = {make.format(n=n)}",
+                      f"    T = {prefix}.fk(q)          # (1000, 4, 4)", f"    J = {prefix}.jacobian0(q)   # (1000, 6, {n})"])
 
 
 def _py_usage(prefix: str, n: int) -> str:

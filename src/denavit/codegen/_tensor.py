@@ -117,7 +117,11 @@ class TensorRobot:
     def jacobian(self, q, frame: Frame | str = "base"):
         """Geometric Jacobian, shape (..., 6, n), rows (v, ω): ``base`` J0 or ``tool`` Je (as
         :func:`denavit.geometric_jacobian`)."""
-        return self._call("jacobian0" if Frame(frame) is Frame.BASE else "jacobiane", (q,), ("q",))
+        try:
+            base = Frame(frame) is Frame.BASE
+        except ValueError:
+            raise ValueError(f"frame must be 'base' or 'tool', got {frame!r}") from None
+        return self._call("jacobian0" if base else "jacobiane", (q,), ("q",))
 
     # --- dynamics -------------------------------------------------------------------------------------------
     def rnea(self, q, qd, qdd):

@@ -121,7 +121,8 @@ def _kernel(spec: KernelSpec) -> list[str]:
 def tensor_module(specs: dict[str, KernelSpec], framework: str, title: str) -> str:
     """A module needing only ``framework`` (``"torch"`` or ``"jax"``) with one function per kernel, named as the
     kernel (``fk(q)``, ``jacobian0(q)``, ``rnea(q, qd, qdd)``, …), on inputs (..., k) broadcast over their leading
-    axes, and ``forward_dynamics(q, qd, tau)`` when ``rnea`` and ``mass_matrix`` are among them.
+    axes, and ``forward_dynamics(q, qd, tau)`` (by the framework's linear solve) when ``rnea`` and ``mass_matrix``
+    are among them (a traced ``forward_dynamics`` kernel is left out).
 
     ``title`` opens the module's docstring (no user text: a ``\"\"\"`` or a backslash is refused).
     """
@@ -135,7 +136,8 @@ def tensor_module(specs: dict[str, KernelSpec], framework: str, title: str) -> s
             'jit-compatible (no in-place writes)."""', "", _PRELUDES[framework], ""]
     body: list[str] = []
     for spec in specs.values():
-        body += _kernel(spec)
+        if spec.name != "forward_dynamics":  # the traced LDLᵀ solve gives way to the framework's (below)
+            body += _kernel(spec)
     text = "\n".join(head + body).rstrip() + "\n"
     if "rnea" in specs and "mass_matrix" in specs:
         text += _FORWARD_DYNAMICS

@@ -1,0 +1,141 @@
+"""denavit.compile(robot, backend="jax") and ``denavit export --lang jax``: values against the numpy backend,
+gradients by jax.jacfwd / jax.jacrev against denavit's analytic derivatives, jax.jit and vmap, errors (checks in
+tests/_tensor_backends.py, shared with the PyTorch backend).
+
+float64 needs JAX's x64 mode, switched on here for this test process (float32 inputs stay float32 in it).  JAX run
+op by op compiles each primitive for each new shape and dtype (about 30 ms each, 0.4 s per shape for FK): the tests
+use few shapes and arms, and those over 2 CPU-s (whichever meets a shape first pays) are marked slow."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+jax = pytest.importorskip("jax")
+jax.config.update("jax_enable_x64", True)
+jnp = jax.numpy
+
+import _tensor_backends as checks  # noqa: E402
+from _random_robots import random_robot as random_kinematic_robot  # noqa: E402
+from conftest import robots  # noqa: E402
+from test_dynamics_numeric import random_robot as random_dynamic_robot  # noqa: E402
+
+import denavit  # noqa: E402
+from denavit.cli import main  # noqa: E402
+from denavit.errors import MissingDependencyError, ModelError, ShapeError  # noqa: E402
+
+SEEDS = st.integers(0, 2**32 - 1)
+
+
+class Jax:
+    name = "jax"
+
+    @staticmethod
+    def tensor(x, bits):
+        return jnp.asarray(np.asarray(x), dtype=jnp.float64 if bits == 64 else jnp.float32)
+
+    @staticmethod
+    def numpy(t):
+        return np.asarray(t)
+
+    @staticmethod
+    def dtype_bits(t):
+        return {jnp.dtype(jnp.float64): 64, jnp.dtype(jnp.float32): 32}[t.dtype]
+
+    @staticmethod
+    def jacobian(f, *xs):
+        """Forward mode for one input, reverse mode for several: both of JAX's routes are exercised."""
+        if len(xs) == 1:
+            return jax.jacfwd(f)(xs[0])
+        return jax.jacrev(f, argnums=tuple(range(len(xs))))(*xs)
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "kernels"))
+
+
+def dynamic_arm(seed, n=None):
+    """A random arm with inertial data, motor inertia and friction (both conventions, prismatic, fixed rows)."""
+    return random_dynamic_robot(np.random.default_rng(seed), n=n, motor=True, friction=True)
+
+
+@pytest.mark.slow
+@settings(max_examples=4)
+@given(robot=robots(), seed=SEEDS)
+def test_kinematics_equal_the_numpy_backend_on_random_arms(robot, seed):
+    checks.check_kinematics_values(Jax, robot, np.random.default_rng(seed), shapes=((), (3, 2)))
+
+
+@pytest.mark.slow
+@settings(max_examples=2)
+@given(seed=SEEDS)
+def test_dynamics_equal_the_numpy_backend_on_random_arms(seed):
+    checks.check_dynamics_values(Jax, dynamic_arm(seed, n=2 + seed % 3), np.random.default_rng(seed))
+
+
+@pytest.mark.slow
+@settings(max_examples=2)
+@given(robot=robots(), seed=SEEDS)
+def test_jacfwd_through_fk_and_jacobian_equals_the_analytic_derivatives(robot, seed):
+    checks.check_kinematics_gradients(Jax, robot, np.random.default_rng(seed))
+
+
+@pytest.mark.slow
+@settings(max_examples=2)
+@given(seed=SEEDS)
+def test_jacrev_through_rnea_and_forward_dynamics_equals_the_analytic_derivatives(seed):
+    checks.check_dynamics_gradients(Jax, dynamic_arm(seed, n=2 + seed % 2), np.random.default_rng(seed))
+
+
+def test_export_lang_jax_writes_a_module_giving_the_same_values(tmp_path, rng):
+    checks.check_export(Jax, denavit.load_robot("puma560"), tmp_path, rng)
+    assert main(["export", "puma560", "--lang", "jax", "-o", str(tmp_path / "out")]) == 0
+    text = (tmp_path / "out" / "puma560.py").read_text()
+    assert "import jax.numpy as xp" in text and "numpy as np" not in text and "denavit" not in text.split('"""')[2]
+
+
+@pytest.mark.slow
+def test_jit_grad_and_vmap_give_the_eager_values(rng):
+    """jax.jit of FK (batched) and of the gradient of a loss through it, and vmap over single configurations."""
+    fast = denavit.compile(denavit.load_robot("puma560"), backend="jax")
+    q = jnp.asarray(rng.uniform(-np.pi, np.pi, (5, 6)))
+    eager = fast.fk(q)
+    checks.assert_close(jax.jit(fast.fk)(q), eager, 1e-12, "jit fk")
+    checks.assert_close(jax.vmap(fast.fk)(q), eager, 1e-12, "vmap fk")
+
+    def loss(q):
+        return jnp.sum(fast.position(q) ** 2)
+
+    checks.assert_close(jax.jit(jax.grad(loss))(q), jax.grad(loss)(q), 1e-12, "jit grad")
+
+
+def test_results_keep_the_input_dtype_and_batch_shape_and_accept_lists():
+    fast = denavit.compile(denavit.load_robot("puma560"), backend="jax")
+    T = fast.fk(jnp.zeros((2, 1, 3, 6), dtype=jnp.float32))
+    assert T.shape == (2, 1, 3, 4, 4) and T.dtype == jnp.float32
+    assert fast.jacobian([0, 0, 0, 0, 0, 0], "tool").shape == (6, 6)  # integers: the default float
+    assert fast.mass_matrix(jnp.zeros((0, 6))).shape == (0, 6, 6)
+
+
+def test_bad_inputs_raise_clear_errors():
+    fast = denavit.compile(denavit.load_robot("puma560"), backend="jax")
+    with pytest.raises(ShapeError, match=r"q: expected shape \(\.\.\., 6\) for a 6-joint robot, got \(5,\)"):
+        fast.fk(jnp.zeros(5))
+    with pytest.raises(ShapeError, match="do not broadcast"):
+        fast.rnea(jnp.zeros((2, 6)), jnp.zeros((3, 6)), jnp.zeros(6))
+    with pytest.raises(ValueError, match="frame must be 'base' or 'tool', got 'world'"):
+        fast.jacobian(jnp.zeros(6), "world")
+    kinematic = denavit.compile(random_kinematic_robot(np.random.default_rng(1), n_rows=2), backend="jax")
+    with pytest.raises(ModelError, match="no inertial data"):
+        kinematic.rnea(jnp.zeros(2), jnp.zeros(2), jnp.zeros(2))
+
+
+def test_missing_jax_names_the_pip_line(monkeypatch):
+    monkeypatch.setitem(sys.modules, "jax.numpy", None)
+    with pytest.raises(MissingDependencyError, match=r"pip install 'denavit\[jax\]'"):
+        denavit.compile(denavit.load_robot("planar2r"), backend="jax")
