@@ -23,7 +23,7 @@ from ._common import OneLineParser, emit, one_line
 __all__ = ["main", "build_parser"]
 
 # Modules that add subcommands, in the order they appear in --help.
-COMMAND_MODULES = ("_model", "_report", "_viz", "_scale", "_ik", "_jacobian", "_singularities", "_dynamics", "_regressor", "_interop", "_codegen", "_calibrate", "_excite", "_identify")
+COMMAND_MODULES = ("_model", "_report", "_viz", "_scale", "_ik", "_jacobian", "_singularities", "_dynamics", "_regressor", "_interop", "_codegen", "_calibrate", "_excite", "_identify", "_serve")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,129 @@
+"""The workbench's long work, run in a child process (:mod:`denavit.web._jobs`): the symbolic T_0_n, the
+derivation report and the checker.
+
+Each job is a function ``(payload, progress) -> dict`` of JSON data; the robot is re-read from its file mapping
+here (``robot_from_dict``), so nothing but JSON crosses the process boundary.  The report is the library's
+own: :func:`denavit.report.derive` rendered by :func:`~denavit.report.render_html` (and Markdown/LaTeX for the
+downloads); the check is :func:`denavit.grade.grade_text` for a report and :func:`denavit.check.check_file`
+for a claims file, as ``denavit check`` does.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from .. import ParseError, robot_from_dict
+
+__all__ = ["KINDS", "MAX_TEXT_CHARS", "run"]
+
+#: Longest report or claims text accepted for checking (characters).
+MAX_TEXT_CHARS = 400_000
+#: Report formats of an uploaded report, by the name the page sends.
+_REPORT_FORMATS = ("md", "tex", "txt")
+
+
+def _robot(payload: dict[str, Any]) -> Any:
+    doc = payload.get("robot")
+    if not isinstance(doc, dict):
+        raise ParseError("'robot' must be the robot-file mapping")
+    return robot_from_dict(doc, where="table")
+
+
+def formula(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """T_0_n and the end-effector position as LaTeX, from the report's forward-kinematics section."""
+    from ..report import Equation, Text, derive, math_of
+
+    progress("symbolic forward kinematics")
+    section = derive(_robot(payload), topics=["fk"]).section("fk")
+    steps = []
+    for step in section.steps:
+        if isinstance(step, Equation):
+            steps.append({"math": math_of(step)})
+        elif isinstance(step, Text):
+            steps.append({"text": step.text})
+    return {"steps": steps, "status": section.status, "reason": section.reason}
+
+
+def report(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """The derivation report: its sections (title, status) and the HTML, Markdown and LaTeX renderings."""
+    from ..report import TOPICS, derive, render_html, render_latex, render_markdown
+
+    topics = payload.get("topics") or list(TOPICS)
+    if not isinstance(topics, list) or not all(isinstance(t, str) for t in topics):
+        raise ParseError(f"'topics' must be a list of names from {', '.join(TOPICS)}")
+    q = payload.get("q")
+    d = derive(_robot(payload), q=q if isinstance(q, list) and q else None, topics=topics, progress=progress)
+    progress("rendering")
+    md, md_files = render_markdown(d, "report-")
+    tex, _ = render_latex(d, "report-")
+    return {"title": d.title,
+            "sections": [{"key": s.key, "title": s.title, "status": s.status, "reason": s.reason} for s in d.sections],
+            "html": render_html(d)[0], "md": md, "tex": tex,
+            "note": (f"the Markdown and LaTeX downloads refer to {len(md_files)} picture file(s) that are only in the "
+                     "HTML download") if md_files else ""}
+
+
+def check(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """Grade a report (``kind`` md/tex/txt) or judge a claims file (``kind`` yaml) as ``denavit check`` does."""
+    text, kind = payload.get("text"), payload.get("kind")
+    if not isinstance(text, str) or not text.strip():
+        raise ParseError("'text' must be the report or claims file to check")
+    if len(text) > MAX_TEXT_CHARS:
+        raise ParseError(f"the text to check is too long ({len(text)} characters; at most {MAX_TEXT_CHARS})")
+    if kind in _REPORT_FORMATS:
+        from ..grade import grade_text, graded_text, render_checked_html
+
+        robot = _robot(payload) if payload.get("use_arm") else None
+        progress("grading the report")
+        graded = grade_text(text, kind, robot=robot, source=str(payload.get("name") or "report")[:80])
+        return {"kind": "report", "summary": graded.summary(), "text": graded_text(graded),
+                "html": render_checked_html(graded),
+                "claims": [{"line": c.line, "verdict": c.verdict, "quantity": c.quantity} for c in graded.claims]}
+    if kind == "yaml":
+        from ..check import check_file, verdicts_text
+
+        robot = _robot(payload)
+        progress("judging the claims")
+        with tempfile.TemporaryDirectory(prefix="denavit-web-") as tmp:  # check_file reads a file: ours, private
+            path = Path(tmp) / "claims.yaml"
+            path.write_text(text, encoding="utf-8")
+            result = check_file(robot, path)
+        data = result.to_json()
+        return {"kind": "claims", "summary": data["summary"], "text": verdicts_text(result).replace(str(path), "claims"),
+                "claims": [{"id": c["id"], "verdict": c["verdict"], "quantity": c["quantity"], "message": c["message"]}
+                           for c in data["claims"]]}
+    raise ParseError("'kind' must be md, tex or txt (a report) or yaml (a claims file)")
+
+
+#: The jobs a page may start, by name.
+KINDS: dict[str, Callable[[dict[str, Any], Callable[[str], None]], dict[str, Any]]] = {
+    "formula": formula, "report": report, "check": check,
+}
+
+
+def run(kind: str, payload: dict[str, Any], conn: Any, cpu_seconds: float) -> None:
+    """Child process entry: run the job, sending ``("progress", text)`` messages then ``("done", result)`` or
+    ``("error", line)``.  The CPU limit ends a runaway job (SIGXCPU) as the OS enforces it."""
+    import resource
+    import warnings
+
+    import numpy as np
+
+    from ._handlers import one_line
+
+    limit = int(cpu_seconds)
+    resource.setrlimit(resource.RLIMIT_CPU, (limit, limit + 5))
+    warnings.simplefilter("ignore")
+    try:
+        with np.errstate(all="ignore"):
+            result = KINDS[kind](payload, lambda text: conn.send(("progress", one_line(text))))
+        conn.send(("done", result))
+    except (ValueError, ArithmeticError, LookupError, TypeError, RecursionError, MemoryError) as exc:
+        conn.send(("error", one_line(exc)))
+    except Exception as exc:  # noqa: BLE001 — denavit errors and anything else: one line, never a traceback
+        conn.send(("error", one_line(f"{type(exc).__name__}: {exc}")))
+    finally:
+        conn.close()

@@ -1,0 +1,350 @@
+/* denavit workbench: the page edits a robot file (its DH table), the server answers (kinematics, IK, dynamics,
+ * jobs).  The 3-D view is denavit's own viewer page (viz/assets/viewer.js) in an iframe, one slider per joint;
+ * this script listens to its sliders.  No dependencies besides the bundled KaTeX.
+ */
+(function () {
+  "use strict";
+  var $ = function (id) { return document.getElementById(id); };
+  var FIELDS = ["a", "alpha", "d", "theta"];
+  var doc = null;            // the robot-file mapping being edited
+  var good = null;           // {doc, info} of the last table the server read
+  var q = [];                // the sliders' joint values
+  // for tests and tools: slider -> T/J written (latencies) and -> the next animation frame (painted), in ms
+  var wb = window.workbench = { latencies: [], painted: [], seq: 0, shown: -1, robotLoads: 0, kinCount: 0 };
+
+  // ---- server -------------------------------------------------------------------------------------
+  function post(path, body) {
+    return fetch(path, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) })
+      .then(function (r) { return r.json().then(function (data) { data._status = r.status; return data; }); });
+  }
+  function status(text) { $("status").textContent = text; }
+  function fmt(x, w) { if (x === null) return "nan"; var s = (Math.abs(x) < 5e-5 ? 0 : x).toFixed(4); return (s.charAt(0) === "-" ? "" : " ") + s; }
+  function matText(M) { return M.map(function (r) { return r.map(fmt).join("  "); }).join("\n"); }
+  function vecText(v) { return v.map(fmt).join("  "); }
+
+  // ---- the table ----------------------------------------------------------------------------------
+  function kindOf(row) {
+    var has = function (f) { return /(^|[^A-Za-z0-9_])q\d*([^A-Za-z0-9_(]|$)/.test(String(row[f] === undefined ? "" : row[f])); };
+    return has("theta") ? "revolute" : has("d") ? "prismatic" : "fixed";
+  }
+  function stripQ(text) {
+    var t = String(text).trim(), m;
+    if (/^q\d*$/.test(t)) return "0";
+    if ((m = /^q\d*\s*\+\s*(.+)$/.exec(t))) return m[1];
+    if ((m = /^q\d*\s*-\s*(.+)$/.exec(t))) return "-(" + m[1] + ")";
+    if ((m = /^(.+?)\s*\+\s*q\d*$/.exec(t))) return m[1];
+    return t;
+  }
+  function addQ(text) { var t = String(text).trim(); return (t === "" || t === "0") ? "q" : "q + " + t; }
+
+  function renderTable() {
+    var body = $("dh").tBodies[0];
+    body.innerHTML = "";
+    doc.joints.forEach(function (row, i) {
+      var tr = document.createElement("tr");
+      tr.innerHTML = "<td>" + (i + 1) + "</td>";
+      var td = document.createElement("td"), sel = document.createElement("select");
+      [["revolute", "R"], ["prismatic", "P"], ["fixed", "fixed"]].forEach(function (o) {
+        var opt = document.createElement("option"); opt.value = o[0]; opt.textContent = o[1]; sel.appendChild(opt);
+      });
+      sel.value = kindOf(row); sel.className = "joint-type"; sel.dataset.row = i;
+      sel.addEventListener("change", function () { setKind(i, sel.value); });
+      td.appendChild(sel); tr.appendChild(td);
+      FIELDS.forEach(function (f) {
+        var c = document.createElement("td"), inp = document.createElement("input");
+        inp.value = row[f] === undefined ? "0" : String(row[f]);
+        inp.size = 9; inp.id = "cell-" + (i + 1) + "-" + f; inp.dataset.row = i; inp.dataset.field = f;
+        inp.addEventListener("input", function () { doc.joints[i][f] = inp.value; tableChanged(); });
+        c.appendChild(inp); tr.appendChild(c);
+      });
+      var del = document.createElement("td"), b = document.createElement("button");
+      b.type = "button"; b.textContent = "×"; b.title = "remove row " + (i + 1);
+      b.addEventListener("click", function () { if (doc.joints.length > 1) { doc.joints.splice(i, 1); renderTable(); tableChanged(); } });
+      del.appendChild(b); tr.appendChild(del);
+      body.appendChild(tr);
+    });
+    $("robot-name").value = doc.name || "";
+    $("convention").value = doc.convention || "standard";
+    $("angle-unit").value = doc.angle_unit || "rad";
+    var p = doc.parameters || {};
+    $("parameters").value = Object.keys(p).map(function (k) { return k + " = " + p[k]; }).join("\n");
+    var mod = doc.convention === "modified";
+    $("h-a").innerHTML = mod ? "a<sub>i−1</sub>" : "a<sub>i</sub>";
+    $("h-alpha").innerHTML = mod ? "α<sub>i−1</sub>" : "α<sub>i</sub>";
+  }
+  function setKind(i, kind) {
+    var row = doc.joints[i];
+    row.theta = stripQ(row.theta === undefined ? "0" : row.theta);
+    row.d = stripQ(row.d === undefined ? "0" : row.d);
+    if (kind === "revolute") row.theta = addQ(row.theta);
+    if (kind === "prismatic") row.d = addQ(row.d);
+    if (kind === "fixed") delete row.limits;
+    renderTable(); tableChanged();
+  }
+  function readParameters() {
+    var out = {};
+    $("parameters").value.split("\n").forEach(function (line) {
+      var k = line.indexOf("=");
+      if (line.trim() === "") return;
+      if (k < 0) out[line.trim()] = "";   // the server names the bad line
+      else out[line.slice(0, k).trim()] = line.slice(k + 1).trim();
+    });
+    return out;
+  }
+  var editTimer = null;
+  function tableChanged() {
+    doc.name = $("robot-name").value;
+    doc.convention = $("convention").value;
+    doc.angle_unit = $("angle-unit").value;
+    doc.parameters = readParameters();
+    clearTimeout(editTimer);
+    editTimer = setTimeout(sendTable, 150);
+  }
+  function markCell(err) {
+    document.querySelectorAll(".bad").forEach(function (el) { el.classList.remove("bad"); el.removeAttribute("title"); });
+    $("table-error").textContent = err ? err.error : "";
+    if (!err || !err.cell) return;
+    var el = err.cell.row ? $("cell-" + err.cell.row + "-" + err.cell.field)
+      : ({ parameters: $("parameters"), convention: $("convention"), angle_unit: $("angle-unit") })[err.cell.field];
+    if (el) { el.classList.add("bad"); el.title = err.error; }
+  }
+  function sendTable() {
+    var sent = JSON.parse(JSON.stringify(doc));
+    var body = { robot: sent };
+    post("/api/robot", body).then(function (r) {
+      if (r._status !== 200) { markCell(r); status("the table has an error: the arm shown is the last good one"); return; }
+      markCell(null);
+      good = { doc: sent, info: r };
+      wb.robotLoads++;
+      $("table-notes").textContent = r.notes.join(" · ");
+      document.querySelectorAll(".joint-type").forEach(function (s) { s.value = r.rows[+s.dataset.row]; });
+      status(r.name + ": " + r.dof + " joints, " + r.convention + " DH");
+      var keep = q.length === r.dof ? q.slice() : null;
+      loadViewer(r.viewer, keep);
+      startFormula();
+    }).catch(function (e) { status("no answer from the server: " + e); });
+  }
+
+  // ---- the 3-D view and the live panels ---------------------------------------------------------------
+  function viewerSliders() { var d = $("viewer").contentDocument; return good ? good.info.joint_types.map(function (_, k) { return d.getElementById("q" + (k + 1)); }) : []; }
+  function loadViewer(html, keep) {
+    var frame = $("viewer");
+    frame.onload = function () {
+      var sliders = viewerSliders();
+      sliders.forEach(function (s, k) {
+        s.step = "any";                                     // IK solutions and kept values exactly, not on a grid
+        if (keep) { s.value = keep[k]; s.dispatchEvent(new Event("input")); }
+        s.addEventListener("input", onSliders);
+      });
+      onSliders();
+    };
+    frame.srcdoc = html;
+  }
+  var inFlight = false, again = false, started = {};
+  function onSliders() {
+    q = viewerSliders().map(function (s) { return parseFloat(s.value); });
+    wb.seq++;
+    started[wb.seq] = performance.now();
+    if (inFlight) { again = true; return; }
+    sendKinematics();
+  }
+  function sendKinematics() {
+    inFlight = true; again = false;
+    var seq = wb.seq;
+    post("/api/kinematics", { robot: good.doc, q: q, seq: seq }).then(function (r) {
+      inFlight = false;
+      if (r._status === 200) {
+        $("T").textContent = matText(r.T);
+        $("J").textContent = matText(r.J);
+        $("measures").textContent = (r.det === null ? "" : "det J = " + r.det.toPrecision(5) + " · ") +
+          "manipulability √det(J Jᵀ) = " + r.manipulability.toPrecision(5) + " · σ_min = " +
+          r.singular_values[r.singular_values.length - 1].toPrecision(4);
+        $("T").dataset.q = JSON.stringify(r.q);
+        $("T").dataset.full = JSON.stringify(r.T);
+        wb.shown = seq; wb.kinCount++;
+        if (started[seq] !== undefined) {
+          var t0 = started[seq];
+          wb.latencies.push(performance.now() - t0);
+          requestAnimationFrame(function () { wb.painted.push(performance.now() - t0); });
+        }
+        Object.keys(started).forEach(function (k) { if (+k <= seq) delete started[k]; });
+      } else status(r.error);
+      if (again) sendKinematics(); else refreshDynamics();
+    }).catch(function (e) { inFlight = false; status("no answer from the server: " + e); });
+  }
+  var dynTimer = null;
+  function refreshDynamics() {
+    clearTimeout(dynTimer);
+    dynTimer = setTimeout(function () {
+      if (!good) return;
+      post("/api/dynamics", { robot: good.doc, q: q, qd: $("qd").value }).then(function (r) {
+        $("dyn-error").textContent = r._status === 200 ? "" : r.error;
+        if (r._status === 200) { $("M").textContent = matText(r.M); $("cg").textContent = "c: " + vecText(r.c) + "\ng: " + vecText(r.g); }
+      });
+      post("/api/statics", { robot: good.doc, q: q, wrench: $("wrench").value, frame: $("wrench-frame").value }).then(function (r) {
+        $("statics-error").textContent = r._status === 200 ? "" : r.error;
+        if (r._status === 200) $("tau").textContent = vecText(r.tau);
+      });
+    }, 60);
+  }
+
+  // ---- inverse kinematics -------------------------------------------------------------------------------
+  function solveIK() {
+    var body = { robot: good.doc, q: q }, t = $("ik-target").value.trim();
+    if (t) body.pose = t;
+    post("/api/ik", body).then(function (r) {
+      var list = $("ik-list");
+      list.innerHTML = "";
+      if (r._status !== 200) { $("ik-error").textContent = r.error; return; }
+      $("ik-error").textContent = r.solutions.length + " solution(s) (" + r.method + ")" +
+        (r.outside_limits ? ", " + r.outside_limits + " more outside the joint limits" : "");
+      r.solutions.forEach(function (s, i) {
+        var li = document.createElement("li"), b = document.createElement("button");
+        b.type = "button"; b.className = "ik-solution"; b.dataset.q = JSON.stringify(s.q);
+        b.textContent = "[" + s.q.map(function (x) { return x.toFixed(4); }).join(", ") + "] " + s.branch;
+        b.addEventListener("click", function () { showSolution(s.q); });
+        li.appendChild(b); list.appendChild(li);
+      });
+    });
+  }
+  function showSolution(sol) {
+    viewerSliders().forEach(function (s, k) { s.value = sol[k]; });
+    viewerSliders().forEach(function (s) { s.dispatchEvent(new Event("input")); });
+  }
+
+  // ---- jobs: the formula, the report, the check --------------------------------------------------------
+  function runJob(kind, payload, onProgress, onDone) {
+    return post("/api/jobs", { kind: kind, payload: payload }).then(function (r) {
+      if (r._status !== 200) { onDone(null, r.error); return null; }
+      var job = { id: r.id, stopped: false };
+      (function poll() {
+        if (job.stopped) return;
+        fetch("/api/jobs/" + job.id).then(function (x) { return x.json(); }).then(function (s) {
+          if (s.state === "running") { onProgress(s.progress); setTimeout(poll, 150); }
+          else onDone(s.state === "done" ? s.result : null, s.state === "done" ? "" : s.error);
+        });
+      })();
+      return job;
+    });
+  }
+  function cancelJob(job) { if (job) { job.stopped = true; post("/api/jobs/" + job.id + "/cancel", {}); } }
+
+  var formulaJob = null;
+  function startFormula() {
+    cancelJob(formulaJob);
+    $("formula-status").textContent = "deriving…";
+    var t0 = performance.now();
+    runJob("formula", { robot: good.doc }, function () {}, function (res, err) {
+      if (!res) { $("formula-status").textContent = err; return; }
+      var box = $("formula"); box.innerHTML = "";
+      res.steps.forEach(function (s) {
+        var el = document.createElement(s.math ? "div" : "p");
+        if (s.math && window.katex) katex.render(s.math, el, { displayMode: true, throwOnError: false });
+        else el.textContent = s.math || s.text;
+        box.appendChild(el);
+      });
+      $("formula-status").textContent = "derived in " + ((performance.now() - t0) / 1000).toFixed(2) + " s";
+      wb.formulaSeconds = (performance.now() - t0) / 1000;
+    }).then(function (j) { formulaJob = j; });
+  }
+
+  var reportJob = null, report = null;
+  function startReport() {
+    $("report-start").disabled = true; $("report-cancel").disabled = false;
+    $("report-downloads").hidden = true; $("report-sections").innerHTML = "";
+    runJob("report", { robot: good.doc, q: q }, function (p) {
+      var last = p[p.length - 1] || "starting", m = /section (\d+)\/(\d+)/.exec(last);
+      $("report-status").textContent = last;
+      if (m) $("report-progress").value = (m[1] - 1) / m[2];
+    }, function (res, err) {
+      $("report-start").disabled = false; $("report-cancel").disabled = true;
+      $("report-progress").value = res ? 1 : 0;
+      if (!res) { $("report-status").textContent = err; return; }
+      report = res;
+      $("report-status").textContent = res.title + (res.note ? " (" + res.note + ")" : "");
+      res.sections.forEach(function (s, i) {
+        var li = document.createElement("li"), a = document.createElement("a");
+        a.href = "#"; a.textContent = s.title + (s.status === "done" ? "" : " — " + s.status + ": " + s.reason);
+        a.addEventListener("click", function (e) {
+          e.preventDefault();
+          var t = $("report").contentDocument.getElementById(s.key); if (t) t.scrollIntoView();
+        });
+        li.appendChild(a); $("report-sections").appendChild(li);
+      });
+      $("report").hidden = false; $("report").srcdoc = res.html; $("report-downloads").hidden = false;
+    }).then(function (j) { reportJob = j; });
+  }
+  function download(text, name, type) {
+    var a = document.createElement("a");
+    a.href = URL.createObjectURL(new Blob([text], { type: type }));
+    a.download = name; document.body.appendChild(a); a.click(); a.remove();
+  }
+
+  function startCheck() {
+    var file = $("check-file").files[0];
+    var textP = file ? file.text() : Promise.resolve($("check-text").value);
+    textP.then(function (text) {
+      $("check-status").textContent = "checking…"; $("check-summary").textContent = "";
+      var payload = { text: text, kind: $("check-kind").value, use_arm: $("check-use-arm").checked,
+                      robot: good ? good.doc : doc, name: file ? file.name : "pasted report" };
+      runJob("check", payload, function (p) { $("check-status").textContent = p[p.length - 1] || "checking…"; }, function (res, err) {
+        if (!res) { $("check-status").textContent = err; return; }
+        $("check-status").textContent = "";
+        var s = res.summary;
+        $("check-summary").textContent = Object.keys(s).filter(function (k) { return s[k]; })
+          .map(function (k) { return s[k] + " " + k; }).join(", ") || "nothing to judge was found";
+        $("check-summary").dataset.summary = JSON.stringify(s);
+        $("checked").hidden = !res.html; $("check-text-result").hidden = !!res.html;
+        if (res.html) $("checked").srcdoc = res.html; else $("check-text-result").textContent = res.text;
+      });
+    });
+  }
+
+  // ---- wiring -------------------------------------------------------------------------------------------
+  function loadDoc(d) { doc = d; renderTable(); sendTable(); }
+  $("add-row").addEventListener("click", function () { doc.joints.push({ a: "0", alpha: "0", d: "0", theta: "q" }); renderTable(); tableChanged(); });
+  ["robot-name", "parameters"].forEach(function (id) { $(id).addEventListener("input", tableChanged); });
+  ["convention", "angle-unit"].forEach(function (id) { $(id).addEventListener("change", function () { tableChanged(); renderTable(); }); });
+  $("catalogue").addEventListener("change", function () {
+    if (!this.value) return;
+    post("/api/catalogue/load", { name: this.value }).then(function (r) { if (r._status === 200) loadDoc(r.robot); else status(r.error); });
+  });
+  $("paste-import").addEventListener("click", function () {
+    post("/api/table", { text: $("paste").value }).then(function (r) {
+      $("paste-error").textContent = r._status === 200 ? r.notes.join(" · ") : r.error;
+      if (r._status === 200) loadDoc(r.robot);
+    });
+  });
+  $("download-yaml").addEventListener("click", function () {
+    if (!good) return;
+    post("/api/robot-file", { robot: good.doc, format: "yaml" }).then(function (r) { if (r._status === 200) download(r.text, r.filename, "text/yaml"); });
+  });
+  $("ik-solve").addEventListener("click", solveIK);
+  $("qd").addEventListener("input", refreshDynamics);
+  $("wrench").addEventListener("input", refreshDynamics);
+  $("wrench-frame").addEventListener("change", refreshDynamics);
+  $("report-start").addEventListener("click", startReport);
+  $("report-cancel").addEventListener("click", function () {
+    cancelJob(reportJob); $("report-start").disabled = false; $("report-cancel").disabled = true;
+    $("report-status").textContent = "cancelled"; $("report-progress").value = 0;
+  });
+  document.querySelectorAll("#report-downloads button").forEach(function (b) {
+    b.addEventListener("click", function () {
+      var f = b.dataset.fmt, type = { html: "text/html", md: "text/markdown", tex: "application/x-tex" }[f];
+      download(report[f], (good.info.name || "report") + "-report." + f, type);
+    });
+  });
+  $("check-file").addEventListener("change", function () {
+    var f = this.files[0], m = f && /\.(md|markdown|tex|txt|ya?ml)$/i.exec(f.name);
+    if (m) $("check-kind").value = { markdown: "md", yml: "yaml" }[m[1].toLowerCase()] || m[1].toLowerCase();
+  });
+  $("check-start").addEventListener("click", startCheck);
+  wb.showSolution = showSolution;
+  wb.doc = function () { return good ? good.doc : doc; };
+  wb.busy = function () { return inFlight || again; };
+
+  fetch("/api/catalogue").then(function (r) { return r.json(); }).then(function (r) {
+    r.names.forEach(function (n) { var o = document.createElement("option"); o.value = n; o.textContent = n; $("catalogue").appendChild(o); });
+  });
+  loadDoc(JSON.parse($("start").textContent).robot);
+})();

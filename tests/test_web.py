@@ -1,0 +1,280 @@
+"""The workbench's server (``denavit serve``): its JSON endpoints through Starlette's TestClient, its jobs, and the
+command itself.  Truth comes from routes independent of the code under test: the DH product written out here,
+central differences of it for the Jacobian, the closed-form dynamics of the planar elbow arm (Spong et al. 2006,
+Sec. 7.4, point masses at the link ends), and a report whose right and wrong lines are known by hand."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+
+import numpy as np
+import pytest
+
+pytest.importorskip("starlette")
+pytest.importorskip("httpx")
+
+from starlette.testclient import TestClient
+
+from denavit.cli import main
+from denavit.web import create_app
+from denavit.web._jobs import Jobs
+
+PLANAR = {"name": "two-link", "convention": "standard", "parameters": {"L1": "0.7", "L2": "0.4"},
+          "joints": [{"a": "L1", "alpha": 0, "d": 0, "theta": "q"}, {"a": "L2", "alpha": 0, "d": 0, "theta": "q"}]}
+POSTS = ["/api/robot", "/api/kinematics", "/api/ik", "/api/dynamics", "/api/statics", "/api/table",
+         "/api/catalogue/load", "/api/robot-file", "/api/jobs"]
+
+
+@pytest.fixture(scope="module")
+def client():
+    with TestClient(create_app(allowed_hosts=["testserver"], jobs=Jobs(cpu_seconds=120))) as c:
+        yield c
+
+
+def _dh(rows, q, convention="standard"):
+    """T_0_n by the DH product written out here (Spong 2006 eq. 3.10 / Craig 2005 eq. 3.6), rows (a, α, d, θ, kind)."""
+    T, k = np.eye(4), 0
+    for a, al, d, th, kind in rows:
+        if kind == "R":
+            th, k = th + q[k], k + 1
+        elif kind == "P":
+            d, k = d + q[k], k + 1
+        ct, st, ca, sa = math.cos(th), math.sin(th), math.cos(al), math.sin(al)
+        if convention == "standard":
+            A = np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
+        else:
+            A = np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -sa * d], [st * sa, ct * sa, ca, ca * d], [0, 0, 0, 1]])
+        T = T @ A
+    return T
+
+
+def _one_line_error(r, status):
+    assert r.status_code == status, r.text
+    err = r.json()["error"]
+    assert err and "\n" not in err and len(err) <= 400
+    return r.json()
+
+
+def test_kinematics_of_an_edited_table_match_the_dh_product_and_differences(client):
+    doc = json.loads(json.dumps(PLANAR))
+    doc["joints"].append({"a": 0, "alpha": "pi/2", "d": "q + 0.1", "theta": "pi/6"})  # a prismatic row
+    info = client.post("/api/robot", json={"robot": doc}).json()
+    assert info["rows"] == ["revolute", "revolute", "prismatic"] and info["dof"] == 3
+    rows = [(0.7, 0, 0, 0, "R"), (0.4, 0, 0, 0, "R"), (0, math.pi / 2, 0.1, math.pi / 6, "P")]
+    q = np.array([0.3, -1.1, 0.25])
+    r = client.post("/api/kinematics", json={"robot": doc, "q": q.tolist(), "seq": 7}).json()
+    assert r["seq"] == 7
+    np.testing.assert_allclose(r["T"], _dh(rows, q), atol=1e-12)
+    h = 1e-6  # linear rows of J0 = ∂p/∂q by central differences of the product
+    Jv = np.column_stack([(_dh(rows, q + h * e)[:3, 3] - _dh(rows, q - h * e)[:3, 3]) / (2 * h) for e in np.eye(3)])
+    np.testing.assert_allclose(np.array(r["J"])[:3], Jv, atol=1e-8)
+    J = np.array(r["J"])
+    assert r["det"] is None and r["manipulability"] == pytest.approx(math.sqrt(np.linalg.det(J @ J.T)), abs=1e-12)
+
+
+def test_a_bad_cell_is_named_by_row_and_field(client):
+    doc = json.loads(json.dumps(PLANAR))
+    doc["joints"][1]["theta"] = "q + sin("
+    err = _one_line_error(client.post("/api/robot", json={"robot": doc}), 422)
+    assert err["cell"] == {"row": 2, "field": "theta"}
+    doc["joints"][1]["theta"] = "q"
+    doc["joints"][0]["alpha"] = "q"  # the variable where it may not be
+    assert _one_line_error(client.post("/api/robot", json={"robot": doc}), 422)["cell"] == {"row": 1, "field": "alpha"}
+    doc["joints"][0]["alpha"] = 0
+    doc["parameters"]["L1"] = "__import__('os')"
+    assert _one_line_error(client.post("/api/robot", json={"robot": doc}), 422)["cell"]["field"] == "parameters"
+
+
+def test_every_ik_solution_reaches_the_target_and_includes_the_start(client):
+    doc = client.post("/api/catalogue/load", json={"name": "puma560"}).json()["robot"]
+    q = np.array([0.2, 0.5, -0.9, 0.4, 0.7, -0.3])
+    r = client.post("/api/ik", json={"robot": doc, "q": q.tolist()}).json()
+    assert len(r["solutions"]) >= 2
+    Tq = client.post("/api/kinematics", json={"robot": doc, "q": q.tolist()}).json()["T"]
+    for s in r["solutions"]:
+        Ts = client.post("/api/kinematics", json={"robot": doc, "q": s["q"]}).json()["T"]
+        np.testing.assert_allclose(Ts, Tq, atol=1e-9)
+    assert min(np.abs(np.array(s["q"]) - q).max() for s in r["solutions"]) < 1e-9
+    # a typed target: x, y, z, roll, pitch, yaw (rpy = Rz(yaw) Ry(pitch) Rx(roll))
+    r = client.post("/api/ik", json={"robot": doc, "pose": "0.5, 0.1, 0.6, 0, 90deg, 0"}).json()
+    assert r["solutions"]
+    np.testing.assert_allclose(np.array(r["target"])[:3, 3], [0.5, 0.1, 0.6], atol=1e-12)
+    np.testing.assert_allclose(np.array(r["target"])[:3, 2], [1, 0, 0], atol=1e-12)  # Ry(90°) z = x
+
+
+def test_dynamics_match_the_closed_form_planar_elbow_and_statics_the_transpose(client):
+    doc = client.post("/api/catalogue/load", json={"name": "planar2r"}).json()["robot"]  # L = m = 1, g along -y
+    q, qd = np.array([0.4, -0.9]), np.array([0.7, -0.2])
+    r = client.post("/api/dynamics", json={"robot": doc, "q": q.tolist(), "qd": "0.7, -0.2"}).json()
+    c2, s2, g0 = math.cos(q[1]), math.sin(q[1]), 9.81
+    M = [[3 + 2 * c2, 1 + c2], [1 + c2, 1]]  # m1 L1² + m2 (L1² + 2 L1 L2 c2 + L2²), ...
+    c = [-s2 * (2 * qd[0] * qd[1] + qd[1] ** 2), s2 * qd[0] ** 2]
+    g = [2 * g0 * math.cos(q[0]) + g0 * math.cos(q[0] + q[1]), g0 * math.cos(q[0] + q[1])]
+    np.testing.assert_allclose(r["M"], M, atol=1e-12)
+    np.testing.assert_allclose(r["c"], c, atol=1e-12)
+    np.testing.assert_allclose(r["g"], g, atol=1e-12)
+    w = np.array([3.0, -2.0, 0, 0, 0, 0.5])
+    tau = client.post("/api/statics", json={"robot": doc, "q": q.tolist(), "wrench": "3, -2, 0, 0, 0, 0.5"}).json()["tau"]
+    rows = [(1, 0, 0, 0, "R"), (1, 0, 0, 0, "R")]
+    h = 1e-6
+    Jv = np.column_stack([(_dh(rows, q + h * e)[:3, 3] - _dh(rows, q - h * e)[:3, 3]) / (2 * h) for e in np.eye(2)])
+    np.testing.assert_allclose(tau, Jv.T @ w[:3] + w[5] * np.ones(2), atol=1e-8)  # planar: ω = q̇1 + q̇2 about z
+
+
+def test_a_pasted_table_becomes_a_robot_with_its_notes(client):
+    text = "| i | a_{i-1} | alpha_{i-1} | d_i | theta_i |\n|---|---|---|---|---|\n| 1 | 0 | 0 | 0 | theta_1 |\n" \
+           "| 2 | 0.5 | 90 | 0 | theta_2 |\n"
+    r = client.post("/api/table", json={"text": text}).json()
+    assert r["robot"]["convention"] == "modified" and any("degrees" in n for n in r["notes"])
+    q = [0.3, 0.8]
+    T = client.post("/api/kinematics", json={"robot": r["robot"], "q": q}).json()["T"]
+    np.testing.assert_allclose(T, _dh([(0, 0, 0, 0, "R"), (0.5, math.pi / 2, 0, 0, "R")], q, "modified"), atol=1e-12)
+    _one_line_error(client.post("/api/table", json={"text": "no table here"}), 422)
+
+
+def test_catalogue_names_only_never_paths_and_the_robot_file_loads_back(client, tmp_path):
+    names = client.get("/api/catalogue").json()["names"]
+    assert "puma560" in names
+    for bad in ["../../../etc/passwd", "/etc/passwd", "puma560.yaml", 5, None]:
+        _one_line_error(client.post("/api/catalogue/load", json={"name": bad}), 404)
+    r = client.post("/api/robot-file", json={"robot": PLANAR}).json()
+    path = tmp_path / r["filename"]
+    path.write_text(r["text"], encoding="utf-8")
+    from denavit import forward_kinematics, load_robot
+
+    np.testing.assert_allclose(forward_kinematics(load_robot(path), [0.2, 0.3]),
+                               _dh([(0.7, 0, 0, 0, "R"), (0.4, 0, 0, 0, "R")], [0.2, 0.3]), atol=1e-12)
+
+
+def test_bodies_are_bounded_typed_and_json(client):
+    big = b'{"robot": "' + b"x" * 300_000 + b'"}'
+    _one_line_error(client.post("/api/robot", content=big, headers={"Content-Type": "application/json"}), 413)
+    _one_line_error(client.post("/api/robot", content=b'{"robot": 1}', headers={"Content-Type": "text/plain"}), 415)
+    deep = b"[" * 100_000 + b"]" * 100_000
+    _one_line_error(client.post("/api/kinematics", content=deep, headers={"Content-Type": "application/json"}), 400)
+    _one_line_error(client.post("/api/kinematics", content=b'{"q": NaN}', headers={"Content-Type": "application/json"}), 400)
+    _one_line_error(client.get("/etc/passwd"), 404)
+    _one_line_error(client.get("/static/..%2F_app.py"), 404)
+    assert client.get("/", headers={"Host": "evil.example"}).status_code == 400  # DNS rebinding: wrong Host
+    page = client.get("/")
+    assert page.status_code == 200 and '"two-link"' not in page.text and "puma560" in page.text
+
+
+def test_hostile_bodies_get_one_line_4xx_never_500(client):
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    leaf = st.none() | st.booleans() | st.integers(-10**30, 10**30) | st.floats() | st.text(max_size=30)
+    value = st.recursive(leaf, lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=8), inner,
+                                                                                               max_size=5), max_leaves=20)
+    cell = st.sampled_from(["q", "0", "pi/2", "L1", "q + q", "1e400", "nan", "sin(", "deg(90)", "", "q2", "__class__",
+                            "a" * 300]) | value
+    keys = st.sampled_from(["robot", "q", "qd", "pose", "wrench", "frame", "text", "name", "format", "kind", "payload"])
+
+    @settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
+    @given(path=st.sampled_from(POSTS), body=st.dictionaries(keys, value, max_size=4) | value,
+           row=st.integers(0, 1), field=st.sampled_from(["a", "alpha", "d", "theta", "limits"]), text=cell)
+    def hostile(path, body, row, field, text):
+        doc = json.loads(json.dumps(PLANAR))
+        doc["joints"][row][field] = text
+        for b in (body, {"robot": doc, "q": [0.1, 0.2], "pose": "0.5, 0, 0, 0, 0, 0", "qd": text, "wrench": text}):
+            r = client.post(path, content=json.dumps(b, allow_nan=True), headers={"Content-Type": "application/json"})
+            assert r.status_code < 500, (path, b, r.text)
+            if r.status_code >= 400:
+                _one_line_error(r, r.status_code)
+            elif path == "/api/jobs":
+                client.post(f"/api/jobs/{r.json()['id']}/cancel")
+
+    hostile()
+
+
+def _wait(client, job_id, states=("done", "failed", "cancelled"), polls=1200):
+    for _ in range(polls):
+        s = client.get(f"/api/jobs/{job_id}").json()
+        if s["state"] in states:
+            return s
+        time.sleep(0.05)
+    raise AssertionError(f"job {job_id} still {s['state']}: {s['progress'][-1:]}")
+
+
+def test_a_report_check_job_marks_the_right_and_the_wrong_line(client):
+    report = ("# Planar arm\n\n| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |\n|---|---|---|---|---|\n"
+              "| 1 | $L_1$ | 0 | 0 | $\\theta_1$ |\n| 2 | $L_2$ | 0 | 0 | $\\theta_2$ |\n\n"
+              "$$x = L_1 c_1 + L_2 c_{12}$$\n\n$$y = L_1 s_1$$\n")  # x right; y misses L_2 s_12 (Spong eq. 3.13)
+    job = client.post("/api/jobs", json={"kind": "check", "payload": {"text": report, "kind": "md"}}).json()
+    s = _wait(client, job["id"])
+    assert s["state"] == "done", s
+    res = s["result"]
+    assert res["summary"]["correct"] == 1 and res["summary"]["incorrect"] == 1
+    assert [(c["line"], c["verdict"]) for c in res["claims"]] == [(8, "correct"), (10, "incorrect")]
+    assert "<html" in res["html"].lower() and "incorrect" in res["html"]
+
+
+def test_a_long_job_is_cancelled_and_never_blocks_the_quick_answers(client):
+    """A full report of a 7-joint arm (symbolic dynamics: minutes) runs in its own process: while it runs, quick
+    answers come back; cancel ends its process."""
+    panda = client.post("/api/catalogue/load", json={"name": "panda"}).json()["robot"]
+    job = client.post("/api/jobs", json={"kind": "report", "payload": {"robot": panda}}).json()
+    assert job["state"] == "running"
+    for k in range(20):
+        r = client.post("/api/kinematics", json={"robot": panda, "q": [0.1 * k] * 7})
+        assert r.status_code == 200
+    assert client.get(f"/api/jobs/{job['id']}").json()["state"] == "running"  # 20 answers while it worked
+    assert client.post(f"/api/jobs/{job['id']}/cancel").json()["state"] == "cancelled"
+    proc = client.app.state.jobs._jobs[job["id"]].process
+    proc.join(timeout=30)
+    assert not proc.is_alive() and proc.exitcode == -signal.SIGTERM
+    assert _wait(client, job["id"])["state"] == "cancelled"
+    _one_line_error(client.get("/api/jobs/no-such-job"), 404)
+
+
+def test_the_formula_job_gives_the_symbolic_pose(client):
+    s = _wait(client, client.post("/api/jobs", json={"kind": "formula", "payload": {"robot": PLANAR}}).json()["id"])
+    assert s["state"] == "done", s
+    maths = " ".join(st["math"] for st in s["result"]["steps"] if "math" in st)
+    # p_x = L1 cos q1 + L2 cos(q1 + q2) for the planar elbow arm (Spong 2006 eq. 3.13): both lengths appear
+    assert "L_{1}" in maths and "L_{2}" in maths and "T" in maths
+
+
+def test_serve_without_the_extra_says_what_to_install(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "starlette", None)
+    assert main(["serve", "planar2r"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'pip install "denavit[web]"' in err[0]
+
+
+def test_serve_on_a_port_in_use_is_one_line(capsys):
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen(1)
+        port = s.getsockname()[1]
+        assert main(["serve", "planar2r", "--port", str(port)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"port {port}" in err[0] and "in use" in err[0]
+
+
+def test_serve_prints_its_address_warns_off_loopback_and_answers():
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen([sys.executable, "-m", "denavit", "serve", "planar2r", "--port", "0", "--host", "127.0.0.2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        line = proc.stdout.readline()
+        assert line.startswith("denavit workbench at http://127.0.0.2:"), line
+        url = line.split()[3]
+        page = urllib.request.urlopen(url, timeout=60).read().decode()
+        assert "planar2r" in page and "/static/workbench.js" in page
+        names = json.loads(urllib.request.urlopen(url + "api/catalogue", timeout=60).read())["names"]
+        assert "puma560" in names
+    finally:
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    assert proc.returncode in (0, 130)  # Ctrl-C: the command line's 130 when uvicorn passes the signal on
+    assert "warning: listening on 127.0.0.2" in err.splitlines()[0] and "Traceback" not in err
