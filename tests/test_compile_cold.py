@@ -63,3 +63,28 @@ def test_batches_of_every_kernel_share_one_compiled_function(fresh, rng):
     np.testing.assert_allclose(fast.coriolis(Q, QD), denavit.coriolis_vector(robot, Q, QD), atol=1e-12)
     np.testing.assert_allclose(fast.mass_matrix(Q), denavit.mass_matrix(robot, Q), atol=1e-12)
     assert overloads(m.group_n) == 1
+
+
+def test_kernels_compile_with_one_o3_pass_and_the_rest_of_numba_untouched(fresh, rng):
+    """The kernels' compiles skip numba's per-function -O3 pass (denavit.codegen._lean); the IK solvers of the same
+    module, and numba outside the block, keep numba's pipeline; the lean kernels' numbers are the plain functions'."""
+    from numba.core import codegen
+
+    from denavit.codegen import _lean
+
+    robot, fast = fresh
+    m = fast._m
+    original = codegen.CPUCodeLibrary._optimize_functions
+    assert getattr(m.group_n.compile, "_denavit_lean", False)
+    assert getattr(m.rnea_1.compile, "_denavit_lean", False)
+    solvers = [v for k, v in vars(m).items() if "ik" in k and hasattr(v, "compile")]
+    assert solvers and not any(getattr(v.compile, "_denavit_lean", False) for v in solvers)
+    with _lean.lean():
+        assert codegen.CPUCodeLibrary._optimize_functions is _lean._layout_only
+        with _lean.lean():  # nested: still lean, and the outer block restores numba's own
+            pass
+        assert codegen.CPUCodeLibrary._optimize_functions is _lean._layout_only
+    assert codegen.CPUCodeLibrary._optimize_functions is original
+    Q = rng.uniform(-1, 1, (7, 2))
+    np.testing.assert_allclose(fast.mass_matrix(Q), denavit.mass_matrix(robot, Q), atol=1e-12)
+    np.testing.assert_allclose(fast.jacobian(Q[0]), denavit.geometric_jacobian(robot, Q[0]), atol=1e-12)

@@ -26,6 +26,7 @@ from pathlib import Path
 from ..errors import DenavitWarning
 from ..model import DHRobot
 from . import _cache_folder as _folder
+from ._lean import lean_kernels
 from ._cache_folder import (
     CACHE_ENV,
     MODULE_PREFIX,
@@ -146,6 +147,7 @@ def load_module(key: str, tag: str, make_source):
         mod = _execute(modname, path, code)
         if numba:
             _guard_numba(mod)
+            lean_kernels(mod)  # the kernels' compiles run LLVM's -O3 once (see _lean)
         _LOADED[modname] = mod
         return mod
 

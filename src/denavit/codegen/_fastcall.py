@@ -30,6 +30,8 @@ import sys
 
 import numpy as np
 
+from ._lean import lean
+
 __all__ = ["entry_intrinsic", "install", "ENTRY_SUFFIX"]
 
 #: the generated module's fast-call function of kernel <name> is <name><ENTRY_SUFFIX>
@@ -294,7 +296,8 @@ def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tupl
         cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
         cf.enable_caching()
         guard(cf)
-        cf.compile()
+        with lean():  # LLVM's -O3 once, as for the kernels (see denavit.codegen._lean)
+            cf.compile()
         _CFUNCS[(module.__name__, name)] = cf
     doc = (method.__doc__ or "").encode("utf-8", "replace")
     definition = _MethodDef(method.__name__.encode(), cf.address, _METH_FASTCALL_KEYWORDS, doc)
