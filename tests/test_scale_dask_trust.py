@@ -163,10 +163,11 @@ def test_a_dying_worker_is_one_error_and_no_log(capfd):
 # ---- the CLI's cluster and signals ----------------------------------------------------------------------------
 
 #: ``python -m denavit`` as a terminal's shell starts it: Ctrl-C at Python's default.  A child inherits ignored
-#: signals, and the xdist worker running these tests can have SIGINT (and SIGQUIT) ignored by the time it gets
-#: here — seen in full runs (/proc SigIgn 0x...1001006), never at a worker's start (0x...1001000); which earlier
-#: test leaves it so is not known yet.  A program started with SIGINT ignored rightly ignores Ctrl-C (POSIX: a
-#: background job), so without this line the test waited 60 s for an exit that could not come.
+#: signals, and pytest itself may run with SIGINT and SIGQUIT ignored: POSIX shells start an asynchronous command
+#: (``python -m pytest ... &``) with both ignored when job control is off, as in scripts and CI runners (seen: /proc
+#: SigIgn 0x...1001006 in pytest, its xdist workers and the CLI they launched; ``bash -c 'grep SigIgn
+#: /proc/self/status & wait'`` shows 0x6).  A program started with SIGINT ignored rightly ignores Ctrl-C, so
+#: without this line the test waited 60 s for an exit that could not come.
 _AS_FROM_A_SHELL = ("import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
                     "sys.argv[0] = 'denavit'; runpy.run_module('denavit', run_name='__main__', alter_sys=True)")
 
