@@ -20,7 +20,7 @@ from ._handlers import RequestError, one_line
 
 __all__ = ["JOB_CPU_SECONDS", "MAX_KEPT", "MAX_RUNNING", "Jobs"]
 
-MAX_RUNNING = 2
+MAX_RUNNING = 4
 MAX_KEPT = 16
 #: CPU seconds a job may use (a 7-joint arm's full report takes minutes on a slow machine).
 JOB_CPU_SECONDS = 900.0
@@ -39,11 +39,12 @@ class _Job:
         self.started = time.monotonic()
         self.finished: float | None = None
         self.process: Any = None
+        self.cpu_seconds: float | None = None  # the job process's own CPU time, when it finished
 
     def to_json(self, with_result: bool = True) -> dict[str, Any]:
         end = self.finished if self.finished is not None else time.monotonic()
         out = {"id": self.id, "kind": self.kind, "state": self.state, "progress": list(self.progress),
-               "error": self.error, "seconds": round(end - self.started, 3)}
+               "error": self.error, "seconds": round(end - self.started, 3), "cpu_seconds": self.cpu_seconds}
         if with_result and self.state == "done":
             out["result"] = self.result
         return out
@@ -106,6 +107,8 @@ class Jobs:
                     break
                 if kind == "progress":
                     job.progress = (job.progress + [data])[-MAX_PROGRESS:]
+                elif kind == "cpu":
+                    job.cpu_seconds = round(float(data), 3)
                 elif kind == "done":
                     job.result, job.state = data, "done"
                 elif kind == "error":

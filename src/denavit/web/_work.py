@@ -120,6 +120,8 @@ def run(kind: str, payload: dict[str, Any], conn: Any, cpu_seconds: float) -> No
     try:
         with np.errstate(all="ignore"):
             result = KINDS[kind](payload, lambda text: conn.send(("progress", one_line(text))))
+        usage = resource.getrusage(resource.RUSAGE_SELF)
+        conn.send(("cpu", usage.ru_utime + usage.ru_stime))
         conn.send(("done", result))
     except (ValueError, ArithmeticError, LookupError, TypeError, RecursionError, MemoryError) as exc:
         conn.send(("error", one_line(exc)))

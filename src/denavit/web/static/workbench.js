@@ -195,14 +195,19 @@
     post("/api/ik", body).then(function (r) {
       var list = $("ik-list");
       list.innerHTML = "";
-      if (r._status !== 200) { $("ik-error").textContent = r.error; return; }
-      $("ik-error").textContent = r.solutions.length + " solution(s) (" + r.method + ")" +
+      $("ik-error").textContent = r._status === 200 ? "" : r.error;
+      $("ik-info").textContent = "";
+      if (r._status !== 200) return;
+      $("ik-info").textContent = r.solutions.length + " solution(s) (" + r.method + ")" +
         (r.outside_limits ? ", " + r.outside_limits + " more outside the joint limits" : "");
       r.solutions.forEach(function (s, i) {
         var li = document.createElement("li"), b = document.createElement("button");
         b.type = "button"; b.className = "ik-solution"; b.dataset.q = JSON.stringify(s.q);
         b.textContent = "[" + s.q.map(function (x) { return x.toFixed(4); }).join(", ") + "] " + s.branch;
-        b.addEventListener("click", function () { showSolution(s.q); });
+        b.addEventListener("click", function () {
+          document.querySelectorAll(".ik-solution").forEach(function (o) { o.classList.remove("current"); });
+          b.classList.add("current"); showSolution(s.q);
+        });
         li.appendChild(b); list.appendChild(li);
       });
     });
@@ -213,28 +218,43 @@
   }
 
   // ---- jobs: the formula, the report, the check --------------------------------------------------------
+  var running = {};          // this page's jobs by id, cancelled when the page goes away
   function runJob(kind, payload, onProgress, onDone) {
-    return post("/api/jobs", { kind: kind, payload: payload }).then(function (r) {
-      if (r._status !== 200) { onDone(null, r.error); return null; }
-      var job = { id: r.id, stopped: false };
+    var job = { id: null, stopped: false }, polls = 0;
+    post("/api/jobs", { kind: kind, payload: payload }).then(function (r) {
+      if (r._status !== 200) { if (!job.stopped) onDone(null, r.error, r); return; }
+      job.id = r.id;
+      if (job.stopped) { cancelJob(job); return; }   // superseded before it started
+      running[job.id] = job;
       (function poll() {
         if (job.stopped) return;
         fetch("/api/jobs/" + job.id).then(function (x) { return x.json(); }).then(function (s) {
-          if (s.state === "running") { onProgress(s.progress); setTimeout(poll, 150); }
-          else onDone(s.state === "done" ? s.result : null, s.state === "done" ? "" : s.error);
+          if (job.stopped) return;
+          if (s.state === "running") { onProgress(s.progress); setTimeout(poll, ++polls < 40 ? 50 : 250); return; }
+          delete running[job.id];
+          onDone(s.state === "done" ? s.result : null, s.state === "done" ? "" : s.error, s);
         });
       })();
-      return job;
     });
+    return job;
   }
-  function cancelJob(job) { if (job) { job.stopped = true; post("/api/jobs/" + job.id + "/cancel", {}); } }
+  function cancelJob(job) {
+    if (!job) return;
+    job.stopped = true;
+    if (job.id) { delete running[job.id]; post("/api/jobs/" + job.id + "/cancel", {}); }
+  }
+  window.addEventListener("pagehide", function () {
+    Object.keys(running).forEach(function (id) {
+      navigator.sendBeacon("/api/jobs/" + id + "/cancel", new Blob(["{}"], { type: "application/json" }));
+    });
+  });
 
   var formulaJob = null;
   function startFormula() {
     cancelJob(formulaJob);
     $("formula-status").textContent = "deriving…";
     var t0 = performance.now();
-    runJob("formula", { robot: good.doc }, function () {}, function (res, err) {
+    formulaJob = runJob("formula", { robot: good.doc }, function () {}, function (res, err, st) {
       if (!res) { $("formula-status").textContent = err; return; }
       var box = $("formula"); box.innerHTML = "";
       res.steps.forEach(function (s) {
@@ -243,16 +263,17 @@
         else el.textContent = s.math || s.text;
         box.appendChild(el);
       });
-      $("formula-status").textContent = "derived in " + ((performance.now() - t0) / 1000).toFixed(2) + " s";
       wb.formulaSeconds = (performance.now() - t0) / 1000;
-    }).then(function (j) { formulaJob = j; });
+      wb.formulaCpu = st.cpu_seconds;
+      $("formula-status").textContent = "derived in " + wb.formulaSeconds.toFixed(2) + " s (" + st.cpu_seconds + " s of CPU)";
+    });
   }
 
   var reportJob = null, report = null;
   function startReport() {
     $("report-start").disabled = true; $("report-cancel").disabled = false;
     $("report-downloads").hidden = true; $("report-sections").innerHTML = "";
-    runJob("report", { robot: good.doc, q: q }, function (p) {
+    reportJob = runJob("report", { robot: good.doc, q: q }, function (p) {
       var last = p[p.length - 1] || "starting", m = /section (\d+)\/(\d+)/.exec(last);
       $("report-status").textContent = last;
       if (m) $("report-progress").value = (m[1] - 1) / m[2];
@@ -272,7 +293,7 @@
         li.appendChild(a); $("report-sections").appendChild(li);
       });
       $("report").hidden = false; $("report").srcdoc = res.html; $("report-downloads").hidden = false;
-    }).then(function (j) { reportJob = j; });
+    });
   }
   function download(text, name, type) {
     var a = document.createElement("a");
