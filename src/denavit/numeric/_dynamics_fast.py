@@ -192,7 +192,9 @@ def _body_wrench(body, R, w, wd, acc):
 
     f = m a_O + ω̇ × h + ω × (ω × h),   n_O = J ω̇ + ω × (J ω) + h × a_O,
 
-    with h, J turned into world axes by R = (x, y, z) of the body's frame.
+    with h turned into world axes by R = (x, y, z) of the body's frame, and the J terms evaluated in the body's
+    own axes: R (J ω̇_b + ω_b × (J ω_b)) with ω_b = Rᵀ ω, ω̇_b = Rᵀ ω̇ (R (a × b) = R a × R b) — three turns of
+    axes, where R J Rᵀ applied to ω̇ and to ω takes four (a quarter of the ∂RNEA kernel's operations went there).
     """
     _, m, h, J, _ = body
     x, y, z = R
@@ -203,15 +205,15 @@ def _body_wrench(body, R, w, wd, acc):
         f = _add(f, _add(_cross(wd, hw), _cross(w, _cross(w, hw)))) if w is not ZERO3 else _add(f, _cross(wd, hw))
         n = _cross(hw, acc)
 
-    def Jw(v):  # R (J (Rᵀ v))
-        u = (_dot(x, v), _dot(y, v), _dot(z, v))
-        Ju = [_sum_any([J[i][j] * u[j] for j in range(3) if _nonzero(J[i][j])]) for i in range(3)]
-        return _combine_any(Ju, (x, y, z))
+    def J_times(u):  # J u in the body's axes (terms with a float-zero J_ij skipped)
+        return tuple(_sum_any([J[i][j] * u[j] for j in range(3) if _nonzero(J[i][j])]) for i in range(3))
 
     if any(_nonzero(c) for row in J for c in row) and (wd is not ZERO3 or w is not ZERO3):
-        n = _add(n, Jw(wd))
+        n_b = J_times((_dot(x, wd), _dot(y, wd), _dot(z, wd)))
         if w is not ZERO3:
-            n = _add(n, _cross(w, Jw(w)))
+            w_b = (_dot(x, w), _dot(y, w), _dot(z, w))
+            n_b = _add(n_b, _cross(w_b, J_times(w_b)))
+        n = _add(n, _combine_any(n_b, (x, y, z)))
     return f, n
 
 
