@@ -30,7 +30,7 @@ from denavit.web._jobs import Jobs
 PLANAR = {"name": "two-link", "convention": "standard", "parameters": {"L1": "0.7", "L2": "0.4"},
           "joints": [{"a": "L1", "alpha": 0, "d": 0, "theta": "q"}, {"a": "L2", "alpha": 0, "d": 0, "theta": "q"}]}
 POSTS = ["/api/robot", "/api/kinematics", "/api/ik", "/api/dynamics", "/api/statics", "/api/table",
-         "/api/catalogue/load", "/api/robot-file", "/api/jobs"]
+         "/api/catalogue/load", "/api/robot-file", "/api/open", "/api/jobs"]
 
 
 @pytest.fixture(scope="module")
@@ -154,6 +154,48 @@ def test_catalogue_names_only_never_paths_and_the_robot_file_loads_back(client, 
                                _dh([(0.7, 0, 0, 0, "R"), (0.4, 0, 0, 0, "R")], [0.2, 0.3]), atol=1e-12)
 
 
+def test_an_opened_robot_file_keeps_its_cells_a_urdf_becomes_rows_and_no_text_is_a_path(client, tmp_path):
+    text = "convention: modified\nparameters: {L: 0.5}\njoints:\n  - {a: 0, alpha: 0, d: 0, theta: q}\n" \
+           "  - {a: L, alpha: pi/2, d: 0, theta: q + pi/2}\n"
+    r = client.post("/api/open", json={"text": text, "filename": "arm.yaml"}).json()
+    assert r["robot"]["joints"][1] == {"a": "L", "alpha": "pi/2", "d": 0, "theta": "q + pi/2"}  # as written
+    q = [0.3, -0.4]
+    T = client.post("/api/kinematics", json={"robot": r["robot"], "q": q}).json()["T"]
+    np.testing.assert_allclose(T, _dh([(0, 0, 0, 0, "R"), (0.5, math.pi / 2, 0, math.pi / 2, "R")], q, "modified"),
+                               atol=1e-12)
+    urdf = ('<robot name="r1"><link name="a"/><link name="b"/><joint name="j" type="revolute"><parent link="a"/>'
+            '<child link="b"/><origin xyz="0 0 0.5"/><axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint></robot>')
+    r = client.post("/api/open", json={"text": urdf, "filename": "r1.urdf"}).json()
+    T = client.post("/api/kinematics", json={"robot": r["robot"], "q": [0.7]}).json()["T"]
+    np.testing.assert_allclose(np.array(T)[:3, 3], [0, 0, 0.5], atol=1e-12)  # a joint 0.5 m up, turning about z
+    np.testing.assert_allclose(np.array(T)[:2, 0], [math.cos(0.7), math.sin(0.7)], atol=1e-12)
+    secret = tmp_path / "secret.urdf"
+    secret.write_text(urdf, encoding="utf-8")
+    for name in ("x.urdf", "x.yaml", "x.exe"):  # a path as the text is text, never opened
+        _one_line_error(client.post("/api/open", json={"text": str(secret), "filename": name}), 422)
+    err = _one_line_error(client.post("/api/open", json={"text": text.replace("pi/2}", "pi/"), "filename": "a.yaml"}), 422)
+    assert "a.yaml" in err["error"]
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+                                                         for p, c in zip("abcdefg", "bcdefgh"))
+    _one_line_error(client.post("/api/open", json={"text": bomb, "filename": "bomb.yaml"}), 422)
+
+
+def test_the_workspace_job_of_the_planar_elbow_arm_is_the_disk_of_radius_two(client):
+    pytest.importorskip("matplotlib")
+    doc = client.post("/api/catalogue/load", json={"name": "planar2r"}).json()["robot"]  # L1 = L2 = 1, full turns
+    s = _wait(client, client.post("/api/jobs", json={"kind": "workspace", "payload": {"robot": doc, "samples": 20000}}
+                                  ).json()["id"])
+    assert s["state"] == "done", s
+    res = s["result"]
+    assert res["planar"] and 1.99 < res["reach"] <= 2 + 1e-12
+    assert abs(res["area"] - 4 * math.pi) < 0.15 * 4 * math.pi  # pixel counting of the disk r <= L1 + L2
+    import base64
+
+    assert base64.b64decode(res["png"])[:8] == b"\x89PNG\r\n\x1a\n"
+    err = client.post("/api/jobs", json={"kind": "workspace", "payload": {"robot": doc, "samples": 10**9}}).json()
+    assert _wait(client, err["id"])["error"].startswith("'samples' must be")
+
+
 def test_bodies_are_bounded_typed_and_json(client):
     big = b'{"robot": "' + b"x" * 300_000 + b'"}'
     _one_line_error(client.post("/api/robot", content=big, headers={"Content-Type": "application/json"}), 413)
@@ -177,7 +219,8 @@ def test_hostile_bodies_get_one_line_4xx_never_500(client):
                                                                                                max_size=5), max_leaves=20)
     cell = st.sampled_from(["q", "0", "pi/2", "L1", "q + q", "1e400", "nan", "sin(", "deg(90)", "", "q2", "__class__",
                             "a" * 300]) | value
-    keys = st.sampled_from(["robot", "q", "qd", "pose", "wrench", "frame", "text", "name", "format", "kind", "payload"])
+    keys = st.sampled_from(["robot", "q", "qd", "pose", "wrench", "frame", "text", "name", "format", "kind", "payload",
+                            "filename"])
 
     @settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
     @given(path=st.sampled_from(POSTS), body=st.dictionaries(keys, value, max_size=4) | value,

@@ -30,7 +30,7 @@ __all__ = ["MAX_BODY_BYTES", "MAX_CHECK_BYTES", "create_app"]
 
 #: Largest JSON body of a request (a 64-row table with inertial data is about 20 kB).
 MAX_BODY_BYTES = 256_000
-#: Largest body of a check job (the report or claims text travels inside it).
+#: Largest body of a check job or an opened file (the report, claims, robot file or URDF text travels inside it).
 MAX_CHECK_BYTES = 1_200_000
 _STATIC = {"workbench.js": "text/javascript", "workbench.css": "text/css"}
 
@@ -123,6 +123,7 @@ def _routes() -> list[Route]:
         Route("/api/statics", _post(H.statics), methods=["POST"]),
         Route("/api/table", _post(H.table), methods=["POST"]),
         Route("/api/robot-file", _post(H.robot_file), methods=["POST"]),
+        Route("/api/open", _post(H.opened_file, MAX_CHECK_BYTES), methods=["POST"]),
         Route("/api/jobs", _job_start, methods=["POST"]),
         Route("/api/jobs/{job}", _job_status),
         Route("/api/jobs/{job}/cancel", _job_cancel, methods=["POST"]),

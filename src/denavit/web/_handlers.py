@@ -289,3 +289,37 @@ def robot_file(body: Any) -> dict[str, Any]:
         raise RequestError("'format' must be yaml or json")
     robot = robot_of(body)
     return {"text": dump_robot(robot, fmt), "filename": f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', robot.name)[:60] or 'robot'}.{fmt}"}
+
+
+_FILE_SUFFIXES = (".yaml", ".yml", ".json", ".toml", ".urdf")
+
+
+def opened_file(body: Any) -> dict[str, Any]:
+    """A robot file or URDF opened in the page (its text; the name only gives the format), as a robot-file mapping.
+
+    A robot file is read safely (:func:`denavit.io.load_data`: bounded nesting, aliases, sizes) and kept as written,
+    so its cells show as the author typed them; a URDF's chain becomes DH rows (:func:`denavit.from_urdf`, XML
+    read with entities disabled).  The text is never taken for a path.
+    """
+    from .. import from_urdf
+
+    text, name = _field(body, "text"), _field(body, "filename")
+    if not isinstance(text, str) or not isinstance(name, str):
+        raise RequestError("'text' and 'filename' must be the file's text and name")
+    suffix = "." + name.rsplit(".", 1)[-1].lower() if "." in name else ""
+    if suffix not in _FILE_SUFFIXES:
+        raise RequestError(f"{one_line(name, 60)!r}: open a robot file ({', '.join(_FILE_SUFFIXES[:4])}) or a .urdf")
+    where = one_line(name, 60)
+    try:
+        if suffix == ".urdf":
+            if not text.lstrip().startswith("<"):
+                raise RequestError(f"{where}: a URDF is XML text starting with '<'")
+            return {"robot": robot_to_dict(from_urdf(text)), "notes": ["DH rows extracted from the URDF's chain"]}
+        data = load_data(text, suffix, where)
+        if not isinstance(data, dict):
+            raise RequestError(f"{where}: a robot file is a mapping with 'convention' and 'joints'")
+        data = json.loads(json.dumps(data, default=str))
+        robot_from_dict(data, where=where)  # refused here, naming the file, row and field
+    except DenavitError as exc:
+        raise RequestError(str(exc), 422, _cell_of(exc)) from None
+    return {"robot": data, "notes": []}

@@ -1,5 +1,5 @@
 """The workbench's long work, run in a child process (:mod:`denavit.web._jobs`): the symbolic T_0_n, the
-derivation report and the checker.
+derivation report, the checker and the workspace picture.
 
 Each job is a function ``(payload, progress) -> dict`` of JSON data; the robot is re-read from its file mapping
 here (``robot_from_dict``), so nothing but JSON crosses the process boundary.  The report is the library's
@@ -98,9 +98,37 @@ def check(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str,
     raise ParseError("'kind' must be md, tex or txt (a report) or yaml (a claims file)")
 
 
+#: Most configurations sampled by one workspace job.
+MAX_WORKSPACE_SAMPLES = 2_000_000
+
+
+def workspace(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """The sampled workspace (:func:`denavit.viz.workspace`) and its picture (:func:`~denavit.viz.plot_workspace`)."""
+    import base64
+    import io
+
+    import numpy as np
+
+    from ..viz import plot_workspace
+    from ..viz import workspace as sample
+
+    samples = payload.get("samples", 100_000)
+    if not isinstance(samples, int) or isinstance(samples, bool) or not 1_000 <= samples <= MAX_WORKSPACE_SAMPLES:
+        raise ParseError(f"'samples' must be a whole number from 1000 to {MAX_WORKSPACE_SAMPLES}")
+    robot = _robot(payload)
+    progress(f"sampling {samples} configurations")
+    ws = sample(robot, samples, rng=np.random.default_rng(0))
+    progress("drawing")
+    fig = plot_workspace(ws, title=robot.name)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    return {"png": base64.b64encode(buf.getvalue()).decode("ascii"), "samples": ws.samples, "reach": ws.reach,
+            "volume": ws.volume, "area": ws.area, "planar": ws.planar, "extent": ws.extent.tolist()}
+
+
 #: The jobs a page may start, by name.
 KINDS: dict[str, Callable[[dict[str, Any], Callable[[str], None]], dict[str, Any]]] = {
-    "formula": formula, "report": report, "check": check,
+    "formula": formula, "report": report, "check": check, "workspace": workspace,
 }
 
 

@@ -121,6 +121,9 @@
       status(r.name + ": " + r.dof + " joints, " + r.convention + " DH");
       var keep = q.length === r.dof ? q.slice() : null;
       loadViewer(r.viewer, keep);
+      var poses = $("poses");
+      poses.length = 1;
+      Object.keys(r.poses).forEach(function (n) { var o = document.createElement("option"); o.value = n; o.textContent = n; poses.appendChild(o); });
       startFormula();
     }).catch(function (e) { status("no answer from the server: " + e); });
   }
@@ -321,6 +324,32 @@
     });
   }
 
+  var wsJob = null;
+  function startWorkspace() {
+    var n = parseInt($("ws-samples").value, 10);
+    $("ws-start").disabled = true; $("ws-cancel").disabled = false; $("ws-progress").value = 0;
+    wsJob = runJob("workspace", { robot: good.doc, samples: n }, function (p) {
+      var last = p[p.length - 1] || "starting";
+      $("ws-status").textContent = last; $("ws-progress").value = /drawing/.test(last) ? 1 : 0.2;
+    }, function (res, err) {
+      $("ws-start").disabled = false; $("ws-cancel").disabled = true; $("ws-progress").value = res ? 2 : 0;
+      if (!res) { $("ws-status").textContent = err; return; }
+      $("ws-status").textContent = res.samples + " samples, reach " + res.reach.toFixed(3) + " m, " +
+        (res.planar ? "area " + res.area.toFixed(3) + " m²" : "volume " + res.volume.toFixed(3) + " m³");
+      $("ws-picture").src = "data:image/png;base64," + res.png; $("ws-picture").hidden = false;
+    });
+  }
+  function openFile() {
+    var f = $("open-file").files[0];
+    if (!f) return;
+    f.text().then(function (text) {
+      post("/api/open", { text: text, filename: f.name }).then(function (r) {
+        $("open-error").textContent = r._status === 200 ? r.notes.join(" · ") : r.error;
+        if (r._status === 200) loadDoc(r.robot);
+      });
+    });
+  }
+
   // ---- wiring -------------------------------------------------------------------------------------------
   function loadDoc(d) { doc = d; renderTable(); sendTable(); }
   $("add-row").addEventListener("click", function () { doc.joints.push({ a: "0", alpha: "0", d: "0", theta: "q" }); renderTable(); tableChanged(); });
@@ -360,6 +389,15 @@
     if (m) $("check-kind").value = { markdown: "md", yml: "yaml" }[m[1].toLowerCase()] || m[1].toLowerCase();
   });
   $("check-start").addEventListener("click", startCheck);
+  $("ws-start").addEventListener("click", startWorkspace);
+  $("ws-cancel").addEventListener("click", function () {
+    cancelJob(wsJob); $("ws-start").disabled = false; $("ws-cancel").disabled = true;
+    $("ws-status").textContent = "cancelled"; $("ws-progress").value = 0;
+  });
+  $("open-file").addEventListener("change", openFile);
+  $("poses").addEventListener("change", function () {
+    if (this.value && good) showSolution(good.info.poses[this.value]);
+  });
   wb.showSolution = showSolution;
   wb.doc = function () { return good ? good.doc : doc; };
   wb.busy = function () { return inFlight || again; };
