@@ -196,6 +196,16 @@ def test_the_workspace_job_of_the_planar_elbow_arm_is_the_disk_of_radius_two(cli
     assert _wait(client, err["id"])["error"].startswith("'samples' must be")
 
 
+def test_the_singular_sets_of_the_planar_elbow_arm_are_stretched_and_folded(client):
+    """det J = L1 L2 sin q2 for the planar elbow arm (Spong 2006 Sec. 4.9): singular at q2 = 0 and q2 = π only."""
+    s = _wait(client, client.post("/api/jobs", json={"kind": "singularities", "payload": {"robot": PLANAR}}).json()["id"])
+    assert s["state"] == "done", s
+    conds = s["result"]["conditions"]
+    values = sorted(v for c in conds for x in c["solutions"] for v in x["values"] if x["variable"] == "q2")
+    assert [x["variable"] for c in conds for x in c["solutions"]] == ["q2"] * len(values)
+    np.testing.assert_allclose(values, [0, math.pi], atol=1e-12)
+
+
 def test_bodies_are_bounded_typed_and_json(client):
     big = b'{"robot": "' + b"x" * 300_000 + b'"}'
     _one_line_error(client.post("/api/robot", content=big, headers={"Content-Type": "application/json"}), 413)

@@ -214,10 +214,20 @@ def test_upload_a_report_and_see_its_marks(page, tmp_path):
     assert frame.locator(".katex").count() >= 2  # the report's mathematics typeset offline
 
 
-def test_the_report_is_derived_in_the_background_section_by_section(page):
+def test_the_singular_sets_and_the_report_in_the_background(page):
     page.select_option("#catalogue", "planar2r")
     page.wait_for_function("window.workbench.doc().name === 'planar2r' && window.workbench.kinCount > 0 && "
                            "!window.workbench.busy()", timeout=60_000)
+    # the singular sets, and the nearest one named as the slider moves (planar 2R: q2 = 0 or π, Spong Sec. 4.9)
+    page.click("#sing-start")
+    page.wait_for_function("document.getElementById('sing-nearest').textContent.length > 0", timeout=120_000)
+    count = page.evaluate("window.workbench.kinCount")
+    page.evaluate("""() => { const s = document.getElementById('viewer').contentDocument.getElementById('q2');
+                             s.value = 2.9; s.dispatchEvent(new Event('input')); }""")
+    _settle(page, count)
+    nearest = page.locator("#sing-nearest")
+    assert "q2 = 3.1416" in nearest.text_content()
+    assert float(nearest.get_attribute("data-distance")) == pytest.approx(np.pi - 2.9, abs=1e-12)
     page.click("#report-start")
     page.wait_for_function("document.querySelectorAll('#report-sections li').length > 0", timeout=240_000)
     items = page.locator("#report-sections li").all_text_contents()

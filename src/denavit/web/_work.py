@@ -1,5 +1,5 @@
 """The workbench's long work, run in a child process (:mod:`denavit.web._jobs`): the symbolic T_0_n, the
-derivation report, the checker and the workspace picture.
+derivation report, the checker, the singular conditions and the workspace picture.
 
 Each job is a function ``(payload, progress) -> dict`` of JSON data; the robot is re-read from its file mapping
 here (``robot_from_dict``), so nothing but JSON crosses the process boundary.  The report is the library's
@@ -98,6 +98,22 @@ def check(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str,
     raise ParseError("'kind' must be md, tex or txt (a report) or yaml (a claims file)")
 
 
+def singularities(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """The singular conditions of the arm's Jacobian (:func:`denavit.symbolic.singularity_analysis`, as
+    ``denavit singularities``), each with the joint values that solve it, so the page can name the nearest one."""
+    import sympy as sp
+
+    from ..symbolic import singularity_analysis
+
+    res = singularity_analysis(_robot(payload), "auto", "base", progress=progress)
+    return {"measure": res.measure, "rows": list(res.rows), "everywhere": res.everywhere, "reason": res.reason,
+            "determinant": sp.latex(res.determinant),
+            "complete": not ("minors" in res.measure and not res.conditions and not res.everywhere),
+            "conditions": [{"latex": sp.latex(c.factor) + " = 0", "kind": c.kind, "explanation": c.explanation,
+                            "solutions": [{"variable": x.variable, "values": [float(v) for v in x.values]}
+                                          for x in c.solutions]} for c in res.conditions]}
+
+
 #: Most configurations sampled by one workspace job.
 MAX_WORKSPACE_SAMPLES = 2_000_000
 
@@ -129,6 +145,7 @@ def workspace(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[
 #: The jobs a page may start, by name.
 KINDS: dict[str, Callable[[dict[str, Any], Callable[[str], None]], dict[str, Any]]] = {
     "formula": formula, "report": report, "check": check, "workspace": workspace,
+    "singularities": singularities,
 }
 
 

@@ -163,6 +163,7 @@
           "manipulability √det(J Jᵀ) = " + r.manipulability.toPrecision(5) + " · σ_min = " +
           r.singular_values[r.singular_values.length - 1].toPrecision(4);
         $("T").dataset.q = JSON.stringify(r.q);
+        showNearest();
         $("T").dataset.full = JSON.stringify(r.T);
         wb.shown = seq; wb.kinCount++;
         if (started[seq] !== undefined) {
@@ -324,6 +325,50 @@
     });
   }
 
+  // ---- singular sets: derived once (a job), the nearest one named at every slider move -------------------
+  var singular = null, singDoc = null;
+  function startSingularities() {
+    $("sing-start").disabled = true; $("sing-status").textContent = "deriving…";
+    var sent = good.doc;
+    runJob("singularities", { robot: sent }, function (p) { $("sing-status").textContent = p[p.length - 1] || "deriving…"; },
+      function (res, err) {
+        $("sing-start").disabled = false;
+        if (!res) { $("sing-status").textContent = err; return; }
+        singular = res; singDoc = sent;
+        $("sing-status").textContent = res.everywhere ? "singular everywhere: " + res.reason :
+          res.conditions.length ? res.measure + " vanishes when:" : (res.complete ? "no singular configuration" :
+          "not solved symbolically (non-square J: all minors vanish together)");
+        var list = $("sing-list"); list.innerHTML = "";
+        res.conditions.forEach(function (c) {
+          var li = document.createElement("li"), m = document.createElement("span");
+          if (window.katex) katex.render(c.latex, m, { throwOnError: false }); else m.textContent = c.latex;
+          li.appendChild(m); li.appendChild(document.createTextNode(" — " + c.kind + ": " + c.explanation));
+          list.appendChild(li);
+        });
+        showNearest();
+      });
+  }
+  function wrap(x) { return Math.abs(Math.atan2(Math.sin(x), Math.cos(x))); }
+  function showNearest() {
+    var out = $("sing-nearest");
+    if (singular && singDoc !== good.doc) {   // the table changed: those conditions were another arm's
+      singular = null; $("sing-list").innerHTML = ""; $("sing-status").textContent = "the table changed: find them again";
+    }
+    if (!singular) { out.textContent = ""; return; }
+    var best = null;
+    singular.conditions.forEach(function (c) {
+      c.solutions.forEach(function (s) {
+        var k = parseInt(s.variable.slice(1), 10) - 1, rev = good.info.joint_types[k] === "revolute";
+        s.values.forEach(function (v) {
+          var d = rev ? wrap(q[k] - v) : Math.abs(q[k] - v);
+          if (!best || d < best.d) best = { d: d, text: s.variable + " = " + v.toFixed(4) + " (" + c.kind + ")", unit: rev ? " rad" : " m" };
+        });
+      });
+    });
+    out.textContent = best ? "nearest: " + best.text + ", " + best.d.toFixed(4) + best.unit + " away" : "";
+    out.dataset.distance = best ? best.d : "";
+  }
+
   var wsJob = null;
   function startWorkspace() {
     var n = parseInt($("ws-samples").value, 10);
@@ -390,6 +435,7 @@
   });
   $("check-start").addEventListener("click", startCheck);
   $("ws-start").addEventListener("click", startWorkspace);
+  $("sing-start").addEventListener("click", startSingularities);
   $("ws-cancel").addEventListener("click", function () {
     cancelJob(wsJob); $("ws-start").disabled = false; $("ws-cancel").disabled = true;
     $("ws-status").textContent = "cancelled"; $("ws-progress").value = 0;
