@@ -351,3 +351,16 @@ def test_exported_python_has_the_derivative_kernels(tmp_path):
     X = r[:, :-1].reshape(3, 3, n, n)
     for k, ref in enumerate(denavit.forward_dynamics_derivatives(robot, q, qd, qdd)):
         assert rel_err(X[:, k], ref) <= REL
+
+
+@pytest.mark.parametrize(("name", "budget"), [("puma560", 4_850), ("panda", 12_000)])
+def test_traced_rnea_derivatives_stay_within_their_operation_budget(name, budget):
+    """An operation count, not a time: the traced ∂RNEA kernel (what every backend runs) of the Puma had 5,152
+    operations before the body wrench's inertia terms moved into body axes, 4,809 after (Panda 12,719 → 11,891).
+    A change of the RNEA or of the tracer that adds work fails here; every operation still counts (no dead code)."""
+    from denavit.codegen import registered_kernels
+
+    spec = registered_kernels()["rnea_derivatives"].trace(denavit.load_robot(name), True)
+    ops = [spec.tape.ops[i][0] for i in spec.tape.program(spec.outputs)]
+    count = sum(op != "input" for op in ops)
+    assert 0.8 * budget < count <= budget  # far below: the kernel lost work it should do (or the count broke)
