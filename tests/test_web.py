@@ -289,6 +289,18 @@ def test_a_long_job_is_cancelled_and_never_blocks_the_quick_answers(client):
     _one_line_error(client.get("/api/jobs/no-such-job"), 404)
 
 
+def test_a_report_job_reads_a_typed_q_exactly_and_takes_the_rates_and_the_wrench(client):
+    payload = {"robot": PLANAR, "q": "pi/4, -pi/3", "qd": "0.1, 0.2", "wrench": "10, 0, -5, 0, 0, 1",
+               "topics": ["case", "statics"]}
+    s = _wait(client, client.post("/api/jobs", json={"kind": "report", "payload": payload}).json()["id"])
+    assert s["state"] == "done", s
+    res = s["result"]
+    assert [x["key"] for x in res["sections"]] == ["case", "statics"] and all(x["status"] == "done" for x in res["sections"])
+    # A_1 at q1 = π/4 exactly: cos = sin = √2/2 (not 0.7071); the wrench is the typed one
+    assert "A_{1} = \\begin{bmatrix}\\frac{\\sqrt{2}}{2} & - \\frac{\\sqrt{2}}{2}" in res["md"]
+    assert "F = (10, 0, -5, 0, 0, 1)" in res["md"] and "<section" in res["html"] and "\\begin" in res["tex"]
+
+
 def test_the_formula_job_gives_the_symbolic_pose(client):
     s = _wait(client, client.post("/api/jobs", json={"kind": "formula", "payload": {"robot": PLANAR}}).json()["id"])
     assert s["state"] == "done", s

@@ -32,6 +32,20 @@ def _robot(payload: dict[str, Any]) -> Any:
     return robot_from_dict(doc, where="table")
 
 
+def _values(raw: Any, what: str) -> list[Any] | None:
+    """A report input: None or empty (not given), a list of numbers (the sliders), or a typed text such as
+    ``"0, pi/4, -pi/3"`` split into its values, which the report reads exactly (cos(π/4) stays √2/2)."""
+    from ..io import split_values
+
+    if raw is None or raw == "" or raw == []:
+        return None
+    if isinstance(raw, str):
+        return split_values(raw, what)
+    if isinstance(raw, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw):
+        return raw
+    raise ParseError(f"'{what}' must be a list of numbers or a text like \"0, pi/4\"")
+
+
 def formula(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
     """T_0_n and the end-effector position as LaTeX, from the report's forward-kinematics section."""
     from ..report import Equation, Text, derive, math_of
@@ -54,8 +68,8 @@ def report(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str
     topics = payload.get("topics") or list(TOPICS)
     if not isinstance(topics, list) or not all(isinstance(t, str) for t in topics):
         raise ParseError(f"'topics' must be a list of names from {', '.join(TOPICS)}")
-    q = payload.get("q")
-    d = derive(_robot(payload), q=q if isinstance(q, list) and q else None, topics=topics, progress=progress)
+    given = {key: _values(payload.get(key), key) for key in ("q", "qd", "wrench")}
+    d = derive(_robot(payload), topics=topics, progress=progress, **given)
     progress("rendering")
     md, md_files = render_markdown(d, "report-")
     tex, _ = render_latex(d, "report-")

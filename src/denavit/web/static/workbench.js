@@ -277,7 +277,9 @@
   function startReport() {
     $("report-start").disabled = true; $("report-cancel").disabled = false;
     $("report-downloads").hidden = true; $("report-sections").innerHTML = "";
-    reportJob = runJob("report", { robot: good.doc, q: q }, function (p) {
+    var typed = qTyped && qTyped.values.every(function (v, k) { return Math.abs(v - q[k]) < 1e-12; });
+    reportJob = runJob("report", { robot: good.doc, q: typed ? qTyped.text : q, qd: $("qd").value.trim(),
+                                   wrench: $("wrench").value.trim() }, function (p) {
       var last = p[p.length - 1] || "starting", m = /section (\d+)\/(\d+)/.exec(last);
       $("report-status").textContent = last;
       if (m) $("report-progress").value = (m[1] - 1) / m[2];
@@ -369,6 +371,18 @@
     out.dataset.distance = best ? best.d : "";
   }
 
+  // a typed q sets the sliders; the report then reads it exactly as typed (pi/4, not 0.7854)
+  var qTyped = null;
+  function setTypedQ() {
+    var text = $("q-text").value.trim();
+    post("/api/kinematics", { robot: good.doc, q: text }).then(function (r) {
+      $("q-error").textContent = r._status === 200 ? "" : r.error;
+      if (r._status !== 200) return;
+      qTyped = { text: text, values: r.q };
+      showSolution(r.q);
+    });
+  }
+
   var wsJob = null;
   function startWorkspace() {
     var n = parseInt($("ws-samples").value, 10);
@@ -436,6 +450,7 @@
   $("check-start").addEventListener("click", startCheck);
   $("ws-start").addEventListener("click", startWorkspace);
   $("sing-start").addEventListener("click", startSingularities);
+  $("q-set").addEventListener("click", setTypedQ);
   $("ws-cancel").addEventListener("click", function () {
     cancelJob(wsJob); $("ws-start").disabled = false; $("ws-cancel").disabled = true;
     $("ws-status").textContent = "cancelled"; $("ws-progress").value = 0;
