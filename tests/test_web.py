@@ -301,6 +301,31 @@ def test_a_report_job_reads_a_typed_q_exactly_and_takes_the_rates_and_the_wrench
     assert "F = (10, 0, -5, 0, 0, 1)" in res["md"] and "<section" in res["html"] and "\\begin" in res["tex"]
 
 
+def test_a_pdf_report_when_a_latex_engine_is_there(client):
+    from denavit.report import latex_engine
+
+    payload = {"robot": PLANAR, "topics": ["model"], "pdf": True}
+    res = _wait(client, client.post("/api/jobs", json={"kind": "report", "payload": payload}).json()["id"])["result"]
+    import base64
+
+    if latex_engine() is None:
+        assert res["pdf"] == "" and "no LaTeX engine" in res["pdf_note"]
+    else:
+        assert base64.b64decode(res["pdf"])[:5] == b"%PDF-" and res["pdf_note"] == ""
+
+
+def test_a_claims_file_is_judged_claim_by_claim(client):
+    """planar2r (L1 = L2 = 1): at q = 0 the end effector is at x = 2, stretched along x; at q = (π/2, 0) at y = 2."""
+    claims = ("claims:\n  - id: stretched\n    quantity: position\n    q: '0, 0'\n    value: [2, 0, 0]\n"
+              "  - id: wrong\n    quantity: position\n    q: 'pi/2, 0'\n    value: [2, 0, 0]\n")
+    doc = client.post("/api/catalogue/load", json={"name": "planar2r"}).json()["robot"]
+    payload = {"text": claims, "kind": "yaml", "robot": doc}
+    s = _wait(client, client.post("/api/jobs", json={"kind": "check", "payload": payload}).json()["id"])
+    assert s["state"] == "done", s
+    assert [(c["id"], c["verdict"]) for c in s["result"]["claims"]] == [("stretched", "correct"), ("wrong", "incorrect")]
+    assert "tmp" not in s["result"]["text"] and "denavit-web-" not in s["result"]["text"]  # no private path shown
+
+
 def test_the_formula_job_gives_the_symbolic_pose(client):
     s = _wait(client, client.post("/api/jobs", json={"kind": "formula", "payload": {"robot": PLANAR}}).json()["id"])
     assert s["state"] == "done", s

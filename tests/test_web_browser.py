@@ -198,6 +198,14 @@ def test_pick_an_ik_solution_and_the_arm_goes_there(page):
     assert np.abs(q1 - q0).max() > 0.1                            # another configuration ...
     np.testing.assert_allclose(T1, T0, atol=1e-9)                  # ... reaching the same pose
     np.testing.assert_allclose(T1, denavit.forward_kinematics(robot, q1), atol=1e-12)
+    # a q̇ slider: c(q, q̇) follows (4 decimals shown)
+    before = page.locator("#cg").text_content()
+    page.evaluate("() => { const s = document.getElementById('qd2'); s.value = 1.5; s.dispatchEvent(new Event('input')); }")
+    page.wait_for_function("([b]) => document.getElementById('cg').textContent !== b", arg=[before], timeout=60_000)
+    c_line = page.locator("#cg").text_content().splitlines()[0]
+    c = np.array([float(x) for x in c_line.split(":")[1].split()])
+    np.testing.assert_allclose(c, denavit.coriolis_vector(robot, q1, [0, 1.5, 0, 0, 0, 0]), atol=6e-5)
+    assert np.abs(c).max() > 1e-3
 
 
 def test_upload_a_report_and_see_its_marks(page, tmp_path):

@@ -72,8 +72,19 @@ def report(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str
     d = derive(_robot(payload), topics=topics, progress=progress, **given)
     progress("rendering")
     md, md_files = render_markdown(d, "report-")
-    tex, _ = render_latex(d, "report-")
-    return {"title": d.title,
+    tex, tex_files = render_latex(d, "report-")
+    pdf, pdf_note = "", ""
+    if payload.get("pdf") is True:
+        from ..report import latex_engine, pdf_from_latex
+
+        if latex_engine() is None:
+            pdf_note = "no PDF: no LaTeX engine is installed (Debian: texlive-latex-extra)"
+        else:
+            progress("typesetting the PDF")
+            import base64
+
+            pdf = base64.b64encode(pdf_from_latex(tex, tex_files)).decode("ascii")
+    return {"title": d.title, "pdf": pdf, "pdf_note": pdf_note,
             "sections": [{"key": s.key, "title": s.title, "status": s.status, "reason": s.reason} for s in d.sections],
             "html": render_html(d)[0], "md": md, "tex": tex,
             "note": (f"the Markdown and LaTeX downloads refer to {len(md_files)} picture file(s) that are only in the "

@@ -121,6 +121,7 @@
       status(r.name + ": " + r.dof + " joints, " + r.convention + " DH");
       var keep = q.length === r.dof ? q.slice() : null;
       loadViewer(r.viewer, keep);
+      makeRateSliders(r.dof);
       var poses = $("poses");
       poses.length = 1;
       Object.keys(r.poses).forEach(function (n) { var o = document.createElement("option"); o.value = n; o.textContent = n; poses.appendChild(o); });
@@ -175,6 +176,20 @@
       } else status(r.error);
       if (again) sendKinematics(); else refreshDynamics();
     }).catch(function (e) { inFlight = false; status("no answer from the server: " + e); });
+  }
+  function makeRateSliders(n) {   // q̇ sliders, ±2 rad/s (or m/s), written into the q̇ field
+    var box = $("qd-sliders");
+    if (box.children.length === n) return;
+    box.innerHTML = "";
+    for (var k = 0; k < n; k++) {
+      var s = document.createElement("input");
+      s.type = "range"; s.min = -2; s.max = 2; s.step = 0.01; s.value = 0; s.id = "qd" + (k + 1); s.title = "q̇" + (k + 1);
+      s.addEventListener("input", function () {
+        $("qd").value = Array.prototype.map.call(box.children, function (e) { return e.value; }).join(", ");
+        refreshDynamics();
+      });
+      box.appendChild(s);
+    }
   }
   var dynTimer = null;
   function refreshDynamics() {
@@ -279,7 +294,7 @@
     $("report-downloads").hidden = true; $("report-sections").innerHTML = "";
     var typed = qTyped && qTyped.values.every(function (v, k) { return Math.abs(v - q[k]) < 1e-12; });
     reportJob = runJob("report", { robot: good.doc, q: typed ? qTyped.text : q, qd: $("qd").value.trim(),
-                                   wrench: $("wrench").value.trim() }, function (p) {
+                                   wrench: $("wrench").value.trim(), pdf: $("report-pdf").checked }, function (p) {
       var last = p[p.length - 1] || "starting", m = /section (\d+)\/(\d+)/.exec(last);
       $("report-status").textContent = last;
       if (m) $("report-progress").value = (m[1] - 1) / m[2];
@@ -288,7 +303,8 @@
       $("report-progress").value = res ? 1 : 0;
       if (!res) { $("report-status").textContent = err; return; }
       report = res;
-      $("report-status").textContent = res.title + (res.note ? " (" + res.note + ")" : "");
+      $("report-status").textContent = res.title + [res.note, res.pdf_note].filter(Boolean).map(function (n) { return " (" + n + ")"; }).join("");
+      document.querySelector("#report-downloads [data-fmt=pdf]").hidden = !res.pdf;
       res.sections.forEach(function (s, i) {
         var li = document.createElement("li"), a = document.createElement("a");
         a.href = "#"; a.textContent = s.title + (s.status === "done" ? "" : " — " + s.status + ": " + s.reason);
@@ -439,8 +455,10 @@
   });
   document.querySelectorAll("#report-downloads button").forEach(function (b) {
     b.addEventListener("click", function () {
-      var f = b.dataset.fmt, type = { html: "text/html", md: "text/markdown", tex: "application/x-tex" }[f];
-      download(report[f], (good.info.name || "report") + "-report." + f, type);
+      var f = b.dataset.fmt, type = { html: "text/html", md: "text/markdown", tex: "application/x-tex", pdf: "application/pdf" }[f];
+      var data = report[f];
+      if (f === "pdf") data = Uint8Array.from(atob(report.pdf), function (c) { return c.charCodeAt(0); });
+      download(data, (good.info.name || "report") + "-report." + f, type);
     });
   });
   $("check-file").addEventListener("change", function () {
