@@ -72,7 +72,7 @@ def active_cache_dir() -> Path:
 #: missed the modules new kernel groups trace through, and an upgrade that changed one would have read a stale
 #: module.  A changed generator never reads a stale module.
 GENERATOR_VERSION = "2"  # 2: verified modules (key and hash line, checked-hash .pyc)
-_SOURCE_PACKAGES = ("codegen", "chain", "numeric")
+_SOURCE_PACKAGES = ("codegen", "chain", "numeric", "ik")  # ik: the closed forms the IK kernels call
 _DIGEST: list[str] = []
 
 

@@ -25,14 +25,8 @@ ELBOW_LAYOUT = (("X_e", 3), ("C0i", 16), ("R6", 9), ("R1", 9), ("p1", 3), ("a", 
 
 IK_ELBOW_SOURCE = '''
 
-@njit(cache=True, nogil=True)
-def _elbow_half_angle(lo, hi, tol):
-    """x with (1 - cos x)/2 = lo, (1 + cos x)/2 = hi, from the smaller one; NaN when out of range."""
-    if lo < -0.5 * tol or hi < -0.5 * tol:
-        return np.nan
-    if lo <= hi:
-        return 2.0 * math.asin(math.sqrt(min(1.0, max(0.0, lo))))
-    return math.pi - 2.0 * math.asin(math.sqrt(min(1.0, max(0.0, hi))))
+from denavit.codegen._ik_jit import (WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roots, wrist_qb,
+                                      wrist_rest)
 
 
 @njit(cache=True, nogil=True)
@@ -57,7 +51,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide)."""
     h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
-    free_tol, ratio_tol, aligned_tol = tols[0], tols[1], tols[6]  # the others: _ik_finish's
+    free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
     # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
     ws = np.empty(145)
@@ -78,107 +72,62 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         for i in range(3):
             for j in range(3):
                 Y[i, j] = T[b, i, 0] * R6[j, 0] + T[b, i, 1] * R6[j, 1] + T[b, i, 2] * R6[j, 2]
-        # shoulder: (Rz(q1) a).W = h
-        c = h - a[2] * W[2]
-        A = a[0] * W[0] + a[1] * W[1]
-        Bq = a[0] * W[1] - a[1] * W[0]
-        rho = math.hypot(A, Bq)
-        if (math.hypot(W[0], W[1]) < tiny and abs(c) < tiny) or rho <= 1e-12:
-            status = 1
-        ratio = c / rho if rho > 1e-12 else 2.0
+        # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): shoulder, elbow, wrist
+        q1a, q1b, free1, ratio = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
+        if free1 or (ratio == 0.0 and q1a != q1a):
+            status = 1  # joint 1 free, or the shoulder equation independent of q1
         if abs(abs(ratio) - 1.0) < 1e-6:
             status = 1  # next to a double root: the plain solver polishes and looks for partners
+        if rho_w < 1e-12:
+            status = 1
         ncand = 0
         for k in range(8):
             ok[k] = False
-        if status == 0 and abs(ratio) <= 1.0 + ratio_tol:
-            base1 = math.atan2(Bq, A)
-            delta = math.acos(min(1.0, max(-1.0, ratio)))
-            for s1 in range(2):
-                q1 = base1 + delta if s1 == 0 else base1 - delta
-                c1, s1v = math.cos(q1), math.sin(q1)
-                d0 = c1 * W[0] + s1v * W[1] - p1[0]
-                d1 = -s1v * W[0] + c1 * W[1] - p1[1]
-                d2 = W[2] - p1[2]
-                g0 = d0 * R1[0, 0] + d1 * R1[1, 0] + d2 * R1[2, 0]
-                g1 = d0 * R1[0, 1] + d1 * R1[1, 1] + d2 * R1[2, 1]
-                G = math.hypot(g0, g1)
-                den = 4.0 * na * nb
-                sm, df = na + nb, abs(na - nb)
-                x = _elbow_half_angle((sm - G) * (sm + G) / den, (G - df) * (G + df) / den, ratio_tol)
-                if x != x:
-                    continue
-                if x < 1e-6 or math.pi - x < 1e-6:
-                    status = 1  # folded or stretched elbow: a double root
-                for s3 in range(2):
-                    q3 = base3 + x if s3 == 0 else base3 - x
-                    c3, s3v = math.cos(q3), math.sin(q3)
-                    u0, u1 = c3 * P[0] - s3v * P[1], s3v * P[0] + c3 * P[1]
-                    vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
-                    vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
-                    if math.hypot(vx, vy) < tiny:
-                        status = 1
-                    q2 = math.atan2(g1, g0) - math.atan2(vy, vx)
-                    # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
+        for s1 in range(2 if status == 0 else 0):
+            q1 = q1a if s1 == 0 else q1b
+            if q1 != q1:
+                continue
+            g0, g1 = elbow_plane(q1, W[0], W[1], W[2], R1, p1)
+            q3a, q3b, x = elbow_roots(math.hypot(g0, g1), na, nb, base3, ratio_tol)
+            if x != x:
+                continue
+            if x < 1e-6 or math.pi - x < 1e-6:
+                status = 1  # folded or stretched elbow: a double root
+            for s3 in range(2):
+                q3 = q3a if s3 == 0 else q3b
+                q2, free2, _vxy = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
+                if free2:
+                    status = 1
+                # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
+                for i in range(3):
+                    cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
+                for kk in range(3):
+                    qk = q1 if kk == 0 else (q2 if kk == 1 else q3)
+                    ck, sk = math.cos(qk), math.sin(qk)
                     for i in range(3):
-                        cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
-                    for kk in range(3):
-                        qk = q1 if kk == 0 else (q2 if kk == 1 else q3)
-                        ck, sk = math.cos(qk), math.sin(qk)
-                        for i in range(3):
-                            xi, yi = cx[i], cy[i]
-                            cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
-                        C = consts[kk + 1]
-                        for i in range(3):
-                            xi, yi, zi = cx[i], cy[i], cz[i]
-                            cx[i] = xi * C[0, 0] + yi * C[1, 0] + zi * C[2, 0]
-                            cy[i] = xi * C[0, 1] + yi * C[1, 1] + zi * C[2, 1]
-                            cz[i] = xi * C[0, 2] + yi * C[1, 2] + zi * C[2, 2]
-                    for j in range(3):
-                        M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
-                        M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
-                        M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
-                    # wrist: r^T Rz(qb) u = M_zz (half-angle form), qa onto M e_z, qc from the x-row
-                    if rho_w < 1e-12:
-                        status = 1
-                        continue
-                    phi = math.atan2(math.hypot(M[0, 2], M[1, 2]), M[2, 2])
-                    dm, smw = br - bu, br + bu
-                    xw = _elbow_half_angle(math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w,
-                                           math.sin((smw + phi) / 2) * math.sin((smw - phi) / 2) / rho_w, ratio_tol)
-                    if xw != xw:
-                        continue
-                    for s5 in range(2):
-                        qb = base_w + xw if s5 == 0 else base_w - xw
-                        cb, sb = math.cos(qb), math.sin(qb)
-                        # v = Ra Rz(qb) u, u = Rb e_z
-                        ux, uy, uz = R5[0, 2], R5[1, 2], R5[2, 2]
-                        rx, ry = cb * ux - sb * uy, sb * ux + cb * uy
-                        v0 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * uz
-                        v1 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * uz
-                        if math.hypot(v0, v1) < aligned_tol:
-                            status = 1  # wrist singular: a continuum
-                        qa = math.atan2(M[1, 2], M[0, 2]) - math.atan2(v1, v0)
-                        ca, sa = math.cos(qa), math.sin(qa)
-                        y0 = ca * M[0, 0] + sa * M[1, 0]
-                        y1 = -sa * M[0, 0] + ca * M[1, 0]
-                        n2 = M[2, 0]
-                        ex, ey, ez = R5[0, 0], R5[1, 0], R5[2, 0]
-                        rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
-                        x00 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * ez
-                        x01 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * ez
-                        x02 = R4[2, 0] * rx + R4[2, 1] * ry + R4[2, 2] * ez
-                        ex, ey, ez = R5[0, 1], R5[1, 1], R5[2, 1]
-                        rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
-                        x10 = R4[0, 0] * rx + R4[0, 1] * ry + R4[0, 2] * ez
-                        x11 = R4[1, 0] * rx + R4[1, 1] * ry + R4[1, 2] * ez
-                        x12 = R4[2, 0] * rx + R4[2, 1] * ry + R4[2, 2] * ez
-                        N00 = x00 * y0 + x01 * y1 + x02 * n2
-                        N10 = x10 * y0 + x11 * y1 + x12 * n2
-                        qc = math.atan2(N10, N00)
-                        cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
-                        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
-                        ncand += 1
+                        xi, yi = cx[i], cy[i]
+                        cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
+                    C = consts[kk + 1]
+                    for i in range(3):
+                        xi, yi, zi = cx[i], cy[i], cz[i]
+                        cx[i] = xi * C[0, 0] + yi * C[1, 0] + zi * C[2, 0]
+                        cy[i] = xi * C[0, 1] + yi * C[1, 1] + zi * C[2, 1]
+                        cz[i] = xi * C[0, 2] + yi * C[1, 2] + zi * C[2, 2]
+                for j in range(3):
+                    M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
+                    M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
+                    M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
+                qba, qbb, _lo, _hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)
+                if qba != qba:
+                    continue
+                for s5 in range(2):
+                    qb = qba if s5 == 0 else qbb
+                    qa, qc, singular, _sign, _vxy = wrist_rest(qb, M, R4, R5)
+                    if singular:
+                        status = 1  # wrist singular: a continuum
+                    cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
+                    cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
+                    ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
         kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags,

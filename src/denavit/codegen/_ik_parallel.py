@@ -13,7 +13,8 @@ nearly parallel to axes 2–4 (the wrist-singular continuum; NEAR_SINGULAR), a t
 plain solver substitutes a reachable stand-in (``far``), a candidate that would need polishing, two solutions
 closer than the merge radius.  The compiled path answers only where its answer is the plain solver's.  The text
 below is appended to each generated numba module (numba compiles it for the arms that call it); it calls that
-module's ``fk_1`` and the elbow solver's ``_elbow_half_angle``; nothing of the robot or the user is pasted into it.
+module's ``fk_1`` and the closed forms of :mod:`denavit.ik.forms` (jitted by :mod:`._ik_jit`); nothing of the
+robot or the user is pasted into it.
 """
 
 from __future__ import annotations
@@ -78,6 +79,8 @@ def parallel_constants(robot, plan) -> np.ndarray:
 
 IK_PARALLEL_SOURCE = '''
 
+from denavit.codegen._ik_jit import elbow_q2, trig_roots, wrist_qb
+
 @njit(cache=True, nogil=True)
 def ik_parallel_packed(T, K, f, i):
     """All solutions of each pose T[b] of a 6R UR-class arm, the constants in K (PARALLEL_LAYOUT order); outputs as
@@ -128,23 +131,19 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
     for r in range(3):  # T_R C6_R^T
         for j in range(3):
             TC[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
+    # the formulas of denavit.ik.forms (the plain solver's own functions, jitted), in the plain plan's order
     # q1: (Rz(q1) a) . V = h + a . pc1 (subproblem 1, as solve_trig)
-    A = a[0] * V[0] + a[1] * V[1]
-    Bq = a[0] * V[1] - a[1] * V[0]
-    c = c0 - a[2] * V[2]
-    rho = math.hypot(A, Bq)
+    q1a, q1b, rho, ratio = trig_roots(a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0], c0 - a[2] * V[2], tol)
     if rho <= max(wide, 1e-11):
         return 0, 1  # Q on (or next to) axis 1
-    ratio = c / rho
     if abs(abs(ratio) - 1.0) < 1e-6:
         status = 1  # next to a double root: the plain solver polishes and looks for partners
-    if abs(ratio) > 1.0 + tol or rho_w < 1e-12:
+    if q1a != q1a or rho_w < 1e-12:
         return 0, max(status, 1 if rho_w < 1e-12 else 0)
-    base1 = math.atan2(Bq, A)
     delta = math.acos(min(1.0, max(-1.0, ratio)))
     e1 = max(1.0, scale / rho) / max(math.sin(delta), 1e-300)  # rounding error of q1 [eps] (COND_MAX)
     for s1 in range(2):
-        q1 = base1 + delta if s1 == 0 else base1 - delta
+        q1 = q1a if s1 == 0 else q1b
         c1, s1v = math.cos(q1), math.sin(q1)
         _frame1(C, c1, s1v, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
         RL02 = cols[0, 0] * TC[0, 2] + cols[0, 1] * TC[1, 2] + cols[0, 2] * TC[2, 2]
@@ -153,18 +152,14 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
         ell0 = cols[2, 0] * TC[0, 0] + cols[2, 1] * TC[1, 0] + cols[2, 2] * TC[2, 0]
         ell1 = cols[2, 0] * TC[0, 1] + cols[2, 1] * TC[1, 1] + cols[2, 2] * TC[2, 1]
         # q5: r^T Rz(q5) u = m_z, m = (RL e_z) with its z scaled by sigma (axis_angle_roots)
-        phi = math.atan2(math.hypot(RL02, RL12), sigma * RL22)
-        dm, sm = br - bu, br + bu
-        lo = math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w
-        hi = math.sin((sm + phi) / 2) * math.sin((sm - phi) / 2) / rho_w
+        q5a, q5b, lo, hi = wrist_qb(RL02, RL12, sigma * RL22, rho_w, base_w, br, bu, tol)
         if -2.0 * tol < min(lo, hi) < 1e-12:
             status = 1  # the two q5 roots (nearly) coincide
-        x5 = _elbow_half_angle(lo, hi, tol)
-        if x5 != x5:
+        if q5a != q5a:
             continue
-        e5 = (1.0 + e1) / max(rho_w * math.sin(x5), 1e-300)
+        e5 = (1.0 + e1) / max(rho_w * math.sin(0.5 * (q5a - q5b)), 1e-300)
         for s5 in range(2):
-            q5 = base_w + x5 if s5 == 0 else base_w - x5
+            q5 = q5a if s5 == 0 else q5b
             c5, s5v = math.cos(q5), math.sin(q5)
             t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
             y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
@@ -190,30 +185,25 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
             # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
             if math.hypot(P0, P1) < wide:
                 status = 1  # Q on (or next to) axis 2
-            rho3 = math.hypot(ap2, bp2)
+            q3a, q3b, rho3, ratio3 = trig_roots(ap2, bp2, P0 * P0 + P1 * P1 + k0, tol)
             if rho3 <= 1e-12:
                 status = 1
                 continue
-            ratio3 = (P0 * P0 + P1 * P1 + k0) / rho3
             if abs(abs(ratio3) - 1.0) < 1e-6:
                 status = 1  # elbow stretched or folded: a double root
-            if abs(ratio3) > 1.0 + tol:
+            if q3a != q3a:
                 continue
-            base3 = math.atan2(bp2, ap2)
             d3 = math.acos(min(1.0, max(-1.0, ratio3)))
             e3 = eP * 2.0 * math.hypot(P0, P1) * scale / max(rho3 * math.sin(d3), 1e-300)
             for s3 in range(2):
-                q3 = base3 + d3 if s3 == 0 else base3 - d3
+                q3 = q3a if s3 == 0 else q3b
                 c3, s3v = math.cos(q3), math.sin(q3)
-                u0, u1 = c3 * C[3, 0, 3] - s3v * C[3, 1, 3], s3v * C[3, 0, 3] + c3 * C[3, 1, 3]
-                v0 = C[2, 0, 3] + C[2, 0, 0] * u0 + C[2, 0, 1] * u1 + C[2, 0, 2] * C[3, 2, 3]
-                v1 = C[2, 1, 3] + C[2, 1, 0] * u0 + C[2, 1, 1] * u1 + C[2, 1, 2] * C[3, 2, 3]
-                if math.hypot(v0, v1) < wide:
+                q2, _free, vxy = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
+                if vxy < wide:
                     status = 1
-                e2 = (eP + e3) * scale / max(min(math.hypot(P0, P1), math.hypot(v0, v1)), 1e-300)
+                e2 = (eP + e3) * scale / max(min(math.hypot(P0, P1), vxy), 1e-300)
                 if e2 + e3 + eP > sc[10]:  # q4's error is about that sum
                     status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
-                q2 = math.atan2(P1, P0) - math.atan2(v1, v0)
                 # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
                 c2, s2v = math.cos(q2), math.sin(q2)
                 z0, z1, z2 = c2 * xr[0] + s2v * xr[1], -s2v * xr[0] + c2 * xr[1], xr[2]

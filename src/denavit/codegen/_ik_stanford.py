@@ -14,7 +14,7 @@ with its arm next to axis 2 (free or ill-conditioned joints; NEAR_SINGULAR of :m
 axes 4 and 6 (nearly) aligned, a candidate whose estimated rounding error exceeds COND_MAX, a target beyond the
 plain solver's bound (prismatic travel included: it then reports no solution, not even outside the limits), a
 candidate needing polish, two solutions about to merge.  The text below is appended to each generated numba
-module; it calls that module's ``fk_1``, ``_elbow_half_angle`` and ``_ik_finish``.
+module; it calls that module's ``fk_1`` and ``_ik_finish`` and ``half_angle`` of :mod:`denavit.ik.forms`.
 """
 
 from __future__ import annotations
@@ -69,6 +69,8 @@ def stanford_constants(robot, plan) -> np.ndarray:
 
 IK_STANFORD_SOURCE = '''
 
+from denavit.codegen._ik_jit import WRIST_TOL, stanford_q1, stanford_q2, stanford_q3, wrist_qb, wrist_rest
+
 @njit(cache=True, nogil=True)
 def ik_stanford_packed(T, K, f, i):
     """All solutions of each pose T[b] of a Stanford-class arm, the constants in K (STANFORD_LAYOUT order); outputs
@@ -110,42 +112,33 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
     status = 0
     if math.hypot(D[0], D[1]) < wide or rho_w < 1e-12:
         return 0, 1  # wrist centre on or next to axis 1: q1 free or ill-conditioned
-    nD = math.sqrt(D[0] * D[0] + D[1] * D[1] + D[2] * D[2])
-    disc = (nD - uperp) * (nD + uperp)
+    # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): q3, then q2, then q1
+    q3a, q3b, disc, root = stanford_q3(D[0], D[1], D[2], uz, uperp, L)
     if disc < near * L * L:
         status = 1  # q3 next to its double root (or none)
-    if disc < -1e-12 * L * L:
+    if q3a != q3a:
         return 0, status
-    root = math.sqrt(max(disc, 0.0))
     e3 = 1.0 + L / max(root, 1e-300)  # rounding error of q3 [eps, per L]: as COND_MAX of _ik_parallel
     ncand = 0
     for s3 in range(2):
-        q3 = -uz + root if s3 == 0 else -uz - root
+        q3 = q3a if s3 == 0 else q3b
         w0, w1, w2 = geom[3] + q3 * geom[6], geom[4] + q3 * geom[7], geom[5] + q3 * geom[8]
         if math.hypot(w0, w1) < wide:
             status = 1  # the arm next to axis 2: q2 free or ill-conditioned
-        r0, r1, r2 = C[1, 2, 0], C[1, 2, 1], C[1, 2, 2]
-        A = r0 * w0 + r1 * w1
-        Bq = r1 * w0 - r0 * w1
-        rho = math.hypot(A, Bq)
+        q2a, q2b, rho, ratio = stanford_q2(w0, w1, w2, D[2], C[1, 2, :3], tol)
         if rho <= 1e-12:
             status = 1
             continue
-        ratio = (D[2] - r2 * w2) / rho
         if abs(abs(ratio) - 1.0) < 1e-6:
             status = 1  # next to a double root of q2
-        if abs(ratio) > 1.0 + tol:
+        if q2a != q2a:
             continue
-        base2 = math.atan2(Bq, A)
         delta = math.acos(min(1.0, max(-1.0, ratio)))
         e2 = (1.0 + e3) * max(1.0, L / rho) / max(math.sin(delta), 1e-300)
         for s2 in range(2):
-            q2 = base2 + delta if s2 == 0 else base2 - delta
+            q2 = q2a if s2 == 0 else q2b
             c2, s2v = math.cos(q2), math.sin(q2)
-            x, y = c2 * w0 - s2v * w1, s2v * w0 + c2 * w1  # Rz(q2) w
-            ex = C[1, 0, 0] * x + C[1, 0, 1] * y + C[1, 0, 2] * w2
-            ey = C[1, 1, 0] * x + C[1, 1, 1] * y + C[1, 1, 2] * w2
-            q1 = math.atan2(D[1], D[0]) - math.atan2(ey, ex)
+            q1, ex, ey = stanford_q1(q2, w0, w1, w2, D[0], D[1], C[1, :3, :3])
             e1 = (1.0 + e2 + e3) * L / max(min(math.hypot(D[0], D[1]), math.hypot(ex, ey)), 1e-300)
             # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 C3 (joint 3 slides): its columns, then M = R_0_3^T Y
             _frame1(C, math.cos(q1), math.sin(q1), cols)
@@ -164,43 +157,21 @@ def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, 
     """The two wrist solutions of Rz(q4) R4 Rz(q5) R5 Rz(q6) = M (as wrist_angles: q5 from the z-row in the
     half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand; eM: the
     rounding error of M [eps], for the COND_MAX test."""
-    phi = math.atan2(math.hypot(M[0, 2], M[1, 2]), M[2, 2])
-    dm, smw = br - bu, br + bu
-    lo = math.sin((phi + dm) / 2) * math.sin((phi - dm) / 2) / rho_w
-    hi = math.sin((smw + phi) / 2) * math.sin((smw - phi) / 2) / rho_w
+    qba, qbb, lo, hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)  # denavit.ik.forms
     if -2e-7 < min(lo, hi) < 1e-12:
         status = 1  # the two wrist roots (nearly) coincide
-    xw = _elbow_half_angle(lo, hi, 1e-9)  # axis_angle_roots' default tolerance, as wrist_angles calls it
-    if xw != xw:
+    if qba != qba:
         return ncand, status
-    e5 = eM / max(rho_w * math.sin(xw), 1e-300)
+    e5 = eM / max(rho_w * math.sin(0.5 * (qba - qbb)), 1e-300)
     for s5 in range(2):
-        qb = base_w + xw if s5 == 0 else base_w - xw
-        cb, sb = math.cos(qb), math.sin(qb)
-        ux, uy, uz = C[5, 0, 2], C[5, 1, 2], C[5, 2, 2]
-        rx, ry = cb * ux - sb * uy, sb * ux + cb * uy
-        v0 = C[4, 0, 0] * rx + C[4, 0, 1] * ry + C[4, 0, 2] * uz
-        v1 = C[4, 1, 0] * rx + C[4, 1, 1] * ry + C[4, 1, 2] * uz
-        if math.hypot(v0, v1) < near:
+        qb = qba if s5 == 0 else qbb
+        qa, qc, _singular, _sign, vxy = wrist_rest(qb, M, C[4, :3, :3], C[5, :3, :3])
+        if vxy < near:
             status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
-        qa = math.atan2(M[1, 2], M[0, 2]) - math.atan2(v1, v0)
-        if eM + e5 + (eM + e5) / max(math.hypot(v0, v1), 1e-300) > cond_max:
+        if eM + e5 + (eM + e5) / max(vxy, 1e-300) > cond_max:
             status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
-        ca, sa = math.cos(qa), math.sin(qa)
-        y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]
-        N0 = N1 = 0.0
-        for jj in range(2):  # (R4 Rz(qb) R5 e_j) . (Rz(qa)^T M e_x), j = x, y
-            ex, ey, ez = C[5, 0, jj], C[5, 1, jj], C[5, 2, jj]
-            rx, ry = cb * ex - sb * ey, sb * ex + cb * ey
-            x0 = C[4, 0, 0] * rx + C[4, 0, 1] * ry + C[4, 0, 2] * ez
-            x1 = C[4, 1, 0] * rx + C[4, 1, 1] * ry + C[4, 1, 2] * ez
-            x2 = C[4, 2, 0] * rx + C[4, 2, 1] * ry + C[4, 2, 2] * ez
-            if jj == 0:
-                N0 = x0 * y0 + x1 * y1 + x2 * n2
-            else:
-                N1 = x0 * y0 + x1 * y1 + x2 * n2
         cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
-        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, math.atan2(N1, N0)
+        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
         ncand += 1
     return ncand, status
 

@@ -10,6 +10,7 @@ The solvers work on the arm as the chain ``C0 · J1(q1) · C1 ⋯ Jn(qn) · Cn``
 numeric engine (:mod:`denavit.numeric`) for forward kinematics and Jacobians; nothing there imports this package.
 """
 
+from . import _forms as forms  # the closed forms in numba's subset of Python (denavit.codegen jits them)
 from ._analytic import AnalyticIKResult, analytic_ik, ik_plan, ik_structure
 from ._line import cartesian_line
 from ._path import PathResult, PathTrajectory, ik_path

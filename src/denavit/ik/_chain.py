@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._forms import trig_roots
+
 __all__ = ["damped_solve", "joint_motion", "solve_trig", "angle_about_z", "wrap_angle"]
 
 
@@ -42,14 +44,8 @@ def solve_trig(a, b, c, tol: float = 1e-9) -> np.ndarray:
     not depend on θ (ρ ≈ 0).  A ratio within ``tol`` beyond ±1 is taken as the tangent (double) root.
     """
     a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (a, b, c)))
-    rho = np.hypot(a, b)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = c / rho
-    ok = (rho > 1e-12) & (np.abs(ratio) <= 1 + tol)
-    base = np.arctan2(b, a)
-    delta = np.arccos(np.clip(np.where(ok, ratio, 0.0), -1.0, 1.0))
-    out = np.stack([base + delta, base - delta], axis=-1)
-    return np.where(ok[..., None], out, np.nan)
+    plus, minus, _, _ = trig_roots(a, b, c, tol)  # the one copy of the formula (numba compiles it too)
+    return np.stack([plus, minus], axis=-1)
 
 
 def angle_about_z(u: np.ndarray, v: np.ndarray) -> np.ndarray:

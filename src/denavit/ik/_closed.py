@@ -26,8 +26,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._chain import solve_trig
-from ._subproblems import ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, split_aligned
+from ._forms import (
+    elbow_plane,
+    elbow_q2,
+    elbow_roots,
+    shoulder_roots,
+    stanford_q1,
+    stanford_q2,
+    stanford_q3,
+    wrist_rest,
+)
+from ._subproblems import axis_angle_roots
 
 __all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
 
@@ -37,10 +46,6 @@ FREE_TOL = 1e-10  # relative distance of the wrist centre to axis 1 or 2 under w
 # named; farther out the joint is determined and computed, however ill-conditioned)
 NEAR_FREE = 1e-7  # relative distance of the point to axis 2 (Stanford class) under which q2 is named free
 RATIO_TOL = 1e-7  # |c/ρ| up to 1 + this counts as the tangent (double) root, as in the general route
-
-
-def _angle(y: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.arctan2(y, x)
 
 
 class ElbowPosition:
@@ -81,45 +86,21 @@ class ElbowPosition:
 
         Returns q (B, 4, 3), NaN rows where there is none, and free (B, 4) int flags as
         :meth:`Position3.solve`: bit 1 = q1 free (wrist centre on axis 1), bit 2 = q2 free (on axis 2)."""
-        a, Wx, Wy, Wz = self.a, W[:, 0], W[:, 1], W[:, 2]
+        Wx, Wy, Wz = W[:, 0], W[:, 1], W[:, 2]
         tiny = FREE_TOL * self.L
-        # shoulder: (Rz(q1) a)·W = h  (Craig eq. 4.65 in joint-screw form)
-        c = self.h - a[2] * Wz
-        q1 = solve_trig(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, c, tol=RATIO_TOL)  # (B, 2)
-        free1 = (np.hypot(Wx, Wy) < tiny) & (np.abs(c) < tiny)  # on axis 1: every q1 (0 returned)
-        q1 = np.where(free1[:, None], [0.0, np.nan], q1)
-        c1, s1 = np.cos(q1), np.sin(q1)
-        d = np.stack([c1 * Wx[:, None] + s1 * Wy[:, None] - self.p1[0], -s1 * Wx[:, None] + c1 * Wy[:, None]
-                      - self.p1[1], np.broadcast_to(Wz[:, None] - self.p1[2], q1.shape)], -1)  # (B, 2, 3)
-        g = d @ self.R1  # R1ᵀ (Rz(−q1) W − p1): the wrist centre in the frame of joint 2
-        # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P  (Craig eq. 4.69), i.e.
-        # |g_xy|² = |a|² + |b|² + 2|a||b| cos x, x = q3 − atan2(β, α), |a| = |p2_xy|, |b| = |P_xy|; written with
-        # (1 ∓ cos x)/2 as products (Kahan's triangle angles) so that a folded or stretched elbow (x ≈ π or 0,
-        # the wrist centre next to axis 2 or at full reach) keeps its digits: arccos lost half of them there
-        q3 = _elbow_angles(np.hypot(g[..., 0], g[..., 1]), self.na, self.nb, self.base)  # (B, 2, 2)
-        c3, s3 = np.cos(q3), np.sin(q3)
-        P, R2 = self.P, self.R2
-        u = np.stack([c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]], -1)  # Rz(q3) P, xy (z is P_z)
-        vx = self.p2[0] + R2[0, 0] * u[..., 0] + R2[0, 1] * u[..., 1] + R2[0, 2] * P[2]
-        vy = self.p2[1] + R2[1, 0] * u[..., 0] + R2[1, 1] * u[..., 1] + R2[1, 2] * P[2]
-        q2 = _angle(g[..., None, 1], g[..., None, 0]) - _angle(vy, vx)  # (B, 2, 2)
-        free2 = np.hypot(vx, vy) < tiny  # on axis 2: every q2 (0 returned)
-        q2 = np.where(free2, 0.0, q2)
+        # the formulas are :mod:`._forms`' (the one copy, compiled by numba for denavit.compile as well), here on
+        # the batch with the branches on trailing axes: q1 (B, 2), then q3 and q2 (B, 2, 2)
+        # shoulder: (Rz(q1) a)·W = h  (Craig eq. 4.65 in joint-screw form); on axis 1 every q1 (0 returned)
+        q1a, q1b, free1, _ = shoulder_roots(Wx, Wy, Wz, self.a, self.h, tiny, RATIO_TOL)
+        q1 = np.stack([q1a, q1b], -1)  # (B, 2)
+        g0, g1 = elbow_plane(q1, Wx[:, None], Wy[:, None], Wz[:, None], self.R1, self.p1)  # wrist centre, frame 2
+        # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P (Craig eq. 4.69), with (1 ∓ cos x)/2 as
+        # products (Kahan's triangle angles) so that a folded or stretched elbow keeps its digits
+        q3a, q3b, _ = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, RATIO_TOL)
+        q3 = np.stack([q3a, q3b], -1)  # (B, 2, 2)
+        q2, free2, _ = elbow_q2(g0[..., None], g1[..., None], q3, self.R2, self.p2, self.P, tiny)  # on axis 2: 0
         q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
         return q, _flags(q, free1[:, None, None] * 1 + free2 * 2)
-
-
-def _elbow_angles(g: np.ndarray, na: float, nb: float, base: float) -> np.ndarray:
-    """q3 = base ± x with g² = na² + nb² + 2 na nb cos x (the elbow's law of cosines), (..., 2); NaN where g is
-    out of reach (beyond RATIO_TOL)."""
-    den = 4 * na * nb
-    s, d = na + nb, abs(na - nb)
-    lo = (s - g) * (s + g) / den  # (1 − cos x)/2
-    hi = (g - d) * (g + d) / den  # (1 + cos x)/2
-    ok = (lo >= -0.5 * RATIO_TOL) & (hi >= -0.5 * RATIO_TOL)
-    x = np.where(lo <= hi, 2 * np.arcsin(np.sqrt(np.clip(lo, 0.0, 1.0))),
-                 np.pi - 2 * np.arcsin(np.sqrt(np.clip(hi, 0.0, 1.0))))
-    return np.where(ok[..., None], np.stack([base + x, base - x], -1), np.nan)
 
 
 class StanfordPosition:
@@ -155,36 +136,27 @@ class StanfordPosition:
         """All (q1, q2, q3) placing the wrist centre at W (B, 3); q (B, 4, 3) and free (B, 4) as ElbowPosition."""
         D = W - self.O  # (B, 3)
         tiny = FREE_TOL * self.L
-        # |W − O|² = |u + q3 z|²: q3² + 2 (u·z) q3 + |u|² − |D|² = 0; the discriminant |D|² − |u⊥|² written as
-        # (|D| − |u⊥|)(|D| + |u⊥|) keeps its digits next to the double root (the point at its nearest to O)
-        nD = np.linalg.norm(D, axis=-1)
-        disc = (nD - self.uperp) * (nD + self.uperp)
-        ok = disc >= -1e-12 * self.L**2
-        root = np.sqrt(np.where(ok, np.maximum(disc, 0.0), np.nan))
-        q3 = np.stack([-self.uz + root, -self.uz - root], -1)  # (B, 2)
+        # the formulas are :mod:`._forms`' (the one copy, compiled by numba for denavit.compile as well)
+        q3a, q3b, _, _ = stanford_q3(D[:, 0], D[:, 1], D[:, 2], self.uz, self.uperp, self.L)
+        q3 = np.stack([q3a, q3b], -1)  # (B, 2)
         w = self.u + q3[..., None] * self.z  # (B, 2, 3)
         # height along axis 1: D_z = rᵀ Rz(q2) w
         r = self.r
-        q2 = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
-                        D[:, None, 2] - r[2] * w[..., 2], tol=RATIO_TOL)  # (B, 2, 2)
+        q2a, q2b, _, _ = stanford_q2(w[..., 0], w[..., 1], w[..., 2], D[:, None, 2], r, RATIO_TOL)
+        q2 = np.stack([q2a, q2b], -1)  # (B, 2, 2)
         wxy = np.hypot(w[..., 0], w[..., 1])
         # next to axis 2 (within NEAR_FREE · L: q3 there is known only to ~√ε L, the double root above) q2 is named
         # free; the row stays the solution of the equation as computed, its tangent root if rounding left none
         near2 = wxy < NEAR_FREE * self.L
         if near2.any():
-            loose = solve_trig(r[0] * w[..., 0] + r[1] * w[..., 1], r[1] * w[..., 0] - r[0] * w[..., 1],
-                               D[:, None, 2] - r[2] * w[..., 2], tol=np.inf)
+            loose = np.stack(stanford_q2(w[..., 0], w[..., 1], w[..., 2], D[:, None, 2], r, np.inf)[:2], -1)
             q2 = np.where((near2 & ~np.isfinite(q2).any(-1))[..., None], loose, q2)
         q2 = np.where((wxy < tiny)[..., None], [0.0, np.nan], q2)  # w on axis 2: every q2 (0 returned)
         free2 = near2
-        c2, s2 = np.cos(q2), np.sin(q2)
-        wx, wy, wz = (w[..., None, k] for k in range(3))
-        x, y = c2 * wx - s2 * wy, s2 * wx + c2 * wy  # Rz(q2) w
-        R1 = self.R1
-        ex = R1[0, 0] * x + R1[0, 1] * y + R1[0, 2] * wz  # R1 Rz(q2) w, xy
-        ey = R1[1, 0] * x + R1[1, 1] * y + R1[1, 2] * wz
         free1 = np.broadcast_to((np.hypot(D[:, 0], D[:, 1]) < tiny)[:, None, None], q2.shape)  # W − O on axis 1
-        q1 = np.where(free1, 0.0, _angle(D[:, None, None, 1], D[:, None, None, 0]) - _angle(ey, ex))
+        q1, _, _ = stanford_q1(q2, *(w[..., None, k] for k in range(3)), D[:, None, None, 0], D[:, None, None, 1],
+                               self.R1)
+        q1 = np.where(free1, 0.0, q1)
         q = np.stack([q1, q2, np.broadcast_to(q3[..., None], q2.shape)], -1).reshape(len(W), 4, 3)
         return q, _flags(q, free1 * 1 + free2[..., None] * 2)
 
@@ -213,27 +185,6 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     """
     r, u = Ra[2, :], Rb[:, 2]
     qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
-    cb, sb = np.cos(qb), np.sin(qb)
-
-    def rz_then_ra(x):  # Ra Rz(qb) x for a constant 3-vector x → three (..., 2) arrays
-        rx, ry = cb * x[0] - sb * x[1], sb * x[0] + cb * x[1]
-        return [Ra[i, 0] * rx + Ra[i, 1] * ry + Ra[i, 2] * x[2] for i in range(3)]
-
-    v = rz_then_ra(u)
-    m0, m1 = M[..., None, 0, 2], M[..., None, 1, 2]
-    vxy = np.hypot(v[0], v[1])
-    singular = vxy < AXES_ALIGNED_TOL
-    qa = np.where(vxy < ALIGNED_EXACT, 0.0, _angle(m1, m0) - _angle(v[1], v[0]))
-    ca, sa = np.cos(qa), np.sin(qa)
-    n0, n1, n2 = (M[..., None, k, 0] for k in range(3))  # M e_x
-    y0, y1 = ca * n0 + sa * n1, -sa * n0 + ca * n1  # Rz(qa)ᵀ M e_x
-    x0, x1 = (rz_then_ra(Rb[:, j]) for j in (0, 1))  # Ra Rz(qb) Rb e_x, … e_y
-    N00 = x0[0] * y0 + x0[1] * y1 + x0[2] * n2
-    N10 = x1[0] * y0 + x1[1] * y1 + x1[2] * n2
-    qc = _angle(N10, N00)
-    sign = np.where(v[2] >= 0, 1.0, -1.0)
-    exact = vxy < ALIGNED_EXACT
-    if exact.any():  # the continuum's representative in the middle of the family (inside the wrist limits)
-        qa0, qc = split_aligned(exact, sign, qc)
-        qa = np.where(exact, qa0, qa)
-    return np.stack([qa, qb, qc], -1), singular & np.isfinite(qb), sign
+    Mt = np.moveaxis(M, (-2, -1), (0, 1))[..., None]  # M[i, j] of each pose, against the two roots of qb
+    qa, qc, singular, sign, _ = wrist_rest(qb, Mt, Ra, Rb)  # the one copy (numba compiles it too)
+    return np.stack([qa, qb, qc], -1), singular, sign

@@ -13,9 +13,16 @@ from ..chain import Screws, screw_axes, screw_pose, screw_walk
 from ..numeric import inverse_transform
 from ._chain import angle_about_z, solve_trig
 from ._closed import closed_position, wrist_angles
+from ._forms import elbow_q2
 from ._position3 import Position3
 from ._structure import arm_scale, common_point, free_text, rot_z_angle
-from ._subproblems import ALIGNED_EXACT, AXES_ALIGNED_TOL, axis_angle_roots, rotation3, rz_bilinear
+from ._subproblems import (
+    ALIGNED_EXACT,
+    AXES_ALIGNED_TOL,
+    axis_angle_roots,
+    rotation3,
+    rz_bilinear,
+)
 
 __all__ = ["pieper_plan", "parallel_plan", "elbow_constants"]
 
@@ -105,10 +112,7 @@ def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
     vz = p2[2] + R2[2, 2] * p3[2]
     rhs = np.sum(P[..., :2] ** 2, -1) - p2 @ p2 - p3 @ p3 + vz**2 - 2 * g
     qb = solve_trig(2 * a, 2 * b, rhs, tol=1e-7)
-    cb, sb = np.cos(qb), np.sin(qb)
-    v = np.stack([cb * p3[0] - sb * p3[1], sb * p3[0] + cb * p3[1], np.full(qb.shape, p3[2])], -1)
-    v = p2 + v @ R2.T
-    qa = angle_about_z(v, np.broadcast_to(P[..., None, :], v.shape))
+    qa, _, _ = elbow_q2(P[..., None, 0], P[..., None, 1], qb, R2, p2, p3, 0.0)  # turns v onto P (._forms)
     return qa, qb
 
 

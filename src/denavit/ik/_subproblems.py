@@ -9,16 +9,17 @@ from __future__ import annotations
 import numpy as np
 
 from ._chain import angle_about_z
+from ._forms import ALIGNED_EXACT, AXES_ALIGNED_TOL, WRIST_TOL, wrist_qb
 
 __all__ = ["rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "split_aligned",
            "AXES_ALIGNED_TOL", "ALIGNED_EXACT"]
 
-ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
-AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the
-# parallel axes of a UR-type arm) under which a solution is reported as the continuum of the aligned axes
+# ALIGNED_EXACT: below this angle [rad] the representative of the continuum is taken with qa = 0; AXES_ALIGNED_TOL:
+# angle [rad] between the two outer axes of a three-axis wrist (or between axis 6 and the parallel axes of a UR-type
+# arm) under which a solution is reported as the continuum of the aligned axes (both kept in ._forms)
 
 
-def axis_angle_roots(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+def axis_angle_roots(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = WRIST_TOL) -> np.ndarray:
     """All θ with ``rᵀ Rz(θ) u = m_z`` for unit vectors r, u (3,) and unit m (..., 3), shape (..., 2).
 
     The same roots as ``solve_trig`` on ``a cos θ + b sin θ = m_z − r_z u_z`` (θ = base ± x), but x is computed
@@ -29,20 +30,10 @@ def axis_angle_roots(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = 1
     ``(1 + cos x)/2`` likewise with Σ = β_r + β_u; the smaller one gives x.  NaN where there is no root.
     """
     a, b, _ = rz_bilinear(r, u)
-    rho = float(np.hypot(a, b))
-    base = float(np.arctan2(b, a))
-    phi = np.arctan2(np.hypot(m[..., 0], m[..., 1]), m[..., 2])
-    if rho < 1e-12:
-        return np.full(phi.shape + (2,), np.nan)
+    rho, base = float(np.hypot(a, b)), float(np.arctan2(b, a))
     br, bu = np.arctan2(np.hypot(r[0], r[1]), r[2]), np.arctan2(np.hypot(u[0], u[1]), u[2])
-    dm, sm = br - bu, br + bu
-    lo = np.sin((phi + dm) / 2) * np.sin((phi - dm) / 2) / rho  # (1 − cos x) / 2
-    hi = np.sin((sm + phi) / 2) * np.sin((sm - phi) / 2) / rho  # (1 + cos x) / 2
-    ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
-    x = np.where(lo <= hi, 2 * np.arcsin(np.sqrt(np.clip(lo, 0.0, 1.0))),
-                 np.pi - 2 * np.arcsin(np.sqrt(np.clip(hi, 0.0, 1.0))))
-    out = np.stack([base + x, base - x], axis=-1)
-    return np.where(ok[..., None], out, np.nan)
+    plus, minus, _, _ = wrist_qb(m[..., 0], m[..., 1], m[..., 2], rho, base, br, bu, tol)  # the one copy (numba too)
+    return np.stack([plus, minus], axis=-1)
 
 
 def rz_bilinear(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,0 +1,190 @@
+"""The closed forms of the analytic IK written once, for numpy batches and for numba alike.
+
+Each function here is elementwise: its arguments are floats or numpy arrays of one broadcast shape (constant
+vectors and matrices are indexed, ``R[0, 1]``, and give floats), and it uses only arithmetic, comparisons, ``&``,
+``|``, ``abs`` and the numpy ufuncs numba compiles on floats (``np.arctan2``, ``np.hypot``, ``np.sqrt``,
+``np.arcsin``, ``np.arccos``, ``np.sin``, ``np.cos``, ``np.minimum``, ``np.maximum``, ``np.mod``), plus
+:func:`select` for a choice per element.  So the plain solver calls them on whole batches (numpy, the branch
+slots stacked on trailing axes) and :mod:`denavit.codegen` jits the very same functions (``register_jitable``,
+with ``select`` as ``a if c else b``) for its one-pose loops: one copy of every formula, no source strings.
+
+Formulas (joint-screw form of :mod:`._chain`; derivations in :mod:`._closed` and docs/ik.md):
+
+- :func:`trig_roots` — ``a cos θ + b sin θ = c`` (Paden–Kahan subproblem 1 in scalar form).
+- :func:`half_angle` — x from ``(1 − cos x)/2`` and ``(1 + cos x)/2`` given as products (Kahan's digit-keeping
+  triangle angles), the smaller of the two.
+- :func:`shoulder_roots`, :func:`elbow_plane`, :func:`elbow_roots`, :func:`elbow_q2` — the elbow arm's joints
+  1–3 (Craig 3rd ed. Sec. 4.7, eqs. 4.65–4.76).
+- :func:`stanford_q3`, :func:`stanford_q2`, :func:`stanford_q1` — the Stanford arm's joints 1–3 (R R P, axes 1, 2
+  meeting; Spong, Hutchinson & Vidyasagar 2006, Sec. 5.3.3).
+- :func:`wrist_qb`, :func:`wrist_rest` — the three-axis wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` (Paden–Kahan
+  subproblems 2 and 1; Murray, Li & Sastry 1994, Sec. 3.3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "half_angle", "shoulder_roots", "elbow_plane", "elbow_roots",
+           "elbow_q2", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2", "stanford_q1"]
+
+ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
+AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the outer axes of a three-axis wrist under which it is singular
+WRIST_TOL = 1e-9  # how far (1 ∓ cos x)/2 of the wrist's z-row may fall below 0 and still count as the double root
+
+
+def select(c, a, b):
+    """a where c, else b (``np.where``; numba compiles it as ``a if c else b``)."""
+    return np.where(c, a, b)
+
+
+def _clip(x, lo, hi):
+    return np.minimum(np.maximum(x, lo), hi)
+
+
+def trig_roots(a, b, c, tol):
+    """(θ₊, θ₋) with ``a cos θ + b sin θ = c``: ``atan2(b, a) ± arccos(c/ρ)``, ρ = √(a² + b²); NaN where |c| > ρ
+    beyond ``tol`` (a ratio within it is the tangent, double root) or where ρ ≤ 1e-12 (no dependence on θ).
+    Also returns ρ and the ratio c/ρ (0 where ρ ≤ 1e-12)."""
+    rho = np.hypot(a, b)
+    some = rho > 1e-12
+    ratio = select(some, c / select(some, rho, 1.0), 0.0)
+    ok = some & (abs(ratio) <= 1.0 + tol)
+    base = np.arctan2(b, a)
+    delta = np.arccos(_clip(select(ok, ratio, 0.0), -1.0, 1.0))
+    return select(ok, base + delta, np.nan), select(ok, base - delta, np.nan), rho, ratio
+
+
+def half_angle(lo, hi, tol):
+    """x in [0, π] with (1 − cos x)/2 = lo and (1 + cos x)/2 = hi, from the smaller one (its digits survive next to
+    x = 0 or π, where arccos loses half of them); NaN when either is below −tol/2 (out of range)."""
+    ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
+    x = select(lo <= hi, 2.0 * np.arcsin(np.sqrt(_clip(lo, 0.0, 1.0))),
+               np.pi - 2.0 * np.arcsin(np.sqrt(_clip(hi, 0.0, 1.0))))
+    return select(ok, x, np.nan)
+
+
+def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
+    """The elbow arm's q1: ``(Rz(q1) a)·W = h`` (Craig eq. 4.65 in joint-screw form), a the axis of joints 2, 3
+    in the frame after joint 1, W the wrist centre in the frame before joint 1.
+
+    Returns (q1₊, q1₋, free, ratio): where W lies on axis 1 (within ``tiny``) q1 is free: (0, NaN) and free True;
+    ratio = c/ρ of the equation (|ratio| near 1: the double root)."""
+    c = h - a[2] * Wz
+    q1a, q1b, _rho, ratio = trig_roots(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, c, tol)
+    free = (np.hypot(Wx, Wy) < tiny) & (abs(c) < tiny)
+    return select(free, 0.0, q1a), select(free, np.nan, q1b), free, ratio
+
+
+def elbow_plane(q1, Wx, Wy, Wz, R1, p1):
+    """(g0, g1): the xy of g = R1ᵀ (Rz(−q1) W − p1), the wrist centre in the frame of joint 2."""
+    c1, s1 = np.cos(q1), np.sin(q1)
+    d0 = c1 * Wx + s1 * Wy - p1[0]
+    d1 = -s1 * Wx + c1 * Wy - p1[1]
+    d2 = Wz - p1[2]
+    return d0 * R1[0, 0] + d1 * R1[1, 0] + d2 * R1[2, 0], d0 * R1[0, 1] + d1 * R1[1, 1] + d2 * R1[2, 1]
+
+
+def elbow_roots(G, na, nb, base, tol):
+    """(q3₊, q3₋, x): q3 = base ± x with G² = na² + nb² + 2 na nb cos x (the elbow's law of cosines, Craig eq.
+    4.69), (1 ∓ cos x)/2 written as products so that a folded or stretched elbow keeps its digits; NaN beyond
+    the reach (``tol``)."""
+    den = 4.0 * na * nb
+    s, d = na + nb, abs(na - nb)
+    x = half_angle((s - G) * (s + G) / den, (G - d) * (G + d) / den, tol)
+    return base + x, base - x, x
+
+
+def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
+    """(q2, free, |v_xy|): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow triangle: the wrist centre, or the
+    UR arm's planar-pair point) onto g about axis 2; where v lies on axis 2 (within ``tiny``) q2 is free: 0 and
+    free True (a planar pair passes tiny = 0 and reads |v_xy| instead)."""
+    c3, s3 = np.cos(q3), np.sin(q3)
+    u0, u1 = c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]  # Rz(q3) P, xy (z is P_z)
+    vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
+    vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
+    vxy = np.hypot(vx, vy)
+    free = vxy < tiny
+    return select(free, 0.0, np.arctan2(g1, g0) - np.arctan2(vy, vx)), free, vxy
+
+
+def wrist_qb(m0, m1, m2, rho, base, br, bu, tol):
+    """(qb₊, qb₋, lo, hi): the roots of the wrist's z-row ``rᵀ Rz(qb) u = m_z`` (m = M e_z, r = Raᵀ e_z, u = Rb e_z;
+    ρ, base: hypot and atan2 of its cos/sin coefficients; br, bu: the angles of r and u to the z axis).
+
+    x from φ = ∠(m, e_z) taken with atan2 from all of m: ``(1 − cos x)/2 = sin((φ + Δ)/2) sin((φ − Δ)/2)/ρ``,
+    Δ = br − bu, and ``(1 + cos x)/2`` likewise with br + bu (see ``axis_angle_roots``); NaN where ρ < 1e-12.
+    lo and hi (the two products) tell how near the roots are to a double root."""
+    phi = np.arctan2(np.hypot(m0, m1), m2)
+    dm, sm = br - bu, br + bu
+    r = select(rho < 1e-12, np.nan, rho)
+    lo = np.sin((phi + dm) / 2) * np.sin((phi - dm) / 2) / r  # (1 − cos x)/2
+    hi = np.sin((sm + phi) / 2) * np.sin((sm - phi) / 2) / r  # (1 + cos x)/2
+    x = half_angle(lo, hi, tol)
+    return base + x, base - x, lo, hi
+
+
+def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
+    """Row i of Ra Rz(qb) x for a constant vector x."""
+    return Ra[i, 0] * (cb * x0 - sb * x1) + Ra[i, 1] * (sb * x0 + cb * x1) + Ra[i, 2] * x2
+
+
+def wrist_rest(qb, M, Ra, Rb):
+    """(qa, qc, singular, sign, vxy) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb is known: qa turns
+    v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan subproblems
+    2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
+
+    singular: axes a and c aligned within AXES_ALIGNED_TOL (only qa ± qc is determined, sign +1 for qa + qc);
+    aligned within ALIGNED_EXACT the representative is the middle of the family: qa = ±w/2, qc = w/2.  vxy: sine
+    of the angle between axes a and c (how near the wrist is to its singularity)."""
+    cb, sb = np.cos(qb), np.sin(qb)
+    v0 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 0)
+    v1 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 1)
+    v2 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 2)
+    vxy = np.hypot(v0, v1)
+    exact = vxy < ALIGNED_EXACT
+    qa = select(exact, 0.0, np.arctan2(M[1, 2], M[0, 2]) - np.arctan2(v1, v0))
+    ca, sa = np.cos(qa), np.sin(qa)
+    y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]  # Rz(qa)ᵀ M e_x
+    N00 = (_ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 0) * y0
+           + _ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 1) * y1
+           + _ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 2) * n2)
+    N10 = (_ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 0) * y0
+           + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 1) * y1
+           + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 2) * n2)
+    qc = np.arctan2(N10, N00)
+    sign = select(v2 >= 0.0, 1.0, -1.0)
+    w = np.pi - np.mod(np.pi - qc, 2.0 * np.pi)  # the determined qa ± qc, wrapped (computed with qa = 0)
+    singular = (vxy < AXES_ALIGNED_TOL) & np.isfinite(qb)
+    return select(exact, sign * w / 2, qa), select(exact, w / 2, qc), singular, sign, vxy
+
+
+def stanford_q3(Dx, Dy, Dz, uz, uperp, L):
+    """(q3₊, q3₋, disc, root) of the Stanford arm's prismatic joint: turning about axes 1 and 2 keeps |D| (D the
+    wrist centre from the point O where they meet), so |D|² = |u + q3 z|², q3 = −u·z ± √disc (Spong, Hutchinson &
+    Vidyasagar 2006, Sec. 5.3.3); the discriminant |D|² − |u⊥|² written as (|D| − |u⊥|)(|D| + |u⊥|) keeps its
+    digits next to the double root; NaN where disc < −1e-12 L²."""
+    nD = np.sqrt(Dx * Dx + Dy * Dy + Dz * Dz)
+    disc = (nD - uperp) * (nD + uperp)
+    root = np.sqrt(select(disc >= -1e-12 * L * L, np.maximum(disc, 0.0), np.nan))
+    return -uz + root, -uz - root, disc, root
+
+
+def stanford_q2(w0, w1, w2, Dz, r, tol):
+    """(q2₊, q2₋, ρ, ratio): the height along axis 1, ``D_z = rᵀ Rz(q2) w`` (w = u + q3 z, the wrist centre in the
+    frame of joint 2; r = axis 1 there), by :func:`trig_roots`."""
+    return trig_roots(r[0] * w0 + r[1] * w1, r[1] * w0 - r[0] * w1, Dz - r[2] * w2, tol)
+
+
+def stanford_q1(q2, w0, w1, w2, Dx, Dy, R1):
+    """(q1, ex, ey): q1 turns e = R1 Rz(q2) w (its xy: ex, ey) onto D about axis 1."""
+    c2, s2 = np.cos(q2), np.sin(q2)
+    x, y = c2 * w0 - s2 * w1, s2 * w0 + c2 * w1  # Rz(q2) w
+    ex = R1[0, 0] * x + R1[0, 1] * y + R1[0, 2] * w2
+    ey = R1[1, 0] * x + R1[1, 1] * y + R1[1, 2] * w2
+    return np.arctan2(Dy, Dx) - np.arctan2(ey, ex), ex, ey
+
+
+#: The functions numba compiles (``select`` gets its scalar twin there), callers after callees.
+JITTABLE = (_clip, trig_roots, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2, wrist_qb, _ra_rz,
+            wrist_rest, stanford_q3, stanford_q2, stanford_q1)
