@@ -32,7 +32,7 @@ __all__ = ["MAX_BODY_BYTES", "MAX_CHECK_BYTES", "create_app"]
 MAX_BODY_BYTES = 256_000
 #: Largest body of a check job or an opened file (the report, claims, robot file or URDF text travels inside it).
 MAX_CHECK_BYTES = 1_200_000
-_STATIC = {"workbench.js": "text/javascript", "workbench.css": "text/css"}
+_STATIC = {"workbench.js": "text/javascript", "jobs.js": "text/javascript", "workbench.css": "text/css"}
 
 
 def _asset(name: str) -> str:

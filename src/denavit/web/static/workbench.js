@@ -1,5 +1,5 @@
-/* denavit workbench: the page edits a robot file (its DH table), the server answers (kinematics, IK, dynamics,
- * jobs).  The 3-D view is denavit's own viewer page (viz/assets/viewer.js) in an iframe, one slider per joint;
+/* denavit workbench: the page edits a robot file (its DH table), the server answers (kinematics, IK, dynamics);
+ * the long work (jobs) is in jobs.js.  The 3-D view is denavit's own viewer page (viz/assets/viewer.js) in an iframe, one slider per joint;
  * this script listens to its sliders.  No dependencies besides the bundled KaTeX.
  */
 (function () {
@@ -125,7 +125,7 @@
       var poses = $("poses");
       poses.length = 1;
       Object.keys(r.poses).forEach(function (n) { var o = document.createElement("option"); o.value = n; o.textContent = n; poses.appendChild(o); });
-      startFormula();
+      if (wb.onRobot) wb.onRobot();      // jobs.js: the symbolic T_0n
     }).catch(function (e) { status("no answer from the server: " + e); });
   }
 
@@ -164,7 +164,7 @@
           "manipulability √det(J Jᵀ) = " + r.manipulability.toPrecision(5) + " · σ_min = " +
           r.singular_values[r.singular_values.length - 1].toPrecision(4);
         $("T").dataset.q = JSON.stringify(r.q);
-        showNearest();
+        if (wb.onPose) wb.onPose();        // jobs.js: the nearest singular set
         $("T").dataset.full = JSON.stringify(r.T);
         wb.shown = seq; wb.kinCount++;
         if (started[seq] !== undefined) {
@@ -198,7 +198,8 @@
       if (!good) return;
       post("/api/dynamics", { robot: good.doc, q: q, qd: $("qd").value }).then(function (r) {
         $("dyn-error").textContent = r._status === 200 ? "" : r.error;
-        if (r._status === 200) { $("M").textContent = matText(r.M); $("cg").textContent = "c: " + vecText(r.c) + "\ng: " + vecText(r.g); }
+        if (r._status === 200) { $("M").textContent = matText(r.M); $("cg").textContent = "c: " + vecText(r.c) + "\ng: " + vecText(r.g);
+          $("cg").dataset.q = JSON.stringify(r.q); $("cg").dataset.qd = JSON.stringify(r.qd); }
       });
       post("/api/statics", { robot: good.doc, q: q, wrench: $("wrench").value, frame: $("wrench-frame").value }).then(function (r) {
         $("statics-error").textContent = r._status === 200 ? "" : r.error;
@@ -236,155 +237,10 @@
     viewerSliders().forEach(function (s) { s.dispatchEvent(new Event("input")); });
   }
 
-  // ---- jobs: the formula, the report, the check --------------------------------------------------------
-  var running = {};          // this page's jobs by id, cancelled when the page goes away
-  function runJob(kind, payload, onProgress, onDone) {
-    var job = { id: null, stopped: false }, polls = 0;
-    post("/api/jobs", { kind: kind, payload: payload }).then(function (r) {
-      if (r._status !== 200) { if (!job.stopped) onDone(null, r.error, r); return; }
-      job.id = r.id;
-      if (job.stopped) { cancelJob(job); return; }   // superseded before it started
-      running[job.id] = job;
-      (function poll() {
-        if (job.stopped) return;
-        fetch("/api/jobs/" + job.id).then(function (x) { return x.json(); }).then(function (s) {
-          if (job.stopped) return;
-          if (s.state === "running") { onProgress(s.progress); setTimeout(poll, ++polls < 40 ? 50 : 250); return; }
-          delete running[job.id];
-          onDone(s.state === "done" ? s.result : null, s.state === "done" ? "" : s.error, s);
-        });
-      })();
-    });
-    return job;
-  }
-  function cancelJob(job) {
-    if (!job) return;
-    job.stopped = true;
-    if (job.id) { delete running[job.id]; post("/api/jobs/" + job.id + "/cancel", {}); }
-  }
-  window.addEventListener("pagehide", function () {
-    Object.keys(running).forEach(function (id) {
-      navigator.sendBeacon("/api/jobs/" + id + "/cancel", new Blob(["{}"], { type: "application/json" }));
-    });
-  });
-
-  var formulaJob = null;
-  function startFormula() {
-    cancelJob(formulaJob);
-    $("formula-status").textContent = "deriving…";
-    var t0 = performance.now();
-    formulaJob = runJob("formula", { robot: good.doc }, function () {}, function (res, err, st) {
-      if (!res) { $("formula-status").textContent = err; return; }
-      var box = $("formula"); box.innerHTML = "";
-      res.steps.forEach(function (s) {
-        var el = document.createElement(s.math ? "div" : "p");
-        if (s.math && window.katex) katex.render(s.math, el, { displayMode: true, throwOnError: false });
-        else el.textContent = s.math || s.text;
-        box.appendChild(el);
-      });
-      wb.formulaSeconds = (performance.now() - t0) / 1000;
-      wb.formulaCpu = st.cpu_seconds;
-      $("formula-status").textContent = "derived in " + wb.formulaSeconds.toFixed(2) + " s (" + st.cpu_seconds + " s of CPU)";
-    });
-  }
-
-  var reportJob = null, report = null;
-  function startReport() {
-    $("report-start").disabled = true; $("report-cancel").disabled = false;
-    $("report-downloads").hidden = true; $("report-sections").innerHTML = "";
-    var typed = qTyped && qTyped.values.every(function (v, k) { return Math.abs(v - q[k]) < 1e-12; });
-    reportJob = runJob("report", { robot: good.doc, q: typed ? qTyped.text : q, qd: $("qd").value.trim(),
-                                   wrench: $("wrench").value.trim(), pdf: $("report-pdf").checked }, function (p) {
-      var last = p[p.length - 1] || "starting", m = /section (\d+)\/(\d+)/.exec(last);
-      $("report-status").textContent = last;
-      if (m) $("report-progress").value = (m[1] - 1) / m[2];
-    }, function (res, err) {
-      $("report-start").disabled = false; $("report-cancel").disabled = true;
-      $("report-progress").value = res ? 1 : 0;
-      if (!res) { $("report-status").textContent = err; return; }
-      report = res;
-      $("report-status").textContent = res.title + [res.note, res.pdf_note].filter(Boolean).map(function (n) { return " (" + n + ")"; }).join("");
-      document.querySelector("#report-downloads [data-fmt=pdf]").hidden = !res.pdf;
-      res.sections.forEach(function (s, i) {
-        var li = document.createElement("li"), a = document.createElement("a");
-        a.href = "#"; a.textContent = s.title + (s.status === "done" ? "" : " — " + s.status + ": " + s.reason);
-        a.addEventListener("click", function (e) {
-          e.preventDefault();
-          var t = $("report").contentDocument.getElementById(s.key); if (t) t.scrollIntoView();
-        });
-        li.appendChild(a); $("report-sections").appendChild(li);
-      });
-      $("report").hidden = false; $("report").srcdoc = res.html; $("report-downloads").hidden = false;
-    });
-  }
   function download(text, name, type) {
     var a = document.createElement("a");
     a.href = URL.createObjectURL(new Blob([text], { type: type }));
     a.download = name; document.body.appendChild(a); a.click(); a.remove();
-  }
-
-  function startCheck() {
-    var file = $("check-file").files[0];
-    var textP = file ? file.text() : Promise.resolve($("check-text").value);
-    textP.then(function (text) {
-      $("check-status").textContent = "checking…"; $("check-summary").textContent = "";
-      var payload = { text: text, kind: $("check-kind").value, use_arm: $("check-use-arm").checked,
-                      robot: good ? good.doc : doc, name: file ? file.name : "pasted report" };
-      runJob("check", payload, function (p) { $("check-status").textContent = p[p.length - 1] || "checking…"; }, function (res, err) {
-        if (!res) { $("check-status").textContent = err; return; }
-        $("check-status").textContent = "";
-        var s = res.summary;
-        $("check-summary").textContent = Object.keys(s).filter(function (k) { return s[k]; })
-          .map(function (k) { return s[k] + " " + k; }).join(", ") || "nothing to judge was found";
-        $("check-summary").dataset.summary = JSON.stringify(s);
-        $("checked").hidden = !res.html; $("check-text-result").hidden = !!res.html;
-        if (res.html) $("checked").srcdoc = res.html; else $("check-text-result").textContent = res.text;
-      });
-    });
-  }
-
-  // ---- singular sets: derived once (a job), the nearest one named at every slider move -------------------
-  var singular = null, singDoc = null;
-  function startSingularities() {
-    $("sing-start").disabled = true; $("sing-status").textContent = "deriving…";
-    var sent = good.doc;
-    runJob("singularities", { robot: sent }, function (p) { $("sing-status").textContent = p[p.length - 1] || "deriving…"; },
-      function (res, err) {
-        $("sing-start").disabled = false;
-        if (!res) { $("sing-status").textContent = err; return; }
-        singular = res; singDoc = sent;
-        $("sing-status").textContent = res.everywhere ? "singular everywhere: " + res.reason :
-          res.conditions.length ? res.measure + " vanishes when:" : (res.complete ? "no singular configuration" :
-          "not solved symbolically (non-square J: all minors vanish together)");
-        var list = $("sing-list"); list.innerHTML = "";
-        res.conditions.forEach(function (c) {
-          var li = document.createElement("li"), m = document.createElement("span");
-          if (window.katex) katex.render(c.latex, m, { throwOnError: false }); else m.textContent = c.latex;
-          li.appendChild(m); li.appendChild(document.createTextNode(" — " + c.kind + ": " + c.explanation));
-          list.appendChild(li);
-        });
-        showNearest();
-      });
-  }
-  function wrap(x) { return Math.abs(Math.atan2(Math.sin(x), Math.cos(x))); }
-  function showNearest() {
-    var out = $("sing-nearest");
-    if (singular && singDoc !== good.doc) {   // the table changed: those conditions were another arm's
-      singular = null; $("sing-list").innerHTML = ""; $("sing-status").textContent = "the table changed: find them again";
-    }
-    if (!singular) { out.textContent = ""; return; }
-    var best = null;
-    singular.conditions.forEach(function (c) {
-      c.solutions.forEach(function (s) {
-        var k = parseInt(s.variable.slice(1), 10) - 1, rev = good.info.joint_types[k] === "revolute";
-        s.values.forEach(function (v) {
-          var d = rev ? wrap(q[k] - v) : Math.abs(q[k] - v);
-          if (!best || d < best.d) best = { d: d, text: s.variable + " = " + v.toFixed(4) + " (" + c.kind + ")", unit: rev ? " rad" : " m" };
-        });
-      });
-    });
-    out.textContent = best ? "nearest: " + best.text + ", " + best.d.toFixed(4) + best.unit + " away" : "";
-    out.dataset.distance = best ? best.d : "";
   }
 
   // a typed q sets the sliders; the report then reads it exactly as typed (pi/4, not 0.7854)
@@ -399,21 +255,6 @@
     });
   }
 
-  var wsJob = null;
-  function startWorkspace() {
-    var n = parseInt($("ws-samples").value, 10);
-    $("ws-start").disabled = true; $("ws-cancel").disabled = false; $("ws-progress").value = 0;
-    wsJob = runJob("workspace", { robot: good.doc, samples: n }, function (p) {
-      var last = p[p.length - 1] || "starting";
-      $("ws-status").textContent = last; $("ws-progress").value = /drawing/.test(last) ? 1 : 0.2;
-    }, function (res, err) {
-      $("ws-start").disabled = false; $("ws-cancel").disabled = true; $("ws-progress").value = res ? 2 : 0;
-      if (!res) { $("ws-status").textContent = err; return; }
-      $("ws-status").textContent = res.samples + " samples, reach " + res.reach.toFixed(3) + " m, " +
-        (res.planar ? "area " + res.area.toFixed(3) + " m²" : "volume " + res.volume.toFixed(3) + " m³");
-      $("ws-picture").src = "data:image/png;base64," + res.png; $("ws-picture").hidden = false;
-    });
-  }
   function openFile() {
     var f = $("open-file").files[0];
     if (!f) return;
@@ -448,36 +289,15 @@
   $("qd").addEventListener("input", refreshDynamics);
   $("wrench").addEventListener("input", refreshDynamics);
   $("wrench-frame").addEventListener("change", refreshDynamics);
-  $("report-start").addEventListener("click", startReport);
-  $("report-cancel").addEventListener("click", function () {
-    cancelJob(reportJob); $("report-start").disabled = false; $("report-cancel").disabled = true;
-    $("report-status").textContent = "cancelled"; $("report-progress").value = 0;
-  });
-  document.querySelectorAll("#report-downloads button").forEach(function (b) {
-    b.addEventListener("click", function () {
-      var f = b.dataset.fmt, type = { html: "text/html", md: "text/markdown", tex: "application/x-tex", pdf: "application/pdf" }[f];
-      var data = report[f];
-      if (f === "pdf") data = Uint8Array.from(atob(report.pdf), function (c) { return c.charCodeAt(0); });
-      download(data, (good.info.name || "report") + "-report." + f, type);
-    });
-  });
-  $("check-file").addEventListener("change", function () {
-    var f = this.files[0], m = f && /\.(md|markdown|tex|txt|ya?ml)$/i.exec(f.name);
-    if (m) $("check-kind").value = { markdown: "md", yml: "yaml" }[m[1].toLowerCase()] || m[1].toLowerCase();
-  });
-  $("check-start").addEventListener("click", startCheck);
-  $("ws-start").addEventListener("click", startWorkspace);
-  $("sing-start").addEventListener("click", startSingularities);
   $("q-set").addEventListener("click", setTypedQ);
-  $("ws-cancel").addEventListener("click", function () {
-    cancelJob(wsJob); $("ws-start").disabled = false; $("ws-cancel").disabled = true;
-    $("ws-status").textContent = "cancelled"; $("ws-progress").value = 0;
-  });
   $("open-file").addEventListener("change", openFile);
   $("poses").addEventListener("change", function () {
     if (this.value && good) showSolution(good.info.poses[this.value]);
   });
   wb.showSolution = showSolution;
+  // what jobs.js uses
+  wb.internals = { $: $, post: post, download: download, good: function () { return good; }, q: function () { return q; },
+                   doc: function () { return doc; }, qTyped: function () { return qTyped; } };
   wb.doc = function () { return good ? good.doc : doc; };
   wb.busy = function () { return inFlight || again; };
 
