@@ -88,3 +88,25 @@ def test_kernels_compile_with_one_o3_pass_and_the_rest_of_numba_untouched(fresh,
     Q = rng.uniform(-1, 1, (7, 2))
     np.testing.assert_allclose(fast.mass_matrix(Q), denavit.mass_matrix(robot, Q), atol=1e-12)
     np.testing.assert_allclose(fast.jacobian(Q[0]), denavit.geometric_jacobian(robot, Q[0]), atol=1e-12)
+
+
+def test_the_builtins_of_a_module_come_from_one_numba_compile(fresh, rng):
+    """The first built-in asked for compiles those of every kernel of the module at once (one cfunc, one LLVM
+    module: numba's fixed cost paid once); each then answers its own call, with the plain functions' numbers."""
+    from denavit.codegen import _fastcall
+
+    robot, fast = fresh
+    q, qd, qdd = (rng.uniform(-1, 1, 2) for _ in range(3))
+    np.testing.assert_allclose(fast.fk(q), denavit.forward_kinematics(robot, q), atol=1e-12)
+    made = {k: v for (mod, k), v in _fastcall._CFUNCS.items() if mod == fast._m.__name__}
+    assert set(made) == {"fk", "position", "jacobian0", "rnea", "mass_matrix", "gravity", "coriolis",
+                         "forward_dynamics"}
+    assert len({id(cf) for cf, _ in made.values()}) == 1 and len({a for _, a in made.values()}) == 8
+    np.testing.assert_allclose(fast.position(q), denavit.forward_kinematics(robot, q)[:3, 3], atol=1e-12)
+    np.testing.assert_allclose(fast.jacobian(q), denavit.geometric_jacobian(robot, q), atol=1e-12)
+    np.testing.assert_allclose(fast.mass_matrix(q), denavit.mass_matrix(robot, q), atol=1e-12)
+    np.testing.assert_allclose(fast.gravity(q), denavit.gravity_torques(robot, q), atol=1e-12)
+    np.testing.assert_allclose(fast.coriolis(q, qd), denavit.coriolis_vector(robot, q, qd), atol=1e-12)
+    np.testing.assert_allclose(fast.rnea(q, qd, qdd), denavit.rnea(robot, q, qd, qdd), atol=1e-12)
+    for method in ("fk", "position", "jacobian", "mass_matrix", "gravity", "coriolis", "rnea"):
+        assert type(getattr(fast, method)).__name__ == "builtin_function_or_method", method

@@ -194,13 +194,13 @@ class CompiledRobot(BaseMethods, IKMethods, KinDerivativeMethods, DynDerivativeM
         ``method``: a call with exactly the kernel's float64 vectors runs in machine code from the call on (a
         tuple of fresh arrays where the method returns a tuple); every other call goes to the method itself.
         Nothing changes when the built-in cannot be made here (None is returned; else the built-in)."""
-        n, reg = self.dof, registered_kernels().get(name)
-        lengths = self._lengths.get(name) or (n,) * _ARITY.get(name, 1)
-        blocks, flagged = _BUILTIN_RESULTS.get(name, (lambda n: (self._shapes[name],), False))
+        reg = registered_kernels().get(name)
+        module = self._groups[reg.group if reg else BASE_GROUP][0]
         try:
-            made = _fastcall.install(self._groups[reg.group if reg else BASE_GROUP][0], name, lengths,
-                                     self._shapes[name], blocks(n), getattr(type(self), method).__get__(self),
-                                     guard_cache, flagged)
+            together = self._builtin_specs(module)
+            spec = next(s for s in together if s[0] == name)
+            made = _fastcall.install(module, name, *spec[1:4], getattr(type(self), method).__get__(self),
+                                     guard_cache, spec[4], together)
         except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
             made = None
         if made is None:
@@ -208,6 +208,19 @@ class CompiledRobot(BaseMethods, IKMethods, KinDerivativeMethods, DynDerivativeM
         setattr(self, method, made[0])
         self._keep.append(made[1])
         return made[0]
+
+    def _builtin_specs(self, module) -> tuple:
+        """``(name, input lengths, kernel shape, result blocks, flagged)`` of every kernel of ``module`` with a
+        built-in, in one fixed order whichever is asked for first: their built-ins are made by one numba compile."""
+        n, reg, specs = self.dof, registered_kernels(), []
+        for k in _BUILTIN_METHODS:
+            if not hasattr(module, f"{k}{_fastcall.ENTRY_SUFFIX}"):
+                continue
+            lengths = tuple(x for _, x in reg[k].inputs(n)) if k in reg else (n,) * _ARITY.get(k, 1)
+            shape = tuple(reg[k].shape(n)) if k in reg else self._shapes[k]
+            blocks, flagged = _BUILTIN_RESULTS.get(k, (lambda n, s=shape: (s,), False))
+            specs.append((k, lengths, shape, blocks(n), flagged))
+        return tuple(specs)
 
     def _missing(self, name: str):
         def kernel(*args):

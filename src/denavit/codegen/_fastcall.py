@@ -43,7 +43,7 @@ _OFF_TYPE, _OFF_DATA, _OFF_ND, _OFF_DIMS, _OFF_STRIDES, _OFF_DESCR = 8, 16, 24, 
 _SYMBOLS = ("denavit_ndarray_type", "denavit_float64_descr", "denavit_pyarray_new", "denavit_vectorcall",
             "denavit_tuple_new", "denavit_tuple_setitem", "denavit_decref")
 _STATE: dict = {}
-_CFUNCS: dict = {}  # (generated module's name, kernel) -> its compiled CFunc, for every object of that module
+_CFUNCS: dict = {}  # (generated module's name, kernel) -> (its CFunc, the entry's address), for every object
 
 
 class _MethodDef(ctypes.Structure):
@@ -222,50 +222,77 @@ def _checked_arrays(e: _Emitter, argv, nargs, kwnames, lengths: tuple) -> list:
     return arrays
 
 
-def entry_intrinsic(lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: tuple, outputs: tuple,
-                    flagged: bool = False):
-    """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the program
-    and the result (module docstring).  The kernel's outputs (``kernel_shape``, C order) fill the result ``blocks``
-    in turn: one block is returned as an array, several as a tuple.  ``flagged``: the output after the blocks must
-    be > 0 (forward dynamics: M regular), else the result is released and the Python method called (it raises)."""
+def _emit_entry(builder, argv4, lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: tuple, outputs: tuple,
+                flagged: bool):
+    """Lower one fast-call entry at ``builder`` (its arguments ``argv4`` = self, args, nargs, kwnames): the checks,
+    the program, the result (module docstring); returns the object to return (a phi)."""
     from llvmlite import ir
-    from numba.core import types
-    from numba.extending import intrinsic
 
     from ._llvm import emit_steps
 
     sizes = [int(np.prod(s, dtype=np.int64)) for s in blocks]
     flat = _flat_outputs(outputs, kernel_shape)
+    e = _Emitter(builder)
+    this, args, nargs, kwnames = argv4
+    argv = builder.bitcast(args, e.ptr.as_pointer())
+    arrays = _checked_arrays(e, argv, nargs, kwnames, lengths)
+
+    def load(arg, k):
+        data, stride = arrays[arg]
+        return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(e.i64, k), stride)]),
+                                            ir.DoubleType().as_pointer()))
+
+    # allocated first, so the program's values go to memory as they are made (not held across the calls)
+    result, data = e.results(blocks)
+    operand = emit_steps(builder, steps, 0, load)
+    flag = flat.pop(sum(sizes)) if flagged else None
+    start = 0
+    for block, size in enumerate(sizes):
+        for f in range(start, start + size):
+            if f in flat:
+                builder.store(operand(flat[f]), builder.gep(data[block], [ir.Constant(e.i64, f - start)]))
+        start += size
+    if flagged:  # not > 0: the result is released and the method raises the error
+        discard = builder.function.append_basic_block("dv_discard")
+        e.require(builder.fcmp_ordered(">", operand(flag), ir.Constant(ir.DoubleType(), 0.0)), discard)
+        here = builder.block
+        builder.position_at_end(discard)
+        e.call("denavit_decref", ir.VoidType(), [result], [e.ptr])
+        builder.branch(e.fallback)
+        builder.position_at_end(here)
+    return e.finish(result, (this, argv, nargs, kwnames))
+
+
+def _sibling(module, symbol: str, program: tuple) -> None:
+    """Another kernel's entry as a function ``symbol`` of the same LLVM module, with the C signature of the
+    fast-call convention (``PyObject *f(PyObject *, PyObject *const *, Py_ssize_t, PyObject *)``)."""
+    from llvmlite import ir
+
+    ptr = ir.IntType(8).as_pointer()
+    fn = ir.Function(module, ir.FunctionType(ptr, [ptr, ptr, ir.IntType(64), ptr]), name=symbol)
+    builder = ir.IRBuilder(fn.append_basic_block("entry"))
+    builder.ret(_emit_entry(builder, fn.args, *program))
+
+
+def entry_intrinsic(lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: tuple, outputs: tuple,
+                    flagged: bool = False, siblings: tuple = ()):
+    """A numba intrinsic ``f(self, args, nargs, kwnames) -> PyObject*`` (all pointer-sized): the checks, the program
+    and the result (module docstring).  The kernel's outputs (``kernel_shape``, C order) fill the result ``blocks``
+    in turn: one block is returned as an array, several as a tuple.  ``flagged``: the output after the blocks must
+    be > 0 (forward dynamics: M regular), else the result is released and the Python method called (it raises).
+    ``siblings``: ``(symbol, program)`` pairs, ``program`` the arguments above of another kernel: its entry is
+    written into the same LLVM module as a function of that (process-wide) name, so that one numba compile —
+    its fixed cost paid once — makes the built-ins of several kernels."""
+    from numba.core import types
+    from numba.extending import intrinsic
+
+    program = (tuple(lengths), tuple(kernel_shape), tuple(map(tuple, blocks)), steps, outputs, flagged)
 
     def codegen(context, builder, sig, args):
-        e = _Emitter(builder)
-        argv = builder.bitcast(args[1], e.ptr.as_pointer())
-        arrays = _checked_arrays(e, argv, args[2], args[3], lengths)
-
-        def load(arg, k):
-            data, stride = arrays[arg]
-            return builder.load(builder.bitcast(builder.gep(data, [builder.mul(ir.Constant(e.i64, k), stride)]),
-                                                ir.DoubleType().as_pointer()))
-
-        # allocated first, so the program's values go to memory as they are made (not held across the calls)
-        result, data = e.results(blocks)
-        operand = emit_steps(builder, steps, 0, load)
-        flag = flat.pop(sum(sizes)) if flagged else None
-        start = 0
-        for block, size in enumerate(sizes):
-            for f in range(start, start + size):
-                if f in flat:
-                    builder.store(operand(flat[f]), builder.gep(data[block], [ir.Constant(e.i64, f - start)]))
-            start += size
-        if flagged:  # not > 0: the result is released and the method raises the error
-            discard = builder.function.append_basic_block("dv_discard")
-            e.require(builder.fcmp_ordered(">", operand(flag), ir.Constant(ir.DoubleType(), 0.0)), discard)
-            here = builder.block
-            builder.position_at_end(discard)
-            e.call("denavit_decref", ir.VoidType(), [result], [e.ptr])
-            builder.branch(e.fallback)
-            builder.position_at_end(here)
-        return e.finish(result, (args[0], argv, args[2], args[3]))
+        for symbol, other in siblings:
+            if symbol not in builder.module.globals:
+                _sibling(builder.module, symbol, other)
+        return _emit_entry(builder, args, *program)
 
     @intrinsic
     def entry(typingctx, this, argv, nargs, kwnames):
@@ -274,33 +301,64 @@ def entry_intrinsic(lengths: tuple, kernel_shape: tuple, blocks: tuple, steps: t
     return entry
 
 
-def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tuple, method, guard,
-            flagged: bool = False):
-    """``(function, keep)``: the built-in function of kernel ``name`` of the generated ``module``, calling ``method``
-    (the Python method, bound) for everything it does not handle itself, and what must live as long as it; None
-    when this process cannot have one.  ``kernel_shape``: the kernel's output; ``blocks``: the result's arrays
-    (``flagged``: see :func:`entry_intrinsic`).  ``guard(cfunc)`` puts the disk cache's guard in front of numba's
-    cache before anything is loaded."""
-    py_func = getattr(module, f"{name}{ENTRY_SUFFIX}", None)
-    if py_func is None or not _setup():
-        return None
+def _symbol(module, name: str) -> str:
+    """The process-wide name of kernel ``name``'s entry in the cfunc of ``module`` (a generated module's name is
+    made of its cache key: unique per arm, backend and kernels)."""
+    return f"denavit_entry_{''.join(c if c.isalnum() else '_' for c in module.__name__)}_{name}"
+
+
+def _compiled_entries(module, specs: tuple, guard) -> dict:
+    """Compile (or load from the disk cache) the built-ins of every kernel of ``specs`` — ``(name, lengths,
+    kernel_shape, blocks, flagged)`` each — in one numba cfunc, made from the first one's ``<name>_entry``:
+    {name: (the CFunc, the entry's address)}; a kernel whose address cannot be had is left out."""
     from numba.core import sigutils, types
     from numba.core.ccallback import CFunc
 
-    cf = _CFUNCS.get((module.__name__, name))  # one per generated module and kernel, whatever the objects
-    if cf is None:
-        setattr(module, f"_{name}{ENTRY_SUFFIX}", entry_intrinsic(
-            tuple(lengths), tuple(kernel_shape), tuple(map(tuple, blocks)), getattr(module, f"_{name}_steps"),
-            getattr(module, f"_{name}_outputs"), flagged))
-        sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
-        cf = CFunc(py_func, sig, {}, {})  # what numba.cfunc(sig, cache=True) does, with the guard put in first
-        cf.enable_caching()
-        guard(cf)
-        with lean():  # LLVM's -O3 once, as for the kernels (see denavit.codegen._lean)
-            cf.compile()
-        _CFUNCS[(module.__name__, name)] = cf
+    def program(name, lengths, kernel_shape, blocks, flagged):
+        return (tuple(lengths), tuple(kernel_shape), tuple(map(tuple, blocks)), getattr(module, f"_{name}_steps"),
+                getattr(module, f"_{name}_outputs"), flagged)
+
+    lead, *rest = specs
+    siblings = tuple((_symbol(module, s[0]), program(*s)) for s in rest)
+    setattr(module, f"_{lead[0]}{ENTRY_SUFFIX}", entry_intrinsic(*program(*lead), siblings=siblings))
+    sig = sigutils.normalize_signature(types.voidptr(types.voidptr, types.voidptr, types.intp, types.voidptr))
+    cf = CFunc(getattr(module, f"{lead[0]}{ENTRY_SUFFIX}"), sig, {}, {})  # numba.cfunc(sig, cache=True), guarded
+    cf.enable_caching()
+    guard(cf)
+    with lean():  # LLVM's -O3 once, as for the kernels (see denavit.codegen._lean)
+        cf.compile()
+    entries = {lead[0]: (cf, cf.address)}
+    for (name, *_), (symbol, _) in zip(rest, siblings):
+        address = cf._library.get_pointer_to_function(symbol)
+        if address:
+            entries[name] = (cf, address)
+    return entries
+
+
+def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tuple, method, guard,
+            flagged: bool = False, together: tuple = ()):
+    """``(function, keep)``: the built-in function of kernel ``name`` of the generated ``module``, calling ``method``
+    (the Python method, bound) for everything it does not handle itself, and what must live as long as it; None
+    when this process cannot have one.  ``kernel_shape``: the kernel's output; ``blocks``: the result's arrays
+    (``flagged``: see :func:`entry_intrinsic`).  ``together``: ``(name, lengths, kernel_shape, blocks, flagged)`` of
+    every kernel of ``module`` with a built-in (``name`` among them, the same tuple whichever is asked for first):
+    their built-ins are compiled at once, in one numba cfunc.  ``guard(cfunc)`` puts the disk cache's guard in front
+    of numba's cache before anything is loaded."""
+    if getattr(module, f"{name}{ENTRY_SUFFIX}", None) is None or not _setup():
+        return None
+    made = _CFUNCS.get((module.__name__, name))  # one per generated module and kernel, whatever the objects
+    if made is None:
+        specs = tuple(together) if any(s[0] == name for s in together) else (
+            (name, lengths, kernel_shape, blocks, flagged),)
+        entries = _compiled_entries(module, specs, guard)
+        for kernel in (s[0] for s in specs):
+            _CFUNCS[(module.__name__, kernel)] = entries.get(kernel, (None, 0))
+        made = _CFUNCS[(module.__name__, name)]
+    cf, address = made
+    if not address:
+        return None
     doc = (method.__doc__ or "").encode("utf-8", "replace")
-    definition = _MethodDef(method.__name__.encode(), cf.address, _METH_FASTCALL_KEYWORDS, doc)
+    definition = _MethodDef(method.__name__.encode(), address, _METH_FASTCALL_KEYWORDS, doc)
     make = ctypes.pythonapi.PyCFunction_NewEx
     make.restype, make.argtypes = ctypes.py_object, [ctypes.POINTER(_MethodDef), ctypes.py_object, ctypes.py_object]
     builtin = make(ctypes.byref(definition), method, None)
