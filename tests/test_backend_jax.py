@@ -2,7 +2,8 @@
 gradients by jax.jacfwd / jax.jacrev against denavit's analytic derivatives, jax.jit and vmap, errors (checks in
 tests/_tensor_backends.py, shared with the PyTorch backend).
 
-float64 needs JAX's x64 mode, switched on here for this test process (float32 inputs stay float32 in it).  JAX run
+float64 needs JAX's x64 mode, switched on around each test here (float32 inputs stay float32 in it), not for the
+process: other tests and the docs' examples keep JAX's default.  JAX run
 op by op compiles each primitive for each new shape and dtype (about 30 ms each, 0.4 s per shape for FK): the tests
 use few shapes and arms, and those over 2 CPU-s (whichever meets a shape first pays) are marked slow."""
 
@@ -16,7 +17,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 jax = pytest.importorskip("jax")
-jax.config.update("jax_enable_x64", True)
 jnp = jax.numpy
 
 import _tensor_backends as checks  # noqa: E402
@@ -57,6 +57,12 @@ class Jax:
 @pytest.fixture(autouse=True)
 def _cache(tmp_path_factory, monkeypatch):
     monkeypatch.setenv("DENAVIT_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "kernels"))
+
+
+@pytest.fixture(autouse=True)
+def _x64():
+    with jax.enable_x64(True):
+        yield
 
 
 def dynamic_arm(seed, n=None):

@@ -1,0 +1,140 @@
+"""denavit's torch and JAX backends against pytorch_kinematics, and jax.jit against the numba batch kernel, in one run.
+
+Run:  python benchmarks/bench_tensor.py [--robots puma560 panda] [--batches 10000 1000000] [--repeat 3]
+Prints a Markdown table of ratios (peer time / denavit time: > 1 means denavit is faster), one process, CPU, one
+thread for every library (torch.set_num_threads(1), XLA's CPU client on one thread, numba threads=1), so the
+figures compare the code and not how many of the machine's cores each one grabs.
+
+Both sides get the same arm: pytorch_kinematics builds its serial chain from denavit's URDF export of the robot
+(``denavit.to_urdf``), and its results are first checked to equal denavit's (FK and J0 to 1e-6 in float64: the URDF
+holds the numbers as printed, 1e-8 apart) on the
+configurations timed.  Rows, each batch size × dtype:
+  FK        fast.fk(q) → (B, 4, 4)                  chain.forward_kinematics(q).get_matrix()
+  J         fast.jacobian(q) → (B, 6, n), J0         chain.jacobian(q) (base axes, end-effector origin: J0)
+  FK f+b    T = fk(q) with q.requires_grad; T.sum().backward(): forward and backward pass, both libraries
+  jax.jit   jax.jit(fast.fk) on a jax array (JAX's own layout, (B, 4, 4)) against the numba backend's batch
+            fk(q, threads=1) on a NumPy array, same float64 q (ratio = numba time / jax time: ≥ 0.5 is "within 2×")
+Each time is the best of ``repeat`` calls (after one warm-up call each, which also compiles), the libraries taking
+turns.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import time
+
+os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1")
+
+import numpy as np  # noqa: E402
+
+import denavit  # noqa: E402
+
+
+def once(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def best_pair(ours, theirs, repeat: int) -> tuple[float, float]:
+    """Best of ``repeat`` timed calls of each, after one warm-up call each (which also compiles), taking turns so
+    that a change of the machine's load hits both."""
+    ours(), theirs()
+    t_ours = t_theirs = np.inf
+    for _ in range(repeat):
+        t_ours, t_theirs = min(t_ours, once(ours)), min(t_theirs, once(theirs))
+    return t_ours, t_theirs
+
+
+def pk_chain(robot, dtype):
+    """pytorch_kinematics' serial chain of the robot, from denavit's URDF (its last link is the tool)."""
+    import pytorch_kinematics as pk
+
+    text = denavit.to_urdf(robot)
+    end = re.findall(r'<link name="([^"]+)"', text)[-1]
+    return pk.build_serial_chain_from_urdf(text.encode(), end).to(dtype=dtype)
+
+
+def check_agreement(fast, chain, q) -> None:
+    T = fast.fk(q)
+    T_pk = chain.forward_kinematics(q).get_matrix()
+    J, J_pk = fast.jacobian(q), chain.jacobian(q)
+    for what, a, b in (("FK", T, T_pk), ("J0", J, J_pk)):
+        err = float((a - b).abs().max())
+        if err > 1e-6:  # the URDF holds the numbers as printed (about 9 digits): 1e-8 differences
+            raise SystemExit(f"pytorch_kinematics and denavit disagree on {what}: max difference {err:.3g}")
+
+
+def fwd_bwd(fk, q):
+    def run():
+        x = q.detach().requires_grad_()
+        fk(x).sum().backward()
+        return x.grad
+
+    return run
+
+
+def torch_rows(robot, batch: int, repeat: int, rng):
+    import torch
+
+    fast = denavit.compile(robot, backend="torch")
+    rows = []
+    for dtype in (torch.float32, torch.float64):
+        chain = pk_chain(robot, dtype)
+        q = torch.tensor(rng.uniform(-np.pi, np.pi, (batch, robot.dof)), dtype=dtype)
+        if dtype == torch.float64:
+            check_agreement(fast, chain, q[:1000])
+        pairs = {"FK": (lambda: fast.fk(q), lambda: chain.forward_kinematics(q).get_matrix()),
+                 "J": (lambda: fast.jacobian(q), lambda: chain.jacobian(q)),
+                 "FK f+b": (fwd_bwd(fast.fk, q), fwd_bwd(lambda x: chain.forward_kinematics(x).get_matrix(), q))}
+        for op, (ours, theirs) in pairs.items():
+            t_ours, t_pk = best_pair(ours, theirs, repeat)
+            rows.append((robot.name, op, batch, str(dtype).split(".")[-1], t_pk / t_ours))
+    return rows
+
+
+def jax_row(robot, batch: int, repeat: int, rng):
+    import jax
+
+    with jax.enable_x64(True):
+        fast = denavit.compile(robot, backend="jax")
+        nb = denavit.compile(robot, backend="numba")
+        q = rng.uniform(-np.pi, np.pi, (batch, robot.dof))
+        qj = jax.numpy.asarray(q)
+        fk = jax.jit(fast.fk)
+        np.testing.assert_allclose(np.asarray(fk(qj)), nb.fk(q, threads=1), atol=1e-12)
+        t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
+    return (robot.name, "jax.jit FK vs numba", batch, "float64", t_nb / t_jax)
+
+
+def main(argv=None) -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--robots", nargs="+", default=["puma560", "panda"])
+    p.add_argument("--batches", nargs="+", type=float, default=[1e4, 1e6])
+    p.add_argument("--repeat", type=int, default=3)
+    args = p.parse_args(argv)
+    import torch
+
+    torch.set_num_threads(1)
+    rng = np.random.default_rng(0)
+    rows = []
+    for name in args.robots:
+        robot = denavit.load_robot(name)
+        for batch in (int(b) for b in args.batches):
+            rows += torch_rows(robot, batch, args.repeat, rng)
+            rows.append(jax_row(robot, batch, args.repeat, rng))
+            print(f"... {name} batch {batch} done", flush=True)
+    from importlib.metadata import version
+
+    print(f"\ntorch {torch.__version__}, pytorch_kinematics {version('pytorch_kinematics')}, jax {version('jax')}, "
+          f"numba {version('numba')}; one thread each\n")
+    print("| robot | operation | batch | dtype | ratio (peer time / denavit time) |")
+    print("|---|---|---|---|---|")
+    for name, op, batch, dtype, ratio in rows:
+        print(f"| {name} | {op} | {batch:.0e} | {dtype} | {ratio:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
