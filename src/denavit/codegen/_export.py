@@ -85,11 +85,8 @@ def export_sources(robot: DHRobot, lang: str, prefix: str | None = None, kernels
     specs.update(trace_registered(robot, [k for k in kernels if k in reg]))
     n = robot.dof
     title = f"Kernels of a {n}-joint arm ({robot.convention.value} DH), exported by denavit."
-    if lang in FRAMEWORKS:  # forward dynamics by the framework's solve of M: rnea and mass_matrix instead
-        if "forward_dynamics" in specs:
-            specs.update(trace_kernels(robot, [k for k in ("rnea", "mass_matrix") if k not in specs]))
-        specs = {k: v for k, v in specs.items() if k not in INTERNAL and k != "forward_dynamics"}
-        return {f"{prefix}.py": tensor_module(specs, lang, title + _tensor_usage(prefix, n, lang))}
+    if lang in FRAMEWORKS:
+        return _tensor_export(robot, specs, lang, prefix, title)
     if lang == "c":
         usage = _c_usage(prefix, n, "rnea" in specs)
         header, source = c_sources(specs, prefix, title + usage)
@@ -128,6 +125,15 @@ def _c_usage(prefix: str, n: int, dynamics: bool) -> str:
                   f"    {prefix}_forward_dynamics(q, qd, tau, a);  (qdd in a[0..{n - 1}]; a[{n}] > 0 iff M is regular)"]
     lines += [f"Build: cc -std=c99 -O2 -c {prefix}.c && link with -lm."]
     return "\n".join(lines)
+
+
+def _tensor_export(robot: DHRobot, specs: dict, lang: str, prefix: str, title: str) -> dict[str, str]:
+    """``{<prefix>.py: text}``: the kernels for torch or jax; forward dynamics by the framework's solve of M (rnea and
+    mass_matrix traced for it), the IK solvers' internal kernel left out."""
+    if "forward_dynamics" in specs:
+        specs.update(trace_kernels(robot, [k for k in ("rnea", "mass_matrix") if k not in specs]))
+    specs = {k: v for k, v in specs.items() if k not in INTERNAL and k != "forward_dynamics"}
+    return {f"{prefix}.py": tensor_module(specs, lang, title + _tensor_usage(prefix, robot.dof, lang))}
 
 
 def _tensor_usage(prefix: str, n: int, lang: str) -> str:
