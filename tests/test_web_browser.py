@@ -139,6 +139,37 @@ def test_edit_a_cell_and_T_changes_a_bad_cell_is_marked_and_the_page_keeps_the_a
     assert page.locator(".bad").count() == 0
 
 
+def test_rows_added_removed_retyped_and_a_named_pose(page):
+    loads = page.evaluate("window.workbench.robotLoads")
+    page.click("#add-row")  # a seventh row: revolute by default
+    page.wait_for_function(f"window.workbench.robotLoads > {loads}", timeout=60_000)
+    assert page.evaluate("window.workbench.doc().joints.length") == 7
+    assert page.frame_locator("#viewer").locator("#q7").count() == 1  # a slider for the new joint
+    loads = page.evaluate("window.workbench.robotLoads")
+    page.select_option("select.joint-type[data-row='6']", "prismatic")  # row 7 becomes P: q moves from θ to d
+    page.wait_for_function(f"window.workbench.robotLoads > {loads}", timeout=60_000)
+    row = page.evaluate("window.workbench.doc().joints[6]")
+    assert (row["theta"], row["d"]) == ("0", "q")
+    edited = denavit.robot_from_dict(_doc(page))
+    assert [t.value for t in edited.joint_types][-1] == "prismatic"
+    loads = page.evaluate("window.workbench.robotLoads")
+    assert page.locator("#poses option").count() == 1  # the 6-joint named poses went with the 7th row
+    page.click("button[title='remove row 7']")
+    page.wait_for_function(f"window.workbench.robotLoads > {loads}", timeout=60_000)
+    assert page.evaluate("window.workbench.doc().joints.length") == 6
+    page.select_option("#catalogue", "puma560")  # the arm again, with its named poses
+    page.wait_for_function("document.querySelectorAll('#poses option').length > 1", timeout=60_000)
+    count = page.evaluate("window.workbench.kinCount")
+    page.select_option("#poses", "qr")  # puma560's ready pose
+    page.wait_for_function("""([count]) => window.workbench.kinCount > count && !window.workbench.busy() &&
+        Math.abs(JSON.parse(document.getElementById('T').dataset.q)[1] - Math.PI / 2) < 1e-12""", arg=[count],
+                           timeout=60_000)
+    q, T = _shown(page)
+    robot = denavit.load_robot("puma560")
+    np.testing.assert_allclose(q, dict(robot.poses)["qr"], atol=1e-12)
+    np.testing.assert_allclose(T, denavit.forward_kinematics(robot, q), atol=1e-12)
+
+
 def test_sliders_move_the_pose_and_J_within_100_ms(page):
     """The issue's done-when: slider -> updated pose and Jacobian on screen in <= 100 ms (median of 20 moves)."""
     robot = denavit.load_robot("puma560")

@@ -59,7 +59,9 @@
       });
       var del = document.createElement("td"), b = document.createElement("button");
       b.type = "button"; b.textContent = "×"; b.title = "remove row " + (i + 1);
-      b.addEventListener("click", function () { if (doc.joints.length > 1) { doc.joints.splice(i, 1); renderTable(); tableChanged(); } });
+      b.addEventListener("click", function () {
+        if (doc.joints.length > 1) { if (kindOf(doc.joints[i]) !== "fixed") dropPoses(); doc.joints.splice(i, 1); renderTable(); tableChanged(); }
+      });
       del.appendChild(b); tr.appendChild(del);
       body.appendChild(tr);
     });
@@ -72,8 +74,10 @@
     $("h-a").innerHTML = mod ? "a<sub>i−1</sub>" : "a<sub>i</sub>";
     $("h-alpha").innerHTML = mod ? "α<sub>i−1</sub>" : "α<sub>i</sub>";
   }
+  function dropPoses() { delete doc.poses; }   // the named poses had one value per joint of the old table
   function setKind(i, kind) {
     var row = doc.joints[i];
+    if ((kindOf(row) === "fixed") !== (kind === "fixed")) dropPoses();
     row.theta = stripQ(row.theta === undefined ? "0" : row.theta);
     row.d = stripQ(row.d === undefined ? "0" : row.d);
     if (kind === "revolute") row.theta = addQ(row.theta);
@@ -268,7 +272,7 @@
 
   // ---- wiring -------------------------------------------------------------------------------------------
   function loadDoc(d) { doc = d; renderTable(); sendTable(); }
-  $("add-row").addEventListener("click", function () { doc.joints.push({ a: "0", alpha: "0", d: "0", theta: "q" }); renderTable(); tableChanged(); });
+  $("add-row").addEventListener("click", function () { dropPoses(); doc.joints.push({ a: "0", alpha: "0", d: "0", theta: "q" }); renderTable(); tableChanged(); });
   ["robot-name", "parameters"].forEach(function (id) { $(id).addEventListener("input", tableChanged); });
   ["convention", "angle-unit"].forEach(function (id) { $(id).addEventListener("change", function () { tableChanged(); renderTable(); }); });
   $("catalogue").addEventListener("change", function () {
