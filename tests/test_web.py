@@ -129,6 +129,36 @@ def test_dynamics_match_the_closed_form_planar_elbow_and_statics_the_transpose(c
     np.testing.assert_allclose(tau, Jv.T @ w[:3] + w[5] * np.ones(2), atol=1e-8)  # planar: ω = q̇1 + q̇2 about z
 
 
+def test_an_ik_answer_runs_off_the_event_loop_so_slider_answers_still_come(monkeypatch):
+    """The general-6R IK takes tenths of a second: while one is held (here: until the test lets it go), the
+    kinematics answers of the sliders keep coming on the one event loop."""
+    import threading
+
+    from denavit.web import _handlers as H
+
+    release, entered, out = threading.Event(), threading.Event(), {}
+    real = H.inverse_kinematics
+
+    def held(body):
+        entered.set()
+        release.wait(timeout=60)
+        return real(body)
+
+    monkeypatch.setattr(H, "inverse_kinematics", held)
+    jobs = Jobs()
+    jobs.warm_up = lambda: None  # no fork server needed here
+    with TestClient(create_app(allowed_hosts=["testserver"], jobs=jobs)) as c:  # one event loop for all requests
+        t = threading.Thread(target=lambda: out.setdefault("ik", c.post("/api/ik", json={"robot": PLANAR, "q": [0.3, 0.5]})))
+        t.start()
+        assert entered.wait(timeout=60)
+        answers = [c.post("/api/kinematics", json={"robot": PLANAR, "q": [0.1 * k, 0.2]}).status_code for k in range(5)]
+        held_meanwhile = "ik" not in out
+        release.set()
+        t.join(timeout=60)
+    assert answers == [200] * 5 and held_meanwhile
+    assert out["ik"].status_code == 200 and len(out["ik"].json()["solutions"]) == 2  # elbow up and down
+
+
 def test_a_pasted_table_becomes_a_robot_with_its_notes(client):
     text = "| i | a_{i-1} | alpha_{i-1} | d_i | theta_i |\n|---|---|---|---|---|\n| 1 | 0 | 0 | 0 | theta_1 |\n" \
            "| 2 | 0.5 | 90 | 0 | theta_2 |\n"

@@ -17,6 +17,7 @@ from importlib import resources
 from typing import Any
 
 from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
 from starlette.middleware import Middleware
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.requests import Request
@@ -69,12 +70,15 @@ def _error(exc: H.RequestError) -> JSONResponse:
     return JSONResponse(exc.to_json(), status_code=exc.status)
 
 
-def _post(handler: Callable[[Any], dict[str, Any]], limit: int = MAX_BODY_BYTES) -> Callable:
-    """An endpoint calling ``handler(body)``: its dict as JSON, or the one-line error."""
+def _post(handler: Callable[[Any], dict[str, Any]], limit: int = MAX_BODY_BYTES, threaded: bool = False) -> Callable:
+    """An endpoint calling ``handler(body)``: its dict as JSON, or the one-line error.  ``threaded``: in a worker
+    thread (an answer that can take a few tenths of a second, the general-6R IK, must not hold the event loop,
+    where the slider answers run)."""
 
     async def endpoint(request: Request) -> Response:
         try:
-            return JSONResponse(handler(await _read_json(request, limit)))
+            body = await _read_json(request, limit)
+            return JSONResponse(await run_in_threadpool(handler, body) if threaded else handler(body))
         except H.RequestError as exc:
             return _error(exc)
         except RecursionError:
@@ -118,7 +122,7 @@ def _routes() -> list[Route]:
         Route("/api/catalogue/load", _post(H.catalogue_robot), methods=["POST"]),
         Route("/api/robot", _post(H.robot_info), methods=["POST"]),
         Route("/api/kinematics", _post(H.kinematics), methods=["POST"]),
-        Route("/api/ik", _post(H.inverse_kinematics), methods=["POST"]),
+        Route("/api/ik", _post(H.inverse_kinematics, threaded=True), methods=["POST"]),
         Route("/api/dynamics", _post(H.dynamics), methods=["POST"]),
         Route("/api/statics", _post(H.statics), methods=["POST"]),
         Route("/api/table", _post(H.table), methods=["POST"]),

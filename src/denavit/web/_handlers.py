@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import threading
 import warnings
 from collections import OrderedDict
 from importlib import resources
@@ -97,6 +98,7 @@ def _cell_of(exc: DenavitError) -> dict[str, Any] | None:
 
 
 _robots: OrderedDict[str, tuple[Any, tuple[str, ...]]] = OrderedDict()
+_robots_lock = threading.Lock()  # the IK answers run in worker threads
 
 
 def robot_of(body: Any) -> Any:
@@ -109,10 +111,16 @@ def _robot_and_notes(body: Any) -> tuple[Any, tuple[str, ...]]:
     if not isinstance(doc, dict):
         raise RequestError("'robot' must be the robot-file mapping {convention, joints, ...}", 422, {"row": None, "field": "joints"})
     key = json.dumps(doc, sort_keys=True)
-    hit = _robots.get(key)
-    if hit is not None:
-        _robots.move_to_end(key)
-        return hit
+    with _robots_lock:
+        hit = _robots.get(key)
+        if hit is not None:
+            _robots.move_to_end(key)
+            return hit
+        return _parse(doc, key)
+
+
+def _parse(doc: dict, key: str) -> tuple[Any, tuple[str, ...]]:
+    """Read a table (under the cache's lock) and remember it with its warnings as notes."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
