@@ -268,17 +268,9 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     if backend == NUMBA:
         body += _numba_group(specs)
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
-        from ._ik_elbow import IK_ELBOW_SOURCE
-        from ._ik_finish import IK_FINISH_SOURCE
-        from ._ik_lm import IK_LM_SOURCE
-        from ._ik_parallel import IK_PARALLEL_SOURCE
-        from ._ik_stanford import IK_STANFORD_SOURCE
+        from ._ik_lm import IK_LM_SOURCE  # the closed forms are module-level kernels (codegen/_ik_nb_*.py)
 
         body.append(IK_LM_SOURCE)
-        body.append(IK_FINISH_SOURCE)  # verification, folding, merging: shared by the three closed forms
-        body.append(IK_ELBOW_SOURCE)
-        body.append(IK_PARALLEL_SOURCE)  # numba compiles a function on its first call only: no cost to other arms
-        body.append(IK_STANFORD_SOURCE)
     return "\n".join(head + body).rstrip() + "\n"
 
 

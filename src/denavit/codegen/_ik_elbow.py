@@ -1,176 +1,23 @@
-"""Analytic IK on the generated kernels: the elbow + spherical-wrist closed form in numba.
+"""Analytic IK on the compiled kernels: the elbow + spherical-wrist closed form, its constants.
 
-The same formulas as :class:`denavit.ik._closed.ElbowPosition` and ``wrist_angles`` (Craig 3rd ed.
-Sec. 4.7; Paden–Kahan subproblems 1 and 2; the digit-keeping half-angle forms of those modules), for the eight
-candidates of one pose at a time, each verified by the arm's compiled FK, folded into the joint limits, merged
-when equal and labelled (shoulder, elbow, wrist: the tests of docs/ik.md).
+The same formulas as :class:`denavit.ik._closed.ElbowPosition` and ``wrist_angles`` — the very functions of
+:mod:`denavit.ik.forms` (Craig 3rd ed. Sec. 4.7; Paden–Kahan subproblems 1 and 2; the digit-keeping half-angle
+forms), compiled by numba in :mod:`._ik_nb_elbow` — for the eight candidates of one pose at a time, each verified by
+the FK of the arm's chain, folded into the joint limits, merged when equal and labelled (shoulder, elbow, wrist: the
+tests of docs/ik.md).
 
 Every case the plain solver treats specially is handed back to it (``status`` 1): a joint left free by the
 pose (wrist centre on axis 1 or 2, wrist axes aligned), a root next to a double root (|ratio| near 1), a
 candidate that would need polishing, or two solutions closer than the merge radius.  The compiled path answers
-only where its answer is the plain solver's.  The text below is appended to each generated numba module of an
-arm whose IK plan is this closed form; it calls that module's ``fk_1`` and the verification, folding, merging
-and sorting shared by the three closed forms (``_ik_finish`` of :mod:`._ik_finish`, appended to the same module);
-nothing of the robot or the user is pasted into it.
+only where its answer is the plain solver's.  This module holds what needs no numba: the layout of the constants.
 """
 
 from __future__ import annotations
 
-__all__ = ["IK_ELBOW_SOURCE", "ELBOW_LAYOUT"]
+__all__ = ["ELBOW_LAYOUT"]
 
-#: The constants of ``ik_elbow_packed``'s vector K, in order, with their sizes (181 numbers for a 6R arm).
+#: The constants of ``ik_elbow_packed``'s vector K, in order, with their sizes (293 numbers for a 6R arm; "chain":
+#: the chain's constants C0 … C6, whose FK verifies the candidates).
 ELBOW_LAYOUT = (("X_e", 3), ("C0i", 16), ("R6", 9), ("R1", 9), ("p1", 3), ("a", 3), ("R2", 9), ("p2", 3), ("P", 3),
                 ("consts", 64), ("R4", 9), ("R5", 9), ("scalars", 9), ("lo", 6), ("hi", 6), ("revolute", 6),
-                ("theta", 6), ("tols", 8))
-
-IK_ELBOW_SOURCE = '''
-
-from denavit.codegen._ik_jit import (WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roots, wrist_qb,
-                                      wrist_rest)
-
-
-@njit(cache=True, nogil=True)
-def ik_elbow_packed(T, K, f, i):
-    """:func:`ik_elbow` with the constants packed in one vector K (ELBOW_LAYOUT order) and the outputs in two
-    arrays (f: solutions, residuals, outside-limits solutions; i: label codes, then k, j, status): four
-    arguments instead of twenty-three to unbox per call."""
-    X_e, C0i, R6 = K[0:3], K[3:19].reshape((4, 4)), K[19:28].reshape((3, 3))
-    R1, p1, a = K[28:37].reshape((3, 3)), K[37:40], K[40:43]
-    R2, p2, P = K[43:52].reshape((3, 3)), K[52:55], K[55:58]
-    consts = K[58:122].reshape((4, 4, 4))
-    R4, R5, sc = K[122:131].reshape((3, 3)), K[131:140].reshape((3, 3)), K[140:149]
-    lo_lim, hi_lim, rev, theta, tols = K[149:155], K[155:161], K[161:167], K[167:173], K[173:181]
-    ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, rev, theta, tols,
-             f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:])
-
-
-@njit(cache=True, nogil=True)
-def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, revolute, theta, tols,
-             out_q, out_err, out_label, out_outq, out_status):
-    """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
-    residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
-    solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide)."""
-    h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
-    free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
-    tiny = free_tol * L
-    # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
-    ws = np.empty(145)
-    F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
-    Xw, W, Y, M = ws[86:89], ws[89:92], ws[92:101].reshape((3, 3)), ws[101:110].reshape((3, 3))
-    cx, cy, cz = ws[110:113], ws[113:116], ws[116:119]
-    x1, y1c, z1, S, E, dW = ws[119:122], ws[122:125], ws[125:128], ws[128:131], ws[131:134], ws[134:137]
-    perm = ws[137:145]  # the candidate in each sorted slot
-    flags = np.zeros(24, dtype=np.bool_)
-    ok = flags[0:8]
-    for b in range(T.shape[0]):
-        status = 0
-        # wrist centre and the target rotation without the last constant
-        for i in range(3):
-            Xw[i] = T[b, i, 0] * X_e[0] + T[b, i, 1] * X_e[1] + T[b, i, 2] * X_e[2] + T[b, i, 3]
-        for i in range(3):
-            W[i] = C0i[i, 0] * Xw[0] + C0i[i, 1] * Xw[1] + C0i[i, 2] * Xw[2] + C0i[i, 3]
-        for i in range(3):
-            for j in range(3):
-                Y[i, j] = T[b, i, 0] * R6[j, 0] + T[b, i, 1] * R6[j, 1] + T[b, i, 2] * R6[j, 2]
-        # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): shoulder, elbow, wrist
-        q1a, q1b, free1, ratio = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
-        if free1 or (ratio == 0.0 and q1a != q1a):
-            status = 1  # joint 1 free, or the shoulder equation independent of q1
-        if abs(abs(ratio) - 1.0) < 1e-6:
-            status = 1  # next to a double root: the plain solver polishes and looks for partners
-        if rho_w < 1e-12:
-            status = 1
-        ncand = 0
-        for k in range(8):
-            ok[k] = False
-        for s1 in range(2 if status == 0 else 0):
-            q1 = q1a if s1 == 0 else q1b
-            if q1 != q1:
-                continue
-            g0, g1 = elbow_plane(q1, W[0], W[1], W[2], R1, p1)
-            q3a, q3b, x = elbow_roots(math.hypot(g0, g1), na, nb, base3, ratio_tol)
-            if x != x:
-                continue
-            if x < 1e-6 or math.pi - x < 1e-6:
-                status = 1  # folded or stretched elbow: a double root
-            for s3 in range(2):
-                q3 = q3a if s3 == 0 else q3b
-                q2, free2, _vxy = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
-                if free2:
-                    status = 1
-                # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
-                for i in range(3):
-                    cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
-                for kk in range(3):
-                    qk = q1 if kk == 0 else (q2 if kk == 1 else q3)
-                    ck, sk = math.cos(qk), math.sin(qk)
-                    for i in range(3):
-                        xi, yi = cx[i], cy[i]
-                        cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
-                    C = consts[kk + 1]
-                    for i in range(3):
-                        xi, yi, zi = cx[i], cy[i], cz[i]
-                        cx[i] = xi * C[0, 0] + yi * C[1, 0] + zi * C[2, 0]
-                        cy[i] = xi * C[0, 1] + yi * C[1, 1] + zi * C[2, 1]
-                        cz[i] = xi * C[0, 2] + yi * C[1, 2] + zi * C[2, 2]
-                for j in range(3):
-                    M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
-                    M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
-                    M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
-                qba, qbb, _lo, _hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)
-                if qba != qba:
-                    continue
-                for s5 in range(2):
-                    qb = qba if s5 == 0 else qbb
-                    qa, qc, singular, _sign, _vxy = wrist_rest(qb, M, R4, R5)
-                    if singular:
-                        status = 1  # wrist singular: a continuum
-                    cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
-                    cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
-                    ncand += 1
-        # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
-        # UR and Stanford kernels); then the labels
-        kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags,
-                                     out_q[b], out_err[b], out_outq[b], perm)
-        status = max(status, st)
-        for slot in range(kept):
-            best = int(perm[slot])
-            # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5))
-            q1 = cand[best, 0]
-            c1, s1v = math.cos(q1), math.sin(q1)
-            code = 0
-            # frame after joint 1: columns of C0 Rz(q1) C1
-            for i in range(3):
-                xi, yi = consts[0, i, 0], consts[0, i, 1]
-                rx, ry, rz = c1 * xi + s1v * yi, c1 * yi - s1v * xi, consts[0, i, 2]
-                x1[i] = rx * consts[1, 0, 0] + ry * consts[1, 1, 0] + rz * consts[1, 2, 0]
-                y1c[i] = rx * consts[1, 0, 1] + ry * consts[1, 1, 1] + rz * consts[1, 2, 1]
-                z1[i] = rx * consts[1, 0, 2] + ry * consts[1, 1, 2] + rz * consts[1, 2, 2]
-                S[i] = consts[0, i, 3] + rx * consts[1, 0, 3] + ry * consts[1, 1, 3] + rz * consts[1, 2, 3]
-            s_right = 0.0
-            for i in range(3):
-                s_right += x1[i] * (Xw[i] - consts[0, i, 3])
-            if s_right < 0.0:
-                code |= 1
-            # a point of axis 3: origin of C0 Rz(q1) C1 Rz(q2) C2
-            q2 = cand[best, 1]
-            c2, s2v = math.cos(q2), math.sin(q2)
-            for i in range(3):
-                rx, ry = c2 * x1[i] + s2v * y1c[i], c2 * y1c[i] - s2v * x1[i]
-                E[i] = S[i] + rx * consts[2, 0, 3] + ry * consts[2, 1, 3] + z1[i] * consts[2, 2, 3]
-            for i in range(3):
-                dW[i] = Xw[i] - S[i]
-            nrm0 = z1[1] * dW[2] - z1[2] * dW[1]
-            nrm1 = z1[2] * dW[0] - z1[0] * dW[2]
-            nrm2 = z1[0] * dW[1] - z1[1] * dW[0]
-            towards = 1.0 if consts[0, 0, 2] * nrm0 + consts[0, 1, 2] * nrm1 + consts[0, 2, 2] * nrm2 >= 0.0 else -1.0
-            side = (E[0] - S[0]) * nrm0 + (E[1] - S[1]) * nrm1 + (E[2] - S[2]) * nrm2
-            if side * towards < 0.0:
-                code |= 2
-            if math.sin(cand[best, 4] + theta[4]) < 0.0:
-                code |= 4
-            out_label[b, slot] = code
-        out_status[b, 0] = kept
-        out_status[b, 1] = n_out
-        out_status[b, 2] = status
-'''
+                ("theta", 6), ("tols", 8), ("chain", 112))

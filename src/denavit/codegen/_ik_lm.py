@@ -17,6 +17,9 @@ __all__ = ["IK_LM_SOURCE"]
 
 IK_LM_SOURCE = '''
 
+from denavit.codegen._ik_nb_finish import ik_check  # module-level, compiled once per machine
+
+
 @njit(cache=True, nogil=True)
 def _ik_residual(T, P, w, e):
     """e = W (p_t - p, log(R_t R^T)) for the pose P (16 entries, row-major); returns (|position rows|,
@@ -65,29 +68,6 @@ def _ik_residual(T, P, w, e):
         else:
             e[i] = 0.0
     return math.sqrt(pe), math.sqrt(re), 0.5 * cost
-
-
-@njit(cache=True, nogil=True)
-def ik_check(T, Q):
-    """The largest |R^T R - I| entry over the targets (the test of denavit's as_transform); inf if a target
-    holds a NaN or an infinity, -1 if a seed does."""
-    for b in range(Q.shape[0]):
-        for k in range(Q.shape[1]):
-            if not math.isfinite(Q[b, k]):
-                return -1.0
-    worst = 0.0
-    for b in range(T.shape[0]):
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[b, i, j]):
-                    return np.inf
-        for i in range(3):
-            for j in range(3):
-                s = T[b, 0, i] * T[b, 0, j] + T[b, 1, i] * T[b, 1, j] + T[b, 2, i] * T[b, 2, j]
-                d = abs(s - (1.0 if i == j else 0.0))
-                if d > worst:
-                    worst = d
-    return worst
 
 
 @njit(cache=True, nogil=True)

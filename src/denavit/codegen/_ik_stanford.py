@@ -1,20 +1,20 @@
-"""Analytic IK on the generated kernels: the Stanford class (joints R R P with axes 1, 2 meeting, spherical wrist).
+"""Analytic IK on the compiled kernels: the Stanford class (joints R R P with axes 1, 2 meeting, spherical wrist).
 
 The same formulas as :class:`denavit.ik._closed.StanfordPosition` and ``wrist_angles`` (Spong, Hutchinson &
 Vidyasagar 2006, Sec. 5.3.3; Paden–Kahan subproblems 1 and 2): turning about axes 1 and 2 keeps ``|W − O|`` (W the
 wrist centre, O the point where axes 1 and 2 meet), a quadratic in the prismatic q3 whose discriminant is written as
 ``(|D| − |u⊥|)(|D| + |u⊥|)``; the height along axis 1 gives q2 (``α cos q2 + β sin q2 = γ``); q1 turns the point onto
 W; the wrist angles follow from ``R_0_3ᵀ R R6ᵀ`` as for the elbow class.  The eight candidates of one pose are each
-verified by the arm's compiled FK, folded, merged and labelled (shoulder, wrist: docs/ik.md) by the UR-class
-module's ``_ik_finish``.
+verified by the FK of the arm's chain, folded, merged (``ik_finish`` of :mod:`._ik_nb_finish`) and labelled
+(shoulder, wrist: docs/ik.md).
 
 Every case the plain solver treats specially goes back to it (``status`` 1): q3 next to its double root (the wrist
 centre at its nearest to O), a q2 or wrist root next to a double root, the wrist centre on or next to axis 1 or
 with its arm next to axis 2 (free or ill-conditioned joints; NEAR_SINGULAR of :mod:`._ik_parallel`), the wrist
 axes 4 and 6 (nearly) aligned, a candidate whose estimated rounding error exceeds COND_MAX, a target beyond the
 plain solver's bound (prismatic travel included: it then reports no solution, not even outside the limits), a
-candidate needing polish, two solutions about to merge.  The text below is appended to each generated numba
-module; it calls that module's ``fk_1`` and ``_ik_finish`` and ``half_angle`` of :mod:`denavit.ik.forms`.
+candidate needing polish, two solutions about to merge.  The kernel is :mod:`._ik_nb_stanford` (compiled once per
+machine; the formulas are :mod:`denavit.ik.forms`'); this module holds its constants.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from ..numeric import inverse_transform
 from ._ik_parallel import COND_MAX, NEAR_SINGULAR
 from ._ik_finish import pack_constants
 
-__all__ = ["IK_STANFORD_SOURCE", "STANFORD_LAYOUT", "stanford_constants"]
+__all__ = ["STANFORD_LAYOUT", "stanford_constants"]
 
 #: The constants of ``ik_stanford_packed``'s vector K, in order, with their sizes (182 numbers).
 STANFORD_LAYOUT = (("X_e", 3), ("C0i", 16), ("consts", 112), ("geom", 9), ("scalars", 9), ("lo", 6), ("hi", 6),
@@ -65,129 +65,3 @@ def stanford_constants(robot, plan) -> np.ndarray:
              scalars=scalars, lo=lim[:, 0], hi=lim[:, 1],
              revolute=[float(t.value == "revolute") for t in robot.joint_types])
     return pack_constants(k, STANFORD_LAYOUT, "Stanford")
-
-
-IK_STANFORD_SOURCE = '''
-
-from denavit.codegen._ik_jit import WRIST_TOL, stanford_q1, stanford_q2, stanford_q3, wrist_qb, wrist_rest
-
-@njit(cache=True, nogil=True)
-def ik_stanford_packed(T, K, f, i):
-    """All solutions of each pose T[b] of a Stanford-class arm, the constants in K (STANFORD_LAYOUT order); outputs
-    as ik_elbow_packed (label codes: 1 shoulder left, 2 wrist flip)."""
-    X_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
-    geom, sc, lo_lim, hi_lim = K[131:140], K[140:149], K[149:155], K[155:161]
-    rev, theta, tols, far = K[161:167], K[167:173], K[173:181], K[181]
-    ws = np.empty(139)
-    cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)), \\
-        ws[83:89]
-    flags = np.zeros(24, dtype=np.bool_)
-    for b in range(T.shape[0]):
-        if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
-            i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond the bound of _solve (prismatic travel included): its stand-in
-            continue
-        for r in range(3):
-            X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
-        ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
-        kept, n_out, st = _ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
-                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139])
-        for s in range(kept):
-            i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
-        i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
-
-
-@njit(cache=True, nogil=True)
-def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
-    """The candidates of one pose in the plain plan's order (q3 root, q2 root, wrist root; + before -) into cand
-    (ws: 42 floats of scratch); returns (count, status)."""
-    uz, uperp, L, rho_w, base_w, br, bu, near = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
-    tol = tols[1]
-    wide = near * L
-    D, Y, cols, M = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:33].reshape((3, 3))
-    for r in range(3):  # wrist centre from O, in the frame of C0
-        D[r] = C0i[r, 0] * X[0] + C0i[r, 1] * X[1] + C0i[r, 2] * X[2] + C0i[r, 3] - geom[r]
-    for r in range(3):  # T_R C6_R^T
-        for j in range(3):
-            Y[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
-    status = 0
-    if math.hypot(D[0], D[1]) < wide or rho_w < 1e-12:
-        return 0, 1  # wrist centre on or next to axis 1: q1 free or ill-conditioned
-    # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): q3, then q2, then q1
-    q3a, q3b, disc, root = stanford_q3(D[0], D[1], D[2], uz, uperp, L)
-    if disc < near * L * L:
-        status = 1  # q3 next to its double root (or none)
-    if q3a != q3a:
-        return 0, status
-    e3 = 1.0 + L / max(root, 1e-300)  # rounding error of q3 [eps, per L]: as COND_MAX of _ik_parallel
-    ncand = 0
-    for s3 in range(2):
-        q3 = q3a if s3 == 0 else q3b
-        w0, w1, w2 = geom[3] + q3 * geom[6], geom[4] + q3 * geom[7], geom[5] + q3 * geom[8]
-        if math.hypot(w0, w1) < wide:
-            status = 1  # the arm next to axis 2: q2 free or ill-conditioned
-        q2a, q2b, rho, ratio = stanford_q2(w0, w1, w2, D[2], C[1, 2, :3], tol)
-        if rho <= 1e-12:
-            status = 1
-            continue
-        if abs(abs(ratio) - 1.0) < 1e-6:
-            status = 1  # next to a double root of q2
-        if q2a != q2a:
-            continue
-        delta = math.acos(min(1.0, max(-1.0, ratio)))
-        e2 = (1.0 + e3) * max(1.0, L / rho) / max(math.sin(delta), 1e-300)
-        for s2 in range(2):
-            q2 = q2a if s2 == 0 else q2b
-            c2, s2v = math.cos(q2), math.sin(q2)
-            q1, ex, ey = stanford_q1(q2, w0, w1, w2, D[0], D[1], C[1, :3, :3])
-            e1 = (1.0 + e2 + e3) * L / max(min(math.hypot(D[0], D[1]), math.hypot(ex, ey)), 1e-300)
-            # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 C3 (joint 3 slides): its columns, then M = R_0_3^T Y
-            _frame1(C, math.cos(q1), math.sin(q1), cols)
-            _next_frame(cols, c2, s2v, C[2], cols)
-            _next_frame(cols, 1.0, 0.0, C[3], cols)  # joint 3 slides: no turn
-            for r in range(3):
-                for j in range(3):
-                    M[r, j] = cols[r, 0] * Y[0, j] + cols[r, 1] * Y[1, j] + cols[r, 2] * Y[2, j]
-            ncand, status = _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status,
-                                            1.0 + e1 + e2 + e3, sc[8])
-    return ncand, status
-
-
-@njit(cache=True, nogil=True)
-def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status, eM, cond_max):
-    """The two wrist solutions of Rz(q4) R4 Rz(q5) R5 Rz(q6) = M (as wrist_angles: q5 from the z-row in the
-    half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand; eM: the
-    rounding error of M [eps], for the COND_MAX test."""
-    qba, qbb, lo, hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)  # denavit.ik.forms
-    if -2e-7 < min(lo, hi) < 1e-12:
-        status = 1  # the two wrist roots (nearly) coincide
-    if qba != qba:
-        return ncand, status
-    e5 = eM / max(rho_w * math.sin(0.5 * (qba - qbb)), 1e-300)
-    for s5 in range(2):
-        qb = qba if s5 == 0 else qbb
-        qa, qc, _singular, _sign, vxy = wrist_rest(qb, M, C[4, :3, :3], C[5, :3, :3])
-        if vxy < near:
-            status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
-        if eM + e5 + (eM + e5) / max(vxy, 1e-300) > cond_max:
-            status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
-        cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
-        cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
-        ncand += 1
-    return ncand, status
-
-
-@njit(cache=True, nogil=True)
-def _stanford_label(qs, X, C, theta):
-    """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the wrist centre),
-    2 wrist flip (sin(q5 + theta5) < 0)."""
-    c1, s1 = math.cos(qs[0]), math.sin(qs[0])
-    s_right = 0.0
-    for r in range(3):
-        x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
-        x, y = c1 * x + s1 * y, c1 * y - s1 * x
-        s_right += (x * C[1, 0, 0] + y * C[1, 1, 0] + z * C[1, 2, 0]) * (X[r] - C[0, r, 3])
-    code = 1 if s_right < 0.0 else 0
-    if math.sin(qs[4] + theta[4]) < 0.0:
-        code |= 2
-    return code
-'''

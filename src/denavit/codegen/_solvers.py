@@ -7,6 +7,7 @@ import random as _random
 import numpy as np
 
 from .._threads import resolve_threads, split_rows
+from ..chain import chain_of
 from ..errors import ShapeError
 from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
@@ -167,14 +168,23 @@ class IKMethods:
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
             return False
+        from ._ik_nb_finish import ik_check  # module-level kernels: compiled once per machine (numba's cache)
+
         if plan.kind == "parallel":
-            return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, self._m.ik_check,
-                    self._m.ik_parallel_packed, True]
+            from ._ik_nb_parallel import ik_parallel_packed
+
+            return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
+                    ik_parallel_packed, True]
         if plan.route == "closed form (stanford)":
-            return [stanford_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, self._m.ik_check,
-                    self._m.ik_stanford_packed, True]
+            from ._ik_nb_stanford import ik_stanford_packed
+
+            return [stanford_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
+                    ik_stanford_packed, True]
+        from ._ik_nb_elbow import ik_elbow_packed
+
         k = dict(plan.closed)
         lim = self.robot.q_limits
-        k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types])
+        k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
+                 chain=np.array(chain_of(self.robot).constants, dtype=float))
         K = pack_constants(k, ELBOW_LAYOUT, "elbow")
-        return [K, list(k["labels"]), plan.kind, self._m.ik_check, self._m.ik_elbow_packed, True]
+        return [K, list(k["labels"]), plan.kind, ik_check, ik_elbow_packed, True]

@@ -1,0 +1,174 @@
+"""The step every compiled closed form ends with, for one pose, as numba functions compiled once per machine
+(``cache=True``; nothing of a robot in them: its chain constants are arguments): candidates verified by the FK of
+the chain (:func:`chain_fk`), folded into the joint limits, duplicates dropped, the rest sorted as the plain solver
+returns them (:func:`ik_finish`); and :func:`ik_check`, the targets' orthonormality test.
+
+The same rules as :func:`denavit.analytic_ik` (its VERIFY_TOL, POLISH_ABOVE, DUPLICATE_TOL and MERGE_RADIUS,
+packed in ``tols``); where the plain solver would do more (polish a candidate, merge a pair by the FK of its
+midpoint) or where a rounding difference could change the folding, the status asks for the plain solver.
+Imported only where numba is (:mod:`._solvers`, for the numba backend).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._ik_finish import FOLD_EDGE
+
+__all__ = ["chain_fk", "ik_check", "ik_finish"]
+
+
+@njit(cache=True, nogil=True)
+def chain_fk(C, revolute, q, F):
+    """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
+    base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one."""
+    for r in range(4):
+        for c in range(4):
+            F[r, c] = C[0, r, c]
+    for k in range(q.shape[0]):
+        if revolute[k] != 0.0:  # F <- F Rz(q_k): columns x, y turn
+            ck, sk = math.cos(q[k]), math.sin(q[k])
+            for r in range(3):
+                x, y = F[r, 0], F[r, 1]
+                F[r, 0], F[r, 1] = ck * x + sk * y, ck * y - sk * x
+        else:  # F <- F Tz(q_k)
+            for r in range(3):
+                F[r, 3] += q[k] * F[r, 2]
+        Ck = C[k + 1]
+        for r in range(3):  # F <- F C_k (last row of C_k: 0 0 0 1)
+            a0, a1, a2, a3 = F[r, 0], F[r, 1], F[r, 2], F[r, 3]
+            for c in range(3):
+                F[r, c] = a0 * Ck[0, c] + a1 * Ck[1, c] + a2 * Ck[2, c]
+            F[r, 3] = a0 * Ck[0, 3] + a1 * Ck[1, 3] + a2 * Ck[2, 3] + a3
+
+@njit(cache=True, nogil=True)
+def _near_fold_edge(x, lo, hi):
+    """A wrapped angle x within FOLD_EDGE of ±π or of a limit (itself, or shifted by a whole turn)."""
+    if math.pi - abs(x) < FOLD_EDGE:
+        return True
+    for shift in (-2.0 * math.pi, 0.0, 2.0 * math.pi):
+        if abs(x + shift - lo) < FOLD_EDGE or abs(x + shift - hi) < FOLD_EDGE:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq, perm,
+              C):
+    """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
+    would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
+    status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
+    others into out_outq, perm[slot] the candidate in each slot; C (7, 4, 4) the arm's chain constants (its FK:
+    :func:`chain_fk`).  Returns (kept, outside, status)."""
+    verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
+    ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
+    status = 0
+    for k in range(ncand):
+        for j in range(6):
+            q[j] = cand[k, j]
+        chain_fk(C, revolute, q, F)
+        pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)
+        tr = 0.0  # rotation error: the angle of R_t R^T
+        for i in range(3):
+            for j in range(3):
+                tr += Tb[i, j] * F[i, j]
+        v0 = v1 = v2 = 0.0
+        for j in range(3):
+            v0 += Tb[2, j] * F[1, j] - Tb[1, j] * F[2, j]
+            v1 += Tb[0, j] * F[2, j] - Tb[2, j] * F[0, j]
+            v2 += Tb[1, j] * F[0, j] - Tb[0, j] * F[1, j]
+        re = math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0))
+        cerr[k, 0], cerr[k, 1] = pe, re
+        size = pe + reach * re
+        if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
+            status = 1  # would be polished by the plain solver
+        ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
+    for k in range(ncand):
+        if not ok[k]:
+            continue
+        ins = True
+        for j in range(6):
+            x = cand[k, j]
+            if revolute[j] != 0.0:
+                x = math.pi - ((math.pi - x) % (2.0 * math.pi))
+                if _near_fold_edge(x, lo_lim[j], hi_lim[j]):
+                    status = 1  # a rounding difference could fold it elsewhere: the plain solver decides
+                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
+                    x += 2.0 * math.pi
+                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
+                    x -= 2.0 * math.pi
+            elif abs(x - lo_lim[j]) < FOLD_EDGE or abs(x - hi_lim[j]) < FOLD_EDGE:
+                status = 1
+            cand[k, j] = x
+            ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
+        inside[k] = ins
+        for m in range(k):
+            if not ok[m]:
+                continue
+            dmax = 0.0
+            for j in range(6):
+                d = abs(cand[k, j] - cand[m, j])
+                if revolute[j] != 0.0:
+                    d = abs(d - 2.0 * math.pi * np.rint(d / (2.0 * math.pi)))
+                dmax = max(dmax, d)
+            if dmax < dup_tol:
+                ok[k] = False
+                break
+            if dmax < merge_r:
+                status = 1  # the plain solver merges such a pair by the FK of its midpoint
+    kept = 0
+    n_out = 0
+    for k in range(ncand):
+        if ok[k] and not inside[k]:
+            for j in range(6):
+                out_outq[n_out, j] = cand[k, j]
+            n_out += 1
+            ok[k] = False
+        elif ok[k]:
+            kept += 1
+    for k in range(8):
+        used[k] = False
+    for slot in range(kept):
+        best = -1
+        for k in range(ncand):
+            if ok[k] and not used[k]:
+                if best < 0:
+                    best = k
+                else:
+                    for j in range(6):
+                        if cand[k, j] != cand[best, j]:
+                            if cand[k, j] < cand[best, j]:
+                                best = k
+                            break
+        used[best] = True
+        perm[slot] = best
+        for j in range(6):
+            out_q[slot, j] = cand[best, j]
+        out_err[slot, 0], out_err[slot, 1] = cerr[best, 0], cerr[best, 1]
+    return kept, n_out, status
+
+
+@njit(cache=True, nogil=True)
+def ik_check(T, Q):
+    """The largest |R^T R - I| entry over the targets (the test of denavit's as_transform); inf if a target
+    holds a NaN or an infinity, -1 if a seed does."""
+    for b in range(Q.shape[0]):
+        for k in range(Q.shape[1]):
+            if not math.isfinite(Q[b, k]):
+                return -1.0
+    worst = 0.0
+    for b in range(T.shape[0]):
+        for i in range(4):
+            for j in range(4):
+                if not math.isfinite(T[b, i, j]):
+                    return np.inf
+        for i in range(3):
+            for j in range(3):
+                s = T[b, 0, i] * T[b, 0, j] + T[b, 1, i] * T[b, 1, j] + T[b, 2, i] * T[b, 2, j]
+                d = abs(s - (1.0 if i == j else 0.0))
+                if d > worst:
+                    worst = d
+    return worst

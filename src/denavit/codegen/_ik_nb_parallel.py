@@ -1,0 +1,230 @@
+"""The UR-class closed form (6R, axes 2, 3, 4 parallel, axes 5, 6 meeting) compiled by numba, once per machine
+(``cache=True``): see :mod:`._ik_parallel` for the method and the hand-over rules (NEAR_SINGULAR, COND_MAX); the
+formulas of :mod:`denavit.ik.forms` (jitted through :mod:`._ik_jit`), verified, folded, merged and sorted by
+:func:`._ik_nb_finish.ik_finish`.  The constants (``PARALLEL_LAYOUT``) are arguments.  Imported only where numba is.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._ik_jit import elbow_q2, trig_roots, wrist_qb
+from ._ik_nb_finish import ik_finish
+
+__all__ = ["ik_parallel_packed", "frame1", "next_frame"]
+
+
+
+@njit(cache=True, nogil=True)
+def ik_parallel_packed(T, K, f, i):
+    """All solutions of each pose T[b] of a 6R UR-class arm, the constants in K (PARALLEL_LAYOUT order); outputs as
+    ik_elbow_packed: f[b, :k, :6] solutions (folded, sorted), f[b, :k, 6:8] (position, orientation) residuals,
+    f[b, :j, 8:] the solutions outside the limits; i[b, :k] label codes (1 shoulder left, 2 elbow down, 4 wrist
+    flip), i[b, 8:] = (k, j, 1 if the plain solver must decide)."""
+    Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
+    a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
+    rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
+    # scratch: one float and one flag allocation, sliced
+    ws = np.empty(190)
+    cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)),         ws[83:89]
+    f1, f2, f3 = ws[89:101].reshape((4, 3)), ws[101:113].reshape((4, 3)), ws[113:125].reshape((4, 3))  # labels
+    trig, perm = ws[134:182].reshape((8, 6)), ws[182:190]  # cos, sin of q1, q2, q3 per candidate; sorted order
+    flags = np.zeros(24, dtype=np.bool_)
+    for b in range(T.shape[0]):
+        if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
+            i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
+            continue
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, trig, ws[89:134])
+        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
+                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C)
+        for r in range(3):
+            X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
+        for s in range(kept):
+            i[b, s] = _parallel_label(trig[int(perm[s])], f[b, s, 4], X, C, theta, f1, f2, f3)
+        i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
+
+
+@njit(cache=True, nogil=True)
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
+    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand,
+    the cosines and sines of their q1, q2, q3 into trig (for the labels); ws: 45 floats of scratch.  Returns
+    (count, status)."""
+    c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
+    tol, reach = tols[1], tols[7]
+    wide = sc[9] * reach  # NEAR_SINGULAR
+    scale = max(reach, 1e-3)
+    status = 0
+    ncand = 0
+    V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
+    xr, w, g = ws[36:39], ws[39:42], ws[42:45]
+    for r in range(3):  # Q in the world, then in the frame of C0
+        w[r] = Tb[r, 0] * Q_e[0] + Tb[r, 1] * Q_e[1] + Tb[r, 2] * Q_e[2] + Tb[r, 3]
+    for r in range(3):
+        V[r] = C0i[r, 0] * w[0] + C0i[r, 1] * w[1] + C0i[r, 2] * w[2] + C0i[r, 3]
+    for r in range(3):  # T_R C6_R^T
+        for j in range(3):
+            TC[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
+    # the formulas of denavit.ik.forms (the plain solver's own functions, jitted), in the plain plan's order
+    # q1: (Rz(q1) a) . V = h + a . pc1 (subproblem 1, as solve_trig)
+    q1a, q1b, rho, ratio = trig_roots(a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0], c0 - a[2] * V[2], tol)
+    if rho <= max(wide, 1e-11):
+        return 0, 1  # Q on (or next to) axis 1
+    if abs(abs(ratio) - 1.0) < 1e-6:
+        status = 1  # next to a double root: the plain solver polishes and looks for partners
+    if math.isnan(q1a) or rho_w < 1e-12:
+        return 0, max(status, 1 if rho_w < 1e-12 else 0)
+    delta = math.acos(min(1.0, max(-1.0, ratio)))
+    e1 = max(1.0, scale / rho) / max(math.sin(delta), 1e-300)  # rounding error of q1 [eps] (COND_MAX)
+    for s1 in range(2):
+        q1 = q1a if s1 == 0 else q1b
+        c1, s1v = math.cos(q1), math.sin(q1)
+        frame1(C, c1, s1v, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
+        RL02 = cols[0, 0] * TC[0, 2] + cols[0, 1] * TC[1, 2] + cols[0, 2] * TC[2, 2]
+        RL12 = cols[1, 0] * TC[0, 2] + cols[1, 1] * TC[1, 2] + cols[1, 2] * TC[2, 2]
+        RL22 = cols[2, 0] * TC[0, 2] + cols[2, 1] * TC[1, 2] + cols[2, 2] * TC[2, 2]
+        ell0 = cols[2, 0] * TC[0, 0] + cols[2, 1] * TC[1, 0] + cols[2, 2] * TC[2, 0]
+        ell1 = cols[2, 0] * TC[0, 1] + cols[2, 1] * TC[1, 1] + cols[2, 2] * TC[2, 1]
+        # q5: r^T Rz(q5) u = m_z, m = (RL e_z) with its z scaled by sigma (axis_angle_roots)
+        q5a, q5b, lo, hi = wrist_qb(RL02, RL12, sigma * RL22, rho_w, base_w, br, bu, tol)
+        if -2.0 * tol < min(lo, hi) < 1e-12:
+            status = 1  # the two q5 roots (nearly) coincide
+        if math.isnan(q5a):
+            continue
+        e5 = (1.0 + e1) / max(rho_w * math.sin(0.5 * (q5a - q5b)), 1e-300)
+        for s5 in range(2):
+            q5 = q5a if s5 == 0 else q5b
+            c5, s5v = math.cos(q5), math.sin(q5)
+            t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
+            y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
+            y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])
+            if math.hypot(y0, y1) < sc[9]:
+                status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
+            q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
+            e6 = (1.0 + e1 + e5) / max(math.hypot(y0, y1), 1e-300)
+            eP = 1.0 + e1 + e5 + e6  # of the point P, per reach
+            _tail(C, q5, q6, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
+            # X = F1^-1 T tail^-1: its origin P and first column xr
+            for r in range(3):
+                w[r] = Tb[r, 3] - cols[3, r]
+                for j in range(3):
+                    m_rj = Tb[r, 0] * tl[0, j] + Tb[r, 1] * tl[1, j] + Tb[r, 2] * tl[2, j]  # (T_R Rt^T)[r, j]
+                    w[r] -= m_rj * tl[3, j]
+            P0 = cols[0, 0] * w[0] + cols[0, 1] * w[1] + cols[0, 2] * w[2]
+            P1 = cols[1, 0] * w[0] + cols[1, 1] * w[1] + cols[1, 2] * w[2]
+            for r in range(3):
+                g[r] = Tb[r, 0] * tl[0, 0] + Tb[r, 1] * tl[1, 0] + Tb[r, 2] * tl[2, 0]
+            for r in range(3):
+                xr[r] = cols[r, 0] * g[0] + cols[r, 1] * g[1] + cols[r, 2] * g[2]
+            # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
+            if math.hypot(P0, P1) < wide:
+                status = 1  # Q on (or next to) axis 2
+            q3a, q3b, rho3, ratio3 = trig_roots(ap2, bp2, P0 * P0 + P1 * P1 + k0, tol)
+            if rho3 <= 1e-12:
+                status = 1
+                continue
+            if abs(abs(ratio3) - 1.0) < 1e-6:
+                status = 1  # elbow stretched or folded: a double root
+            if math.isnan(q3a):
+                continue
+            d3 = math.acos(min(1.0, max(-1.0, ratio3)))
+            e3 = eP * 2.0 * math.hypot(P0, P1) * scale / max(rho3 * math.sin(d3), 1e-300)
+            for s3 in range(2):
+                q3 = q3a if s3 == 0 else q3b
+                c3, s3v = math.cos(q3), math.sin(q3)
+                q2, _free, vxy = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
+                if vxy < wide:
+                    status = 1
+                e2 = (eP + e3) * scale / max(min(math.hypot(P0, P1), vxy), 1e-300)
+                if e2 + e3 + eP > sc[10]:  # q4's error is about that sum
+                    status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
+                # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
+                c2, s2v = math.cos(q2), math.sin(q2)
+                z0, z1, z2 = c2 * xr[0] + s2v * xr[1], -s2v * xr[0] + c2 * xr[1], xr[2]
+                e0 = C[2, 0, 0] * z0 + C[2, 1, 0] * z1 + C[2, 2, 0] * z2
+                e1 = C[2, 0, 1] * z0 + C[2, 1, 1] * z1 + C[2, 2, 1] * z2
+                e2 = C[2, 0, 2] * z0 + C[2, 1, 2] * z1 + C[2, 2, 2] * z2
+                f0, f1 = c3 * e0 + s3v * e1, -s3v * e0 + c3 * e1
+                N00 = C[3, 0, 0] * f0 + C[3, 1, 0] * f1 + C[3, 2, 0] * e2
+                N10 = C[3, 0, 1] * f0 + C[3, 1, 1] * f1 + C[3, 2, 1] * e2
+                q4 = math.atan2(N10, N00)
+                cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
+                cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
+                trig[ncand, 0], trig[ncand, 1], trig[ncand, 2] = c1, s1v, c2
+                trig[ncand, 3], trig[ncand, 4], trig[ncand, 5] = s2v, c3, s3v
+                ncand += 1
+    return ncand, status
+
+
+@njit(cache=True, nogil=True)
+def frame1(C, c, s, cols):
+    """Columns x, y, z and origin of C0 Rz(q1) C1 into cols (4, 3), c, s = cos q1, sin q1 (as the chain's
+    walker: x <- c x + s y, ...)."""
+    for r in range(3):
+        x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
+        x, y = c * x + s * y, c * y - s * x
+        cols[0, r] = x * C[1, 0, 0] + y * C[1, 1, 0] + z * C[1, 2, 0]
+        cols[1, r] = x * C[1, 0, 1] + y * C[1, 1, 1] + z * C[1, 2, 1]
+        cols[2, r] = x * C[1, 0, 2] + y * C[1, 1, 2] + z * C[1, 2, 2]
+        cols[3, r] = C[0, r, 3] + x * C[1, 0, 3] + y * C[1, 1, 3] + z * C[1, 2, 3]
+
+
+@njit(cache=True, nogil=True)
+def next_frame(cols, c, s, Ck, out):
+    """Columns and origin of F Rz(q) Ck into out (4, 3), F given by its columns cols (4, 3), c, s = cos q, sin q
+    (out may be cols)."""
+    for r in range(3):
+        x, y, z = c * cols[0, r] + s * cols[1, r], c * cols[1, r] - s * cols[0, r], cols[2, r]
+        out[0, r] = x * Ck[0, 0] + y * Ck[1, 0] + z * Ck[2, 0]
+        out[1, r] = x * Ck[0, 1] + y * Ck[1, 1] + z * Ck[2, 1]
+        out[2, r] = x * Ck[0, 2] + y * Ck[1, 2] + z * Ck[2, 2]
+        out[3, r] = cols[3, r] + x * Ck[0, 3] + y * Ck[1, 3] + z * Ck[2, 3]
+
+
+@njit(cache=True, nogil=True)
+def _tail(C, q5, q6, tl):
+    """Columns and origin of C4 Rz(q5) C5 Rz(q6) C6 into tl (4, 3)."""
+    c5, s5, c6, s6 = math.cos(q5), math.sin(q5), math.cos(q6), math.sin(q6)
+    for r in range(3):
+        x, y, z, p = C[4, r, 0], C[4, r, 1], C[4, r, 2], C[4, r, 3]
+        x, y = c5 * x + s5 * y, c5 * y - s5 * x
+        x, y, z, p = (x * C[5, 0, 0] + y * C[5, 1, 0] + z * C[5, 2, 0],
+                      x * C[5, 0, 1] + y * C[5, 1, 1] + z * C[5, 2, 1],
+                      x * C[5, 0, 2] + y * C[5, 1, 2] + z * C[5, 2, 2],
+                      p + x * C[5, 0, 3] + y * C[5, 1, 3] + z * C[5, 2, 3])
+        x, y = c6 * x + s6 * y, c6 * y - s6 * x
+        tl[0, r] = x * C[6, 0, 0] + y * C[6, 1, 0] + z * C[6, 2, 0]
+        tl[1, r] = x * C[6, 0, 1] + y * C[6, 1, 1] + z * C[6, 2, 1]
+        tl[2, r] = x * C[6, 0, 2] + y * C[6, 1, 2] + z * C[6, 2, 2]
+        tl[3, r] = p + x * C[6, 0, 3] + y * C[6, 1, 3] + z * C[6, 2, 3]
+
+
+@njit(cache=True, nogil=True)
+def _parallel_label(t, q5, X, C, theta, f1, f2, f3):
+    """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
+    (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
+    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  t: cos, sin of q1, q2, q3 (from before the
+    folding into the limits, which moves them by whole turns); f1, f2, f3: (4, 3) scratch for the frames after
+    joints 1, 2, 3."""
+    frame1(C, t[0], t[1], f1)
+    next_frame(f1, t[2], t[3], C[2], f2)
+    next_frame(f2, t[4], t[5], C[3], f3)
+    code = 0
+    s_right = 0.0
+    for r in range(3):
+        s_right += f1[0, r] * (X[r] - C[0, r, 3])
+    if s_right < 0.0:
+        code |= 1
+    d0, d1, d2 = f3[3, 0] - f1[3, 0], f3[3, 1] - f1[3, 1], f3[3, 2] - f1[3, 2]  # W - S
+    n0 = f1[2, 1] * d2 - f1[2, 2] * d1
+    n1 = f1[2, 2] * d0 - f1[2, 0] * d2
+    n2 = f1[2, 0] * d1 - f1[2, 1] * d0
+    towards = 1.0 if C[0, 0, 2] * n0 + C[0, 1, 2] * n1 + C[0, 2, 2] * n2 >= 0.0 else -1.0
+    side = (f2[3, 0] - f1[3, 0]) * n0 + (f2[3, 1] - f1[3, 1]) * n1 + (f2[3, 2] - f1[3, 2]) * n2
+    if side * towards < 0.0:
+        code |= 2
+    if math.sin(q5 + theta[4]) < 0.0:
+        code |= 4
+    return code
