@@ -110,6 +110,22 @@ def test_every_ik_solution_reaches_the_target_and_includes_the_start(client):
     np.testing.assert_allclose(np.array(r["target"])[:3, 2], [1, 0, 0], atol=1e-12)  # Ry(90°) z = x
 
 
+def test_a_redundant_arm_is_solved_with_a_held_joint(client):
+    panda = client.post("/api/catalogue/load", json={"name": "panda"}).json()["robot"]
+    q = [0.1, 0.2, 0.3, -1.4, 0.5, 1.6, 0.7]
+    err = _one_line_error(client.post("/api/ik", json={"robot": panda, "q": q}), 422)
+    assert "redundant" in err["error"]
+    r = client.post("/api/ik", json={"robot": panda, "q": q, "lock": "q7"}).json()
+    Tq = client.post("/api/kinematics", json={"robot": panda, "q": q}).json()["T"]
+    assert r["solutions"] and all(s["q"][6] == pytest.approx(0.7, abs=1e-12) for s in r["solutions"])
+    for s in r["solutions"]:
+        np.testing.assert_allclose(client.post("/api/kinematics", json={"robot": panda, "q": s["q"]}).json()["T"], Tq,
+                                   atol=1e-9)
+    assert min(np.abs(np.array(s["q"]) - q).max() for s in r["solutions"]) < 1e-9
+    for bad in ("q9", "x7", "q7 = pi/", "q0"):
+        _one_line_error(client.post("/api/ik", json={"robot": panda, "q": q, "lock": bad}), 422)
+
+
 def test_dynamics_match_the_closed_form_planar_elbow_and_statics_the_transpose(client):
     doc = client.post("/api/catalogue/load", json={"name": "planar2r"}).json()["robot"]  # L = m = 1, g along -y
     q, qd = np.array([0.4, -0.9]), np.array([0.7, -0.2])

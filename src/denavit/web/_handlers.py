@@ -207,7 +207,8 @@ def kinematics(body: Any) -> dict[str, Any]:
 
 
 def inverse_kinematics(body: Any) -> dict[str, Any]:
-    """Every analytic IK solution of the target: ``pose`` "x, y, z, roll, pitch, yaw" (m, rad) or the pose at ``q``."""
+    """Every analytic IK solution of the target: ``pose`` "x, y, z, roll, pitch, yaw" (m, rad) or the pose at ``q``;
+    ``lock`` holds joints of a redundant arm (``"q7"`` at its value in ``q``, or ``"q7 = 0.3"``)."""
     from ..numeric import transform_from_xyz_rpy
 
     robot = robot_of(body)
@@ -219,7 +220,7 @@ def inverse_kinematics(body: Any) -> dict[str, Any]:
     else:
         T = forward_kinematics(robot, _q(body, robot))
     try:
-        res = analytic_ik(robot, T)
+        res = analytic_ik(robot, T, _locked(body, robot) or None)
     except DenavitError as exc:
         raise RequestError(str(exc), 422) from None
     k = min(len(res.solutions), MAX_SOLUTIONS)
@@ -228,6 +229,29 @@ def inverse_kinematics(body: Any) -> dict[str, Any]:
                            "position_error": float(res.position_error[i]),
                            "orientation_error": float(res.orientation_error[i])} for i in range(k)],
             "outside_limits": len(res.outside_limits)}
+
+
+_LOCK = re.compile(r"^\s*q(\d{1,3})\s*(?:=\s*(.+?))?\s*$")
+
+
+def _locked(body: Any, robot: Any) -> dict[str, float]:
+    """The held joints of a redundant arm's IK: ``"q7"`` (at its value in ``q``) or ``"q7 = 0.3"``, comma-separated."""
+    text = _field(body, "lock")
+    if text in (None, ""):
+        return {}
+    if not isinstance(text, str) or len(text) > 400:
+        raise RequestError("'lock' must be a text such as \"q7\" or \"q7 = 0.3\"")
+    held: dict[str, float] = {}
+    for part in text.split(","):
+        m = _LOCK.match(part)
+        if not m or not 1 <= int(m.group(1)) <= robot.dof:
+            raise RequestError(f"lock: {one_line(part, 40)!r} is not q1 … q{robot.dof}, alone or '= value'")
+        k = int(m.group(1))
+        if m.group(2) is None:
+            held[f"q{k}"] = float(_q(body, robot)[k - 1])
+        else:
+            held[f"q{k}"] = float(_values({"v": [m.group(2)]}, "v", 1)[0])
+    return held
 
 
 def dynamics(body: Any) -> dict[str, Any]:

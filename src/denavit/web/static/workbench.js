@@ -216,6 +216,7 @@
   function solveIK() {
     var body = { robot: good.doc, q: q }, t = $("ik-target").value.trim();
     if (t) body.pose = t;
+    if ($("ik-lock").value.trim()) body.lock = $("ik-lock").value.trim();
     post("/api/ik", body).then(function (r) {
       var list = $("ik-list");
       list.innerHTML = "";
