@@ -80,6 +80,19 @@ def test_kinematics_of_an_edited_table_match_the_dh_product_and_differences(clie
     assert r["det"] is None and r["manipulability"] == pytest.approx(math.sqrt(np.linalg.det(J @ J.T)), abs=1e-12)
 
 
+def test_measures_on_task_rows_det_of_the_planar_arm(client):
+    """Planar 2R on its task rows (vx, vy): det J = a1 a2 sin q2 (Spong 2006 Sec. 4.9); on all six rows J Jᵀ is
+    singular and Yoshikawa's w is 0."""
+    q = [0.3, 1.1]
+    r = client.post("/api/kinematics", json={"robot": PLANAR, "q": q, "rows": ["vx", "vy"]}).json()
+    assert r["rows"] == ["vx", "vy"]
+    assert r["det"] == pytest.approx(0.7 * 0.4 * math.sin(1.1), abs=1e-12)
+    assert r["manipulability"] == pytest.approx(abs(r["det"]), abs=1e-12)
+    r6 = client.post("/api/kinematics", json={"robot": PLANAR, "q": q}).json()
+    assert r6["rows"] == ["vx", "vy", "vz", "wx", "wy", "wz"] and r6["manipulability"] == 0 and r6["det"] is None
+    _one_line_error(client.post("/api/kinematics", json={"robot": PLANAR, "q": q, "rows": ["vx", "up"]}), 422)
+
+
 def test_a_bad_cell_is_named_by_row_and_field(client):
     doc = json.loads(json.dumps(PLANAR))
     doc["joints"][1]["theta"] = "q + sin("

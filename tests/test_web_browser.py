@@ -272,6 +272,11 @@ def test_the_singular_sets_and_the_report_in_the_background(page):
     nearest = page.locator("#sing-nearest")
     assert "q2 = 3.1416" in nearest.text_content()
     assert float(nearest.get_attribute("data-distance")) == pytest.approx(np.pi - 2.9, abs=1e-12)
+    # the measures now on the task rows the analysis chose: det J[vx,vy] = L1 L2 sin q2 (L1 = L2 = 1)
+    page.wait_for_function("document.getElementById('measures').textContent.includes('det J[vx,vy]')", timeout=60_000)
+    q = _shown(page)[0]
+    det = float(page.locator("#measures").text_content().split("det J[vx,vy] = ")[1].split()[0])
+    assert det == pytest.approx(np.sin(q[1]), rel=1e-4)
     page.click("#report-start")
     page.wait_for_function("document.querySelectorAll('#report-sections li').length > 0", timeout=240_000)
     items = page.locator("#report-sections li").all_text_contents()

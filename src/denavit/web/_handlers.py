@@ -191,16 +191,26 @@ def robot_info(body: Any) -> dict[str, Any]:
 
 
 def kinematics(body: Any) -> dict[str, Any]:
-    """T (world pose of the end effector), J0 and its measures at ``q``; ``seq`` is echoed for the page."""
+    """T (world pose of the end effector), J0 and its measures at ``q`` (on the task ``rows``, all six by default:
+    with fewer joints than rows J Jᵀ is singular and Yoshikawa's w = √det(J Jᵀ) is 0); ``seq`` is echoed."""
+    from ..numeric import TWIST_ROWS, select_rows
+
     robot = robot_of(body)
     q = _q(body, robot)
     T = forward_kinematics(robot, q)                    # (4, 4)
     J = geometric_jacobian(robot, q)                    # (6, n), rows (v, ω) in base axes
-    sv = np.linalg.svd(J, compute_uv=False)
-    out = {"q": _matrix(q), "T": _matrix(T), "J": _matrix(J), "manipulability": float(manipulability(J)),
-           "singular_values": _matrix(sv), "det": None, "seq": _field(body, "seq")}
-    if J.shape[0] == J.shape[1]:
-        out["det"] = float(np.linalg.det(J))
+    rows = _field(body, "rows")                         # task rows of the measures, e.g. ["vx", "vy"] (planar)
+    try:
+        idx = select_rows(rows if isinstance(rows, list) and all(isinstance(r, str) for r in rows) else None)
+    except ValueError as exc:
+        raise RequestError(f"rows: {exc}") from None
+    Jt = J[idx]                                         # (m, n)
+    sv = np.linalg.svd(Jt, compute_uv=False)
+    out = {"q": _matrix(q), "T": _matrix(T), "J": _matrix(J), "manipulability": float(manipulability(Jt)),
+           "rows": [TWIST_ROWS[i] for i in idx], "singular_values": _matrix(sv), "det": None,
+           "seq": _field(body, "seq")}
+    if Jt.shape[0] == Jt.shape[1]:
+        out["det"] = float(np.linalg.det(Jt))
     if not isinstance(out["seq"], (int, float)) or isinstance(out["seq"], bool):
         out["seq"] = None
     return out

@@ -122,6 +122,7 @@
         $("sing-start").disabled = false;
         if (!res) { $("sing-status").textContent = err; return; }
         singular = res; singDoc = sent;
+        if (wb.refresh) wb.refresh();   // the measures on the task rows just found
         $("sing-status").textContent = res.everywhere ? "singular everywhere: " + res.reason :
           res.conditions.length ? res.measure + " vanishes when:" : (res.complete ? "no singular configuration" :
           "not solved symbolically (non-square J: all minors vanish together)");
@@ -200,4 +201,6 @@
   });
   wb.onRobot = function () { sync(); startFormula(); };
   wb.onPose = showNearest;
+  // the measures' task rows: those the singularity analysis chose (vx, vy for a planar arm), for this table
+  wb.taskRows = function () { sync(); return singular && singDoc === good.doc ? singular.rows : null; };
 })();

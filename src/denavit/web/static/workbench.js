@@ -159,14 +159,16 @@
   function sendKinematics() {
     inFlight = true; again = false;
     var seq = wb.seq;
-    post("/api/kinematics", { robot: good.doc, q: q, seq: seq }).then(function (r) {
+    post("/api/kinematics", { robot: good.doc, q: q, seq: seq, rows: wb.taskRows && wb.taskRows() }).then(function (r) {
       inFlight = false;
       if (r._status === 200) {
         $("T").textContent = matText(r.T);
         $("J").textContent = matText(r.J);
-        $("measures").textContent = (r.det === null ? "" : "det J = " + r.det.toPrecision(5) + " · ") +
-          "manipulability √det(J Jᵀ) = " + r.manipulability.toPrecision(5) + " · σ_min = " +
-          r.singular_values[r.singular_values.length - 1].toPrecision(4);
+        var sub = r.rows.length === 6 ? "J" : "J[" + r.rows.join(",") + "]";
+        $("measures").textContent = (r.det === null ? "" : "det " + sub + " = " + r.det.toPrecision(5) + " · ") +
+          "manipulability √det(" + sub + " " + sub + "ᵀ) = " + r.manipulability.toPrecision(5) + " · σ_min = " +
+          r.singular_values[r.singular_values.length - 1].toPrecision(4) +
+          (r.rows.length > good.info.dof ? " (fewer joints than rows: find the singular sets to pick the task rows)" : "");
         $("T").dataset.q = JSON.stringify(r.q);
         if (wb.onPose) wb.onPose();        // jobs.js: the nearest singular set
         $("T").dataset.full = JSON.stringify(r.T);
@@ -300,6 +302,7 @@
     if (this.value && good) showSolution(good.info.poses[this.value]);
   });
   wb.showSolution = showSolution;
+  wb.refresh = onSliders;
   // what jobs.js uses
   wb.internals = { $: $, post: post, download: download, good: function () { return good; }, q: function () { return q; },
                    doc: function () { return doc; }, qTyped: function () { return qTyped; } };
