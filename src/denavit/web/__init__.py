@@ -9,8 +9,9 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import MissingDependencyError
+from ._jobs import JOB_CPU_SECONDS, MAX_RUNNING, Jobs
 
-__all__ = ["create_app", "require_web"]
+__all__ = ["JOB_CPU_SECONDS", "MAX_RUNNING", "Jobs", "create_app", "require_web"]
 
 WEB_EXTRA = 'the workbench needs Starlette and uvicorn, which are not installed: pip install "denavit[web]"'
 
