@@ -24,8 +24,7 @@ pytest.importorskip("httpx")
 from starlette.testclient import TestClient
 
 from denavit.cli import main
-from denavit.web import create_app
-from denavit.web._jobs import Jobs
+from denavit.web import Jobs, create_app
 
 PLANAR = {"name": "two-link", "convention": "standard", "parameters": {"L1": "0.7", "L2": "0.4"},
           "joints": [{"a": "L1", "alpha": 0, "d": 0, "theta": "q"}, {"a": "L2", "alpha": 0, "d": 0, "theta": "q"}]}
