@@ -13,8 +13,8 @@ from numba.extending import overload, register_jitable
 
 from ..ik import forms
 
-__all__ = ["WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb", "wrist_rest",
-           "stanford_q1", "stanford_q2", "stanford_q3", "trig_roots"]
+__all__ = ["WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
+           "wrist_rest", "stanford_q1", "stanford_q2", "stanford_q3", "trig_roots"]
 
 
 @overload(forms.select, jit_options={"nogil": True})

@@ -20,6 +20,7 @@ from ._ik_stanford import stanford_constants
 __all__ = ["IKMethods"]
 
 _ndarray, _F64 = np.ndarray, np.dtype(np.float64)
+_new = object.__new__
 _NO_SEEDS = np.zeros((0, 1))
 #: Fewest targets a thread is given by a batch solve_ik (a target takes tens of microseconds: far more than an FK).
 IK_MIN_ROWS = 64
@@ -158,8 +159,12 @@ class IKMethods:
             return analytic_ik(self.robot, T)
         k, j = int(i[0, 8]), int(i[0, 9])
         g = f[0]
-        return AnalyticIKResult(g[:k, :6], tuple([labels[code] for code in i[0, :k].tolist()]), _NO_FREE[:k],
-                                g[:k, 6], g[:k, 7], g[:j, 8:], kind, "pose", _ALL_VALID[k])
+        # the frozen result filled in one step (its __init__ sets nine fields one by one: ~2 µs of a ~9 µs call)
+        res = _new(AnalyticIKResult)
+        res.__dict__.update(solutions=g[:k, :6], branches=tuple([labels[code] for code in i[0, :k].tolist()]),
+                            free=_NO_FREE[:k], position_error=g[:k, 6], orientation_error=g[:k, 7],
+                            outside_limits=g[:j, 8:], method=kind, controlled="pose", valid=_ALL_VALID[k])
+        return res
 
     def _analytic_solver(self):
         """``[K, labels, kind, check, solve, first call]`` for the compiled closed form of this arm's IK plan

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "half_angle", "shoulder_roots", "elbow_plane", "elbow_roots",
-           "elbow_q2", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2", "stanford_q1"]
+__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "half_angle", "shoulder_roots", "elbow_plane",
+           "elbow_roots", "elbow_q2", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2", "stanford_q1"]
 
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the outer axes of a three-axis wrist under which it is singular
