@@ -1,6 +1,7 @@
 """Benchmark of inverse kinematics: denavit (numeric LM batched, analytic all-solutions batched) against peers.
 
 Run:  python benchmarks/bench_ik.py [--n 10000] [--peer-n 500] [--robot puma560] [--markdown docs/ik_bench.md]
+      python benchmarks/bench_ik.py --per-pose [--n 2000] [--robot ur5]   (compiled one-pose IK vs ik-geo, EAIK)
 
 Targets: FK of random joint values uniformly within the joint limits (seeded).  For Pieper arms of the elbow and
 Stanford classes a row "general resultant route" times the same analytic pipeline forced onto the resultant
@@ -14,6 +15,10 @@ Peers (skipped when not importable or when they do not model the arm): roboticst
 eigenvalue route" times analytic_ik forced onto the Raghavan–Roth / Manocha–Canny solver on arms that have a
 closed form (on jaco2-6dof it is analytic_ik's own route).  "solutions / target" is the mean number of distinct
 verified solutions returned by the all-solution solvers.
+
+``--per-pose`` (issue 30): ``denavit.compile(robot).analytic_ik``, one pose per call, against ik-geo and EAIK (C++)
+on the same poses in interleaved rounds (median µs/pose, median ratio denavit/peer), after counting the poses whose
+solution sets differ (1e-6, modulo 2π); then 10⁵ poses through the compiled kernel's own loop on one core.
 """
 
 from __future__ import annotations
@@ -193,14 +198,9 @@ def bench_ikpy(robot, T):
     return float(np.mean(ok)), *_stats(times)
 
 
-def bench_ikgeo(robot, T):
-    """ik-geo (Elias & Wen 2022, subproblem decomposition, Rust): all solutions of 6R arms it has a class for.
-
-    The arm is given in product-of-exponentials form: axes h_i and points on them at q = 0 (the point shared by
-    intersecting axes), the home rotation R_M = R(FK(0)) taken off the target (ik-geo's home rotation is I).
-    Success: some returned solution (folded into the limits) reproduces the target within the limits.
-    (The binding takes R transposed — checked against its own forward_kinematics and ours.)
-    """
+def ikgeo_robot(robot):
+    """ik-geo's model of ``robot`` and M = FK(0), or None: axes h_i and points on them at q = 0 (the point shared by
+    intersecting axes); R(M) is taken off the target (ik-geo's home rotation is I; its binding reads R transposed)."""
     try:
         from ik_geo import Robot
     except ImportError:
@@ -213,6 +213,7 @@ def bench_ikgeo(robot, T):
     if ch.n != 6 or ch.prismatic.any() or kind not in ("pieper", "parallel", "general"):
         return None
     pts, h = axis_lines(ch, np.zeros(6))
+
     def meet(idx):  # least-squares common point of the axes idx
         A = sum(np.eye(3) - np.outer(h[i], h[i]) for i in idx)
         b = sum((np.eye(3) - np.outer(h[i], h[i])) @ pts[i] for i in idx)
@@ -228,7 +229,35 @@ def bench_ikgeo(robot, T):
         make = Robot.gen_six_dof  # no special structure: ik-geo's 2-D search
     M = forward_kinematics(robot, np.zeros(6))
     p = np.vstack([P[0], np.diff(P, axis=0), M[:3, 3] - P[5]])  # p01, p12, …, p56, p6T
-    bot = make(h, p)
+    return make(h, p), M
+
+
+def eaik_robot(robot):
+    """EAIK's model of ``robot`` (C++, subproblem decomposition; Ostermeier et al. 2024), or None: axes h_i and
+    offsets between points on them at q = 0 (H-P form), R(FK(0)) as its tool rotation: our targets and q unchanged."""
+    try:
+        import eaik.pybindings.EAIK as EAIK
+    except ImportError:
+        return None
+    from denavit.chain import screw_axes, screws_of
+
+    ch = screws_of(robot)
+    if ch.n != 6 or ch.prismatic.any():
+        return None
+    pts, h = screw_axes(ch, np.zeros(6))
+    M = forward_kinematics(robot, np.zeros(6))
+    P = np.vstack([pts[0], np.diff(pts, axis=0), M[:3, 3] - pts[5]])
+    bot = EAIK.Robot(h.T, P.T, M[:3, :3], [], True)
+    return bot if bot.has_known_decomposition() else None
+
+
+def bench_ikgeo(robot, T):
+    """ik-geo (Elias & Wen 2022, Rust): all solutions of 6R arms it has a class for; success: some returned solution
+    (folded into the limits) reproduces the target within the limits."""
+    made = ikgeo_robot(robot)
+    if made is None:
+        return None
+    bot, M = made
     times, ok, count = [], [], []
     for Tk in T:
         R = (Tk[:3, :3] @ M[:3, :3].T).T  # the Python binding reads the 3x3 in column-major order
@@ -249,13 +278,88 @@ def _distinct(qs, tol=1e-6):
     return out
 
 
+def _same_set(A, B, rev, tol=1e-6):
+    """Every row of A is within tol of some row of B (revolute angles modulo 2π), and the other way round."""
+
+    def covered(X, Y):
+        if len(X) == 0 or len(Y) == 0:
+            return len(X) == 0
+        d = np.abs(X[:, None] - Y[None])
+        d = np.where(rev, np.abs((d + np.pi) % (2 * np.pi) - np.pi), d)
+        return bool(np.all(d.max(-1).min(-1) < tol))
+    return covered(A, B) and covered(B, A)
+
+
+def per_pose(name, n, rounds=5, batch=100_000):
+    """Compiled analytic_ik (one pose per call) against ik-geo and EAIK on the same n poses, after checking that the
+    three return the same solution sets (denavit's inside and outside the limits: the peers ignore limits)."""
+    robot = load_robot(name)
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    _, T = _targets(robot, n, seed=7)
+    rev = np.array([t.value == "revolute" for t in robot.joint_types])
+    geo, eaik = ikgeo_robot(robot), eaik_robot(robot)
+    Rg = [(Tk[:3, :3] @ geo[1][:3, :3].T).T.copy() for Tk in T] if geo else None
+    Ts = [np.ascontiguousarray(Tk) for Tk in T]
+    solvers = {"denavit": lambda k: fast.analytic_ik(Ts[k]), "EAIK": eaik and (lambda k: eaik.calculate_IK(Ts[k])),
+               "ik-geo": geo and (lambda k: geo[0].get_ik(Rg[k], T[k, :3, 3]))}
+    solvers = {who: f for who, f in solvers.items() if f}
+    differ = dict.fromkeys(list(solvers)[1:], 0)
+    for k in range(n):  # completeness, against each other
+        res = fast.analytic_ik(Ts[k])
+        mine = np.concatenate([res.solutions, np.reshape(res.outside_limits, (-1, robot.dof))])
+        peers = {}
+        if geo:
+            peers["ik-geo"] = np.array([x for x, ls in solvers["ik-geo"](k) if not ls]).reshape(-1, 6)
+        if eaik:
+            s = solvers["EAIK"](k)
+            peers["EAIK"] = np.asarray(s.Q)[~np.asarray(s.is_LS, bool)].reshape(-1, 6)
+        for who, Q in peers.items():
+            differ[who] += not _same_set(mine, Q, rev)
+    times = {who: [] for who in solvers}
+    for _ in range(rounds):  # interleaved rounds: the machine's load hits every solver alike
+        for who, f in solvers.items():
+            t0 = time.perf_counter()
+            for k in range(n):
+                f(k)
+            times[who].append((time.perf_counter() - t0) / n * 1e6)
+    med = {who: float(np.median(t)) for who, t in times.items()}
+    ratios = {who: float(np.median(np.array(times["denavit"]) / np.array(times[who]))) for who in differ}
+    return med, ratios, differ, _batch_rates(fast, eaik, _targets(robot, batch, seed=8)[1])
+
+
+def _batch_rates(fast, eaik, Tb):
+    """Poses per second of the compiled kernel's own loop over the batch Tb (one thread) and of EAIK's batched call
+    with one worker thread; the share of poses the kernel hands to the plain solver."""
+    kern, out = fast._analytic_solver(), {}
+    if kern:
+        K, solve = kern[0], kern[4]
+        f, i = np.empty((len(Tb), 8, 14)), np.empty((len(Tb), 11), dtype=np.int64)
+        solve(Tb[:10], K, f[:10], i[:10])
+        t0 = time.perf_counter()
+        solve(np.ascontiguousarray(Tb), K, f, i)
+        dt = time.perf_counter() - t0
+        out = {"kernel poses/s": len(Tb) / dt, "kernel µs/pose": dt / len(Tb) * 1e6, "handed over": i[:, 10].mean()}
+    if eaik:
+        t0 = time.perf_counter()
+        eaik.calculate_IK_batched(list(Tb), 1)
+        out["EAIK batched (1 thread) poses/s"] = len(Tb) / (time.perf_counter() - t0)
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=10000, help="targets for denavit (default 10000)")
     ap.add_argument("--peer-n", type=int, default=500, help="targets for the per-call peers (default 500)")
     ap.add_argument("--robot", action="append", help="catalogue arm (repeatable; default puma560, ur5, stanford)")
     ap.add_argument("--markdown", help="also write the table to this Markdown file")
+    ap.add_argument("--per-pose", action="store_true", help="only the compiled one-pose analytic IK against ik-geo "
+                    "and EAIK (puma560, ur5, offset-6r unless --robot), and a 1e5-pose batch of the compiled kernel")
     args = ap.parse_args(argv)
+    if args.per_pose:
+        for name in args.robot or ["puma560", "ur5", "offset-6r"]:
+            parts = per_pose(name, min(args.n, 2000))  # µs/pose, denavit/peer, poses whose sets differ, batch
+            print(name, " | ".join(", ".join(f"{w} {v:.3g}" for w, v in d.items()) for d in parts))
+        return
     rows = []
     for name in args.robot or ["puma560", "ur5", "stanford", "jaco2-6dof"]:
         robot = load_robot(name)
