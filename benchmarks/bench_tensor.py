@@ -133,7 +133,7 @@ def main(argv=None) -> None:
     print("| robot | operation | batch | dtype | ratio (peer time / denavit time) |")
     print("|---|---|---|---|---|")
     for name, op, batch, dtype, ratio in rows:
-        print(f"| {name} | {op} | {batch:.0e} | {dtype} | {ratio:.2f} |")
+        print(f"| {name} | {op} | {batch:.0e} | {dtype} | {ratio:.3g} |")
 
 
 if __name__ == "__main__":
