@@ -350,3 +350,25 @@ def test_random_stanford_class_arms_compiled_equals_plain(seed, _kernel_cache):
     fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
     _check_arm(robot, fast, np.random.default_rng(seed), N_POSES // 2, 6 if REDUCED else 12, STANFORD_SINGULAR,
                handed_over=0.6)
+
+
+def test_kernel_cache_entries_go_when_a_source_they_inline_changes(tmp_path):
+    """numba stamps a cached kernel by its own file only, and the kernels inline denavit.ik.forms: fresh_cache drops
+    their index files where the stamped digest of their sources is another (here a stale stamp written by hand),
+    keeps them where it is the same, and leaves other functions' entries alone."""
+    from types import SimpleNamespace
+
+    from denavit.codegen import _ik_jit
+
+    assert {p.name for p in _ik_jit.kernel_sources()} >= {"_forms.py", "_ik_nb_elbow.py", "_ik_nb_finish.py"}
+    fake = SimpleNamespace(_cache=SimpleNamespace(_cache_path=str(tmp_path)))
+    for name in ("_ik_nb_elbow.ik_elbow-46.py311.nbi", "_ik_nb_finish.ik_finish-58.py311.nbi", "other.f-1.py311.nbi"):
+        (tmp_path / name).write_text("index")
+    (tmp_path / _ik_jit.STAMP).write_text("stale")
+    _ik_jit.fresh_cache(fake, force=True)
+    assert sorted(p.name for p in tmp_path.glob("*.nbi")) == ["other.f-1.py311.nbi"]
+    digest = (tmp_path / _ik_jit.STAMP).read_text()
+    assert len(digest) == 64 and digest != "stale"
+    (tmp_path / "_ik_nb_elbow.ik_elbow-46.py311.nbi").write_text("index")  # compiled again from the same sources
+    _ik_jit.fresh_cache(fake, force=True)
+    assert (tmp_path / "_ik_nb_elbow.ik_elbow-46.py311.nbi").exists()

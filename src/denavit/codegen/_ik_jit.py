@@ -3,17 +3,24 @@
 Every function of ``forms.JITTABLE`` is registered with ``numba.extending.register_jitable`` (numba compiles the
 very function the plain solver runs on numpy batches, inlined into each compiled caller), and ``forms.select``
 gets its scalar meaning ``a if c else b`` (``np.where`` would make a 0-d array of each choice).  Importing this
-module is what registers them: the compiled closed forms import their names from here.  The generated modules'
-cache key covers the ik package's sources (:mod:`._cache`), so a changed formula never meets a stale kernel.
+module is what registers them: the compiled closed forms import their names from here.
+
+numba keys the cached machine code of a function by its own file's modification time and size only, while the
+kernels of ``codegen/_ik_nb_*.py`` inline :mod:`denavit.ik.forms` and each other: :func:`fresh_cache` keeps a
+digest of all those sources beside numba's cache and drops the kernels' cache entries when it changes, so a
+changed formula never meets a stale kernel.
 """
 
 from __future__ import annotations
+
+import hashlib
+from pathlib import Path
 
 from numba.extending import overload, register_jitable
 
 from ..ik import forms
 
-__all__ = ["WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
+__all__ = ["fresh_cache", "WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
            "wrist_rest", "stanford_q1", "stanford_q2", "stanford_q3", "trig_roots"]
 
 
@@ -30,3 +37,39 @@ elbow_plane, elbow_q2, elbow_roots = forms.elbow_plane, forms.elbow_q2, forms.el
 shoulder_roots, wrist_qb, wrist_rest = forms.shoulder_roots, forms.wrist_qb, forms.wrist_rest
 stanford_q1, stanford_q2, stanford_q3 = forms.stanford_q1, forms.stanford_q2, forms.stanford_q3
 trig_roots = forms.trig_roots
+
+#: The stamp file kept beside numba's cache of the kernels: the SHA-256 of the sources they are compiled from.
+STAMP = "denavit_ik_kernels.sha256"
+_CHECKED: list[bool] = []
+
+
+def kernel_sources() -> list[Path]:
+    """The files whose text the closed-form kernels are compiled from (their own, the shared forms, this one)."""
+    here = Path(__file__).resolve().parent
+    return sorted(here.glob("_ik_nb_*.py")) + [here / "_ik_jit.py", here / "_ik_finish.py",
+                                                  here.parent / "ik" / "_forms.py"]
+
+
+def fresh_cache(*dispatchers, force: bool = False) -> None:
+    """Before the kernels' first call in this process: where numba caches ``dispatchers``, compare the digest of
+    :func:`kernel_sources` with the one stamped there (:data:`STAMP`); when they differ, remove the kernels' index
+    files (``_ik_nb_*.nbi``: numba compiles them afresh) and stamp the new digest.  An unwritable cache is left
+    alone (numba does not write there either)."""
+    if _CHECKED and not force:
+        return
+    _CHECKED.append(True)
+    h = hashlib.sha256()
+    for path in kernel_sources():
+        h.update(path.name.encode() + b"\0" + path.read_bytes())
+    digest = h.hexdigest()
+    for folder in {getattr(getattr(d, "_cache", None), "_cache_path", None) for d in dispatchers} - {None}:
+        stamp = Path(folder) / STAMP
+        try:
+            if stamp.is_file() and stamp.read_text() == digest:
+                continue
+            for index in Path(folder).glob("_ik_nb_*.nbi"):
+                index.unlink(missing_ok=True)
+            Path(folder).mkdir(parents=True, exist_ok=True)
+            stamp.write_text(digest)
+        except OSError:
+            continue

@@ -173,20 +173,20 @@ class IKMethods:
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
             return False
+        from ._ik_jit import fresh_cache
+        from ._ik_nb_elbow import ik_elbow_packed
         from ._ik_nb_finish import ik_check  # module-level kernels: compiled once per machine (numba's cache)
+        from ._ik_nb_parallel import ik_parallel_packed
+        from ._ik_nb_stanford import ik_stanford_packed
+
+        fresh_cache(ik_check, ik_elbow_packed, ik_parallel_packed, ik_stanford_packed)  # none stale (see there)
 
         if plan.kind == "parallel":
-            from ._ik_nb_parallel import ik_parallel_packed
-
             return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
                     ik_parallel_packed, True]
         if plan.route == "closed form (stanford)":
-            from ._ik_nb_stanford import ik_stanford_packed
-
             return [stanford_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
                     ik_stanford_packed, True]
-        from ._ik_nb_elbow import ik_elbow_packed
-
         k = dict(plan.closed)
         lim = self.robot.q_limits
         k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
