@@ -24,25 +24,32 @@ __all__ = ["chain_fk", "ik_check", "ik_finish"]
 @njit(cache=True, nogil=True)
 def chain_fk(C, revolute, q, F):
     """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
-    base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one."""
-    for r in range(4):
-        for c in range(4):
-            F[r, c] = C[0, r, c]
+    base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one.  The 3×4 top of
+    the product is kept in twelve local floats (registers), written to F once at the end."""
+    x0, x1, x2, y0, y1, y2 = C[0, 0, 0], C[0, 1, 0], C[0, 2, 0], C[0, 0, 1], C[0, 1, 1], C[0, 2, 1]
+    z0, z1, z2, p0, p1, p2 = C[0, 0, 2], C[0, 1, 2], C[0, 2, 2], C[0, 0, 3], C[0, 1, 3], C[0, 2, 3]
     for k in range(q.shape[0]):
         if revolute[k] != 0.0:  # F <- F Rz(q_k): columns x, y turn
-            ck, sk = math.cos(q[k]), math.sin(q[k])
-            for r in range(3):
-                x, y = F[r, 0], F[r, 1]
-                F[r, 0], F[r, 1] = ck * x + sk * y, ck * y - sk * x
+            c, s = math.cos(q[k]), math.sin(q[k])
+            x0, y0 = c * x0 + s * y0, c * y0 - s * x0
+            x1, y1 = c * x1 + s * y1, c * y1 - s * x1
+            x2, y2 = c * x2 + s * y2, c * y2 - s * x2
         else:  # F <- F Tz(q_k)
-            for r in range(3):
-                F[r, 3] += q[k] * F[r, 2]
-        Ck = C[k + 1]
-        for r in range(3):  # F <- F C_k (last row of C_k: 0 0 0 1)
-            a0, a1, a2, a3 = F[r, 0], F[r, 1], F[r, 2], F[r, 3]
-            for c in range(3):
-                F[r, c] = a0 * Ck[0, c] + a1 * Ck[1, c] + a2 * Ck[2, c]
-            F[r, 3] = a0 * Ck[0, 3] + a1 * Ck[1, 3] + a2 * Ck[2, 3] + a3
+            p0, p1, p2 = p0 + q[k] * z0, p1 + q[k] * z1, p2 + q[k] * z2
+        D = C[k + 1]  # F <- F C_{k+1} (last row of C: 0 0 0 1)
+        p0, p1, p2 = (p0 + x0 * D[0, 3] + y0 * D[1, 3] + z0 * D[2, 3], p1 + x1 * D[0, 3] + y1 * D[1, 3] + z1 * D[2, 3],
+                      p2 + x2 * D[0, 3] + y2 * D[1, 3] + z2 * D[2, 3])
+        x0, y0, z0 = (x0 * D[0, 0] + y0 * D[1, 0] + z0 * D[2, 0], x0 * D[0, 1] + y0 * D[1, 1] + z0 * D[2, 1],
+                      x0 * D[0, 2] + y0 * D[1, 2] + z0 * D[2, 2])
+        x1, y1, z1 = (x1 * D[0, 0] + y1 * D[1, 0] + z1 * D[2, 0], x1 * D[0, 1] + y1 * D[1, 1] + z1 * D[2, 1],
+                      x1 * D[0, 2] + y1 * D[1, 2] + z1 * D[2, 2])
+        x2, y2, z2 = (x2 * D[0, 0] + y2 * D[1, 0] + z2 * D[2, 0], x2 * D[0, 1] + y2 * D[1, 1] + z2 * D[2, 1],
+                      x2 * D[0, 2] + y2 * D[1, 2] + z2 * D[2, 2])
+    F[0, 0], F[0, 1], F[0, 2], F[0, 3] = x0, y0, z0, p0
+    F[1, 0], F[1, 1], F[1, 2], F[1, 3] = x1, y1, z1, p1
+    F[2, 0], F[2, 1], F[2, 2], F[2, 3] = x2, y2, z2, p2
+    F[3, 0], F[3, 1], F[3, 2], F[3, 3] = 0.0, 0.0, 0.0, 1.0
+
 
 @njit(cache=True, nogil=True)
 def _near_fold_edge(x, lo, hi):
