@@ -24,7 +24,7 @@ pytest.importorskip("httpx")
 from starlette.testclient import TestClient
 
 from denavit.cli import main
-from denavit.web import Jobs, create_app
+from denavit.web import MAX_RUNNING, Jobs, create_app
 
 PLANAR = {"name": "two-link", "convention": "standard", "parameters": {"L1": "0.7", "L2": "0.4"},
           "joints": [{"a": "L1", "alpha": 0, "d": 0, "theta": "q"}, {"a": "L2", "alpha": 0, "d": 0, "theta": "q"}]}
@@ -345,6 +345,27 @@ def test_a_long_job_is_cancelled_and_never_blocks_the_quick_answers(client):
     assert not proc.is_alive() and proc.exitcode == -signal.SIGTERM
     assert _wait(client, job["id"])["state"] == "cancelled"
     _one_line_error(client.get("/api/jobs/no-such-job"), 404)
+
+
+def test_a_job_in_the_same_slot_supersedes_the_running_one_and_never_counts_against_the_limit(client):
+    """A page's panel names its slot: the next job there cancels the running one in the same step (the page's own
+    cancel may arrive late on a busy machine), so a panel restarted more often than MAX_RUNNING never gets a 429;
+    another slot's job is left alone."""
+    panda = client.post("/api/catalogue/load", json={"name": "panda"}).json()["robot"]
+    start = lambda slot: client.post("/api/jobs", json={"kind": "report", "payload": {"robot": panda}, "slot": slot})
+    other = start("page:other").json()
+    firsts = [start("page:report").json() for _ in range(MAX_RUNNING + 1)]
+    assert all(j["state"] == "running" for j in firsts)  # no 429, though MAX_RUNNING + 2 were started
+    jobs = client.app.state.jobs._jobs
+    assert [jobs[j["id"]].state for j in firsts] == ["cancelled"] * MAX_RUNNING + ["running"]
+    assert jobs[other["id"]].state == "running"
+    for j in firsts + [other]:
+        client.post(f"/api/jobs/{j['id']}/cancel")
+    for j in firsts + [other]:
+        jobs[j["id"]].process.join(timeout=30)
+        assert not jobs[j["id"]].process.is_alive()
+    _one_line_error(start("x" * 65), 422)
+    _one_line_error(start(7), 422)
 
 
 def test_a_report_job_reads_a_typed_q_exactly_and_takes_the_rates_and_the_wrench(client):

@@ -168,7 +168,10 @@ async def _job_start(request: Request) -> Response:
             raise H.RequestError("a job is {\"kind\": ..., \"payload\": {...}}", 422)
         if kind != "check":
             H.robot_of(payload)  # a bad table is refused here, with its cell, before a process starts
-        return JSONResponse(request.app.state.jobs.start(kind, payload))
+        slot = body.get("slot")
+        if slot is not None and not (isinstance(slot, str) and 0 < len(slot) <= 64):
+            raise H.RequestError("a job's \"slot\" is a string of at most 64 characters", 422)
+        return JSONResponse(request.app.state.jobs.start(kind, payload, slot))
     except H.RequestError as exc:
         return _error(exc)
 

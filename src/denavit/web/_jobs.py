@@ -40,6 +40,7 @@ class _Job:
         self.finished: float | None = None
         self.process: Any = None
         self.cpu_seconds: float | None = None  # the job process's own CPU time, when it finished
+        self.slot: str | None = None  # a new job in the same slot supersedes this one (one page's one panel)
 
     def to_json(self, with_result: bool = True) -> dict[str, Any]:
         end = self.finished if self.finished is not None else time.monotonic()
@@ -76,17 +77,24 @@ class Jobs:
 
             forkserver.ensure_running()
 
-    def start(self, kind: str, payload: dict[str, Any]) -> dict[str, Any]:
-        """Start a job; 429 when :attr:`max_running` already run."""
+    def start(self, kind: str, payload: dict[str, Any], slot: str | None = None) -> dict[str, Any]:
+        """Start a job; 429 when :attr:`max_running` already run.  A running job in the same ``slot`` (a page's
+        panel: its formula, its report, ...) is cancelled first, in the same step: superseded work never counts
+        against the limit, however slowly the page's own cancel arrives."""
         from ._work import KINDS, run
 
         if kind not in KINDS:
             raise RequestError(f"unknown job {one_line(kind, 40)!r}; jobs: {', '.join(KINDS)}", 404)
         with self._lock:
+            if slot is not None:
+                for old in self._jobs.values():
+                    if old.slot == slot and old.state == "running":
+                        self._terminate(old)
             running = sum(j.state == "running" for j in self._jobs.values())
             if running >= self.max_running:
                 raise RequestError(f"{running} jobs are running (at most {self.max_running}): wait or cancel one", 429)
             job = _Job(kind)
+            job.slot = slot
             ctx = self._context()
             parent, child = ctx.Pipe(duplex=False)
             job.process = ctx.Process(target=run, args=(kind, payload, child, self.cpu_seconds), daemon=True)
@@ -142,10 +150,14 @@ class Jobs:
         job = self._get(job_id)
         with self._lock:
             if job.state == "running":
-                job.state = "cancelled"
-                job.error = "cancelled"
-                job.process.terminate()
+                self._terminate(job)
         return job.to_json(with_result=False)
+
+    @staticmethod
+    def _terminate(job: _Job) -> None:
+        job.state = "cancelled"
+        job.error = "cancelled"
+        job.process.terminate()
 
     def shutdown(self) -> None:
         """Terminate every running job (the server is stopping)."""

@@ -9,9 +9,11 @@
   function sync() { good = I.good(); q = I.q(); }   // the page's current table and sliders
 
   var running = {};          // this page's jobs by id, cancelled when the page goes away
+  // this page's name for its panels: the server cancels a panel's running job when the panel starts the next one
+  var pageId = Math.random().toString(36).slice(2, 12);
   function runJob(kind, payload, onProgress, onDone) {
     var job = { id: null, stopped: false }, polls = 0;
-    post("/api/jobs", { kind: kind, payload: payload }).then(function (r) {
+    post("/api/jobs", { kind: kind, payload: payload, slot: pageId + ":" + kind }).then(function (r) {
       if (r._status !== 200) { if (!job.stopped) onDone(null, r.error, r); return; }
       job.id = r.id;
       if (job.stopped) { cancelJob(job); return; }   // superseded before it started
