@@ -24,7 +24,7 @@ pytest.importorskip("httpx")
 from starlette.testclient import TestClient
 
 from denavit.cli import main
-from denavit.web import MAX_RUNNING, Jobs, create_app
+from denavit.web import MAX_RUNNING, Jobs, claim_lines, create_app
 
 PLANAR = {"name": "two-link", "convention": "standard", "parameters": {"L1": "0.7", "L2": "0.4"},
           "joints": [{"a": "L1", "alpha": 0, "d": 0, "theta": "q"}, {"a": "L2", "alpha": 0, "d": 0, "theta": "q"}]}
@@ -403,6 +403,21 @@ def test_a_claims_file_is_judged_claim_by_claim(client):
     assert s["state"] == "done", s
     assert [(c["id"], c["verdict"]) for c in s["result"]["claims"]] == [("stretched", "correct"), ("wrong", "incorrect")]
     assert "tmp" not in s["result"]["text"] and "denavit-web-" not in s["result"]["text"]  # no private path shown
+    # each verdict names its claim's lines in the file, so the page marks it in place; "auto" tells a claims file
+    # (a top-level claims: key) from a report
+    assert [(c["line"], c["end_line"]) for c in s["result"]["claims"]] == [(2, 5), (6, 9)]
+    payload["kind"] = "auto"
+    s = _wait(client, client.post("/api/jobs", json={"kind": "check", "payload": payload}).json()["id"])
+    assert s["result"]["kind"] == "claims" and s["result"]["source"] == claims
+
+
+def test_claim_lines_follow_the_yaml_layout():
+    """The lines of each claim, counted by hand in block, flow and bare-list files."""
+    block = "robot: x\nclaims:\n  - id: a\n    value: 1\n\n  # b next\n  - id: b\n    value: |\n      2\n"
+    assert claim_lines(block) == [(3, 4), (7, 9)]
+    assert claim_lines("claims: [{id: a, value: 1},\n  {id: b, value: 2}]") == [(1, 1), (2, 2)]
+    assert claim_lines("- quantity: fk\n  value: 1\n- quantity: fk\n  value: 2") == [(1, 2), (3, 4)]
+    assert claim_lines("claims: 3\n") == []
 
 
 def test_the_formula_job_gives_the_symbolic_pose(client):

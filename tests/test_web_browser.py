@@ -258,6 +258,31 @@ def test_upload_a_report_and_see_its_marks(page, tmp_path):
     assert frame.locator(".katex").count() >= 2  # the report's mathematics typeset offline
 
 
+def test_upload_a_claims_file_and_see_each_claim_marked_in_place(page, tmp_path):
+    """Two claims about the page's arm (puma560) at one q: the end-effector position as denavit computes it, and
+    that position moved 5 cm along x.  Each verdict is marked beside its claim's first line."""
+    q = [0.3, -0.5, 0.8, 0.1, 0.6, -0.2]
+    p = denavit.forward_kinematics(denavit.load_robot("puma560"), q)[:3, 3]
+    row = lambda v: "[" + ", ".join(repr(float(x)) for x in v) + "]"
+    text = (f"claims:\n  - id: right\n    quantity: position\n    q: '{', '.join(map(str, q))}'\n    value: {row(p)}\n\n"
+            f"  - id: wrong\n    quantity: position\n    q: '{', '.join(map(str, q))}'\n"
+            f"    value: {row(p + [0.05, 0, 0])}\n")
+    path = tmp_path / "claims.yaml"
+    path.write_text(text, encoding="utf-8")
+    page.set_input_files("#check-file", str(path))
+    assert page.locator("#check-kind").input_value() == "yaml"
+    page.click("#check-start")
+    marks = page.locator("#claims-annotated span.verdict")
+    marks.nth(1).wait_for(timeout=120_000)
+    got = [(marks.nth(i).get_attribute("data-claim"), int(marks.nth(i).get_attribute("data-line")),
+            marks.nth(i).get_attribute("data-verdict"), marks.nth(i).text_content()) for i in range(marks.count())]
+    assert got == [("right", 2, "correct", "✓"), ("wrong", 7, "incorrect", "✗")]
+    lines = page.locator("#claims-annotated .claim-line code").all_text_contents()
+    assert lines == text.split("\n")  # the file as written, each line once
+    notes = page.locator("#claims-annotated .claim-note").all_text_contents()
+    assert len(notes) == 2 and notes[1].startswith("incorrect — wrong (position)")
+
+
 def test_the_singular_sets_and_the_report_in_the_background(page):
     page.select_option("#catalogue", "planar2r")
     page.wait_for_function("window.workbench.doc().name === 'planar2r' && window.workbench.kinCount > 0 && "

@@ -10,8 +10,9 @@ from typing import Any
 
 from ..errors import MissingDependencyError
 from ._jobs import JOB_CPU_SECONDS, MAX_RUNNING, Jobs
+from ._work import claim_lines
 
-__all__ = ["JOB_CPU_SECONDS", "MAX_RUNNING", "Jobs", "create_app", "require_web"]
+__all__ = ["JOB_CPU_SECONDS", "MAX_RUNNING", "Jobs", "claim_lines", "create_app", "require_web"]
 
 WEB_EXTRA = 'the workbench needs Starlette and uvicorn, which are not installed: pip install "denavit[web]"'
 

@@ -10,6 +10,7 @@ for a claims file, as ``denavit check`` does.
 
 from __future__ import annotations
 
+import re
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -17,7 +18,7 @@ from typing import Any
 
 from .. import ParseError, robot_from_dict
 
-__all__ = ["KINDS", "MAX_TEXT_CHARS", "run"]
+__all__ = ["KINDS", "MAX_TEXT_CHARS", "claim_lines", "run"]
 
 #: Longest report or claims text accepted for checking (characters).
 MAX_TEXT_CHARS = 400_000
@@ -92,12 +93,16 @@ def report(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str
 
 
 def check(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
-    """Grade a report (``kind`` md/tex/txt) or judge a claims file (``kind`` yaml) as ``denavit check`` does."""
+    """Grade a report (``kind`` md/tex/txt) or judge a claims file (``kind`` yaml) as ``denavit check`` does;
+    ``kind`` auto reads the text as a claims file when it is one (a YAML mapping with a ``claims`` list, or a
+    list of claims), else as a Markdown report."""
     text, kind = payload.get("text"), payload.get("kind")
     if not isinstance(text, str) or not text.strip():
         raise ParseError("'text' must be the report or claims file to check")
     if len(text) > MAX_TEXT_CHARS:
         raise ParseError(f"the text to check is too long ({len(text)} characters; at most {MAX_TEXT_CHARS})")
+    if kind == "auto":
+        kind = "yaml" if _is_claims_file(text) else "md"
     if kind in _REPORT_FORMATS:
         from ..grade import grade_text, graded_text, render_checked_html
 
@@ -108,19 +113,64 @@ def check(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str,
                 "html": render_checked_html(graded),
                 "claims": [{"line": c.line, "verdict": c.verdict, "quantity": c.quantity} for c in graded.claims]}
     if kind == "yaml":
-        from ..check import check_file, verdicts_text
+        return _check_claims_file(text, payload, progress)
+    raise ParseError("'kind' must be md, tex or txt (a report), yaml (a claims file) or auto")
 
-        robot = _robot(payload)
-        progress("judging the claims")
-        with tempfile.TemporaryDirectory(prefix="denavit-web-") as tmp:  # check_file reads a file: ours, private
-            path = Path(tmp) / "claims.yaml"
-            path.write_text(text, encoding="utf-8")
-            result = check_file(robot, path)
-        data = result.to_json()
-        return {"kind": "claims", "summary": data["summary"], "text": verdicts_text(result).replace(str(path), "claims"),
-                "claims": [{"id": c["id"], "verdict": c["verdict"], "quantity": c["quantity"], "message": c["message"]}
-                           for c in data["claims"]]}
-    raise ParseError("'kind' must be md, tex or txt (a report) or yaml (a claims file)")
+
+def _is_claims_file(text: str) -> bool:
+    """Whether ``text`` is laid out as a claims file (docs/claims.md): a top-level ``claims:`` key, or a top-level
+    list whose items start with ``quantity:`` or ``id:``.  A report has neither (the checker then reads it)."""
+    return bool(_CLAIMS_LAYOUT.search(text))
+
+
+_CLAIMS_LAYOUT = re.compile(r"^(claims\s*:|-\s+(quantity|id)\s*:)", re.MULTILINE)
+
+
+def _check_claims_file(text: str, payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """Judge a claims file with :func:`denavit.check.check_file` (the command line's judge) and give each
+    verdict the lines of its claim in the file, so the page marks it in place."""
+    from ..check import check_file, verdicts_text
+
+    robot = _robot(payload)
+    progress("judging the claims")
+    with tempfile.TemporaryDirectory(prefix="denavit-web-") as tmp:  # check_file reads a file: ours, private
+        path = Path(tmp) / "claims.yaml"
+        path.write_text(text, encoding="utf-8")
+        result = check_file(robot, path)
+    data = result.to_json()
+    lines = claim_lines(text)
+    claims = []
+    for k, c in enumerate(data["claims"]):
+        first, last = lines[k] if k < len(lines) else (None, None)
+        claims.append({"id": c["id"], "verdict": c["verdict"], "quantity": c["quantity"], "message": c["message"],
+                       "hints": c["hints"], "line": first, "end_line": last})
+    return {"kind": "claims", "summary": data["summary"], "notes": data["notes"], "source": text,
+            "text": verdicts_text(result).replace(str(path), "claims"), "claims": claims}
+
+
+def claim_lines(text: str) -> list[tuple[int, int]]:
+    """The first and last line (1-based) of each claim of a claims file, in order, from the YAML parser's marks
+    (the claims list of the top mapping, or the top list).  Called on a text the checker has read already, so its
+    nesting and size are within the claims file's bounds; trailing blank and comment lines are not the claim's."""
+    import yaml
+
+    root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    seq = root
+    if isinstance(root, yaml.MappingNode):
+        seq = next((v for k, v in root.value if isinstance(k, yaml.ScalarNode) and k.value == "claims"), None)
+    if not isinstance(seq, yaml.SequenceNode):
+        return []
+    rows = text.split("\n")
+    out = []
+    for node in seq.value:
+        first = node.start_mark.line + 1
+        end = node.end_mark  # just after the claim: on its last line, or at the start of the next item's line
+        ended_inside = end.line < len(rows) and rows[end.line][: end.column].strip() != ""
+        last = max(first, end.line + 1 if ended_inside else end.line)
+        while last > first and (not rows[last - 1].strip() or rows[last - 1].lstrip().startswith("#")):
+            last -= 1
+        out.append((first, last))
+    return out
 
 
 def singularities(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:

@@ -107,10 +107,44 @@
         $("check-summary").textContent = Object.keys(s).filter(function (k) { return s[k]; })
           .map(function (k) { return s[k] + " " + k; }).join(", ") || "nothing to judge was found";
         $("check-summary").dataset.summary = JSON.stringify(s);
-        $("checked").hidden = !res.html; $("check-text-result").hidden = !!res.html;
-        if (res.html) $("checked").srcdoc = res.html; else $("check-text-result").textContent = res.text;
+        $("checked").hidden = !res.html; $("claims-annotated").hidden = res.kind !== "claims";
+        $("check-text-result").hidden = true;
+        if (res.html) $("checked").srcdoc = res.html;
+        if (res.kind === "claims") annotateClaims(res);
       });
     });
+  }
+
+  // a claims file shown as written, each claim's verdict marked beside its first line, the message after its last
+  var MARKS = { correct: "✓", incorrect: "✗", ambiguous: "?", unreadable: "!" };
+  function annotateClaims(res) {
+    var box = $("claims-annotated"), rows = res.source.split("\n"), at = {}, after = {}, loose = [];
+    box.innerHTML = "";
+    res.claims.forEach(function (c) {
+      if (c.line) { (at[c.line] = at[c.line] || []).push(c); (after[c.end_line] = after[c.end_line] || []).push(c); }
+      else loose.push(c);
+    });
+    function note(c) {
+      var d = document.createElement("div");
+      d.className = "claim-note v-" + c.verdict;
+      d.textContent = c.verdict + " — " + c.id + " (" + c.quantity + "): " + c.message +
+        (c.hints.length ? "  hint: " + c.hints.join("; ") : "");
+      return d;
+    }
+    rows.forEach(function (text, i) {
+      var n = i + 1, line = document.createElement("div"), gutter = document.createElement("span"), code = document.createElement("code");
+      line.className = "claim-line"; gutter.className = "gutter"; gutter.textContent = n;
+      (at[n] || []).forEach(function (c) {
+        var m = document.createElement("span");
+        m.className = "verdict v-" + c.verdict; m.textContent = MARKS[c.verdict] || "·";
+        m.dataset.verdict = c.verdict; m.dataset.claim = c.id; m.dataset.line = n; m.title = c.verdict + ": " + c.message;
+        gutter.appendChild(m);
+      });
+      code.textContent = text; line.appendChild(gutter); line.appendChild(code); box.appendChild(line);
+      (after[n] || []).forEach(function (c) { box.appendChild(note(c)); });
+    });
+    loose.forEach(function (c) { box.appendChild(note(c)); });
+    res.notes.forEach(function (t) { var d = document.createElement("div"); d.className = "notes"; d.textContent = t; box.appendChild(d); });
   }
 
   // ---- singular sets: derived once (a job), the nearest one named at every slider move -------------------
@@ -192,7 +226,7 @@
   });
   $("check-file").addEventListener("change", function () {
     var f = this.files[0], m = f && /\.(md|markdown|tex|txt|ya?ml)$/i.exec(f.name);
-    if (m) $("check-kind").value = { markdown: "md", yml: "yaml" }[m[1].toLowerCase()] || m[1].toLowerCase();
+    $("check-kind").value = m ? ({ markdown: "md", yml: "yaml" }[m[1].toLowerCase()] || m[1].toLowerCase()) : "auto";
   });
   $("check-start").addEventListener("click", startCheck);
   $("ws-start").addEventListener("click", startWorkspace);
