@@ -66,27 +66,49 @@ def arm(request, _kernel_cache):
 # --- comparison -------------------------------------------------------------------------------------------------
 
 
-def _match(A: np.ndarray, B: np.ndarray, tol: float) -> list[int]:
-    """Index in B of each row of A (one to one), within tol; fails if some row has no partner."""
+def _match(A: np.ndarray, B: np.ndarray, tol) -> list[int]:
+    """Index in B of each row of A (one to one), within tol (a number, or one per row of A); fails if some row has
+    no partner."""
     assert A.shape == B.shape, (A, B)
+    tol = np.broadcast_to(tol, (len(A),))
     free = list(range(len(B)))
     out = []
-    for row in A:
+    for row, t in zip(A, tol):
         d = [np.max(np.abs(row - B[k])) for k in free]
-        assert d and min(d) < tol, (row, B)
+        assert d and min(d) < t, (row, B, t)
         out.append(free.pop(int(np.argmin(d))))
     return out
 
 
-def _same(robot, T, a, b, tol: float = 1e-10):
-    """a (compiled) and b (plain) give the same answer for T; every solution reproduces T by the plain FK."""
+#: joint-space agreement asked of the two solvers at a well-conditioned solution
+TOL = 1e-10
+
+
+def _tolerance(robot, Q: np.ndarray) -> np.ndarray:
+    """TOL per solution, widened by the Jacobian's condition number there (position rows divided by the arm's
+    length): a pose both solvers reproduce to unit roundoff fixes q only to about eps * sigma_max / sigma_min along
+    the Jacobian's weakest direction, so near a singular set two exact answers differ that much (seed 340: sigma
+    ratio 5.6e5, the two answers 1.07e-10 apart, each reproducing T to 1e-15)."""
+    if len(Q) == 0:
+        return np.zeros(0)
+    L = max(1.0, sum(abs(l.a) + abs(l.d) for l in robot.links))
+    J = denavit.geometric_jacobian(robot, Q)  # (k, 6, n)
+    s = np.linalg.svd(J * np.array([1 / L] * 3 + [1.0] * 3)[:, None], compute_uv=False)  # (k, 6)
+    return TOL + 16 * np.finfo(float).eps * s[:, 0] / np.maximum(s[:, -1], 1e-300)
+
+
+def _same(robot, T, a, b):
+    """a (compiled) and b (plain) give the same answer for T (to TOL, widened by the conditioning); every solution
+    reproduces T by the plain FK."""
     assert (a.method, a.controlled) == (b.method, b.controlled)
-    idx = _match(np.asarray(a.solutions), np.asarray(b.solutions), tol)
+    A = np.asarray(a.solutions)
+    idx = _match(A, np.asarray(b.solutions), _tolerance(robot, A))
     assert [a.branches[k] for k in range(len(idx))] == [b.branches[j] for j in idx]
     assert [a.free[k] for k in range(len(idx))] == [b.free[j] for j in idx]
     np.testing.assert_allclose(a.position_error, np.asarray(b.position_error)[idx], atol=1e-12)
     np.testing.assert_allclose(a.orientation_error, np.asarray(b.orientation_error)[idx], atol=1e-12)
-    _match(np.asarray(a.outside_limits), np.asarray(b.outside_limits), tol)
+    O = np.asarray(a.outside_limits)
+    _match(O, np.asarray(b.outside_limits), _tolerance(robot, O))
     if len(a.solutions):
         F = denavit.forward_kinematics(robot, np.asarray(a.solutions))
         L = max(1.0, sum(abs(l.a) + abs(l.d) for l in robot.links))
@@ -289,6 +311,7 @@ def _random_ur_class(seed: int) -> DHRobot:
 @pytest.mark.slow
 @settings(max_examples=2 if REDUCED else 5)
 @given(seed=st.integers(0, 2**32 - 1))
+@example(seed=340)  # a pose 3e-6 from a singular set: two exact answers 1.07e-10 apart (see _tolerance)
 @example(seed=391)  # a singular pose with q3 = 0 at a limit of −2π: the folding's knife edge (FOLD_EDGE)
 def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
     """Random UR-class arms (both conventions, offsets, limits, base and tool) x random and singular poses."""
