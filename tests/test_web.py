@@ -307,10 +307,11 @@ def test_hostile_bodies_get_one_line_4xx_never_500(client):
     hostile()
 
 
-def _wait(client, job_id, states=("done", "failed", "cancelled"), polls=1200):
+def _wait(client, job_id, states=("done", "failed", "cancelled"), polls=1200, until=None):
+    """The job's status once it is in one of ``states`` (or ``until(status)`` holds), polled every 50 ms."""
     for _ in range(polls):
         s = client.get(f"/api/jobs/{job_id}").json()
-        if s["state"] in states:
+        if s["state"] in states or (until is not None and until(s)):
             return s
         time.sleep(0.05)
     raise AssertionError(f"job {job_id} still {s['state']}: {s['progress'][-1:]}")
@@ -345,6 +346,26 @@ def test_a_long_job_is_cancelled_and_never_blocks_the_quick_answers(client):
     assert not proc.is_alive() and proc.exitcode == -signal.SIGTERM
     assert _wait(client, job["id"])["state"] == "cancelled"
     _one_line_error(client.get("/api/jobs/no-such-job"), 404)
+
+
+def test_a_reachability_job_reports_its_progress_and_cancel_ends_its_process(client):
+    """The reachability map of puma560 at 5 cm (a minute or more of work): its progress is the library's progress
+    line (a percentage of samples, then of voxels); cancel ends the job's process.  A bad voxel size is one line."""
+    puma = client.post("/api/catalogue/load", json={"name": "puma560"}).json()["robot"]
+    job = client.post("/api/jobs", json={"kind": "reachability",
+                                         "payload": {"robot": puma, "resolution": 0.05, "orientations": 100}}).json()
+    s = _wait(client, job["id"], until=lambda st: any("%" in line for line in st["progress"]))
+    assert s["state"] == "running", s
+    line = next(x for x in s["progress"] if "%" in x)
+    assert line.split("%")[0].replace(".", "").strip().isdigit() and ("samples" in line or "voxels" in line)
+    assert client.post(f"/api/jobs/{job['id']}/cancel").json()["state"] == "cancelled"
+    proc = client.app.state.jobs._jobs[job["id"]].process
+    proc.join(timeout=30)
+    assert not proc.is_alive() and proc.exitcode == -signal.SIGTERM
+    for bad in (0.001, "0.1", True):
+        r = client.post("/api/jobs", json={"kind": "reachability", "payload": {"robot": puma, "resolution": bad}})
+        s = _wait(client, r.json()["id"])
+        assert s["state"] == "failed" and "'resolution'" in s["error"] and "\n" not in s["error"]
 
 
 def test_a_job_in_the_same_slot_supersedes_the_running_one_and_never_counts_against_the_limit(client):

@@ -283,6 +283,27 @@ def test_upload_a_claims_file_and_see_each_claim_marked_in_place(page, tmp_path)
     assert len(notes) == 2 and notes[1].startswith("incorrect — wrong (position)")
 
 
+def test_a_reachability_map_on_demand_with_its_progress_bar_and_cancel(page):
+    """A fine map of puma560 (minutes): the bar moves with the library's progress, cancel stops the job (the
+    server says cancelled).  Then a coarse one (30 cm, one orientation: seconds) runs to its picture."""
+    page.fill("#reach-resolution", "0.05")
+    page.click("#reach-start")
+    page.wait_for_function("+document.getElementById('reach-progress').value > 0", timeout=120_000)
+    assert "%" in page.locator("#reach-status").text_content()
+    page.click("#reach-cancel")
+    state = page.evaluate("fetch('/api/jobs/' + window.workbench.reachJob.id).then(r => r.json()).then(s => s.state)")
+    assert state == "cancelled" and page.locator("#reach-status").text_content() == "cancelled"
+    assert page.locator("#reach-progress").get_attribute("value") in ("0", "0.0")
+    page.fill("#reach-resolution", "0.3")
+    page.fill("#reach-orientations", "1")
+    page.click("#reach-start")
+    page.wait_for_function("!document.getElementById('reach-picture').hidden", timeout=180_000)
+    assert page.evaluate("document.getElementById('reach-picture').naturalWidth") > 100  # a PNG the page decoded
+    status = page.locator("#reach-status").text_content()
+    reached, tested = (int(x) for x in status.split(" voxels")[0].split(" of "))
+    assert 0 < reached < tested and "analytic IK" in status
+
+
 def test_the_singular_sets_and_the_report_in_the_background(page):
     page.select_option("#catalogue", "planar2r")
     page.wait_for_function("window.workbench.doc().name === 'planar2r' && window.workbench.kinCount > 0 && "

@@ -1,5 +1,6 @@
 """The workbench's long work, run in a child process (:mod:`denavit.web._jobs`): the symbolic T_0_n, the
-derivation report, the checker, the singular conditions and the workspace picture.
+derivation report, the checker, the singular conditions, the workspace picture and
+the reachability map.
 
 Each job is a function ``(payload, progress) -> dict`` of JSON data; the robot is re-read from its file mapping
 here (``robot_from_dict``), so nothing but JSON crosses the process boundary.  The report is the library's
@@ -217,10 +218,67 @@ def workspace(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[
             "volume": ws.volume, "area": ws.area, "planar": ws.planar, "extent": ws.extent.tolist()}
 
 
+#: Voxel edges a page's reachability map may ask for [m] (the library refuses too many cells itself).
+REACH_RESOLUTION = (0.01, 10.0)
+#: Most orientations per voxel a page may ask for (each is one IK problem per voxel).
+MAX_REACH_ORIENTATIONS = 1_000
+
+
+def reachability(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
+    """The reachability map (:func:`denavit.scale.reachability`, as ``denavit reachability``: per voxel the share of
+    a fixed set of orientations the arm reaches, and the manipulability) and its picture
+    (:func:`~denavit.viz.plot_reachability`).  The library's progress line (a screen of samples, then the voxels)
+    is passed on as the job's progress."""
+    import base64
+    import io
+    import sys
+
+    from ..scale import reachability as reach_map
+    from ..viz import plot_reachability
+
+    h, k = payload.get("resolution", 0.1), payload.get("orientations", 100)
+    if not isinstance(h, (int, float)) or isinstance(h, bool) or not REACH_RESOLUTION[0] <= h <= REACH_RESOLUTION[1]:
+        raise ParseError(f"'resolution' must be a voxel edge from {REACH_RESOLUTION[0]} to {REACH_RESOLUTION[1]} m")
+    if not isinstance(k, int) or isinstance(k, bool) or not 1 <= k <= MAX_REACH_ORIENTATIONS:
+        raise ParseError(f"'orientations' must be a whole number from 1 to {MAX_REACH_ORIENTATIONS}")
+    robot = _robot(payload)
+    progress(f"reachability of {robot.name}: {k} orientations per {h:g} m voxel")
+    stderr, sys.stderr = sys.stderr, _ProgressLines(progress)
+    try:
+        rmap = reach_map(robot, float(h), k, progress=True)
+    finally:
+        sys.stderr = stderr
+    progress("drawing")
+    buf = io.BytesIO()
+    plot_reachability(rmap, robot.name).savefig(buf, format="png")
+    return {"png": base64.b64encode(buf.getvalue()).decode("ascii"), **rmap.summary()}
+
+
+class _ProgressLines:
+    """A text stream standing in for stderr: each line the library's progress bar redraws (``\\r`` 12.5%  200/1,600
+    voxels …) becomes one progress message."""
+
+    def __init__(self, progress: Callable[[str], None]) -> None:
+        self.progress = progress
+
+    def write(self, text: str) -> int:
+        line = text.replace("\n", "\r").split("\r")
+        line = next((part.strip() for part in reversed(line) if part.strip()), "")
+        if line:
+            self.progress(line)
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return False
+
+
 #: The jobs a page may start, by name.
 KINDS: dict[str, Callable[[dict[str, Any], Callable[[str], None]], dict[str, Any]]] = {
     "formula": formula, "report": report, "check": check, "workspace": workspace,
-    "singularities": singularities,
+    "singularities": singularities, "reachability": reachability,
 }
 
 

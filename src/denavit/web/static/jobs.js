@@ -1,5 +1,5 @@
 /* denavit workbench, the long work: jobs run by the server in their own processes (the symbolic T_0n, the singular
- * sets, the report, the check, the workspace), polled for progress, cancelled when superseded or when the page goes.
+ * sets, the report, the check, the workspace, the reachability map), polled for progress, cancelled when superseded or when the page goes.
  * Uses the page's state through window.workbench.internals (workbench.js, loaded first).
  */
 (function () {
@@ -210,6 +210,33 @@
       $("ws-picture").src = "data:image/png;base64," + res.png; $("ws-picture").hidden = false;
     });
   }
+  // the reachability map (denavit reachability): the library's progress line is the job's, a screen of position
+  // samples (the first fifth of the bar) then the voxels
+  var reachJob = null;
+  function number(id) { var t = $(id).value.trim(), x = Number(t); return t && isFinite(x) ? x : t; }
+  function startReach() {
+    sync();
+    $("reach-start").disabled = true; $("reach-cancel").disabled = false; $("reach-progress").value = 0;
+    $("reach-picture").hidden = true;
+    reachJob = wb.reachJob = runJob("reachability", { robot: good.doc, resolution: number("reach-resolution"),
+                                                      orientations: number("reach-orientations") }, function (p) {
+      var last = p[p.length - 1] || "starting", m = /^([\d.]+)%.*\b(samples|voxels)\b/.exec(last);
+      $("reach-status").textContent = last;
+      if (m) $("reach-progress").value = m[2] === "samples" ? 0.2 * m[1] / 100 : 0.2 + 0.8 * m[1] / 100;
+    }, function (res, err) {
+      $("reach-start").disabled = false; $("reach-cancel").disabled = true; $("reach-progress").value = res ? 1 : 0;
+      if (!res) { $("reach-status").textContent = err; return; }
+      $("reach-status").textContent = res.voxels_reached + " of " + res.voxels_tested + " voxels reached (" +
+        res.reachable_volume.toFixed(3) + " m³), at half of the orientations or more " + res.dexterous_volume.toFixed(3) +
+        " m³; " + res.method + " IK";
+      $("reach-picture").src = "data:image/png;base64," + res.png; $("reach-picture").hidden = false;
+    });
+  }
+  $("reach-start").addEventListener("click", startReach);
+  $("reach-cancel").addEventListener("click", function () {
+    cancelJob(reachJob); $("reach-start").disabled = false; $("reach-cancel").disabled = true;
+    $("reach-status").textContent = "cancelled"; $("reach-progress").value = 0;
+  });
   $("report-start").addEventListener("click", startReport);
   $("report-cancel").addEventListener("click", function () {
     cancelJob(reportJob); $("report-start").disabled = false; $("report-cancel").disabled = true;
