@@ -162,17 +162,17 @@ def test_an_ik_answer_runs_off_the_event_loop_so_slider_answers_still_come(monke
     kinematics answers of the sliders keep coming on the one event loop."""
     import threading
 
-    from denavit.web import _handlers as H
+    from denavit.web import _ik
 
     release, entered, out = threading.Event(), threading.Event(), {}
-    real = H.inverse_kinematics
+    real = _ik.inverse_kinematics
 
     def held(body):
         entered.set()
         release.wait(timeout=60)
         return real(body)
 
-    monkeypatch.setattr(H, "inverse_kinematics", held)
+    monkeypatch.setattr(_ik, "inverse_kinematics", held)
     jobs = Jobs()
     jobs.warm_up = lambda: None  # no fork server needed here
     with TestClient(create_app(allowed_hosts=["testserver"], jobs=jobs)) as c:  # one event loop for all requests

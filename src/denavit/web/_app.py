@@ -25,6 +25,7 @@ from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.routing import Route
 
 from . import _handlers as H
+from . import _ik
 from ._jobs import Jobs
 
 __all__ = ["MAX_BODY_BYTES", "MAX_CHECK_BYTES", "create_app"]
@@ -122,7 +123,7 @@ def _routes() -> list[Route]:
         Route("/api/catalogue/load", _post(H.catalogue_robot), methods=["POST"]),
         Route("/api/robot", _post(H.robot_info), methods=["POST"]),
         Route("/api/kinematics", _post(H.kinematics), methods=["POST"]),
-        Route("/api/ik", _post(H.inverse_kinematics, threaded=True), methods=["POST"]),
+        Route("/api/ik", _post(_ik.inverse_kinematics, threaded=True), methods=["POST"]),
         Route("/api/dynamics", _post(H.dynamics), methods=["POST"]),
         Route("/api/statics", _post(H.statics), methods=["POST"]),
         Route("/api/table", _post(H.table), methods=["POST"]),

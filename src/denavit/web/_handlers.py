@@ -24,7 +24,6 @@ import numpy as np
 from .. import (
     DenavitError,
     Frame,
-    analytic_ik,
     catalogue_names,
     coriolis_vector,
     dump_robot,
@@ -45,22 +44,23 @@ __all__ = [
     "catalogue",
     "catalogue_robot",
     "dynamics",
-    "inverse_kinematics",
+    "field_of",
+    "json_matrix",
     "kinematics",
     "one_line",
+    "q_of",
     "robot_file",
     "robot_info",
     "robot_of",
     "statics",
     "table",
+    "values_of",
 ]
 
 #: Longest error line sent back (long user text is cut in the middle).
 MAX_MESSAGE = 300
 #: Robots kept parsed, by the exact JSON of their file mapping (a slider move re-sends the same table).
 ROBOT_CACHE = 64
-#: Most IK solutions listed (an analytic 6R arm has at most 16).
-MAX_SOLUTIONS = 64
 _CELL = re.compile(r"row (\d+), field '([a-z_]+)")
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069]")
 
@@ -136,18 +136,18 @@ def _parse(doc: dict, key: str) -> tuple[Any, tuple[str, ...]]:
     return robot, notes
 
 
-def _field(body: Any, key: str, default: Any = None) -> Any:
+def field_of(body: Any, key: str, default: Any = None) -> Any:
     return body.get(key, default) if isinstance(body, dict) else default
 
 
-def _q(body: Any, robot: Any, key: str = "q") -> np.ndarray:
+def q_of(body: Any, robot: Any, key: str = "q") -> np.ndarray:
     """Joint values ``body[key]`` of ``robot``."""
-    return _values(body, key, robot.dof)
+    return values_of(body, key, robot.dof)
 
 
-def _values(body: Any, key: str, n: int) -> np.ndarray:
+def values_of(body: Any, key: str, n: int) -> np.ndarray:
     """``n`` values: a list of numbers (the sliders) or a text such as ``"0, pi/4, 90deg"`` (radians unless deg)."""
-    raw = _field(body, key)
+    raw = field_of(body, key)
     if raw is None:
         raise RequestError(f"'{key}' is missing: {n} values", 422)
     if not isinstance(raw, (str, list)) or (isinstance(raw, list) and not all(
@@ -163,7 +163,7 @@ def _values(body: Any, key: str, n: int) -> np.ndarray:
     return q
 
 
-def _matrix(a: np.ndarray) -> list:
+def json_matrix(a: np.ndarray) -> list:
     a = np.where(np.abs(a) < 1e-15, 0.0, a)
     return [_finite(x) for x in a.tolist()] if a.ndim == 1 else [[_finite(x) for x in row] for row in a.tolist()]
 
@@ -182,9 +182,9 @@ def robot_info(body: Any) -> dict[str, Any]:
         "name": robot.name, "dof": robot.dof, "convention": robot.convention.value,
         "rows": [link.joint.value for link in robot.links],
         "joint_types": [t.value for t in robot.joint_types],
-        "limits": _matrix(slider_limits(robot)),
+        "limits": json_matrix(slider_limits(robot)),
         "poses": {name: list(q) for name, q in robot.poses},
-        "q0": _matrix(q0), "notes": list(notes),
+        "q0": json_matrix(q0), "notes": list(notes),
         "viewer": viewer_html(robot, q0, title=robot.name),
         "has_inertia": all(link.inertia is not None for link in robot.links if link.is_joint),
     }
@@ -196,19 +196,19 @@ def kinematics(body: Any) -> dict[str, Any]:
     from ..numeric import TWIST_ROWS, select_rows
 
     robot = robot_of(body)
-    q = _q(body, robot)
+    q = q_of(body, robot)
     T = forward_kinematics(robot, q)                    # (4, 4)
     J = geometric_jacobian(robot, q)                    # (6, n), rows (v, ω) in base axes
-    rows = _field(body, "rows")                         # task rows of the measures, e.g. ["vx", "vy"] (planar)
+    rows = field_of(body, "rows")                         # task rows of the measures, e.g. ["vx", "vy"] (planar)
     try:
         idx = select_rows(rows if isinstance(rows, list) and all(isinstance(r, str) for r in rows) else None)
     except ValueError as exc:
         raise RequestError(f"rows: {exc}") from None
     Jt = J[idx]                                         # (m, n)
     sv = np.linalg.svd(Jt, compute_uv=False)
-    out = {"q": _matrix(q), "T": _matrix(T), "J": _matrix(J), "manipulability": float(manipulability(Jt)),
-           "rows": [TWIST_ROWS[i] for i in idx], "singular_values": _matrix(sv), "det": None,
-           "seq": _field(body, "seq")}
+    out = {"q": json_matrix(q), "T": json_matrix(T), "J": json_matrix(J), "manipulability": float(manipulability(Jt)),
+           "rows": [TWIST_ROWS[i] for i in idx], "singular_values": json_matrix(sv), "det": None,
+           "seq": field_of(body, "seq")}
     if Jt.shape[0] == Jt.shape[1]:
         out["det"] = float(np.linalg.det(Jt))
     if not isinstance(out["seq"], (int, float)) or isinstance(out["seq"], bool):
@@ -216,91 +216,43 @@ def kinematics(body: Any) -> dict[str, Any]:
     return out
 
 
-def inverse_kinematics(body: Any) -> dict[str, Any]:
-    """Every analytic IK solution of the target: ``pose`` "x, y, z, roll, pitch, yaw" (m, rad) or the pose at ``q``;
-    ``lock`` holds joints of a redundant arm (``"q7"`` at its value in ``q``, or ``"q7 = 0.3"``)."""
-    from ..numeric import transform_from_xyz_rpy
-
-    robot = robot_of(body)
-    if _field(body, "pose") is not None:
-        if not isinstance(body["pose"], str):
-            raise RequestError("'pose' must be a text \"x, y, z, roll, pitch, yaw\" (m, rad; deg suffix allowed)")
-        p = _values(body, "pose", 6)
-        T = transform_from_xyz_rpy(p[:3], p[3:])
-    else:
-        T = forward_kinematics(robot, _q(body, robot))
-    try:
-        res = analytic_ik(robot, T, _locked(body, robot) or None)
-    except DenavitError as exc:
-        raise RequestError(str(exc), 422) from None
-    k = min(len(res.solutions), MAX_SOLUTIONS)
-    return {"target": _matrix(T), "method": res.method, "controlled": res.controlled,
-            "solutions": [{"q": _matrix(res.solutions[i]), "branch": res.branches[i], "valid": bool(res.valid[i]),
-                           "position_error": float(res.position_error[i]),
-                           "orientation_error": float(res.orientation_error[i])} for i in range(k)],
-            "outside_limits": len(res.outside_limits)}
-
-
-_LOCK = re.compile(r"^\s*q(\d{1,3})\s*(?:=\s*(.+?))?\s*$")
-
-
-def _locked(body: Any, robot: Any) -> dict[str, float]:
-    """The held joints of a redundant arm's IK: ``"q7"`` (at its value in ``q``) or ``"q7 = 0.3"``, comma-separated."""
-    text = _field(body, "lock")
-    if text in (None, ""):
-        return {}
-    if not isinstance(text, str) or len(text) > 400:
-        raise RequestError("'lock' must be a text such as \"q7\" or \"q7 = 0.3\"")
-    held: dict[str, float] = {}
-    for part in text.split(","):
-        m = _LOCK.match(part)
-        if not m or not 1 <= int(m.group(1)) <= robot.dof:
-            raise RequestError(f"lock: {one_line(part, 40)!r} is not q1 … q{robot.dof}, alone or '= value'")
-        k = int(m.group(1))
-        if m.group(2) is None:
-            held[f"q{k}"] = float(_q(body, robot)[k - 1])
-        else:
-            held[f"q{k}"] = float(_values({"v": [m.group(2)]}, "v", 1)[0])
-    return held
-
-
 def dynamics(body: Any) -> dict[str, Any]:
     """M(q), c(q, q̇) = C(q, q̇) q̇ and g(q) by the numeric engine (RNEA; Featherstone 2008, ch. 5)."""
     robot = robot_of(body)
-    q = _q(body, robot)
-    qd = _q(body, robot, "qd") if _field(body, "qd") not in (None, "") else np.zeros(robot.dof)
+    q = q_of(body, robot)
+    qd = q_of(body, robot, "qd") if field_of(body, "qd") not in (None, "") else np.zeros(robot.dof)
     try:
         M, c, g = mass_matrix(robot, q), coriolis_vector(robot, q, qd), gravity_torques(robot, q)
     except DenavitError as exc:
         raise RequestError(str(exc), 422) from None
-    return {"q": _matrix(q), "qd": _matrix(qd), "M": _matrix(M), "c": _matrix(c), "g": _matrix(g)}
+    return {"q": json_matrix(q), "qd": json_matrix(qd), "M": json_matrix(M), "c": json_matrix(c), "g": json_matrix(g)}
 
 
 def statics(body: Any) -> dict[str, Any]:
     """τ = Jᵀ w for the end-effector wrench w = (f, n) [N, N·m] in base or tool axes (Craig eq. 5.105)."""
     robot = robot_of(body)
-    q = _q(body, robot)
-    w = _values(body, "wrench", 6)
-    frame = _field(body, "frame", "base")
+    q = q_of(body, robot)
+    w = values_of(body, "wrench", 6)
+    frame = field_of(body, "frame", "base")
     if frame not in ("base", "tool"):
         raise RequestError("'frame' must be base or tool")
-    return {"q": _matrix(q), "wrench": _matrix(w), "frame": frame,
-            "tau": _matrix(joint_torques(robot, q, w, frame=Frame(frame)))}
+    return {"q": json_matrix(q), "wrench": json_matrix(w), "frame": frame,
+            "tau": json_matrix(joint_torques(robot, q, w, frame=Frame(frame)))}
 
 
 def table(body: Any) -> dict[str, Any]:
     """A DH table pasted from a document (:func:`denavit.tables.import_table`) as a robot-file mapping."""
     from ..tables import import_table
 
-    text = _field(body, "text")
+    text = field_of(body, "text")
     if not isinstance(text, str) or not text.strip():
         raise RequestError("'text' must be the pasted table")
-    conv = _field(body, "convention")
-    deg = _field(body, "degrees")
+    conv = field_of(body, "convention")
+    deg = field_of(body, "degrees")
     if conv not in (None, "standard", "modified") or deg not in (None, True, False):
         raise RequestError("'convention' must be standard, modified or null; 'degrees' true, false or null")
     try:
-        result = import_table(text, name=str(_field(body, "name", "pasted"))[:80], convention=conv, degrees=deg,
+        result = import_table(text, name=str(field_of(body, "name", "pasted"))[:80], convention=conv, degrees=deg,
                               where="pasted table")
     except DenavitError as exc:
         raise RequestError(str(exc), 422) from None
@@ -313,7 +265,7 @@ def catalogue() -> dict[str, Any]:
 
 def catalogue_robot(body: Any) -> dict[str, Any]:
     """A built-in robot's file mapping, read from the package's own data (never a path from the request)."""
-    name = _field(body, "name")
+    name = field_of(body, "name")
     names = catalogue_names()
     if not isinstance(name, str) or (name not in names and name not in CATALOGUE_ALIASES):
         raise RequestError(f"unknown robot {one_line(name, 60)!r}; the {len(names)} built-in names are listed at /api/catalogue", 404)
@@ -326,7 +278,7 @@ def catalogue_robot(body: Any) -> dict[str, Any]:
 
 def robot_file(body: Any) -> dict[str, Any]:
     """The robot file of the table, as YAML or JSON text (:func:`denavit.dump_robot`)."""
-    fmt = _field(body, "format", "yaml")
+    fmt = field_of(body, "format", "yaml")
     if fmt not in ("yaml", "json"):
         raise RequestError("'format' must be yaml or json")
     robot = robot_of(body)
@@ -345,7 +297,7 @@ def opened_file(body: Any) -> dict[str, Any]:
     """
     from .. import from_urdf
 
-    text, name = _field(body, "text"), _field(body, "filename")
+    text, name = field_of(body, "text"), field_of(body, "filename")
     if not isinstance(text, str) or not isinstance(name, str):
         raise RequestError("'text' and 'filename' must be the file's text and name")
     suffix = "." + name.rsplit(".", 1)[-1].lower() if "." in name else ""
