@@ -18,6 +18,8 @@ import urllib.request
 import numpy as np
 import pytest
 
+import denavit
+
 pytest.importorskip("starlette")
 pytest.importorskip("httpx")
 
@@ -136,6 +138,35 @@ def test_a_redundant_arm_is_solved_with_a_held_joint(client):
     assert min(np.abs(np.array(s["q"]) - q).max() for s in r["solutions"]) < 1e-9
     for bad in ("q9", "x7", "q7 = pi/", "q0"):
         _one_line_error(client.post("/api/ik", json={"robot": panda, "q": q, "lock": bad}), 422)
+
+
+def test_numeric_ik_of_a_seven_joint_arm_from_the_sliders_and_a_shifted_target(client):
+    """panda has no closed form for its 7 joints: the numeric answer (Levenberg–Marquardt from the seed) reaches the
+    pose of another configuration within the solver's tolerance, by FK computed here; a target shifted by the
+    drag pad is the pose at q moved along world axes."""
+    from denavit.ik import TOL
+
+    panda = client.post("/api/catalogue/load", json={"name": "panda"}).json()["robot"]
+    assert client.post("/api/robot", json={"robot": panda}).json()["analytic_ik"] is False
+    robot = denavit.robot_from_dict(panda)
+    qb, seed = [0.3, -0.4, 0.2, -1.8, 0.1, 1.6, 0.5], [0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0]
+    r = client.post("/api/ik", json={"robot": panda, "q": qb, "seed": seed, "method": "numeric"}).json()
+    assert len(r["solutions"]) == 1 and r["solutions"][0]["valid"] and r["method"].startswith("numeric")
+    sol = np.array(r["solutions"][0]["q"])
+    assert np.abs(sol - qb).max() > 1e-3  # found from the seed, not handed back
+    Tb = denavit.forward_kinematics(robot, qb)
+    Ts = denavit.forward_kinematics(robot, sol)
+    assert np.linalg.norm(Ts[:3, 3] - Tb[:3, 3]) <= TOL
+    assert np.linalg.norm(Ts[:3, :3] - Tb[:3, :3]) <= 10 * TOL  # ‖ΔR‖_F ≈ √2 |angle| for a small rotation
+    r = client.post("/api/ik", json={"robot": panda, "q": qb, "shift": "0.1, 0, -0.05", "method": "numeric"}).json()
+    np.testing.assert_allclose(np.array(r["target"])[:3, 3], Tb[:3, 3] + [0.1, 0, -0.05], atol=1e-12)
+    np.testing.assert_allclose(np.array(r["target"])[:3, :3], Tb[:3, :3], atol=1e-12)
+    assert r["solutions"] and np.allclose(denavit.forward_kinematics(robot, r["solutions"][0]["q"]), r["target"],
+                                          atol=1e-8)
+    assert client.post("/api/robot", json={"robot": client.post("/api/catalogue/load", json={"name": "puma560"})
+                                           .json()["robot"]}).json()["analytic_ik"] is True
+    for bad in ({"method": "guess"}, {"shift": "1, 2"}, {"shift": "1e4, 0, 0"}, {"seed": [1, 2]}):
+        _one_line_error(client.post("/api/ik", json={"robot": panda, "q": qb, "method": "numeric", **bad}), 422)
 
 
 def test_dynamics_match_the_closed_form_planar_elbow_and_statics_the_transpose(client):

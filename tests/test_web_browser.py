@@ -240,6 +240,85 @@ def test_pick_an_ik_solution_and_the_arm_goes_there(page):
     assert np.abs(c).max() > 1e-3
 
 
+def _set_q(page, text: str, q1: float) -> None:
+    count = page.evaluate("window.workbench.kinCount")
+    page.fill("#q-text", text)
+    page.click("#q-set")
+    page.wait_for_function("""([count, q1]) => window.workbench.kinCount > count && !window.workbench.busy() &&
+        Math.abs(JSON.parse(document.getElementById('T').dataset.q)[0] - q1) < 1e-12""", arg=[count, q1], timeout=60_000)
+
+
+def _drag_pad(page, du: float, dv: float) -> np.ndarray:
+    """Drag the IK pad from its centre by (du, dv) pixels (dv up); the shift of the target it means [m], from the
+    pad's scale (±span over half the pad's width), and the page settled after it."""
+    page.locator("#ik-pad").scroll_into_view_if_needed()
+    box = page.locator("#ik-pad").bounding_box()
+    cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    count = page.evaluate("window.workbench.kinCount")
+    page.mouse.move(round(cx), round(cy))  # whole pixels: the browser's mouse events are
+    page.mouse.down()
+    for k in range(1, 5):
+        page.mouse.move(round(cx + du * k / 4), round(cy - dv * k / 4))
+    page.mouse.up()
+    page.wait_for_function(f"window.workbench.padIdle() && window.workbench.kinCount > {count} && "
+                           "!window.workbench.busy()", timeout=60_000)
+    span = float(page.locator("#ik-span").input_value())
+    return span * np.array([round(cx + du) - cx, cy - round(cy - dv)]) / (box["width"] / 2)
+
+
+def test_drag_the_ik_target_and_the_arm_follows(page):
+    """The pad moves the target in the x–y plane of the world; puma560 follows the analytic solution nearest its q,
+    and the pose shown is the start pose moved by the pad's shift (FK here)."""
+    robot = denavit.load_robot("puma560")
+    _set_q(page, "0.3, 0.4, -0.6, 0.5, 0.8, -0.2", 0.3)
+    q0, T0 = _shown(page)
+    shift = _drag_pad(page, 30, -24)
+    q1, T1 = _shown(page)
+    want = T0.copy()
+    want[:2, 3] += shift
+    np.testing.assert_allclose(T1, want, atol=1e-9)
+    np.testing.assert_allclose(T1, denavit.forward_kinematics(robot, q1), atol=1e-12)
+    assert 1e-3 < np.abs(q1 - q0).max() < 0.5  # the nearest branch: a small move, not another elbow
+    target = [float(x) for x in page.locator("#ik-target").input_value().split(",")]
+    np.testing.assert_allclose(target[:3], want[:3, 3], atol=1e-6)  # the field shows the dragged target
+
+
+def test_numeric_ik_of_a_seven_joint_arm_click_to_go_and_drag(page):
+    """panda (no closed form for 7 joints): 'numeric from q' solves a typed target from the sliders' q; FK of the
+    solution (here) is the target within the solver's tolerance; clicking it moves the arm; dragging the pad then
+    follows with the numeric solver."""
+    from denavit.ik import TOL
+    from denavit.numeric import rpy_from_rotation
+
+    robot = denavit.load_robot("panda")
+    page.select_option("#catalogue", "panda")
+    page.wait_for_function("window.workbench.doc().name === 'panda' && window.workbench.kinCount > 0 && "
+                           "!window.workbench.busy()", timeout=60_000)
+    _set_q(page, "0, 0, 0, -1.5, 0, 1.5, 0", 0.0)
+    Tb = denavit.forward_kinematics(robot, [0.3, -0.4, 0.2, -1.8, 0.1, 1.6, 0.5])
+    page.fill("#ik-target", ", ".join(repr(float(x)) for x in np.r_[Tb[:3, 3], rpy_from_rotation(Tb[:3, :3])]))
+    page.click("#ik-numeric")
+    page.wait_for_function("document.querySelectorAll('.ik-solution').length === 1", timeout=60_000)
+    sol = np.array(json.loads(page.locator(".ik-solution").get_attribute("data-q")))
+    Ts = denavit.forward_kinematics(robot, sol)
+    assert np.linalg.norm(Ts[:3, 3] - Tb[:3, 3]) <= TOL and np.linalg.norm(Ts[:3, :3] - Tb[:3, :3]) <= 10 * TOL
+    count = page.evaluate("window.workbench.kinCount")
+    page.locator(".ik-solution").click()
+    page.wait_for_function("""([count, sol]) => window.workbench.kinCount > count && !window.workbench.busy() &&
+        JSON.parse(document.getElementById('T').dataset.q).every((x, k) => Math.abs(x - sol[k]) < 1e-9)""",
+                           arg=[count, sol.tolist()], timeout=60_000)
+    np.testing.assert_allclose(_shown(page)[1], Tb, atol=1e-8)
+    page.fill("#ik-target", "")
+    page.select_option("#ik-plane", "xz")
+    q0, T0 = _shown(page)
+    shift = _drag_pad(page, -20, 15)
+    q1, T1 = _shown(page)
+    want = T0.copy()
+    want[[0, 2], 3] += shift
+    np.testing.assert_allclose(T1, want, atol=1e-8)
+    assert "numeric" in page.locator("#ik-info").text_content()
+
+
 def test_upload_a_report_and_see_its_marks(page, tmp_path):
     path = tmp_path / "homework.md"
     path.write_text(REPORT, encoding="utf-8")

@@ -187,7 +187,19 @@ def robot_info(body: Any) -> dict[str, Any]:
         "q0": json_matrix(q0), "notes": list(notes),
         "viewer": viewer_html(robot, q0, title=robot.name),
         "has_inertia": all(link.inertia is not None for link in robot.links if link.is_joint),
+        "analytic_ik": _has_analytic_ik(robot),
     }
+
+
+def _has_analytic_ik(robot: Any) -> bool:
+    """Whether :func:`denavit.analytic_ik` has a closed form for the whole arm (no joint held)."""
+    from ..ik import ik_structure
+
+    try:
+        ik_structure(robot)
+    except DenavitError:
+        return False
+    return True
 
 
 def kinematics(body: Any) -> dict[str, Any]:

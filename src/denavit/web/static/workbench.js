@@ -215,18 +215,30 @@
   }
 
   // ---- inverse kinematics -------------------------------------------------------------------------------
-  function solveIK() {
-    var body = { robot: good.doc, q: q }, t = $("ik-target").value.trim();
-    if (t) body.pose = t;
-    if ($("ik-lock").value.trim()) body.lock = $("ik-lock").value.trim();
-    post("/api/ik", body).then(function (r) {
+  // opts: method (analytic | numeric), base (a frozen {pose, q} target: the drag pad's), shift (m, world axes),
+  // follow (move the arm to the solution nearest the sliders); returns the request's promise
+  function ikBody(opts) {
+    var body = { robot: good.doc, q: q, method: opts.method || "analytic" }, t = $("ik-target").value.trim();
+    if (opts.base) { body.q = opts.base.q; if (opts.base.pose) body.pose = opts.base.pose; }   // the target
+    else if (t) body.pose = t;
+    if (opts.method === "numeric") body.seed = q;                                             // where LM starts
+    if (opts.shift) body.shift = opts.shift;
+    if ($("ik-lock").value.trim() && body.method === "analytic") body.lock = $("ik-lock").value.trim();
+    return body;
+  }
+  function solveIK(opts) {
+    opts = opts || {};
+    var body = ikBody(opts);
+    return post("/api/ik", body).then(function (r) {
       var list = $("ik-list");
       list.innerHTML = "";
       $("ik-error").textContent = r._status === 200 ? "" : r.error;
       $("ik-info").textContent = "";
-      if (r._status !== 200) return;
+      if (r._status !== 200) return r;
+      if (opts.shift) $("ik-target").value = r.pose.map(function (x) { return +x.toFixed(6); }).join(", ");
       $("ik-info").textContent = r.solutions.length + " solution(s) (" + r.method + ")" +
-        (r.outside_limits ? ", " + r.outside_limits + " more outside the joint limits" : "");
+        (r.outside_limits ? ", " + r.outside_limits + " more outside the joint limits" : "") +
+        (r.reason ? ": none from this q (" + r.reason + ")" : "");
       r.solutions.forEach(function (s, i) {
         var li = document.createElement("li"), b = document.createElement("button");
         b.type = "button"; b.className = "ik-solution"; b.dataset.q = JSON.stringify(s.q);
@@ -237,8 +249,52 @@
         });
         li.appendChild(b); list.appendChild(li);
       });
+      if (opts.follow && r.solutions.length) nearest(r.solutions).click();
+      return r;
     });
   }
+  function nearest(solutions) {   // the listed solution closest to the sliders (max joint distance)
+    var best = 0, dist = function (s) { return Math.max.apply(null, s.q.map(function (x, k) { return Math.abs(x - q[k]); })); };
+    solutions.forEach(function (s, i) { if (dist(s) < dist(solutions[best])) best = i; });
+    return document.querySelectorAll(".ik-solution")[best];
+  }
+
+  // the drag pad: the target moved in a plane of world axes, ±span around where the drag started
+  var PLANES = { xy: [0, 1], xz: [0, 2], yz: [1, 2] }, pad = { drag: null, dot: [0, 0], busy: false, next: null };
+  function drawPad() {
+    var c = $("ik-pad"), g = c.getContext("2d"), w = c.width, h = c.height, ax = PLANES[$("ik-plane").value];
+    g.clearRect(0, 0, w, h); g.strokeStyle = "#bbb"; g.beginPath(); g.moveTo(w / 2, 0); g.lineTo(w / 2, h);
+    g.moveTo(0, h / 2); g.lineTo(w, h / 2); g.stroke();
+    g.fillStyle = "#666"; g.font = "11px sans-serif"; g.fillText("xyz"[ax[0]], w - 10, h / 2 - 4); g.fillText("xyz"[ax[1]], w / 2 + 4, 10);
+    g.fillStyle = "#d62728"; g.beginPath(); g.arc(w / 2 + pad.dot[0], h / 2 - pad.dot[1], 5, 0, 2 * Math.PI); g.fill();
+  }
+  function padShift(e) {   // the mouse's offset from the pad's centre, in metres along the plane's two axes
+    var c = $("ik-pad"), r = c.getBoundingClientRect(), half = c.width / 2, span = parseFloat($("ik-span").value) || 0.2;
+    var u = Math.max(-half, Math.min(half, e.clientX - r.left - half)), v = Math.max(-half, Math.min(half, half - (e.clientY - r.top)));
+    pad.dot = [u, v];
+    var d = [0, 0, 0], ax = PLANES[$("ik-plane").value];
+    d[ax[0]] = span * u / half; d[ax[1]] = span * v / half;
+    return d;
+  }
+  function padSolve(shift) {
+    if (pad.busy) { pad.next = shift; return; }
+    pad.busy = true;
+    var numeric = !good.info.analytic_ik && !$("ik-lock").value.trim();
+    solveIK({ method: numeric ? "numeric" : "analytic", base: pad.drag, shift: shift, follow: true }).then(function () {
+      pad.busy = false; wb.padSolves = (wb.padSolves || 0) + 1;
+      if (pad.next) { var n = pad.next; pad.next = null; padSolve(n); }
+    });
+  }
+  $("ik-pad").addEventListener("mousedown", function (e) {
+    var t = $("ik-target").value.trim();
+    pad.drag = { pose: t || null, q: q.slice() };
+    padSolve(padShift(e)); drawPad(); e.preventDefault();
+  });
+  window.addEventListener("mousemove", function (e) { if (pad.drag) { padSolve(padShift(e)); drawPad(); } });
+  window.addEventListener("mouseup", function () { if (pad.drag) { pad.drag = null; pad.dot = [0, 0]; drawPad(); } });
+  $("ik-plane").addEventListener("change", drawPad);
+  wb.padIdle = function () { return !pad.busy && !pad.next && !pad.drag; };
+  drawPad();
   function showSolution(sol) {
     viewerSliders().forEach(function (s, k) { s.value = sol[k]; });
     viewerSliders().forEach(function (s) { s.dispatchEvent(new Event("input")); });
@@ -292,7 +348,8 @@
     if (!good) return;
     post("/api/robot-file", { robot: good.doc, format: "yaml" }).then(function (r) { if (r._status === 200) download(r.text, r.filename, "text/yaml"); });
   });
-  $("ik-solve").addEventListener("click", solveIK);
+  $("ik-solve").addEventListener("click", function () { solveIK({}); });
+  $("ik-numeric").addEventListener("click", function () { solveIK({ method: "numeric" }); });
   $("qd").addEventListener("input", refreshDynamics);
   $("wrench").addEventListener("input", refreshDynamics);
   $("wrench-frame").addEventListener("change", refreshDynamics);
