@@ -480,11 +480,17 @@ def test_the_formula_job_gives_the_symbolic_pose(client):
     assert "L_{1}" in maths and "L_{2}" in maths and "T" in maths
 
 
-def test_serve_without_the_extra_says_what_to_install(monkeypatch, capsys):
+def test_serve_without_the_extra_says_what_to_install(monkeypatch, capsys, tmp_path):
+    """One line naming the extra, and the exit code of every command's missing extra (1, as ``plot`` without
+    matplotlib: docs/pictures.md), not the 2 of bad input."""
     monkeypatch.setitem(sys.modules, "starlette", None)
     assert main(["serve", "planar2r"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and 'pip install "denavit[web]"' in err[0]
+    assert len(err) == 1 and 'pip install "denavit[web]"' in err[0] and err[0].startswith("denavit serve: ")
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    assert main(["plot", "planar2r", "-q", "0, 0", "-o", str(tmp_path / "arm.png")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pip install 'denavit[plot]'" in err[0]
 
 
 def test_serve_on_a_port_in_use_is_one_line(capsys):

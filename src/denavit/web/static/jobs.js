@@ -45,8 +45,8 @@
   function startFormula() {
     cancelJob(formulaJob);
     $("formula-status").textContent = "deriving…";
-    var t0 = performance.now();
-    formulaJob = runJob("formula", { robot: good.doc }, function () {}, function (res, err, st) {
+    var t0 = performance.now(), sent = good.doc;
+    formulaJob = runJob("formula", { robot: sent }, function () {}, function (res, err, st) {
       if (!res) { $("formula-status").textContent = err; return; }
       var box = $("formula"); box.innerHTML = "";
       res.steps.forEach(function (s) {
@@ -56,7 +56,7 @@
         box.appendChild(el);
       });
       wb.formulaSeconds = (performance.now() - t0) / 1000;
-      wb.formulaCpu = st.cpu_seconds;
+      wb.formulaCpu = st.cpu_seconds; wb.formulaDoc = sent;   // the job's own CPU time, and the table it derived
       $("formula-status").textContent = "derived in " + wb.formulaSeconds.toFixed(2) + " s (" + st.cpu_seconds + " s of CPU)";
     });
   }
