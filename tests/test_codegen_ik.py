@@ -395,3 +395,35 @@ def test_kernel_cache_entries_go_when_a_source_they_inline_changes(tmp_path):
     (tmp_path / "_ik_nb_elbow.ik_elbow-46.py311.nbi").write_text("index")  # compiled again from the same sources
     _ik_jit.fresh_cache(fake, force=True)
     assert (tmp_path / "_ik_nb_elbow.ik_elbow-46.py311.nbi").exists()
+
+
+def test_compiled_result_reads_copies_and_pickles_as_the_plain_one(_kernel_cache):
+    """The compiled one-pose result (its arrays made from the kernel's output when first read) holds what the plain
+    solver's holds, field by field, and stays so when copied, replaced or pickled; a list, a Fortran-ordered or
+    a read-only target gives the same answer, a bad one the plain function's error."""
+    import copy
+    import dataclasses
+    import pickle
+
+    robot = denavit.load_robot("ur5")
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    T = denavit.forward_kinematics(robot, np.array([0.3, -1.1, 1.4, 0.2, 0.9, -0.4]))
+    a, b = fast.analytic_ik(T), denavit.analytic_ik(robot, T)
+    assert isinstance(a, denavit.AnalyticIKResult) and a.count == b.count == 8
+    assert a.solutions is a.solutions and repr(a).startswith("AnalyticIKResult(solutions=array(")
+    _same(robot, T, a, b)
+    for c in (pickle.loads(pickle.dumps(fast.analytic_ik(T))), copy.copy(fast.analytic_ik(T)),
+              dataclasses.replace(fast.analytic_ik(T), method="parallel")):
+        _same(robot, T, c, b)
+    assert type(pickle.loads(pickle.dumps(a))) is denavit.AnalyticIKResult
+    frozen = T.copy()
+    frozen.flags.writeable = False
+    for other in (T.tolist(), np.asfortranarray(T), frozen):
+        _same(robot, T, fast.analytic_ik(other), b)
+    bad = T.copy()
+    bad[0, 1] += 0.5
+    with pytest.raises(denavit.errors.ShapeError, match="orthonormal"):
+        fast.analytic_ik(bad)
+    bad[0, 1] = np.nan
+    with pytest.raises(denavit.errors.ShapeError, match="non-finite"):
+        fast.analytic_ik(bad)

@@ -35,9 +35,12 @@ NEAR_SINGULAR = 1e-5
 #: compiled path answers.  Each step's error is its inputs' errors (plus one rounding) times its condition: 1/sin of
 #: an arccos-type root's distance from its double root, 1/|xy| of a direction turned by atan2, reach/distance of a
 #: point from an axis.  The differences measured between the compiled answer and the plain solver's (the same
-#: formulas evaluated in another order) stay 20-1000 times below this estimate, so beyond 1e6 ε they could approach
-#: 1e-10: such a pose goes to the plain solver (about 1 random UR5 pose in 100; the median time is unchanged).
-COND_MAX = 1e6
+#: formulas evaluated in another order) stay 20-1000 times below this estimate, and an ill-conditioned candidate
+#: is ill-conditioned for both solvers alike: near a singular set two exact answers differ by about eps times the
+#: Jacobian's condition number there (tests/test_codegen_ik.py holds the two to that).  Beyond 1e10 eps (an
+#: estimated 2e-6 rad, near the merge radius) the plain solver decides.  At 1e6 eps, 1 random UR5 pose in 100 went
+#: to the plain solver (2 ms each: 20 µs a pose on average); at 1e10, 1 in 1000 (those at a double root).
+COND_MAX = 1e10
 
 #: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (178 numbers).
 PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 11), ("lo", 6), ("hi", 6),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import random as _random
+from dataclasses import fields
 
 import numpy as np
 
@@ -19,9 +20,8 @@ from ._ik_stanford import stanford_constants
 
 __all__ = ["IKMethods"]
 
-_ndarray, _F64 = np.ndarray, np.dtype(np.float64)
+_ndarray, _F64, _POSE = np.ndarray, np.dtype(np.float64), (4, 4)
 _new = object.__new__
-_NO_SEEDS = np.zeros((0, 1))
 #: Fewest targets a thread is given by a batch solve_ik (a target takes tens of microseconds: far more than an FK).
 IK_MIN_ROWS = 64
 _NO_FREE = ("",) * 8
@@ -134,62 +134,96 @@ class IKMethods:
 
         Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
         polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
-        (its batched path is already the fast one) and arms of other classes.
+        (its batched path is already the fast one) and arms of other classes.  One pose is one machine-code call
+        (the check of T and the kernel, :func:`._ik_nb_entry.ik_one`); the result's arrays are views of its output
+        vector, made when first read.
         """
         c = self._elbow
         if c is None:
             c = self._elbow = self._analytic_solver()
-        Ta = np.asarray(T, dtype=np.float64)
-        if c is False or Ta.shape != (4, 4):
+        if c is False:
             return analytic_ik(self.robot, T)
-        K, labels, kind, check, solve, first = c
-        Tf = np.ascontiguousarray(Ta).reshape(1, 4, 4)
-        err = check(Tf, _NO_SEEDS)
-        if err > 1e-6:
+        if T.__class__ is not _ndarray or T.dtype is not _F64 or T.shape != _POSE or not T.flags.c_contiguous:
+            Ta = np.asarray(T, dtype=np.float64)
+            if Ta.shape != _POSE:
+                return analytic_ik(self.robot, T)
+            T = np.ascontiguousarray(Ta)
+        o = np.empty(c[4])
+        c[2](T, c[0], o)
+        if c[5]:  # numba compiled (or loaded) it on this first call: call its machine code from now on
+            c[2], c[5] = next(iter(c[2].overloads.values())).entry_point, False
+        status = o[122]
+        if status == 0.0:
+            res = _new(_PackedResult)
+            res.__dict__["_p"] = (o, *c[1])
+            return res
+        if status == 2.0:
+            err = o[123]
             raise ShapeError("T has non-finite values" if err == np.inf else
                              f"T: rotation part is not orthonormal (error {err:.2g})")
-        f = np.empty((1, 8, 14))  # solutions (6), residuals (2), outside-limits solutions (6)
-        i = np.empty((1, 11), dtype=np.int64)  # label codes (8), then kept, outside, status
-        solve(Tf, K, f, i)
-        if first:  # numba compiled (or loaded) them on this first call: call their machine code from now on
-            c[3] = next(iter(check.overloads.values())).entry_point
-            c[4] = next(iter(solve.overloads.values())).entry_point
-            c[5] = False
-        if i[0, 10]:
-            return analytic_ik(self.robot, T)
-        k, j = int(i[0, 8]), int(i[0, 9])
-        g = f[0]
-        # the frozen result filled in one step (its __init__ sets nine fields one by one: ~2 µs of a ~9 µs call)
-        res = _new(AnalyticIKResult)
-        res.__dict__.update(solutions=g[:k, :6], branches=tuple([labels[code] for code in i[0, :k].tolist()]),
-                            free=_NO_FREE[:k], position_error=g[:k, 6], orientation_error=g[:k, 7],
-                            outside_limits=g[:j, 8:], method=kind, controlled="pose", valid=_ALL_VALID[k])
-        return res
+        return analytic_ik(self.robot, T)
 
     def _analytic_solver(self):
-        """``[K, labels, kind, check, solve, first call]`` for the compiled closed form of this arm's IK plan
-        (``solve(T, K, f, i)``: the elbow, UR-class or Stanford-class kernel, by plan kind and route), or False
-        where there is none (the plain solver answers)."""
+        """``[K, (labels, plan kind), one, many, OUT_SIZE, first call]`` for the compiled closed form of this arm's
+        IK plan (``one(T, K, o)``, ``many(T, K, o)``: the entries of :mod:`._ik_nb_entry` of its elbow, UR-class or
+        Stanford-class kernel, by plan kind and route), or False where there is none (the plain solver answers)."""
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
             return False
         from ._ik_jit import fresh_cache
-        from ._ik_nb_elbow import ik_elbow_packed
-        from ._ik_nb_finish import ik_check  # module-level kernels: compiled once per machine (numba's cache)
-        from ._ik_nb_parallel import ik_parallel_packed
-        from ._ik_nb_stanford import ik_stanford_packed
-
-        fresh_cache(ik_check, ik_elbow_packed, ik_parallel_packed, ik_stanford_packed)  # none stale (see there)
+        from ._ik_nb_entry import ENTRIES, OUT_SIZE  # module-level kernels: compiled once per machine
 
         if plan.kind == "parallel":
-            return [parallel_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
-                    ik_parallel_packed, True]
-        if plan.route == "closed form (stanford)":
-            return [stanford_constants(self.robot, plan), list(plan.closed["labels"]), plan.kind, ik_check,
-                    ik_stanford_packed, True]
-        k = dict(plan.closed)
-        lim = self.robot.q_limits
-        k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
-                 chain=np.array(chain_of(self.robot).constants, dtype=float))
-        K = pack_constants(k, ELBOW_LAYOUT, "elbow")
-        return [K, list(k["labels"]), plan.kind, ik_check, ik_elbow_packed, True]
+            K, kind = parallel_constants(self.robot, plan), "parallel"
+        elif plan.route == "closed form (stanford)":
+            K, kind = stanford_constants(self.robot, plan), "stanford"
+        else:
+            k = dict(plan.closed)
+            lim = self.robot.q_limits
+            k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
+                     chain=np.array(chain_of(self.robot).constants, dtype=float))
+            K, kind = pack_constants(k, ELBOW_LAYOUT, "elbow"), "elbow"
+        one, many = ENTRIES[kind]
+        fresh_cache(one, many)  # none stale (see there)
+        return [K, (tuple(plan.closed["labels"]), plan.kind), one, many, OUT_SIZE, True]
+
+
+class _PackedResult(AnalyticIKResult):
+    """The :class:`~denavit.AnalyticIKResult` of one pose answered by the compiled kernel, its fields read from
+    the kernel's output vector ``o`` (layout: :mod:`._ik_nb_entry`) when first asked for (views of ``o``, each made
+    once).  Copied or pickled, it is a plain AnalyticIKResult."""
+
+    __slots__ = ()
+
+    def __reduce__(self):
+        return AnalyticIKResult, tuple(getattr(self, f) for f in _FIELDS)
+
+
+class _Lazy:
+    """A non-data descriptor: the field ``name`` computed by ``get(o, labels, kind)`` on first access and kept in
+    the instance's __dict__ (where the frozen dataclass keeps its fields), which is read from then on."""
+
+    __slots__ = ("name", "get")
+
+    def __init__(self, name, get):
+        self.name, self.get = name, get
+
+    def __get__(self, obj, cls=None):
+        if obj is None:
+            return self
+        d = obj.__dict__
+        value = d[self.name] = self.get(*d["_p"])
+        return value
+
+
+_FIELDS = tuple(f.name for f in fields(AnalyticIKResult))
+for _lazy in (_Lazy("solutions", lambda o, labels, kind: o[:112].reshape(8, 14)[: int(o[120]), :6]),
+              _Lazy("position_error", lambda o, labels, kind: o[6:112:14][: int(o[120])]),
+              _Lazy("orientation_error", lambda o, labels, kind: o[7:112:14][: int(o[120])]),
+              _Lazy("outside_limits", lambda o, labels, kind: o[:112].reshape(8, 14)[: int(o[121]), 8:]),
+              _Lazy("branches", lambda o, labels, kind: tuple([labels[int(x)] for x in o[112:112 + int(o[120])]])),
+              _Lazy("free", lambda o, labels, kind: _NO_FREE[: int(o[120])]),
+              _Lazy("method", lambda o, labels, kind: kind), _Lazy("controlled", lambda o, labels, kind: "pose"),
+              _Lazy("valid", lambda o, labels, kind: _ALL_VALID[int(o[120])])):
+    setattr(_PackedResult, _lazy.name, _lazy)
+_PackedResult.__name__ = _PackedResult.__qualname__ = "AnalyticIKResult"  # its repr is a plain result's
