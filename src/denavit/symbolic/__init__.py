@@ -11,6 +11,16 @@ from ._dynamics_format import format_dynamics
 from ._dynamics_trig import fourier_form
 from ._dynamics_types import DynamicsTerms
 from ._regressor import PARAMETER_NAMES, regressor_sym
+from ._derivatives_sym import (
+    DERIVATIVES_MAX_DOF,
+    acceleration_bias_sym,
+    gravity_derivatives_sym,
+    hessian_slice_sym,
+    jacobian_dot_sym,
+    kinematic_hessian_sym,
+    rnea_derivative_entry_sym,
+    rnea_derivatives_sym,
+)
 from ._base_params import SymbolicBaseParameters, base_parameters_sym, compare_base_parameters
 from ._recursive import HAND_FORM_MAX_DOF, RecursiveDynamics, dynamics_form, format_recursive, recursive_dynamics
 from ._lagrange import LagrangeSteps, lagrange_steps, time_derivative
@@ -56,6 +66,14 @@ __all__ = [
     "fourier_form",
     "PARAMETER_NAMES",
     "regressor_sym",
+    "DERIVATIVES_MAX_DOF",
+    "acceleration_bias_sym",
+    "gravity_derivatives_sym",
+    "hessian_slice_sym",
+    "jacobian_dot_sym",
+    "kinematic_hessian_sym",
+    "rnea_derivative_entry_sym",
+    "rnea_derivatives_sym",
     "SymbolicBaseParameters",
     "base_parameters_sym",
     "compare_base_parameters",
