@@ -60,6 +60,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     x1, y1c, z1, S, E, dW = ws[119:122], ws[122:125], ws[125:128], ws[128:131], ws[131:134], ws[134:137]
     perm = ws[137:145]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
+    frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
     ok = flags[0:8]
     for b in range(T.shape[0]):
         status = 0
@@ -129,34 +130,22 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
-        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags,
+        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
                                     out_q[b], out_err[b], out_outq[b], perm, chain)
         status = max(status, st)
         for slot in range(kept):
             best = int(perm[slot])
-            # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5))
-            q1 = cand[best, 0]
-            c1, s1v = math.cos(q1), math.sin(q1)
+            # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5));
+            # the frames after joints 1, 2 from the verifying FK (of the unfolded candidate: whole turns apart)
+            fr = frames[best]
             code = 0
-            # frame after joint 1: columns of C0 Rz(q1) C1
             for i in range(3):
-                xi, yi = consts[0, i, 0], consts[0, i, 1]
-                rx, ry, rz = c1 * xi + s1v * yi, c1 * yi - s1v * xi, consts[0, i, 2]
-                x1[i] = rx * consts[1, 0, 0] + ry * consts[1, 1, 0] + rz * consts[1, 2, 0]
-                y1c[i] = rx * consts[1, 0, 1] + ry * consts[1, 1, 1] + rz * consts[1, 2, 1]
-                z1[i] = rx * consts[1, 0, 2] + ry * consts[1, 1, 2] + rz * consts[1, 2, 2]
-                S[i] = consts[0, i, 3] + rx * consts[1, 0, 3] + ry * consts[1, 1, 3] + rz * consts[1, 2, 3]
+                x1[i], y1c[i], z1[i], S[i], E[i] = fr[i], fr[3 + i], fr[6 + i], fr[9 + i], fr[21 + i]
             s_right = 0.0
             for i in range(3):
                 s_right += x1[i] * (Xw[i] - consts[0, i, 3])
             if s_right < 0.0:
                 code |= 1
-            # a point of axis 3: origin of C0 Rz(q1) C1 Rz(q2) C2
-            q2 = cand[best, 1]
-            c2, s2v = math.cos(q2), math.sin(q2)
-            for i in range(3):
-                rx, ry = c2 * x1[i] + s2v * y1c[i], c2 * y1c[i] - s2v * x1[i]
-                E[i] = S[i] + rx * consts[2, 0, 3] + ry * consts[2, 1, 3] + z1[i] * consts[2, 2, 3]
             for i in range(3):
                 dW[i] = Xw[i] - S[i]
             nrm0 = z1[1] * dW[2] - z1[2] * dW[1]

@@ -22,13 +22,15 @@ __all__ = ["chain_fk", "ik_check", "ik_finish"]
 
 
 @njit(cache=True, nogil=True)
-def chain_fk(C, revolute, q, F):
+def chain_fk(C, revolute, q, P, start, F):
     """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
     base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one.  The 3×4 top of
-    the product is kept in twelve local floats (registers), written to F once at the end."""
-    x0, x1, x2, y0, y1, y2 = C[0, 0, 0], C[0, 1, 0], C[0, 2, 0], C[0, 0, 1], C[0, 1, 1], C[0, 2, 1]
-    z0, z1, z2, p0, p1, p2 = C[0, 0, 2], C[0, 1, 2], C[0, 2, 2], C[0, 0, 3], C[0, 1, 3], C[0, 2, 3]
-    for k in range(q.shape[0]):
+    the product is kept in twelve local floats (registers); P[k] (n+1, 12) keeps it after k joints, and the walk
+    resumes from P[start] (left there by a call for a q with the same first ``start`` joints: the candidates of a
+    closed form come in families sharing q1, or q1 to q3; P[0] must hold C0's top)."""
+    x0, x1, x2, y0, y1, y2 = P[start, 0], P[start, 1], P[start, 2], P[start, 3], P[start, 4], P[start, 5]
+    z0, z1, z2, p0, p1, p2 = P[start, 6], P[start, 7], P[start, 8], P[start, 9], P[start, 10], P[start, 11]
+    for k in range(start, q.shape[0]):
         if revolute[k] != 0.0:  # F <- F Rz(q_k): columns x, y turn
             c, s = math.cos(q[k]), math.sin(q[k])
             x0, y0 = c * x0 + s * y0, c * y0 - s * x0
@@ -45,10 +47,22 @@ def chain_fk(C, revolute, q, F):
                       x1 * D[0, 2] + y1 * D[1, 2] + z1 * D[2, 2])
         x2, y2, z2 = (x2 * D[0, 0] + y2 * D[1, 0] + z2 * D[2, 0], x2 * D[0, 1] + y2 * D[1, 1] + z2 * D[2, 1],
                       x2 * D[0, 2] + y2 * D[1, 2] + z2 * D[2, 2])
+        Pk = P[k + 1]
+        Pk[0], Pk[1], Pk[2], Pk[3], Pk[4], Pk[5] = x0, x1, x2, y0, y1, y2
+        Pk[6], Pk[7], Pk[8], Pk[9], Pk[10], Pk[11] = z0, z1, z2, p0, p1, p2
     F[0, 0], F[0, 1], F[0, 2], F[0, 3] = x0, y0, z0, p0
     F[1, 0], F[1, 1], F[1, 2], F[1, 3] = x1, y1, z1, p1
     F[2, 0], F[2, 1], F[2, 2], F[2, 3] = x2, y2, z2, p2
     F[3, 0], F[3, 1], F[3, 2], F[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@njit(cache=True, nogil=True)
+def _wrap(x):
+    """x wrapped into (−π, π] as ``π − ((π − x) mod 2π)``, the mod by floor (numba's float % calls fmod: 48 of them
+    were 7% of a kernel call); within an ulp of the fmod form, and the fold's knife edges go to the plain solver
+    anyway (FOLD_EDGE)."""
+    y = math.pi - x
+    return math.pi - (y - 2.0 * math.pi * math.floor(y / (2.0 * math.pi)))
 
 
 @njit(cache=True, nogil=True)
@@ -63,20 +77,27 @@ def _near_fold_edge(x, lo, hi):
 
 
 @njit(cache=True, nogil=True)
-def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags, out_q, out_err, out_outq, perm,
-              C):
+def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
+              perm, C):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
     would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
     status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
     others into out_outq, perm[slot] the candidate in each slot; C (7, 4, 4) the arm's chain constants (its FK:
-    :func:`chain_fk`).  Returns (kept, outside, status)."""
+    :func:`chain_fk`); frames[k] (8, 36) the frames after joints 1, 2, 3 of candidate k, unfolded (the FK's
+    products P[1:4]: columns x, y, z, origin each), for the labels.  Returns (kept, outside, status)."""
     verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
     ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     status = 0
+    P = np.empty((7, 12))  # the FK's product after k joints, reused by the next candidate sharing them
+    for r in range(3):
+        P[0, r], P[0, 3 + r], P[0, 6 + r], P[0, 9 + r] = C[0, r, 0], C[0, r, 1], C[0, r, 2], C[0, r, 3]
     for k in range(ncand):
-        for j in range(6):
-            q[j] = cand[k, j]
-        chain_fk(C, revolute, q, F)
+        start = 0
+        while k > 0 and start < 5 and cand[k, start] == cand[k - 1, start]:
+            start += 1
+        chain_fk(C, revolute, cand[k], P, start, F)
+        for j in range(36):
+            frames[k, j] = P[1 + j // 12, j % 12]
         pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)
         tr = 0.0  # rotation error: the angle of R_t R^T
         for i in range(3):
@@ -87,7 +108,8 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags
             v0 += Tb[2, j] * F[1, j] - Tb[1, j] * F[2, j]
             v1 += Tb[0, j] * F[2, j] - Tb[2, j] * F[0, j]
             v2 += Tb[1, j] * F[0, j] - Tb[0, j] * F[1, j]
-        re = math.atan2(0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0))
+        sn, cs = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
+        re = sn / cs if sn < 1e-6 * cs else math.atan2(sn, cs)  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
         cerr[k, 0], cerr[k, 1] = pe, re
         size = pe + reach * re
         if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
@@ -100,7 +122,7 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags
         for j in range(6):
             x = cand[k, j]
             if revolute[j] != 0.0:
-                x = math.pi - ((math.pi - x) % (2.0 * math.pi))
+                x = _wrap(x)
                 if _near_fold_edge(x, lo_lim[j], hi_lim[j]):
                     status = 1  # a rounding difference could fold it elsewhere: the plain solver decides
                 if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
@@ -119,8 +141,10 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, q, flags
             for j in range(6):
                 d = abs(cand[k, j] - cand[m, j])
                 if revolute[j] != 0.0:
-                    d = abs(d - 2.0 * math.pi * np.rint(d / (2.0 * math.pi)))
+                    d = abs(d - 2.0 * math.pi * np.rint(d * (0.5 / math.pi)))
                 dmax = max(dmax, d)
+                if dmax >= merge_r:
+                    break  # neither a duplicate nor a pair to merge (most pairs differ in q1 already)
             if dmax < dup_tol:
                 ok[k] = False
                 break

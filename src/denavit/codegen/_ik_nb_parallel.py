@@ -29,29 +29,30 @@ def ik_parallel_packed(T, K, f, i):
     rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
     # scratch: one float and one flag allocation, sliced
     ws = np.empty(190)
-    cand, cerr, X, F, q = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4)),         ws[83:89]
-    f1, f2, f3 = ws[89:101].reshape((4, 3)), ws[101:113].reshape((4, 3)), ws[113:125].reshape((4, 3))  # labels
-    trig, perm = ws[134:182].reshape((8, 6)), ws[182:190]  # cos, sin of q1, q2, q3 per candidate; sorted order
+    cand, cerr, X, F = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4))
+    perm = ws[182:190]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
+    frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
             continue
-        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, trig, ws[89:134])
-        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, q, flags,
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, ws[89:134])
+        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C)
         for r in range(3):
             X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
         for s in range(kept):
-            i[b, s] = _parallel_label(trig[int(perm[s])], f[b, s, 4], X, C, theta, f1, f2, f3)
+            fr = frames[int(perm[s])]
+            i[b, s] = _parallel_label(fr[0:12].reshape((4, 3)), fr[12:24].reshape((4, 3)), fr[24:36].reshape((4, 3)),
+                                      f[b, s, 4], X, C, theta)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
 @njit(cache=True, nogil=True)
-def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
-    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand,
-    the cosines and sines of their q1, q2, q3 into trig (for the labels); ws: 45 floats of scratch.  Returns
-    (count, status)."""
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
+    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand; ws:
+    45 floats of scratch.  Returns (count, status)."""
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
@@ -152,8 +153,6 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, trig, ws):
                 q4 = math.atan2(N10, N00)
                 cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                 cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
-                trig[ncand, 0], trig[ncand, 1], trig[ncand, 2] = c1, s1v, c2
-                trig[ncand, 3], trig[ncand, 4], trig[ncand, 5] = s2v, c3, s3v
                 ncand += 1
     return ncand, status
 
@@ -202,15 +201,12 @@ def _tail(C, q5, q6, tl):
 
 
 @njit(cache=True, nogil=True)
-def _parallel_label(t, q5, X, C, theta, f1, f2, f3):
+def _parallel_label(f1, f2, f3, q5, X, C, theta):
     """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
     (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
-    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  t: cos, sin of q1, q2, q3 (from before the
-    folding into the limits, which moves them by whole turns); f1, f2, f3: (4, 3) scratch for the frames after
-    joints 1, 2, 3."""
-    frame1(C, t[0], t[1], f1)
-    next_frame(f1, t[2], t[3], C[2], f2)
-    next_frame(f2, t[4], t[5], C[3], f3)
+    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  f1, f2, f3 (4, 3): columns x, y, z and
+    origin of the frames after joints 1, 2, 3 (from the verifying FK, before the folding into the limits, which
+    moves the angles by whole turns)."""
     code = 0
     s_right = 0.0
     for r in range(3):
