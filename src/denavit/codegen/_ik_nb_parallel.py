@@ -16,6 +16,11 @@ from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
 
+#: |ratio| of an arccos-type root (shoulder q1, elbow q3) within this of 1: next to a double root, the plain solver
+#: polishes and looks for the lost partner; beyond it both roots are verified as they are (a root needing
+#: polishing goes to the plain solver through ik_finish's residual test either way)
+DOUBLE_ROOT = 1e-9
+
 
 
 @njit(cache=True, nogil=True)
@@ -73,7 +78,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
     q1a, q1b, rho, ratio = trig_roots(a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0], c0 - a[2] * V[2], tol)
     if rho <= max(wide, 1e-11):
         return 0, 1  # Q on (or next to) axis 1
-    if abs(abs(ratio) - 1.0) < 1e-6:
+    if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
         status = 1  # next to a double root: the plain solver polishes and looks for partners
     if math.isnan(q1a) or rho_w < 1e-12:
         return 0, max(status, 1 if rho_w < 1e-12 else 0)
@@ -126,7 +131,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             if rho3 <= 1e-12:
                 status = 1
                 continue
-            if abs(abs(ratio3) - 1.0) < 1e-6:
+            if abs(abs(ratio3) - 1.0) < DOUBLE_ROOT:
                 status = 1  # elbow stretched or folded: a double root
             if math.isnan(q3a):
                 continue
