@@ -61,6 +61,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     perm = ws[137:145]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
     frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
+    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (ik_finish's, for its FK)
     ok = flags[0:8]
     for b in range(T.shape[0]):
         status = 0
@@ -131,7 +132,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
-                                    out_q[b], out_err[b], out_outq[b], perm, chain)
+                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, False)
         status = max(status, st)
         for slot in range(kept):
             best = int(perm[slot])

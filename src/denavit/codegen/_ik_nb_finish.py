@@ -22,17 +22,18 @@ __all__ = ["chain_fk", "ik_check", "ik_finish"]
 
 
 @njit(cache=True, nogil=True)
-def chain_fk(C, revolute, q, P, start, F):
+def chain_fk(C, revolute, q, cs, P, start, F):
     """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
     base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one.  The 3×4 top of
-    the product is kept in twelve local floats (registers); P[k] (n+1, 12) keeps it after k joints, and the walk
+    the product is kept in twelve local floats (registers), cs = (cos q1, sin q1, cos q2, …) given (a prismatic
+    joint's pair unused); P[k] (n+1, 12) keeps the product after k joints, and the walk
     resumes from P[start] (left there by a call for a q with the same first ``start`` joints: the candidates of a
     closed form come in families sharing q1, or q1 to q3; P[0] must hold C0's top)."""
     x0, x1, x2, y0, y1, y2 = P[start, 0], P[start, 1], P[start, 2], P[start, 3], P[start, 4], P[start, 5]
     z0, z1, z2, p0, p1, p2 = P[start, 6], P[start, 7], P[start, 8], P[start, 9], P[start, 10], P[start, 11]
     for k in range(start, q.shape[0]):
         if revolute[k] != 0.0:  # F <- F Rz(q_k): columns x, y turn
-            c, s = math.cos(q[k]), math.sin(q[k])
+            c, s = cs[2 * k], cs[2 * k + 1]
             x0, y0 = c * x0 + s * y0, c * y0 - s * x0
             x1, y1 = c * x1 + s * y1, c * y1 - s * x1
             x2, y2 = c * x2 + s * y2, c * y2 - s * x2
@@ -78,13 +79,15 @@ def _near_fold_edge(x, lo, hi):
 
 @njit(cache=True, nogil=True)
 def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
-              perm, C):
+              perm, C, cs, given):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
     would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
     status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
     others into out_outq, perm[slot] the candidate in each slot; C (7, 4, 4) the arm's chain constants (its FK:
     :func:`chain_fk`); frames[k] (8, 36) the frames after joints 1, 2, 3 of candidate k, unfolded (the FK's
-    products P[1:4]: columns x, y, z, origin each), for the labels.  Returns (kept, outside, status)."""
+    products P[1:4]: columns x, y, z, origin each), for the labels; cs[k] (8, 12) the cosine and sine of each
+    joint of candidate k, given by the closed form (``given``: the very values of math.cos, math.sin of those
+    floats, so the FK computes no sine) or computed here.  Returns (kept, outside, status)."""
     verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
     ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     status = 0
@@ -95,7 +98,10 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
         start = 0
         while k > 0 and start < 5 and cand[k, start] == cand[k - 1, start]:
             start += 1
-        chain_fk(C, revolute, cand[k], P, start, F)
+        if not given:
+            for j in range(start, 6):
+                cs[k, 2 * j], cs[k, 2 * j + 1] = math.cos(cand[k, j]), math.sin(cand[k, j])
+        chain_fk(C, revolute, cand[k], cs[k], P, start, F)
         for j in range(36):
             frames[k, j] = P[1 + j // 12, j % 12]
         pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)
@@ -108,8 +114,8 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
             v0 += Tb[2, j] * F[1, j] - Tb[1, j] * F[2, j]
             v1 += Tb[0, j] * F[2, j] - Tb[2, j] * F[0, j]
             v2 += Tb[1, j] * F[0, j] - Tb[0, j] * F[1, j]
-        sn, cs = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
-        re = sn / cs if sn < 1e-6 * cs else math.atan2(sn, cs)  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
+        sn, co = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
+        re = sn / co if sn < 1e-6 * co else math.atan2(sn, co)  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
         cerr[k, 0], cerr[k, 1] = pe, re
         size = pe + reach * re
         if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):

@@ -38,26 +38,26 @@ def ik_parallel_packed(T, K, f, i):
     perm = ws[182:190]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
     frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
+    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (from the closed form, for the FK)
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
             continue
-        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, ws[89:134])
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, cs, ws[89:134])
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C)
+                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C, cs, True)
         for r in range(3):
             X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
         for s in range(kept):
-            fr = frames[int(perm[s])]
-            i[b, s] = _parallel_label(fr[0:12].reshape((4, 3)), fr[12:24].reshape((4, 3)), fr[24:36].reshape((4, 3)),
-                                      f[b, s, 4], X, C, theta)
+            i[b, s] = _parallel_label(frames[int(perm[s])], f[b, s, 4], X, C, theta)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
 @njit(cache=True, nogil=True)
-def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
-    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand; ws:
-    45 floats of scratch.  Returns (count, status)."""
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
+    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand, the
+    cosines and sines of their joints into cs (8, 12: cos q1, sin q1, cos q2, …; for the verifying FK, which then
+    computes none); ws: 45 floats of scratch.  Returns (count, status)."""
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
@@ -106,12 +106,13 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
             y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
             y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])
-            if math.hypot(y0, y1) < sc[9]:
+            if math.sqrt(y0 * y0 + y1 * y1) < sc[9]:
                 status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
             q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
-            e6 = (1.0 + e1 + e5) / max(math.hypot(y0, y1), 1e-300)
+            e6 = (1.0 + e1 + e5) / max(math.sqrt(y0 * y0 + y1 * y1), 1e-300)
             eP = 1.0 + e1 + e5 + e6  # of the point P, per reach
-            _tail(C, q5, q6, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
+            c6, s6v = math.cos(q6), math.sin(q6)
+            _tail(C, c5, s5v, c6, s6v, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
             # X = F1^-1 T tail^-1: its origin P and first column xr
             for r in range(3):
                 w[r] = Tb[r, 3] - cols[3, r]
@@ -125,7 +126,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             for r in range(3):
                 xr[r] = cols[r, 0] * g[0] + cols[r, 1] * g[1] + cols[r, 2] * g[2]
             # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
-            if math.hypot(P0, P1) < wide:
+            if math.sqrt(P0 * P0 + P1 * P1) < wide:
                 status = 1  # Q on (or next to) axis 2
             q3a, q3b, rho3, ratio3 = trig_roots(ap2, bp2, P0 * P0 + P1 * P1 + k0, tol)
             if rho3 <= 1e-12:
@@ -136,14 +137,14 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
             if math.isnan(q3a):
                 continue
             d3 = math.acos(min(1.0, max(-1.0, ratio3)))
-            e3 = eP * 2.0 * math.hypot(P0, P1) * scale / max(rho3 * math.sin(d3), 1e-300)
+            e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sin(d3), 1e-300)
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
                 c3, s3v = math.cos(q3), math.sin(q3)
                 q2, _free, vxy = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
                 if vxy < wide:
                     status = 1
-                e2 = (eP + e3) * scale / max(min(math.hypot(P0, P1), vxy), 1e-300)
+                e2 = (eP + e3) * scale / max(min(math.sqrt(P0 * P0 + P1 * P1), vxy), 1e-300)
                 if e2 + e3 + eP > sc[10]:  # q4's error is about that sum
                     status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
                 # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
@@ -156,6 +157,9 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, ws):
                 N00 = C[3, 0, 0] * f0 + C[3, 1, 0] * f1 + C[3, 2, 0] * e2
                 N10 = C[3, 0, 1] * f0 + C[3, 1, 1] * f1 + C[3, 2, 1] * e2
                 q4 = math.atan2(N10, N00)
+                cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1v, c2, s2v
+                cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, math.cos(q4), math.sin(q4)
+                cs[ncand, 8], cs[ncand, 9], cs[ncand, 10], cs[ncand, 11] = c5, s5v, c6, s6v
                 cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                 cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
                 ncand += 1
@@ -188,9 +192,8 @@ def next_frame(cols, c, s, Ck, out):
 
 
 @njit(cache=True, nogil=True)
-def _tail(C, q5, q6, tl):
-    """Columns and origin of C4 Rz(q5) C5 Rz(q6) C6 into tl (4, 3)."""
-    c5, s5, c6, s6 = math.cos(q5), math.sin(q5), math.cos(q6), math.sin(q6)
+def _tail(C, c5, s5, c6, s6, tl):
+    """Columns and origin of C4 Rz(q5) C5 Rz(q6) C6 into tl (4, 3), from the cosines and sines of q5, q6."""
     for r in range(3):
         x, y, z, p = C[4, r, 0], C[4, r, 1], C[4, r, 2], C[4, r, 3]
         x, y = c5 * x + s5 * y, c5 * y - s5 * x
@@ -206,24 +209,24 @@ def _tail(C, q5, q6, tl):
 
 
 @njit(cache=True, nogil=True)
-def _parallel_label(f1, f2, f3, q5, X, C, theta):
+def _parallel_label(fr, q5, X, C, theta):
     """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
     (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
-    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  f1, f2, f3 (4, 3): columns x, y, z and
-    origin of the frames after joints 1, 2, 3 (from the verifying FK, before the folding into the limits, which
-    moves the angles by whole turns)."""
+    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  fr (36,): columns x, y, z and origin of the
+    frames after joints 1, 2, 3, three floats each (from the verifying FK, before the folding into the limits,
+    which moves the angles by whole turns; indexed, not reshaped: a reshape is a helper call)."""
     code = 0
     s_right = 0.0
     for r in range(3):
-        s_right += f1[0, r] * (X[r] - C[0, r, 3])
+        s_right += fr[r] * (X[r] - C[0, r, 3])
     if s_right < 0.0:
         code |= 1
-    d0, d1, d2 = f3[3, 0] - f1[3, 0], f3[3, 1] - f1[3, 1], f3[3, 2] - f1[3, 2]  # W - S
-    n0 = f1[2, 1] * d2 - f1[2, 2] * d1
-    n1 = f1[2, 2] * d0 - f1[2, 0] * d2
-    n2 = f1[2, 0] * d1 - f1[2, 1] * d0
+    d0, d1, d2 = fr[33] - fr[9], fr[34] - fr[10], fr[35] - fr[11]  # W - S (origins after joints 3 and 1)
+    n0 = fr[7] * d2 - fr[8] * d1  # z1 x (W - S)
+    n1 = fr[8] * d0 - fr[6] * d2
+    n2 = fr[6] * d1 - fr[7] * d0
     towards = 1.0 if C[0, 0, 2] * n0 + C[0, 1, 2] * n1 + C[0, 2, 2] * n2 >= 0.0 else -1.0
-    side = (f2[3, 0] - f1[3, 0]) * n0 + (f2[3, 1] - f1[3, 1]) * n1 + (f2[3, 2] - f1[3, 2]) * n2
+    side = (fr[21] - fr[9]) * n0 + (fr[22] - fr[10]) * n1 + (fr[23] - fr[11]) * n2  # (E - S) . n
     if side * towards < 0.0:
         code |= 2
     if math.sin(q5 + theta[4]) < 0.0:

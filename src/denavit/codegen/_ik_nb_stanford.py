@@ -37,6 +37,7 @@ def ik_stanford_packed(T, K, f, i):
     cand, cerr, X, F = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4))
     flags = np.zeros(24, dtype=np.bool_)
     frames = np.empty((8, 36))  # ik_finish's frames after joints 1-3 (unused here: the labels need q1 only)
+    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (ik_finish's, for its FK)
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond the bound of _solve (prismatic travel included): its stand-in
@@ -45,7 +46,7 @@ def ik_stanford_packed(T, K, f, i):
             X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
         ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139], C)
+                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139], C, cs, False)
         for s in range(kept):
             i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
