@@ -261,6 +261,7 @@ def _set_q(page, text: str, q1: float) -> None:
 def _drag_pad(page, du: float, dv: float) -> np.ndarray:
     """Drag the IK pad from its centre by (du, dv) pixels (dv up); the shift of the target it means [m], from the
     pad's scale (±span over half the pad's width), and the page settled after it."""
+    page.wait_for_function("window.workbench.formulaSeconds !== undefined", timeout=120_000)  # no reflow from it
     page.locator("#ik-pad").scroll_into_view_if_needed()
     box = page.locator("#ik-pad").bounding_box()
     cx, cy = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
@@ -273,7 +274,8 @@ def _drag_pad(page, du: float, dv: float) -> np.ndarray:
     page.wait_for_function(f"window.workbench.padIdle() && window.workbench.kinCount > {count} && "
                            "!window.workbench.busy()", timeout=60_000)
     span = float(page.locator("#ik-span").input_value())
-    return span * np.array([round(cx + du) - cx, cy - round(cy - dv)]) / (box["width"] / 2)
+    half = page.evaluate("document.getElementById('ik-pad').clientWidth") / 2  # the drawing, inside the border
+    return span * np.array([round(cx + du) - cx, cy - round(cy - dv)]) / half
 
 
 def test_drag_the_ik_target_and_the_arm_follows(page):

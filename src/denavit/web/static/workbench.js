@@ -269,28 +269,30 @@
     g.fillStyle = "#d62728"; g.beginPath(); g.arc(w / 2 + pad.dot[0], h / 2 - pad.dot[1], 5, 0, 2 * Math.PI); g.fill();
   }
   function padShift(e) {   // the mouse's offset from the pad's centre, in metres along the plane's two axes
-    var c = $("ik-pad"), r = c.getBoundingClientRect(), half = c.width / 2, span = parseFloat($("ik-span").value) || 0.2;
-    var u = Math.max(-half, Math.min(half, e.clientX - r.left - half)), v = Math.max(-half, Math.min(half, half - (e.clientY - r.top)));
+    var c = $("ik-pad"), r = pad.rect, half = c.width / 2, span = parseFloat($("ik-span").value) || 0.2;
+    var u = Math.max(-half, Math.min(half, e.clientX - r.left - r.width / 2)),    // from the centre (borders alike)
+        v = Math.max(-half, Math.min(half, r.top + r.height / 2 - e.clientY));
     pad.dot = [u, v];
     var d = [0, 0, 0], ax = PLANES[$("ik-plane").value];
     d[ax[0]] = span * u / half; d[ax[1]] = span * v / half;
     return d;
   }
-  function padSolve(shift) {
-    if (pad.busy) { pad.next = shift; return; }
+  function padSolve(base, shift) {   // one request at a time; the latest move waits, with its drag's base target
+    if (pad.busy) { pad.next = [base, shift]; return; }
     pad.busy = true;
     var numeric = !good.info.analytic_ik && !$("ik-lock").value.trim();
-    solveIK({ method: numeric ? "numeric" : "analytic", base: pad.drag, shift: shift, follow: true }).then(function () {
+    solveIK({ method: numeric ? "numeric" : "analytic", base: base, shift: shift, follow: true }).then(function () {
       pad.busy = false; wb.padSolves = (wb.padSolves || 0) + 1;
-      if (pad.next) { var n = pad.next; pad.next = null; padSolve(n); }
+      if (pad.next) { var n = pad.next; pad.next = null; padSolve(n[0], n[1]); }
     });
   }
   $("ik-pad").addEventListener("mousedown", function (e) {
     var t = $("ik-target").value.trim();
     pad.drag = { pose: t || null, q: q.slice() };
-    padSolve(padShift(e)); drawPad(); e.preventDefault();
+    pad.rect = $("ik-pad").getBoundingClientRect();   // where the pad was when pressed: the page may reflow meanwhile
+    padSolve(pad.drag, padShift(e)); drawPad(); e.preventDefault();
   });
-  window.addEventListener("mousemove", function (e) { if (pad.drag) { padSolve(padShift(e)); drawPad(); } });
+  window.addEventListener("mousemove", function (e) { if (pad.drag) { padSolve(pad.drag, padShift(e)); drawPad(); } });
   window.addEventListener("mouseup", function () { if (pad.drag) { pad.drag = null; pad.dot = [0, 0]; drawPad(); } });
   $("ik-plane").addEventListener("change", drawPad);
   wb.padIdle = function () { return !pad.busy && !pad.next && !pad.drag; };
