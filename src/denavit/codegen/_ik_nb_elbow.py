@@ -61,7 +61,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     perm = ws[137:145]  # the candidate in each sorted slot
     flags = np.zeros(24, dtype=np.bool_)
     frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
-    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (ik_finish's, for its FK)
+    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (from the closed form, for the FK)
     ok = flags[0:8]
     for b in range(T.shape[0]):
         status = 0
@@ -89,6 +89,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
             if math.isnan(q1):
                 continue
             g0, g1 = elbow_plane(q1, W[0], W[1], W[2], R1, p1)
+            c1, s1c = math.cos(q1), math.sin(q1)
             q3a, q3b, x = elbow_roots(math.hypot(g0, g1), na, nb, base3, ratio_tol)
             if math.isnan(x):
                 continue
@@ -102,9 +103,10 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                 # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
                 for i in range(3):
                     cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
+                c2, s2v = math.cos(q2), math.sin(q2)
+                c3, s3v = math.cos(q3), math.sin(q3)
                 for kk in range(3):
-                    qk = q1 if kk == 0 else (q2 if kk == 1 else q3)
-                    ck, sk = math.cos(qk), math.sin(qk)
+                    ck, sk = (c1, s1c) if kk == 0 else ((c2, s2v) if kk == 1 else (c3, s3v))
                     for i in range(3):
                         xi, yi = cx[i], cy[i]
                         cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
@@ -128,11 +130,16 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                         status = 1  # wrist singular: a continuum
                     cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                     cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
+                    # cos, sin of the joints for the verifying FK (math.cos/sin of these very floats)
+                    cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1c, c2, s2v
+                    cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, math.cos(qa), math.sin(qa)
+                    cs[ncand, 8], cs[ncand, 9] = math.cos(qb), math.sin(qb)
+                    cs[ncand, 10], cs[ncand, 11] = math.cos(qc), math.sin(qc)
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
-                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, False)
+                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, True)
         status = max(status, st)
         for slot in range(kept):
             best = int(perm[slot])
