@@ -1,9 +1,12 @@
 """denavit's torch and JAX backends against pytorch_kinematics, and jax.jit against the numba batch kernel, in one run.
 
 Run:  python benchmarks/bench_tensor.py [--robots puma560 panda] [--batches 10000 1000000] [--repeat 3]
-Prints a Markdown table of ratios (peer time / denavit time: > 1 means denavit is faster), one process, CPU, one
-thread for every library (torch.set_num_threads(1), XLA's CPU client on one thread, numba threads=1), so the
-figures compare the code and not how many of the machine's cores each one grabs.
+                                        [--only torch|jax]
+Prints a Markdown table of ratios (peer time / denavit time: > 1 means denavit is faster), one process pinned to
+one CPU core (os.sched_setaffinity, before any library starts its threads: XLA then plans no parallel loops),
+torch.set_num_threads(1), numba threads=1, so the figures compare the code and not how many of the machine's
+cores each one grabs.  Times are the process's CPU time (time.process_time), not wall time: on a loaded machine a
+call longer than the scheduler's slice is preempted, and best-of wall times then favour the shorter calls.
 
 Both sides get the same arm: pytorch_kinematics builds its serial chain from denavit's URDF export of the robot
 (``denavit.to_urdf``), and its results are first checked to equal denavit's (FK and J0 to 1e-6 in float64: the URDF
@@ -12,8 +15,9 @@ configurations timed.  Rows, each batch size × dtype:
   FK        fast.fk(q) → (B, 4, 4)                  chain.forward_kinematics(q).get_matrix()
   J         fast.jacobian(q) → (B, 6, n), J0         chain.jacobian(q) (base axes, end-effector origin: J0)
   FK f+b    T = fk(q) with q.requires_grad; T.sum().backward(): forward and backward pass, both libraries
-  jax.jit   jax.jit(fast.fk) on a jax array (JAX's own layout, (B, 4, 4)) against the numba backend's batch
-            fk(q, threads=1) on a NumPy array, same float64 q (ratio = numba time / jax time: ≥ 0.5 is "within 2×")
+  jax.jit   jax.jit(fast.fk) on a jax array (float64, and float32 at the same rounded q) against the numba
+            backend's batch fk(q, threads=1) on the float64 NumPy array (numba's kernels are float64 only);
+            ratio = numba time / jax time: ≥ 0.5 is "within 2×"
 Each time is the best of ``repeat`` calls (after one warm-up call each, which also compiles), the libraries taking
 turns.
 """
@@ -25,7 +29,9 @@ import os
 import re
 import time
 
-os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=1")
+if hasattr(os, "sched_setaffinity"):  # one core for the whole process (Linux), before jax, torch, numba start
+    os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false")
 
 import numpy as np  # noqa: E402
 
@@ -33,9 +39,10 @@ import denavit  # noqa: E402
 
 
 def once(fn) -> float:
-    t0 = time.perf_counter()
+    """CPU seconds of one call (all the process's threads: on one core, the work the call did)."""
+    t0 = time.process_time()
     fn()
-    return time.perf_counter() - t0
+    return time.process_time() - t0
 
 
 def best_pair(ours, theirs, repeat: int) -> tuple[float, float]:
@@ -95,18 +102,21 @@ def torch_rows(robot, batch: int, repeat: int, rng):
     return rows
 
 
-def jax_row(robot, batch: int, repeat: int, rng):
+def jax_rows(robot, batch: int, repeat: int, rng):
     import jax
 
+    rows = []
     with jax.enable_x64(True):
-        fast = denavit.compile(robot, backend="jax")
-        nb = denavit.compile(robot, backend="numba")
+        fast = denavit.compile(robot, backend="jax", kernels=["fk"])
+        nb = denavit.compile(robot, backend="numba", kernels=["fk"])
         q = rng.uniform(-np.pi, np.pi, (batch, robot.dof))
-        qj = jax.numpy.asarray(q)
         fk = jax.jit(fast.fk)
-        np.testing.assert_allclose(np.asarray(fk(qj)), nb.fk(q, threads=1), atol=1e-12)
-        t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
-    return (robot.name, "jax.jit FK vs numba", batch, "float64", t_nb / t_jax)
+        for dtype, tol in ((np.float64, 1e-12), (np.float32, 1e-5)):
+            qj = jax.numpy.asarray(q.astype(dtype))
+            np.testing.assert_allclose(np.asarray(fk(qj)), nb.fk(q.astype(dtype).astype(np.float64)), atol=tol)
+            t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
+            rows.append((robot.name, "jax.jit FK vs numba", batch, dtype.__name__, t_nb / t_jax))
+    return rows
 
 
 def main(argv=None) -> None:
@@ -114,6 +124,7 @@ def main(argv=None) -> None:
     p.add_argument("--robots", nargs="+", default=["puma560", "panda"])
     p.add_argument("--batches", nargs="+", type=float, default=[1e4, 1e6])
     p.add_argument("--repeat", type=int, default=3)
+    p.add_argument("--only", choices=("torch", "jax"), help="only the rows of one framework")
     args = p.parse_args(argv)
     import torch
 
@@ -123,13 +134,15 @@ def main(argv=None) -> None:
     for name in args.robots:
         robot = denavit.load_robot(name)
         for batch in (int(b) for b in args.batches):
-            rows += torch_rows(robot, batch, args.repeat, rng)
-            rows.append(jax_row(robot, batch, args.repeat, rng))
+            if args.only != "jax":
+                rows += torch_rows(robot, batch, args.repeat, rng)
+            if args.only != "torch":
+                rows += jax_rows(robot, batch, args.repeat, rng)
             print(f"... {name} batch {batch} done", flush=True)
     from importlib.metadata import version
 
     print(f"\ntorch {torch.__version__}, pytorch_kinematics {version('pytorch_kinematics')}, jax {version('jax')}, "
-          f"numba {version('numba')}; one thread each\n")
+          f"numba {version('numba')}; one core, CPU time\n")
     print("| robot | operation | batch | dtype | ratio (peer time / denavit time) |")
     print("|---|---|---|---|---|")
     for name, op, batch, dtype, ratio in rows:

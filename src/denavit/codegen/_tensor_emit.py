@@ -72,8 +72,13 @@ def _split(x, k):
 
 
 def _join(entries, shape):
-    \"\"\"Entries of shape (...) -> one array of shape (...) + shape (stacked: nothing written in place).\"\"\"
-    return xp.stack(entries, -1).reshape(tuple(entries[0].shape) + shape)
+    \"\"\"Entries of shape (...) -> one array of shape (...) + shape, stacked row by row (nothing written in place).
+    Rows of a few entries let XLA fuse the entries' loops into the output's; one stack of 16 entries or more it
+    leaves as a copy of 16 separate results (a 4x4 pose: 1.3-1.5x the time at 1e4-1e6 configurations).\"\"\"
+    if len(shape) == 1:
+        return xp.stack(entries, -1)
+    step = len(entries) // shape[0]
+    return xp.stack([_join(entries[i * step:(i + 1) * step], shape[1:]) for i in range(shape[0])], -len(shape))
 
 
 def _broadcast(*xs):
