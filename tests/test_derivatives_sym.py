@@ -69,7 +69,8 @@ def _three_joint_arm(seed: int, convention: str):
 
 
 KIN_ARMS = [("planar2r", None), ("cylindrical-rpp", None), ("spherical-rrp", None),
-            ("random-standard", 11), ("random-modified", 12)]
+            ("random-standard", 15), ("random-modified", 12),  # both with a generic twist; 15 with base and tool
+            pytest.param("random-standard", 13, marks=pytest.mark.slow)]  # two generic twists, base, tool: ~4 CPU-s
 
 
 def _arm(name, seed):
@@ -172,3 +173,83 @@ def test_one_entry_beyond_the_bound_and_a_clear_refusal():
         S.rnea_derivatives_sym(panda)
     with pytest.raises(denavit.UnsupportedRobotError, match="DERIVATIVES_MAX_DOF"):
         S.gravity_derivatives_sym(panda)
+
+
+# --- command line ------------------------------------------------------------------------------------------------
+
+def _cli(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    return out
+
+
+def _parse(entries, symbols):
+    """JSON strings → sympy, read with a namespace of the expected symbols only (the test's own output)."""
+    ns = {s.name: s for s in symbols}
+    return sp.Matrix([[sp.sympify(e, locals=ns) for e in row] for row in entries])
+
+
+@pytest.mark.parametrize("frame", ["base", "tool"])
+def test_cli_jacobian_dot_and_hessian_symbolic(capsys, frame):
+    robot = denavit.load_robot("planar2r")
+    js = S.joint_symbols(2)
+    syms = [*js.q, *js.qd, *S.parameter_symbols(robot).values()]
+    data = json.loads(_cli(capsys, "jacobian", "planar2r", "--dot", "--hessian", "--symbolic", "--frame", frame,
+                           "--json"))
+    at = {**dict(zip(js.q, (0.3, -0.8))), **dict(zip(js.qd, (1.5, 0.4))), **{s: v for s, v in zip(
+        S.parameter_symbols(robot).values(), robot.parameter_values.values())}}
+    Jd = np.array(_parse(data["Jdot_symbolic"], syms).subs(at), dtype=float)
+    np.testing.assert_allclose(Jd, denavit.jacobian_dot(robot, [0.3, -0.8], [1.5, 0.4], frame), atol=1e-12)
+    a = np.array(_parse(data["Jdot_qd_symbolic"], syms).subs(at), dtype=float).ravel()
+    np.testing.assert_allclose(a, Jd @ [1.5, 0.4], atol=1e-12)
+    H = np.array([[[float(sp.sympify(e, locals={s.name: s for s in syms}).subs(at)) for e in row] for row in plane]
+                  for plane in data["H_symbolic"]])
+    np.testing.assert_allclose(H, denavit.kinematic_hessian(robot, [0.3, -0.8], frame), atol=1e-12)
+    assert len(data["H_latex"]) == 2 and data["Jdot_latex"].startswith("\\left[")
+    text = _cli(capsys, "jacobian", "planar2r", "--dot", "--hessian", "--symbolic", "--frame", frame)
+    assert "dJ/dq2 =" in text and ("dJ0/dt =" if frame == "base" else "dJe/dt =") in text
+    assert "qd" in text and "cos" in text
+    latex = _cli(capsys, "jacobian", "planar2r", "--dot", "--symbolic", "--latex")
+    assert "\\cos{\\left(q_{1} + q_{2} \\right)}" in latex
+
+
+def test_cli_symbolic_with_numbers_prints_both(capsys):
+    data = json.loads(_cli(capsys, "jacobian", "planar2r", "--dot", "--symbolic", "-q", "0.3, 0.5", "--qd", "1, -2",
+                           "--json"))
+    assert "Jdot_symbolic" in data and np.array(data["Jdot"]).shape == (6, 2)
+
+
+def test_cli_dynamics_derivatives_symbolic(capsys):
+    robot = denavit.load_robot("planar2r")
+    js = S.joint_symbols(2)
+    params = S.parameter_symbols(robot)
+    syms = [*js.q, *js.qd, *js.qdd, *params.values()]
+    data = json.loads(_cli(capsys, "dynamics", "planar2r", "--symbolic", "--derivatives", "--json"))
+    q, qd, qdd = (0.4, -1.1), (0.7, 1.3), (-0.5, 2.0)
+    at = {**dict(zip(js.q, q)), **dict(zip(js.qd, qd)), **dict(zip(js.qdd, qdd)),
+          **{params[k]: v for k, v in robot.parameter_values.items()}}
+    want_q, want_qd = denavit.rnea_derivatives(robot, q, qd, qdd)
+    for key, want in (("dtau_dq", want_q), ("dtau_dqd", want_qd), ("dg_dq", denavit.gravity_derivatives(robot, q))):
+        got = np.array(_parse(data[f"{key}_symbolic"], syms).subs(at), dtype=float)
+        np.testing.assert_allclose(got, want, atol=1e-12)
+        assert data[f"{key}_latex"].startswith("\\left[")
+    text = _cli(capsys, "dynamics", "planar2r", "--symbolic", "--derivatives")
+    assert "dtau/dq[2,2] = C2*L1*L2*m2*qd1**2 - L1*L2*S2*m2*qdd1 - L2*S12*g*m2" in text
+    assert "dg/dq[1,2] = -L2*S12*g*m2" in text
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["jacobian", "planar2r", "--dot"], "or --symbolic for the formulas"),
+    (["jacobian", "planar2r", "--dot", "--symbolic", "--qd", "1, 2"], "--qd goes with -q"),
+    (["jacobian", "planar2r", "--hessian", "--symbolic", "--method", "propagation"], "does not go with --method"),
+    (["jacobian", "planar2r", "--hessian", "--symbolic", "--frame", "1"], "choose base or tool"),
+    (["jacobian", "planar2r", "--dot", "--symbolic", "--analytic", "rpy"], "does not go with --analytic"),
+    (["dynamics", "planar2r", "--derivatives"], "or --symbolic for the formulas"),
+    (["dynamics", "planar2r", "--derivatives", "--symbolic", "--method", "newton-euler"], "drop --method"),
+    (["dynamics", "panda", "--derivatives", "--symbolic"], f"limited to {S.DERIVATIVES_MAX_DOF} joints"),
+])
+def test_cli_bad_combinations_exit_2_with_one_line(capsys, argv, message):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err and message in err, err

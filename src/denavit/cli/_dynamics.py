@@ -29,7 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--qdd", metavar="QDD", help="joint accelerations (default zeros)")
     p.add_argument("--symbolic", action="store_true", help="the symbolic equations of motion")
     p.add_argument("--derivatives", action="store_true",
-                   help="also dtau/dq and dtau/dqd at -q/--qd/--qdd (per rad or m; friction included)")
+                   help="also dtau/dq and dtau/dqd at -q/--qd/--qdd (per rad or m; friction included); with "
+                        "--symbolic also as formulas, with dg/dq (arms of up to 6 joints)")
     p.add_argument("--method", choices=["lagrange", "newton-euler", "steps"], default="lagrange",
                    help="symbolic route: Lagrange in Jacobian form (fast), Newton-Euler, or the literal Lagrange steps")
     p.add_argument("--format", choices=["text", "latex", "markdown"], default="text", help="symbolic output format")
@@ -96,8 +97,10 @@ def cmd_dynamics(args: argparse.Namespace):
     require_dynamics(robot)
     data: dict = {"robot": robot.name}
     lines: list[str] = []
-    if args.derivatives and args.q is None:
-        raise ParseError("--derivatives: give the joint values with -q (and --qd, --qdd)")
+    if args.derivatives and args.q is None and not args.symbolic:
+        raise ParseError("--derivatives: give the joint values with -q (and --qd, --qdd), or --symbolic for the formulas")
+    if args.derivatives and args.symbolic:
+        _check_symbolic_derivatives(robot, args)
     if args.q is not None:  # bad values fail now, not after the symbolic work
         joint_values(args, robot, args.q)
         _rates(args, robot, args.qd, "qd")
@@ -107,6 +110,10 @@ def cmd_dynamics(args: argparse.Namespace):
         sdata, slines = _symbolic(robot, args)
         data.update(sdata)
         lines += slines
+        if args.derivatives:
+            ddata, dlines = _symbolic_derivatives(robot, args)
+            data.update(ddata)
+            lines += dlines
     elif args.q is None:
         raise ParseError("give joint values with -q (or --symbolic for the equations)")
     if args.q is not None:
@@ -180,6 +187,45 @@ def _symbolic(robot, args):
         data["C_symbolic"] = terms.C
     data["M_latex"] = sp.latex(terms.M)
     return data, [f"{robot.name}: equations of motion ({args.method}, {elapsed:.2f} s)", _fitted(text, args)]
+
+
+def _check_symbolic_derivatives(robot, args) -> None:
+    from .. import symbolic as S
+
+    require_symbolic_size(robot, "dynamics --derivatives --symbolic", S.DERIVATIVES_MAX_DOF)
+    if args.method != "lagrange":
+        raise ParseError(f"--derivatives --symbolic differentiates the Lagrangian equations: drop --method {args.method}")
+
+
+def _symbolic_derivatives(robot, args):
+    """dtau/dq, dtau/dqd and dg/dq as formulas (:func:`denavit.symbolic.rnea_derivatives_sym`), entry by entry in
+    text (C12 = cos(q1 + q2) as the equations above), whole matrices in LaTeX and Markdown.  Gravity is the
+    symbol g in the printed forms, its value in JSON."""
+    import sympy as sp
+
+    from .. import symbolic as S
+
+    kw = dict(simplify=args.simplify, numeric=args.numeric_params, gravity_symbol=not args.json)
+    dq, dqd = S.rnea_derivatives_sym(robot, **kw)
+    dg = S.gravity_derivatives_sym(robot, **kw)
+    q = S.joint_symbols(robot.dof).q
+    blocks = (("dtau/dq", "dtau_dq", dq, "rows tau_i, columns q_k"),
+              ("dtau/dqd", "dtau_dqd", dqd, "rows tau_i, columns qd_k; viscous friction on the diagonal, Coulomb friction 0 away "
+                                    "from qd = 0"),
+              ("dg/dq", "dg_dq", dg, "symmetric: the Hessian of the potential energy"))
+    lines = ["", f"{robot.name}: derivatives of tau = M qdd + c + g + friction (dtau/dqdd = M)"]
+    data: dict = {}
+    for title, key, D, note in blocks:
+        lines.append(f"{title} ({note}):")
+        if args.format == "latex":
+            lines.append(sp.latex(D))
+        elif args.format == "markdown":
+            lines.append("$$\n" + sp.latex(D) + "\n$$")
+        else:
+            lines.append(_fitted("\n".join(f"{title}[{i + 1},{k + 1}] = {S.shorthand(D[i, k], q, collapse=False)}"
+                                           for i in range(D.rows) for k in range(D.cols)), args))
+        data.update({f"{key}_symbolic": D, f"{key}_latex": sp.latex(D)})
+    return data, lines
 
 
 def _fitted(text: str, args) -> str:

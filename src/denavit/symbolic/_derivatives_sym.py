@@ -41,34 +41,46 @@ J. Carpentier, N. Mansard, "Analytical Derivatives of Rigid Body Dynamics Algori
 
 from __future__ import annotations
 
+from collections import defaultdict
 from functools import lru_cache
 
 import sympy as sp
+from sympy.utilities.iterables import sift
 
 from ..errors import UnsupportedRobotError
 from ..model import DHRobot, Frame
 from ._dynamics import lagrangian_dynamics
 from ._dynamics_data import joint_parameters
-from ._dynamics_trig import collect_trig
 from ._jacobians import geometric_jacobian_sym
 from ._simplify import POLICIES, simplify_expr
 from ._symbols import joint_symbols
 
 __all__ = ["kinematic_hessian_sym", "jacobian_dot_sym", "acceleration_bias_sym", "hessian_slice_sym",
-           "rnea_derivatives_sym", "gravity_derivatives_sym", "rnea_derivative_entry_sym", "DERIVATIVES_MAX_DOF"]
+           "rnea_derivatives_sym", "gravity_derivatives_sym", "rnea_derivative_entry_sym", "DERIVATIVES_MAX_DOF", "GRAVITY"]
 
 #: Joints up to which :func:`rnea_derivatives_sym` and :func:`gravity_derivatives_sym` form the whole matrices
 #: (Puma 560: ∂τ/∂q about 6 s and 30 k operations, measured 2026-12; a 7-joint arm is several times that).
 DERIVATIVES_MAX_DOF = 6
 
 
+def _collect(e: sp.Expr) -> sp.Expr:
+    """A sum collected on its sine/cosine factors, each exact coefficient factored (L2 (qd1 + qd2)² cos(q1 + q2))."""
+    groups: dict = defaultdict(list)
+    for t in sp.Add.make_args(sp.expand(e)):
+        trig, rest = sift(sp.Mul.make_args(t), lambda f: isinstance(f, (sp.cos, sp.sin)), binary=True)
+        groups[sp.Mul(*trig)].append(sp.Mul(*rest))
+    coefficients = [sp.Add(*v) for v in groups.values()]  # factoring float coefficients is slow and gains little
+    return sp.Add(*[(sp.factor_terms(c) if c.has(sp.Float) else sp.factor(c)) * k
+                    for c, k in zip(coefficients, groups)])
+
+
 def _simplifier(policy: str):
-    """Entries here are derivatives of expressions already simplified, so "trig" is a cheap collection on their
-    sine/cosine factors (:func:`~denavit.symbolic._dynamics_trig.collect_trig`), not a new simplification."""
+    """Entries here are derivatives of expressions already simplified, so "trig" is a collection on their
+    sine/cosine factors (:func:`_collect`), not a new simplification."""
     if policy not in POLICIES:
         raise ValueError(f"unknown simplification policy {policy!r}; choose one of {', '.join(POLICIES)}")
     if policy == "trig":
-        return collect_trig
+        return _collect
     return lambda e: simplify_expr(e, policy)
 
 
@@ -161,17 +173,25 @@ def _require_size(robot: DHRobot, what: str) -> None:
             "or the numeric rnea_derivatives")
 
 
+#: the symbol of |g₀| with ``gravity_symbol=True`` (the one :func:`denavit.symbolic.format_dynamics` prints)
+GRAVITY = sp.Symbol("g", positive=True)
+
+
 @lru_cache(maxsize=16)
-def _torque_parts(robot: DHRobot, simplify: str, numeric: bool):
-    """(τ without friction = M q̈ + c + g, g, viscous coefficients) from the symbolic equations of motion."""
+def _torque_parts(robot: DHRobot, simplify: str, numeric: bool, gravity_symbol: bool = False):
+    """(τ without friction = M q̈ + c + g, g, viscous coefficients) from the symbolic equations of motion; with
+    ``gravity_symbol`` g = GRAVITY · g_unit (unless the robot names a parameter g)."""
     t = lagrangian_dynamics(robot, simplify, numeric, coriolis=False)
-    tau = t.M * sp.Matrix(t.qdd) + t.c + t.g
+    g = t.g
+    if gravity_symbol and t.g_unit is not None and "g" not in robot.parameter_values:
+        g = sp.ImmutableMatrix([GRAVITY * e for e in t.g_unit])
+    tau = t.M * sp.Matrix(t.qdd) + t.c + g
     _, viscous, _ = joint_parameters(robot, numeric)
-    return sp.ImmutableMatrix(tau), t.g, tuple(viscous)
+    return sp.ImmutableMatrix(tau), g, tuple(viscous)
 
 
 def rnea_derivative_entry_sym(robot: DHRobot, i: int, wrt: str, k: int, simplify: str = "trig",
-                              numeric: bool = False, friction: bool = True) -> sp.Expr:
+                              numeric: bool = False, friction: bool = True, gravity_symbol: bool = False) -> sp.Expr:
     """One entry ∂τ_i/∂q_k (``wrt="q"``) or ∂τ_i/∂q̇_k (``wrt="qd"``), indices from 0; any number of joints.
 
     Costs the symbolic equations of motion of the arm (:func:`denavit.symbolic.lagrangian_dynamics`) once and one
@@ -182,7 +202,7 @@ def rnea_derivative_entry_sym(robot: DHRobot, i: int, wrt: str, k: int, simplify
         raise ValueError(f"wrt must be 'q' or 'qd', got {wrt!r}")
     if not (0 <= i < n and 0 <= k < n):
         raise ValueError(f"entry ({i}, {k}) out of range for {robot.name}'s {n} joints (indices 0 ... {n - 1})")
-    tau, _, viscous = _torque_parts(robot, simplify, numeric)
+    tau, _, viscous = _torque_parts(robot, simplify, numeric, gravity_symbol)
     js = joint_symbols(n)
     x = (js.q if wrt == "q" else js.qd)[k]
     e = tau[i].diff(x)
@@ -193,7 +213,7 @@ def rnea_derivative_entry_sym(robot: DHRobot, i: int, wrt: str, k: int, simplify
 
 @lru_cache(maxsize=16)
 def rnea_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool = False,
-                         friction: bool = True) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
+                         friction: bool = True, gravity_symbol: bool = False) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
     """``(dtau_dq, dtau_dqd)``: ∂τ/∂q and ∂τ/∂q̇ as n×n sympy matrices, [output, input] (rows τ_i, columns q_k).
 
     Parameters
@@ -204,6 +224,9 @@ def rnea_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool =
         As :func:`denavit.symbolic.lagrangian_dynamics`; "trig": each entry collected on its sines and cosines.
     friction : bool
         Add diag(viscous) to ∂τ/∂q̇ (the Coulomb term contributes 0, module notes).
+    gravity_symbol : bool
+        Write |g₀| as the symbol ``g`` (:data:`GRAVITY`; as ``format_dynamics(..., gravity_symbol=True)``), not
+        as its value; substitute it before evaluating.
 
     Returns
     -------
@@ -224,7 +247,7 @@ def rnea_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool =
     """
     _require_size(robot, "rnea_derivatives_sym")
     n = robot.dof
-    tau, _, viscous = _torque_parts(robot, simplify, numeric)
+    tau, _, viscous = _torque_parts(robot, simplify, numeric, gravity_symbol)
     js = joint_symbols(n)
     simp = _simplifier(simplify)
     dq = sp.ImmutableMatrix(n, n, [simp(tau[i].diff(js.q[k])) for i in range(n) for k in range(n)])
@@ -235,15 +258,17 @@ def rnea_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool =
 
 
 @lru_cache(maxsize=16)
-def gravity_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool = False) -> sp.ImmutableMatrix:
+def gravity_derivatives_sym(robot: DHRobot, simplify: str = "trig", numeric: bool = False,
+                            gravity_symbol: bool = False) -> sp.ImmutableMatrix:
     """∂g/∂q, an n×n symmetric sympy matrix in q (the Hessian of the potential energy), [output, input].
 
-    g(q) from :func:`denavit.symbolic.lagrangian_dynamics` (``robot.gravity``), differentiated entry by entry.
+    g(q) from :func:`denavit.symbolic.lagrangian_dynamics` (``robot.gravity``), differentiated entry by entry;
+    ``gravity_symbol`` as :func:`rnea_derivatives_sym`.
     Raises :class:`~denavit.errors.UnsupportedRobotError` beyond :data:`DERIVATIVES_MAX_DOF` joints.
     """
     _require_size(robot, "gravity_derivatives_sym")
     n = robot.dof
-    _, g, _ = _torque_parts(robot, simplify, numeric)
+    _, g, _ = _torque_parts(robot, simplify, numeric, gravity_symbol)
     q = joint_symbols(n).q
     simp = _simplifier(simplify)
     return sp.ImmutableMatrix(n, n, [simp(g[i].diff(q[k])) for i in range(n) for k in range(n)])
