@@ -281,7 +281,8 @@ def test_the_workspace_job_of_the_planar_elbow_arm_is_the_disk_of_radius_two(cli
     import base64
 
     assert base64.b64decode(res["png"])[:8] == b"\x89PNG\r\n\x1a\n"
-    err = client.post("/api/jobs", json={"kind": "workspace", "payload": {"robot": doc, "samples": 10**9}}).json()
+    assert res["low"] <= res["area"] <= res["high"] and res["volume"] is None
+    err = client.post("/api/jobs", json={"kind": "workspace", "payload": {"robot": doc, "samples": 10**10}}).json()
     assert _wait(client, err["id"])["error"].startswith("'samples' must be")
 
 
@@ -397,6 +398,20 @@ def test_a_reachability_job_reports_its_progress_and_cancel_ends_its_process(cli
         r = client.post("/api/jobs", json={"kind": "reachability", "payload": {"robot": puma, "resolution": bad}})
         s = _wait(client, r.json()["id"])
         assert s["state"] == "failed" and "'resolution'" in s["error"] and "\n" not in s["error"]
+
+
+def test_a_workspace_of_a_hundred_million_samples_reports_its_progress_and_is_cancelled(client):
+    """The issue's long work: puma560's workspace at 10⁸ samples streams through the library's sampler with its
+    progress line (a percentage of the samples) as the job's progress; cancel ends the process."""
+    puma = client.post("/api/catalogue/load", json={"name": "puma560"}).json()["robot"]
+    job = client.post("/api/jobs", json={"kind": "workspace", "payload": {"robot": puma, "samples": 10**8}}).json()
+    s = _wait(client, job["id"], until=lambda st: any("%" in line for line in st["progress"]))
+    assert s["state"] == "running", s
+    assert any(x.endswith("samples") or "samples " in x for x in s["progress"] if "%" in x)
+    assert client.post(f"/api/jobs/{job['id']}/cancel").json()["state"] == "cancelled"
+    proc = client.app.state.jobs._jobs[job["id"]].process
+    proc.join(timeout=30)
+    assert not proc.is_alive() and proc.exitcode == -signal.SIGTERM
 
 
 def test_a_job_in_the_same_slot_supersedes_the_running_one_and_never_counts_against_the_limit(client):

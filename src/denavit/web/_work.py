@@ -11,6 +11,7 @@ for a claims file, as ``denavit check`` does.
 
 from __future__ import annotations
 
+import contextlib
 import re
 import tempfile
 from collections.abc import Callable
@@ -190,32 +191,46 @@ def singularities(payload: dict[str, Any], progress: Callable[[str], None]) -> d
                                           for x in c.solutions]} for c in res.conditions]}
 
 
-#: Most configurations sampled by one workspace job.
-MAX_WORKSPACE_SAMPLES = 2_000_000
+#: Most configurations sampled by one workspace job (10⁸ take about 30 s of CPU for a 6-joint arm with numba).
+MAX_WORKSPACE_SAMPLES = 10**9
 
 
 def workspace(payload: dict[str, Any], progress: Callable[[str], None]) -> dict[str, Any]:
-    """The sampled workspace (:func:`denavit.viz.workspace`) and its picture (:func:`~denavit.viz.plot_workspace`)."""
+    """The workspace by streamed sampling (:func:`denavit.scale.occupancy`, as ``denavit workspace``: reach, area or
+    volume with its interval) and its picture (:func:`~denavit.viz.plot_occupancy`).  Threads, not processes: the
+    job is a daemon process, which may not start others.  The library's progress line is the job's progress."""
     import base64
     import io
 
-    import numpy as np
+    from ..scale import occupancy
+    from ..viz import plot_occupancy
 
-    from ..viz import plot_workspace
-    from ..viz import workspace as sample
-
-    samples = payload.get("samples", 100_000)
+    samples = payload.get("samples", 1_000_000)
     if not isinstance(samples, int) or isinstance(samples, bool) or not 1_000 <= samples <= MAX_WORKSPACE_SAMPLES:
-        raise ParseError(f"'samples' must be a whole number from 1000 to {MAX_WORKSPACE_SAMPLES}")
+        raise ParseError(f"'samples' must be a whole number from 1000 to {MAX_WORKSPACE_SAMPLES:.0e}")
     robot = _robot(payload)
     progress(f"sampling {samples} configurations")
-    ws = sample(robot, samples, rng=np.random.default_rng(0))
+    with _progress_lines(progress):
+        ws = occupancy(robot, samples, seed=0, scheduler="threads", progress=True)
     progress("drawing")
-    fig = plot_workspace(ws, title=robot.name)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png")
+    plot_occupancy(ws, robot.name).savefig(buf, format="png")
+    e = ws.estimate
     return {"png": base64.b64encode(buf.getvalue()).decode("ascii"), "samples": ws.samples, "reach": ws.reach,
-            "volume": ws.volume, "area": ws.area, "planar": ws.planar, "extent": ws.extent.tolist()}
+            "volume": None if ws.planar else e.value, "area": e.value if ws.planar else None, "low": e.low,
+            "high": e.high, "planar": ws.planar, "extent": ws.extent.tolist()}
+
+
+@contextlib.contextmanager
+def _progress_lines(progress: Callable[[str], None]):
+    """The library's progress line (written to stderr) sent as the job's progress while the block runs."""
+    import sys
+
+    stderr, sys.stderr = sys.stderr, _ProgressLines(progress)
+    try:
+        yield
+    finally:
+        sys.stderr = stderr
 
 
 #: Voxel edges a page's reachability map may ask for [m] (the library refuses too many cells itself).
@@ -231,7 +246,6 @@ def reachability(payload: dict[str, Any], progress: Callable[[str], None]) -> di
     is passed on as the job's progress."""
     import base64
     import io
-    import sys
 
     from ..scale import reachability as reach_map
     from ..viz import plot_reachability
@@ -243,11 +257,8 @@ def reachability(payload: dict[str, Any], progress: Callable[[str], None]) -> di
         raise ParseError(f"'orientations' must be a whole number from 1 to {MAX_REACH_ORIENTATIONS}")
     robot = _robot(payload)
     progress(f"reachability of {robot.name}: {k} orientations per {h:g} m voxel")
-    stderr, sys.stderr = sys.stderr, _ProgressLines(progress)
-    try:
+    with _progress_lines(progress):
         rmap = reach_map(robot, float(h), k, progress=True)
-    finally:
-        sys.stderr = stderr
     progress("drawing")
     buf = io.BytesIO()
     plot_reachability(rmap, robot.name).savefig(buf, format="png")

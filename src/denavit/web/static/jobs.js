@@ -197,16 +197,19 @@
   var wsJob = null;
   function startWorkspace() {
     sync();
-    var n = parseInt($("ws-samples").value, 10);
+    var n = number("ws-samples");   // 1e8 as typed; the server names a bad count
     $("ws-start").disabled = true; $("ws-cancel").disabled = false; $("ws-progress").value = 0;
-    wsJob = runJob("workspace", { robot: good.doc, samples: n }, function (p) {
-      var last = p[p.length - 1] || "starting";
-      $("ws-status").textContent = last; $("ws-progress").value = /drawing/.test(last) ? 1 : 0.2;
+    wsJob = wb.wsJob = runJob("workspace", { robot: good.doc, samples: n }, function (p) {
+      var last = p[p.length - 1] || "starting", m = /^([\d.]+)%/.exec(last);
+      $("ws-status").textContent = last;
+      if (m) $("ws-progress").value = 0.95 * m[1] / 100; else if (/drawing/.test(last)) $("ws-progress").value = 0.95;
     }, function (res, err) {
-      $("ws-start").disabled = false; $("ws-cancel").disabled = true; $("ws-progress").value = res ? 2 : 0;
+      $("ws-start").disabled = false; $("ws-cancel").disabled = true; $("ws-progress").value = res ? 1 : 0;
       if (!res) { $("ws-status").textContent = err; return; }
+      var unit = res.planar ? " m²" : " m³";
       $("ws-status").textContent = res.samples + " samples, reach " + res.reach.toFixed(3) + " m, " +
-        (res.planar ? "area " + res.area.toFixed(3) + " m²" : "volume " + res.volume.toFixed(3) + " m³");
+        (res.planar ? "area " : "volume ") + (res.planar ? res.area : res.volume).toFixed(3) + unit +
+        " (between " + res.low.toFixed(3) + " and " + res.high.toFixed(3) + unit + ")";
       $("ws-picture").src = "data:image/png;base64," + res.png; $("ws-picture").hidden = false;
     });
   }
