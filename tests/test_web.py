@@ -320,7 +320,7 @@ def test_hostile_bodies_get_one_line_4xx_never_500(client):
     cell = st.sampled_from(["q", "0", "pi/2", "L1", "q + q", "1e400", "nan", "sin(", "deg(90)", "", "q2", "__class__",
                             "a" * 300]) | value
     keys = st.sampled_from(["robot", "q", "qd", "pose", "wrench", "frame", "text", "name", "format", "kind", "payload",
-                            "filename"])
+                            "filename", "shift", "seed", "method", "lock"])
 
     @settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
     @given(path=st.sampled_from(POSTS), body=st.dictionaries(keys, value, max_size=4) | value,
@@ -328,7 +328,8 @@ def test_hostile_bodies_get_one_line_4xx_never_500(client):
     def hostile(path, body, row, field, text):
         doc = json.loads(json.dumps(PLANAR))
         doc["joints"][row][field] = text
-        for b in (body, {"robot": doc, "q": [0.1, 0.2], "pose": "0.5, 0, 0, 0, 0, 0", "qd": text, "wrench": text}):
+        for b in (body, {"robot": doc, "q": [0.1, 0.2], "pose": "0.5, 0, 0, 0, 0, 0", "qd": text, "wrench": text},
+                  {"robot": PLANAR, "q": [0.1, 0.2], "method": "numeric", "shift": text, "seed": text}):
             r = client.post(path, content=json.dumps(b, allow_nan=True), headers={"Content-Type": "application/json"})
             assert r.status_code < 500, (path, b, r.text)
             if r.status_code >= 400:
