@@ -430,7 +430,7 @@ def test_compiled_analytic_ik_equals_the_plain_solver(name):
         if k < len(Q):
             assert a.count >= 1  # q itself is a solution (inside the limits)
     batch = denavit.forward_kinematics(robot, Q[:5])
-    _same_analytic(fast.analytic_ik(batch), denavit.analytic_ik(robot, batch))  # a batch: the plain path
+    _same_analytic(fast.analytic_ik(batch), denavit.analytic_ik(robot, batch))  # a batch: the compiled loop, in the plain layout
 
 
 @needs_numba

@@ -116,6 +116,21 @@ def _same(robot, T, a, b):
         assert np.all(np.abs(F[:, :3, :3] - T[:3, :3]).max(axis=(-1, -2)) < 1e-9)
 
 
+def _same_batch(robot, a, b):
+    """Batched results a (compiled) and b (plain) in the same layout: the same slots filled (valid, NaN rows),
+    labels, continuum texts and outside-limits counts; the filled rows equal to the conditioning-scaled tolerance
+    of _tolerance."""
+    np.testing.assert_array_equal(a.valid, b.valid)
+    np.testing.assert_array_equal(np.isnan(a.solutions), np.isnan(b.solutions))
+    np.testing.assert_array_equal(np.asarray(a.branches, dtype=object), np.asarray(b.branches, dtype=object))
+    np.testing.assert_array_equal(np.asarray(a.free, dtype=object), np.asarray(b.free, dtype=object))
+    np.testing.assert_array_equal(a.outside_limits, b.outside_limits)
+    assert (a.method, a.controlled) == (b.method, b.controlled)
+    A, Bs = a.solutions[a.valid], b.solutions[b.valid]  # (m, n), filled rows in the same order
+    assert np.all(np.abs(A - Bs).max(axis=-1, initial=0.0) < _tolerance(robot, A))
+    np.testing.assert_allclose(a.position_error[a.valid], b.position_error[b.valid], atol=1e-12)
+
+
 @contextlib.contextmanager
 def _handovers():
     """Calls of the plain solver made by the compiled analytic_ik (its status-1 path), counted in the list yielded."""
@@ -271,9 +286,7 @@ def test_catalogue_arms_compiled_equals_plain(arm):
         far[:3, 3] = dist * np.array([1.0, 1 / 3, -1 / 7])
         _same(robot, far, fast.analytic_ik(far), denavit.analytic_ik(robot, far))
     batch = denavit.forward_kinematics(robot, rng.uniform(robot.q_limits[:, 0], robot.q_limits[:, 1], (4, 6)))
-    a, b = fast.analytic_ik(batch), denavit.analytic_ik(robot, batch)  # a batch: the plain path
-    np.testing.assert_array_equal(np.isnan(a.solutions), np.isnan(b.solutions))
-    np.testing.assert_allclose(a.solutions, b.solutions, atol=1e-12)
+    _same_batch(robot, fast.analytic_ik(batch), denavit.analytic_ik(robot, batch))
 
 
 def _random_ur_class(seed: int) -> DHRobot:
@@ -427,3 +440,23 @@ def test_compiled_result_reads_copies_and_pickles_as_the_plain_one(_kernel_cache
     bad[0, 1] = np.nan
     with pytest.raises(denavit.errors.ShapeError, match="non-finite"):
         fast.analytic_ik(bad)
+
+
+def test_compiled_batch_keeps_the_plain_layout(arm):
+    """A batch through the compiled kernel's loop comes back in the plain solver's batched layout (slot = rank among
+    the verified candidates, NaN rows for duplicates and solutions outside the limits), with singular and rounded
+    poses (handed to the plain solver as one sub-batch) among random ones, in a (2, 15) batch."""
+    robot, fast = arm
+    rng = np.random.default_rng(5)
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (30, robot.dof))
+    singular, _ = _singular_set(robot, rng, 2, *SINGULAR[robot.name])
+    Q[:10] = singular[rng.choice(len(singular), 10, replace=False)]
+    T = denavit.forward_kinematics(robot, Q).reshape(2, 15, 4, 4)
+    with _handovers() as calls:
+        a = fast.analytic_ik(T)
+    assert len(calls) <= 1  # at most one plain sub-batch
+    b = denavit.analytic_ik(robot, T)
+    assert a.solutions.shape == b.solutions.shape and a.solutions.shape[:2] == (2, 15)
+    _same_batch(robot, a, b)
+    assert np.all(a.count.reshape(-1)[10:] >= 1)  # the random poses: q itself is a solution, inside the limits

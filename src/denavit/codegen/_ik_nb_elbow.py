@@ -30,7 +30,8 @@ __all__ = ["ik_elbow_packed", "ik_elbow"]
 @njit(cache=True, nogil=True)
 def ik_elbow_packed(T, K, f, i):
     """:func:`ik_elbow` with the constants packed in one vector K (ELBOW_LAYOUT order) and the outputs in two
-    arrays (f: solutions, residuals, outside-limits solutions; i: label codes, then k, j, status): four
+    arrays (f: solutions, residuals, outside-limits solutions; i (B, 20): label codes, then k, j, status, then the
+    batched layout's slots (ik_finish's out_rank)): four
     arguments instead of twenty-four to unbox per call."""
     X_e, C0i, R6 = K[0:3], K[3:19].reshape((4, 4)), K[19:28].reshape((3, 3))
     R1, p1, a = K[28:37].reshape((3, 3)), K[37:40], K[40:43]
@@ -40,15 +41,16 @@ def ik_elbow_packed(T, K, f, i):
     lo_lim, hi_lim, rev, theta, tols = K[149:155], K[155:161], K[161:167], K[167:173], K[173:181]
     chain = K[181:293].reshape((7, 4, 4))
     ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, rev, theta, tols, chain,
-             f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:])
+             f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:11], i[:, 11:20])
 
 
 @njit(cache=True, nogil=True)
 def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, revolute, theta, tols, chain,
-             out_q, out_err, out_label, out_outq, out_status):
+             out_q, out_err, out_label, out_outq, out_status, out_rank):
     """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
-    solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide)."""
+    solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
+    of the batched layout (:func:`._ik_nb_finish.ik_finish`)."""
     h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
@@ -139,7 +141,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
-                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, True)
+                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, True,
+                                    out_rank[b])
         status = max(status, st)
         for slot in range(kept):
             best = int(perm[slot])

@@ -5,8 +5,9 @@ were half of a call's time).  Compiled once per machine (``cache=True``); import
 
 Layout of the output vector ``o`` (OUT_SIZE floats): ``o[:112]`` the (8, 14) block of the kernels (solutions,
 residuals, solutions outside the limits), ``o[112:120]`` the label codes, ``o[120]`` kept, ``o[121]`` outside,
-``o[122]`` status (0 answered, 1 for the plain solver, 2 a bad target), ``o[123]`` the target's orthonormality
-error (inf for NaN or inf entries).
+``o[122]`` status (0 answered, 1 for the plain solver, 2 a bad target), ``o[123:131]`` each kept solution's slot
+in the plain solver's batched layout (its rank among the verified candidates), ``o[131]`` their number, ``o[132]``
+the target's orthonormality error (inf for NaN or inf entries).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from ._ik_nb_stanford import ik_stanford_packed
 
 __all__ = ["OUT_SIZE", "ENTRIES", "BAD_TARGET", "pose_error"]
 
-OUT_SIZE = 124
+OUT_SIZE = 133
 #: a target whose rotation is this far from orthonormal (the largest |RᵀR − I| entry) is refused
 BAD_TARGET = 1e-6
 
@@ -46,7 +47,7 @@ def pose_error(T):
 def _checked(T, o):
     """Record T's orthonormality error in o; False (status 2, nothing found) for a bad target."""
     err = pose_error(T)
-    o[123] = err
+    o[132] = err
     if err > BAD_TARGET:
         o[120], o[121], o[122] = 0.0, 0.0, 2.0
         return False
@@ -60,21 +61,21 @@ def _checked(T, o):
 def ik_one_elbow(T, K, o):
     """Every closed-form solution of the one pose T into o (layout in the module notes): the elbow kernel."""
     if _checked(T, o):
-        ik_elbow_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:123].reshape((1, 11)))
+        ik_elbow_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
 
 
 @njit(cache=True, nogil=True)
 def ik_one_parallel(T, K, o):
     """:func:`ik_one_elbow` by the UR-class kernel."""
     if _checked(T, o):
-        ik_parallel_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:123].reshape((1, 11)))
+        ik_parallel_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
 
 
 @njit(cache=True, nogil=True)
 def ik_one_stanford(T, K, o):
     """:func:`ik_one_elbow` by the Stanford-class kernel."""
     if _checked(T, o):
-        ik_stanford_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:123].reshape((1, 11)))
+        ik_stanford_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
 
 
 @njit(cache=True, nogil=True)

@@ -79,7 +79,7 @@ def _near_fold_edge(x, lo, hi):
 
 @njit(cache=True, nogil=True)
 def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
-              perm, C, cs, given):
+              perm, C, cs, given, out_rank):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
     would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
     status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
@@ -87,7 +87,9 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
     :func:`chain_fk`); frames[k] (8, 36) the frames after joints 1, 2, 3 of candidate k, unfolded (the FK's
     products P[1:4]: columns x, y, z, origin each), for the labels; cs[k] (8, 12) the cosine and sine of each
     joint of candidate k, given by the closed form (``given``: the very values of math.cos, math.sin of those
-    floats, so the FK computes no sine) or computed here.  Returns (kept, outside, status)."""
+    floats, so the FK computes no sine) or computed here; out_rank[slot] (9,) the rank of each kept solution
+    among the verified candidates in candidate order, out_rank[8] their number (the slots of the plain solver's
+    batched layout).  Returns (kept, outside, status)."""
     verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
     ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     status = 0
@@ -121,6 +123,13 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
         if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
             status = 1  # would be polished by the plain solver
         ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
+    vr = np.empty(8)  # rank of each verified candidate among them
+    nver = 0
+    for k in range(ncand):
+        if ok[k]:
+            vr[k] = nver
+            nver += 1
+    out_rank[8] = nver
     for k in range(ncand):
         if not ok[k]:
             continue
@@ -182,6 +191,7 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
                             break
         used[best] = True
         perm[slot] = best
+        out_rank[slot] = vr[best]
         for j in range(6):
             out_q[slot, j] = cand[best, j]
         out_err[slot, 0], out_err[slot, 1] = cerr[best, 0], cerr[best, 1]

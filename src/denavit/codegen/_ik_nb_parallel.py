@@ -28,7 +28,7 @@ def ik_parallel_packed(T, K, f, i):
     """All solutions of each pose T[b] of a 6R UR-class arm, the constants in K (PARALLEL_LAYOUT order); outputs as
     ik_elbow_packed: f[b, :k, :6] solutions (folded, sorted), f[b, :k, 6:8] (position, orientation) residuals,
     f[b, :j, 8:] the solutions outside the limits; i[b, :k] label codes (1 shoulder left, 2 elbow down, 4 wrist
-    flip), i[b, 8:] = (k, j, 1 if the plain solver must decide)."""
+    flip), i[b, 8:11] = (k, j, 1 if the plain solver must decide), i[b, 11:20] the batched layout's slots."""
     Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
     a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
     rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
@@ -45,7 +45,7 @@ def ik_parallel_packed(T, K, f, i):
             continue
         ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, cs, ws[89:134])
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C, cs, True)
+                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C, cs, True, i[b, 11:20])
         for r in range(3):
             X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
         for s in range(kept):

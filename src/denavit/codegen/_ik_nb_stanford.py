@@ -46,7 +46,8 @@ def ik_stanford_packed(T, K, f, i):
             X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
         ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139], C, cs, False)
+                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139], C, cs, False,
+                                    i[b, 11:20])
         for s in range(kept):
             i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)

@@ -133,10 +133,10 @@ class IKMethods:
         (R R P with axes 1, 2 meeting, spherical wrist).
 
         Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
-        polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are batches
-        (its batched path is already the fast one) and arms of other classes.  One pose is one machine-code call
-        (the check of T and the kernel, :func:`._ik_nb_entry.ik_one`); the result's arrays are views of its output
-        vector, made when first read.
+        polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are arms of other
+        classes.  One pose is one machine-code call (the check of T and the kernel, :mod:`._ik_nb_entry`); the
+        result's arrays are views of its output vector, made when first read.  A batch (..., 4, 4) goes through
+        the kernel's own loop and comes back in the plain solver's batched layout (:func:`_batch`).
         """
         c = self._elbow
         if c is None:
@@ -146,6 +146,8 @@ class IKMethods:
         if T.__class__ is not _ndarray or T.dtype is not _F64 or T.shape != _POSE or not T.flags.c_contiguous:
             Ta = np.asarray(T, dtype=np.float64)
             if Ta.shape != _POSE:
+                if Ta.ndim > 2 and Ta.shape[-2:] == _POSE and Ta.size:
+                    return _batch(self.robot, c, Ta)
                 return analytic_ik(self.robot, T)
             T = np.ascontiguousarray(Ta)
         o = np.empty(c[4])
@@ -158,7 +160,7 @@ class IKMethods:
             res.__dict__["_p"] = (o, *c[1])
             return res
         if status == 2.0:
-            err = o[123]
+            err = o[132]
             raise ShapeError("T has non-finite values" if err == np.inf else
                              f"T: rotation part is not orthonormal (error {err:.2g})")
         return analytic_ik(self.robot, T)
@@ -229,3 +231,45 @@ for _lazy in (_Lazy("solutions", lambda o, labels, kind: o[:112].reshape(8, 14)[
               _Lazy("valid", lambda o, labels, kind: _ALL_VALID[int(o[120])])):
     setattr(_PackedResult, _lazy.name, _lazy)
 _PackedResult.__name__ = _PackedResult.__qualname__ = "AnalyticIKResult"  # its repr is a plain result's
+
+
+def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
+    """The solutions of a batch of poses Ta (..., 4, 4) by the compiled kernel's own loop, in the plain solver's
+    batched layout: slot k of a pose is its k-th verified candidate in candidate order (NaN rows, ``valid``
+    False, where that candidate was a duplicate or outside the limits), K slots = the most verified candidates
+    of any pose; ``outside_limits`` counts per pose.  Poses the kernel hands over are solved by
+    :func:`denavit.analytic_ik` as one sub-batch and put in their rows."""
+    batch, n = Ta.shape[:-2], robot.dof
+    Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))  # (B, 4, 4)
+    B = len(Tf)
+    o = np.empty((B, c[4]))
+    c[3](Tf, c[0], o)
+    status = o[:, 122]
+    if (status == 2.0).any():
+        err = o[int(np.argmax(status == 2.0)), 132]
+        raise ShapeError("T has non-finite values" if err == np.inf else
+                         f"T: rotation part is not orthonormal (error {err:.2g})")
+    hand = np.flatnonzero(status == 1.0)
+    sub = analytic_ik(robot, Tf[hand]) if len(hand) else None
+    answered = status == 0.0
+    K = max(1, int(o[answered, 131].max(initial=0)), 0 if sub is None else sub.solutions.shape[1])
+    kept = np.where(answered, o[:, 120], 0).astype(int)
+    bb, ss = np.nonzero(np.arange(8) < kept[:, None])  # every kept solution: pose, sorted slot
+    col = o[bb, 123 + ss].astype(int)  # its slot in the batched layout
+    g = o[:, :112].reshape(B, 8, 14)
+    sol, pe, re = np.full((B, K, n), np.nan), np.full((B, K), np.nan), np.full((B, K), np.nan)
+    valid, codes = np.zeros((B, K), dtype=bool), np.full((B, K), -1)
+    sol[bb, col], pe[bb, col], re[bb, col] = g[bb, ss, :6], g[bb, ss, 6], g[bb, ss, 7]
+    valid[bb, col], codes[bb, col] = True, o[bb, 112 + ss].astype(int)
+    labels, kind = c[1]
+    branches = np.array(list(labels) + [""], dtype=object)[codes]  # code -1: ""
+    free = np.full((B, K), "", dtype=object)
+    outside = np.where(answered, o[:, 121], 0).astype(int)
+    if sub is not None:
+        k = sub.solutions.shape[1]
+        sol[hand, :k], pe[hand, :k], re[hand, :k] = sub.solutions, sub.position_error, sub.orientation_error
+        valid[hand, :k], branches[hand, :k], free[hand, :k] = sub.valid, sub.branches, sub.free
+        outside[hand] = sub.outside_limits
+    return AnalyticIKResult(sol.reshape(batch + (K, n)), branches.reshape(batch + (K,)), free.reshape(batch + (K,)),
+                            pe.reshape(batch + (K,)), re.reshape(batch + (K,)), outside.reshape(batch), kind, "pose",
+                            valid.reshape(batch + (K,)))
