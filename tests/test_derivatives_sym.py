@@ -175,6 +175,25 @@ def test_one_entry_beyond_the_bound_and_a_clear_refusal():
         S.gravity_derivatives_sym(panda)
 
 
+
+def test_policies_and_numeric_parameters_give_the_same_values():
+    """simplify="none" (entries as differentiated) and numeric=True (values substituted) are the same functions."""
+    robot = denavit.load_robot("planar2r")
+    rng = np.random.default_rng(10)
+    values = list(robot.parameter_values.values())
+    q, qd, qdd = _point(rng, robot)
+    trig = _evaluator(robot, *S.rnea_derivatives_sym(robot), S.jacobian_dot_sym(robot, "tool"))(q, qd, qdd, values)
+    none = _evaluator(robot, *S.rnea_derivatives_sym(robot, simplify="none"),
+                      S.jacobian_dot_sym(robot, "tool", simplify="none"))(q, qd, qdd, values)
+    numeric = S.rnea_derivatives_sym(robot, numeric=True)
+    assert not any(m.free_symbols & set(S.parameter_symbols(robot).values()) for m in numeric)
+    for a, b in zip(trig, none):
+        _close(b, a)
+    for a, b in zip(trig, _evaluator(robot, *numeric)(q, qd, qdd, values)):
+        _close(b, a)
+    with pytest.raises(ValueError, match="choose one of"):
+        S.rnea_derivatives_sym(robot, simplify="fast")
+
 # --- command line ------------------------------------------------------------------------------------------------
 
 def _cli(capsys, *argv):
