@@ -332,7 +332,8 @@ def per_pose(name, n, rounds=5, batch=100_000):
 
 
 def _batch_rates(fast, eaik, Tb):
-    """Poses per second of the compiled kernel's own loop over the batch Tb (one thread) and of EAIK's batched call
+    """Poses per second of the compiled kernel's own loop over the batch Tb (one thread), of the public batched
+    ``analytic_ik`` (that loop, the hand-overs to the plain solver, the batched layout) and of EAIK's batched call
     with one worker thread; the share of poses the kernel hands to the plain solver."""
     kern, out = fast._analytic_solver(), {}
     if kern:
@@ -344,6 +345,9 @@ def _batch_rates(fast, eaik, Tb):
         dt = time.perf_counter() - t0
         out = {"kernel poses/s": len(Tb) / dt, "kernel µs/pose": dt / len(Tb) * 1e6,
                "handed over": (o[:, 122] == 1).mean()}
+        t0 = time.perf_counter()
+        fast.analytic_ik(Tb)  # the public batched call: kernel loop, hand-overs, the plain solver's layout
+        out["analytic_ik(batch) poses/s"] = len(Tb) / (time.perf_counter() - t0)
     if eaik:
         t0 = time.perf_counter()
         eaik.calculate_IK_batched(list(Tb), 1)
