@@ -124,7 +124,8 @@ def test_the_polynomial_sine_and_cosine_are_numpys_to_an_ulp_or_two_with_libm_be
     """The generated module's _sincos (vectorisable polynomials instead of XLA's per-element libm calls) against
     numpy's sin and cos: float64 to 2 ulp of 1 on |x| < 100 (the quadrant boundaries k·π/4 included) and up to the
     reduction's range, angles beyond it (libm), ±inf and NaN as numpy gives them; float32 to 1 ulp of 1 in float32
-    (against float64 at the same rounded x); derivatives cos and −sin through jax.jacfwd; a sine computed once."""
+    (against float64 at the same rounded x); under vmap one lax.cond still; derivatives cos and −sin through
+    jax.jacfwd; a sine computed once."""
     from denavit.codegen import _llvm, _tensor_emit
 
     assert _tensor_emit._PIO2_64 == _llvm._PIO2 and _tensor_emit._SIN_TAYLOR == _llvm._SIN  # the numba kernels' own
@@ -135,10 +136,9 @@ def test_the_polynomial_sine_and_cosine_are_numpys_to_an_ulp_or_two_with_libm_be
     rng = np.random.default_rng(5)
     near = np.concatenate([np.arange(-400, 401) * (np.pi / 4), rng.uniform(-100, 100, 4000)])
     far = rng.uniform(-8e5, 8e5, 1000)
-    tol = 2 * np.finfo(np.float64).eps
-    for x in (near, far):
-        s, c = sincos(jnp.asarray(x))
-        assert np.abs(np.asarray(s) - np.sin(x)).max() <= tol and np.abs(np.asarray(c) - np.cos(x)).max() <= tol
+    tol, x = 2 * np.finfo(np.float64).eps, np.concatenate([near, far])
+    s, c = sincos(jnp.asarray(x))
+    assert np.abs(np.asarray(s) - np.sin(x)).max() <= tol and np.abs(np.asarray(c) - np.cos(x)).max() <= tol
     odd = np.array([1e7, -3e12, 1e300, np.inf, -np.inf, np.nan, 0.5])  # beyond the range: libm (XLA's sin, cos)
     s, c = sincos(jnp.asarray(odd))
     with np.errstate(invalid="ignore"):
@@ -150,7 +150,10 @@ def test_the_polynomial_sine_and_cosine_are_numpys_to_an_ulp_or_two_with_libm_be
     ulp = np.finfo(np.float32).eps
     assert np.abs(np.asarray(s) - np.sin(x32.astype(np.float64))).max() <= ulp
     assert np.abs(np.asarray(c) - np.cos(x32.astype(np.float64))).max() <= ulp
-    x = jnp.asarray(rng.uniform(-4, 4, 3))
+    x = jnp.asarray(rng.uniform(-4, 4, (2, 3)))  # vmap: the batch at once, still one lax.cond (no select of both)
+    checks.assert_close(jax.vmap(sincos)(x)[0], np.sin(np.asarray(x)), 2.3e-16, "vmap sin")
+    assert "stablehlo.case" in jax.jit(jax.vmap(sincos)).lower(x).as_text()
+    x = x[0]
     ds, dc = jax.jacfwd(sincos)(x)
     checks.assert_close(ds, np.diag(np.cos(np.asarray(x))), 1e-15, "d sin")
     checks.assert_close(dc, -np.diag(np.sin(np.asarray(x))), 1e-15, "d cos")

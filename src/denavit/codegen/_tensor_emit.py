@@ -60,6 +60,7 @@ def _solve(M, b):
 '''
 
 _JAX = """import jax
+import jax.custom_batching
 import jax.numpy as xp
 from jax import lax
 
@@ -124,7 +125,6 @@ def _poly_sincos(x, in_range):
     return xp.where((n & 2) != 0, -s, s), xp.where(((n + 1) & 2) != 0, -c, c)
 
 
-@jax.custom_jvp
 def _sincos_rows(x):
     \"\"\"(sin x, cos x), elementwise, each computed once: the branches of a lax.cond are kept whole, where XLA
     would otherwise recompute the polynomials inside every fused loop that uses them.  Angles beyond the
@@ -144,17 +144,28 @@ def _sincos_rows(x):
     return lax.cond(xp.any(xp.abs(x) > limit), with_libm, polynomial, x)
 
 
-@_sincos_rows.defjvp
+def _sincos_batched(axis_size, in_batched, x):
+    \"\"\"Under vmap: the whole batched array at once (elementwise), so that the range test stays one lax.cond
+    rather than a select evaluating both branches.\"\"\"
+    return _sincos_rows_vmap(x), (in_batched[0], in_batched[0])
+
+
+_sincos_rows_vmap = jax.custom_batching.custom_vmap(_sincos_rows)
+_sincos_rows_vmap.def_vmap(_sincos_batched)
+_sincos_d = jax.custom_jvp(_sincos_rows_vmap)
+
+
+@_sincos_d.defjvp
 def _sincos_jvp(primals, tangents):
     (x,), (dx,) = primals, tangents
-    s, c = _sincos_rows(x)
+    s, c = _sincos_d(x)
     return (s, c), (c * dx, -s * dx)
 
 
 @jax.jit
 def _sincos(x):
     \"\"\"(sin x, cos x) of an array (one compiled call when run op by op; inlined under jax.jit).\"\"\"
-    return _sincos_rows(x)
+    return _sincos_d(x)
 """
 
 #: The JAX prelude's sine and cosine (the numba backend's SIMD polynomials, denavit.codegen._llvm): π/2 in three
