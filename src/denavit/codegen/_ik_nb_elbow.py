@@ -99,14 +99,13 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
-                q2, free2, _vxy = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
+                q2, free2, _vxy, c3, s3v = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
                 if free2:
                     status = 1
                 # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
                 for i in range(3):
                     cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
                 c2, s2v = math.cos(q2), math.sin(q2)
-                c3, s3v = math.cos(q3), math.sin(q3)
                 for kk in range(3):
                     ck, sk = (c1, s1c) if kk == 0 else ((c2, s2v) if kk == 1 else (c3, s3v))
                     for i in range(3):
@@ -127,15 +126,15 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                     continue
                 for s5 in range(2):
                     qb = qba if s5 == 0 else qbb
-                    qa, qc, singular, _sign, _vxy = wrist_rest(qb, M, R4, R5)
+                    qa, qc, singular, _sign, _vxy, cb, sb, ca, sa = wrist_rest(qb, M, R4, R5)
                     if singular:
                         status = 1  # wrist singular: a continuum
                     cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                     cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
                     # cos, sin of the joints for the verifying FK (math.cos/sin of these very floats)
                     cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1c, c2, s2v
-                    cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, math.cos(qa), math.sin(qa)
-                    cs[ncand, 8], cs[ncand, 9] = math.cos(qb), math.sin(qb)
+                    cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, ca, sa  # qa as computed:
+                    cs[ncand, 8], cs[ncand, 9] = cb, sb  # it differs only where singular (handed over)
                     cs[ncand, 10], cs[ncand, 11] = math.cos(qc), math.sin(qc)
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the

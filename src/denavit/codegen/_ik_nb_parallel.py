@@ -140,8 +140,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
             e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sin(d3), 1e-300)
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
-                c3, s3v = math.cos(q3), math.sin(q3)
-                q2, _free, vxy = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
+                q2, _free, vxy, c3, s3v = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
                 if vxy < wide:
                     status = 1
                 e2 = (eP + e3) * scale / max(min(math.sqrt(P0 * P0 + P1 * P1), vxy), 1e-300)

@@ -98,7 +98,7 @@ class ElbowPosition:
         # products (Kahan's triangle angles) so that a folded or stretched elbow keeps its digits
         q3a, q3b, _ = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, RATIO_TOL)
         q3 = np.stack([q3a, q3b], -1)  # (B, 2, 2)
-        q2, free2, _ = elbow_q2(g0[..., None], g1[..., None], q3, self.R2, self.p2, self.P, tiny)  # on axis 2: 0
+        q2, free2 = elbow_q2(g0[..., None], g1[..., None], q3, self.R2, self.p2, self.P, tiny)[:2]  # on axis 2: 0
         q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
         return q, _flags(q, free1[:, None, None] * 1 + free2 * 2)
 
@@ -186,5 +186,5 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     r, u = Ra[2, :], Rb[:, 2]
     qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
     Mt = np.moveaxis(M, (-2, -1), (0, 1))[..., None]  # M[i, j] of each pose, against the two roots of qb
-    qa, qc, singular, sign, _ = wrist_rest(qb, Mt, Ra, Rb)  # the one copy (numba compiles it too)
+    qa, qc, singular, sign = wrist_rest(qb, Mt, Ra, Rb)[:4]  # the one copy (numba compiles it too)
     return np.stack([qa, qb, qc], -1), singular, sign

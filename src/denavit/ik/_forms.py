@@ -96,16 +96,17 @@ def elbow_roots(G, na, nb, base, tol):
 
 
 def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
-    """(q2, free, |v_xy|): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow triangle: the wrist centre, or the
-    UR arm's planar-pair point) onto g about axis 2; where v lies on axis 2 (within ``tiny``) q2 is free: 0 and
-    free True (a planar pair passes tiny = 0 and reads |v_xy| instead)."""
+    """(q2, free, |v_xy|, cos q3, sin q3): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow triangle: the
+    wrist centre, or the UR arm's planar-pair point) onto g about axis 2; where v lies on axis 2 (within ``tiny``)
+    q2 is free: 0 and free True (a planar pair passes tiny = 0 and reads |v_xy| instead).  The cosine and sine of
+    q3 are returned for callers that need them again (the compiled kernels' verifying FK)."""
     c3, s3 = np.cos(q3), np.sin(q3)
     u0, u1 = c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]  # Rz(q3) P, xy (z is P_z)
     vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
     vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
     vxy = np.hypot(vx, vy)
     free = vxy < tiny
-    return select(free, 0.0, np.arctan2(g1, g0) - np.arctan2(vy, vx)), free, vxy
+    return select(free, 0.0, np.arctan2(g1, g0) - np.arctan2(vy, vx)), free, vxy, c3, s3
 
 
 def wrist_qb(m0, m1, m2, rho, base, br, bu, tol):
@@ -130,7 +131,8 @@ def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
 
 
 def wrist_rest(qb, M, Ra, Rb):
-    """(qa, qc, singular, sign, vxy) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb is known: qa turns
+    """(qa, qc, singular, sign, vxy, cb, sb, ca, sa) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb is
+    known (cb, sb, ca, sa: cos and sin of qb and of qa as computed, before the exact-alignment choice): qa turns
     v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan subproblems
     2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
 
@@ -156,7 +158,7 @@ def wrist_rest(qb, M, Ra, Rb):
     sign = select(v2 >= 0.0, 1.0, -1.0)
     w = np.pi - np.mod(np.pi - qc, 2.0 * np.pi)  # the determined qa ± qc, wrapped (computed with qa = 0)
     singular = (vxy < AXES_ALIGNED_TOL) & np.isfinite(qb)
-    return select(exact, sign * w / 2, qa), select(exact, w / 2, qc), singular, sign, vxy
+    return select(exact, sign * w / 2, qa), select(exact, w / 2, qc), singular, sign, vxy, cb, sb, ca, sa
 
 
 def stanford_q3(Dx, Dy, Dz, uz, uperp, L):

@@ -112,7 +112,7 @@ def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
     vz = p2[2] + R2[2, 2] * p3[2]
     rhs = np.sum(P[..., :2] ** 2, -1) - p2 @ p2 - p3 @ p3 + vz**2 - 2 * g
     qb = solve_trig(2 * a, 2 * b, rhs, tol=1e-7)
-    qa, _, _ = elbow_q2(P[..., None, 0], P[..., None, 1], qb, R2, p2, p3, 0.0)  # turns v onto P (._forms)
+    qa = elbow_q2(P[..., None, 0], P[..., None, 1], qb, R2, p2, p3, 0.0)[0]  # turns v onto P (._forms)
     return qa, qb
 
 
