@@ -17,7 +17,9 @@ configurations timed.  Rows, each batch size × dtype:
   FK f+b    T = fk(q) with q.requires_grad; T.sum().backward(): forward and backward pass, both libraries
   jax.jit   jax.jit(fast.fk) on a jax array (float64, and float32 at the same rounded q) against the numba
             backend's batch fk(q, threads=1) on the float64 NumPy array (numba's kernels are float64 only);
-            ratio = numba time / jax time: ≥ 0.5 is "within 2×"
+            ratio = numba time / jax time: ≥ 0.5 is "within 2×"; "(out=)": numba writing into a preallocated
+            array, its kernel's work alone (XLA allocates its output and temporaries on every call: at 10⁶ rows
+            most of both sides' allocating time is the kernel's page faults, which vary from process to process)
 Each time is the best of ``repeat`` calls (after one warm-up call each, which also compiles), the libraries taking
 turns.
 """
@@ -114,8 +116,11 @@ def jax_rows(robot, batch: int, repeat: int, rng):
         for dtype, tol in ((np.float64, 1e-12), (np.float32, 1e-5)):
             qj = jax.numpy.asarray(q.astype(dtype))
             np.testing.assert_allclose(np.asarray(fk(qj)), nb.fk(q.astype(dtype).astype(np.float64)), atol=tol)
+            out = np.empty((batch, 4, 4))
             t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
             rows.append((robot.name, "jax.jit FK vs numba", batch, dtype.__name__, t_nb / t_jax))
+            t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1, out=out), repeat)
+            rows.append((robot.name, "jax.jit FK vs numba (out=)", batch, dtype.__name__, t_nb / t_jax))
     return rows
 
 
