@@ -244,3 +244,23 @@ def test_general_arm_at_and_near_singular_poses():
         # to ~1e-9 / σ_min(J): on the set (a double root) and 1e-6 off it that is ~1e-4, 1e-3 off it ~1e-6.
         # What must hold is that the generating branch is there: its nearest solution within that bound.
         assert np.all(d < {0.0: 1e-3, 1e-6: 1e-3, 1e-3: 1e-5}[eps]), d
+
+
+#: jaco2-6dof configurations 1e-6 rad (in q2) from a q2-singular set (det J0 = 0 found by bisection along q2)
+JACO2_NEAR_FOLD = [[1.0700682205022236, -1.80939259827905, -2.1127734961563718, -2.991494808592177,
+                    -2.7296472176220012, 2.918296668248497],
+                   [-2.464861578883915, -1.3207118714962969, -0.9976761044189124, -2.8967423312302962,
+                    -2.3019906712043046, 1.9226565715336719]]
+
+
+def test_jaco2_generating_solution_next_to_a_fold():
+    """Issue 30 item 5: next to a fold the eigenvalue route returns one candidate midway between the two nearby
+    roots (1.5e-5 apart here), with a residual of ~1e-11 — under the old FOLD_ROUGH (1e-10 L), so no partner was
+    sought, and the polish went to the other root: the generating solution was lost (these two poses, and ~1 in
+    100 such poses in a batch).  Every polished candidate now counts as a possible half of a merged pair."""
+    robot = denavit.load_robot("jaco2-6dof")
+    for q in np.array(JACO2_NEAR_FOLD):
+        res = denavit.analytic_ik(robot, forward_kinematics(robot, q))
+        assert angle_distance(res.solutions, q).min() < 1e-8
+        F = forward_kinematics(robot, res.solutions)
+        assert np.abs(pose_error(np.broadcast_to(forward_kinematics(robot, q), F.shape), F)).max() < 1e-9

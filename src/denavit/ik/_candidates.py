@@ -24,7 +24,9 @@ MERGE_RADIUS = 1e-5  # up to this distance two solutions are also the same when 
 POLISH_ABOVE = 1e-12  # residual [m] under which a closed-form candidate is kept as it is
 POLISH_STEPS = 30
 PREFILTER = 0.05  # candidates farther than this fraction of the reach are not polished
-FOLD_ROUGH = 1e-10  # candidate residual [m, rad] (relative to the reach) above which a root lost ~half its digits
+FOLD_ROUGH = 1e-12  # candidate residual [m, rad] (relative to the reach) above which a root may be one of a merged
+# pair: every polished candidate (1e-10 missed the eigenvalue route's midpoint candidates, residual ~1e-11, between
+# two roots 1.5e-5 apart next to a jaco2-6dof fold: the polish reached one, the other was never sought)
 FOLD_SIGMA = 1e-3  # σ_min/σ_max of a polished solution under which the partner of a near-double root is sought
 SINGULAR_RCOND = 1e-8  # σ_min/σ_max of such a solution under which it is on the singularity: named a continuum
 FOLD_RESIDUAL = 1e-12  # residual [m, rad] a partner found that way must reach (Newton converged, not stalled)
