@@ -253,6 +253,27 @@ JACO2_NEAR_FOLD = [[1.0700682205022236, -1.80939259827905, -2.1127734961563718, 
                     -2.3019906712043046, 1.9226565715336719]]
 
 
+#: a jaco2-6dof configuration 1e-4 rad (in q2) from a q2-singular set, and the same 1e-12 from it
+JACO2_SPLIT_ROOT = [[-2.212171091737661, -1.1029377227737804, 1.1516255947980714, 1.8038832849133222,
+                     -1.9376321902977616, 1.8998100546581602],
+                    [-2.212171091737661, -1.1030377227727803, 1.1516255947980714, 1.8038832849133222,
+                     -1.9376321902977616, 1.8998100546581602]]
+
+
+def test_jaco2_double_root_split_by_rounding_into_a_complex_pair():
+    """Issue 30 item 5: the double root of det Σ(x3) behind these poses comes out of the 24×24 eigenproblem as
+    0.70275 ± 0.00071i (rounding splits a double root by ~√ε times the pencil's condition); a pair that far from
+    the real axis (4e-4 relative) was dropped, and both solutions with it (the generating one 2.1 rad from every
+    solution returned).  Its real part is now tried (NEAR_REAL_TOL 1e-2): the polish and the partner search find
+    both."""
+    robot = denavit.load_robot("jaco2-6dof")
+    for q in np.array(JACO2_SPLIT_ROOT):
+        res = denavit.analytic_ik(robot, forward_kinematics(robot, q))
+        assert angle_distance(res.solutions, q).min() < 1e-5  # (a double root 1e-12 off: fixed to ~√ε only)
+        F = forward_kinematics(robot, res.solutions)
+        assert np.abs(pose_error(np.broadcast_to(forward_kinematics(robot, q), F.shape), F)).max() < 1e-9
+
+
 def test_jaco2_generating_solution_next_to_a_fold():
     """Issue 30 item 5: next to a fold the eigenvalue route returns one candidate midway between the two nearby
     roots (1.5e-5 apart here), with a residual of ~1e-11 — under the old FOLD_ROUGH (1e-10 L), so no partner was
