@@ -103,6 +103,7 @@ def test_export_lang_jax_writes_a_module_giving_the_same_values(tmp_path, rng):
     assert main(["export", "puma560", "--lang", "jax", "-o", str(tmp_path / "out")]) == 0
     text = (tmp_path / "out" / "puma560.py").read_text()
     assert "import jax.numpy as xp" in text and "numpy as np" not in text and "denavit" not in text.split('"""')[2]
+    assert text.count("_sincos(q)") >= 3 and "xp.sin(q_" not in text  # fk, jacobian0, jacobiane: the polynomials
 
 
 @pytest.mark.slow
