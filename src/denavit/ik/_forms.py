@@ -59,9 +59,9 @@ def half_angle(lo, hi, tol):
     """x in [0, π] with (1 − cos x)/2 = lo and (1 + cos x)/2 = hi, from the smaller one (its digits survive next to
     x = 0 or π, where arccos loses half of them); NaN when either is below −tol/2 (out of range)."""
     ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
-    x = select(lo <= hi, 2.0 * np.arcsin(np.sqrt(_clip(lo, 0.0, 1.0))),
-               np.pi - 2.0 * np.arcsin(np.sqrt(_clip(hi, 0.0, 1.0))))
-    return select(ok, x, np.nan)
+    small = lo <= hi
+    y = 2.0 * np.arcsin(np.sqrt(_clip(select(small, lo, hi), 0.0, 1.0)))  # one arcsin: select evaluates both sides
+    return select(ok, select(small, y, np.pi - y), np.nan)
 
 
 def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
