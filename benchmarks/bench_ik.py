@@ -303,7 +303,8 @@ def per_pose(name, n, rounds=5, batch=100_000):
     Rg = [(Tk[:3, :3] @ geo[1][:3, :3].T).T.copy() for Tk in T] if geo else None
     Ts = [np.ascontiguousarray(Tk) for Tk in T]
     solvers = {"denavit": lambda k: fast.analytic_ik(Ts[k]),
-               "denavit, solutions read": lambda k: fast.analytic_ik(Ts[k]).solutions, "EAIK": eaik and (lambda k: eaik.calculate_IK(Ts[k])),
+               "denavit, solutions read": lambda k: fast.analytic_ik(Ts[k]).solutions,
+               "EAIK": eaik and (lambda k: eaik.calculate_IK(Ts[k])),
                "ik-geo": geo and (lambda k: geo[0].get_ik(Rg[k], T[k, :3, 3]))}
     solvers = {who: f for who, f in solvers.items() if f}
     differ = dict.fromkeys(list(solvers)[2:], 0)

@@ -1,7 +1,7 @@
 """The one machine-code call behind ``CompiledRobot.analytic_ik`` for one pose: the target's check and the arm's
-closed-form kernel (elbow, UR class or Stanford class: one entry each) in one compiled function, every output in one float vector
-(one allocation and one call from Python; the check, the kernel call, two output arrays and the result's views
-were half of a call's time).  Compiled once per machine (``cache=True``); imported only where numba is.
+closed-form kernel (elbow, UR class or Stanford class: one entry each) in one compiled function, every output in
+one float vector (one allocation and one call from Python; the check, the kernel call, two output arrays and the
+result's views were half of a call's time).  Compiled once per machine (``cache=True``); imported only where numba is.
 
 Layout of the output vector ``o`` (OUT_SIZE floats): ``o[:112]`` the (8, 14) block of the kernels (solutions,
 residuals, solutions outside the limits), ``o[112:120]`` the label codes, ``o[120]`` kept, ``o[121]`` outside,

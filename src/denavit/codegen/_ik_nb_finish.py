@@ -22,35 +22,35 @@ __all__ = ["chain_fk", "ik_check", "ik_finish"]
 
 
 @njit(cache=True, nogil=True)
-def chain_fk(C, revolute, q, cs, P, start, F):
+def chain_fk(C, revolute, Q, CS, r, P, start, F):
     """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
     base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one.  The 3×4 top of
-    the product is kept in twelve local floats (registers), cs = (cos q1, sin q1, cos q2, …) given (a prismatic
-    joint's pair unused); P[k] (n+1, 12) keeps the product after k joints, and the walk
+    the product is kept in twelve local floats (registers); q = Q[r], its (cos q1, sin q1, cos q2, …) given in
+    CS[r] (a prismatic joint's pair unused; rows indexed, not sliced: a view costs an atomic reference count);
+    P[k] (n+1, 12) keeps the product after k joints, and the walk
     resumes from P[start] (left there by a call for a q with the same first ``start`` joints: the candidates of a
     closed form come in families sharing q1, or q1 to q3; P[0] must hold C0's top)."""
     x0, x1, x2, y0, y1, y2 = P[start, 0], P[start, 1], P[start, 2], P[start, 3], P[start, 4], P[start, 5]
     z0, z1, z2, p0, p1, p2 = P[start, 6], P[start, 7], P[start, 8], P[start, 9], P[start, 10], P[start, 11]
-    for k in range(start, q.shape[0]):
+    for k in range(start, Q.shape[1]):
         if revolute[k] != 0.0:  # F <- F Rz(q_k): columns x, y turn
-            c, s = cs[2 * k], cs[2 * k + 1]
+            c, s = CS[r, 2 * k], CS[r, 2 * k + 1]
             x0, y0 = c * x0 + s * y0, c * y0 - s * x0
             x1, y1 = c * x1 + s * y1, c * y1 - s * x1
             x2, y2 = c * x2 + s * y2, c * y2 - s * x2
         else:  # F <- F Tz(q_k)
-            p0, p1, p2 = p0 + q[k] * z0, p1 + q[k] * z1, p2 + q[k] * z2
-        D = C[k + 1]  # F <- F C_{k+1} (last row of C: 0 0 0 1)
-        p0, p1, p2 = (p0 + x0 * D[0, 3] + y0 * D[1, 3] + z0 * D[2, 3], p1 + x1 * D[0, 3] + y1 * D[1, 3] + z1 * D[2, 3],
-                      p2 + x2 * D[0, 3] + y2 * D[1, 3] + z2 * D[2, 3])
-        x0, y0, z0 = (x0 * D[0, 0] + y0 * D[1, 0] + z0 * D[2, 0], x0 * D[0, 1] + y0 * D[1, 1] + z0 * D[2, 1],
-                      x0 * D[0, 2] + y0 * D[1, 2] + z0 * D[2, 2])
-        x1, y1, z1 = (x1 * D[0, 0] + y1 * D[1, 0] + z1 * D[2, 0], x1 * D[0, 1] + y1 * D[1, 1] + z1 * D[2, 1],
-                      x1 * D[0, 2] + y1 * D[1, 2] + z1 * D[2, 2])
-        x2, y2, z2 = (x2 * D[0, 0] + y2 * D[1, 0] + z2 * D[2, 0], x2 * D[0, 1] + y2 * D[1, 1] + z2 * D[2, 1],
-                      x2 * D[0, 2] + y2 * D[1, 2] + z2 * D[2, 2])
-        Pk = P[k + 1]
-        Pk[0], Pk[1], Pk[2], Pk[3], Pk[4], Pk[5] = x0, x1, x2, y0, y1, y2
-        Pk[6], Pk[7], Pk[8], Pk[9], Pk[10], Pk[11] = z0, z1, z2, p0, p1, p2
+            p0, p1, p2 = p0 + Q[r, k] * z0, p1 + Q[r, k] * z1, p2 + Q[r, k] * z2
+        m = k + 1  # F <- F C_m (last row of C: 0 0 0 1); C indexed, not sliced: a view is an atomic refcount
+        a00, a01, a02, a03 = C[m, 0, 0], C[m, 0, 1], C[m, 0, 2], C[m, 0, 3]
+        a10, a11, a12, a13 = C[m, 1, 0], C[m, 1, 1], C[m, 1, 2], C[m, 1, 3]
+        a20, a21, a22, a23 = C[m, 2, 0], C[m, 2, 1], C[m, 2, 2], C[m, 2, 3]
+        p0, p1, p2 = (p0 + x0 * a03 + y0 * a13 + z0 * a23, p1 + x1 * a03 + y1 * a13 + z1 * a23,
+                      p2 + x2 * a03 + y2 * a13 + z2 * a23)
+        x0, y0, z0 = (x0 * a00 + y0 * a10 + z0 * a20, x0 * a01 + y0 * a11 + z0 * a21, x0 * a02 + y0 * a12 + z0 * a22)
+        x1, y1, z1 = (x1 * a00 + y1 * a10 + z1 * a20, x1 * a01 + y1 * a11 + z1 * a21, x1 * a02 + y1 * a12 + z1 * a22)
+        x2, y2, z2 = (x2 * a00 + y2 * a10 + z2 * a20, x2 * a01 + y2 * a11 + z2 * a21, x2 * a02 + y2 * a12 + z2 * a22)
+        P[m, 0], P[m, 1], P[m, 2], P[m, 3], P[m, 4], P[m, 5] = x0, x1, x2, y0, y1, y2
+        P[m, 6], P[m, 7], P[m, 8], P[m, 9], P[m, 10], P[m, 11] = z0, z1, z2, p0, p1, p2
     F[0, 0], F[0, 1], F[0, 2], F[0, 3] = x0, y0, z0, p0
     F[1, 0], F[1, 1], F[1, 2], F[1, 3] = x1, y1, z1, p1
     F[2, 0], F[2, 1], F[2, 2], F[2, 3] = x2, y2, z2, p2
@@ -103,7 +103,7 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
         if not given:
             for j in range(start, 6):
                 cs[k, 2 * j], cs[k, 2 * j + 1] = math.cos(cand[k, j]), math.sin(cand[k, j])
-        chain_fk(C, revolute, cand[k], cs[k], P, start, F)
+        chain_fk(C, revolute, cand, cs, k, P, start, F)
         for j in range(36):
             frames[k, j] = P[1 + j // 12, j % 12]
         pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)

@@ -182,7 +182,8 @@ class IKMethods:
         else:
             k = dict(plan.closed)
             lim = self.robot.q_limits
-            k.update(lo=lim[:, 0], hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
+            k.update(lo=lim[:, 0], hi=lim[:, 1],
+                     revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
                      chain=np.array(chain_of(self.robot).constants, dtype=float))
             if not np.array_equal(np.reshape(k["consts"], (4, 4, 4))[:3], k["chain"][:3]):
                 return False  # the kernel's labels read the frames after joints 1, 2 off its verifying FK
