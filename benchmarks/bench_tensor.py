@@ -117,6 +117,8 @@ def jax_rows(robot, batch: int, repeat: int, rng):
             qj = jax.numpy.asarray(q.astype(dtype))
             np.testing.assert_allclose(np.asarray(fk(qj)), nb.fk(q.astype(dtype).astype(np.float64)), atol=tol)
             out = np.empty((batch, 4, 4))
+            for _ in range(3):  # XLA's first calls after compiling ran slower (the process's first jax row: 2x)
+                fk(qj).block_until_ready()
             t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
             rows.append((robot.name, "jax.jit FK vs numba", batch, dtype.__name__, t_nb / t_jax))
             t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1, out=out), repeat)
