@@ -8,6 +8,12 @@ or, better on a busy machine, from CPU seconds (tests/conftest.py writes them wh
 
     DENAVIT_CPU_TIMES=cpu.txt python -m pytest -q -m "not slow" -p no:cacheprovider
     python scripts/slow_tests.py --cpu cpu.txt
+    python scripts/slow_tests.py --cpu cpu.txt --budget 60   # the costliest, until the rest take <= 60 CPU-s
+
+``--budget`` bounds the sum of the tests' own CPU seconds.  The start-up comes on top: each pytest-xdist worker
+imports every test module (about 16 CPU-s here) and the controlling process handles every report (2-5 ms a
+test): 40-50 CPU-s on two workers.  ``--budget 60`` keeps the quick subset near two minutes of CPU; CPU seconds
+grow by a third or more at load 10, so measure on a quiet machine.
 
 tests/conftest.py gives every test listed there the ``slow`` mark.  A test's time is the sum of its setup, call
 and teardown, in wall-clock seconds of the run the report comes from: on a busy machine that is more than its
@@ -52,6 +58,26 @@ def slow_ids_cpu(report: str, threshold: float) -> set[str]:
     return out
 
 
+def within_budget(report: str, budget: float, listed: set[str]) -> set[str]:
+    """The costliest tests of a CPU report (not already listed) until the others sum to at most ``budget``."""
+    cost: dict[str, float] = {}
+    for line in report.splitlines():
+        seconds, _, node = line.partition(" ")
+        try:
+            if node.strip() and node.strip() not in listed:
+                cost[node.strip()] = cost.get(node.strip(), 0.0) + float(seconds)
+        except ValueError:
+            continue
+    total, out = sum(cost.values()), set()
+    for node, seconds in sorted(cost.items(), key=lambda kv: -kv[1]):
+        if total <= budget:
+            break
+        out.add(node)
+        total -= seconds
+    print(f"the quick subset's tests: {sum(cost.values()):.0f} -> {total:.0f} CPU-s ({len(out)} more listed)")
+    return out
+
+
 def read_list(path: Path = LIST) -> set[str]:
     if not path.exists():
         return set()
@@ -64,9 +90,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("report", type=Path, help="the output of pytest --durations=0 (or, with --cpu, of DENAVIT_CPU_TIMES)")
     ap.add_argument("--cpu", action="store_true", help="the report is CPU seconds per test (DENAVIT_CPU_TIMES)")
     ap.add_argument("--threshold", type=float, default=2.0, help="seconds (default 2)")
+    ap.add_argument("--budget", type=float, default=None,
+                    help="with --cpu: also list the costliest tests until the rest sum to at most this many CPU-s")
     args = ap.parse_args(argv)
+    if args.budget is not None and not args.cpu:
+        ap.error("--budget needs a CPU report (--cpu)")
     read = slow_ids_cpu if args.cpu else slow_ids
-    ids = read_list() | read(args.report.read_text(encoding="utf-8", errors="replace"), args.threshold)
+    text = args.report.read_text(encoding="utf-8", errors="replace")
+    ids = read_list() | read(text, args.threshold)
+    if args.budget is not None:
+        ids |= within_budget(text, args.budget, ids)
     LIST.write_text(HEADER + "".join(f"{node}\n" for node in sorted(ids)), encoding="utf-8")
     print(f"{len(ids)} tests listed in {LIST.relative_to(ROOT)}")
     return 0

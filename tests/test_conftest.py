@@ -104,3 +104,27 @@ def test_numeric_function_equals_lambdify_on_random_formulas():
         numeric_function([x], [sp.Matrix([sp.besselj(0, x)])])(1.0)
     with pytest.raises(KeyError, match="no value for symbol y"):
         numeric_function([x], [sp.Matrix([x * y])])(1.0)
+
+
+def test_slow_tests_budget_lists_the_costliest_until_the_rest_fit():
+    """scripts/slow_tests.py --budget: the most expensive tests (repeated lines summed) are listed until the others
+    sum to at most the budget; already listed tests neither count nor get listed again."""
+    import importlib.util
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parent
+    spec = importlib.util.spec_from_file_location("slow_tests", here.parent / "scripts" / "slow_tests.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    rng = np.random.default_rng(3)
+    cost = {f"t.py::test_{k}": float(c) for k, c in enumerate(rng.uniform(0.01, 3.0, 40))}
+    report = "".join(f"{c / 2:.3f} {node}\n{c / 2:.3f} {node}\n" for node, c in cost.items()) + "garbage line\n"
+    listed = {"t.py::test_0"}
+    for budget in (0.0, 5.0, 20.0, 1e6):
+        out = script.within_budget(report, budget, listed)
+        rest = {node: c for node, c in cost.items() if node not in out and node not in listed}
+        assert sum(rest.values()) <= budget + 1e-3 * len(cost)
+        assert not out & listed
+        if out:  # nothing cheaper was listed while a dearer one stayed
+            assert min(cost[n] for n in out) >= max(rest.values(), default=0.0) - 2e-3
+    assert script.within_budget(report, 1e6, listed) == set()
