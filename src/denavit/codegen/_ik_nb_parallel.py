@@ -11,16 +11,11 @@ import math
 import numpy as np
 from numba import njit
 
+from ._ik_finish import DOUBLE_ROOT
 from ._ik_jit import elbow_q2, trig_roots, wrist_qb
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
-
-#: |ratio| of an arccos-type root (shoulder q1, elbow q3) within this of 1: next to a double root, the plain solver
-#: polishes and looks for the lost partner; beyond it both roots are verified as they are (a root needing
-#: polishing goes to the plain solver through ik_finish's residual test either way)
-DOUBLE_ROOT = 1e-9
-
 
 
 @njit(cache=True, nogil=True)
