@@ -12,6 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ._ik_finish import DOUBLE_ROOT
 from ._ik_jit import (
     WRIST_TOL,
     elbow_plane,
@@ -79,8 +80,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         q1a, q1b, free1, ratio = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
         if free1 or (ratio == 0.0 and math.isnan(q1a)):
             status = 1  # joint 1 free, or the shoulder equation independent of q1
-        if abs(abs(ratio) - 1.0) < 1e-6:
-            status = 1  # next to a double root: the plain solver polishes and looks for partners
+        if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
+            status = 1  # next to a double root (DOUBLE_ROOT: beyond it both roots are verified as they are)
         if rho_w < 1e-12:
             status = 1
         ncand = 0

@@ -11,6 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ._ik_finish import DOUBLE_ROOT
 from ._ik_jit import (
     WRIST_TOL,
     stanford_q1,
@@ -86,7 +87,7 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
         if rho <= 1e-12:
             status = 1
             continue
-        if abs(abs(ratio) - 1.0) < 1e-6:
+        if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
             status = 1  # next to a double root of q2
         if math.isnan(q2a):
             continue
