@@ -343,7 +343,7 @@ def per_pose(name, n, rounds=7, batch=100_000):
             times[who].append((time.process_time() - t0) / n * 1e6)
     med = {who: float(np.median(t)) for who, t in times.items()}
     ratios = {f"{me} / {who}": float(np.median(np.array(times[me]) / np.array(times[who])))
-              for who in differ for me in list(solvers)[:2]}
+              for who in differ for me in [*list(solvers)[:2], "denavit kernel"] if me in times}
     return med, ratios, differ, _batch_rates(fast, eaik, _targets(robot, batch, seed=8)[1])
 
 

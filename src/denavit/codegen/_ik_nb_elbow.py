@@ -127,16 +127,17 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                     continue
                 for s5 in range(2):
                     qb = qba if s5 == 0 else qbb
-                    qa, qc, singular, _sign, _vxy, cb, sb, ca, sa = wrist_rest(qb, M, R4, R5)
+                    qa, qc, singular, _sign, _vxy, cb, sb, ca, sa, cc, sc = wrist_rest(qb, M, R4, R5)
                     if singular:
                         status = 1  # wrist singular: a continuum
                     cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                     cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
-                    # cos, sin of the joints for the verifying FK (math.cos/sin of these very floats)
+                    # cos, sin of the joints for the verifying FK (of these very floats, or their closed form's
+                    # normalised (cos, sin) pairs whose atan2 they are)
                     cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1c, c2, s2v
                     cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, ca, sa  # qa as computed:
                     cs[ncand, 8], cs[ncand, 9] = cb, sb  # it differs only where singular (handed over)
-                    cs[ncand, 10], cs[ncand, 11] = math.cos(qc), math.sin(qc)
+                    cs[ncand, 10], cs[ncand, 11] = cc, sc
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels

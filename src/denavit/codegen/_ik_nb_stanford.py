@@ -123,7 +123,7 @@ def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, 
     e5 = eM / max(rho_w * math.sin(0.5 * (qba - qbb)), 1e-300)
     for s5 in range(2):
         qb = qba if s5 == 0 else qbb
-        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa = wrist_rest(qb, M, C[4, :3, :3], C[5, :3, :3])
+        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa, _cc, _sc = wrist_rest(qb, M, C[4, :3, :3], C[5, :3, :3])
         if vxy < near:
             status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
         if eM + e5 + (eM + e5) / max(vxy, 1e-300) > cond_max:

@@ -131,10 +131,13 @@ def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
 
 
 def wrist_rest(qb, M, Ra, Rb):
-    """(qa, qc, singular, sign, vxy, cb, sb, ca, sa) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb is
-    known (cb, sb, ca, sa: cos and sin of qb and of qa as computed, before the exact-alignment choice): qa turns
-    v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan subproblems
-    2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
+    """(qa, qc, singular, sign, vxy, cb, sb, ca, sa, cc, sc) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb
+    is known (cb, sb, ca, sa, cc, sc: cos and sin of qb, qa and qc as computed, before the exact-alignment choice):
+    qa turns v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan
+    subproblems 2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
+
+    Each angle is one atan2 of a (sine, cosine) pair whose normalised values are its cosine and sine, so no cos or
+    sin of qa or qc is computed: qa = atan2(v_xy × m_xy, v_xy · m_xy), qc = atan2(N10, N00).
 
     singular: axes a and c aligned within AXES_ALIGNED_TOL (only qa ± qc is determined, sign +1 for qa + qc);
     aligned within ALIGNED_EXACT the representative is the middle of the family: qa = ±w/2, qc = w/2.  vxy: sine
@@ -143,10 +146,14 @@ def wrist_rest(qb, M, Ra, Rb):
     v0 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 0)
     v1 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 1)
     v2 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 2)
-    vxy = np.hypot(v0, v1)
+    vxy = np.sqrt(v0 * v0 + v1 * v1)  # unit vectors: no overflow to guard against (hypot is a libm call)
     exact = vxy < ALIGNED_EXACT
-    qa = select(exact, 0.0, np.arctan2(M[1, 2], M[0, 2]) - np.arctan2(v1, v0))
-    ca, sa = np.cos(qa), np.sin(qa)
+    dot, crs = v0 * M[0, 2] + v1 * M[1, 2], v0 * M[1, 2] - v1 * M[0, 2]  # |v_xy| |m_xy| (cos qa, sin qa)
+    h = np.sqrt(dot * dot + crs * crs)
+    zero = exact | (h == 0.0)  # qa = 0 there (atan2(0, 0)); NaN stays NaN
+    h = select(zero, 1.0, h)
+    qa = select(zero, 0.0, np.arctan2(crs, dot))
+    ca, sa = select(zero, 1.0, dot / h), select(zero, 0.0, crs / h)
     y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]  # Rz(qa)ᵀ M e_x
     N00 = (_ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 0) * y0
            + _ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 1) * y1
@@ -155,10 +162,14 @@ def wrist_rest(qb, M, Ra, Rb):
            + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 1) * y1
            + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 2) * n2)
     qc = np.arctan2(N10, N00)
+    r = np.sqrt(N00 * N00 + N10 * N10)  # 1 up to rounding (a row of a rotation with N20 = 0 there)
+    rn = select(r == 0.0, 1.0, r)
     sign = select(v2 >= 0.0, 1.0, -1.0)
-    w = np.pi - np.mod(np.pi - qc, 2.0 * np.pi)  # the determined qa ± qc, wrapped (computed with qa = 0)
+    y = np.pi - qc  # the determined qa ± qc (computed with qa = 0) wrapped into (−π, π], the mod by floor
+    w = np.pi - (y - 2.0 * np.pi * np.floor(y / (2.0 * np.pi)))
     singular = (vxy < AXES_ALIGNED_TOL) & np.isfinite(qb)
-    return select(exact, sign * w / 2, qa), select(exact, w / 2, qc), singular, sign, vxy, cb, sb, ca, sa
+    return (select(exact, sign * w / 2, qa), select(exact, w / 2, qc), singular, sign, vxy, cb, sb, ca, sa,
+            select(r == 0.0, 1.0, N00 / rn), N10 / rn)
 
 
 def stanford_q3(Dx, Dy, Dz, uz, uperp, L):
