@@ -25,6 +25,11 @@ from ._ik_nb_parallel import frame1, next_frame
 
 __all__ = ["ik_stanford_packed"]
 
+#: |x1 . (X - O1)| (relative) under which the shoulder label is on its knife edge and the pose goes to the plain solver
+#: (seed 273 of test_random_stanford_class_arms_compiled_equals_plain: q2 = 3e-15 against the plain solver's -9e-16
+#: on the singular set q2 = 0, labelled left against right)
+LABEL_EDGE = 1e-12
+
 
 
 @njit(cache=True, nogil=True)
@@ -51,6 +56,8 @@ def ik_stanford_packed(T, K, f, i):
                                     i[b, 11:20])
         for s in range(kept):
             i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
+            if i[b, s] < 0.0:  # the shoulder label on its knife edge: the plain solver's rounding decides
+                status = 1
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
@@ -137,13 +144,16 @@ def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, 
 @njit(cache=True, nogil=True)
 def _stanford_label(qs, X, C, theta):
     """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the wrist centre),
-    2 wrist flip (sin(q5 + theta5) < 0)."""
+    2 wrist flip (sin(q5 + theta5) < 0); -1 where |x1 . (X - O1)| is below LABEL_EDGE times the arm's size (the wrist
+    centre next to the plane that decides the shoulder label: a rounding difference could flip it)."""
     c1, s1 = math.cos(qs[0]), math.sin(qs[0])
     s_right = 0.0
     for r in range(3):
         x, y, z = C[0, r, 0], C[0, r, 1], C[0, r, 2]
         x, y = c1 * x + s1 * y, c1 * y - s1 * x
         s_right += (x * C[1, 0, 0] + y * C[1, 1, 0] + z * C[1, 2, 0]) * (X[r] - C[0, r, 3])
+    if abs(s_right) < LABEL_EDGE * (1.0 + abs(X[0] - C[0, 0, 3]) + abs(X[1] - C[0, 1, 3]) + abs(X[2] - C[0, 2, 3])):
+        return -1
     code = 1 if s_right < 0.0 else 0
     if math.sin(qs[4] + theta[4]) < 0.0:
         code |= 2
