@@ -100,13 +100,12 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
-                q2, free2, _vxy, c3, s3v = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
+                q2, free2, _vxy, c3, s3v, c2, s2v = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
                 if free2:
                     status = 1
                 # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
                 for i in range(3):
                     cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
-                c2, s2v = math.cos(q2), math.sin(q2)
                 for kk in range(3):
                     ck, sk = (c1, s1c) if kk == 0 else ((c2, s2v) if kk == 1 else (c3, s3v))
                     for i in range(3):

@@ -61,6 +61,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
     ncand = 0
     V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
     xr, w, g = ws[36:39], ws[39:42], ws[42:45]
+    R2, p2, p3 = C[2, :3, :3], C[2, :3, 3], C[3, :3, 3]  # views made once (each is an atomic refcount)
     for r in range(3):  # Q in the world, then in the frame of C0
         w[r] = Tb[r, 0] * Q_e[0] + Tb[r, 1] * Q_e[1] + Tb[r, 2] * Q_e[2] + Tb[r, 3]
     for r in range(3):
@@ -135,14 +136,13 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
             e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sin(d3), 1e-300)
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
-                q2, _free, vxy, c3, s3v = elbow_q2(P0, P1, q3, C[2, :3, :3], C[2, :3, 3], C[3, :3, 3], 0.0)
+                q2, _free, vxy, c3, s3v, c2, s2v = elbow_q2(P0, P1, q3, R2, p2, p3, 0.0)
                 if vxy < wide:
                     status = 1
                 e2 = (eP + e3) * scale / max(min(math.sqrt(P0 * P0 + P1 * P1), vxy), 1e-300)
                 if e2 + e3 + eP > sc[10]:  # q4's error is about that sum
                     status = 1  # ill-conditioned (COND_MAX): the two solvers' rounding could differ by > 1e-10
                 # q4 = atan2(N10, N00), N = (Rz(q2) R2 Rz(q3) R3)^T X_R: column 0 by R3^T Rz(q3)^T R2^T Rz(q2)^T xr
-                c2, s2v = math.cos(q2), math.sin(q2)
                 z0, z1, z2 = c2 * xr[0] + s2v * xr[1], -s2v * xr[0] + c2 * xr[1], xr[2]
                 e0 = C[2, 0, 0] * z0 + C[2, 1, 0] * z1 + C[2, 2, 0] * z2
                 e1 = C[2, 0, 1] * z0 + C[2, 1, 1] * z1 + C[2, 2, 1] * z2

@@ -96,17 +96,23 @@ def elbow_roots(G, na, nb, base, tol):
 
 
 def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
-    """(q2, free, |v_xy|, cos q3, sin q3): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow triangle: the
-    wrist centre, or the UR arm's planar-pair point) onto g about axis 2; where v lies on axis 2 (within ``tiny``)
-    q2 is free: 0 and free True (a planar pair passes tiny = 0 and reads |v_xy| instead).  The cosine and sine of
-    q3 are returned for callers that need them again (the compiled kernels' verifying FK)."""
+    """(q2, free, |v_xy|, cos q3, sin q3, cos q2, sin q2): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow
+    triangle: the wrist centre, or the UR arm's planar-pair point) onto g about axis 2, by one atan2 of v_xy × g and
+    v_xy · g (their normalised values are cos q2 and sin q2); where v lies on axis 2 (within ``tiny``) q2 is free: 0
+    and free True (a planar pair passes tiny = 0 and reads |v_xy| instead).  The cosines and sines are returned for
+    callers that need them again (the compiled kernels' verifying FK)."""
     c3, s3 = np.cos(q3), np.sin(q3)
     u0, u1 = c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]  # Rz(q3) P, xy (z is P_z)
     vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
     vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
-    vxy = np.hypot(vx, vy)
+    vxy = np.sqrt(vx * vx + vy * vy)  # lengths of an arm: no overflow to guard against (hypot is a libm call)
     free = vxy < tiny
-    return select(free, 0.0, np.arctan2(g1, g0) - np.arctan2(vy, vx)), free, vxy, c3, s3
+    dot, crs = vx * g0 + vy * g1, vx * g1 - vy * g0  # |v_xy| |g| (cos q2, sin q2)
+    h = np.sqrt(dot * dot + crs * crs)
+    zero = free | (h == 0.0)  # q2 = 0 there; NaN stays NaN
+    h = select(zero, 1.0, h)
+    return (select(zero, 0.0, np.arctan2(crs, dot)), free, vxy, c3, s3, select(zero, 1.0, dot / h),
+            select(zero, 0.0, crs / h))
 
 
 def wrist_qb(m0, m1, m2, rho, base, br, bu, tol):
