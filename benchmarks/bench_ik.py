@@ -353,14 +353,18 @@ def _batch_rates(fast, eaik, Tb):
     with one worker thread; the share of poses the kernel hands to the plain solver."""
     kern, out = fast._analytic_solver(), {}
     if kern:
-        K, many = kern[0], kern[3]
-        o, Tb = np.empty((len(Tb), kern[4])), np.ascontiguousarray(Tb)
-        many(Tb[:10], K, o[:10])
+        K, many, B, n = kern[0], kern[3], len(Tb), fast.dof
+        Tb = np.ascontiguousarray(Tb)
+
+        def layout():  # the batched layout the kernel writes (as codegen._solvers._batch)
+            return (np.empty((B, 8, n)), np.empty((B, 8)), np.empty((B, 8)), np.empty((B, 8), dtype=bool),
+                    np.empty((B, 8), dtype=np.int8), np.empty(B, dtype=np.int64), np.empty(B, dtype=np.int8))
+        many(Tb[:10], K, *(a[:10] for a in layout()))
+        outs = layout()
         t0 = time.process_time()
-        many(Tb, K, o)
+        many(Tb, K, *outs)
         dt = time.process_time() - t0
-        out = {"kernel poses/s": len(Tb) / dt, "kernel µs/pose": dt / len(Tb) * 1e6,
-               "handed over": (o[:, 122] == 1).mean()}
+        out = {"kernel poses/s": B / dt, "kernel µs/pose": dt / B * 1e6, "handed over": (outs[-1] == 1).mean()}
         t0 = time.process_time()
         fast.analytic_ik(Tb)  # the public batched call: kernel loop, hand-overs, the plain solver's layout
         out["analytic_ik(batch) poses/s"] = len(Tb) / (time.process_time() - t0)

@@ -238,34 +238,30 @@ def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
     """The solutions of a batch of poses Ta (..., 4, 4) by the compiled kernel's own loop, in the plain solver's
     batched layout: slot k of a pose is its k-th verified candidate in candidate order (NaN rows, ``valid``
     False, where that candidate was a duplicate or outside the limits), K slots = the most verified candidates
-    of any pose; ``outside_limits`` counts per pose.  Poses the kernel hands over are solved by
-    :func:`denavit.analytic_ik` as one sub-batch and put in their rows."""
+    of any pose; ``outside_limits`` counts per pose.  The kernel writes that layout itself (:mod:`._ik_nb_entry`);
+    poses it hands over are solved by :func:`denavit.analytic_ik` as one sub-batch and put in their rows."""
     batch, n = Ta.shape[:-2], robot.dof
     Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))  # (B, 4, 4)
     B = len(Tf)
-    o = np.empty((B, c[4]))
-    c[3](Tf, c[0], o)
-    status = o[:, 122]
-    if (status == 2.0).any():
-        err = o[int(np.argmax(status == 2.0)), 132]
+    sol, pe, re = np.empty((B, 8, n)), np.empty((B, 8)), np.empty((B, 8))
+    valid, codes = np.empty((B, 8), dtype=bool), np.empty((B, 8), dtype=np.int8)
+    outside, status = np.empty(B, dtype=np.int64), np.empty(B, dtype=np.int8)
+    most, bad, err = c[3](Tf, c[0], sol, pe, re, valid, codes, outside, status)
+    if bad >= 0:
         raise ShapeError("T has non-finite values" if err == np.inf else
                          f"T: rotation part is not orthonormal (error {err:.2g})")
-    hand = np.flatnonzero(status == 1.0)
+    hand = np.flatnonzero(status == 1)
     sub = analytic_ik(robot, Tf[hand]) if len(hand) else None
-    answered = status == 0.0
-    K = max(1, int(o[answered, 131].max(initial=0)), 0 if sub is None else sub.solutions.shape[1])
-    kept = np.where(answered, o[:, 120], 0).astype(int)
-    bb, ss = np.nonzero(np.arange(8) < kept[:, None])  # every kept solution: pose, sorted slot
-    col = o[bb, 123 + ss].astype(int)  # its slot in the batched layout
-    g = o[:, :112].reshape(B, 8, 14)
-    sol, pe, re = np.full((B, K, n), np.nan), np.full((B, K), np.nan), np.full((B, K), np.nan)
-    valid, codes = np.zeros((B, K), dtype=bool), np.full((B, K), -1)
-    sol[bb, col], pe[bb, col], re[bb, col] = g[bb, ss, :6], g[bb, ss, 6], g[bb, ss, 7]
-    valid[bb, col], codes[bb, col] = True, o[bb, 112 + ss].astype(int)
+    K = max(1, most, 0 if sub is None else sub.solutions.shape[1])
+    if K > 8:  # the plain solver found more slots (partners of a double root): room for them
+        sol, pe, re = _widen(sol, K, np.nan), _widen(pe, K, np.nan), _widen(re, K, np.nan)
+        valid, codes = _widen(valid, K, False), _widen(codes, K, -1)
+    elif K < 8:
+        sol, pe, re = (np.ascontiguousarray(a[:, :K]) for a in (sol, pe, re))
+        valid, codes = np.ascontiguousarray(valid[:, :K]), codes[:, :K]
     labels, kind = c[1]
     branches = np.array(list(labels) + [""], dtype=object)[codes]  # code -1: ""
     free = np.full((B, K), "", dtype=object)
-    outside = np.where(answered, o[:, 121], 0).astype(int)
     if sub is not None:
         k = sub.solutions.shape[1]
         sol[hand, :k], pe[hand, :k], re[hand, :k] = sub.solutions, sub.position_error, sub.orientation_error
@@ -274,3 +270,8 @@ def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
     return AnalyticIKResult(sol.reshape(batch + (K, n)), branches.reshape(batch + (K,)), free.reshape(batch + (K,)),
                             pe.reshape(batch + (K,)), re.reshape(batch + (K,)), outside.reshape(batch), kind, "pose",
                             valid.reshape(batch + (K,)))
+
+
+def _widen(a: np.ndarray, K: int, fill) -> np.ndarray:
+    """a (B, k, ...) with slots k..K-1 added, filled with ``fill``."""
+    return np.concatenate([a, np.full(a.shape[:1] + (K - a.shape[1],) + a.shape[2:], fill, a.dtype)], axis=1)
