@@ -77,7 +77,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
             for j in range(3):
                 Y[i, j] = T[b, i, 0] * R6[j, 0] + T[b, i, 1] * R6[j, 1] + T[b, i, 2] * R6[j, 2]
         # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): shoulder, elbow, wrist
-        q1a, q1b, free1, ratio = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
+        q1a, q1b, free1, ratio, c1a, s1a, c1b, s1b = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
         if free1 or (ratio == 0.0 and math.isnan(q1a)):
             status = 1  # joint 1 free, or the shoulder equation independent of q1
         if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
@@ -88,11 +88,10 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
         for k in range(8):
             ok[k] = False
         for s1 in range(2 if status == 0 else 0):
-            q1 = q1a if s1 == 0 else q1b
+            q1, c1, s1c = (q1a, c1a, s1a) if s1 == 0 else (q1b, c1b, s1b)
             if math.isnan(q1):
                 continue
-            g0, g1 = elbow_plane(q1, W[0], W[1], W[2], R1, p1)
-            c1, s1c = math.cos(q1), math.sin(q1)
+            g0, g1 = elbow_plane(c1, s1c, W[0], W[1], W[2], R1, p1)
             q3a, q3b, x = elbow_roots(math.hypot(g0, g1), na, nb, base3, ratio_tol)
             if math.isnan(x):
                 continue

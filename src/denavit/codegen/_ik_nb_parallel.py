@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from ._ik_finish import DOUBLE_ROOT
-from ._ik_jit import elbow_q2, trig_roots, wrist_qb
+from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_qb
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
@@ -71,18 +71,19 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
             TC[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
     # the formulas of denavit.ik.forms (the plain solver's own functions, jitted), in the plain plan's order
     # q1: (Rz(q1) a) . V = h + a . pc1 (subproblem 1, as solve_trig)
-    q1a, q1b, rho, ratio = trig_roots(a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0], c0 - a[2] * V[2], tol)
+    ea, eb = a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0]
+    q1a, q1b, rho, ratio = trig_roots(ea, eb, c0 - a[2] * V[2], tol)
+    c1a, s1a, c1b, s1b = trig_pairs(ea, eb, rho, ratio, tol)  # cos, sin of the roots, algebraically
     if rho <= max(wide, 1e-11):
         return 0, 1  # Q on (or next to) axis 1
     if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
         status = 1  # next to a double root: the plain solver polishes and looks for partners
     if math.isnan(q1a) or rho_w < 1e-12:
         return 0, max(status, 1 if rho_w < 1e-12 else 0)
-    delta = math.acos(min(1.0, max(-1.0, ratio)))
-    e1 = max(1.0, scale / rho) / max(math.sin(delta), 1e-300)  # rounding error of q1 [eps] (COND_MAX)
-    for s1 in range(2):
-        q1 = q1a if s1 == 0 else q1b
-        c1, s1v = math.cos(q1), math.sin(q1)
+    r1 = min(1.0, max(-1.0, ratio))
+    e1 = max(1.0, scale / rho) / max(math.sqrt((1.0 - r1) * (1.0 + r1)), 1e-300)  # rounding error of q1 [eps]
+    for s1 in range(2):  # (COND_MAX; 1/sin of the root's distance from the double root)
+        q1, c1, s1v = (q1a, c1a, s1a) if s1 == 0 else (q1b, c1b, s1b)
         frame1(C, c1, s1v, cols)  # F1 = C0 Rz(q1) C1: columns x, y, z, origin
         RL02 = cols[0, 0] * TC[0, 2] + cols[0, 1] * TC[1, 2] + cols[0, 2] * TC[2, 2]
         RL12 = cols[1, 0] * TC[0, 2] + cols[1, 1] * TC[1, 2] + cols[1, 2] * TC[2, 2]
@@ -132,8 +133,9 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
                 status = 1  # elbow stretched or folded: a double root
             if math.isnan(q3a):
                 continue
-            d3 = math.acos(min(1.0, max(-1.0, ratio3)))
-            e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sin(d3), 1e-300)
+            r3 = min(1.0, max(-1.0, ratio3))  # sin of the root's distance from the double root: sqrt(1 - r3^2)
+            e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sqrt((1.0 - r3) * (1.0 + r3)),
+                                                                          1e-300)
             for s3 in range(2):
                 q3 = q3a if s3 == 0 else q3b
                 q2, _free, vxy, c3, s3v, c2, s2v = elbow_q2(P0, P1, q3, R2, p2, p3, 0.0)

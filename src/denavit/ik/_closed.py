@@ -91,9 +91,10 @@ class ElbowPosition:
         # the formulas are :mod:`._forms`' (the one copy, compiled by numba for denavit.compile as well), here on
         # the batch with the branches on trailing axes: q1 (B, 2), then q3 and q2 (B, 2, 2)
         # shoulder: (Rz(q1) a)·W = h  (Craig eq. 4.65 in joint-screw form); on axis 1 every q1 (0 returned)
-        q1a, q1b, free1, _ = shoulder_roots(Wx, Wy, Wz, self.a, self.h, tiny, RATIO_TOL)
+        q1a, q1b, free1, _, c1a, s1a, c1b, s1b = shoulder_roots(Wx, Wy, Wz, self.a, self.h, tiny, RATIO_TOL)
         q1 = np.stack([q1a, q1b], -1)  # (B, 2)
-        g0, g1 = elbow_plane(q1, Wx[:, None], Wy[:, None], Wz[:, None], self.R1, self.p1)  # wrist centre, frame 2
+        c1, s1 = np.stack([c1a, c1b], -1), np.stack([s1a, s1b], -1)  # cos q1, sin q1 (B, 2)
+        g0, g1 = elbow_plane(c1, s1, Wx[:, None], Wy[:, None], Wz[:, None], self.R1, self.p1)  # wrist centre, frame 2
         # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P (Craig eq. 4.69), with (1 ∓ cos x)/2 as
         # products (Kahan's triangle angles) so that a folded or stretched elbow keeps its digits
         q3a, q3b, _ = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, RATIO_TOL)

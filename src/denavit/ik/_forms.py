@@ -10,7 +10,8 @@ with ``select`` as ``a if c else b``) for its one-pose loops: one copy of every 
 
 Formulas (joint-screw form of :mod:`._chain`; derivations in :mod:`._closed` and docs/ik.md):
 
-- :func:`trig_roots` — ``a cos θ + b sin θ = c`` (Paden–Kahan subproblem 1 in scalar form).
+- :func:`trig_roots` — ``a cos θ + b sin θ = c`` (Paden–Kahan subproblem 1 in scalar form); :func:`trig_pairs` —
+  the cosines and sines of its roots, algebraically (only the angles themselves need atan2 and arccos).
 - :func:`half_angle` — x from ``(1 − cos x)/2`` and ``(1 + cos x)/2`` given as products (Kahan's digit-keeping
   triangle angles), the smaller of the two.
 - :func:`shoulder_roots`, :func:`elbow_plane`, :func:`elbow_roots`, :func:`elbow_q2` — the elbow arm's joints
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "half_angle", "shoulder_roots", "elbow_plane",
+__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "trig_pairs", "half_angle", "shoulder_roots", "elbow_plane",
            "elbow_roots", "elbow_q2", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2", "stanford_q1"]
 
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
@@ -55,6 +56,18 @@ def trig_roots(a, b, c, tol):
     return select(ok, base + delta, np.nan), select(ok, base - delta, np.nan), rho, ratio
 
 
+def trig_pairs(a, b, rho, ratio, tol):
+    """(cos θ₊, sin θ₊, cos θ₋, sin θ₋) of the roots θ± = β ± δ of :func:`trig_roots` (given its ρ and ratio) with
+    no cos or sin: the sum formulas with cos β = a/ρ, sin β = b/ρ, cos δ = ratio, sin δ = √((1 − ratio)(1 + ratio))
+    (the ratio clipped to [−1, 1] as there); NaN where trig_roots gives NaN."""
+    ok = (rho > 1e-12) & (abs(ratio) <= 1.0 + tol)
+    r = _clip(select(ok, ratio, 0.0), -1.0, 1.0)
+    sd = np.sqrt((1.0 - r) * (1.0 + r))
+    n = select(ok, rho, np.nan)
+    cb, sb = a / n, b / n
+    return cb * r - sb * sd, sb * r + cb * sd, cb * r + sb * sd, sb * r - cb * sd
+
+
 def half_angle(lo, hi, tol):
     """x in [0, π] with (1 − cos x)/2 = lo and (1 + cos x)/2 = hi, from the smaller one (its digits survive next to
     x = 0 or π, where arccos loses half of them); NaN when either is below −tol/2 (out of range)."""
@@ -68,17 +81,21 @@ def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
     """The elbow arm's q1: ``(Rz(q1) a)·W = h`` (Craig eq. 4.65 in joint-screw form), a the axis of joints 2, 3
     in the frame after joint 1, W the wrist centre in the frame before joint 1.
 
-    Returns (q1₊, q1₋, free, ratio): where W lies on axis 1 (within ``tiny``) q1 is free: (0, NaN) and free True;
-    ratio = c/ρ of the equation (|ratio| near 1: the double root)."""
+    Returns (q1₊, q1₋, free, ratio, cos q1₊, sin q1₊, cos q1₋, sin q1₋) (the cosines and sines by
+    :func:`trig_pairs`): where W lies on axis 1 (within ``tiny``) q1 is free: (0, NaN) and free True; ratio = c/ρ of
+    the equation (|ratio| near 1: the double root)."""
     c = h - a[2] * Wz
-    q1a, q1b, _rho, ratio = trig_roots(a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx, c, tol)
+    ea, eb = a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx
+    q1a, q1b, rho, ratio = trig_roots(ea, eb, c, tol)
+    ca, sa, cb, sb = trig_pairs(ea, eb, rho, ratio, tol)
     free = (np.hypot(Wx, Wy) < tiny) & (abs(c) < tiny)
-    return select(free, 0.0, q1a), select(free, np.nan, q1b), free, ratio
+    return (select(free, 0.0, q1a), select(free, np.nan, q1b), free, ratio, select(free, 1.0, ca),
+            select(free, 0.0, sa), select(free, np.nan, cb), select(free, np.nan, sb))
 
 
-def elbow_plane(q1, Wx, Wy, Wz, R1, p1):
-    """(g0, g1): the xy of g = R1ᵀ (Rz(−q1) W − p1), the wrist centre in the frame of joint 2."""
-    c1, s1 = np.cos(q1), np.sin(q1)
+def elbow_plane(c1, s1, Wx, Wy, Wz, R1, p1):
+    """(g0, g1): the xy of g = R1ᵀ (Rz(−q1) W − p1), the wrist centre in the frame of joint 2 (c1, s1: cos q1,
+    sin q1)."""
     d0 = c1 * Wx + s1 * Wy - p1[0]
     d1 = -s1 * Wx + c1 * Wy - p1[1]
     d2 = Wz - p1[2]
@@ -205,5 +222,5 @@ def stanford_q1(q2, w0, w1, w2, Dx, Dy, R1):
 
 
 #: The functions numba compiles (``select`` gets its scalar twin there), callers after callees.
-JITTABLE = (_clip, trig_roots, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2, wrist_qb, _ra_rz,
-            wrist_rest, stanford_q3, stanford_q2, stanford_q1)
+JITTABLE = (_clip, trig_roots, trig_pairs, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2, wrist_qb,
+            _ra_rz, wrist_rest, stanford_q3, stanford_q2, stanford_q1)
