@@ -22,7 +22,7 @@ from ..ik import forms
 
 __all__ = ["fresh_cache", "WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
            "wrist_rest", "stanford_q1", "stanford_q2", "stanford_q3", "trig_roots",
-           "trig_pairs"]
+           "trig_pairs", "wrist_constants"]
 
 
 @overload(forms.select, jit_options={"nogil": True})
@@ -36,6 +36,7 @@ for _f in forms.JITTABLE:
 WRIST_TOL, half_angle = forms.WRIST_TOL, forms.half_angle
 elbow_plane, elbow_q2, elbow_roots = forms.elbow_plane, forms.elbow_q2, forms.elbow_roots
 shoulder_roots, wrist_qb, wrist_rest = forms.shoulder_roots, forms.wrist_qb, forms.wrist_rest
+wrist_constants = forms.wrist_constants
 stanford_q1, stanford_q2, stanford_q3 = forms.stanford_q1, forms.stanford_q2, forms.stanford_q3
 trig_roots, trig_pairs = forms.trig_roots, forms.trig_pairs
 

@@ -19,6 +19,7 @@ from ._ik_jit import (
     elbow_q2,
     elbow_roots,
     shoulder_roots,
+    wrist_constants,
     wrist_qb,
     wrist_rest,
 )
@@ -55,6 +56,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
+    wc = wrist_constants(rho_w, base_w, br, bu)
     # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
     ws = np.empty(145)
     F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
@@ -120,12 +122,12 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                     M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
                     M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
                     M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
-                qba, qbb, _lo, _hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)
+                qba, qbb, _lo, _hi, cba, sba, cbb, sbb = wrist_qb(M[0, 2], M[1, 2], M[2, 2], wc, WRIST_TOL)
                 if math.isnan(qba):
                     continue
                 for s5 in range(2):
-                    qb = qba if s5 == 0 else qbb
-                    qa, qc, singular, _sign, _vxy, cb, sb, ca, sa, cc, sc = wrist_rest(qb, M, R4, R5)
+                    qb, cb, sb = (qba, cba, sba) if s5 == 0 else (qbb, cbb, sbb)
+                    qa, qc, singular, _sign, _vxy, _cb, _sb, ca, sa, cc, sc = wrist_rest(qb, cb, sb, M, R4, R5)
                     if singular:
                         status = 1  # wrist singular: a continuum
                     cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3

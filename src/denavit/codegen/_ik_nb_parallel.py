@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from ._ik_finish import DOUBLE_ROOT
-from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_qb
+from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_constants, wrist_qb
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
@@ -56,6 +56,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
     c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
+    wc = wrist_constants(rho_w, base_w, br, bu)
     scale = max(reach, 1e-3)
     status = 0
     ncand = 0
@@ -91,15 +92,14 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
         ell0 = cols[2, 0] * TC[0, 0] + cols[2, 1] * TC[1, 0] + cols[2, 2] * TC[2, 0]
         ell1 = cols[2, 0] * TC[0, 1] + cols[2, 1] * TC[1, 1] + cols[2, 2] * TC[2, 1]
         # q5: r^T Rz(q5) u = m_z, m = (RL e_z) with its z scaled by sigma (axis_angle_roots)
-        q5a, q5b, lo, hi = wrist_qb(RL02, RL12, sigma * RL22, rho_w, base_w, br, bu, tol)
+        q5a, q5b, lo, hi, c5a, s5a, c5b, s5b = wrist_qb(RL02, RL12, sigma * RL22, wc, tol)
         if -2.0 * tol < min(lo, hi) < 1e-12:
             status = 1  # the two q5 roots (nearly) coincide
         if math.isnan(q5a):
             continue
         e5 = (1.0 + e1) / max(rho_w * math.sin(0.5 * (q5a - q5b)), 1e-300)
         for s5 in range(2):
-            q5 = q5a if s5 == 0 else q5b
-            c5, s5v = math.cos(q5), math.sin(q5)
+            q5, c5, s5v = (q5a, c5a, s5a) if s5 == 0 else (q5b, c5b, s5b)
             t0, t1, t2 = C[4, 2, 0] * c5 + C[4, 2, 1] * s5v, -C[4, 2, 0] * s5v + C[4, 2, 1] * c5, C[4, 2, 2]
             y0 = sigma * (t0 * C[5, 0, 0] + t1 * C[5, 1, 0] + t2 * C[5, 2, 0])
             y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])

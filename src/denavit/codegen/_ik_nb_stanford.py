@@ -17,6 +17,7 @@ from ._ik_jit import (
     stanford_q1,
     stanford_q2,
     stanford_q3,
+    wrist_constants,
     wrist_qb,
     wrist_rest,
 )
@@ -66,6 +67,7 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
     """The candidates of one pose in the plain plan's order (q3 root, q2 root, wrist root; + before -) into cand
     (ws: 42 floats of scratch); returns (count, status)."""
     uz, uperp, L, rho_w, base_w, br, bu, near = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7]
+    wc = wrist_constants(rho_w, base_w, br, bu)
     tol = tols[1]
     wide = near * L
     D, Y, cols, M = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:33].reshape((3, 3))
@@ -112,25 +114,26 @@ def _stanford_candidates(Tb, X, C0i, C, geom, sc, tols, cand, ws):
             for r in range(3):
                 for j in range(3):
                     M[r, j] = cols[r, 0] * Y[0, j] + cols[r, 1] * Y[1, j] + cols[r, 2] * Y[2, j]
-            ncand, status = _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status,
+            ncand, status = _stanford_wrist(M, C, q1, q2, q3, wc, near, cand, ncand, status,
                                             1.0 + e1 + e2 + e3, sc[8])
     return ncand, status
 
 
 @njit(cache=True, nogil=True)
-def _stanford_wrist(M, C, q1, q2, q3, rho_w, base_w, br, bu, near, cand, ncand, status, eM, cond_max):
+def _stanford_wrist(M, C, q1, q2, q3, wc, near, cand, ncand, status, eM, cond_max):
     """The two wrist solutions of Rz(q4) R4 Rz(q5) R5 Rz(q6) = M (as wrist_angles: q5 from the z-row in the
     half-angle form, q4 turns R4 Rz(q5) R5 e_z onto M e_z, q6 from the x-row), appended to cand; eM: the
     rounding error of M [eps], for the COND_MAX test."""
-    qba, qbb, lo, hi = wrist_qb(M[0, 2], M[1, 2], M[2, 2], rho_w, base_w, br, bu, WRIST_TOL)  # denavit.ik.forms
+    qba, qbb, lo, hi, cba, sba, cbb, sbb = wrist_qb(M[0, 2], M[1, 2], M[2, 2], wc, WRIST_TOL)  # denavit.ik.forms
     if -2e-7 < min(lo, hi) < 1e-12:
         status = 1  # the two wrist roots (nearly) coincide
     if math.isnan(qba):
         return ncand, status
-    e5 = eM / max(rho_w * math.sin(0.5 * (qba - qbb)), 1e-300)
+    e5 = eM / max(wc[0] * math.sin(0.5 * (qba - qbb)), 1e-300)
     for s5 in range(2):
-        qb = qba if s5 == 0 else qbb
-        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa, _cc, _sc = wrist_rest(qb, M, C[4, :3, :3], C[5, :3, :3])
+        qb, cb, sb = (qba, cba, sba) if s5 == 0 else (qbb, cbb, sbb)
+        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa, _cc, _sc = wrist_rest(qb, cb, sb, M, C[4, :3, :3],
+                                                                                 C[5, :3, :3])
         if vxy < near:
             status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
         if eM + e5 + (eM + e5) / max(vxy, 1e-300) > cond_max:

@@ -36,7 +36,7 @@ from ._forms import (
     stanford_q3,
     wrist_rest,
 )
-from ._subproblems import axis_angle_roots
+from ._subproblems import axis_angle_pairs
 
 __all__ = ["ElbowPosition", "StanfordPosition", "closed_position", "wrist_angles"]
 
@@ -185,7 +185,7 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     Returns q (..., 2, 3), singular (..., 2), sign (..., 2) as :func:`._subproblems.rotation3`.
     """
     r, u = Ra[2, :], Rb[:, 2]
-    qb = axis_angle_roots(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
+    qb, cb, sb = axis_angle_pairs(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
     Mt = np.moveaxis(M, (-2, -1), (0, 1))[..., None]  # M[i, j] of each pose, against the two roots of qb
-    qa, qc, singular, sign = wrist_rest(qb, Mt, Ra, Rb)[:4]  # the one copy (numba compiles it too)
+    qa, qc, singular, sign = wrist_rest(qb, cb, sb, Mt, Ra, Rb)[:4]  # the one copy (numba compiles it too)
     return np.stack([qa, qb, qc], -1), singular, sign

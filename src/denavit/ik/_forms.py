@@ -18,8 +18,8 @@ Formulas (joint-screw form of :mod:`._chain`; derivations in :mod:`._closed` and
   1–3 (Craig 3rd ed. Sec. 4.7, eqs. 4.65–4.76).
 - :func:`stanford_q3`, :func:`stanford_q2`, :func:`stanford_q1` — the Stanford arm's joints 1–3 (R R P, axes 1, 2
   meeting; Spong, Hutchinson & Vidyasagar 2006, Sec. 5.3.3).
-- :func:`wrist_qb`, :func:`wrist_rest` — the three-axis wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` (Paden–Kahan
-  subproblems 2 and 1; Murray, Li & Sastry 1994, Sec. 3.3).
+- :func:`wrist_constants`, :func:`wrist_qb`, :func:`wrist_rest` — the three-axis wrist
+  ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` (Paden–Kahan subproblems 2 and 1; Murray, Li & Sastry 1994, Sec. 3.3).
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "trig_pairs", "half_angle", "shoulder_roots", "elbow_plane",
-           "elbow_roots", "elbow_q2", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2", "stanford_q1"]
+           "elbow_roots", "elbow_q2", "wrist_constants", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2",
+           "stanford_q1"]
 
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the outer axes of a three-axis wrist under which it is singular
@@ -69,12 +70,17 @@ def trig_pairs(a, b, rho, ratio, tol):
 
 
 def half_angle(lo, hi, tol):
-    """x in [0, π] with (1 − cos x)/2 = lo and (1 + cos x)/2 = hi, from the smaller one (its digits survive next to
-    x = 0 or π, where arccos loses half of them); NaN when either is below −tol/2 (out of range)."""
+    """(x, cos x, sin x), x in [0, π] with (1 − cos x)/2 = lo and (1 + cos x)/2 = hi, from the smaller one, y (its
+    digits survive next to x = 0 or π, where arccos loses half of them): x = 2 arcsin √y (or π minus it), cos x =
+    ±(1 − 2y), sin x = 2 √y √(1 − y) (no cos or sin); NaN when either is below −tol/2 (out of range)."""
     ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
     small = lo <= hi
-    y = 2.0 * np.arcsin(np.sqrt(_clip(select(small, lo, hi), 0.0, 1.0)))  # one arcsin: select evaluates both sides
-    return select(ok, select(small, y, np.pi - y), np.nan)
+    y = _clip(select(small, lo, hi), 0.0, 1.0)
+    r = np.sqrt(y)
+    x = 2.0 * np.arcsin(r)  # one arcsin: select evaluates both sides
+    c = 1.0 - 2.0 * y
+    return (select(ok, select(small, x, np.pi - x), np.nan), select(ok, select(small, c, -c), np.nan),
+            select(ok, 2.0 * r * np.sqrt(1.0 - y), np.nan))
 
 
 def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
@@ -108,7 +114,7 @@ def elbow_roots(G, na, nb, base, tol):
     the reach (``tol``)."""
     den = 4.0 * na * nb
     s, d = na + nb, abs(na - nb)
-    x = half_angle((s - G) * (s + G) / den, (G - d) * (G + d) / den, tol)
+    x = half_angle((s - G) * (s + G) / den, (G - d) * (G + d) / den, tol)[0]
     return base + x, base - x, x
 
 
@@ -132,20 +138,34 @@ def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
             select(zero, 0.0, crs / h))
 
 
-def wrist_qb(m0, m1, m2, rho, base, br, bu, tol):
-    """(qb₊, qb₋, lo, hi): the roots of the wrist's z-row ``rᵀ Rz(qb) u = m_z`` (m = M e_z, r = Raᵀ e_z, u = Rb e_z;
-    ρ, base: hypot and atan2 of its cos/sin coefficients; br, bu: the angles of r and u to the z axis).
+def wrist_constants(rho, base, br, bu):
+    """The constants of :func:`wrist_qb` for one wrist, as one tuple: (ρ, β, cos β, sin β, cos Δ/2, sin Δ/2,
+    cos Σ/2, sin Σ/2) with ρ, β the hypot and atan2 of the z-row's cos/sin coefficients, Δ = br − bu, Σ = br + bu
+    (br, bu: the angles of r and u to the z axis)."""
+    return (rho, base, np.cos(base), np.sin(base), np.cos(0.5 * (br - bu)), np.sin(0.5 * (br - bu)),
+            np.cos(0.5 * (br + bu)), np.sin(0.5 * (br + bu)))
 
-    x from φ = ∠(m, e_z) taken with atan2 from all of m: ``(1 − cos x)/2 = sin((φ + Δ)/2) sin((φ − Δ)/2)/ρ``,
-    Δ = br − bu, and ``(1 + cos x)/2`` likewise with br + bu (see ``axis_angle_roots``); NaN where ρ < 1e-12.
-    lo and hi (the two products) tell how near the roots are to a double root."""
-    phi = np.arctan2(np.hypot(m0, m1), m2)
-    dm, sm = br - bu, br + bu
+
+def wrist_qb(m0, m1, m2, wc, tol):
+    """(qb₊, qb₋, lo, hi, cos qb₊, sin qb₊, cos qb₋, sin qb₋): the roots of the wrist's z-row ``rᵀ Rz(qb) u = m_z``
+    (m = M e_z, r = Raᵀ e_z, u = Rb e_z; wc: :func:`wrist_constants`), qb = β ± x.
+
+    x from φ = ∠(m, e_z), whose half-angle cosine and sine are taken from all of m (cos φ = m_z, sin φ = |m_xy|,
+    each from the side where it is well conditioned): ``(1 − cos x)/2 = sin((φ + Δ)/2) sin((φ − Δ)/2)/ρ`` and
+    ``(1 + cos x)/2 = sin((Σ + φ)/2) sin((Σ − φ)/2)/ρ`` (see ``axis_angle_roots``), each sine by the sum formula;
+    NaN where ρ < 1e-12.  lo and hi (the two products) tell how near the roots are to a double root; the cosines
+    and sines of the roots by the sum formulas from :func:`half_angle`'s (no cos or sin of qb)."""
+    rho, base, cb, sb, cd, sd, cs, ss = wc
+    t = np.sqrt(m0 * m0 + m1 * m1)  # sin φ
+    up = m2 >= 0.0
+    hc, hs = np.sqrt(np.maximum(0.5 * (1.0 + m2), 0.0)), np.sqrt(np.maximum(0.5 * (1.0 - m2), 0.0))
+    ch = select(up, hc, t / (2.0 * select(up, 1.0, hs)))  # cos φ/2
+    sh = select(up, t / (2.0 * select(up, hc, 1.0)), hs)  # sin φ/2
     r = select(rho < 1e-12, np.nan, rho)
-    lo = np.sin((phi + dm) / 2) * np.sin((phi - dm) / 2) / r  # (1 − cos x)/2
-    hi = np.sin((sm + phi) / 2) * np.sin((sm - phi) / 2) / r  # (1 + cos x)/2
-    x = half_angle(lo, hi, tol)
-    return base + x, base - x, lo, hi
+    lo = (sh * cd + ch * sd) * (sh * cd - ch * sd) / r  # (1 − cos x)/2
+    hi = (ss * ch + cs * sh) * (ss * ch - cs * sh) / r  # (1 + cos x)/2
+    x, cx, sx = half_angle(lo, hi, tol)
+    return base + x, base - x, lo, hi, cb * cx - sb * sx, sb * cx + cb * sx, cb * cx + sb * sx, sb * cx - cb * sx
 
 
 def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
@@ -153,9 +173,10 @@ def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
     return Ra[i, 0] * (cb * x0 - sb * x1) + Ra[i, 1] * (sb * x0 + cb * x1) + Ra[i, 2] * x2
 
 
-def wrist_rest(qb, M, Ra, Rb):
+def wrist_rest(qb, cb, sb, M, Ra, Rb):
     """(qa, qc, singular, sign, vxy, cb, sb, ca, sa, cc, sc) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb
-    is known (cb, sb, ca, sa, cc, sc: cos and sin of qb, qa and qc as computed, before the exact-alignment choice):
+    is known, with its cos and sin cb, sb (ca, sa, cc, sc: cos and sin of qa and qc as computed, before the
+    exact-alignment choice):
     qa turns v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan
     subproblems 2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
 
@@ -165,7 +186,6 @@ def wrist_rest(qb, M, Ra, Rb):
     singular: axes a and c aligned within AXES_ALIGNED_TOL (only qa ± qc is determined, sign +1 for qa + qc);
     aligned within ALIGNED_EXACT the representative is the middle of the family: qa = ±w/2, qc = w/2.  vxy: sine
     of the angle between axes a and c (how near the wrist is to its singularity)."""
-    cb, sb = np.cos(qb), np.sin(qb)
     v0 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 0)
     v1 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 1)
     v2 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 2)
@@ -222,5 +242,5 @@ def stanford_q1(q2, w0, w1, w2, Dx, Dy, R1):
 
 
 #: The functions numba compiles (``select`` gets its scalar twin there), callers after callees.
-JITTABLE = (_clip, trig_roots, trig_pairs, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2, wrist_qb,
-            _ra_rz, wrist_rest, stanford_q3, stanford_q2, stanford_q1)
+JITTABLE = (_clip, trig_roots, trig_pairs, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2,
+            wrist_constants, wrist_qb, _ra_rz, wrist_rest, stanford_q3, stanford_q2, stanford_q1)

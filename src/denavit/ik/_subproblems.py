@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from ._chain import angle_about_z
-from ._forms import ALIGNED_EXACT, AXES_ALIGNED_TOL, WRIST_TOL, wrist_qb
+from ._forms import ALIGNED_EXACT, AXES_ALIGNED_TOL, WRIST_TOL, wrist_constants, wrist_qb
 
-__all__ = ["rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "split_aligned",
+__all__ = ["rotation3", "trig_coefficients", "rz_bilinear", "axis_angle_roots", "axis_angle_pairs", "split_aligned",
            "AXES_ALIGNED_TOL", "ALIGNED_EXACT"]
 
 # ALIGNED_EXACT: below this angle [rad] the representative of the continuum is taken with qa = 0; AXES_ALIGNED_TOL:
@@ -29,11 +29,18 @@ def axis_angle_roots(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = W
     ``(1 − cos x)/2 = sin((φ + Δ)/2) sin((φ − Δ)/2) / (sin β_r sin β_u)``, Δ = β_r − β_u, and
     ``(1 + cos x)/2`` likewise with Σ = β_r + β_u; the smaller one gives x.  NaN where there is no root.
     """
+    return axis_angle_pairs(r, u, m, tol)[0]
+
+
+def axis_angle_pairs(r: np.ndarray, u: np.ndarray, m: np.ndarray, tol: float = WRIST_TOL):
+    """:func:`axis_angle_roots` (..., 2) with the cosines and sines of the roots (..., 2) each, by the same formulas
+    (``forms.wrist_qb``: no cos or sin of the roots)."""
     a, b, _ = rz_bilinear(r, u)
     rho, base = float(np.hypot(a, b)), float(np.arctan2(b, a))
     br, bu = np.arctan2(np.hypot(r[0], r[1]), r[2]), np.arctan2(np.hypot(u[0], u[1]), u[2])
-    plus, minus, _, _ = wrist_qb(m[..., 0], m[..., 1], m[..., 2], rho, base, br, bu, tol)  # the one copy (numba too)
-    return np.stack([plus, minus], axis=-1)
+    wc = wrist_constants(rho, base, br, bu)
+    plus, minus, _, _, cp, sp, cm, sm = wrist_qb(m[..., 0], m[..., 1], m[..., 2], wc, tol)  # the one copy (numba too)
+    return np.stack([plus, minus], axis=-1), np.stack([cp, cm], axis=-1), np.stack([sp, sm], axis=-1)
 
 
 def rz_bilinear(m: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
