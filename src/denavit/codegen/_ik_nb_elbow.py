@@ -57,6 +57,7 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
     free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
     wc = wrist_constants(rho_w, base_w, br, bu)
+    cb3, sb3 = math.cos(base3), math.sin(base3)
     # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
     ws = np.empty(145)
     F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
@@ -94,14 +95,14 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
             if math.isnan(q1):
                 continue
             g0, g1 = elbow_plane(c1, s1c, W[0], W[1], W[2], R1, p1)
-            q3a, q3b, x = elbow_roots(math.hypot(g0, g1), na, nb, base3, ratio_tol)
+            q3a, q3b, x, c3a, s3a, c3b, s3b = elbow_roots(math.hypot(g0, g1), na, nb, base3, cb3, sb3, ratio_tol)
             if math.isnan(x):
                 continue
             if x < 1e-6 or math.pi - x < 1e-6:
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
-                q3 = q3a if s3 == 0 else q3b
-                q2, free2, _vxy, c3, s3v, c2, s2v = elbow_q2(g0, g1, q3, R2, p2, P, tiny)
+                q3, c3, s3v = (q3a, c3a, s3a) if s3 == 0 else (q3b, c3b, s3b)
+                q2, free2, _vxy, c2, s2v = elbow_q2(g0, g1, c3, s3v, R2, p2, P, tiny)
                 if free2:
                     status = 1
                 # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
@@ -112,12 +113,15 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
                     for i in range(3):
                         xi, yi = cx[i], cy[i]
                         cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
-                    C = consts[kk + 1]
+                    m = kk + 1  # consts[m] indexed, not sliced: a view is an atomic reference count
+                    c00, c01, c02 = consts[m, 0, 0], consts[m, 0, 1], consts[m, 0, 2]
+                    c10, c11, c12 = consts[m, 1, 0], consts[m, 1, 1], consts[m, 1, 2]
+                    c20, c21, c22 = consts[m, 2, 0], consts[m, 2, 1], consts[m, 2, 2]
                     for i in range(3):
                         xi, yi, zi = cx[i], cy[i], cz[i]
-                        cx[i] = xi * C[0, 0] + yi * C[1, 0] + zi * C[2, 0]
-                        cy[i] = xi * C[0, 1] + yi * C[1, 1] + zi * C[2, 1]
-                        cz[i] = xi * C[0, 2] + yi * C[1, 2] + zi * C[2, 2]
+                        cx[i] = xi * c00 + yi * c10 + zi * c20
+                        cy[i] = xi * c01 + yi * c11 + zi * c21
+                        cz[i] = xi * c02 + yi * c12 + zi * c22
                 for j in range(3):
                     M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
                     M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
@@ -149,10 +153,10 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, 
             best = int(perm[slot])
             # labels: shoulder (x1 . (X - O1)), elbow (side of the shoulder-wrist line), wrist (sin(q5 + theta5));
             # the frames after joints 1, 2 from the verifying FK (of the unfolded candidate: whole turns apart)
-            fr = frames[best]
             code = 0
-            for i in range(3):
-                x1[i], y1c[i], z1[i], S[i], E[i] = fr[i], fr[3 + i], fr[6 + i], fr[9 + i], fr[21 + i]
+            for i in range(3):  # frames[best] indexed, not sliced
+                x1[i], y1c[i], z1[i] = frames[best, i], frames[best, 3 + i], frames[best, 6 + i]
+                S[i], E[i] = frames[best, 9 + i], frames[best, 21 + i]
             s_right = 0.0
             for i in range(3):
                 s_right += x1[i] * (Xw[i] - consts[0, i, 3])

@@ -126,6 +126,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
             if math.sqrt(P0 * P0 + P1 * P1) < wide:
                 status = 1  # Q on (or next to) axis 2
             q3a, q3b, rho3, ratio3 = trig_roots(ap2, bp2, P0 * P0 + P1 * P1 + k0, tol)
+            c3a, s3a, c3b, s3b = trig_pairs(ap2, bp2, rho3, ratio3, tol)
             if rho3 <= 1e-12:
                 status = 1
                 continue
@@ -137,8 +138,8 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
             e3 = eP * 2.0 * math.sqrt(P0 * P0 + P1 * P1) * scale / max(rho3 * math.sqrt((1.0 - r3) * (1.0 + r3)),
                                                                           1e-300)
             for s3 in range(2):
-                q3 = q3a if s3 == 0 else q3b
-                q2, _free, vxy, c3, s3v, c2, s2v = elbow_q2(P0, P1, q3, R2, p2, p3, 0.0)
+                q3, c3, s3v = (q3a, c3a, s3a) if s3 == 0 else (q3b, c3b, s3b)
+                q2, _free, vxy, c2, s2v = elbow_q2(P0, P1, c3, s3v, R2, p2, p3, 0.0)
                 if vxy < wide:
                     status = 1
                 e2 = (eP + e3) * scale / max(min(math.sqrt(P0 * P0 + P1 * P1), vxy), 1e-300)

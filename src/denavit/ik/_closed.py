@@ -68,6 +68,7 @@ class ElbowPosition:
         self.k = float(p2 @ p2 + self.P @ self.P - self.vz**2 + 2 * self.gamma)
         self.na, self.nb = float(np.hypot(p2[0], p2[1])), float(np.hypot(self.P[0], self.P[1]))
         self.base = float(np.arctan2(self.beta, self.alpha))
+        self.cb, self.sb = float(np.cos(self.base)), float(np.sin(self.base))
 
     @classmethod
     def recognise(cls, C1, C2, P, prismatic, scale) -> "ElbowPosition | None":
@@ -97,9 +98,11 @@ class ElbowPosition:
         g0, g1 = elbow_plane(c1, s1, Wx[:, None], Wy[:, None], Wz[:, None], self.R1, self.p1)  # wrist centre, frame 2
         # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P (Craig eq. 4.69), with (1 ∓ cos x)/2 as
         # products (Kahan's triangle angles) so that a folded or stretched elbow keeps its digits
-        q3a, q3b, _ = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, RATIO_TOL)
+        q3a, q3b, _, c3a, s3a, c3b, s3b = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, self.cb,
+                                                       self.sb, RATIO_TOL)
         q3 = np.stack([q3a, q3b], -1)  # (B, 2, 2)
-        q2, free2 = elbow_q2(g0[..., None], g1[..., None], q3, self.R2, self.p2, self.P, tiny)[:2]  # on axis 2: 0
+        c3, s3 = np.stack([c3a, c3b], -1), np.stack([s3a, s3b], -1)  # cos q3, sin q3 (B, 2, 2)
+        q2, free2 = elbow_q2(g0[..., None], g1[..., None], c3, s3, self.R2, self.p2, self.P, tiny)[:2]  # on axis 2: 0
         q = np.stack([np.broadcast_to(q1[..., None], q2.shape), q2, q3], -1).reshape(len(W), 4, 3)
         return q, _flags(q, free1[:, None, None] * 1 + free2 * 2)
 

@@ -108,23 +108,23 @@ def elbow_plane(c1, s1, Wx, Wy, Wz, R1, p1):
     return d0 * R1[0, 0] + d1 * R1[1, 0] + d2 * R1[2, 0], d0 * R1[0, 1] + d1 * R1[1, 1] + d2 * R1[2, 1]
 
 
-def elbow_roots(G, na, nb, base, tol):
-    """(q3₊, q3₋, x): q3 = base ± x with G² = na² + nb² + 2 na nb cos x (the elbow's law of cosines, Craig eq.
-    4.69), (1 ∓ cos x)/2 written as products so that a folded or stretched elbow keeps its digits; NaN beyond
-    the reach (``tol``)."""
+def elbow_roots(G, na, nb, base, cb, sb, tol):
+    """(q3₊, q3₋, x, cos q3₊, sin q3₊, cos q3₋, sin q3₋): q3 = base ± x with G² = na² + nb² + 2 na nb cos x (the
+    elbow's law of cosines, Craig eq. 4.69), (1 ∓ cos x)/2 written as products so that a folded or stretched elbow
+    keeps its digits; NaN beyond the reach (``tol``).  cb, sb: cos and sin of base; the cosines and sines of the
+    roots by the sum formulas from :func:`half_angle`'s."""
     den = 4.0 * na * nb
     s, d = na + nb, abs(na - nb)
-    x = half_angle((s - G) * (s + G) / den, (G - d) * (G + d) / den, tol)[0]
-    return base + x, base - x, x
+    x, cx, sx = half_angle((s - G) * (s + G) / den, (G - d) * (G + d) / den, tol)
+    return base + x, base - x, x, cb * cx - sb * sx, sb * cx + cb * sx, cb * cx + sb * sx, sb * cx - cb * sx
 
 
-def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
-    """(q2, free, |v_xy|, cos q3, sin q3, cos q2, sin q2): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow
-    triangle: the wrist centre, or the UR arm's planar-pair point) onto g about axis 2, by one atan2 of v_xy × g and
-    v_xy · g (their normalised values are cos q2 and sin q2); where v lies on axis 2 (within ``tiny``) q2 is free: 0
-    and free True (a planar pair passes tiny = 0 and reads |v_xy| instead).  The cosines and sines are returned for
-    callers that need them again (the compiled kernels' verifying FK)."""
-    c3, s3 = np.cos(q3), np.sin(q3)
+def elbow_q2(g0, g1, c3, s3, R2, p2, P, tiny):
+    """(q2, free, |v_xy|, cos q2, sin q2): q2 turns v = p2 + R2 Rz(q3) P (the point of the elbow triangle: the
+    wrist centre, or the UR arm's planar-pair point; c3, s3: cos q3, sin q3) onto g about axis 2, by one atan2 of
+    v_xy × g and v_xy · g (their normalised values are cos q2 and sin q2, returned for the compiled kernels'
+    verifying FK); where v lies on axis 2 (within ``tiny``) q2 is free: 0 and free True (a planar pair passes
+    tiny = 0 and reads |v_xy| instead)."""
     u0, u1 = c3 * P[0] - s3 * P[1], s3 * P[0] + c3 * P[1]  # Rz(q3) P, xy (z is P_z)
     vx = p2[0] + R2[0, 0] * u0 + R2[0, 1] * u1 + R2[0, 2] * P[2]
     vy = p2[1] + R2[1, 0] * u0 + R2[1, 1] * u1 + R2[1, 2] * P[2]
@@ -134,7 +134,7 @@ def elbow_q2(g0, g1, q3, R2, p2, P, tiny):
     h = np.sqrt(dot * dot + crs * crs)
     zero = free | (h == 0.0)  # q2 = 0 there; NaN stays NaN
     h = select(zero, 1.0, h)
-    return (select(zero, 0.0, np.arctan2(crs, dot)), free, vxy, c3, s3, select(zero, 1.0, dot / h),
+    return (select(zero, 0.0, np.arctan2(crs, dot)), free, vxy, select(zero, 1.0, dot / h),
             select(zero, 0.0, crs / h))
 
 

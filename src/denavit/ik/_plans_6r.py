@@ -13,7 +13,7 @@ from ..chain import Screws, screw_axes, screw_pose, screw_walk
 from ..numeric import inverse_transform
 from ._chain import angle_about_z, solve_trig
 from ._closed import closed_position, wrist_angles
-from ._forms import elbow_q2
+from ._forms import elbow_q2, trig_pairs, trig_roots
 from ._position3 import Position3
 from ._structure import arm_scale, common_point, free_text, rot_z_angle
 from ._subproblems import (
@@ -111,8 +111,11 @@ def _planar_pair(P: np.ndarray, p2: np.ndarray, R2: np.ndarray, p3: np.ndarray):
     a, b, g = rz_bilinear(R2.T @ p2, p3)
     vz = p2[2] + R2[2, 2] * p3[2]
     rhs = np.sum(P[..., :2] ** 2, -1) - p2 @ p2 - p3 @ p3 + vz**2 - 2 * g
-    qb = solve_trig(2 * a, 2 * b, rhs, tol=1e-7)
-    qa = elbow_q2(P[..., None, 0], P[..., None, 1], qb, R2, p2, p3, 0.0)[0]  # turns v onto P (._forms)
+    a2, b2, rhs = np.broadcast_arrays(2.0 * a, 2.0 * b, rhs)
+    qp, qm, rho, ratio = trig_roots(a2, b2, rhs, 1e-7)  # as solve_trig, with the roots' cos and sin (._forms)
+    cp, sp, cm, sm = trig_pairs(a2, b2, rho, ratio, 1e-7)
+    qb, cb, sb = np.stack([qp, qm], -1), np.stack([cp, cm], -1), np.stack([sp, sm], -1)
+    qa = elbow_q2(P[..., None, 0], P[..., None, 1], cb, sb, R2, p2, p3, 0.0)[0]  # turns v onto P (._forms)
     return qa, qb
 
 
