@@ -61,9 +61,11 @@ def _checked(T, o):
 
 @njit(cache=True, nogil=True)
 def ik_one_elbow(T, K, o):
-    """Every closed-form solution of the one pose T into o (layout in the module notes): the elbow kernel."""
+    """Every closed-form solution of the one pose T into o (layout in the module notes): the elbow kernel.  Returns
+    the status o[122] (read from Python as a float, not as a numpy scalar)."""
     if _checked(T, o):
         ik_elbow_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
+    return o[122]
 
 
 @njit(cache=True, nogil=True)
@@ -71,6 +73,7 @@ def ik_one_parallel(T, K, o):
     """:func:`ik_one_elbow` by the UR-class kernel."""
     if _checked(T, o):
         ik_parallel_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
+    return o[122]
 
 
 @njit(cache=True, nogil=True)
@@ -78,6 +81,7 @@ def ik_one_stanford(T, K, o):
     """:func:`ik_one_elbow` by the Stanford-class kernel."""
     if _checked(T, o):
         ik_stanford_packed(T.reshape((1, 4, 4)), K, o[:112].reshape((1, 8, 14)), o[112:132].reshape((1, 20)))
+    return o[122]
 
 
 @njit(cache=True, nogil=True)

@@ -151,13 +151,13 @@ class IKMethods:
                 return analytic_ik(self.robot, T)
             T = np.ascontiguousarray(Ta)
         o = np.empty(c[4])
-        c[2](T, c[0], o)
+        status = c[2](T, c[0], o)
         if c[5]:  # numba compiled (or loaded) it on this first call: call its machine code from now on
             c[2], c[5] = next(iter(c[2].overloads.values())).entry_point, False
-        status = o[122]
         if status == 0.0:
             res = _new(_PackedResult)
-            res.__dict__["_p"] = (o, *c[1])
+            _set_o(res, o)  # the slots' own setters: the frozen dataclass refuses setattr, and no __dict__ is made
+            _set_m(res, c[1])
             return res
         if status == 2.0:
             err = o[132]
@@ -195,10 +195,10 @@ class IKMethods:
 
 class _PackedResult(AnalyticIKResult):
     """The :class:`~denavit.AnalyticIKResult` of one pose answered by the compiled kernel, its fields read from
-    the kernel's output vector ``o`` (layout: :mod:`._ik_nb_entry`) when first asked for (views of ``o``, each made
-    once).  Copied or pickled, it is a plain AnalyticIKResult."""
+    the kernel's output vector ``o`` (layout: :mod:`._ik_nb_entry`; kept in a slot with the labels and plan kind) when
+    first asked for (views of ``o``, each made once).  Copied or pickled, it is a plain AnalyticIKResult."""
 
-    __slots__ = ()
+    __slots__ = ("_o", "_m")  # the output vector; (labels, plan kind)
 
     def __reduce__(self):
         return AnalyticIKResult, tuple(getattr(self, f) for f in _FIELDS)
@@ -216,8 +216,7 @@ class _Lazy:
     def __get__(self, obj, cls=None):
         if obj is None:
             return self
-        d = obj.__dict__
-        value = d[self.name] = self.get(*d["_p"])
+        value = obj.__dict__[self.name] = self.get(obj._o, *obj._m)
         return value
 
 
@@ -232,6 +231,7 @@ for _lazy in (_Lazy("solutions", lambda o, labels, kind: o[:112].reshape(8, 14)[
               _Lazy("valid", lambda o, labels, kind: _ALL_VALID[int(o[120])])):
     setattr(_PackedResult, _lazy.name, _lazy)
 _PackedResult.__name__ = _PackedResult.__qualname__ = "AnalyticIKResult"  # its repr is a plain result's
+_set_o, _set_m = _PackedResult._o.__set__, _PackedResult._m.__set__
 
 
 def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
