@@ -60,7 +60,8 @@ def check_kinematics_values(fw, robot, rng, shapes=((), (1,), (3, 2))) -> None:
 
 def check_dynamics_values(fw, robot, rng) -> None:
     """rnea, M, g, c and forward dynamics of the framework equal the numpy backend's (float64 1e-12, float32 1e-5
-    relative), with q̇ of shape (n,) broadcast against a (2, 3) batch of q."""
+    relative; forward dynamics in float32 1e-5 times the condition number of M, which the solve amplifies the
+    float32 rounding of M and the bias by), with q̇ of shape (n,) broadcast against a (2, 3) batch of q."""
     ref, fast = numpy_backend(robot), denavit.compile(robot, backend=fw.name)
     n = robot.dof
     q, qd, qdd = rng.uniform(-np.pi, np.pi, (2, 3, n)), rng.uniform(-2, 2, n), rng.uniform(-3, 3, (2, 3, n))
@@ -73,7 +74,10 @@ def check_dynamics_values(fw, robot, rng) -> None:
         want32 = getattr(ref, name)(*[a.astype(np.float64) for a in args32])
         got32 = getattr(fast, name)(*[fw.tensor(a, 32) for a in args32])
         assert fw.dtype_bits(got32) == 32
-        assert_close(fw.numpy(got32), want32, 1e-5, f"{name} float32")
+        rel = 1e-5
+        if name == "forward_dynamics":  # seen: cond(M) 166, error 2.4e-4 on results of 13.9 (bias 148)
+            rel *= max(1.0, float(np.linalg.cond(ref.mass_matrix(args32[0].astype(np.float64))).max()))
+        assert_close(fw.numpy(got32), want32, rel, f"{name} float32")
 
 
 def _skew(w):
