@@ -103,7 +103,8 @@ def test_export_lang_jax_writes_a_module_giving_the_same_values(tmp_path, rng):
     assert main(["export", "puma560", "--lang", "jax", "-o", str(tmp_path / "out")]) == 0
     text = (tmp_path / "out" / "puma560.py").read_text()
     assert "import jax.numpy as xp" in text and "numpy as np" not in text and "denavit" not in text.split('"""')[2]
-    assert text.count("_sincos(q)") >= 3 and "xp.sin(q_" not in text  # fk, jacobian0, jacobiane: the polynomials
+    # fk, jacobian0, jacobiane: the polynomials, on the columns moved first
+    assert text.count("_sincos(xp.moveaxis(q, -1, 0))") >= 3 and "xp.sin(q_" not in text
 
 
 @pytest.mark.slow
@@ -132,7 +133,8 @@ def test_the_polynomial_sine_and_cosine_are_numpys_to_an_ulp_or_two_with_libm_be
     assert _tensor_emit._PIO2_64 == _llvm._PIO2 and _tensor_emit._SIN_TAYLOR == _llvm._SIN  # the numba kernels' own
     assert _tensor_emit._COS_TAYLOR == _llvm._COS and _tensor_emit._RANGE_64 == _llvm._REDUCTION_RANGE
     fast = denavit.compile(denavit.load_robot("puma560"), backend="jax", kernels=["fk"])
-    assert fast.source.count("_sincos(q)") == 1 and "xp.sin(" not in fast.source.split("def fk")[1]
+    fk_source = fast.source.split("def fk")[1]
+    assert fast.source.count("_sincos(xp.moveaxis(q, -1, 0))") == 1 and "xp.sin(" not in fk_source
     sincos = fast.module._sincos
     rng = np.random.default_rng(5)
     near = np.concatenate([np.arange(-400, 401) * (np.pi / 4), rng.uniform(-100, 100, 4000)])
@@ -158,6 +160,48 @@ def test_the_polynomial_sine_and_cosine_are_numpys_to_an_ulp_or_two_with_libm_be
     ds, dc = jax.jacfwd(sincos)(x)
     checks.assert_close(ds, np.diag(np.cos(np.asarray(x))), 1e-15, "d sin")
     checks.assert_close(dc, -np.diag(np.sin(np.asarray(x))), 1e-15, "d cos")
+
+
+def _blocked_module(monkeypatch):
+    """A 2-joint arm's module (XLA compiles its kernels quickly) running batches from 16 rows on in blocks of 8
+    (the module's own: 2**18 and 4096)."""
+    mod = denavit.compile(denavit.load_robot("planar2r"), backend="jax", kernels=["fk", "position", "rnea"]).module
+    assert (mod._BLOCKED_FROM, mod._BLOCK) == (2**18, 4096)
+    monkeypatch.setattr(mod, "_BLOCK", 8)
+    monkeypatch.setattr(mod, "_BLOCKED_FROM", 16)
+    return mod
+
+
+def test_large_batches_run_in_blocks_with_the_same_values(monkeypatch, rng):
+    """From _BLOCKED_FROM rows on a kernel runs its rows in blocks inside one lax.fori_loop, the last block
+    overlapping the one before (39 rows: 5 blocks of 8): the numpy backend's values, dtype and batch shape kept;
+    below, one pass."""
+    mod = _blocked_module(monkeypatch)
+    q = jnp.asarray(rng.uniform(-np.pi, np.pi, (3, 13, 2)))
+    fk = jax.jit(lambda x: mod.fk(x))
+    assert "while" in fk.lower(q).as_text() and "while" not in fk.lower(q[0]).as_text()
+    checks.assert_close(fk(q), checks.numpy_backend(denavit.load_robot("planar2r")).fk(np.asarray(q)), 1e-12, "fk")
+    T32 = fk(q.astype(jnp.float32))
+    assert T32.dtype == jnp.float32 and T32.shape == (3, 13, 4, 4)
+    checks.assert_close(T32, fk(q), 1e-6, "fk float32")
+
+
+@pytest.mark.slow
+def test_large_batches_in_blocks_give_one_pass_derivatives_vmap_and_broadcast_inputs(monkeypatch, rng):
+    """Through the blocks (a scan for reverse mode): jax.grad, jacfwd, vmap (13 rows per call under it: one pass)
+    and rnea on inputs broadcast first, all as in one pass."""
+    mod = _blocked_module(monkeypatch)
+    q, qd, qdd = (jnp.asarray(rng.uniform(-np.pi, np.pi, shape)) for shape in ((3, 13, 2), (13, 2), (2,)))
+
+    def runs():  # fresh functions each time (jax.jit keeps a trace per function), jitted (op by op is slow)
+        return (jax.jit(jax.grad(lambda x: jnp.sum(mod.fk(x) ** 2)))(q),
+                jax.jit(jax.jacfwd(lambda x: mod.position(x).sum(0)))(q[0]),
+                jax.jit(jax.vmap(lambda x: mod.fk(x)))(q), jax.jit(lambda *a: mod.rnea(*a))(q, qd, qdd))
+
+    blocked = runs()
+    monkeypatch.setattr(mod, "_BLOCKED_FROM", 2**18)
+    for what, a, b in zip(("grad", "jacfwd", "vmap", "rnea"), blocked, runs()):
+        checks.assert_close(a, b, 1e-13, what)
 
 
 def test_results_keep_the_input_dtype_and_batch_shape_and_accept_lists():
