@@ -138,13 +138,6 @@ _SC = {"float64": (TWO_OVER_PI_64, P_64, RANGE_64, SIN_TAYLOR, COS_TAYLOR),
        "float32": (TWO_OVER_PI_32, P_32, RANGE_32, SIN_TAYLOR_32, COS_TAYLOR_32)}
 
 
-def _horner(coefficients, z):
-    acc = coefficients[-1]
-    for c in reversed(coefficients[:-1]):
-        acc = acc * z + c
-    return acc
-
-
 def _poly_sincos(x, in_range):
     \"\"\"(sin x, cos x) for |x| <= RANGE (NaN stays NaN).\"\"\"
     two_over_pi, parts, _, sin_taylor, cos_taylor = _SC[x.dtype.name]
@@ -153,11 +146,19 @@ def _poly_sincos(x, in_range):
     for p in parts:
         r = r - k * p
     z = r * r
-    s = r + (z * r) * _horner(sin_taylor, z)
-    c = (1.0 - z * 0.5) + (z * z) * _horner(cos_taylor, z)
     n = xp.where(in_range, k, 0.0).astype(xp.int32)
-    swap = (n & 1) != 0
-    s, c = xp.where(swap, c, s), xp.where(swap, s, c)
+    odd = (n & 1) != 0  # sin x is +-cos r, cos x is +-sin r
+    cos_taylor = tuple(cos_taylor) + (0.0,) * (len(sin_taylor) - len(cos_taylor))  # acc = 0 * z + C[-1] first
+
+    def one(use_cos):
+        \"\"\"sin r or cos r, whichever use_cos picks: one polynomial per output element, its coefficients selected
+        (XLA computes sin x and cos x in two loops: with both polynomials in each, 2-10% slower).\"\"\"
+        acc = xp.where(use_cos, cos_taylor[-1], sin_taylor[-1])
+        for cs, cc in zip(reversed(sin_taylor[:-1]), reversed(cos_taylor[:-1])):
+            acc = acc * z + xp.where(use_cos, cc, cs)
+        return xp.where(use_cos, 1.0 - z * 0.5, r) + xp.where(use_cos, z * z, z * r) * acc
+
+    s, c = one(odd), one(~odd)
     return xp.where((n & 2) != 0, -s, s), xp.where(((n + 1) & 2) != 0, -c, c)
 
 
