@@ -20,6 +20,10 @@ configurations timed.  Rows, each batch size × dtype:
             ratio = numba time / jax time: ≥ 0.5 is "within 2×"; "(out=)": numba writing into a preallocated
             array, its kernel's work alone (XLA allocates its output and temporaries on every call: at 10⁶ rows
             most of both sides' allocating time is the kernel's page faults, which vary from process to process)
+  (donated) jax.jit(lambda q, T: fast.fk(q), donate_argnums=1, keep_unused=True) called as T = fk(q, T), XLA
+            writing into the previous result's buffer (JAX's counterpart of out=), against numba's out= call
+  XLA floor jax.jit of a function that only fills a fresh (B, 4, 4) array (one pass, no arithmetic) against the
+            same numba call: the ratio no jitted FK returning a fresh pose array can beat in this process
 Each time is the best of ``repeat`` calls (after one warm-up call each, which also compiles), the libraries taking
 turns.
 """
@@ -123,6 +127,23 @@ def jax_rows(robot, batch: int, repeat: int, rng):
             rows.append((robot.name, "jax.jit FK vs numba", batch, dtype.__name__, t_nb / t_jax))
             t_jax, t_nb = best_pair(lambda: fk(qj).block_until_ready(), lambda: nb.fk(q, threads=1, out=out), repeat)
             rows.append((robot.name, "jax.jit FK vs numba (out=)", batch, dtype.__name__, t_nb / t_jax))
+            into = jax.jit(lambda q, T: fast.fk(q), donate_argnums=1, keep_unused=True)
+            T = [into(qj, fk(qj))]
+            for _ in range(3):
+                T[0] = into(qj, T[0]).block_until_ready()
+
+            def donated():
+                T[0] = into(qj, T[0]).block_until_ready()
+
+            t_jax, t_nb = best_pair(donated, lambda: nb.fk(q, threads=1, out=out), repeat)
+            rows.append((robot.name, "jax.jit FK, result donated, vs numba (out=)", batch, dtype.__name__,
+                         t_nb / t_jax))
+            fill = jax.jit(lambda x: jax.numpy.broadcast_to(x[..., :1, None], x.shape[:-1] + (4, 4)) + 0.0)
+            for _ in range(4):
+                fill(qj).block_until_ready()
+            t_fill, t_nb = best_pair(lambda: fill(qj).block_until_ready(), lambda: nb.fk(q, threads=1), repeat)
+            rows.append((robot.name, "XLA floor: fresh (B, 4, 4) output alone vs numba", batch, dtype.__name__,
+                         t_nb / t_fill))
     return rows
 
 
