@@ -219,7 +219,7 @@ _SIN_TAYLOR = tuple((-1.0) ** (k + 1) / math.factorial(2 * k + 3) for k in range
 _COS_TAYLOR = tuple((-1.0) ** k / math.factorial(2 * k + 4) for k in range(7))
 _TAYLOR_TERMS_32 = 4
 #: The JAX kernels' batches from BLOCKED_FROM configurations on run in blocks of BLOCK_ROWS (the prelude's
-#: _blocked; Puma 560 FK, one core: from 5·10⁵ rows on 1.4-1.8x faster than one pass, at 3·10⁵ even, below slower).
+#: _blocked; Puma 560 FK, one core: from 5·10⁵ rows on 1.4-1.7x faster than one pass, at 3·10⁵ even, below slower).
 BLOCK_ROWS = 4096
 BLOCKED_FROM = 2 ** 18
 
