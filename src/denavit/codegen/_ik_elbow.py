@@ -16,8 +16,10 @@ from __future__ import annotations
 
 __all__ = ["ELBOW_LAYOUT"]
 
-#: The constants of ``ik_elbow_packed``'s vector K, in order, with their sizes (293 numbers for a 6R arm; "chain":
-#: the chain's constants C0 … C6, whose FK verifies the candidates).
-ELBOW_LAYOUT = (("X_e", 3), ("C0i", 16), ("R6", 9), ("R1", 9), ("p1", 3), ("a", 3), ("R2", 9), ("p2", 3), ("P", 3),
-                ("consts", 64), ("R4", 9), ("R5", 9), ("scalars", 9), ("lo", 6), ("hi", 6), ("revolute", 6),
-                ("theta", 6), ("tols", 8), ("chain", 112))
+#: The constants of ``ik_elbow_packed``'s vector K, in order, with their sizes (303 numbers for a 6R arm; "chain":
+#: the chain's constants C0 … C6, whose FK verifies the candidates; "trig": ``forms.wrist_constants`` of the wrist and
+#: cos, sin of the elbow's base angle).  The 4×4 blocks come first and the 3-vectors and 3×3 blocks next, so that
+#: the kernel views each group with one reshape (a reshape is a helper call; views of its rows are free).
+ELBOW_LAYOUT = (("C0i", 16), ("consts", 64), ("chain", 112), ("R6", 9), ("R1", 9), ("R2", 9), ("R4", 9), ("R5", 9),
+                ("X_e", 3), ("p1", 3), ("a", 3), ("p2", 3), ("P", 3), ("scalars", 9), ("trig", 10), ("lo", 6),
+                ("hi", 6), ("revolute", 6), ("theta", 6), ("tols", 8))

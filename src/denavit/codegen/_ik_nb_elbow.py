@@ -19,7 +19,6 @@ from ._ik_jit import (
     elbow_q2,
     elbow_roots,
     shoulder_roots,
-    wrist_constants,
     wrist_qb,
     wrist_rest,
 )
@@ -35,39 +34,38 @@ def ik_elbow_packed(T, K, f, i):
     arrays (f: solutions, residuals, outside-limits solutions; i (B, 20): label codes, then k, j, status, then the
     batched layout's slots (ik_finish's out_rank)): four
     arguments instead of twenty-four to unbox per call."""
-    X_e, C0i, R6 = K[0:3], K[3:19].reshape((4, 4)), K[19:28].reshape((3, 3))
-    R1, p1, a = K[28:37].reshape((3, 3)), K[37:40], K[40:43]
-    R2, p2, P = K[43:52].reshape((3, 3)), K[52:55], K[55:58]
-    consts = K[58:122].reshape((4, 4, 4))
-    R4, R5, sc = K[122:131].reshape((3, 3)), K[131:140].reshape((3, 3)), K[140:149]
-    lo_lim, hi_lim, rev, theta, tols = K[149:155], K[155:161], K[161:167], K[167:173], K[173:181]
-    chain = K[181:293].reshape((7, 4, 4))
-    ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, rev, theta, tols, chain,
+    K4, K3 = K[0:192].reshape((12, 4, 4)), K[192:252].reshape((20, 3))  # two reshapes; row views are free
+    C0i, consts, chain = K4[0], K4[1:5], K4[5:12]
+    R6, R1, R2, R4, R5 = K3[0:3], K3[3:6], K3[6:9], K3[9:12], K3[12:15]
+    X_e, p1, a, p2, P = K3[15], K3[16], K3[17], K3[18], K3[19]
+    sc, trig, lo_lim, hi_lim = K[252:261], K[261:271], K[271:277], K[277:283]
+    rev, theta, tols = K[283:289], K[289:295], K[295:303]
+    ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo_lim, hi_lim, rev, theta, tols, chain,
              f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:11], i[:, 11:20])
 
 
 @njit(cache=True, nogil=True)
-def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, lo_lim, hi_lim, revolute, theta, tols, chain,
-             out_q, out_err, out_label, out_outq, out_status, out_rank):
+def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo_lim, hi_lim, revolute, theta, tols,
+             chain, out_q, out_err, out_label, out_outq, out_status, out_rank):
     """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
     of the batched layout (:func:`._ik_nb_finish.ik_finish`)."""
-    h, na, nb, base3, L, rho_w, base_w, br, bu = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
+    h, na, nb, base3, L, rho_w = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]
     free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
-    wc = wrist_constants(rho_w, base_w, br, bu)
-    cb3, sb3 = math.cos(base3), math.sin(base3)
-    # scratch: one float and one flag allocation, sliced (not twenty-two small ones: ~1 µs per call)
-    ws = np.empty(145)
-    F, q, cand, cerr = ws[0:16].reshape((4, 4)), ws[16:22], ws[22:70].reshape((8, 6)), ws[70:86].reshape((8, 2))
-    Xw, W, Y, M = ws[86:89], ws[89:92], ws[92:101].reshape((3, 3)), ws[101:110].reshape((3, 3))
-    cx, cy, cz = ws[110:113], ws[113:116], ws[116:119]
-    x1, y1c, z1, S, E, dW = ws[119:122], ws[122:125], ws[125:128], ws[128:131], ws[131:134], ws[134:137]
-    perm = ws[137:145]  # the candidate in each sorted slot
+    wc = (trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], trig[6], trig[7])  # forms.wrist_constants
+    cb3, sb3 = trig[8], trig[9]  # cos, sin of base3
+    # scratch: three float and one flag allocation, viewed without reshapes (a reshape is a helper call)
+    ws = np.empty(62)
+    q, Xw, W, cx, cy, cz = ws[0:6], ws[6:9], ws[9:12], ws[12:15], ws[15:18], ws[18:21]
+    x1, y1c, z1, S, E, dW = ws[21:24], ws[24:27], ws[27:30], ws[30:33], ws[33:36], ws[36:39]
+    perm = ws[39:47]  # the candidate in each sorted slot
+    w4 = np.empty((10, 4))
+    F, Y, M = w4[0:4], w4[4:7, 0:3], w4[7:10, 0:3]
+    w8 = np.empty((8, 56))  # per candidate: joints, residuals, frames after joints 1-3 (from the FK, for the
+    cand, cerr, frames, cs = w8[:, 0:6], w8[:, 6:8], w8[:, 8:44], w8[:, 44:56]  # labels), cos and sin of the joints
     flags = np.zeros(24, dtype=np.bool_)
-    frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
-    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (from the closed form, for the FK)
     ok = flags[0:8]
     for b in range(T.shape[0]):
         status = 0

@@ -12,6 +12,7 @@ from ..chain import chain_of
 from ..errors import ShapeError
 from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
+from ..ik import forms as ik_forms
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
 from ._ik_finish import pack_constants
@@ -182,9 +183,11 @@ class IKMethods:
         else:
             k = dict(plan.closed)
             lim = self.robot.q_limits
+            sc = np.asarray(k["scalars"], dtype=float)  # h, na, nb, base3, L, rho_w, base_w, br, bu
             k.update(lo=lim[:, 0], hi=lim[:, 1],
                      revolute=[float(t.value == "revolute") for t in self.robot.joint_types],
-                     chain=np.array(chain_of(self.robot).constants, dtype=float))
+                     chain=np.array(chain_of(self.robot).constants, dtype=float),
+                     trig=[*ik_forms.wrist_constants(*sc[5:9]), np.cos(sc[3]), np.sin(sc[3])])
             if not np.array_equal(np.reshape(k["consts"], (4, 4, 4))[:3], k["chain"][:3]):
                 return False  # the kernel's labels read the frames after joints 1, 2 off its verifying FK
             K, kind = pack_constants(k, ELBOW_LAYOUT, "elbow"), "elbow"
