@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from ._ik_finish import DOUBLE_ROOT
-from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_constants, wrist_qb
+from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_qb
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
@@ -26,7 +26,7 @@ def ik_parallel_packed(T, K, f, i):
     flip), i[b, 8:11] = (k, j, 1 if the plain solver must decide), i[b, 11:20] the batched layout's slots."""
     Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
     a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
-    rev, theta, tols, far = K[157:163], K[163:169], K[169:177], K[177]
+    rev, theta, tols, far, trig = K[157:163], K[163:169], K[169:177], K[177], K[178:186]
     # scratch: one float and one flag allocation, sliced
     ws = np.empty(190)
     cand, cerr, X, F = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4))
@@ -38,7 +38,7 @@ def ik_parallel_packed(T, K, f, i):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
             continue
-        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, tols, cand, cs, ws[89:134])
+        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws[89:134])
         kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
                                     f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C, cs, True, i[b, 11:20])
         for r in range(3):
@@ -49,14 +49,15 @@ def ik_parallel_packed(T, K, f, i):
 
 
 @njit(cache=True, nogil=True)
-def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, tols, cand, cs, ws):
+def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
     """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand, the
     cosines and sines of their joints into cs (8, 12: cos q1, sin q1, cos q2, …; for the verifying FK, which then
-    computes none); ws: 45 floats of scratch.  Returns (count, status)."""
-    c0, sigma, rho_w, base_w, br, bu, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7], sc[8]
+    computes none); trig: the wrist's constants (forms.wrist_constants); ws: 45 floats of scratch.  Returns
+    (count, status)."""
+    c0, sigma, rho_w, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
-    wc = wrist_constants(rho_w, base_w, br, bu)
+    wc = (trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], trig[6], trig[7])  # forms.wrist_constants
     scale = max(reach, 1e-3)
     status = 0
     ncand = 0

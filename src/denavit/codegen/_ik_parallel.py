@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..chain import chain_of
+from ..ik import forms as ik_forms
 from ..numeric import inverse_transform
 from ._ik_finish import pack_constants
 
@@ -42,9 +43,10 @@ NEAR_SINGULAR = 1e-5
 #: to the plain solver (2 ms each: 20 µs a pose on average); at 1e10, 1 in 1000 (those at a double root).
 COND_MAX = 1e10
 
-#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (178 numbers).
+#: The constants of ``ik_parallel_packed``'s vector K, in order, with their sizes (186 numbers; "trig": the wrist's
+#: ``forms.wrist_constants``, computed once per arm).
 PARALLEL_LAYOUT = (("Q_e", 3), ("C0i", 16), ("consts", 112), ("a", 3), ("scalars", 11), ("lo", 6), ("hi", 6),
-                   ("revolute", 6), ("theta", 6), ("tols", 8), ("far", 1))
+                   ("revolute", 6), ("theta", 6), ("tols", 8), ("far", 1), ("trig", 8))
 
 
 def parallel_constants(robot, plan) -> np.ndarray:
@@ -75,5 +77,6 @@ def parallel_constants(robot, plan) -> np.ndarray:
                NEAR_SINGULAR, COND_MAX]
     lim = robot.q_limits
     k = dict(plan.closed, Q_e=Q_e, C0i=inverse_transform(C[0]), consts=C, a=a, scalars=scalars, lo=lim[:, 0],
-             hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types])
+             hi=lim[:, 1], revolute=[float(t.value == "revolute") for t in robot.joint_types],
+             trig=ik_forms.wrist_constants(*scalars[2:6]))
     return pack_constants(k, PARALLEL_LAYOUT, "parallel")
