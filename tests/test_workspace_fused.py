@@ -1,7 +1,7 @@
 """The fused workspace task (denavit.scale._fused / _sink) against the numpy route.
 
-Oracles: numpy's own ``Philox`` generator (the fused kernel's random words), the numpy route of
-``run_task`` (numpy's Philox, the compiled position kernel's batch call, numpy cell arithmetic and a sort) on
+Oracles: SplitMix64 stepped in Python integers (the fused kernel's random words), the numpy route of
+``run_task`` (SplitMix64 in numpy, the compiled position kernel's batch call, numpy cell arithmetic and a sort) on
 random arms, and the same run on other chunk sizes, workers, accumulators and schedulers (identical counts).
 Memory: tracemalloc peaks (not wall clock) and the accumulators' budget arithmetic.
 """
@@ -61,28 +61,65 @@ def _same(a, b):
         assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
 
 
-def test_random_values_are_the_halves_of_numpys_philox_words_across_calls():
-    """Rows drawn in pieces (starting mid-way through a Philox output) are lo + (h·2⁻³²)·span, h the 32-bit
-    halves (low first) of numpy's raw Philox words, and the numpy route's rows too."""
+def _splitmix64(state: int, count: int) -> list[int]:
+    """``count`` outputs of SplitMix64 from ``state``, stepped one at a time in Python integers (Vigna's
+    splitmix64.c: state += γ, then the output function)."""
+    out, m = [], 2**64
+    for _ in range(count):
+        state = (state + 0x9E3779B97F4A7C15) % m
+        z = ((state ^ (state >> 30)) * 0xBF58476D1CE4E5B9) % m
+        z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) % m
+        out.append(z ^ (z >> 31))
+    return out
+
+
+def test_splitmix64_reference_vector_and_block_starts():
+    """The published first outputs of SplitMix64 from state 0; block b of a seed starts 2³² words after
+    block b − 1 of one stream keyed by SeedSequence(seed) (blocks cannot overlap)."""
+    assert _splitmix64(0, 3) == [0xE220A8397B1DCDAF, 0x6E789E6AA1B965F4, 0x06C45D188009454F]
+    key = int(np.random.SeedSequence(77).generate_state(1, np.uint64)[0])
+    states = _fused.block_keys(77, 5, 3)
+    for i, s in enumerate(states):
+        assert int(s) == (key + (5 + i) * 2**32 * 0x9E3779B97F4A7C15) % 2**64
+
+
+def test_random_values_are_the_halves_of_splitmix64_words_across_calls():
+    """Rows drawn in pieces (starting mid-way through a word) are lo + (h·2⁻³²)·span, h the 32-bit halves
+    (low first) of the block's SplitMix64 words stepped in Python integers, and the numpy route's rows too."""
     from denavit.scale._sampler import _draw
 
-    assert np.little_endian  # the halves below are read through a uint32 view
     for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6), (9, 1, 1)):
-        key = _fused.block_keys(seed, block, 1)[0]
-        raw = np.random.Philox(np.random.SeedSequence(seed, spawn_key=(block,))).random_raw(41 * n)
-        h = raw.view(np.uint32)[:41 * n].reshape(41, n).astype(float)
+        state = _fused.block_keys(seed, block, 1)[0]
+        words = _splitmix64(int(state), -(-41 * n // 2))
+        h = np.array([half for w in words for half in (w & 0xFFFFFFFF, w >> 32)][:41 * n], float).reshape(41, n)
         lo, hi = np.linspace(-1, 1, n), np.linspace(0.5, 3, n) + 1.0
         span = hi - lo  # as the numpy route computes it
         ref = h * 2.0**-32 * span + lo
         q = np.empty((41, n))
-        buf = np.empty(41 * n, np.uint64)
-        j = _fused._draw(q[:3], 3, 0, key[0], key[1], lo, span, buf)
+        j = _fused._draw(q[:3], 3, 0, state, lo, span)
         assert j == 3 * n
-        assert _fused._draw(q[3:], 38, j, key[0], key[1], lo, span, buf) == 41 * n
+        assert _fused._draw(q[3:], 38, j, state, lo, span) == 41 * n
         assert np.array_equal(q, ref)
         job = SimpleNamespace(entropy=seed, limits=np.stack([lo, hi], axis=1))
         assert np.array_equal(_draw(job, block, np.empty((41, n))), ref)
         assert 0 <= h.min() and h.max() < 2**32 and len(np.unique(h)) > 40 * n  # 32 random bits each
+
+
+def test_joint_values_are_uniform_over_the_limits():
+    """Kolmogorov–Smirnov distance of 2¹⁸ joint values of each joint from the uniform law on its range, and the
+    correlation of consecutive values (the joints of a sample, and one sample's last with the next one's first),
+    within 5 standard errors."""
+    from denavit.scale._sampler import _draw
+
+    n, m = 3, 2**18
+    lo, hi = np.array([-np.pi, -1.0, 0.2]), np.array([np.pi, 2.5, 0.3])
+    q = _draw(SimpleNamespace(entropy=12345, limits=np.stack([lo, hi], axis=1)), 4, np.empty((m, n)))
+    u = (q - lo) / (hi - lo)
+    grid = np.arange(1, m + 1) / m
+    for a in range(n):
+        assert np.abs(np.sort(u[:, a]) - grid).max() < 1.63 / np.sqrt(m) + 1 / m  # KS at the 1 % level
+    flat = u.reshape(-1) - 0.5
+    assert abs(np.mean(flat[1:] * flat[:-1]) / np.mean(flat * flat)) < 5 / np.sqrt(flat.size)
 
 
 def test_fused_tasks_equal_the_numpy_route_on_random_arms():

@@ -3,11 +3,11 @@
 One jitted function per arm does, for every sample of a task, what :func:`denavit.scale._sampler.run_task`
 does in numpy passes: draw the joint values, compute the origin, its cell and sub-cell, and count them.
 
-- **Random numbers.**  Block b's stream is numpy's own ``Philox`` (Philox4x64-10, Salmon et al., SC 2011,
-  "Parallel random numbers: as easy as 1, 2, 3") keyed by ``SeedSequence(seed, spawn_key=(b,))``: the j-th
-  64-bit word of the block is word j mod 4 of Philox(counter j div 4 + 1, key), and the j-th double is
-  (word >> 11)·2⁻⁵³ — numpy's ``Generator.random`` bit for bit (tested against numpy), so the samples are
-  those of the numpy route.  The 64×64 → 128-bit products of the rounds are one LLVM ``mul i128``.
+- **Random numbers.**  Block b's words are SplitMix64's (Steele, Lea & Flood, OOPSLA 2014: a Weyl sequence
+  through a 64-bit mixing function, which passes BigCrush) from the state K + b·2³²·γ, K from
+  ``SeedSequence(seed)`` (:func:`denavit.scale._sampler.block_state`): word w is mix(state + (w + 1)·γ), a pure
+  function of its counter, so any worker starts any block; each word gives two 32-bit joint values (the
+  numpy route's ``_sampler._draw`` bit for bit, tested against SplitMix64 stepped in Python integers).
 - **Position.**  The arm's traced ``position`` program (:func:`denavit.codegen.trace_kernels`) made into
   machine code by :func:`denavit.codegen.kernel_intrinsic`, the emitter of ``denavit.compile(robot).position``:
   the same instructions, so the same doubles as :class:`~denavit.scale.CompiledPositionFK`.
@@ -26,15 +26,14 @@ import threading
 import numpy as np
 from numba import njit
 
+from ._sampler import GAMMA, MIX1, MIX2
+
 __all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel"]
 
 #: Rows drawn, positioned and counted per step (their joint values and origins stay in the L1 cache).
 SUB_ROWS = 256
 #: Status codes of a fused run.
 OK, NON_FINITE, OUTSIDE = 0, 1, 2
-#: Philox4x64 multipliers and Weyl key increments (Random123, philox.h).
-_M0, _M1 = 0xD2E7470EE14C6C93, 0xCA5A826395121157
-_W0, _W1 = 0x9E3779B97F4A7C15, 0xBB67AE8584CAA73B
 
 _kernels: dict = {}
 _kernels_lock = threading.Lock()
@@ -43,12 +42,10 @@ _KEEP = 8
 
 
 def block_keys(entropy: int, first: int, count: int) -> np.ndarray:
-    """Philox keys (count, 2) of blocks first … first+count−1: ``SeedSequence(entropy, spawn_key=(b,))``'s first
-    two 64-bit words (what ``numpy.random.Philox`` takes as its key; its counter starts at 0)."""
-    keys = np.empty((count, 2), dtype=np.uint64)
-    for j in range(count):
-        keys[j] = np.random.SeedSequence(entropy, spawn_key=(first + j,)).generate_state(2, np.uint64)
-    return keys
+    """Starting states (count,) uint64 of blocks first … first+count−1 (``_sampler.block_state``)."""
+    from ._sampler import block_state
+
+    return block_state(entropy, first + np.arange(count, dtype=np.uint64))
 
 
 def _program(spec) -> tuple[tuple, tuple]:
@@ -89,78 +86,70 @@ def fused_kernel(robot):
         return hit
 
 
-def _mulhilo_intrinsic():
-    """The intrinsic (a, b) → (high, low) 64-bit words of the 128-bit product a·b (uint64): one ``mul i128``."""
+def _bits_intrinsic():
+    """The intrinsic uint64 → float64 of the same 64 bits (an LLVM ``bitcast``: no conversion)."""
     from llvmlite import ir
     from numba import types
     from numba.extending import intrinsic
 
     @intrinsic
-    def mulhilo(typingctx, a, b):
-        sig = types.UniTuple(types.uint64, 2)(types.uint64, types.uint64)
-
+    def as_double(typingctx, x):
         def codegen(context, builder, sig, args):
-            i128, i64 = ir.IntType(128), ir.IntType(64)
-            p = builder.mul(builder.zext(args[0], i128), builder.zext(args[1], i128))
-            hi = builder.trunc(builder.lshr(p, ir.Constant(i128, 64)), i64)
-            return context.make_tuple(builder, sig.return_type, (hi, builder.trunc(p, i64)))
+            return builder.bitcast(args[0], ir.DoubleType())
 
-        return sig, codegen
+        return types.float64(types.uint64), codegen
 
-    return mulhilo
+    return as_double
 
 
-_mulhilo = _mulhilo_intrinsic()
-_M0, _M1, _W0, _W1 = np.uint64(_M0), np.uint64(_M1), np.uint64(_W0), np.uint64(_W1)
+_as_double = _bits_intrinsic()
 _Z, _S32, _ONE, _LOW6, _LOW32 = np.uint64(0), np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
+_GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
+_S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
+_EXP52 = np.uint64(0x4330000000000000)  # the bits of 2⁵²: 2⁵² + h for h < 2³² by an OR
 _HALF = 2.0**-32
 
 
-@njit(nogil=True, cache=True)
-def _philox(c0, k0, k1):
-    """Philox4x64-10 of the counter (c0, 0, 0, 0) under the key (k0, k1): 4 words (Random123's philox.h)."""
-    c1 = c2 = c3 = _Z
-    for r in range(10):
-        if r:
-            k0 = k0 + _W0
-            k1 = k1 + _W1
-        hi0, lo0 = _mulhilo(_M0, c0)
-        hi1, lo1 = _mulhilo(_M1, c2)
-        c0, c1, c2, c3 = hi1 ^ c1 ^ k0, lo1, hi0 ^ c3 ^ k1, lo0
-    return c0, c1, c2, c3
+@njit(nogil=True, cache=True, inline="always")
+def _mix(z):
+    """SplitMix64's output function (Steele, Lea & Flood, OOPSLA 2014; Vigna's constants)."""
+    z = (z ^ (z >> _S30)) * _MIX1
+    z = (z ^ (z >> _S27)) * _MIX2
+    return z ^ (z >> _S31)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _unit(h):
+    """h·2⁻³² for h < 2³² (uint64), exactly: (2⁵² + h) − 2⁵² by bits, which vectorises (no int → double)."""
+    return (_as_double(_EXP52 | h) - 4503599627370496.0) * _HALF
 
 
 @njit(nogil=True, cache=True)
-def _draw(q, r, j, k0, k1, lo, span, buf):
-    """Rows 0 … r−1 of q (C-contiguous) from values j, j+1 … of the block's stream; returns the next value's
-    index.  Value v is the low (v even) or high (v odd) 32-bit half h of word v div 2, word w is word w mod 4 of
-    Philox(w div 4 + 1); the joint value is lo + (h·2⁻³²)·span (as ``_sampler._draw``).  ``buf``: scratch of at
-    least r·n/2 + 8 words (the Philox outputs, then converted in one straight loop)."""
+def _draw(q, r, j, state, lo, span):
+    """Rows 0 … r−1 of q (C-contiguous) from values j, j+1 … of the block whose starting state is ``state``;
+    returns the next value's index.  Value v is the low (v even) or high (v odd) 32-bit half h of word
+    w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_sampler._draw``); the joint value is
+    lo + (h·2⁻³²)·span, in that order."""
     n = q.shape[1]
-    end = j + r * n
-    c0, c1 = (j >> 1) >> 2, ((end - 1) >> 1) >> 2  # the Philox counters (minus one) these values come from
-    for c in range(c0, c1 + 1):
-        w0, w1, w2, w3 = _philox(np.uint64(c + 1), k0, k1)
-        o = 4 * (c - c0)
-        buf[o], buf[o + 1], buf[o + 2], buf[o + 3] = w0, w1, w2, w3
     flat = q.reshape(-1)
     m = r * n
     if j & 1:  # a start in the middle of a word (not reached by run: blocks start at 0, steps are even)
         for v in range(m):
-            w = j + v - 8 * c0
-            flat[v] = np.int64((buf[w >> 1] >> (_S32 * np.uint64(w & 1))) & _LOW32) * _HALF
+            w = np.uint64((j + v) >> 1)
+            h = (_mix(state + (w + _ONE) * _GAMMA) >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
+            flat[v] = _unit(h)
     else:
-        off = (j >> 1) - 4 * c0
+        base = state + np.uint64((j >> 1) + 1) * _GAMMA
         for p in range(m // 2):  # both halves of each word
-            w = buf[off + p]
-            flat[2 * p] = np.int64(w & _LOW32) * _HALF
-            flat[2 * p + 1] = np.int64(w >> _S32) * _HALF
+            w = _mix(base + np.uint64(p) * _GAMMA)
+            flat[2 * p] = _unit(w & _LOW32)
+            flat[2 * p + 1] = _unit(w >> _S32)
         if m & 1:
-            flat[m - 1] = np.int64(buf[off + m // 2] & _LOW32) * _HALF
+            flat[m - 1] = _unit(_mix(base + np.uint64(m // 2) * _GAMMA) & _LOW32)
     for i in range(r):
         for a in range(n):
             flat[i * n + a] = flat[i * n + a] * span[a] + lo[a]
-    return end
+    return j + m
 
 
 @njit(nogil=True, cache=True)
@@ -193,6 +182,37 @@ def _coordinates(P, r, grid, basis, ident, origin, T, R2):
             T[a, i] = ((P[i, 0] - cx) * b0 + (P[i, 1] - cy) * b1 + (P[i, 2] - cz) * b2 - glo) * inv
 
 
+@njit(nogil=True, cache=True, fastmath={"nnan", "ninf", "nsz"})
+def _bounds(P, r, R2, stats):
+    """stats[:7] = min xyz, max xyz, max R2 over P[:r] and what stats held.  Exact for finite values (min and
+    max do not round; the flags let them vectorise); a non-finite sample fails the run anyway (``_cells``)."""
+    x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
+    for i in range(r):
+        x, y, z = P[i, 0], P[i, 1], P[i, 2]
+        x0, y0, z0, x1, y1, z1 = min(x0, x), min(y0, y), min(z0, z), max(x1, x), max(y1, y), max(z1, z)
+        reach = max(reach, R2[i])
+    stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6] = x0, y0, z0, x1, y1, z1, reach
+
+
+@njit(nogil=True, cache=True)
+def _flat(T, r, dim, side, cells):
+    """cells[i] = row-major flat index of the cells (int32: < MAX_CELLS = 2²⁴) of coordinates T[:, i]; returns
+    how many samples fall outside [0, side) on some axis (NaN does too).  Inside, truncation is floor."""
+    s = float(side)
+    bad = 0
+    if dim == 3:
+        for i in range(r):
+            t0, t1, t2 = T[0, i], T[1, i], T[2, i]
+            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (t2 >= 0.0) & (t2 < s))
+            cells[i] = (np.int32(t0) * np.int32(side) + np.int32(t1)) * np.int32(side) + np.int32(t2)
+    else:
+        for i in range(r):
+            t0, t1 = T[0, i], T[1, i]
+            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s))
+            cells[i] = np.int32(t0) * np.int32(side) + np.int32(t1)
+    return bad
+
+
 @njit(nogil=True, cache=True)
 def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2):
     """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
@@ -200,21 +220,8 @@ def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, s
     the origins P[:r]; returns (status, ns).  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
     dim, k = basis.shape[0], int(grid[5])
     _coordinates(P, r, grid, basis, ident, origin, T, R2)
-    x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
-    for i in range(r):
-        x, y, z = P[i, 0], P[i, 1], P[i, 2]
-        x0, y0, z0, x1, y1, z1 = min(x0, x), min(y0, y), min(z0, z), max(x1, x), max(y1, y), max(z1, z)
-        reach = max(reach, R2[i])
-    stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6] = x0, y0, z0, x1, y1, z1, reach
-    bad = False
-    for i in range(r):
-        flat = 0
-        for a in range(dim):
-            f = np.floor(T[a, i])
-            bad |= not (f >= 0 and f < side)  # NaN fails too
-            flat = flat * side + int(f)
-        cells[i] = flat
-    if bad:
+    _bounds(P, r, R2, stats)
+    if _flat(T, r, dim, side, cells):
         for i in range(r):
             if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
                 return 1, 0
@@ -226,8 +233,9 @@ def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, s
             word = words[flat >> 6]
             b = np.uint64(flat) & _LOW6
             idx = prefix[flat >> 6] + np.int64(_popcount(word & ((_ONE << b) - _ONE)))
-            for a in range(dim):
-                idx = idx * k + int(np.floor(T[a, i] * k) - k * np.floor(T[a, i]))
+            for a in range(dim):  # T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
+                t = T[a, i]
+                idx = idx * k + (np.int64(t * k) - k * np.int64(t))
             subs[ns] = idx
             ns += np.int64((word >> b) & _ONE)
     return 0, ns
@@ -261,15 +269,14 @@ def _build(rows):
     def run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, words, prefix, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
-        buf = np.empty(q.shape[0] * q.shape[1] // 2 + 8, dtype=np.uint64)
         T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
         for blk in range(keys.shape[0]):
-            k0, k1 = keys[blk, 0], keys[blk, 1]
+            state = keys[blk]
             j = 0
             for s in range(0, sizes[blk], q.shape[0]):
                 r = min(q.shape[0], sizes[blk] - s)
                 qs, Ps = q[:r], P[:r]
-                j = _draw(qs, r, j, k0, k1, lo, span, buf)
+                j = _draw(qs, r, j, state, lo, span)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
                 status, ns = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T,

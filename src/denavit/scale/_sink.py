@@ -178,7 +178,7 @@ def run_fused(job, first: int, count: int) -> tuple:
     args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), ident,
             g.side, job.base_origin)
     scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (SUB_ROWS, 3), np.float64),
-               _work.get("fcells", (SUB_ROWS,), np.int64), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
+               _work.get("fcells", (SUB_ROWS,), np.int32), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
                stats)
     kernel = fused_kernel(job.fk.robot)
     sink = _sinks.get(job.sink) if job.sink else None
