@@ -1,11 +1,14 @@
 """Workspace and reachability at scale (denavit.scale): throughput, memory and the volume interval vs samples.
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
-              [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--kernel-ratio 1e8] [--markdown FILE]
+              [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--kernel-ratio 1e8 [--pin 1]
+              [--rounds 2]] [--markdown FILE]
 ``--kernel-ratio N`` compares, in one process, the bare compiled position kernel (``compile(robot).position`` on
 a batch of 65 536 configurations, one thread) with the whole pipeline (``occupancy`` of N samples on the threads
 scheduler: random numbers, FK, cells, counts, merge, volume), both per CPU-second (so per core, whatever else
-the machine runs) and per wall second.
+the machine runs) and per wall second; ``--pin CORE`` pins the process to one core first (the pipeline then
+runs on one thread: its per-core rate without the other thread's cache traffic) and ``--rounds R`` interleaves
+R kernel/pipeline pairs (best of each).
 Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows
 only) of this process and of the largest finished worker process, the peak PSS of the whole process tree
 during the run (sampled every 0.5 s; shared library pages split between the processes), the 1-minute load
@@ -145,10 +148,11 @@ def run_cluster(robot, n, repeat: int = 1) -> list[str]:
     return lines
 
 
-def kernel_ratio(robot, n: int, workers) -> list[str]:
+def kernel_ratio(robot, n: int, workers, rounds: int = 1) -> list[str]:
     """Bare position kernel vs the pipeline, same process: throughput per CPU-second (per core, whatever else
-    the machine runs) and per wall second.  The kernel: ``compile(robot).position`` on one block of 65 536
-    configurations within the limits, 64 calls a round, best of 3 rounds, one thread."""
+    the machine runs) and per wall second, ``rounds`` interleaved kernel/pipeline pairs (best of each).  The
+    kernel: ``compile(robot).position`` on one block of 65 536 configurations within the limits, 64 calls a
+    round, best of 3 rounds, one thread."""
     from denavit.scale import CompiledPositionFK, sampling_limits
 
     c = denavit.compile(robot, kernels=["position"])
@@ -159,7 +163,7 @@ def kernel_ratio(robot, n: int, workers) -> list[str]:
     rows = ["| what | samples | wall [s] | CPU [s] | samples/s (wall) | samples per CPU-second (per core) | load |",
             "|---|---:|---:|---:|---:|---:|---:|"]
     figures = {}
-    for what in ("kernel", "pipeline", "kernel"):
+    for what in ("kernel",) + ("pipeline", "kernel") * rounds:
         best = None
         for _ in range(3 if what == "kernel" else 1):
             t, cpu = time.perf_counter(), time.process_time()
@@ -178,7 +182,7 @@ def kernel_ratio(robot, n: int, workers) -> list[str]:
         rows.append(f"| {what} | {m:.3g} | {wall:.2f} | {cpu:.2f} | {m / wall:.3g} | {m / cpu:.3g} | "
                     f"{os.getloadavg()[0]:.1f} |")
         print(rows[-1], flush=True)
-    k, p = max(figures["kernel"]), figures["pipeline"][0]
+    k, p = max(figures["kernel"]), max(figures["pipeline"])
     rows.append(f"\npipeline ÷ kernel per core: {p / k:.2f} ({robot.name}, {workers or os.cpu_count()} threads)")
     print(rows[-1], flush=True)
     return rows
@@ -205,13 +209,18 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1, help="cluster comparison: runs of each, alternating (medians)")
     ap.add_argument("--reach", help="e.g. 0.05x100: resolution [m] x orientations")
     ap.add_argument("--kernel-ratio", type=float, help="pipeline of this many samples vs the bare kernel")
+    ap.add_argument("--pin", type=int, help="pin the process to this core (and run one worker thread)")
+    ap.add_argument("--rounds", type=int, default=1, help="--kernel-ratio: interleaved kernel/pipeline pairs")
     ap.add_argument("--markdown")
     a = ap.parse_args()
     robot = denavit.load_robot(a.robot)
-    lines = [f"{a.robot}, scheduler {a.scheduler}, workers {a.workers or os.cpu_count()}, "
-             f"load average {os.getloadavg()[0]:.2f}", ""]
+    if a.pin is not None:
+        os.sched_setaffinity(0, {a.pin})
+        a.workers = 1
+    lines = [f"{a.robot}, scheduler {a.scheduler}, workers {a.workers or os.cpu_count()}"
+             f"{'' if a.pin is None else f', pinned to core {a.pin}'}, load average {os.getloadavg()[0]:.2f}", ""]
     if a.kernel_ratio:
-        lines += kernel_ratio(robot, int(a.kernel_ratio), a.workers)
+        lines += kernel_ratio(robot, int(a.kernel_ratio), a.workers, a.rounds)
     lines += run_samples(robot, [int(float(x)) for x in a.samples.split(",") if x], a.scheduler, a.workers)
     if a.cluster:
         more = run_cluster(robot, int(float(a.samples.split(",")[-1])), a.repeat)

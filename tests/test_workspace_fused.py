@@ -96,9 +96,10 @@ def test_random_values_are_the_halves_of_splitmix64_words_across_calls():
         span = hi - lo  # as the numpy route computes it
         ref = h * 2.0**-32 * span + lo
         q = np.empty((41, n))
-        j = _fused._draw(q[:3], 3, 0, state, lo, span)
+        tiled = np.tile(lo, 41), np.tile(span, 41)
+        j = _fused._draw(q[:3], 3, 0, state, *tiled)
         assert j == 3 * n
-        assert _fused._draw(q[3:], 38, j, state, lo, span) == 41 * n
+        assert _fused._draw(q[3:], 38, j, state, *tiled) == 41 * n
         assert np.array_equal(q, ref)
         job = SimpleNamespace(entropy=seed, limits=np.stack([lo, hi], axis=1))
         assert np.array_equal(_draw(job, block, np.empty((41, n))), ref)

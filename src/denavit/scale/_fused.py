@@ -28,7 +28,7 @@ from numba import njit
 
 from ._sampler import GAMMA, MIX1, MIX2
 
-__all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel"]
+__all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel", "merge"]
 
 #: Rows drawn, positioned and counted per step (their joint values and origins stay in the L1 cache).
 SUB_ROWS = 256
@@ -102,7 +102,23 @@ def _bits_intrinsic():
     return as_double
 
 
-_as_double = _bits_intrinsic()
+def _ctpop_intrinsic():
+    """The intrinsic: set bits of a uint64 (LLVM ``ctpop``: one ``popcnt`` instruction where the CPU has it)."""
+    from llvmlite import ir
+    from numba import types
+    from numba.extending import intrinsic
+
+    @intrinsic
+    def ctpop(typingctx, x):
+        def codegen(context, builder, sig, args):
+            return builder.ctpop(args[0])
+
+        return types.uint64(types.uint64), codegen
+
+    return ctpop
+
+
+_as_double, _popcount = _bits_intrinsic(), _ctpop_intrinsic()
 _Z, _S32, _ONE, _LOW6, _LOW32 = np.uint64(0), np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
 _GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
 _S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
@@ -126,38 +142,27 @@ def _unit(h):
 
 @njit(nogil=True, cache=True)
 def _draw(q, r, j, state, lo, span):
-    """Rows 0 … r−1 of q (C-contiguous) from values j, j+1 … of the block whose starting state is ``state``;
-    returns the next value's index.  Value v is the low (v even) or high (v odd) 32-bit half h of word
-    w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_sampler._draw``); the joint value is
-    lo + (h·2⁻³²)·span, in that order."""
-    n = q.shape[1]
+    """Rows 0 … r−1 of q (C-contiguous, n columns) from values j, j+1 … (j a multiple of n) of the block whose
+    starting state is ``state``; returns the next value's index.  Value v is the low (v even) or high (v odd)
+    32-bit half h of word w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_sampler._draw``); the
+    joint value is lo + (h·2⁻³²)·span, in that order, with ``lo``, ``span`` the limits tiled row after row (at
+    least r·n entries: value i of the rows takes entry i, so the loop is straight and vectorises)."""
     flat = q.reshape(-1)
-    m = r * n
+    m = r * q.shape[1]
     if j & 1:  # a start in the middle of a word (not reached by run: blocks start at 0, steps are even)
         for v in range(m):
             w = np.uint64((j + v) >> 1)
             h = (_mix(state + (w + _ONE) * _GAMMA) >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
-            flat[v] = _unit(h)
+            flat[v] = _unit(h) * span[v] + lo[v]
     else:
         base = state + np.uint64((j >> 1) + 1) * _GAMMA
         for p in range(m // 2):  # both halves of each word
             w = _mix(base + np.uint64(p) * _GAMMA)
-            flat[2 * p] = _unit(w & _LOW32)
-            flat[2 * p + 1] = _unit(w >> _S32)
+            flat[2 * p] = _unit(w & _LOW32) * span[2 * p] + lo[2 * p]
+            flat[2 * p + 1] = _unit(w >> _S32) * span[2 * p + 1] + lo[2 * p + 1]
         if m & 1:
-            flat[m - 1] = _unit(_mix(base + np.uint64(m // 2) * _GAMMA) & _LOW32)
-    for i in range(r):
-        for a in range(n):
-            flat[i * n + a] = flat[i * n + a] * span[a] + lo[a]
+            flat[m - 1] = _unit(_mix(base + np.uint64(m // 2) * _GAMMA) & _LOW32) * span[m - 1] + lo[m - 1]
     return j + m
-
-
-@njit(nogil=True, cache=True)
-def _popcount(x):
-    x = x - ((x >> _ONE) & np.uint64(0x5555555555555555))
-    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
-    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
-    return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
 
 
 @njit(nogil=True, cache=True)
@@ -214,7 +219,7 @@ def _flat(T, r, dim, side, cells):
 
 
 @njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T, R2):
+def _cells(P, r, grid, basis, ident, side, origin, slots, cells, subs, stats, T, R2):
     """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
     is taken at the end), cells (cells[:r]) and the sub-cells of those in refined cells (subs[:ns], in order) of
     the origins P[:r]; returns (status, ns).  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
@@ -227,17 +232,20 @@ def _cells(P, r, grid, basis, ident, side, origin, words, prefix, cells, subs, s
                 return 1, 0
         return 2, 0
     ns = 0
-    if words.size:  # branch-free: every sample's index is written, only those in refined cells are kept
-        for i in range(r):
+    if slots.shape[0]:
+        for i in range(r):  # branch-free: the rows in refined cells, in order, into subs[:ns]
             flat = cells[i]
-            word = words[flat >> 6]
-            b = np.uint64(flat) & _LOW6
-            idx = prefix[flat >> 6] + np.int64(_popcount(word & ((_ONE << b) - _ONE)))
-            for a in range(dim):  # T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
-                t = T[a, i]
-                idx = idx * k + (np.int64(t * k) - k * np.int64(t))
-            subs[ns] = idx
-            ns += np.int64((word >> b) & _ONE)
+            subs[ns] = i
+            ns += np.int64((slots[flat >> 6, 0] >> (np.uint64(flat) & _LOW6)) & _ONE)
+        for t in range(ns):  # their sub-cells; T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
+            i = subs[t]
+            flat = cells[i]
+            word, before = slots[flat >> 6, 0], slots[flat >> 6, 1]
+            idx = np.int64(before + _popcount(word & ((_ONE << (np.uint64(flat) & _LOW6)) - _ONE)))
+            for a in range(dim):
+                x = T[a, i]
+                idx = idx * k + (np.int64(x * k) - k * np.int64(x))
+            subs[t] = idx
     return 0, ns
 
 
@@ -259,28 +267,41 @@ def _add(cells, r, acc, touched, nt):
     return nt
 
 
+@njit(nogil=True, cache=True)
+def merge(total, part):
+    """total += part and part = 0, touching only the nonzero entries of part (one pass, no temporaries)."""
+    for i in range(part.size):
+        v = part[i]
+        if v:
+            total[i] += v
+            part[i] = 0
+
+
 def _build(rows):
     """The fused task function around ``rows`` (a ``kernel_intrinsic`` batch form of the position program):
-    ``run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, words, prefix, fine, ftouched,
+    ``run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, slots, fine, ftouched,
     q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks, 2), sizes
     (blocks,) samples each), SUB_ROWS rows at a time (q, P, cells, subs: scratch of that many rows)."""
 
     @njit(nogil=True)
-    def run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, words, prefix, fine, ftouched,
+    def run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, slots, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
         T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
+        los, spans = np.empty(q.size), np.empty(q.size)  # the limits tiled row after row (see _draw)
+        for i in range(q.shape[0]):
+            for a in range(q.shape[1]):
+                los[i * q.shape[1] + a], spans[i * q.shape[1] + a] = lo[a], span[a]
         for blk in range(keys.shape[0]):
             state = keys[blk]
             j = 0
             for s in range(0, sizes[blk], q.shape[0]):
                 r = min(q.shape[0], sizes[blk] - s)
                 qs, Ps = q[:r], P[:r]
-                j = _draw(qs, r, j, state, lo, span)
+                j = _draw(qs, r, j, state, los, spans)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
-                status, ns = _cells(Ps, r, grid, basis, ident, side, origin, words, prefix, cells, subs, stats, T,
-                                    R2)
+                status, ns = _cells(Ps, r, grid, basis, ident, side, origin, slots, cells, subs, stats, T, R2)
                 if status:
                     return nt, nft, status
                 nt = _add(cells, r, acc, touched, nt)

@@ -80,7 +80,7 @@ def plan_refinement(counts: np.ndarray, factor: int | None, pilot: int) -> Refin
     """The refinement the pilot's counts call for (``factor`` None: automatic — only when the pilot's coverage
     of the grid reaches REFINE_COVERAGE; the factor is then the largest that fits REFINE_CELLS)."""
     total = float(counts.sum())
-    if factor is None and (total == 0 or 1.0 - float((counts == 1).sum()) / total < REFINE_COVERAGE):
+    if factor is None and (total == 0 or 1.0 - np.count_nonzero(counts == 1) / total < REFINE_COVERAGE):
         return None
     occ = counts > 0
     grown = occ.copy()
@@ -113,20 +113,20 @@ _maps: dict = {}
 _maps_lock = threading.Lock()
 
 
-def slot_map(ref: Refinement, size: int) -> tuple[np.ndarray, np.ndarray]:
+def slot_map(ref: Refinement, size: int) -> np.ndarray:
     """Per process, for a grid of ``size`` cells: the refined cells as a bitmap of 64-bit words (bit i of word
-    w ↔ cell 64·w + i; size/8 bytes, so the test of every sample stays in cache) and, per word, how many
-    refined cells come before it (int64): the slot of a refined cell is that count plus the set bits below it
-    in its word."""
+    w ↔ cell 64·w + i) beside, per word, how many refined cells come before it: ``slots[w] = (word, count)``,
+    uint64 (w, 2) — a sample's test and its slot read one cache line (size/4 bytes in all).  The slot of a
+    refined cell is the count plus the set bits below it in its word."""
     with _maps_lock:
         hit = _maps.get(ref.token)
-        if hit is None or hit[0].size != -(-size // 64):
+        if hit is None or hit.shape[0] != -(-size // 64):
             mask = np.zeros(-(-size // 64) * 64, dtype=bool)
             mask[ref.cells] = True
             words = np.packbits(mask, bitorder="little").view(np.uint64)
-            prefix = np.zeros(words.size, dtype=np.int64)
-            np.cumsum(popcount(words)[:-1], out=prefix[1:])
-            hit = (words, prefix)
+            hit = np.zeros((words.size, 2), dtype=np.uint64)
+            hit[:, 0] = words
+            hit[1:, 1] = np.cumsum(popcount(words)[:-1])
             _maps.clear()  # one run at a time per process: keep memory bounded
             _maps[ref.token] = hit
         return hit
@@ -143,12 +143,13 @@ def popcount(x: np.ndarray) -> np.ndarray:
 
 
 def _coarsen_sub(F: np.ndarray, d: int) -> np.ndarray:
-    """Sum 2^d blocks of sub-cells inside each refined cell: (r, j, …) → (r, j/2, …)."""
-    j = F.shape[1]
-    shape = [F.shape[0]]
-    for _ in range(d):
-        shape += [j // 2, 2]
-    return F.reshape(shape).sum(axis=tuple(range(2, 2 * d + 1, 2)), dtype=np.uint64)
+    """Sum 2^d blocks of sub-cells inside each refined cell: (r, j, …) → (r, j/2, …), in F's dtype (uint32 only
+    when fewer than 2³² samples follow the pilot, so no sum of sub-cells can overflow it)."""
+    for ax in range(1, d + 1):  # pairs along each sub-cell axis in turn
+        even, odd = [slice(None)] * (d + 1), [slice(None)] * (d + 1)
+        even[ax], odd[ax] = slice(0, None, 2), slice(1, None, 2)
+        F = F[tuple(even)] + F[tuple(odd)]
+    return F
 
 
 def _sub_interior(Fo: np.ndarray, rows: np.ndarray, neighbour_slots: list, d: int) -> int:
@@ -182,11 +183,11 @@ def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarr
     occ = counts > 0
     inner = interior(occ)
     flat_occ, flat_in = occ.reshape(-1), inner.reshape(-1)
-    n_in = int(flat_in.sum())
+    n_in = np.count_nonzero(flat_in)
     boundary = flat_occ[ref.cells] & ~flat_in[ref.cells]  # refined cells in B
     rows = np.flatnonzero(boundary)
-    n_unrefined = int(flat_occ.sum()) - n_in - rows.size  # cells of B without sub-cell counts
-    f1h, f2h = int((counts == 1).sum()), int((counts == 2).sum())
+    n_unrefined = np.count_nonzero(flat_occ) - n_in - rows.size  # cells of B without sub-cell counts
+    f1h, f2h = np.count_nonzero(counts == 1), np.count_nonzero(counts == 2)
     m_h, sd_h = chao1(f1h, f2h)
     cover_h = 1.0 - f1h / max(float(counts.sum()), 1.0)
     # the row of each neighbour (offset o) of each refined cell of B: its slot, r (no data) or r + 1 (interior)
@@ -205,9 +206,9 @@ def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarr
     while j >= 2:
         Fo = np.concatenate([F > 0, np.zeros((1,) + F.shape[1:], bool), np.ones((1,) + F.shape[1:], bool)])
         sub_in = _sub_interior(Fo, rows, neighbour_slots, d)
-        per = F.reshape(r, -1)  # statistics of the rows in B, without a copy of their counts
-        f1, f2 = (int((per == v).sum(axis=1)[rows].sum()) for v in (1, 2))
-        N, n_occ = float(per.sum(axis=1)[rows].sum()), int((per > 0).sum(axis=1)[rows].sum())
+        per = F.reshape(r, -1)[rows]  # the rows in B
+        f1, f2 = np.count_nonzero(per == 1), np.count_nonzero(per == 2)
+        N, n_occ = float(per.sum(dtype=np.uint64)), np.count_nonzero(per)
         m, sd = chao1(f1, f2)
         K, cell, big = j**d, (h / j) ** d, h**d
         low = n_in * big + sub_in * cell

@@ -287,7 +287,8 @@ def _sub_cells(job: Job, flat: np.ndarray, T: np.ndarray, out: np.ndarray) -> in
     front of ``out``; returns how many."""
     ref, g = job.refine, job.grid
     k = ref.factor
-    words, prefix = slot_map(ref, g.side**g.dim)
+    slots = slot_map(ref, g.side**g.dim)
+    words, prefix = slots[:, 0], slots[:, 1].view(np.int64)
     w = np.right_shift(flat, 6, out=_scratch.get("w", flat.shape, np.int32))
     b = np.bitwise_and(flat, 63, out=_scratch.get("b", flat.shape, np.uint64), casting="unsafe")
     word = np.take(words, w, out=_scratch.get("word", flat.shape, np.uint64))

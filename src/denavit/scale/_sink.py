@@ -34,7 +34,7 @@ _MOST = 2**32 - 1
 _sinks: dict = {}
 _sinks_lock = threading.Lock()
 _tokens = itertools.count()
-_E32, _E64, _EU64 = np.empty(0, np.int32), np.empty(0, np.int64), np.empty(0, np.uint64)
+_E32, _E64, _SLOTS = np.empty(0, np.int32), np.empty(0, np.int64), np.empty((0, 2), np.uint64)
 _NONE = np.empty(0, np.uint32)  # no counts (read-only use: nothing is ever written to it)
 
 
@@ -80,11 +80,13 @@ class Sink:
             self.cond.notify()
 
     def _flush_one(self, acc: _Accumulator) -> None:
-        np.add(self.counts, acc.counts, out=self.counts)
-        acc.counts[:] = 0
+        from ._fused import merge
+
+        if acc.tally == 0:  # nothing counted since the last flush: the accumulator is all zeros
+            return
+        merge(self.counts, acc.counts)
         if acc.fine is not None and self.fine is not None:
-            np.add(self.fine, acc.fine, out=self.fine, casting="unsafe")  # uint32 + uint32 into uint32 or uint64
-            acc.fine[:] = 0
+            merge(self.fine, acc.fine)  # uint32 into uint32 (fewer than 2³² samples after the pilot) or uint64
         acc.tally = 0
 
     def close(self) -> None:
@@ -172,7 +174,7 @@ def run_fused(job, first: int, count: int) -> tuple:
     span = job.limits[:, 1] - job.limits[:, 0]
     grid = np.array([*g.centre, g.lo, 1.0 / g.resolution, ref.factor if ref is not None else 0], dtype=float)
     ident = bool(g.dim == 3 and np.array_equal(g.basis, np.eye(3)))
-    words, prefix = slot_map(ref, g.side**g.dim) if ref is not None else (_EU64, _E64)
+    slots = slot_map(ref, g.side**g.dim) if ref is not None else _SLOTS
     fine_size = 0 if ref is None else ref.cells.size * ref.factor**g.dim
     stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
     args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), ident,
@@ -183,17 +185,17 @@ def run_fused(job, first: int, count: int) -> tuple:
     kernel = fused_kernel(job.fk.robot)
     sink = _sinks.get(job.sink) if job.sink else None
     if sink is not None:
-        idx, cnt, fidx, fcnt = _into_sink(kernel, args, scratch, sink, total, words, prefix, fine_size)
+        idx, cnt, fidx, fcnt = _into_sink(kernel, args, scratch, sink, total, slots, fine_size)
     else:
-        idx, cnt, fidx, fcnt = _sparse(kernel, args, scratch, g.side**g.dim, total, words, prefix, fine_size)
+        idx, cnt, fidx, fcnt = _sparse(kernel, args, scratch, g.side**g.dim, total, slots, fine_size)
     return idx, cnt, stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, fidx, fcnt
 
 
-def _into_sink(kernel, args, scratch, sink: Sink, total: int, words, prefix, fine_size: int) -> tuple:
+def _into_sink(kernel, args, scratch, sink: Sink, total: int, slots, fine_size: int) -> tuple:
     """Count into a free accumulator of the run's sink; no cells returned (empty arrays)."""
     acc = sink.acquire(total, fine_size)
     try:
-        _, _, status = kernel(*args, acc.counts, _E32, words, prefix, acc.fine if fine_size else _NONE, _E64,
+        _, _, status = kernel(*args, acc.counts, _E32, slots, acc.fine if fine_size else _NONE, _E64,
                               *scratch)
     finally:
         sink.release(acc)
@@ -201,7 +203,7 @@ def _into_sink(kernel, args, scratch, sink: Sink, total: int, words, prefix, fin
     return _E32, _NONE, _E64, _NONE
 
 
-def _sparse(kernel, args, scratch, cells: int, total: int, words, prefix, fine_size: int) -> tuple:
+def _sparse(kernel, args, scratch, cells: int, total: int, slots, fine_size: int) -> tuple:
     """Count into this thread's zeroed accumulators; return the cells hit and their counts (and the sub-cells'),
     and zero those cells again."""
     acc, fine = _work.dense("cells", cells), _work.dense("fine", fine_size)
@@ -209,7 +211,7 @@ def _sparse(kernel, args, scratch, cells: int, total: int, words, prefix, fine_s
     ftouched = _work.get("fftouch", (total if fine_size else 0,), np.int64)
     nt = nft = 0
     try:
-        nt, nft, status = kernel(*args, acc, touched, words, prefix, fine, ftouched, *scratch)
+        nt, nft, status = kernel(*args, acc, touched, slots, fine, ftouched, *scratch)
         idx, fidx = touched[:nt].copy(), ftouched[:nft].copy()
         cnt, fcnt = acc[idx], fine[fidx]
     finally:

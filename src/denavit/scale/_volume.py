@@ -73,24 +73,29 @@ class VolumeEstimate:
 
 
 def coarsen(counts: np.ndarray) -> np.ndarray:
-    """Sum 2×2(×2) blocks of cells (an odd last row is dropped into a padded zero row)."""
+    """Sum 2×2(×2) blocks of cells (an odd last row is dropped into a padded zero row); uint64."""
     pad = [(0, s % 2) for s in counts.shape]
     c = np.pad(counts, pad) if any(p for _, p in pad) else counts
-    shape = []
-    for s in c.shape:
-        shape += [s // 2, 2]
-    return c.reshape(shape).sum(axis=tuple(range(1, 2 * c.ndim, 2)), dtype=np.uint64)
+    c = c.astype(np.uint64, copy=False)
+    for ax in range(c.ndim):  # pairs along each axis in turn (integer sums: any order gives the same)
+        even, odd = [slice(None)] * c.ndim, [slice(None)] * c.ndim
+        even[ax], odd[ax] = slice(0, None, 2), slice(1, None, 2)
+        c = c[tuple(even)] + c[tuple(odd)]
+    return c
 
 
 def interior(occupied: np.ndarray) -> np.ndarray:
-    """Occupied cells whose 3^d − 1 neighbours are all occupied (erosion by a full 3×…×3 block)."""
-    out = occupied.copy()
+    """Occupied cells whose 3^d − 1 neighbours are all occupied (erosion by a full 3×…×3 block; cells on the
+    grid's faces have neighbours outside it, which are empty)."""
+    out = occupied
     for ax in range(occupied.ndim):  # the full block is separable: AND of shifts along each axis in turn
-        cur = np.pad(out, [(1, 1) if a == ax else (0, 0) for a in range(out.ndim)])
         sl = [slice(None)] * out.ndim
         left, mid, right = list(sl), list(sl), list(sl)
         left[ax], mid[ax], right[ax] = slice(0, -2), slice(1, -1), slice(2, None)
-        out = cur[tuple(left)] & cur[tuple(mid)] & cur[tuple(right)]
+        new = np.zeros_like(out)
+        np.logical_and(out[tuple(left)], out[tuple(mid)], out=new[tuple(mid)])
+        np.logical_and(new[tuple(mid)], out[tuple(right)], out=new[tuple(mid)])
+        out = new
     return out
 
 
@@ -104,10 +109,10 @@ def chao1(f1: int, f2: int) -> tuple[float, float]:
 
 def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
     occ = counts > 0
-    n_occ = int(occ.sum())
-    n_in = int(interior(occ).sum())
-    f1 = int((counts == 1).sum())
-    m, sd = chao1(f1, int((counts == 2).sum()))
+    n_occ = np.count_nonzero(occ)
+    n_in = np.count_nonzero(interior(occ))
+    f1 = np.count_nonzero(counts == 1)
+    m, sd = chao1(f1, np.count_nonzero(counts == 2))
     cell = h ** counts.ndim
     low, high = n_in * cell, (n_occ + m + 2 * sd) * cell
     coverage = 1.0 - f1 / max(float(counts.sum()), 1.0)
