@@ -154,6 +154,23 @@ def test_tilted_plane_cells_are_the_numpy_routes():
     _same_task(run_task(job, 0, 2), run_task(dataclasses.replace(job, fused=False), 0, 2))
 
 
+def test_coordinate_plane_cells_are_the_numpy_routes():
+    """A planar arm in a coordinate plane (the fused kernel reads the plane's two coordinates directly; the numpy
+    route projects on the basis): the same cells, refined sub-cells and bounds."""
+    robot = denavit.load_robot("planar2r")
+    job = make_job(robot, 3 * BLOCK, None, 8, CompiledPositionFK(robot))
+    assert job.grid.dim == 2 and np.all(np.isin(job.grid.basis, (0.0, 1.0)))
+    numpy_job = dataclasses.replace(job, fused=False)
+    ref = run_task(numpy_job, 0, 1)
+    _same_task(run_task(job, 0, 1), ref)
+    counts = np.zeros(job.grid.shape, np.uint64)
+    counts.reshape(-1)[ref[0]] += ref[1]
+    plan = plan_refinement(counts, 2, 1)
+    a = run_task(dataclasses.replace(job, refine=plan), 1, 2)
+    assert a[6].size > 0
+    _same_task(a, run_task(dataclasses.replace(numpy_job, refine=plan), 1, 2))
+
+
 def test_identical_for_chunks_workers_accumulators_and_routes(monkeypatch):
     robot = denavit.load_robot("stanford")
     n = 5 * BLOCK + 999

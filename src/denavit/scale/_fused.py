@@ -166,20 +166,22 @@ def _draw(q, r, j, state, lo, span):
 
 
 @njit(nogil=True, cache=True)
-def _coordinates(P, r, grid, basis, ident, origin, T, R2):
-    """T[a, i] = (u_a − lo)/h, u = (p_i − centre) in the grid's basis (u_a = (d0·b_a0 + d1·b_a1) + d2·b_a2 unless
-    the basis is the identity), and R2[i] = |p_i − origin|² ((dx² + dy²) + dz²), for i < r: straight loops with
-    no branches (vectorised)."""
+def _coordinates(P, r, grid, basis, axes, origin, T, R2):
+    """T[a, i] = (u_a − lo)/h, u = (p_i − centre) in the grid's basis (u_a = (d0·b_a0 + d1·b_a1) + d2·b_a2), and
+    R2[i] = |p_i − origin|² ((dx² + dy²) + dz²), for i < r: straight loops with no branches (vectorised).  When
+    every basis row is a coordinate axis (``axes[a]`` its index; else ``axes`` is empty) u_a is d_axes[a]: the
+    same double (the other products are zeros; −0 + 0 only changes the sign of a zero, and zero − lo is −lo)."""
     cx, cy, cz, glo, inv = grid[0], grid[1], grid[2], grid[3], grid[4]
     ox, oy, oz = origin[0], origin[1], origin[2]
     for i in range(r):
         dx, dy, dz = P[i, 0] - ox, P[i, 1] - oy, P[i, 2] - oz
         R2[i] = dx * dx + dy * dy + dz * dz
-    if ident:
-        for i in range(r):
-            T[0, i] = (P[i, 0] - cx - glo) * inv
-            T[1, i] = (P[i, 1] - cy - glo) * inv
-            T[2, i] = (P[i, 2] - cz - glo) * inv
+    if axes.size:
+        for a in range(axes.size):
+            k = axes[a]
+            c = grid[k]
+            for i in range(r):
+                T[a, i] = (P[i, k] - c - glo) * inv
         return
     for a in range(basis.shape[0]):
         b0, b1, b2 = basis[a, 0], basis[a, 1], basis[a, 2]
@@ -200,9 +202,10 @@ def _bounds(P, r, R2, stats):
 
 
 @njit(nogil=True, cache=True)
-def _flat(T, r, dim, side, cells):
+def _flat(T, R2, r, dim, side, cells):
     """cells[i] = row-major flat index of the cells (int32: < MAX_CELLS = 2²⁴) of coordinates T[:, i]; returns
-    how many samples fall outside [0, side) on some axis (NaN does too).  Inside, truncation is floor."""
+    how many samples fall outside [0, side) on some axis (NaN does too) or have a non-finite R2[i] (a planar
+    grid's coordinates leave one axis out: a non-finite value there shows in R2).  Inside, truncation is floor."""
     s = float(side)
     bad = 0
     if dim == 3:
@@ -213,20 +216,20 @@ def _flat(T, r, dim, side, cells):
     else:
         for i in range(r):
             t0, t1 = T[0, i], T[1, i]
-            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s))
+            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (R2[i] < np.inf))
             cells[i] = np.int32(t0) * np.int32(side) + np.int32(t1)
     return bad
 
 
 @njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, ident, side, origin, slots, cells, subs, stats, T, R2):
+def _cells(P, r, grid, basis, axes, side, origin, slots, cells, subs, stats, T, R2):
     """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
     is taken at the end), cells (cells[:r]) and the sub-cells of those in refined cells (subs[:ns], in order) of
     the origins P[:r]; returns (status, ns).  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
     dim, k = basis.shape[0], int(grid[5])
-    _coordinates(P, r, grid, basis, ident, origin, T, R2)
+    _coordinates(P, r, grid, basis, axes, origin, T, R2)
     _bounds(P, r, R2, stats)
-    if _flat(T, r, dim, side, cells):
+    if _flat(T, R2, r, dim, side, cells):
         for i in range(r):
             if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
                 return 1, 0
@@ -279,12 +282,12 @@ def merge(total, part):
 
 def _build(rows):
     """The fused task function around ``rows`` (a ``kernel_intrinsic`` batch form of the position program):
-    ``run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, slots, fine, ftouched,
+    ``run(keys, sizes, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
     q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks, 2), sizes
     (blocks,) samples each), SUB_ROWS rows at a time (q, P, cells, subs: scratch of that many rows)."""
 
     @njit(nogil=True)
-    def run(keys, sizes, lo, span, grid, basis, ident, side, origin, acc, touched, slots, fine, ftouched,
+    def run(keys, sizes, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
         T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
@@ -301,7 +304,7 @@ def _build(rows):
                 j = _draw(qs, r, j, state, los, spans)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
-                status, ns = _cells(Ps, r, grid, basis, ident, side, origin, slots, cells, subs, stats, T, R2)
+                status, ns = _cells(Ps, r, grid, basis, axes, side, origin, slots, cells, subs, stats, T, R2)
                 if status:
                     return nt, nft, status
                 nt = _add(cells, r, acc, touched, nt)

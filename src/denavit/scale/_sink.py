@@ -173,11 +173,12 @@ def run_fused(job, first: int, count: int) -> tuple:
     lo = np.ascontiguousarray(job.limits[:, 0])
     span = job.limits[:, 1] - job.limits[:, 0]
     grid = np.array([*g.centre, g.lo, 1.0 / g.resolution, ref.factor if ref is not None else 0], dtype=float)
-    ident = bool(g.dim == 3 and np.array_equal(g.basis, np.eye(3)))
+    unit = (g.basis == 1) & (np.abs(g.basis).sum(axis=1, keepdims=True) == 1)  # rows that are coordinate axes
+    axes = np.flatnonzero(unit) % 3 if unit.any(axis=1).all() else _E64
     slots = slot_map(ref, g.side**g.dim) if ref is not None else _SLOTS
     fine_size = 0 if ref is None else ref.cells.size * ref.factor**g.dim
     stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
-    args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), ident,
+    args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), axes,
             g.side, job.base_origin)
     scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (SUB_ROWS, 3), np.float64),
                _work.get("fcells", (SUB_ROWS,), np.int32), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
