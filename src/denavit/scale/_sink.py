@@ -3,7 +3,9 @@
 In this process (``threads`` and ``synchronous`` schedulers) a run opens a :class:`Sink`: a pool of dense
 ``uint32`` accumulators of the grid's size (and of the refined sub-cells').  A task takes one, counts into it
 with the GIL released (``_fused``), gives it back and returns no counts at all; the driver adds the
-accumulators into its ``uint64`` counts at the pilot's barrier and at the end (``flush``).  An accumulator is
+accumulators into its ``uint64`` counts at the pilot's barrier and at the end (``flush``, a jitted pass over the
+nonzero entries; an accumulator untouched since its last flush is skipped).  The first accumulator to count
+sub-cells counts them straight into the driver's sub-cell array when that is ``uint32``.  An accumulator is
 also flushed before its samples could pass 2³² − 1 (no cell can overflow).  At most ``cap`` accumulators exist
 (ACC_BUDGET bytes; a task waits for a free one), so memory does not grow with the workers beyond that.
 
@@ -55,6 +57,7 @@ class Sink:
         self.all: list[_Accumulator] = []
         self.free: list[_Accumulator] = []
         self.cond = threading.Condition()
+        self.owner: _Accumulator | None = None  # the accumulator counting sub-cells straight into self.fine
 
     def acquire(self, samples: int, fine_size: int) -> _Accumulator:
         """A free accumulator (made while fewer than ``cap`` exist, else waited for) with room for
@@ -69,10 +72,20 @@ class Sink:
                 self.all.append(acc)
             if acc.tally + samples > _MOST:
                 self._flush_one(acc)
-        if fine_size and (acc.fine is None or acc.fine.size != fine_size):
-            acc.fine = np.zeros(fine_size, dtype=np.uint32)
+            if fine_size and (acc.fine is None or acc.fine.size != fine_size):
+                acc.fine = self._fine_for(acc, fine_size)
         acc.tally += samples
         return acc
+
+    def _fine_for(self, acc: _Accumulator, size: int) -> np.ndarray:
+        """Sub-cell counts for ``acc``: the driver's own array for the first accumulator that asks when it is
+        uint32 (fewer than 2³² samples after the pilot, so it cannot overflow) — no second array of up to
+        128 MiB to fault in and merge — else a zeroed one of its own."""
+        f = self.fine
+        if self.owner is None and f is not None and f.dtype == np.uint32 and f.size == size:
+            self.owner = acc
+            return f
+        return np.zeros(size, dtype=np.uint32)
 
     def release(self, acc: _Accumulator) -> None:
         with self.cond:
@@ -85,7 +98,7 @@ class Sink:
         if acc.tally == 0:  # nothing counted since the last flush: the accumulator is all zeros
             return
         merge(self.counts, acc.counts)
-        if acc.fine is not None and self.fine is not None:
+        if acc.fine is not None and self.fine is not None and acc.fine is not self.fine:
             merge(self.fine, acc.fine)  # uint32 into uint32 (fewer than 2³² samples after the pilot) or uint64
         acc.tally = 0
 
