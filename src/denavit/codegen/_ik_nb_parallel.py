@@ -48,7 +48,7 @@ def ik_parallel_packed(T, K, f, i):
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # into ik_parallel_packed (no call with eleven arrays)
 def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
     """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand, the
     cosines and sines of their joints into cs (8, 12: cos q1, sin q1, cos q2, …; for the verifying FK, which then
