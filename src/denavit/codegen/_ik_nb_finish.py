@@ -77,7 +77,7 @@ def _near_fold_edge(x, lo, hi):
     return False
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # into each kernel: no call with nineteen arguments per pose
 def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
               perm, C, cs, given, out_rank):
     """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
