@@ -99,6 +99,21 @@ class FreeJointSweep:
     method: str
 
 
+def _sweep_range(robot: DHRobot, k: int) -> tuple[float, float]:
+    """The range swept for joint k: its limits, or one turn [−π, π] for a revolute joint without them."""
+    lo, hi = (float(x) for x in robot.q_limits[k])
+    if not (np.isfinite(lo) and np.isfinite(hi)) and robot.joint_types[k] is JointType.REVOLUTE:
+        return -np.pi, np.pi
+    return lo, hi
+
+
+def _middle(robot: DHRobot) -> np.ndarray:
+    """(n,) a configuration inside the limits: their middle, 0 for a joint without (finite) limits."""
+    lim = robot.q_limits
+    ok = np.isfinite(lim).all(axis=1)
+    return np.where(ok, 0.5 * (np.where(ok, lim[:, 0], 0.0) + np.where(ok, lim[:, 1], 0.0)), 0.0)
+
+
 def default_free_joint(robot: DHRobot) -> str:
     """The joint :func:`free_joint_sweep` holds by default.
 
@@ -106,18 +121,18 @@ def default_free_joint(robot: DHRobot) -> str:
     route, which is slower and less well conditioned near its double roots), the one with the widest limit range
     (its sweep covers most of the self-motion); on a tie the last such joint (an end joint also lets every sample
     be solved in one batch).  Panda: q7 (q5 and q7 tie at ±2.8973 rad).  Without such a joint: the last joint.
+    A revolute joint without limits (Kinova Gen3's q1, q3, q5, q7) counts with its one turn, [−π, π].
     """
-    lim = robot.q_limits
     best, width = f"q{robot.dof}", -1.0
     for k in range(robot.dof):
-        if robot.joint_types[k] is not JointType.REVOLUTE or not np.all(np.isfinite(lim[k])):
+        if robot.joint_types[k] is not JointType.REVOLUTE:
             continue
-        mid = float(lim[k].mean())
+        lo, hi = _sweep_range(robot, k)
         try:
-            res = analytic_ik(robot, forward_kinematics(robot, lim.mean(axis=1)), locked={f"q{k + 1}": mid})
+            res = analytic_ik(robot, forward_kinematics(robot, _middle(robot)), locked={f"q{k + 1}": 0.5 * (lo + hi)})
         except UnsupportedRobotError:
             continue
-        w = float(lim[k, 1] - lim[k, 0])
+        w = hi - lo
         if not res.method.startswith("general") and w >= width:
             best, width = f"q{k + 1}", w
     return best
@@ -128,10 +143,10 @@ class _Held:
 
     def __init__(self, robot: DHRobot, T: np.ndarray, k: int) -> None:
         self.robot, self.T, self.k = robot, T, k
-        lo, hi = robot.q_limits[k]
-        self.v0 = float(0.5 * (lo + hi))
+        lo, hi = _sweep_range(robot, k)
+        self.v0 = 0.5 * (lo + hi)
         self.end = k in (0, robot.dof - 1)
-        self.z = robot.q_limits.mean(axis=1)  # any configuration: X(v), Y(v) do not depend on it
+        self.z = _middle(robot)  # any configuration: X(v), Y(v) do not depend on it
         self.method = ""
 
     def _targets(self, v: np.ndarray) -> np.ndarray:
@@ -275,9 +290,9 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     k = int(joint[1:]) - 1 if isinstance(joint, str) and joint[:1] == "q" and joint[1:].isdigit() else -1
     if not 0 <= k < robot.dof:
         raise ModelError(f"free_joint_sweep: {joint!r} is not a joint of {robot.name} (q1 … q{robot.dof})")
-    lo, hi = (float(x) for x in robot.q_limits[k])
-    if not (np.isfinite(lo) and np.isfinite(hi)):
+    if robot.joint_types[k] is not JointType.REVOLUTE and not np.all(np.isfinite(robot.q_limits[k])):
         raise ModelError(f"free_joint_sweep: {joint} has no finite limits to sweep")
+    lo, hi = _sweep_range(robot, k)
     if not (isinstance(samples, (int, np.integer)) and samples >= 2):
         raise ModelError(f"free_joint_sweep: samples must be an integer ≥ 2, got {samples!r}")
     if not (np.isfinite(tol) and tol > 0):
