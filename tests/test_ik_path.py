@@ -108,7 +108,7 @@ def test_random_lines_are_continuous_and_reproduce_every_pose(name, count):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, count", [("puma560", 200), ("ur5", 200), ("panda", 100)])
+@pytest.mark.parametrize("name, count", [("puma560", 200), ("ur5", 200), ("panda", 200)])
 def test_many_random_lines_per_arm(name, count):
     _run_random(name, count, 2)
 

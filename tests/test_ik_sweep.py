@@ -36,9 +36,14 @@ def panda():
     return load_robot("panda")
 
 
+def _range(robot):
+    """(n, 2) the joint limits, one turn [−π, π] for a joint without them (Gen3's q1, q3, q5, q7)."""
+    return np.where(np.isfinite(robot.q_limits), robot.q_limits, [-np.pi, np.pi])
+
+
 def _poses(robot, n, seed):
     rng = np.random.default_rng(seed)
-    q = rng.uniform(*robot.q_limits.T, (n, robot.dof))
+    q = rng.uniform(*_range(robot).T, (n, robot.dof))
     return q, forward_kinematics(robot, q)
 
 
@@ -85,7 +90,7 @@ def _check_solutions(robot, T, q):
 def _dense(robot, T, k, v, rng):
     """Every solution the numeric search finds with joint k held at v: (m, n) rows, joint k inserted."""
     held = _held_arm(robot, k, v)
-    seeds = rng.uniform(*held.q_limits.T, (SEEDS, held.dof))
+    seeds = rng.uniform(*_range(held).T, (SEEDS, held.dof))
     res = solve_ik(held, np.broadcast_to(T, (SEEDS, 4, 4)), seeds, restarts=0, rng=rng)
     return np.insert(res.q[res.success], k, v, axis=1)
 
@@ -126,7 +131,7 @@ def test_default_free_joint_is_a_closed_form_choice(panda):
     assert analytic_ik(panda, T[0], free={"q3": 0.0}).method.startswith("general")
 
 
-def _sweep_checks(robot, T, q, sweep, rng):
+def _sweep_checks(robot, T, q, sweep, rng, gaps=True):
     k = int(sweep.joint[1:]) - 1
     assert any(a - 1e-12 <= q[k] <= b + 1e-12 for a, b in sweep.intervals), "the generating value is feasible"
     for b in sweep.branches:  # every listed solution: FK matches T, within the limits, held value as listed
@@ -144,7 +149,7 @@ def _sweep_checks(robot, T, q, sweep, rng):
             assert res.count >= 1
             _check_solutions(robot, T, res.solutions)
     for (a0, b0), (a1, b1) in zip(sweep.intervals[:-1], sweep.intervals[1:]):  # gaps: the dense search agrees
-        if a1 - b0 > 1e-3:
+        if gaps and a1 - b0 > 1e-3:
             t = 0.5 * (b0 + a1)
             assert len(_dense(robot, T, k, t, rng)) == 0, f"a solution at {sweep.joint} = {t} in a gap"
     inside = [np.any([(a <= v <= b) for a, b in sweep.intervals]) for v in sweep.values]
@@ -256,6 +261,47 @@ def test_iiwa_sweep_intervals_confirmed():
         robot = load_robot(name)
         q, T = _poses(robot, 1, 50)
         _sweep_checks(robot, T[0], q[0], free_joint_sweep(robot, T[0], joint, samples=48), rng)
+
+
+# --- Kinova Gen3 7-DOF (offset shoulder and elbow, spherical wrist: not S-R-S) ------------------------------------
+
+@pytest.mark.parametrize("joint, n", [(2, 2), (0, 1), (5, 1)])
+def test_gen3_free_joint_solutions_are_complete(joint, n):
+    """q3 (the default) and q1 held: a Pieper arm, closed form; q6 held: the general 6R route."""
+    robot = load_robot("gen3")
+    rng = np.random.default_rng(70 + joint)
+    q, T = _poses(robot, n, 80 + joint)
+    for qi, Ti in zip(q, T):
+        res = analytic_ik(robot, Ti, free={f"q{joint + 1}": qi[joint]})
+        assert res.method.startswith("general" if joint == 5 else "pieper")
+        _check_solutions(robot, Ti, res.solutions)
+        assert _gap(qi[None], res.solutions)[0] < 1e-8
+        numeric = _dense(robot, Ti, joint, qi[joint], rng)
+        assert len(numeric) and not _missing(robot, joint, numeric, res.solutions).any()
+
+
+@pytest.mark.slow
+def test_gen3_sweep_of_a_joint_without_limits_confirmed(capsys):
+    """q3 turns without end: swept over [−π, π], the intervals confirmed as for the Panda; the CLI's --sweep."""
+    robot = load_robot("gen3")
+    assert default_free_joint(robot) == "q3"
+    q, T = _poses(robot, 1, 90)
+    sweep = free_joint_sweep(robot, T[0], samples=24)
+    assert sweep.joint == "q3" and sweep.limits == (-np.pi, np.pi)
+    _sweep_checks(robot, T[0], q[0], sweep, np.random.default_rng(91))
+    qs = ",".join(f"{v:.17g}" for v in q[0])
+    code, out, err = _run(capsys, "ik", "gen3", "--from-q", qs, "--sweep", "--samples", "16", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["joint"] == "q3" and any(a <= q[0, 2] <= b for a, b in data["intervals"])
+
+
+def test_gen3_cli_free(capsys):
+    qs = "0.1,0.5,-1,1.2,0.4,0.7,2"
+    code, out, err = _run(capsys, "ik", "gen3", "--from-q", qs, "--free", "q3=-1", "--json")
+    assert code == 0, err
+    sol = np.array(json.loads(out)["solutions"])
+    assert np.min(_gap(np.array([[0.1, 0.5, -1, 1.2, 0.4, 0.7, 2]]), sol)) < 1e-9
 
 
 def _urdf_fk(path, q, drop_offsets):
