@@ -248,7 +248,8 @@ def _refine(robot, held: _Held, ends: list[tuple[float, float, np.ndarray, str]]
 
 def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: int = SAMPLES,
                      tol: float = SWEEP_TOL) -> FreeJointSweep:
-    """Every IK solution of a redundant arm as a function of one held joint, over that joint's limits.
+    """Every IK solution of a redundant arm as a function of one held joint, over that joint's limits (one turn,
+    [−π, π], for a revolute joint without limits).
 
     The held joint's range is sampled at ``samples`` evenly spaced values; at each, every solution within the
     limits comes from :func:`analytic_ik` with ``free={joint: value}``.  Solutions of neighbouring samples are
