@@ -28,10 +28,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-import denavit  # noqa: E402
-from denavit.errors import UnsupportedRobotError  # noqa: E402
-from denavit.ik import default_free_joint  # noqa: E402
-from test_ik_sweep import _check_solutions, _dense, _missing, _sweep_checks  # noqa: E402
+from test_ik_sweep import _check_solutions, _dense, _missing, _sweep_checks
+
+import denavit
+from denavit.errors import UnsupportedRobotError
+from denavit.ik import default_free_joint
 
 
 def _complete(robot, qi, Ti, k, rng):
