@@ -133,7 +133,9 @@ def test_default_free_joint_is_a_closed_form_choice(panda):
 
 def _sweep_checks(robot, T, q, sweep, rng, gaps=True):
     k = int(sweep.joint[1:]) - 1
-    assert any(a - 1e-12 <= q[k] <= b + 1e-12 for a, b in sweep.intervals), "the generating value is feasible"
+    # the ends are bisected to sweep.tol: a generating value at a fold (the held arm singular there) may fall that
+    # close outside (a Panda pose of the 1,000 run: σ_min 3.6e-6, the interval began 2.3e-7 above q7)
+    assert any(a - sweep.tol <= q[k] <= b + sweep.tol for a, b in sweep.intervals), "the generating value is feasible"
     for b in sweep.branches:  # every listed solution: FK matches T, within the limits, held value as listed
         _check_solutions(robot, T, b.q)
         assert np.array_equal(b.q[:, k], b.values) and b.interval == (b.values[0], b.values[-1])
