@@ -87,7 +87,8 @@ def main(argv=None) -> int:
         if (i + 1) % 50 == 0:
             print(f"  {i + 1} poses, {fails} failed, {time.process_time() - t0:.0f} CPU-s", flush=True)
     what = ("intervals, branches" if args.part == "sweep" else "analytic solutions, numeric hits")
-    print(f"{args.robot} {args.part} ({joint} default): poses {args.start}-{i} of {args.poses} ({tally[2]} checked), {fails} failed; "
+    stop = args.poses if args.stop is None else args.stop
+    print(f"{args.robot} {args.part} ({joint} default): poses {args.start}-{stop - 1} of {args.poses} ({tally[2]} checked), {fails} failed; "
           f"{what}: {tally[0]}, {tally[1]}; {time.process_time() - t0:.0f} CPU-s")
     return 1 if fails else 0
 
