@@ -8,12 +8,14 @@ or, better on a busy machine, from CPU seconds (tests/conftest.py writes them wh
 
     DENAVIT_CPU_TIMES=cpu.txt python -m pytest -q -m "not slow" -p no:cacheprovider
     python scripts/slow_tests.py --cpu cpu.txt
-    python scripts/slow_tests.py --cpu cpu.txt --budget 60   # the costliest, until the rest take <= 60 CPU-s
+    python scripts/slow_tests.py --cpu cpu.txt --budget 45   # the costliest, until the rest take <= 45 CPU-s
 
 ``--budget`` bounds the sum of the tests' own CPU seconds.  The start-up comes on top: each pytest-xdist worker
-imports every test module (about 16 CPU-s here) and the controlling process handles every report (2-5 ms a
-test): 40-50 CPU-s on two workers.  ``--budget 60`` keeps the quick subset near two minutes of CPU; CPU seconds
-grow by a third or more at load 10, so measure on a quiet machine.
+imports every test module (about 16 CPU-s here), the controlling process handles every report (2-5 ms a test),
+and workers and subprocesses start: 60-70 CPU-s in all on two workers.  Measured on 2026-12-04 on a quiet
+2-core machine with warm numba caches: ``--budget 45`` gave a quick subset of 3,098 tests in 117 CPU-s (65 s
+wall).  CPU seconds grow by a third or more at load 10, and by half on the first run after a kernel changed
+(numba compiles it again), so measure on a quiet machine, on the second run.
 
 tests/conftest.py gives every test listed there the ``slow`` mark.  A test's time is the sum of its setup, call
 and teardown, in wall-clock seconds of the run the report comes from: on a busy machine that is more than its
