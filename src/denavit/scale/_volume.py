@@ -62,6 +62,13 @@ class VolumeEstimate:
     dim: int
     coverage: float
 
+    def __post_init__(self):
+        # Python numbers, whatever numpy scalars the counting produced (they print as np.float64(...) in numpy 2)
+        for name, kind in (("value", float), ("low", float), ("high", float), ("resolution", float),
+                           ("occupied", int), ("interior", int), ("unseen", float), ("dim", int),
+                           ("coverage", float)):
+            object.__setattr__(self, name, kind(getattr(self, name)))
+
     @property
     def half_width(self) -> float:
         return 0.5 * (self.high - self.low)
