@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._chain import angle_about_z, damped_solve, joint_motion, solve_trig
+from ._roots import batched_roots, root_clusters
 from ._subproblems import trig_coefficients
 
 __all__ = ["Position3"]
@@ -22,10 +23,6 @@ FREE_AXIS = 1e-10  # distance to axis 1 or 2, relative to the arm's size, under 
 # FREE_TOL of the closed forms)
 REFINE_ABOVE = 1e-13  # residual of the point, relative to the arm's size, above which q1-q3 are refined
 REFINE_STEPS = 4
-CLUSTER_SPREAD = 10.0  # k roots of the resultant within CLUSTER_SPREAD · ε^(1/k) of one (relative) are taken for a
-# k-fold root split by rounding (~ε^(1/k) apart: 6e-5 for k = 3, 1e-3 for 4, 2.5e-2 for 6); those poses are solved
-# in the other elimination order too
-CLUSTER_SIZE = 3  # smallest such k (a double root is split ~√ε only and handled by the refinement)
 SAME_ROOT = 1e-6  # joint-space distance [rad, m per L] under which a root of the other order is one already found
 _ALT_SEED = 20240602  # the other order's structural tests draw from their own fixed stream
 
@@ -161,35 +158,17 @@ class Position3:
         return (R @ np.exp(-1j * np.outer(self.nodes, k))) / N  # c_K … c_{-K}
 
     def _q3_candidates(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Real roots of the resultant in the solved joint (B, m); which poses have roots that cluster (B,):
-        k ≥ CLUSTER_SIZE roots, real or not, within CLUSTER_SPREAD · ε^(1/k) (relative, in e^{iq} or in the
-        scaled length), where a multiple root of the resultant was split by rounding into roots ~ε^(1/k) apart
-        (some of them complex); and the centroid of the largest cluster (B,) (NaN where none): the mean of the k roots a k-fold root split
-        into is exact to rounding (their sum is a coefficient's)."""
+        """Real roots of the resultant in the solved joint (B, m); which poses have roots that cluster (B,) (a
+        multiple root split by rounding, see :func:`._roots.root_clusters`, or a resultant that vanishes); and the
+        centroid of the largest cluster (B,) in the solved joint (NaN where none)."""
         p = self._poly(w)  # (B, 2K+1) or (B, P+1)
         if self.pv:
             top = p.shape[-1] - 1 - self.degree
             p = p[:, top:]
         else:
             p = p[:, _KMAX - self.degree: _KMAX + self.degree + 1]
-        roots = _batched_roots(p)
-        near = np.abs(roots.imag) < 0.1 * (1 + np.abs(roots.real)) if self.pv else np.abs(np.abs(roots) - 1.0) < 0.1
-        m = roots.shape[1]
-        gap = np.abs(roots[:, :, None] - roots[:, None, :]) / (1 + np.abs(roots[:, :, None]))
-        gap[:, np.arange(m), np.arange(m)] = np.inf
-        gap = np.where(near[:, :, None] & near[:, None, :], np.nan_to_num(gap, nan=np.inf), np.inf)
-        # root i and its k − 1 nearest others form a cluster when they lie within CLUSTER_SPREAD · ε^(1/k)
-        ks = np.arange(CLUSTER_SIZE, max(m, CLUSTER_SIZE - 1) + 1)
-        reach = np.sort(gap, axis=2)[:, :, ks - 2]  # (B, m, len(ks)): distance to the (k−1)-th nearest other
-        fits = reach < CLUSTER_SPREAD * np.finfo(float).eps ** (1.0 / ks)
-        clustered = fits.any(axis=(1, 2))
-        kbest = np.where(fits, ks, 0).max(axis=2, initial=0)  # (B, m): the largest cluster around each root
-        b, big = np.arange(len(roots)), np.argmax(kbest, axis=1)
-        kb = kbest[b, big]
-        radius = reach[b, big, np.maximum(kb - CLUSTER_SIZE, 0)] if ks.size else np.zeros(len(roots))
-        member = gap[b, big] <= np.where(kb > 0, radius, -1.0)[:, None]  # the cluster of the largest k
-        member[b, big] = True
-        centre = np.sum(np.where(member, np.nan_to_num(roots), 0), axis=1) / member.sum(axis=1)
+        roots = batched_roots(p)
+        clustered, centre = root_clusters(roots, self.pv)
         clustered |= np.all(np.isnan(roots), axis=1)  # the resultant vanishes at this pose
         if self.pv:
             ok = np.abs(roots.imag) < 1e-4 * (1 + np.abs(roots.real))
@@ -415,24 +394,3 @@ class Position3:
             q2 = np.where(weak[..., None], np.array([0.0, np.pi]), q2)
         return q2, np.broadcast_to(free[..., None], q2.shape)
 
-
-def _batched_roots(p: np.ndarray) -> np.ndarray:
-    """Roots of polynomials (B, m+1), highest coefficient first, via batched companion matrices → (B, m)."""
-    B, m1 = p.shape
-    m = m1 - 1
-    if m <= 0:
-        return np.full((B, 0), np.nan + 0j)
-    bad = ~np.all(np.isfinite(p), axis=1) | ~np.any(p != 0, axis=1)
-    if bad.any():  # no roots for a pose whose coefficients overflowed or all vanish (the resultant ≡ 0 there)
-        out = np.full((B, m), np.nan + 0j)
-        if (~bad).any():
-            out[~bad] = _batched_roots(p[~bad])
-        return out
-    lead = p[:, :1]
-    tiny = np.abs(lead) < 1e-13 * np.max(np.abs(p), axis=1, keepdims=True)
-    lead = np.where(tiny, 1e-13 * np.max(np.abs(p), axis=1, keepdims=True) + 1e-300, lead)
-    comp = np.zeros((B, m, m), dtype=np.result_type(p, float))
-    comp[:, 0, :] = -p[:, 1:] / lead
-    if m > 1:
-        comp[:, np.arange(1, m), np.arange(m - 1)] = 1.0
-    return np.linalg.eigvals(comp)
