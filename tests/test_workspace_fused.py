@@ -86,7 +86,7 @@ def test_splitmix64_reference_vector_and_block_starts():
 def test_random_values_are_the_halves_of_splitmix64_words_across_calls():
     """Rows drawn in pieces (starting mid-way through a word) are lo + (h·2⁻³²)·span, h the 32-bit halves
     (low first) of the block's SplitMix64 words stepped in Python integers, and the numpy route's rows too."""
-    from denavit.scale._sampler import _draw
+    from denavit.scale._stream import draw as _draw
 
     for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6), (9, 1, 1)):
         state = _fused.block_keys(seed, block, 1)[0]
@@ -110,7 +110,7 @@ def test_joint_values_are_uniform_over_the_limits():
     """Kolmogorov–Smirnov distance of 2¹⁸ joint values of each joint from the uniform law on its range, and the
     correlation of consecutive values (the joints of a sample, and one sample's last with the next one's first),
     within 5 standard errors."""
-    from denavit.scale._sampler import _draw
+    from denavit.scale._stream import draw as _draw
 
     n, m = 3, 2**18
     lo, hi = np.array([-np.pi, -1.0, 0.2]), np.array([np.pi, 2.5, 0.3])

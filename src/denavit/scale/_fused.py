@@ -5,9 +5,9 @@ does in numpy passes: draw the joint values, compute the origin, its cell and su
 
 - **Random numbers.**  Block b's words are SplitMix64's (Steele, Lea & Flood, OOPSLA 2014: a Weyl sequence
   through a 64-bit mixing function, which passes BigCrush) from the state K + b·2³²·γ, K from
-  ``SeedSequence(seed)`` (:func:`denavit.scale._sampler.block_state`): word w is mix(state + (w + 1)·γ), a pure
+  ``SeedSequence(seed)`` (:func:`denavit.scale._stream.block_state`): word w is mix(state + (w + 1)·γ), a pure
   function of its counter, so any worker starts any block; each word gives two 32-bit joint values (the
-  numpy route's ``_sampler._draw`` bit for bit, tested against SplitMix64 stepped in Python integers).
+  numpy route's ``_stream.draw`` bit for bit, tested against SplitMix64 stepped in Python integers).
 - **Position.**  The arm's traced ``position`` program (:func:`denavit.codegen.trace_kernels`) made into
   machine code by :func:`denavit.codegen.kernel_intrinsic`, the emitter of ``denavit.compile(robot).position``:
   the same instructions, so the same doubles as :class:`~denavit.scale.CompiledPositionFK`.
@@ -26,7 +26,7 @@ import threading
 import numpy as np
 from numba import njit
 
-from ._sampler import GAMMA, MIX1, MIX2
+from ._stream import GAMMA, MIX1, MIX2
 
 __all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel", "merge"]
 
@@ -42,8 +42,8 @@ _KEEP = 8
 
 
 def block_keys(entropy: int, first: int, count: int) -> np.ndarray:
-    """Starting states (count,) uint64 of blocks first … first+count−1 (``_sampler.block_state``)."""
-    from ._sampler import block_state
+    """Starting states (count,) uint64 of blocks first … first+count−1 (``_stream.block_state``)."""
+    from ._stream import block_state
 
     return block_state(entropy, first + np.arange(count, dtype=np.uint64))
 
@@ -144,7 +144,7 @@ def _unit(h):
 def _draw(q, r, j, state, lo, span):
     """Rows 0 … r−1 of q (C-contiguous, n columns) from values j, j+1 … (j a multiple of n) of the block whose
     starting state is ``state``; returns the next value's index.  Value v is the low (v even) or high (v odd)
-    32-bit half h of word w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_sampler._draw``); the
+    32-bit half h of word w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_stream.draw``); the
     joint value is lo + (h·2⁻³²)·span, in that order, with ``lo``, ``span`` the limits tiled row after row (at
     least r·n entries: value i of the rows takes entry i, so the loop is straight and vectorises)."""
     flat = q.reshape(-1)

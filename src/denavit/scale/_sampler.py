@@ -1,7 +1,7 @@
 """Streaming workspace sampler: counter-based random blocks → FK → voxel counts.
 
 The unit of randomness is the *block* of :data:`BLOCK` samples: block ``b`` draws its joint values from the
-words of one SplitMix64 stream keyed by ``SeedSequence(seed)``, from position b·2³² on (:func:`block_state`;
+words of one SplitMix64 stream keyed by ``SeedSequence(seed)``, from position b·2³² on (``_stream.block_state``;
 two 32-bit joint values a word), so sample ``i`` is the same number whichever task, worker or chunk size computes it.  A *task* is any
 run of whole blocks; tasks return sparse voxel counts (sorted cell index, count) that the driver adds into one
 grid.  Integer sums commute, so the counts, bounds and reach are bit-identical for any number of workers and
@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import DenavitError, ModelError
 from ..model import DHRobot, JointType
 from ._refine import Refinement, popcount, slot_map
+from ._stream import draw
 
 __all__ = ["BLOCK", "Grid", "Job", "PositionFK", "CompiledPositionFK", "default_fk", "COMPILED_FROM", "make_job",
            "reach_bound", "sampling_limits", "positions_block", "run_task", "FINE_CELLS", "MAX_CELLS",
@@ -38,12 +39,6 @@ FINE_CELLS = {3: 256, 2: 2048}
 MAX_CELLS = 2**24
 #: Coarsest level kept: at least this many cells along a side.
 MIN_CELLS = 8
-#: 2⁻³²: a 32-bit random half-word as a number in [0, 1).
-HALF_WORD = 2.0**-32
-#: SplitMix64's Weyl increment γ (the golden ratio's 64 fraction bits) and its output multipliers.
-GAMMA, MIX1, MIX2 = 0x9E3779B97F4A7C15, 0xBF58476D1CE4E5B9, 0x94D049BB133111EB
-#: Words of the stream between the starts of two blocks (a block takes at most BLOCK·n/2 of them).
-BLOCK_STRIDE = 2**32
 #: Runs of at least this many samples use the compiled position kernel by default (when numba is installed).
 COMPILED_FROM = 2_000_000
 
@@ -174,50 +169,10 @@ class Job:
     sink: str | None = None  # the run's accumulators in the driver's process (``_sink``), for in-process tasks
 
 
-def block_state(entropy: int, blocks) -> np.ndarray:
-    """Starting states (uint64, shaped as ``blocks``) of the random blocks ``blocks`` of seed ``entropy``:
-    K + b·2³²·γ (mod 2⁶⁴), K the first 64-bit word of ``SeedSequence(entropy)``.  Block b's words are those of
-    one SplitMix64 stream from position b·2³² on, so blocks never overlap (b < 2³², a block < 2³² words)."""
-    key = np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0]
-    with np.errstate(over="ignore"):
-        return key + np.asarray(blocks, dtype=np.uint64) * np.uint64(BLOCK_STRIDE * GAMMA % 2**64)
-
-
-def mix64(z: np.ndarray) -> np.ndarray:
-    """SplitMix64's output function on uint64 words, in place (Steele, Lea & Flood, OOPSLA 2014)."""
-    z ^= z >> np.uint64(30)
-    z *= np.uint64(MIX1)
-    z ^= z >> np.uint64(27)
-    z *= np.uint64(MIX2)
-    z ^= z >> np.uint64(31)
-    return z
-
-
-def _draw(job: Job, block: int, q: np.ndarray) -> np.ndarray:
-    """Fill q (m, n) (C-contiguous) with the joint values of random block ``block`` (its first m samples).
-
-    Value v of the block (row-major: sample v div n, joint v mod n) is u = h·2⁻³², h the low (v even) or high
-    (v odd) 32 bits of word w = v div 2, and word w is SplitMix64's mix(s + (w + 1)·γ) with s the block's
-    starting state (:func:`block_state`); the joint value is lo + u·(hi − lo).  (32 bits a joint value: steps
-    of 2⁻³² of its range.)"""
-    m, n = q.shape
-    words = np.arange(1, -(-m * n // 2) + 1, dtype=np.uint64)
-    words *= np.uint64(GAMMA)
-    words += block_state(job.entropy, block)
-    mix64(words)
-    flat = q.reshape(-1)
-    flat[0::2] = words[:(m * n + 1) // 2] & np.uint64(0xFFFFFFFF)  # exact: below 2³²
-    flat[1::2] = words[:m * n // 2] >> np.uint64(32)
-    q *= HALF_WORD
-    q *= job.limits[:, 1] - job.limits[:, 0]
-    q += job.limits[:, 0]  # = lo + u·(hi − lo), in place
-    return q
-
-
 def positions_block(job: Job, block: int, rows: int | None = None) -> np.ndarray:
     """End-effector origins (m, 3) of random block ``block`` (its first ``rows`` samples)."""
     m = min(BLOCK, job.samples - block * BLOCK) if rows is None else rows
-    return _positions(job.fk(_draw(job, block, np.empty((m, len(job.limits))))))
+    return _positions(job.fk(draw(job, block, np.empty((m, len(job.limits))))))
 
 
 def _positions(out) -> np.ndarray:
@@ -331,7 +286,7 @@ def run_task(job: Job, first: int, count: int) -> tuple:
     lo, hi, reach, done, kept = np.full(3, np.inf), np.full(3, -np.inf), 0.0, 0, 0
     for b in range(first, first + count):
         m = min(BLOCK, job.samples - b * BLOCK)
-        P = _positions(job.fk(_draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64))))
+        P = _positions(job.fk(draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64))))
         lo, hi = np.minimum(lo, P.min(axis=0)), np.maximum(hi, P.max(axis=0))  # NaN and inf reach these
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
