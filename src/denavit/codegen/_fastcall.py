@@ -32,16 +32,17 @@ import numpy as np
 
 from ._lean import lean
 
-__all__ = ["entry_intrinsic", "install", "ENTRY_SUFFIX"]
+__all__ = ["entry_intrinsic", "install", "ENTRY_SUFFIX", "setup", "extern", "call", "field", "make_builtin",
+           "NPY_DOUBLE", "OFF_TYPE", "OFF_DATA", "OFF_ND", "OFF_DIMS", "OFF_STRIDES", "OFF_DESCR"]
 
 #: the generated module's fast-call function of kernel <name> is <name><ENTRY_SUFFIX>
 ENTRY_SUFFIX = "_entry"
-_NPY_DOUBLE = 12
+NPY_DOUBLE = 12
 _PYARRAY_NEW_SLOT = 93  # numpy/__multiarray_api.h: PyArray_New, stable since numpy 1.0
 #: PyArrayObject_fields (numpy/ndarraytypes.h) after PyObject_HEAD: data, nd, dimensions, strides, base, descr
-_OFF_TYPE, _OFF_DATA, _OFF_ND, _OFF_DIMS, _OFF_STRIDES, _OFF_DESCR = 8, 16, 24, 32, 40, 56
+OFF_TYPE, OFF_DATA, OFF_ND, OFF_DIMS, OFF_STRIDES, OFF_DESCR = 8, 16, 24, 32, 40, 56
 _SYMBOLS = ("denavit_ndarray_type", "denavit_float64_descr", "denavit_pyarray_new", "denavit_vectorcall",
-            "denavit_tuple_new", "denavit_tuple_setitem", "denavit_decref")
+            "denavit_tuple_new", "denavit_tuple_setitem", "denavit_decref", "denavit_incref", "denavit_generic_new")
 _STATE: dict = {}
 _CFUNCS: dict = {}  # (generated module's name, kernel) -> (its CFunc, the entry's address), for every object
 
@@ -54,7 +55,7 @@ class _MethodDef(ctypes.Structure):
 _METH_FASTCALL_KEYWORDS = 0x0080 | 0x0002
 
 
-def _setup() -> bool:
+def setup() -> bool:
     """Give LLVM the addresses by name, once per process; False when this interpreter or numpy is not the layout
     assumed here (then nothing is installed)."""
     if "ok" in _STATE:
@@ -76,18 +77,19 @@ def _setup() -> bool:
                                ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_int,
                                ctypes.c_void_p)(table[_PYARRAY_NEW_SLOT])
         dims = (ctypes.c_ssize_t * 2)(3, 5)
-        a = new(id(np.ndarray), 2, dims, _NPY_DOUBLE, None, None, 0, 0, None)
+        a = new(id(np.ndarray), 2, dims, NPY_DOUBLE, None, None, 0, 0, None)
         if not (type(a) is np.ndarray and a.shape == (3, 5) and a.dtype == np.float64 and a.flags.c_contiguous):
             return False
         word = lambda addr: ctypes.c_ssize_t.from_address(addr).value  # noqa: E731
         base = id(a)
-        if (word(base + _OFF_TYPE) != id(np.ndarray) or word(base + _OFF_DATA) != a.ctypes.data
-                or ctypes.c_int.from_address(base + _OFF_ND).value != 2
-                or word(word(base + _OFF_DIMS) + 8) != 5 or word(word(base + _OFF_STRIDES)) != 40
-                or word(base + _OFF_DESCR) != id(np.dtype(np.float64)) or id(a.dtype) != id(np.dtype(np.float64))):
+        if (word(base + OFF_TYPE) != id(np.ndarray) or word(base + OFF_DATA) != a.ctypes.data
+                or ctypes.c_int.from_address(base + OFF_ND).value != 2
+                or word(word(base + OFF_DIMS) + 8) != 5 or word(word(base + OFF_STRIDES)) != 40
+                or word(base + OFF_DESCR) != id(np.dtype(np.float64)) or id(a.dtype) != id(np.dtype(np.float64))):
             return False
         functions = [ctypes.cast(getattr(api, f), ctypes.c_void_p).value
-                     for f in ("PyObject_Vectorcall", "PyTuple_New", "PyTuple_SetItem", "Py_DecRef")]
+                     for f in ("PyObject_Vectorcall", "PyTuple_New", "PyTuple_SetItem", "Py_DecRef", "Py_IncRef",
+                               "PyType_GenericNew")]
         for name, addr in zip(_SYMBOLS, [id(np.ndarray), id(np.dtype(np.float64)), table[_PYARRAY_NEW_SLOT]]
                               + functions):
             ll.add_symbol(name, addr)
@@ -108,6 +110,29 @@ def _flat_outputs(outputs: tuple, kernel_shape: tuple) -> dict:
     return flat
 
 
+def extern(builder, name: str):
+    """The address (an ``i8*``) of the process-wide symbol ``name`` (given to LLVM by :func:`setup`)."""
+    from llvmlite import ir
+
+    module = builder.module
+    g = module.globals.get(name) or ir.GlobalVariable(module, ir.IntType(8), name)
+    return builder.bitcast(g, ir.IntType(8).as_pointer())
+
+
+def call(builder, name: str, ret, args, types):
+    """A call of the C function at symbol ``name`` (return type ``ret``, argument types ``types``)."""
+    from llvmlite import ir
+
+    return builder.call(builder.bitcast(extern(builder, name), ir.FunctionType(ret, types).as_pointer()), args)
+
+
+def field(builder, obj, offset: int, ty):
+    """The ``ty`` at byte ``offset`` of the object at ``obj`` (an ``i8*``)."""
+    from llvmlite import ir
+
+    return builder.load(builder.bitcast(builder.gep(obj, [ir.Constant(ir.IntType(64), offset)]), ty.as_pointer()))
+
+
 class _Emitter:
     """The IR of one fast-call entry, in the function being lowered: its checks branch to ``fallback``, and every
     way out joins at ``done`` (a phi of the returned object)."""
@@ -124,13 +149,10 @@ class _Emitter:
         self.incoming: list = []
 
     def extern(self, name):
-        module, ir = self.b.module, self.ir
-        g = module.globals.get(name) or ir.GlobalVariable(module, ir.IntType(8), name)
-        return self.b.bitcast(g, self.ptr)
+        return extern(self.b, name)
 
     def call(self, name, ret, args, types):
-        fty = self.ir.FunctionType(ret, types)
-        return self.b.call(self.b.bitcast(self.extern(name), fty.as_pointer()), args)
+        return call(self.b, name, ret, args, types)
 
     def require(self, ok, otherwise=None):
         nxt = self.b.function.append_basic_block("dv_ok")
@@ -138,8 +160,7 @@ class _Emitter:
         self.b.position_at_end(nxt)
 
     def field(self, obj, offset, ty):
-        b = self.b
-        return b.load(b.bitcast(b.gep(obj, [self.ir.Constant(self.i64, offset)]), ty.as_pointer()))
+        return field(self.b, obj, offset, ty)
 
     def new_array(self, shape):
         """``PyArray_New(&PyArray_Type, nd, dims, NPY_DOUBLE, NULL, NULL, 0, 0, NULL)``: a fresh C-contiguous
@@ -151,7 +172,7 @@ class _Emitter:
         for j, s in enumerate(shape):
             self.b.store(ir.Constant(i64, s), self.b.gep(dims, [ir.Constant(i32, j)]))
         return self.call("denavit_pyarray_new", ptr, [
-            self.extern("denavit_ndarray_type"), ir.Constant(i32, len(shape)), dims, ir.Constant(i32, _NPY_DOUBLE),
+            self.extern("denavit_ndarray_type"), ir.Constant(i32, len(shape)), dims, ir.Constant(i32, NPY_DOUBLE),
             null, null, ir.Constant(i32, 0), ir.Constant(i32, 0), null],
             [ptr, i32, i64.as_pointer(), i32, ptr, ptr, i32, i32, ptr])
 
@@ -184,7 +205,7 @@ class _Emitter:
         self.incoming.append((self.null, fail))
         b.branch(self.done)
         b.position_at_end(here)
-        return result, [b.bitcast(self.field(a, _OFF_DATA, ptr), ir.DoubleType().as_pointer()) for a in arrays]
+        return result, [b.bitcast(self.field(a, OFF_DATA, ptr), ir.DoubleType().as_pointer()) for a in arrays]
 
     def finish(self, result, argv):
         """Return ``result`` from here; lower the fallback (the bound method, called with the same arguments)."""
@@ -213,12 +234,12 @@ def _checked_arrays(e: _Emitter, argv, nargs, kwnames, lengths: tuple) -> list:
     arrays = []
     for j, k in enumerate(lengths):
         obj = b.load(b.gep(argv, [ir.Constant(i64, j)]))
-        e.require(b.icmp_unsigned("==", e.field(obj, _OFF_TYPE, ptr), e.extern("denavit_ndarray_type")))
+        e.require(b.icmp_unsigned("==", e.field(obj, OFF_TYPE, ptr), e.extern("denavit_ndarray_type")))
         e.require(b.and_(  # an ndarray: its fields can be read
-            b.icmp_unsigned("==", e.field(obj, _OFF_DESCR, ptr), e.extern("denavit_float64_descr")),
-            b.icmp_signed("==", e.field(obj, _OFF_ND, e.i32), ir.Constant(e.i32, 1))))
-        e.require(b.icmp_signed("==", b.load(e.field(obj, _OFF_DIMS, i64.as_pointer())), ir.Constant(i64, k)))
-        arrays.append((e.field(obj, _OFF_DATA, ptr), b.load(e.field(obj, _OFF_STRIDES, i64.as_pointer()))))
+            b.icmp_unsigned("==", e.field(obj, OFF_DESCR, ptr), e.extern("denavit_float64_descr")),
+            b.icmp_signed("==", e.field(obj, OFF_ND, e.i32), ir.Constant(e.i32, 1))))
+        e.require(b.icmp_signed("==", b.load(e.field(obj, OFF_DIMS, i64.as_pointer())), ir.Constant(i64, k)))
+        arrays.append((e.field(obj, OFF_DATA, ptr), b.load(e.field(obj, OFF_STRIDES, i64.as_pointer()))))
     return arrays
 
 
@@ -344,7 +365,7 @@ def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tupl
     every kernel of ``module`` with a built-in (``name`` among them, the same tuple whichever is asked for first):
     their built-ins are compiled at once, in one numba cfunc.  ``guard(cfunc)`` puts the disk cache's guard in front
     of numba's cache before anything is loaded."""
-    if getattr(module, f"{name}{ENTRY_SUFFIX}", None) is None or not _setup():
+    if getattr(module, f"{name}{ENTRY_SUFFIX}", None) is None or not setup():
         return None
     made = _CFUNCS.get((module.__name__, name))  # one per generated module and kernel, whatever the objects
     if made is None:
@@ -357,12 +378,18 @@ def install(module, name: str, lengths: tuple, kernel_shape: tuple, blocks: tupl
     cf, address = made
     if not address:
         return None
+    builtin, keep = make_builtin(method, address, method)
+    return builtin, (keep, cf)  # the caller keeps these as long as the function (it holds the caller)
+
+
+def make_builtin(method, address: int, this):
+    """``(function, keep)``: a built-in function named and documented as ``method``, its C code the fast-call
+    function at ``address``, called with ``this`` as its first argument; ``keep`` must live as long as it."""
     doc = (method.__doc__ or "").encode("utf-8", "replace")
     definition = _MethodDef(method.__name__.encode(), address, _METH_FASTCALL_KEYWORDS, doc)
     make = ctypes.pythonapi.PyCFunction_NewEx
     make.restype, make.argtypes = ctypes.py_object, [ctypes.POINTER(_MethodDef), ctypes.py_object, ctypes.py_object]
-    builtin = make(ctypes.byref(definition), method, None)
-    return builtin, (definition, doc, cf)  # the caller keeps these as long as the function (it holds the caller)
+    return make(ctypes.byref(definition), this, None), (definition, doc)
 
 
 if sys.maxsize < 2**62:  # pragma: no cover - the offsets above are those of 64-bit builds
