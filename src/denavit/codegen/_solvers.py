@@ -13,6 +13,7 @@ from ..errors import ShapeError
 from ..ik import MAX_ITERATIONS as IK_MAX_ITERATIONS, RESTARTS as IK_RESTARTS, TOL as IK_TOL
 from ..ik import AnalyticIKResult, IKResult, JointLimits, analytic_ik, characteristic_length, ik_plan, row_mask, solve_ik
 from ..ik import forms as ik_forms
+from ._cache import guard_cache
 from ._emit import NUMBA
 from ._ik_elbow import ELBOW_LAYOUT
 from ._ik_finish import pack_constants
@@ -136,7 +137,10 @@ class IKMethods:
         Poses the plain solver treats specially (a joint left free, a double root, a candidate that needs
         polishing, solutions about to merge) are answered by :func:`denavit.analytic_ik`, and so are arms of other
         classes.  One pose is one machine-code call (the check of T and the kernel, :mod:`._ik_nb_entry`); the
-        result's arrays are views of its output vector, made when first read.  A batch (..., 4, 4) goes through
+        result's arrays are views of its output vector, made when first read.  From the first call on, a float64
+        4x4 ndarray is taken by a built-in function in this method's place (:mod:`._ik_fastcall`: the check, the
+        kernel and the result in machine code); it hands everything else, and every pose the kernel does not
+        answer, to this method.  A batch (..., 4, 4) goes through
         the kernel's own loop and comes back in the plain solver's batched layout (:func:`_batch`).
         """
         c = self._elbow
@@ -154,7 +158,9 @@ class IKMethods:
         o = np.empty(c[4])
         status = c[2](T, c[0], o)
         if c[5]:  # numba compiled (or loaded) it on this first call: call its machine code from now on
-            c[2], c[5] = next(iter(c[2].overloads.values())).entry_point, False
+            one, c[5] = c[2], False
+            c[2] = next(iter(one.overloads.values())).entry_point
+            self._ik_builtin(one, c)
         if status == 0.0:
             res = _new(_PackedResult)
             _set_o(res, o)  # the slots' own setters: the frozen dataclass refuses setattr, and no __dict__ is made
@@ -165,6 +171,20 @@ class IKMethods:
             raise ShapeError("T has non-finite values" if err == np.inf else
                              f"T: rotation part is not orthonormal (error {err:.2g})")
         return analytic_ik(self.robot, T)
+
+    def _ik_builtin(self, one, c) -> None:
+        """Put the one-pose built-in of :mod:`._ik_fastcall` on this object in place of ``analytic_ik``: a call with
+        one float64 4x4 ndarray then runs in machine code, result included; every other call, and every pose the
+        kernel does not answer itself, goes to the method, unchanged.  Nothing changes when it cannot be made."""
+        try:
+            from ._ik_fastcall import install
+
+            made = install(one, type(self).analytic_ik.__get__(self), c[0], c[1], _PackedResult, guard_cache)
+        except Exception:  # noqa: BLE001 — a numba or platform difference: the method stays, correct, slower
+            made = None
+        if made is not None:
+            self.analytic_ik = made[0]
+            self._keep.append(made[1])
 
     def _analytic_solver(self):
         """``[K, (labels, plan kind), one, many, OUT_SIZE, first call]`` for the compiled closed form of this arm's
