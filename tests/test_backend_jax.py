@@ -9,7 +9,9 @@ use few shapes and arms, and those over 2 CPU-s (whichever meets a shape first p
 
 from __future__ import annotations
 
+import re
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -202,6 +204,36 @@ def test_large_batches_in_blocks_give_one_pass_derivatives_vmap_and_broadcast_in
     monkeypatch.setattr(mod, "_BLOCKED_FROM", 2**18)
     for what, a, b in zip(("grad", "jacfwd", "vmap", "rnea"), blocked, runs()):
         checks.assert_close(a, b, 1e-13, what)
+
+
+def _vm_flags(address: int) -> list[str]:
+    """The kernel's flags (VmFlags) of the mapping holding ``address``, from /proc/self/smaps."""
+    inside = False
+    for line in Path("/proc/self/smaps").read_text().splitlines():
+        span = re.match(r"([0-9a-f]+)-([0-9a-f]+) ", line)
+        if span:
+            inside = int(span[1], 16) <= address < int(span[2], 16)
+        elif inside and line.startswith("VmFlags:"):
+            return line.split()[1:]
+    raise AssertionError(f"no mapping holds {address:#x}")
+
+
+@pytest.mark.skipif(not Path("/sys/kernel/mm/transparent_hugepage/enabled").exists(),
+                    reason="needs Linux with transparent huge pages")
+def test_large_outputs_are_advised_huge_pages_and_exported_modules_start_from_zeros(rng, tmp_path):
+    """From _BLOCKED_FROM rows on, the blocks write into XLA's own result buffer, left uninitialised and advised
+    huge pages on CPU as numpy advises its large arrays (madvise(MADV_HUGEPAGE): the flag "hg" of its mapping in
+    /proc/self/smaps), with the numpy backend's values; the exported module (JAX only) starts from XLA's zeros:
+    no advice.  Results of 64 MB: above glibc's largest mmap threshold (32 MB), each a mapping of its own."""
+    robot = denavit.load_robot("planar2r")
+    exported = checks.load_exported(denavit.codegen.export_sources(robot, "jax"), tmp_path)
+    cached = denavit.compile(robot, backend="jax", kernels=["fk"]).module
+    q = rng.uniform(-np.pi, np.pi, (2**19, 2))  # from 2**18 rows on: blocks
+    ref = checks.numpy_backend(robot).fk(q)
+    for module, advised in ((exported, False), (cached, True)):
+        T = jax.jit(lambda x, m=module: m.fk(x))(jnp.asarray(q))
+        checks.assert_close(T, ref, 1e-12, "fk")
+        assert ("hg" in _vm_flags(T.unsafe_buffer_pointer() + T.nbytes // 2)) is advised, module.__name__
 
 
 def test_results_keep_the_input_dtype_and_batch_shape_and_accept_lists():

@@ -167,6 +167,6 @@ def compile_tensor(robot: DHRobot, framework: str, kernels=None, friction: bool 
 
     def make_source() -> str:
         return tensor_module(trace_kernels(robot, wanted, friction), framework,
-                             f"Kernels of a {robot.dof}-joint arm.")  # no user text in code
+                             f"Kernels of a {robot.dof}-joint arm.", standalone=False)  # no user text in code
 
     return TensorRobot(robot, load_module(key, framework, make_source), framework, wanted, friction)
