@@ -12,14 +12,15 @@ all in machine code, per call:
 3. the arm's one-pose entry (``ik_one_elbow``, ``ik_one_parallel`` or ``ik_one_stanford`` of :mod:`._ik_nb_entry`:
    the very machine code the method calls, its address given to LLVM by name, ``denavit_ik_one_<kind>``, once
    numba has compiled or loaded it) solves the pose into it, with the constants K of the arm;
-4. status 0 (answered): the result is ``PyType_GenericNew(result type)`` with the output vector and
-   ``(labels, plan kind)`` stored in its two slots — the object the method builds, field for field;
+4. status 0 (answered): the result is ``PyType_GenericNew(result type)`` with the output vector,
+   ``(labels, plan kind)`` and the solutions (a new (k, 6) array, the first k rows of the kernel's (8, 14) block,
+   columns 0-5) stored in its three slots — the object the method builds, field for field;
 5. anything else — another call, another argument, a pose the kernel hands over (status 1) or refuses (status 2),
    an exception in the kernel — releases what was made and calls the Python method with the same arguments, which
    does what it always did (the plain solver, the error).
 
 The built-in's ``self`` is the tuple ``(method, K, (labels, kind), result type)``.  The byte offsets the code reads
-— of a tuple's items and of the result's two slots — are found on real objects by :func:`install` and kept in a
+— of a tuple's items and of the result's three slots — are found on real objects by :func:`install` and kept in a
 process-wide table given to LLVM by name (``denavit_ik_layout``), so the machine code numba caches on disk holds
 no address or offset of this process, nor the kernel (a kernel compiled afresh from changed sources is the one
 called; this module's own code is all the cache holds, keyed by this file).  When anything is not as assumed, or fails, no built-in is made and the
@@ -32,7 +33,7 @@ import ctypes
 
 import numpy as np
 from llvmlite import ir
-from numba import carray, types
+from numba import carray, njit, types
 from numba.core import cgutils, sigutils
 from numba.core.ccallback import CFunc
 from numba.extending import intrinsic
@@ -55,8 +56,9 @@ __all__ = ["install"]
 
 _P, _I32, _I64, _F64 = ir.IntType(8).as_pointer(), ir.IntType(32), ir.IntType(64), ir.DoubleType()
 _NULL = ir.Constant(_P, None)
-#: words of ``denavit_ik_layout``: offset of a tuple's first item, of the result's slots ``_o`` and ``_m``
-_LAYOUT = (ctypes.c_int64 * 3)()
+#: words of ``denavit_ik_layout``: offset of a tuple's first item, of the result's slots ``_o``, ``_m``, ``solutions``
+_SLOTS = ("_o", "_m", "solutions")
+_LAYOUT = (ctypes.c_int64 * (1 + len(_SLOTS)))()
 _STATE: dict = {}
 _MADE: dict = {}  # kind -> (its CFunc, the address of its code), once per process
 
@@ -121,19 +123,27 @@ def _read_pose(typingctx, args, nargs, kwnames, buf):
     return types.boolean(args, nargs, kwnames, buf), lambda context, b, sig, a: _lower_pose(b, *a)
 
 
+def _lower_new(b, dims: list):
+    """``PyArray_New(&PyArray_Type, len(dims), dims, NPY_DOUBLE, …)``: a new reference, or NULL (error set)."""
+    at = cgutils.alloca_once(b, _I64, size=len(dims))
+    for j, d in enumerate(dims):
+        b.store(d, b.gep(at, [_k(j)]))
+    return call(b, "denavit_pyarray_new", _P, [
+        extern(b, "denavit_ndarray_type"), ir.Constant(_I32, len(dims)), at, ir.Constant(_I32, _fastcall.NPY_DOUBLE),
+        _NULL, _NULL, ir.Constant(_I32, 0), ir.Constant(_I32, 0), _NULL],
+        [_P, _I32, _I64.as_pointer(), _I32, _P, _P, _I32, _I32, _P])
+
+
 @intrinsic
 def _new_vector(typingctx):
-    """``PyArray_New(&PyArray_Type, 1, {OUT_SIZE}, NPY_DOUBLE, …)``: a new reference, or NULL (error set)."""
+    """A new float64 array (OUT_SIZE,): a new reference, or NULL (error set)."""
+    return types.voidptr(), lambda context, b, sig, a: _lower_new(b, [_k(OUT_SIZE)])
 
-    def codegen(context, b, sig, a):
-        dims = cgutils.alloca_once(b, _I64, size=1)
-        b.store(_k(OUT_SIZE), dims)
-        return call(b, "denavit_pyarray_new", _P, [
-            extern(b, "denavit_ndarray_type"), ir.Constant(_I32, 1), dims, ir.Constant(_I32, _fastcall.NPY_DOUBLE),
-            _NULL, _NULL, ir.Constant(_I32, 0), ir.Constant(_I32, 0), _NULL],
-            [_P, _I32, _I64.as_pointer(), _I32, _P, _P, _I32, _I32, _P])
 
-    return types.voidptr(), codegen
+@intrinsic
+def _new_rows(typingctx, k):
+    """A new float64 array (k, 6): a new reference, or NULL (error set)."""
+    return types.voidptr(k), lambda context, b, sig, a: _lower_new(b, [a[0], _k(6)])
 
 
 @intrinsic
@@ -184,24 +194,49 @@ def _release(typingctx, p):
 
 
 @intrinsic
-def _result(typingctx, this, out):
-    """``PyType_GenericNew(result type)`` (item 3 of ``this``) holding ``out`` (the reference is given to it) and
-    ``(labels, kind)`` (item 2, a new reference) in its slots; NULL (error set, ``out`` released) if it fails."""
+def _result(typingctx, this, out, rows):
+    """``PyType_GenericNew(result type)`` (item 3 of ``this``) holding ``out`` and ``rows`` (the references are given
+    to it) and ``(labels, kind)`` (item 2, a new reference) in its slots; NULL (error set, ``out`` and ``rows``
+    released) if it fails."""
 
     def codegen(context, b, sig, a):
-        this, out = a
+        this, out, rows = a
         res = call(b, "denavit_generic_new", _P, [_item(b, this, 3), _NULL, _NULL], [_P, _P, _P])
         with b.if_else(b.icmp_unsigned("==", res, _NULL), likely=False) as (failed, made):
             with failed:
-                call(b, "denavit_decref", ir.VoidType(), [out], [_P])
+                for p in (out, rows):
+                    call(b, "denavit_decref", ir.VoidType(), [p], [_P])
             with made:
                 m = _item(b, this, 2)
                 call(b, "denavit_incref", ir.VoidType(), [m], [_P])
-                b.store(out, b.bitcast(b.gep(res, [_word(b, 1)]), _P.as_pointer()))
-                b.store(m, b.bitcast(b.gep(res, [_word(b, 2)]), _P.as_pointer()))
+                for k, p in enumerate((out, m, rows)):
+                    b.store(p, b.bitcast(b.gep(res, [_word(b, 1 + k)]), _P.as_pointer()))
         return res
 
-    return types.voidptr(this, out), codegen
+    return types.voidptr(this, out, rows), codegen
+
+
+@njit(inline="always")
+def _constants(this):
+    """K (item 1 of ``this``) as an array."""
+    return carray(_k_data(this), (_k_size(this),))
+
+
+@njit(inline="always")
+def _answer(this, out):
+    """The result of an answered pose (status 0) whose output vector is ``out``: its solutions copied into a new
+    (k, 6) array, then the result object (:func:`_result`); NULL (error set) if an allocation fails."""
+    o = carray(_data(out), (OUT_SIZE,))
+    k = int(o[120])
+    rows = _new_rows(k)
+    if _is_null(rows):
+        _release(out)
+        return rows
+    q = carray(_data(rows), (k, 6))
+    for s in range(k):
+        for j in range(6):
+            q[s, j] = o[14 * s + j]
+    return _result(this, out, rows)
 
 
 def _kernel_call(kind: str):
@@ -233,9 +268,8 @@ def _elbow(this, args, nargs, kwnames):
         out = _new_vector()
         if _is_null(out):
             return out
-        if _one_elbow(carray(pose, (4, 4)), carray(_k_data(this), (_k_size(this),)),
-                      carray(_data(out), (OUT_SIZE,))) == 0.0:
-            return _result(this, out)
+        if _one_elbow(carray(pose, (4, 4)), _constants(this), carray(_data(out), (OUT_SIZE,))) == 0.0:
+            return _answer(this, out)
         _release(out)
     return _hand_back(this, args, nargs, kwnames)
 
@@ -247,9 +281,8 @@ def _parallel(this, args, nargs, kwnames):
         out = _new_vector()
         if _is_null(out):
             return out
-        if _one_parallel(carray(pose, (4, 4)), carray(_k_data(this), (_k_size(this),)),
-                         carray(_data(out), (OUT_SIZE,))) == 0.0:
-            return _result(this, out)
+        if _one_parallel(carray(pose, (4, 4)), _constants(this), carray(_data(out), (OUT_SIZE,))) == 0.0:
+            return _answer(this, out)
         _release(out)
     return _hand_back(this, args, nargs, kwnames)
 
@@ -261,9 +294,8 @@ def _stanford(this, args, nargs, kwnames):
         out = _new_vector()
         if _is_null(out):
             return out
-        if _one_stanford(carray(pose, (4, 4)), carray(_k_data(this), (_k_size(this),)),
-                         carray(_data(out), (OUT_SIZE,))) == 0.0:
-            return _result(this, out)
+        if _one_stanford(carray(pose, (4, 4)), _constants(this), carray(_data(out), (OUT_SIZE,))) == 0.0:
+            return _answer(this, out)
         _release(out)
     return _hand_back(this, args, nargs, kwnames)
 
@@ -286,19 +318,20 @@ def _layout(result_type) -> bool:
     _STATE[result_type] = False
     if not _fastcall.setup():
         return False
-    a, b = object(), object()
-    pair = (a, b)
+    marks = [object() for _ in _SLOTS]
+    pair = tuple(marks[:2])
     inst = object.__new__(result_type)
-    result_type._o.__set__(inst, a)
-    result_type._m.__set__(inst, b)
+    for name, mark in zip(_SLOTS, marks):
+        getattr(result_type, name).__set__(inst, mark)
     tw, sw = _words(pair, 48), _words(inst, result_type.__basicsize__)
-    if tw.count(id(a)) != 1 or tw[tw.index(id(a)) + 1] != id(b) or sw.count(id(a)) != 1 or sw.count(id(b)) != 1:
+    if (tw.count(id(pair[0])) != 1 or tw[tw.index(id(pair[0])) + 1] != id(pair[1])
+            or any(sw.count(id(mark)) != 1 for mark in marks)):
         return False
     new = ctypes.pythonapi.PyType_GenericNew
     new.restype, new.argtypes = ctypes.py_object, [ctypes.py_object, ctypes.c_void_p, ctypes.c_void_p]
     if type(new(result_type, None, None)) is not result_type:
         return False
-    words = (8 * tw.index(id(a)), 8 * sw.index(id(a)), 8 * sw.index(id(b)))
+    words = (8 * tw.index(id(pair[0])), *(8 * sw.index(id(mark)) for mark in marks))
     if any(_LAYOUT) and tuple(_LAYOUT) != words:  # another result type laid out otherwise
         return False
     from llvmlite import binding as ll

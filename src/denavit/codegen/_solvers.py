@@ -165,6 +165,7 @@ class IKMethods:
             res = _new(_PackedResult)
             _set_o(res, o)  # the slots' own setters: the frozen dataclass refuses setattr, and no __dict__ is made
             _set_m(res, c[1])
+            _set_s(res, o[:112].reshape(8, 14)[: int(o[120]), :6].copy())  # as the built-in's: (k, 6), C order
             return res
         if status == 2.0:
             err = o[132]
@@ -217,11 +218,13 @@ class IKMethods:
 
 
 class _PackedResult(AnalyticIKResult):
-    """The :class:`~denavit.AnalyticIKResult` of one pose answered by the compiled kernel, its fields read from
-    the kernel's output vector ``o`` (layout: :mod:`._ik_nb_entry`; kept in a slot with the labels and plan kind) when
-    first asked for (views of ``o``, each made once).  Copied or pickled, it is a plain AnalyticIKResult."""
+    """The :class:`~denavit.AnalyticIKResult` of one pose answered by the compiled kernel: its solutions a (k, 6)
+    array in a slot, made with it (the field most read; a slot is read as fast as Python reads anything), its other
+    fields read from the kernel's output vector ``o`` (layout: :mod:`._ik_nb_entry`; kept in a slot with the labels
+    and plan kind) when first asked for (views of ``o``, each made once).  Copied or pickled, it is a plain
+    AnalyticIKResult."""
 
-    __slots__ = ("_o", "_m")  # the output vector; (labels, plan kind)
+    __slots__ = ("_o", "_m", "solutions")  # the output vector; (labels, plan kind); the solutions, made at once
 
     def __reduce__(self):
         return AnalyticIKResult, tuple(getattr(self, f) for f in _FIELDS)
@@ -244,8 +247,7 @@ class _Lazy:
 
 
 _FIELDS = tuple(f.name for f in fields(AnalyticIKResult))
-for _lazy in (_Lazy("solutions", lambda o, labels, kind: o[:112].reshape(8, 14)[: int(o[120]), :6]),
-              _Lazy("position_error", lambda o, labels, kind: o[6:112:14][: int(o[120])]),
+for _lazy in (_Lazy("position_error", lambda o, labels, kind: o[6:112:14][: int(o[120])]),
               _Lazy("orientation_error", lambda o, labels, kind: o[7:112:14][: int(o[120])]),
               _Lazy("outside_limits", lambda o, labels, kind: o[:112].reshape(8, 14)[: int(o[121]), 8:]),
               _Lazy("branches", lambda o, labels, kind: tuple([labels[int(x)] for x in o[112:112 + int(o[120])]])),
@@ -254,7 +256,7 @@ for _lazy in (_Lazy("solutions", lambda o, labels, kind: o[:112].reshape(8, 14)[
               _Lazy("valid", lambda o, labels, kind: _ALL_VALID[int(o[120])])):
     setattr(_PackedResult, _lazy.name, _lazy)
 _PackedResult.__name__ = _PackedResult.__qualname__ = "AnalyticIKResult"  # its repr is a plain result's
-_set_o, _set_m = _PackedResult._o.__set__, _PackedResult._m.__set__
+_set_o, _set_m, _set_s = _PackedResult._o.__set__, _PackedResult._m.__set__, _PackedResult.solutions.__set__
 
 
 def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
