@@ -177,3 +177,18 @@ def test_the_method_stays_when_no_builtin_can_be_made(arms, monkeypatch):
     _identical(other.analytic_ik(T), fast.analytic_ik(T))
     assert inspect.ismethod(other.analytic_ik)
     _identical(other.analytic_ik(T), fast.analytic_ik(T))
+
+
+def test_threads_get_the_same_answers(arms):
+    """The built-in lets go of the GIL while its kernel runs (as numba's entry of the nogil kernels did): calls from
+    two threads at once answer as one thread does."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    robot, fast = arms["puma560"]
+    rng = np.random.default_rng(3)
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    Ts = list(denavit.forward_kinematics(robot, rng.uniform(lim[:, 0], lim[:, 1], (200, 6))))
+    with ThreadPoolExecutor(2) as pool:
+        together = list(pool.map(fast.analytic_ik, Ts))
+    for a, T in zip(together, Ts):
+        _identical(a, _method(fast)(T))

@@ -241,14 +241,18 @@ def _answer(this, out):
 
 def _kernel_call(kind: str):
     """An intrinsic ``f(T, K, o) -> float``: the compiled one-pose entry ``ik_one_<kind>`` called by numba's calling
-    convention at the symbol ``denavit_ik_one_<kind>``; 1.0 (hand over) if it raised."""
+    convention at the symbol ``denavit_ik_one_<kind>``, without the GIL (``PyEval_SaveThread`` … ``RestoreThread``,
+    as numba's own entry of these ``nogil`` kernels does: other threads run meanwhile); 1.0 (hand over) if it
+    raised."""
 
     @intrinsic
     def kernel(typingctx, T, K, o):
         def codegen(context, b, sig, args):
             fnty = context.call_conv.get_function_type(sig.return_type, sig.args)
             fn = cgutils.get_or_insert_function(b.module, fnty, f"denavit_ik_one_{kind}")
+            thread = call(b, "denavit_save_thread", _P, [], [])
             status, value = context.call_conv.call_function(b, fn, sig.return_type, sig.args, args)
+            call(b, "denavit_restore_thread", ir.VoidType(), [thread], [_P])
             return b.select(status.is_error, ir.Constant(_F64, 1.0), value)
 
         return types.float64(T, K, o), codegen
@@ -338,6 +342,8 @@ def _layout(result_type) -> bool:
 
     _LAYOUT[:] = words
     ll.add_symbol("denavit_ik_layout", ctypes.addressof(_LAYOUT))
+    for symbol, name in (("denavit_save_thread", "PyEval_SaveThread"), ("denavit_restore_thread", "PyEval_RestoreThread")):
+        ll.add_symbol(symbol, ctypes.cast(getattr(ctypes.pythonapi, name), ctypes.c_void_p).value)
     _STATE[result_type] = True
     return True
 
