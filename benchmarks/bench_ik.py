@@ -18,9 +18,11 @@ verified solutions returned by the all-solution solvers.
 
 ``--per-pose`` (issue 30): ``denavit.compile(robot).analytic_ik``, one pose per call, against ik-geo and EAIK (C++)
 on the same poses in interleaved rounds (CPU time, pinned to one core; median µs/pose, median ratio denavit/peer), after counting the poses whose
-solution sets differ (1e-6, modulo 2π); then 10⁵ poses through the compiled kernel's own loop on one core.  The
-compiled result makes its arrays when first read: "denavit, solutions read" times the call and one read of
-``solutions`` (the peers return their solutions built).
+solution sets differ (1e-6, modulo 2π); then 10⁵ poses through the compiled kernel's own loop on one core.  After
+its first call ``analytic_ik`` is a CPython built-in (codegen/_ik_fastcall.py: check, kernel and result in machine
+code); the result holds its solutions built, its other fields are made when first read: "denavit, solutions read"
+times the call and one read of ``solutions`` (the peers return their solutions built).  "denavit kernel" is numba's
+own entry of the kernel alone, into one reused output vector.
 """
 
 from __future__ import annotations
