@@ -397,3 +397,35 @@ def test_unlimited_prismatic_joint_is_refused():
     robot = DHRobot("p", (DHLink(joint=JointType.PRISMATIC),))
     with pytest.raises(ModelError, match="prismatic"):
         occupancy(robot, 1000, seed=0)
+
+
+@pytest.mark.parametrize("dim, side", [(2, 13), (3, 12)])
+def test_refined_cells_are_the_shell_of_the_pilot_at_twice_the_edge(dim, side):
+    """plan_refinement's cells against the definition, cell by cell: a cell's parent (index // 2) has an occupied
+    parent within one step and an empty (or off-grid) one within two, and the cell itself is not interior at its
+    own edge (a neighbour within one step empty or off-grid)."""
+    import itertools
+
+    from denavit.scale._refine import plan_refinement
+
+    rng = np.random.default_rng(side)
+    counts = (rng.random((side,) * dim) < 0.97).astype(np.uint64) * rng.integers(1, 4, (side,) * dim, dtype=np.uint64)
+    counts[(slice(0, 3),) * dim] = 0  # an empty corner, scattered holes, deep parents
+    ref = plan_refinement(counts, 2, 1)
+    parents = -(-side // 2)
+    occ2 = np.zeros((parents,) * dim, bool)
+    for c in np.argwhere(counts > 0):
+        occ2[tuple(c // 2)] = True
+
+    def any_within(occ, at, r, want):  # a cell within r steps (Chebyshev) of `at` has occupancy `want`
+        for o in itertools.product(range(-r, r + 1), repeat=dim):
+            x = np.array(at) + o
+            inside = np.all((x >= 0) & (x < occ.shape[0]))
+            if (bool(occ[tuple(x)]) if inside else False) == want:
+                return True
+        return False
+
+    expected = [np.ravel_multi_index(c, counts.shape) for c in itertools.product(range(side), repeat=dim)
+                if any_within(occ2, np.array(c) // 2, 1, True) and any_within(occ2, np.array(c) // 2, 2, False)
+                and not (counts[c] > 0 and not any_within(counts > 0, c, 1, False))]
+    assert 0 < len(expected) < side**dim and ref.cells.tolist() == expected
