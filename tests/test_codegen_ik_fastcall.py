@@ -123,7 +123,8 @@ def test_other_calls_are_the_methods(arms):
     bad[0, 1] += 0.5
     nan = T.copy()
     nan[2, 3] = np.nan
-    cases = [((T.tolist(),), {}), ((T.astype(np.float32),), {}), ((T.astype(">f8"),), {}), ((np.eye(4, dtype=int),), {}),
+    cases = [((T.tolist(),), {}), ((T.astype(np.float32),), {}), ((T.astype(">f8"),), {}),
+             ((np.eye(4, dtype=int),), {}),
              ((T.view(_Sub),), {}), ((T[:3],), {}), ((np.stack([T, T]),), {}), ((T.reshape(1, 4, 4),), {}),
              ((), {"T": T}), ((), {}), ((T, T), {}), ((bad,), {}), ((nan,), {}), ((np.full((4, 4), np.inf),), {}),
              ((T.reshape(16),), {}), (("T",), {})]

@@ -11,20 +11,22 @@ all in machine code, per call:
 2. the output vector (OUT_SIZE floats, :mod:`._ik_nb_entry`) is made by numpy's ``PyArray_New``;
 3. the arm's one-pose entry (``ik_one_elbow``, ``ik_one_parallel`` or ``ik_one_stanford`` of :mod:`._ik_nb_entry`:
    the very machine code the method calls, its address given to LLVM by name, ``denavit_ik_one_<kind>``, once
-   numba has compiled or loaded it) solves the pose into it, with the constants K of the arm;
+   numba has compiled or loaded it) solves the pose into it, with the constants K of the arm, the GIL released
+   meanwhile (as numba's entry of these ``nogil`` kernels does);
 4. status 0 (answered): the result is ``PyType_GenericNew(result type)`` with the output vector,
    ``(labels, plan kind)`` and the solutions (a new (k, 6) array, the first k rows of the kernel's (8, 14) block,
    columns 0-5) stored in its three slots — the object the method builds, field for field;
 5. anything else — another call, another argument, a pose the kernel hands over (status 1) or refuses (status 2),
    an exception in the kernel — releases what was made and calls the Python method with the same arguments, which
-   does what it always did (the plain solver, the error).
+   does what it always did (the plain solver, the error; the kernel's second run there is nothing beside the
+   plain solver's milliseconds).
 
 The built-in's ``self`` is the tuple ``(method, K, (labels, kind), result type)``.  The byte offsets the code reads
 — of a tuple's items and of the result's three slots — are found on real objects by :func:`install` and kept in a
 process-wide table given to LLVM by name (``denavit_ik_layout``), so the machine code numba caches on disk holds
 no address or offset of this process, nor the kernel (a kernel compiled afresh from changed sources is the one
-called; this module's own code is all the cache holds, keyed by this file).  When anything is not as assumed, or fails, no built-in is made and the
-method stays.  Imported only where numba is.
+called; this module's own code is all the cache holds, keyed by this file).  When anything is not as assumed, or
+fails, no built-in is made and the method stays.  Imported only where numba is.
 """
 
 from __future__ import annotations
@@ -342,7 +344,8 @@ def _layout(result_type) -> bool:
 
     _LAYOUT[:] = words
     ll.add_symbol("denavit_ik_layout", ctypes.addressof(_LAYOUT))
-    for symbol, name in (("denavit_save_thread", "PyEval_SaveThread"), ("denavit_restore_thread", "PyEval_RestoreThread")):
+    for symbol, name in (("denavit_save_thread", "PyEval_SaveThread"),
+                         ("denavit_restore_thread", "PyEval_RestoreThread")):
         ll.add_symbol(symbol, ctypes.cast(getattr(ctypes.pythonapi, name), ctypes.c_void_p).value)
     _STATE[result_type] = True
     return True
