@@ -214,27 +214,65 @@ SINGLE_ARMS = ["puma560", "puma560-mdh", "ur5", "stanford"]
 
 @pytest.mark.parametrize("name", SINGLE_ARMS)
 def test_single_residual_and_jacobian_match_fk_and_geometric_jacobian(name):
-    """Float residual = pose_error(T, FK(q)) and float Jacobian = geometric_jacobian (other modules)."""
+    """The float chain's pose and J0 = forward_kinematics and geometric_jacobian, and the LM's residual (of
+    denavit.ik.lm, which denavit.compile jits too) = pose_error, weighted (other modules)."""
+    from denavit.ik import lm
     from denavit.ik._single import single_chain
     from denavit.numeric._jacobians import geometric_jacobian
 
     robot, rng = load_robot(name), np.random.default_rng(11)
+    n = robot.dof
     for q, qt in zip(_random_q(robot, rng, 10), _random_q(robot, rng, 10)):
         T = forward_kinematics(robot, qt)
         w = rng.uniform(0.5, 2.0, 6)
-        e, J = single_chain(robot).residual(q.tolist(), T[:3, :3].tolist(), T[:3, 3].tolist(), w.tolist())
-        np.testing.assert_allclose(e, w * pose_error(T, forward_kinematics(robot, q)), atol=1e-12)
-        np.testing.assert_allclose(np.array(J).T, w[:, None] * geometric_jacobian(robot, q), atol=1e-12)
+        P = [0.0] * (16 + 6 * n)
+        single_chain(robot).fk_jacobian0(q.tolist(), P)
+        np.testing.assert_allclose(np.reshape(P[:16], (4, 4)), forward_kinematics(robot, q), atol=1e-12)
+        np.testing.assert_allclose(np.reshape(P[16:], (6, n)), geometric_jacobian(robot, q), atol=1e-12)
+        e = [0.0] * 6
+        pe, re, cost = lm.pose_residual(T.ravel().tolist(), P, w.tolist(), e)
+        ref = pose_error(T, forward_kinematics(robot, q))
+        np.testing.assert_allclose(e, w * ref, atol=1e-12)
+        assert pe == pytest.approx(np.linalg.norm(ref[:3]), abs=1e-12)
+        assert re == pytest.approx(np.linalg.norm(ref[3:]), abs=1e-12)
+        assert cost == pytest.approx(np.sum((w * ref) ** 2), abs=1e-12)
 
 
-def test_single_damped_step_solves_normal_equations():
-    from denavit.ik._single import damped_step
+def test_lm_residual_near_half_turn_and_masked_rows():
+    """Rotations within 0.1 rad of π (the symmetric-part branch of the log) against rotation_log (another
+    module); a row weighted 0 is left out of e, of the norms and of the cost."""
+    from denavit.ik import lm
+    from denavit.numeric import rotation_log as log
+
+    rng = np.random.default_rng(6)
+    for _ in range(20):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        angle = np.pi - rng.uniform(0, 0.1)
+        K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        R = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K  # Rodrigues
+        Tt, P = np.eye(4), np.eye(4)
+        Tt[:3, :3] = R
+        w = [1.0, 1.0, 0.0, 1.0, 1.0, 1.0]
+        e = [0.0] * 6
+        pe, re, cost = lm.pose_residual(Tt.ravel().tolist(), P.ravel().tolist() + [0.0] * 6, w, e)
+        np.testing.assert_allclose(e[3:], log(R), atol=1e-12)
+        assert e[2] == 0.0 and pe == 0.0 and re == pytest.approx(angle, abs=1e-12)
+        assert cost == pytest.approx(angle**2, abs=1e-12)
+
+
+def test_lm_damped_step_solves_normal_equations():
+    from denavit.ik import lm
 
     rng = np.random.default_rng(5)
     for n in (1, 3, 6, 7):
-        J, e, lam = rng.normal(size=(6, n)), rng.normal(size=6), 10.0 ** rng.uniform(-9, 1)
-        A, b = J.T @ J + lam * np.eye(n), J.T @ e
-        dq = np.array(damped_step(J.T.tolist(), e.tolist(), lam))
+        J, e, w, lam = rng.normal(size=(6, n)), rng.normal(size=6), rng.uniform(0.5, 2, 6), 10.0 ** rng.uniform(-9, 1)
+        Jw = w[:, None] * J
+        A, b = Jw.T @ Jw + lam * np.eye(n), Jw.T @ e
+        P = [0.0] * 16 + J.ravel().tolist()
+        dq = [0.0] * n
+        lm.damped_step(P, e.tolist(), w.tolist(), lam, n, [0.0] * (6 * n), [0.0] * (n * n), dq)
+        dq = np.array(dq)
         # backward error (n = 7 > 6 rows with tiny λ is ill-conditioned: compare residuals, not solutions)
         assert np.linalg.norm(A @ dq - b) <= 1e-12 * (np.linalg.norm(A) * np.linalg.norm(dq) + np.linalg.norm(b))
         if n <= 6:

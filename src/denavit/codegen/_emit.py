@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from ._ik_lm import ik_lm_lines
 from ._kernels import INTERNAL, KernelSpec
 from ._llvm import LANES
 
@@ -268,9 +269,7 @@ def python_module(specs: dict[str, KernelSpec], backend: str, title: str) -> str
     if backend == NUMBA:
         body += _numba_group(specs)
     if backend == NUMBA and "fk" in specs and "fk_jacobian0" in specs:
-        from ._ik_lm import IK_LM_SOURCE  # the closed forms are module-level kernels (codegen/_ik_nb_*.py)
-
-        body.append(IK_LM_SOURCE)
+        body += ik_lm_lines()  # the LM of denavit.ik.lm with this module's FK + Jacobian kernel
     return "\n".join(head + body).rstrip() + "\n"
 
 

@@ -20,6 +20,7 @@ from ..chain import reach_ball, screws_of
 from ._residual import (LAMBDA0, LAMBDA_MAX, IKResult, JointLimits, characteristic_length, limits_of, pose_error, row_mask,
                         rotation_log)
 from ._kernel import kernel_of, targets_soa
+from ._lm import RESTART_ITERATIONS  # iteration budget of a restart, relative to max_iterations
 from ._seeds import rescue
 from ._single import solve_single
 from ..numeric import forward_kinematics
@@ -32,7 +33,6 @@ MAX_ITERATIONS = 100
 RESTARTS = 64
 PARALLEL_SEEDS = 32  # at most this many seeds side by side per target once few targets are left
 SMALL_BATCH = 512  # "few": at most this many attempts in flight
-RESTART_ITERATIONS = 0.3  # iteration budget of a restart, relative to max_iterations
 CLIPPED_SEEDS = 0.1  # share of restarts iterated inside the limits (the rest run free and are folded)
 _REASONS = ("", "iterations", "limits", "unreachable")
 
