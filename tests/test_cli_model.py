@@ -159,3 +159,22 @@ def test_show_is_the_dh_table_of_print_robot(capsys):
     assert "[-160°, 160°]" in out
     assert main(["show", "puma560", "--deg"]) == 0  # --deg: every angle in degrees
     assert "90°" in capsys.readouterr().out
+
+
+def test_main_called_twice_in_one_process_keeps_no_state(capsys):
+    """main() reuses one parser per process: options given to one call (an appended --param, --deg) must not
+    reach the next; each answer equals the same command's answer alone in a fresh parser."""
+    from denavit.cli import build_parser, main
+
+    def run(argv):
+        assert main(argv) == 0
+        return json.loads(capsys.readouterr().out)
+
+    plain = ["fk", "planar2r", "-q", "0.3,0.2", "--json"]
+    first = run(plain)
+    changed = run([*plain[:-1], "--param", "L1=2", "--param", "L2=0.5", "--deg", "--json"])
+    again = run(plain)
+    assert again == first
+    assert changed != first
+    fresh = build_parser().parse_args(plain)
+    assert fresh.param == [] and not fresh.deg
