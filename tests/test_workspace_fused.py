@@ -141,6 +141,7 @@ def test_fused_tasks_equal_the_numpy_route_on_random_arms():
                 dataclasses.replace(numpy_job, refine=plan), 1, 3)
             assert a[6].size > 0
             _same_task(a, b)
+            _same_task(run_task(job, 0, 4), ref)  # this thread's accumulator again, its refined flags cleared
 
 
 def test_tilted_plane_cells_are_the_numpy_routes():

@@ -13,8 +13,10 @@ does in numpy passes: draw the joint values, compute the origin, its cell and su
   the same instructions, so the same doubles as :class:`~denavit.scale.CompiledPositionFK`.
 - **Cells.**  The arithmetic of ``_sampler._cells`` / ``_sub_cells`` in the same order of operations (no
   fused multiply-adds): the same cells.  Counts go into dense ``uint32`` arrays (an accumulator of the grid's
-  size; see ``_sink``); with a ``touched`` buffer the first hit of each cell is recorded, so a task run in
-  another process returns its sparse counts without a sort.
+  size; see ``_sink``): the count in the low 31 bits, bit 31 (FLAG) set on the refined cells, so the load of
+  the increment tells whether a sample's sub-cell is wanted (no other look-up for the other samples); with a
+  ``touched`` buffer the first hit of each cell is recorded, so a task run in another process returns its
+  sparse counts without a sort.
 
 So a task's counts, bounds and reach are identical to the numpy route's with the compiled kernel.
 """
@@ -28,12 +30,15 @@ from numba import njit
 
 from ._stream import GAMMA, MIX1, MIX2
 
-__all__ = ["NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel", "merge"]
+__all__ = ["FLAG", "NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "flag", "fused_kernel", "merge"]
 
 #: Rows drawn, positioned and counted per step (their joint values and origins stay in the L1 cache).
 SUB_ROWS = 256
 #: Status codes of a fused run.
 OK, NON_FINITE, OUTSIDE = 0, 1, 2
+#: Bit 31 of a cell's uint32 accumulator: the cell is refined (its samples also count in sub-cells).  The count
+#: is the low 31 bits (an accumulator is flushed before it could pass 2³¹ − 1).
+FLAG = 1 << 31
 
 _kernels: dict = {}
 _kernels_lock = threading.Lock()
@@ -122,6 +127,7 @@ _as_double, _popcount = _bits_intrinsic(), _ctpop_intrinsic()
 _Z, _S32, _ONE, _LOW6, _LOW32 = np.uint64(0), np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
 _GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
 _S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
+_FLAG, _COUNT, _UONE, _S31U = np.uint32(1 << 31), np.uint32(2**31 - 1), np.uint32(1), np.uint32(31)
 _EXP52 = np.uint64(0x4330000000000000)  # the bits of 2⁵²: 2⁵² + h for h < 2³² by an OR
 _HALF = 2.0**-32
 
@@ -222,41 +228,68 @@ def _flat(T, R2, r, dim, side, cells):
 
 
 @njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, axes, side, origin, slots, cells, subs, stats, T, R2):
+def _cells(P, r, grid, basis, axes, side, origin, cells, stats, T, R2):
     """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
-    is taken at the end), cells (cells[:r]) and the sub-cells of those in refined cells (subs[:ns], in order) of
-    the origins P[:r]; returns (status, ns).  The arithmetic of ``_sampler._cells`` / ``_sub_cells``, in their order."""
-    dim, k = basis.shape[0], int(grid[5])
+    is taken at the end) and cells (cells[:r]) of the origins P[:r]; returns the status.  The arithmetic of
+    ``_sampler._cells``, in its order."""
     _coordinates(P, r, grid, basis, axes, origin, T, R2)
     _bounds(P, r, R2, stats)
-    if _flat(T, R2, r, dim, side, cells):
+    if _flat(T, R2, r, basis.shape[0], side, cells):
         for i in range(r):
             if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
-                return 1, 0
-        return 2, 0
+                return NON_FINITE
+        return OUTSIDE
+    return OK
+
+
+@njit(nogil=True, cache=True)
+def _count(cells, r, acc, touched, nt, slots, subs, T, k):
+    """acc[cells[i]] += 1 for i < r (the count in the low 31 bits; bit 31 is FLAG, set on the refined cells of a
+    refined run); the first hit of each cell appended to touched when it has room; returns (nt, ns) with the
+    sub-cells of the samples in refined cells in subs[:ns], in order (``_sampler._sub_cells``' arithmetic).
+
+    The refined flag comes with the count's own load, so a sample outside the refined cells costs no look-up
+    (the bitmap of ``slots`` is read only for the flagged ones).  Its increments are independent, so the cache
+    misses of a large grid overlap."""
     ns = 0
-    if slots.shape[0]:
-        for i in range(r):  # branch-free: the rows in refined cells, in order, into subs[:ns]
-            flat = cells[i]
+    if slots.shape[0] == 0:  # no refined cells, no flags
+        return _add(cells, r, acc, touched, nt), 0
+    if touched.size:
+        for i in range(r):
+            c = cells[i]
+            v = acc[c]
+            if (v & _COUNT) == 0:
+                touched[nt] = c
+                nt += 1
+            acc[c] = v + _UONE
             subs[ns] = i
-            ns += np.int64((slots[flat >> 6, 0] >> (np.uint64(flat) & _LOW6)) & _ONE)
-        for t in range(ns):  # their sub-cells; T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
-            i = subs[t]
-            flat = cells[i]
-            word, before = slots[flat >> 6, 0], slots[flat >> 6, 1]
-            idx = np.int64(before + _popcount(word & ((_ONE << (np.uint64(flat) & _LOW6)) - _ONE)))
-            for a in range(dim):
-                x = T[a, i]
-                idx = idx * k + (np.int64(x * k) - k * np.int64(x))
-            subs[t] = idx
-    return 0, ns
+            ns += np.int64(v >> _S31U)
+    else:
+        for i in range(r):  # the flag of each sample's cell into subs[i] (no loop-carried dependence)
+            c = cells[i]
+            v = acc[c]
+            acc[c] = v + _UONE
+            subs[i] = v >> _S31U
+        for i in range(r):  # branch-free: the rows in refined cells, in order, into subs[:ns]
+            f = subs[i]
+            subs[ns] = i
+            ns += f
+    for t in range(ns):  # their sub-cells; T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
+        i = subs[t]
+        flat = cells[i]
+        word, before = slots[flat >> 6, 0], slots[flat >> 6, 1]
+        idx = np.int64(before + _popcount(word & ((_ONE << (np.uint64(flat) & _LOW6)) - _ONE)))
+        for a in range(T.shape[0]):
+            x = T[a, i]
+            idx = idx * k + (np.int64(x * k) - k * np.int64(x))
+        subs[t] = idx
+    return nt, ns
 
 
 @njit(nogil=True, cache=True)
 def _add(cells, r, acc, touched, nt):
-    """acc[cells[i]] += 1 for i < r; the first hit of each cell appended to touched (when it has room: a buffer
-    of the task's size, or none); returns the new length of touched.  A loop of its own: its increments are
-    independent, so the cache misses of a large grid overlap."""
+    """acc[cells[i]] += 1 for i < r (sub-cell counts: no flag); the first hit of each cell appended to touched
+    (when it has room: a buffer of the task's size, or none); returns the new length of touched."""
     if touched.size:
         for i in range(r):
             c = cells[i]
@@ -272,12 +305,20 @@ def _add(cells, r, acc, touched, nt):
 
 @njit(nogil=True, cache=True)
 def merge(total, part):
-    """total += part and part = 0, touching only the nonzero entries of part (one pass, no temporaries)."""
+    """total += the counts of part (its low 31 bits) and part keeps only its FLAG bits, touching only the
+    nonzero entries of part (one pass, no temporaries).  Sub-cell counts carry no flag: part is zeroed."""
     for i in range(part.size):
         v = part[i]
         if v:
-            total[i] += v
-            part[i] = 0
+            total[i] += v & _COUNT
+            part[i] = v & _FLAG
+
+
+@njit(nogil=True, cache=True)
+def flag(acc, cells, on):
+    """Set (``on``) or clear bit 31 (FLAG) of acc at ``cells``: the refined cells of a run."""
+    for c in cells:
+        acc[c] = (acc[c] | _FLAG) if on else (acc[c] & _COUNT)
 
 
 def _build(rows):
@@ -290,6 +331,7 @@ def _build(rows):
     def run(keys, sizes, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
+        dim, k = basis.shape[0], int(grid[5])
         T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
         los, spans = np.empty(q.size), np.empty(q.size)  # the limits tiled row after row (see _draw)
         for i in range(q.shape[0]):
@@ -304,10 +346,10 @@ def _build(rows):
                 j = _draw(qs, r, j, state, los, spans)
                 for b in range(0, r, 4):
                     rows(qs, Ps, b)
-                status, ns = _cells(Ps, r, grid, basis, axes, side, origin, slots, cells, subs, stats, T, R2)
+                status = _cells(Ps, r, grid, basis, axes, side, origin, cells, stats, T, R2)
                 if status:
                     return nt, nft, status
-                nt = _add(cells, r, acc, touched, nt)
+                nt, ns = _count(cells, r, acc, touched, nt, slots, subs, T[:dim], k)
                 nft = _add(subs, ns, fine, ftouched, nft)
         return nt, nft, 0
 

@@ -260,6 +260,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
             small = job.samples - pilot * BLOCK < 2**32  # no sub-cell count can overflow uint32
             state["fine"] = np.zeros(ref.cells.size * ref.factor**g.dim, dtype=np.uint32 if small else np.uint64)
             sink.flush(state["fine"])
+            sink.flag(ref.cells)  # the fused tasks find a refined cell by bit 31 of its count
         yield from ((state["job"], f, c) for f, c in _tasks(job.samples, chunk, pilot, blocks))
 
     bar = Progress(int(samples), "samples", progress)

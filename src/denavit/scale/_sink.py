@@ -6,12 +6,14 @@ with the GIL released (``_fused``), gives it back and returns no counts at all; 
 accumulators into its ``uint64`` counts at the pilot's barrier and at the end (``flush``, a jitted pass over the
 nonzero entries; an accumulator untouched since its last flush is skipped).  The first accumulator to count
 sub-cells counts them straight into the driver's sub-cell array when that is ``uint32``.  An accumulator is
-also flushed before its samples could pass 2³² − 1 (no cell can overflow).  At most ``cap`` accumulators exist
-(ACC_BUDGET bytes; a task waits for a free one), so memory does not grow with the workers beyond that.
+also flushed before its samples could pass 2³¹ − 1 (no cell's count, the low 31 bits, can overflow: bit 31
+flags the refined cells of a refined run, ``Sink.flag``, so a task tells them from the count it loads anyway).
+At most ``cap`` accumulators exist (ACC_BUDGET bytes; a task waits for a free one), so memory does not grow
+with the workers beyond that.
 
-In another process (a process pool, a cluster) a task counts into a zeroed per-thread accumulator and records
-the first hit of each cell; it returns those cells and their counts (as the numpy route does after its sort)
-and zeroes them again.
+In another process (a process pool, a cluster) a task counts into a zeroed per-thread accumulator (its refined
+cells flagged) and records the first hit of each cell; it returns those cells and their counts (as the numpy
+route does after its sort) and zeroes those counts again.
 
 Integer sums commute, so the counts are those of the numpy route for any tasks, workers and accumulators.
 """
@@ -30,8 +32,9 @@ __all__ = ["ACC_BUDGET", "NoSink", "Sink", "close_sink", "open_sink", "run_fused
 
 #: Most bytes of accumulators a run keeps in this process (at least one accumulator is always made).
 ACC_BUDGET = 3 * 2**27
-#: Most samples an accumulator takes between flushes (its uint32 cells cannot overflow).
-_MOST = 2**32 - 1
+#: Most samples an accumulator takes between flushes (the 31 count bits of its uint32 cells cannot overflow;
+#: bit 31 flags the refined cells, ``_fused.FLAG``).
+_MOST = 2**31 - 1
 
 _sinks: dict = {}
 _sinks_lock = threading.Lock()
@@ -40,9 +43,17 @@ _E32, _E64, _SLOTS = np.empty(0, np.int32), np.empty(0, np.int64), np.empty((0, 
 _NONE = np.empty(0, np.uint32)  # no counts (read-only use: nothing is ever written to it)
 
 
+def _flag(acc: np.ndarray, cells: np.ndarray, on: bool) -> None:
+    from ._fused import flag
+
+    flag(acc, cells, on)
+
+
 class _Accumulator:
-    def __init__(self, cells: int) -> None:
+    def __init__(self, cells: int, refined: np.ndarray | None = None) -> None:
         self.counts = np.zeros(cells, dtype=np.uint32)
+        if refined is not None:
+            _flag(self.counts, refined, True)
         self.fine: np.ndarray | None = None
         self.tally = 0  # samples since the last flush
 
@@ -58,6 +69,7 @@ class Sink:
         self.free: list[_Accumulator] = []
         self.cond = threading.Condition()
         self.owner: _Accumulator | None = None  # the accumulator counting sub-cells straight into self.fine
+        self.refined: np.ndarray | None = None  # the refined cells, flagged in every accumulator
 
     def acquire(self, samples: int, fine_size: int) -> _Accumulator:
         """A free accumulator (made while fewer than ``cap`` exist, else waited for) with room for
@@ -68,7 +80,7 @@ class Sink:
             if self.free:
                 acc = self.free.pop()
             else:
-                acc = _Accumulator(self.counts.size)
+                acc = _Accumulator(self.counts.size, self.refined)
                 self.all.append(acc)
             if acc.tally + samples > _MOST:
                 self._flush_one(acc)
@@ -105,6 +117,13 @@ class Sink:
     def close(self) -> None:
         close_sink(self.token)
 
+    def flag(self, cells: np.ndarray) -> None:
+        """Flag the refined cells ``cells`` in every accumulator, now and to come (called when no task runs)."""
+        with self.cond:
+            self.refined = cells
+            for acc in self.all:
+                _flag(acc.counts, cells, True)
+
     def flush(self, fine: np.ndarray | None = None) -> None:
         """Add every accumulator into the driver's counts (and into ``fine``, the sub-cell counts, once they
         exist); called when no task runs (a barrier, the end)."""
@@ -121,6 +140,9 @@ class NoSink:
     token = None
 
     def flush(self, fine: np.ndarray | None = None) -> None:
+        pass
+
+    def flag(self, cells: np.ndarray) -> None:
         pass
 
     def close(self) -> None:
@@ -150,6 +172,19 @@ class _Work(threading.local):
         a = self.__dict__.get(name)
         if a is None or a.size != size:
             a = self.__dict__[name] = np.zeros(size, dtype=np.uint32)
+            self.__dict__.pop(name + ":flags", None)
+        return a
+
+    def flagged(self, name: str, size: int, ref) -> np.ndarray:
+        """``dense(name, size)`` with FLAG on the cells of the Refinement ``ref`` (None: on none); the flags
+        are redone only when ``ref`` changes (its counts are zero between tasks)."""
+        a = self.dense(name, size)
+        want = None if ref is None else ref.token
+        if self.__dict__.get(name + ":flags", None) != want:
+            a[:] = 0
+            if ref is not None:
+                _flag(a, ref.cells, True)
+            self.__dict__[name + ":flags"] = want
         return a
 
     def get(self, name: str, shape: tuple, dtype) -> np.ndarray:
@@ -201,7 +236,7 @@ def run_fused(job, first: int, count: int) -> tuple:
     if sink is not None:
         idx, cnt, fidx, fcnt = _into_sink(kernel, args, scratch, sink, total, slots, fine_size)
     else:
-        idx, cnt, fidx, fcnt = _sparse(kernel, args, scratch, g.side**g.dim, total, slots, fine_size)
+        idx, cnt, fidx, fcnt = _sparse(kernel, args, scratch, g.side**g.dim, total, slots, fine_size, ref)
     return idx, cnt, stats[:3], stats[3:6], float(np.sqrt(stats[6])), total, fidx, fcnt
 
 
@@ -217,19 +252,19 @@ def _into_sink(kernel, args, scratch, sink: Sink, total: int, slots, fine_size: 
     return _E32, _NONE, _E64, _NONE
 
 
-def _sparse(kernel, args, scratch, cells: int, total: int, slots, fine_size: int) -> tuple:
-    """Count into this thread's zeroed accumulators; return the cells hit and their counts (and the sub-cells'),
-    and zero those cells again."""
-    acc, fine = _work.dense("cells", cells), _work.dense("fine", fine_size)
+def _sparse(kernel, args, scratch, cells: int, total: int, slots, fine_size: int, ref) -> tuple:
+    """Count into this thread's zeroed accumulators (the refined cells of ``ref`` flagged); return the cells hit
+    and their counts (and the sub-cells'), and zero those counts again."""
+    acc, fine = _work.flagged("cells", cells, ref), _work.dense("fine", fine_size)
     touched = _work.get("ftouch", (total,), np.int32)
     ftouched = _work.get("fftouch", (total if fine_size else 0,), np.int64)
     nt = nft = 0
     try:
         nt, nft, status = kernel(*args, acc, touched, slots, fine, ftouched, *scratch)
         idx, fidx = touched[:nt].copy(), ftouched[:nft].copy()
-        cnt, fcnt = acc[idx], fine[fidx]
+        cnt, fcnt = acc[idx] & np.uint32(2**31 - 1), fine[fidx]
     finally:
-        acc[touched[:nt]] = 0  # the kernel reports errors by status, with nt and nft counted so far
+        acc[touched[:nt]] &= np.uint32(2**31)  # the kernel reports errors by status, with nt and nft counted so far
         fine[ftouched[:nft]] = 0
     _check(status)
     return idx, cnt, fidx, fcnt
