@@ -24,6 +24,7 @@ __all__ = [
     "LinkInertia",
     "DHLink",
     "DHRobot",
+    "sampling_ranges",
     "IDENTITY",
     "DH_FIELDS",
     "INERTIA_ORDER",
@@ -293,6 +294,12 @@ class DHRobot:
             out[k] = link.q_limits if link.q_limits is not None else (-np.inf, np.inf)
         return out
 
+    def sampling_ranges(self, travel: float = 1.0) -> np.ndarray:
+        """Where each joint is sampled or swept, shape (dof, 2): its limits, or for a joint without limits one
+        turn [−π, π] (revolute) or [−travel, travel] [m] (prismatic: a length scale of the caller's, having no
+        natural span).  See :func:`sampling_ranges`."""
+        return sampling_ranges(self.q_limits, [t is JointType.REVOLUTE for t in self.joint_types], travel)
+
     @property
     def base_matrix(self) -> np.ndarray:
         return np.array(self.base, dtype=float)
@@ -362,3 +369,17 @@ def inertial_rows(robot: DHRobot) -> list[tuple[int, int, LinkInertia]]:
         if link.inertia is not None and body >= 0:
             out.append((row, body, link.inertia))
     return out
+
+
+def sampling_ranges(limits, revolute, travel: float = 1.0) -> np.ndarray:
+    """The one definition of where joints are sampled or swept: ``limits`` (n, 2) with an infinite end replaced
+    by ∓π for a revolute joint (``revolute[k]``: one turn [−π, π] without limits) or by ∓``travel`` [m] for a
+    prismatic one; where the other end is finite and lies beyond that, by that end ∓ 2π (∓ 2·travel) instead (a
+    model's limits are finite or absent: one-sided limits come from callers' own arrays).  The middle,
+    ``ranges.mean(axis=1)``, is the limits' middle, or 0 for a joint without limits."""
+    lim = np.asarray(limits, dtype=float)
+    span = np.where(np.asarray(revolute, dtype=bool), np.pi, float(travel))
+    lo, hi = lim[:, 0], lim[:, 1]
+    fin_lo, fin_hi = np.isfinite(lo), np.isfinite(hi)
+    return np.stack([np.where(fin_lo, lo, np.where(fin_hi & (hi <= -span), hi - 2 * span, -span)),
+                     np.where(fin_hi, hi, np.where(fin_lo & (lo >= span), lo + 2 * span, span))], axis=1)

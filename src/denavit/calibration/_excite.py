@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError, ShapeError
-from ..model import DHRobot, JointType
+from ..model import DHRobot, JointType, sampling_ranges
 from ..numeric import base_parameters, base_regressor
 from ._excite_series import (
     CHECK_PER_HARMONIC,
@@ -141,9 +141,7 @@ def _limits(robot: DHRobot, margin: float, q_limits, qd_max, qdd_max):
         raise ShapeError(f"q_limits: expected shape ({n}, 2) for a {n}-joint robot, got {lim.shape}")
     if np.isnan(lim).any() or not np.all(lim[:, 0] <= lim[:, 1]):
         raise ValueError("q_limits: each row must be [low, high] with low <= high (no NaN)")
-    for k, jt in enumerate(types):
-        if not np.all(np.isfinite(lim[k])):
-            lim[k] = np.clip(lim[k], -UNLIMITED_WINDOW[jt], UNLIMITED_WINDOW[jt])
+    lim = sampling_ranges(lim, [jt is JointType.REVOLUTE for jt in types], UNLIMITED_WINDOW[JointType.PRISMATIC])
     width = lim[:, 1] - lim[:, 0]
     window = np.column_stack([lim[:, 0] + margin * width, lim[:, 1] - margin * width])
     tight = np.flatnonzero(window[:, 1] - window[:, 0] <= 1e-9)

@@ -28,8 +28,8 @@ import numpy as np
 from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
-from ..ik import analytic_ik, ik_structure
-from ..model import DHRobot
+from ..ik import analytic_ik, characteristic_length, ik_structure
+from ..model import DHRobot, JointType
 from ._ik_targets import (MATCH_TOL, POSE_COLUMNS, controlled_rows, free_joints, joint_distance, reaches,
                           revolute_mask, target_env)
 from ._latex import parse_math
@@ -141,9 +141,9 @@ def _formula_values(names, versions, used_signs, env: dict) -> np.ndarray:
 
 def _targets(robot: DHRobot, rng: np.random.Generator, count: int):
     """(q_gen, T, analytic result) for random reachable, well-conditioned targets."""
-    lim = robot.q_limits
-    lo = np.maximum(np.where(np.isfinite(lim[:, 0]), lim[:, 0], -np.pi), -np.pi)
-    hi = np.minimum(np.where(np.isfinite(lim[:, 1]), lim[:, 1], np.pi), np.pi)
+    ranges = robot.sampling_ranges(characteristic_length(robot))  # ±L for a prismatic joint without limits
+    turn = np.where([t is JointType.REVOLUTE for t in robot.joint_types], np.pi, np.inf)  # one turn (it repeats)
+    lo, hi = np.maximum(ranges[:, 0], -turn), np.minimum(ranges[:, 1], turn)
     out = []
     for _ in range(count * 4):
         q = rng.uniform(lo, hi)

@@ -18,10 +18,9 @@ class Arm:
     def __init__(self, robot: DHRobot, rows: list[int], frame: Frame, rng: np.random.Generator) -> None:
         self.robot, self.rows, self.frame, self.rng = robot, rows, frame, rng
         self.rev = np.array([t is JointType.REVOLUTE for t in robot.joint_types])
-        lim = robot.q_limits
-        self.lo = np.where(np.isfinite(lim[:, 0]), lim[:, 0], np.where(self.rev, -np.pi, -1.0))
-        self.hi = np.where(np.isfinite(lim[:, 1]), lim[:, 1], np.where(self.rev, np.pi, 1.0))
-        self.lo, self.hi = np.maximum(self.lo, -np.pi), np.minimum(self.hi, np.pi)
+        ranges = robot.sampling_ranges(1.0)  # ±1 m for a prismatic joint without limits
+        turn = np.where(self.rev, np.pi, np.inf)  # revolute joints within one turn (the rest repeats)
+        self.lo, self.hi = np.maximum(ranges[:, 0], -turn), np.minimum(ranges[:, 1], turn)
         self.params = dict(robot.parameters)
 
     def random_q(self, k: int = 1) -> np.ndarray:

@@ -67,8 +67,7 @@ class IKMethods:
             w = np.where(row_mask(mask), 1.0, 0.0) * np.array([1.0, 1.0, 1.0, L, L, L])
             lim = JointLimits(self.robot, not respect_limits)
             slo, shi = lim.sample_bounds(L)
-            mid = np.where(np.isfinite(lim.lo) & np.isfinite(lim.hi), 0.5 * (np.nan_to_num(lim.lo) + np.nan_to_num(lim.hi)),
-                           0.0)
+            mid = 0.5 * (slo + shi)  # the middle of the limits, 0 without
             c = self._ik_constants = ((mask if isinstance(mask, str) else tuple(mask), respect_limits), w, L, lim,
                                       slo, shi, lim.revolute.astype(np.bool_), mid)
         _, w, L, lim, slo, shi, revolute, mid = c

@@ -248,9 +248,7 @@ def solve_ik(robot: DHRobot, T, q0=None, *, mask: str | Sequence[bool] | None = 
     Tf = T.reshape(-1, 4, 4)
     B = Tf.shape[0]
     if q0 is None:
-        finite = np.isfinite(limits.lo) & np.isfinite(limits.hi)
-        mid = np.where(finite, 0.5 * (np.where(finite, limits.lo, 0) + np.where(finite, limits.hi, 0)), 0.0)
-        q = np.tile(mid, (B, 1))
+        q = np.tile(np.mean(limits.sample_bounds(L), axis=0), (B, 1))  # the middle of the limits, 0 without
     else:
         q = np.broadcast_to(as_joint_array(q0, n, "q0"), batch + (n,)).reshape(B, n).copy()
     q = limits.project(q)

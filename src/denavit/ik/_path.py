@@ -131,8 +131,7 @@ class _Context:
             k = int(hold[1:]) - 1 if hold[:1] == "q" and hold[1:].isdigit() else -1
             if not 0 <= k < n:
                 raise ModelError(f"hold: {hold!r} is not a joint of {robot.name} (q1 … q{n})")
-            lim = robot.q_limits[k]
-            mid = 0.5 * (lim[0] + lim[1]) if np.all(np.isfinite(lim)) else 0.0
+            mid = float(robot.sampling_ranges()[k].mean())  # the middle of its limits, 0 without
             self.locked = {hold: float(q0[k]) if q0 is not None else mid}
             self.free = np.delete(np.arange(n), k)
         try:

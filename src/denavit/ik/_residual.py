@@ -12,7 +12,7 @@ import numpy as np
 
 from ..chain import chain_of
 from ..errors import ShapeError
-from ..model import DHRobot, JointType
+from ..model import DHRobot, JointType, sampling_ranges
 from ..numeric import rotation_log
 
 __all__ = ["IKResult", "AnalyticIKResult", "row_mask", "rotation_log", "pose_error", "JointLimits", "characteristic_length", "limits_of",
@@ -161,10 +161,10 @@ class JointLimits:
         return np.all((q >= self.lo - tol) & (q <= self.hi + tol), axis=-1)
 
     def sample_bounds(self, scale: float) -> tuple[np.ndarray, np.ndarray]:
-        """Where random restarts are drawn: the limits, or ±π (revolute) / ±scale (prismatic) where infinite."""
-        lo = np.where(np.isfinite(self.lo), self.lo, np.where(self.revolute, -np.pi, -scale))
-        hi = np.where(np.isfinite(self.hi), self.hi, np.where(self.revolute, np.pi, scale))
-        return lo, hi
+        """Where random restarts are drawn: :func:`denavit.model.sampling_ranges` of these limits (±π revolute,
+        ±scale prismatic where infinite)."""
+        r = sampling_ranges(np.column_stack([self.lo, self.hi]), self.revolute, scale)
+        return r[:, 0], r[:, 1]
 
     def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
         lo, hi = self.sample_bounds(scale)

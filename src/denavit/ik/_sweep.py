@@ -100,18 +100,15 @@ class FreeJointSweep:
 
 
 def _sweep_range(robot: DHRobot, k: int) -> tuple[float, float]:
-    """The range swept for joint k: its limits, or one turn [−π, π] for a revolute joint without them."""
-    lo, hi = (float(x) for x in robot.q_limits[k])
-    if not (np.isfinite(lo) and np.isfinite(hi)) and robot.joint_types[k] is JointType.REVOLUTE:
-        return -np.pi, np.pi
-    return lo, hi
+    """The range swept for joint k: its limits, or one turn [−π, π] for a revolute joint without them
+    (:meth:`DHRobot.sampling_ranges`; a prismatic joint without limits is refused before)."""
+    lo, hi = robot.sampling_ranges()[k]
+    return float(lo), float(hi)
 
 
 def _middle(robot: DHRobot) -> np.ndarray:
-    """(n,) a configuration inside the limits: their middle, 0 for a joint without (finite) limits."""
-    lim = robot.q_limits
-    ok = np.isfinite(lim).all(axis=1)
-    return np.where(ok, 0.5 * (np.where(ok, lim[:, 0], 0.0) + np.where(ok, lim[:, 1], 0.0)), 0.0)
+    """(n,) a configuration inside the limits: their middle, 0 for a joint without limits."""
+    return robot.sampling_ranges().mean(axis=1)
 
 
 def default_free_joint(robot: DHRobot) -> str:
