@@ -96,7 +96,7 @@ def _solve(M, b):
 
 
 # Batches of _BLOCKED_FROM configurations or more run in blocks of _BLOCK rows (see _blocked): a block's inputs,
-# sines, cosines and output stay in a 1-MB L2 cache.
+# sines, cosines and output stay in cache.
 _BLOCK = BLOCK_ROWS
 _BLOCKED_FROM = BLOCKED_FROM
 
@@ -107,11 +107,13 @@ def _blocked(kernel, *xs):
     \"\"\"kernel(*xs) on inputs (..., k) whose batch axes are broadcast together; from _BLOCKED_FROM rows on, in
     blocks of _BLOCK rows inside one lax.fori_loop.  XLA otherwise allocates every intermediate array of the whole
     batch afresh on each call, tens of MB, and pays a page fault per 4 KB of it (at 10**6 rows most of the time).
-    Each step computes its block into a buffer of its own and writes the previous block into the output (a
-    result computed straight into the output at a dynamic offset compiles to scalar code).  The last block ends at
-    the last row, overlapping the one before (those rows are written twice with the same values): every row of
-    the output is written, so its initial buffer (_output_buffer) needs no values.  jit, grad (a scan), jacfwd
-    and vmap follow it.\"\"\"
+    Each step computes its block inside a lax.cond whose two branches are the same kernel (the predicate, always
+    true, does not matter): XLA keeps a branch whole, so the block goes into a buffer of its own by the kernel's
+    vectorised loop and is then copied into the output (fused into the write at a dynamic offset, it compiled to
+    scalar code; carried to the next step instead, it cost a copy more: 15-20% of a float64 call).  The last
+    block ends at the last row, overlapping the one before (those rows are written twice with the same values):
+    every row of the output is written, so its initial buffer (_output_buffer) needs no values.  jit, grad (a
+    scan), jacfwd and vmap follow it.\"\"\"
     batch = xs[0].shape[:-1]
     rows = math.prod(batch)
     if rows < max(_BLOCKED_FROM, 2 * _BLOCK):
@@ -119,18 +121,13 @@ def _blocked(kernel, *xs):
     flat = [x.reshape((rows, x.shape[-1])) for x in xs]
     block = jax.eval_shape(kernel, *[jax.ShapeDtypeStruct((_BLOCK, x.shape[-1]), x.dtype) for x in flat])
 
-    def start(i):
-        return xp.minimum(i * _BLOCK, rows - _BLOCK)
+    def step(i, out):
+        start = xp.minimum(i * _BLOCK, rows - _BLOCK)
+        part = [lax.dynamic_slice_in_dim(x, start, _BLOCK) for x in flat]
+        return lax.dynamic_update_slice_in_dim(out, lax.cond(i >= 0, kernel, kernel, *part), start, 0)
 
-    def step(i, carry):
-        out, y = carry  # y: block i - 1
-        out = lax.dynamic_update_slice_in_dim(out, y, start(xp.maximum(i - 1, 0)), 0)
-        return out, kernel(*[lax.dynamic_slice_in_dim(x, start(i), _BLOCK) for x in flat])
-
-    n = -(-rows // _BLOCK)
-    carry = (_output_buffer((rows,) + block.shape[1:], block.dtype), xp.zeros(block.shape, block.dtype))
-    out, y = lax.fori_loop(0, n, step, carry)
-    return lax.dynamic_update_slice_in_dim(out, y, start(n - 1), 0).reshape(batch + block.shape[1:])
+    out = lax.fori_loop(0, -(-rows // _BLOCK), step, _output_buffer((rows,) + block.shape[1:], block.dtype))
+    return out.reshape(batch + block.shape[1:])
 
 
 # sin and cos by polynomials XLA vectorises (its own sine and cosine on CPU are one libm call per element, in
@@ -222,9 +219,10 @@ _SIN_TAYLOR = tuple((-1.0) ** (k + 1) / math.factorial(2 * k + 3) for k in range
 _COS_TAYLOR = tuple((-1.0) ** k / math.factorial(2 * k + 4) for k in range(7))
 _TAYLOR_TERMS_32 = 4
 #: The JAX kernels' batches from BLOCKED_FROM configurations on run in blocks of BLOCK_ROWS (the prelude's
-#: _blocked; Puma 560 FK, one core: from 5·10⁵ rows on 1.4-1.7x faster than one pass, at 3·10⁵ even, below slower).
-BLOCK_ROWS = 4096
-BLOCKED_FROM = 2 ** 18
+#: _blocked; FK, one core, time of one pass / time in blocks: Puma 560 float64 0.92 at 3·10⁴ rows, 0.97 at 7·10⁴,
+#: 1.15 at 10⁵, 2 at 2·10⁵; Panda float32 0.89 at 10⁵, 1.1 at 2·10⁵; blocks of 1024-4096 rows within 7% at 10⁶).
+BLOCK_ROWS = 2048
+BLOCKED_FROM = 2 ** 17
 
 
 def _jax_prelude() -> str:

@@ -118,7 +118,8 @@ def _make_handler():
 
 
 _LOCK = threading.Lock()
-_STATE: list = []  # [handler or None]: the handler stays referenced for the process (XLA keeps its address)
+_STATE: list[bool] = []  # [registered]: decided once per process
+_HANDLERS: list = []  # the handler, referenced for the process whatever happened (XLA may keep its address)
 
 
 def _registered() -> bool:
@@ -126,20 +127,21 @@ def _registered() -> bool:
     rather than failing the backend's start); False when it cannot be."""
     with _LOCK:
         if not _STATE:
-            handler = None
+            ok = False
             if sys.platform.startswith("linux"):
                 try:
                     import jax
                     import jax.ffi
 
                     jax.devices("cpu")
-                    handler = _make_handler()
-                    jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(ctypes.cast(handler, _ptr).value),
+                    _HANDLERS.append(_make_handler())
+                    jax.ffi.register_ffi_target(TARGET, jax.ffi.pycapsule(ctypes.cast(_HANDLERS[0], _ptr).value),
                                                 platform="cpu")
+                    ok = True
                 except Exception:  # noqa: BLE001 - old jax (no jax.ffi), no CPU backend, a refused version
-                    handler = None
-            _STATE.append(handler)
-        return _STATE[0] is not None
+                    ok = False
+            _STATE.append(ok)
+        return _STATE[0]
 
 
 def output_buffer(shape, dtype):
