@@ -355,7 +355,9 @@ def _batch_rates(fast, eaik, Tb):
     with one worker thread; the share of poses the kernel hands to the plain solver."""
     kern, out = fast._analytic_solver(), {}
     if kern:
-        K, many, B, n = kern[0], kern[3], len(Tb), fast.dof
+        from denavit.codegen._ik_nb_batch import batch_entry  # the entry analytic_ik(batch) calls
+
+        K, many, B, n = kern[0], batch_entry(kern[3]), len(Tb), fast.dof
         Tb = np.ascontiguousarray(Tb)
 
         def layout():  # the batched layout the kernel writes (as codegen._solvers._batch)

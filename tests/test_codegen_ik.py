@@ -461,3 +461,37 @@ def test_compiled_batch_keeps_the_plain_layout(arm):
     assert a.solutions.shape == b.solutions.shape and a.solutions.shape[:2] == (2, 15)
     _same_batch(robot, a, b)
     assert np.all(a.count.reshape(-1)[10:] >= 1)  # the random poses: q itself is a solution, inside the limits
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560"])  # the UR-class and the elbow kernel
+def test_batch_over_blocks_equals_pose_by_pose(name, _kernel_cache):
+    """The batch entry (the kernel run over blocks of BLOCK poses, codegen/_ik_nb_batch.py) against the one-pose
+    path, pose by pose, on a batch spanning two blocks and part of a third: random poses, wrist-singular and rounded
+    ones (handed to the plain solver as one sub-batch), one out of reach; each pose's filled slots hold the one-pose
+    call's solutions (to the conditioning-scaled tolerance: a handed-over pose is solved batched there, alone
+    here) with its labels and outside-limits count; a non-orthonormal target in the last block refuses the batch."""
+    from denavit.codegen._ik_nb_batch import BLOCK
+
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    rng = np.random.default_rng(11)
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (2 * BLOCK + 12, robot.dof))
+    Q[5::9, 4] = 0.0  # wrist singular: axes 4 and 6 aligned (a continuum: the plain solver answers)
+    Q[7::9] = np.round(Q[7::9], 1)
+    T = denavit.forward_kinematics(robot, Q)
+    T[BLOCK + 3, :3, 3] = (9.0, 0.0, 0.0)  # out of reach: no solution
+    with _handovers() as calls:
+        a = fast.analytic_ik(T)
+    assert len(calls) == 1
+    assert a.count[BLOCK + 3] == 0 and np.all(np.delete(a.count, BLOCK + 3) >= 1)  # q itself, inside the limits
+    for b in range(len(T)):
+        one = fast.analytic_ik(T[b])
+        S = np.asarray(one.solutions)
+        idx = _match(S, a.solutions[b][a.valid[b]], _tolerance(robot, S))
+        assert list(one.branches) == [a.branches[b][a.valid[b]][j] for j in idx]
+        assert len(one.outside_limits) == a.outside_limits[b]
+    bad = T.copy()
+    bad[2 * BLOCK + 1, 0, 1] += 0.5
+    with pytest.raises(denavit.errors.ShapeError, match="orthonormal"):
+        fast.analytic_ik(bad)

@@ -54,17 +54,18 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
     h, na, nb, base3, L, rho_w = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]
     free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
     tiny = free_tol * L
+    ct5, st5 = math.cos(theta[4]), math.sin(theta[4])  # the wrist label's sin(q5 + theta5), by the sum formula
     wc = (trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], trig[6], trig[7])  # forms.wrist_constants
     cb3, sb3 = trig[8], trig[9]  # cos, sin of base3
-    # scratch: three float and one flag allocation, viewed without reshapes (a reshape is a helper call)
-    ws = np.empty(62)
-    q, Xw, W, cx, cy, cz = ws[0:6], ws[6:9], ws[9:12], ws[12:15], ws[15:18], ws[18:21]
+    # scratch: two float and one flag allocation per call (not per pose), viewed without reshapes (a reshape is a
+    # helper call)
+    ws = np.empty(67)
+    Xw, W, cx, cy, cz = ws[6:9], ws[9:12], ws[12:15], ws[15:18], ws[18:21]
     x1, y1c, z1, S, E, dW = ws[21:24], ws[24:27], ws[27:30], ws[30:33], ws[33:36], ws[36:39]
-    perm = ws[39:47]  # the candidate in each sorted slot
-    w4 = np.empty((10, 4))
-    F, Y, M = w4[0:4], w4[4:7, 0:3], w4[7:10, 0:3]
-    w8 = np.empty((8, 56))  # per candidate: joints, residuals, frames after joints 1-3 (from the FK, for the
-    cand, cerr, frames, cs = w8[:, 0:6], w8[:, 6:8], w8[:, 8:44], w8[:, 44:56]  # labels), cos and sin of the joints
+    perm, vr = ws[39:47], ws[47:67]  # the candidate in each sorted slot; ik_finish's scratch
+    w8 = np.empty((25, 56))  # per candidate: joints, residuals, frames after joints 1-3 (from the FK, for the
+    cand, cerr, frames, cs = w8[0:8, 0:6], w8[0:8, 6:8], w8[0:8, 8:44], w8[0:8, 44:56]  # labels), their cos, sin
+    PF, F, Y, M = w8[8:15, 0:12], w8[15:19, 0:4], w8[19:22, 0:3], w8[22:25, 0:3]  # the FK's partial products, ...
     flags = np.zeros(24, dtype=np.bool_)
     ok = flags[0:8]
     for b in range(T.shape[0]):
@@ -143,9 +144,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
-        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
-                                    out_q[b], out_err[b], out_outq[b], perm, chain, cs, True,
-                                    out_rank[b])
+        kept, n_out, st = ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags,
+                                    out_q, out_err, out_outq, perm, chain, cs, True, out_rank, PF, vr)
         status = max(status, st)
         for slot in range(kept):
             best = int(perm[slot])
@@ -169,7 +169,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
             side = (E[0] - S[0]) * nrm0 + (E[1] - S[1]) * nrm1 + (E[2] - S[2]) * nrm2
             if side * towards < 0.0:
                 code |= 2
-            if math.sin(cand[best, 4] + theta[4]) < 0.0:
+            if cs[best, 9] * ct5 + cs[best, 8] * st5 < 0.0:  # sin(q5 + theta5) from q5's cos and sin (a sign
+                # flip needs it within rounding of 0: the wrist singularity, handed over)
                 code |= 4
             out_label[b, slot] = code
         out_status[b, 0] = kept

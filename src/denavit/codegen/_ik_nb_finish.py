@@ -20,8 +20,10 @@ from ._ik_finish import FOLD_EDGE
 
 __all__ = ["chain_fk", "ik_check", "ik_finish"]
 
+_INV_2PI = 0.5 / math.pi
 
-@njit(cache=True, nogil=True)
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish: no call passing eight arrays per candidate
 def chain_fk(C, revolute, Q, CS, r, P, start, F):
     """F = C0 J1(q1) C1 ⋯ Jn(qn) Cn: the arm's pose from its chain constants C (n+1, 4, 4) (:mod:`denavit.chain`:
     base, DH rows and tool folded in), J = Rz(q) for a revolute joint, Tz(q) for a prismatic one.  The 3×4 top of
@@ -60,10 +62,11 @@ def chain_fk(C, revolute, Q, CS, r, P, start, F):
 @njit(cache=True, nogil=True)
 def _wrap(x):
     """x wrapped into (−π, π] as ``π − ((π − x) mod 2π)``, the mod by floor (numba's float % calls fmod: 48 of them
-    were 7% of a kernel call); within an ulp of the fmod form, and the fold's knife edges go to the plain solver
-    anyway (FOLD_EDGE)."""
+    were 7% of a kernel call) of a product with 1/2π (a division and math.floor's round trip through an integer
+    were the fold's latency); within an ulp of the fmod form, and the fold's knife edges go to the plain solver
+    anyway (FOLD_EDGE: the product and the quotient can floor differently only within an ulp of x = ±π)."""
     y = math.pi - x
-    return math.pi - (y - 2.0 * math.pi * math.floor(y / (2.0 * math.pi)))
+    return math.pi - (y - 2.0 * math.pi * np.floor(y * _INV_2PI))
 
 
 @njit(cache=True, nogil=True)
@@ -78,22 +81,22 @@ def _near_fold_edge(x, lo, hi):
 
 
 @njit(cache=True, nogil=True, inline="always")  # into each kernel: no call with nineteen arguments per pose
-def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
-              perm, C, cs, given, out_rank):
-    """The plain solver's pipeline after the candidates, for one pose: each verified by the FK (a residual that
-    would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge radius:
-    status 1), the ones inside the limits sorted lexicographically into out_q (residuals into out_err), the
-    others into out_outq, perm[slot] the candidate in each slot; C (7, 4, 4) the arm's chain constants (its FK:
-    :func:`chain_fk`); frames[k] (8, 36) the frames after joints 1, 2, 3 of candidate k, unfolded (the FK's
-    products P[1:4]: columns x, y, z, origin each), for the labels; cs[k] (8, 12) the cosine and sine of each
-    joint of candidate k, given by the closed form (``given``: the very values of math.cos, math.sin of those
-    floats, so the FK computes no sine) or computed here; out_rank[slot] (9,) the rank of each kept solution
-    among the verified candidates in candidate order, out_rank[8] their number (the slots of the plain solver's
-    batched layout).  Returns (kept, outside, status)."""
+def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, flags, out_q, out_err, out_outq,
+              perm, C, cs, given, out_rank, P, vr):
+    """The plain solver's pipeline after the candidates, for pose b of T (B, 4, 4): each verified by the FK (a
+    residual that would be polished: status 1), folded into the limits, duplicates dropped (a pair within the merge
+    radius: status 1), the ones inside the limits sorted lexicographically into out_q[b] (residuals into
+    out_err[b]), the others into out_outq[b], perm[slot] the candidate in each slot; C (7, 4, 4) the arm's chain
+    constants (its FK: :func:`chain_fk`); frames[k] (8, 36) the frames after joints 1, 2, 3 of candidate k,
+    unfolded (the FK's products P[1:4]: columns x, y, z, origin each), for the labels; cs[k] (8, 12) the cosine and
+    sine of each joint of candidate k, given by the closed form (``given``: the very values of math.cos, math.sin
+    of those floats, so the FK computes no sine) or computed here; out_rank[b, slot] the rank of each kept solution
+    among the verified candidates in candidate order, out_rank[b, 8] their number (the slots of the plain solver's
+    batched layout).  Scratch: P (7, 12), the FK's partial products; vr (20,).  The outputs are indexed by b, not
+    sliced (a view per pose is an atomic reference count and its release).  Returns (kept, outside, status)."""
     verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
     ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
     status = 0
-    P = np.empty((7, 12))  # the FK's product after k joints, reused by the next candidate sharing them
     for r in range(3):
         P[0, r], P[0, 3 + r], P[0, 6 + r], P[0, 9 + r] = C[0, r, 0], C[0, r, 1], C[0, r, 2], C[0, r, 3]
     for k in range(ncand):
@@ -106,16 +109,16 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
         chain_fk(C, revolute, cand, cs, k, P, start, F)
         for j in range(36):
             frames[k, j] = P[1 + j // 12, j % 12]
-        pe = math.sqrt((F[0, 3] - Tb[0, 3]) ** 2 + (F[1, 3] - Tb[1, 3]) ** 2 + (F[2, 3] - Tb[2, 3]) ** 2)
+        pe = math.sqrt((F[0, 3] - T[b, 0, 3]) ** 2 + (F[1, 3] - T[b, 1, 3]) ** 2 + (F[2, 3] - T[b, 2, 3]) ** 2)
         tr = 0.0  # rotation error: the angle of R_t R^T
         for i in range(3):
             for j in range(3):
-                tr += Tb[i, j] * F[i, j]
+                tr += T[b, i, j] * F[i, j]
         v0 = v1 = v2 = 0.0
         for j in range(3):
-            v0 += Tb[2, j] * F[1, j] - Tb[1, j] * F[2, j]
-            v1 += Tb[0, j] * F[2, j] - Tb[2, j] * F[0, j]
-            v2 += Tb[1, j] * F[0, j] - Tb[0, j] * F[1, j]
+            v0 += T[b, 2, j] * F[1, j] - T[b, 1, j] * F[2, j]
+            v1 += T[b, 0, j] * F[2, j] - T[b, 2, j] * F[0, j]
+            v2 += T[b, 1, j] * F[0, j] - T[b, 0, j] * F[1, j]
         sn, co = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
         re = sn / co if sn < 1e-6 * co else math.atan2(sn, co)  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
         cerr[k, 0], cerr[k, 1] = pe, re
@@ -123,32 +126,16 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
         if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
             status = 1  # would be polished by the plain solver
         ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
-    vr = np.empty(8)  # rank of each verified candidate among them
     nver = 0
     for k in range(ncand):
         if ok[k]:
             vr[k] = nver
             nver += 1
-    out_rank[8] = nver
+    out_rank[b, 8] = nver
+    status = max(status, _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr))
     for k in range(ncand):
         if not ok[k]:
             continue
-        ins = True
-        for j in range(6):
-            x = cand[k, j]
-            if revolute[j] != 0.0:
-                x = _wrap(x)
-                if _near_fold_edge(x, lo_lim[j], hi_lim[j]):
-                    status = 1  # a rounding difference could fold it elsewhere: the plain solver decides
-                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x + 2.0 * math.pi <= hi_lim[j]:
-                    x += 2.0 * math.pi
-                if (x < lo_lim[j] - 1e-12 or x > hi_lim[j] + 1e-12) and lo_lim[j] <= x - 2.0 * math.pi <= hi_lim[j]:
-                    x -= 2.0 * math.pi
-            elif abs(x - lo_lim[j]) < FOLD_EDGE or abs(x - hi_lim[j]) < FOLD_EDGE:
-                status = 1
-            cand[k, j] = x
-            ins = ins and lo_lim[j] - 1e-12 <= x <= hi_lim[j] + 1e-12
-        inside[k] = ins
         for m in range(k):
             if not ok[m]:
                 continue
@@ -170,7 +157,7 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
     for k in range(ncand):
         if ok[k] and not inside[k]:
             for j in range(6):
-                out_outq[n_out, j] = cand[k, j]
+                out_outq[b, n_out, j] = cand[k, j]
             n_out += 1
             ok[k] = False
         elif ok[k]:
@@ -191,11 +178,50 @@ def ik_finish(Tb, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames, 
                             break
         used[best] = True
         perm[slot] = best
-        out_rank[slot] = vr[best]
+        out_rank[b, slot] = vr[best]
         for j in range(6):
-            out_q[slot, j] = cand[best, j]
-        out_err[slot, 0], out_err[slot, 1] = cerr[best, 0], cerr[best, 1]
+            out_q[b, slot, j] = cand[best, j]
+        out_err[b, slot, 0], out_err[b, slot, 1] = cerr[best, 0], cerr[best, 1]
     return kept, n_out, status
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish
+def _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr):
+    """Each verified candidate's joints folded into the limits (revolute: wrapped into (−π, π], then shifted by a
+    whole turn where that brings it inside), in place; inside[k] whether all of candidate k's are within them.
+    Returns 1 if some joint lies within FOLD_EDGE of a decision of the folding (the plain solver decides), else 0.
+    The candidates come in families sharing their first joints (the same floats): a joint equal to the one last
+    folded reuses its result (held in vr[8:14] and vr[14:20]: the last raw value and its folded value per joint;
+    vr[:8] is the caller's)."""
+    status = 0
+    for j in range(6):
+        vr[8 + j] = math.nan  # equal to nothing
+    for k in range(ncand):
+        if not ok[k]:
+            continue
+        ins = True
+        for j in range(6):
+            x = cand[k, j]
+            lo, hi = lo_lim[j], hi_lim[j]
+            if x == vr[8 + j]:
+                x = vr[14 + j]
+            else:
+                vr[8 + j] = x
+                if revolute[j] != 0.0:
+                    x = _wrap(x)
+                    if _near_fold_edge(x, lo, hi):
+                        status = 1  # a rounding difference could fold it elsewhere: the plain solver decides
+                    if (x < lo - 1e-12 or x > hi + 1e-12) and lo <= x + 2.0 * math.pi <= hi:
+                        x += 2.0 * math.pi
+                    if (x < lo - 1e-12 or x > hi + 1e-12) and lo <= x - 2.0 * math.pi <= hi:
+                        x -= 2.0 * math.pi
+                elif abs(x - lo) < FOLD_EDGE or abs(x - hi) < FOLD_EDGE:
+                    status = 1
+                vr[14 + j] = x
+            cand[k, j] = x
+            ins = ins and lo - 1e-12 <= x <= hi + 1e-12
+        inside[k] = ins
+    return status
 
 
 @njit(cache=True, nogil=True)

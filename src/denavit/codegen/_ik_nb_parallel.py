@@ -27,33 +27,41 @@ def ik_parallel_packed(T, K, f, i):
     Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
     a, sc, lo_lim, hi_lim = K[131:134], K[134:145], K[145:151], K[151:157]
     rev, theta, tols, far, trig = K[157:163], K[163:169], K[169:177], K[177], K[178:186]
-    # scratch: one float and one flag allocation, sliced
-    ws = np.empty(190)
-    cand, cerr, X, F = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4))
-    perm = ws[182:190]  # the candidate in each sorted slot
+    # scratch: two float and one flag allocation per call (not per pose); every view made here, once (a view per
+    # pose is an atomic reference count and its release)
+    ws = np.empty(76)
+    X, perm, vr = ws[0:3], ws[3:11], ws[11:31]  # perm: the candidate in each sorted slot
+    V, TC, cols, tl = ws[31:34], ws[34:43].reshape((3, 3)), ws[43:55].reshape((4, 3)), ws[55:67].reshape((4, 3))
+    xr, wv, g = ws[67:70], ws[70:73], ws[73:76]
+    R2, p2, p3 = C[2, :3, :3], C[2, :3, 3], C[3, :3, 3]
+    w = np.empty((27, 36))
+    cand, cerr, cs = w[0:8, 0:6], w[0:8, 6:8], w[0:8, 8:20]  # cs: cos, sin of the joints (closed form's, for the FK)
+    frames, P, F = w[8:16], w[16:23, 0:12], w[23:27, 0:4]  # frames after joints 1-3 (from the FK, for the labels)
     flags = np.zeros(24, dtype=np.bool_)
-    frames = np.empty((8, 36))  # frames after joints 1-3 of each candidate (from the FK), for the labels
-    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (from the closed form, for the FK)
+    fq, fe, fo, rank = f[:, :, :6], f[:, :, 6:8], f[:, :, 8:], i[:, 11:20]
+    ct5, st5 = math.cos(theta[4]), math.sin(theta[4])  # the wrist label's sin(q5 + theta5), by the sum formula
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond every reachable point: the plain solver's stand-in
             continue
-        ncand, status = _parallel_candidates(T[b], Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws[89:134])
-        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], perm, C, cs, True, i[b, 11:20])
+        ncand, status = _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, cols, tl, xr,
+                                             wv, g, R2, p2, p3)
+        kept, n_out, st = ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
+                                    fq, fe, fo, perm, C, cs, True, rank, P, vr)
         for r in range(3):
             X[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
         for s in range(kept):
-            i[b, s] = _parallel_label(frames[int(perm[s])], f[b, s, 4], X, C, theta)
+            k = int(perm[s])
+            i[b, s] = _parallel_label(frames, k, cs[k, 9] * ct5 + cs[k, 8] * st5, X, C)
         i[b, 8], i[b, 9], i[b, 10] = kept, n_out, max(status, st)
 
 
 @njit(cache=True, nogil=True, inline="always")  # into ik_parallel_packed (no call with eleven arrays)
-def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
-    """The candidates of one pose in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand, the
+def _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, cols, tl, xr, w, g, R2, p2, p3):
+    """The candidates of pose b in the plain plan's order (q1 root, q5 root, q3 root; + before -) into cand, the
     cosines and sines of their joints into cs (8, 12: cos q1, sin q1, cos q2, …; for the verifying FK, which then
-    computes none); trig: the wrist's constants (forms.wrist_constants); ws: 45 floats of scratch.  Returns
-    (count, status)."""
+    computes none); trig: the wrist's constants (forms.wrist_constants); V, TC, cols, tl, xr, w, g: scratch; R2, p2,
+    p3: views of C (all made once per call of the kernel, not per pose).  Returns (count, status)."""
     c0, sigma, rho_w, ap2, bp2, k0 = sc[0], sc[1], sc[2], sc[6], sc[7], sc[8]
     tol, reach = tols[1], tols[7]
     wide = sc[9] * reach  # NEAR_SINGULAR
@@ -61,16 +69,13 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
     scale = max(reach, 1e-3)
     status = 0
     ncand = 0
-    V, TC, cols, tl = ws[0:3], ws[3:12].reshape((3, 3)), ws[12:24].reshape((4, 3)), ws[24:36].reshape((4, 3))
-    xr, w, g = ws[36:39], ws[39:42], ws[42:45]
-    R2, p2, p3 = C[2, :3, :3], C[2, :3, 3], C[3, :3, 3]  # views made once (each is an atomic refcount)
     for r in range(3):  # Q in the world, then in the frame of C0
-        w[r] = Tb[r, 0] * Q_e[0] + Tb[r, 1] * Q_e[1] + Tb[r, 2] * Q_e[2] + Tb[r, 3]
+        w[r] = T[b, r, 0] * Q_e[0] + T[b, r, 1] * Q_e[1] + T[b, r, 2] * Q_e[2] + T[b, r, 3]
     for r in range(3):
         V[r] = C0i[r, 0] * w[0] + C0i[r, 1] * w[1] + C0i[r, 2] * w[2] + C0i[r, 3]
     for r in range(3):  # T_R C6_R^T
         for j in range(3):
-            TC[r, j] = Tb[r, 0] * C[6, j, 0] + Tb[r, 1] * C[6, j, 1] + Tb[r, 2] * C[6, j, 2]
+            TC[r, j] = T[b, r, 0] * C[6, j, 0] + T[b, r, 1] * C[6, j, 1] + T[b, r, 2] * C[6, j, 2]
     # the formulas of denavit.ik.forms (the plain solver's own functions, jitted), in the plain plan's order
     # q1: (Rz(q1) a) . V = h + a . pc1 (subproblem 1, as solve_trig)
     ea, eb = a[0] * V[0] + a[1] * V[1], a[0] * V[1] - a[1] * V[0]
@@ -113,14 +118,14 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
             _tail(C, c5, s5v, c6, s6v, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
             # X = F1^-1 T tail^-1: its origin P and first column xr
             for r in range(3):
-                w[r] = Tb[r, 3] - cols[3, r]
+                w[r] = T[b, r, 3] - cols[3, r]
                 for j in range(3):
-                    m_rj = Tb[r, 0] * tl[0, j] + Tb[r, 1] * tl[1, j] + Tb[r, 2] * tl[2, j]  # (T_R Rt^T)[r, j]
+                    m_rj = T[b, r, 0] * tl[0, j] + T[b, r, 1] * tl[1, j] + T[b, r, 2] * tl[2, j]  # (T_R Rt^T)[r, j]
                     w[r] -= m_rj * tl[3, j]
             P0 = cols[0, 0] * w[0] + cols[0, 1] * w[1] + cols[0, 2] * w[2]
             P1 = cols[1, 0] * w[0] + cols[1, 1] * w[1] + cols[1, 2] * w[2]
             for r in range(3):
-                g[r] = Tb[r, 0] * tl[0, 0] + Tb[r, 1] * tl[1, 0] + Tb[r, 2] * tl[2, 0]
+                g[r] = T[b, r, 0] * tl[0, 0] + T[b, r, 1] * tl[1, 0] + T[b, r, 2] * tl[2, 0]
             for r in range(3):
                 xr[r] = cols[r, 0] * g[0] + cols[r, 1] * g[1] + cols[r, 2] * g[2]
             # the planar pair (law of cosines for q3, then q2 turns v onto P), as _planar_pair
@@ -164,7 +169,7 @@ def _parallel_candidates(Tb, Q_e, C0i, C, a, sc, trig, tols, cand, cs, ws):
     return ncand, status
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # no call passing arrays
 def frame1(C, c, s, cols):
     """Columns x, y, z and origin of C0 Rz(q1) C1 into cols (4, 3), c, s = cos q1, sin q1 (as the chain's
     walker: x <- c x + s y, ...)."""
@@ -177,7 +182,7 @@ def frame1(C, c, s, cols):
         cols[3, r] = C[0, r, 3] + x * C[1, 0, 3] + y * C[1, 1, 3] + z * C[1, 2, 3]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # no call passing arrays
 def next_frame(cols, c, s, Ck, out):
     """Columns and origin of F Rz(q) Ck into out (4, 3), F given by its columns cols (4, 3), c, s = cos q, sin q
     (out may be cols)."""
@@ -189,7 +194,7 @@ def next_frame(cols, c, s, Ck, out):
         out[3, r] = cols[3, r] + x * Ck[0, 3] + y * Ck[1, 3] + z * Ck[2, 3]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")  # no call passing arrays
 def _tail(C, c5, s5, c6, s6, tl):
     """Columns and origin of C4 Rz(q5) C5 Rz(q6) C6 into tl (4, 3), from the cosines and sines of q5, q6."""
     for r in range(3):
@@ -206,27 +211,28 @@ def _tail(C, c5, s5, c6, s6, tl):
         tl[3, r] = p + x * C[6, 0, 3] + y * C[6, 1, 3] + z * C[6, 2, 3]
 
 
-@njit(cache=True, nogil=True)
-def _parallel_label(fr, q5, X, C, theta):
+@njit(cache=True, nogil=True, inline="always")  # no call passing arrays
+def _parallel_label(fr, k, s5, X, C):
     """Label code of one solution (docs/ik.md): 1 shoulder left (x1 . (X - O1) < 0, X the point Q), 2 elbow down
     (the point E of axis 3 on the far side of the line from S to W, a point of axis 4, in the plane normal to
-    axis 2, seen from axis 1), 4 wrist flip (sin(q5 + theta5) < 0).  fr (36,): columns x, y, z and origin of the
+    axis 2, seen from axis 1), 4 wrist flip (s5 = sin(q5 + theta5) < 0, from q5's cosine and sine: it differs in
+    sign from the sine of the float only within rounding of 0, the wrist singularity, which is handed over).  fr[k] (36,): columns x, y, z and origin of the
     frames after joints 1, 2, 3, three floats each (from the verifying FK, before the folding into the limits,
-    which moves the angles by whole turns; indexed, not reshaped: a reshape is a helper call)."""
+    which moves the angles by whole turns; indexed, not sliced: a view is a reference count)."""
     code = 0
     s_right = 0.0
     for r in range(3):
-        s_right += fr[r] * (X[r] - C[0, r, 3])
+        s_right += fr[k, r] * (X[r] - C[0, r, 3])
     if s_right < 0.0:
         code |= 1
-    d0, d1, d2 = fr[33] - fr[9], fr[34] - fr[10], fr[35] - fr[11]  # W - S (origins after joints 3 and 1)
-    n0 = fr[7] * d2 - fr[8] * d1  # z1 x (W - S)
-    n1 = fr[8] * d0 - fr[6] * d2
-    n2 = fr[6] * d1 - fr[7] * d0
+    d0, d1, d2 = fr[k, 33] - fr[k, 9], fr[k, 34] - fr[k, 10], fr[k, 35] - fr[k, 11]  # W - S (origins, joints 3, 1)
+    n0 = fr[k, 7] * d2 - fr[k, 8] * d1  # z1 x (W - S)
+    n1 = fr[k, 8] * d0 - fr[k, 6] * d2
+    n2 = fr[k, 6] * d1 - fr[k, 7] * d0
     towards = 1.0 if C[0, 0, 2] * n0 + C[0, 1, 2] * n1 + C[0, 2, 2] * n2 >= 0.0 else -1.0
-    side = (fr[21] - fr[9]) * n0 + (fr[22] - fr[10]) * n1 + (fr[23] - fr[11]) * n2  # (E - S) . n
+    side = (fr[k, 21] - fr[k, 9]) * n0 + (fr[k, 22] - fr[k, 10]) * n1 + (fr[k, 23] - fr[k, 11]) * n2  # (E - S) . n
     if side * towards < 0.0:
         code |= 2
-    if math.sin(q5 + theta[4]) < 0.0:
+    if s5 < 0.0:
         code |= 4
     return code

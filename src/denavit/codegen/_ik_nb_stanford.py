@@ -40,11 +40,14 @@ def ik_stanford_packed(T, K, f, i):
     X_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
     geom, sc, lo_lim, hi_lim = K[131:140], K[140:149], K[149:155], K[155:161]
     rev, theta, tols, far = K[161:167], K[167:173], K[173:181], K[181]
-    ws = np.empty(139)
+    ws = np.empty(159)
     cand, cerr, X, F = ws[0:48].reshape((8, 6)), ws[48:64].reshape((8, 2)), ws[64:67], ws[67:83].reshape((4, 4))
+    perm, vr = ws[131:139], ws[139:159]
     flags = np.zeros(24, dtype=np.bool_)
-    frames = np.empty((8, 36))  # ik_finish's frames after joints 1-3 (unused here: the labels need q1 only)
-    cs = np.empty((8, 12))  # cos, sin of each candidate's joints (ik_finish's, for its FK)
+    w = np.empty((23, 36))
+    frames = w[0:8]  # ik_finish's frames after joints 1-3 (unused here: the labels need q1 only)
+    cs, P = w[8:16, 0:12], w[16:23, 0:12]  # cos, sin of each candidate's joints (ik_finish's, for its FK); its FK's
+    fq, fe, fo, rank = f[:, :, :6], f[:, :, 6:8], f[:, :, 8:], i[:, 11:20]
     for b in range(T.shape[0]):
         if not math.sqrt(T[b, 0, 3] ** 2 + T[b, 1, 3] ** 2 + T[b, 2, 3] ** 2) <= far:
             i[b, 8], i[b, 9], i[b, 10] = 0, 0, 1  # beyond the bound of _solve (prismatic travel included): its stand-in
@@ -52,9 +55,8 @@ def ik_stanford_packed(T, K, f, i):
         for r in range(3):
             X[r] = T[b, r, 0] * X_e[0] + T[b, r, 1] * X_e[1] + T[b, r, 2] * X_e[2] + T[b, r, 3]
         ncand, status = _stanford_candidates(T[b], X, C0i, C, geom, sc, tols, cand, ws[89:131])
-        kept, n_out, st = ik_finish(T[b], cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
-                                    f[b, :, :6], f[b, :, 6:8], f[b, :, 8:], ws[131:139], C, cs, False,
-                                    i[b, 11:20])
+        kept, n_out, st = ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, rev, tols, F, frames, flags,
+                                    fq, fe, fo, perm, C, cs, False, rank, P, vr)
         for s in range(kept):
             i[b, s] = _stanford_label(f[b, s, :6], X, C, theta)
             if i[b, s] < 0.0:  # the shoulder label on its knife edge: the plain solver's rounding decides

@@ -263,14 +263,17 @@ def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
     batched layout: slot k of a pose is its k-th verified candidate in candidate order (NaN rows, ``valid``
     False, where that candidate was a duplicate or outside the limits), K slots = the most verified candidates
     of any pose; ``outside_limits`` counts per pose.  The kernel writes that layout itself (:mod:`._ik_nb_entry`);
-    poses it hands over are solved by :func:`denavit.analytic_ik` as one sub-batch and put in their rows."""
+    poses it hands over are solved by :func:`denavit.analytic_ik` as one sub-batch and put in their rows.  The
+    kernel runs over blocks of poses (:mod:`._ik_nb_batch`: its scratch made once per block, not per pose)."""
+    from ._ik_nb_batch import batch_entry  # numba's: imported only where a compiled solver exists
+
     batch, n = Ta.shape[:-2], robot.dof
     Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))  # (B, 4, 4)
     B = len(Tf)
     sol, pe, re = np.empty((B, 8, n)), np.empty((B, 8)), np.empty((B, 8))
     valid, codes = np.empty((B, 8), dtype=bool), np.empty((B, 8), dtype=np.int8)
     outside, status = np.empty(B, dtype=np.int64), np.empty(B, dtype=np.int8)
-    most, bad, err = c[3](Tf, c[0], sol, pe, re, valid, codes, outside, status)
+    most, bad, err = batch_entry(c[3])(Tf, c[0], sol, pe, re, valid, codes, outside, status)
     if bad >= 0:
         raise ShapeError("T has non-finite values" if err == np.inf else
                          f"T: rotation part is not orthonormal (error {err:.2g})")
