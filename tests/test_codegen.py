@@ -463,3 +463,29 @@ def test_compiled_analytic_ik_other_arms_and_bad_input():
     far = np.eye(4)
     far[:3, 3] = (9.0, 0.0, 0.0)
     assert fast.analytic_ik(far).count == 0
+
+
+
+@needs_numba
+def test_each_arm_binds_its_own_lm_under_its_own_symbol_names():
+    """The LM that a generated module binds (denavit.codegen.numba_ik_lm) calls that module's kernel, and numba
+    names machine code by module, qualified name and a per-process counter: the closures of two arms share code,
+    module and name, so two arms compiled in two processes and loaded from the cache into a third could run one
+    arm's kernel for both (seen: ur5's ik_lm took 34 steps where the plain solver took 6).  Each binding's
+    closures are named after their module (what numba's symbol names are made of, read the way numba reads it)."""
+    from numba.core.bytecode import FunctionIdentity
+
+    from denavit.codegen import numba_ik_lm
+
+    def kernel(q, P):
+        pass
+
+    names = []
+    for owner in ("_denavit_kernels_numba_a", "_denavit_kernels_numba_b"):
+        solve, check = numba_ik_lm(kernel, owner)
+        attempt = dict(zip(solve.__code__.co_freevars, (c.cell_contents for c in solve.__closure__)))["attempt"]
+        for f in (solve, attempt):
+            name = FunctionIdentity.from_function(f).func_qualname
+            assert name.startswith(owner + ".")
+            names.append(name)
+    assert len(set(names)) == 4 and callable(check)

@@ -16,11 +16,16 @@ _REGISTERED: list[bool] = []
 _ARGS = "T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, first, out_q, out_info"
 
 
-def numba_ik_lm(fkj):
-    """``(solve, check)`` for a generated numba module: the ``solve`` of :func:`denavit.ik.lm.bind` for the
-    module's fused kernel ``fkj``, made callable from numba-compiled code with the functions it calls
-    (``numba.extending.register_jitable``), and the targets' test ``ik_check(T, Q)`` (largest |RᵀR − I| entry; inf
-    for a non-finite target, −1 for a non-finite seed)."""
+def numba_ik_lm(fkj, owner: str):
+    """``(solve, check)`` for the generated numba module ``owner`` (its ``__name__``): the ``solve`` of
+    :func:`denavit.ik.lm.bind` for the module's fused kernel ``fkj``, made callable from numba-compiled code with
+    the functions it calls (``numba.extending.register_jitable``), and the targets' test ``ik_check(T, Q)`` (largest
+    |RᵀR − I| entry; inf for a non-finite target, −1 for a non-finite seed).
+
+    The two closures are named after ``owner``: numba names machine code by module, qualified name and a counter
+    of its process, and every arm's closures share module and name; two arms compiled in two processes could get
+    the same counter, and loaded from the cache into one process, one arm's ik_lm then ran the other's code (its
+    kernel): the symbols must differ."""
     from numba.extending import register_jitable
 
     from ..ik import lm
@@ -31,6 +36,8 @@ def numba_ik_lm(fkj):
             register_jitable(f)
         _REGISTERED.append(True)
     attempt, solve = lm.bind(fkj)
+    for f in (attempt, solve):
+        f.__qualname__ = f"{owner}.{f.__name__}"
     register_jitable(attempt)
     register_jitable(solve)
     return solve, ik_check
@@ -38,7 +45,7 @@ def numba_ik_lm(fkj):
 
 def ik_lm_lines() -> list[str]:
     """The binding's text in a generated numba module (fixed: nothing of the robot or the user enters it)."""
-    return ["from denavit.codegen import numba_ik_lm", "", "_lm_solve, ik_check = numba_ik_lm(fk_jacobian0_1)", "", "",
+    return ["from denavit.codegen import numba_ik_lm", "", "_lm_solve, ik_check = numba_ik_lm(fk_jacobian0_1, __name__)", "", "",
             "@njit(cache=True, nogil=True)", f"def ik_lm({_ARGS}):",
             '    """Levenberg-Marquardt of denavit.ik.lm (see there) on this arm\'s fused FK + J0 kernel."""',
             f"    _lm_solve({_ARGS})", ""]

@@ -163,8 +163,9 @@ def _attempt_of(fkj):
     def attempt(Tt, q, lo, hi, revolute, w, L, tol, max_iter, clip, buf):
         """One LM run from q, changed in place to its end point (folded into the limits when converged).  Without
         ``clip`` the iteration ignores the limits (revolute values wrapped); with it every step is folded and clipped
-        into them.  ``buf``: the scratch of :func:`buffers`.  Returns (iterations, converged within the limits)."""
-        P, Pn, e, en, Jw, A, dq, qn = buf
+        into them.  ``buf``: the scratch of :func:`buffers`.  Returns (iterations, converged within the limits, and
+        the position error, orientation error and cost of the end point, see :func:`pose_residual`)."""
+        P, Pn, e, en, A, dq, qn = buf
         n = len(q)
         fold(q, lo, hi, revolute, clip, clip)
         fkj(q, P)
@@ -174,14 +175,20 @@ def _attempt_of(fkj):
         it = 1
         while True:
             if pe <= half and re <= half:
+                for k in range(n):
+                    qn[k] = q[k]
                 fold(q, lo, hi, revolute, True, False)
-                inside = True
+                inside, moved = True, False
                 for k in range(n):
                     inside = inside and lo[k] - 1e-12 <= q[k] <= hi[k] + 1e-12
-                return it, inside
+                    moved = moved or q[k] != qn[k]
+                if moved:  # the folded point judged on its own pose
+                    fkj(q, P)
+                    pe, re, cost = pose_residual(Tt, P, w, e)
+                return it, inside, pe, re, cost
             if it > max_iter:
-                return it, False
-            damped_step(P, e, w, lam, n, Jw, A, dq)
+                return it, False, pe, re, cost
+            damped_step(P, e, w, lam, n, Pn, A, dq)  # Pn as J_W's scratch: the trial point's pose comes next
             for k in range(n):
                 qn[k] = q[k] + dq[k]
             fold(qn, lo, hi, revolute, clip, clip)
@@ -196,11 +203,11 @@ def _attempt_of(fkj):
                 pe, re, cost = pe_n, re_n, cost_n
                 lam = max(lam * 0.2, floor)
                 if flat and not (pe <= half and re <= half):
-                    return it, False  # a local minimum with a residual (or unreachable)
+                    return it, False, pe, re, cost  # a local minimum with a residual (or unreachable)
             else:
                 lam *= 8.0
                 if lam > stuck:
-                    return it, False
+                    return it, False, pe, re, cost
 
     return attempt
 
@@ -208,25 +215,24 @@ def _attempt_of(fkj):
 def buffers(n):
     """The scratch of ``attempt`` for n joints, as arrays."""
     m = 16 + 6 * n
-    return (np.empty(m), np.empty(m), np.empty(6), np.empty(6), np.empty(6 * n), np.empty(n * n), np.empty(n),
-            np.empty(n))
+    return np.empty(m), np.empty(m), np.empty(6), np.empty(6), np.empty(n * n), np.empty(n), np.empty(n)
 
 
 def _solve_of(fkj, attempt):
     def solve(T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, first, out_q, out_info):
         """``attempt`` for each target T[b] (B, 4, 4) from q0[b] (iterating freely, as the plain solver's first
         attempt), then from random q in [slo, shi] (restarts 1, 1 + CLIP_EVERY, ... iterated inside the limits, the
-        others freely) until one converges within the limits; out_q[b] that
-        solution or the best end point, out_info[b] = (success, position error, orientation error, iterations,
-        restarts), the errors of out_q[b] by ``fkj``.  The restarts of target b are drawn from a generator seeded by
-        (seed, first + b), first being the index of T[0] in the whole batch: a batch split into blocks over threads
-        gives every target the draws of the whole batch in one call (numba's generator state is per thread)."""
+        others freely) until one converges within the limits; out_q[b] that solution or the best end point,
+        out_info[b] = (success, position error, orientation error, iterations, restarts), the errors of out_q[b]
+        on its own pose.  The restarts of target b are drawn from a generator seeded by (seed, first + b), first
+        being the index of T[0] in the whole batch: a batch split into blocks over threads gives every target the
+        draws of the whole batch in one call (numba's generator state is per thread)."""
         n = q0.shape[1]
         buf = buffers(n)
-        P, e = np.empty(16 + 6 * n), np.empty(6)
         q = np.empty(n)
+        T16 = T.reshape((T.shape[0], 16))
         for b in range(T.shape[0]):
-            Tt = T[b].reshape(16)
+            Tt = T16[b]
             best_pe, best_re, best_cost = np.inf, np.inf, np.inf
             iterations = 0
             done = False
@@ -241,11 +247,9 @@ def _solve_of(fkj, attempt):
                     for k in range(n):
                         q[k] = slo[k] + (shi[k] - slo[k]) * np.random.random()
                 budget = max_iterations if used == 0 else max(1, int(RESTART_ITERATIONS * max_iterations))
-                it, ok = attempt(Tt, q, lo, hi, revolute, w, L, tol, budget, used % CLIP_EVERY == 1,
-                                 buf)
+                it, ok, pe, re, cost = attempt(Tt, q, lo, hi, revolute, w, L, tol, budget, used % CLIP_EVERY == 1,
+                                               buf)
                 iterations += it
-                fkj(q, P)  # the end point as returned (folded when converged), judged on its own pose
-                pe, re, cost = pose_residual(Tt, P, w, e)
                 if ok and pe <= tol and re <= tol:
                     best_pe, best_re = pe, re
                     for k in range(n):

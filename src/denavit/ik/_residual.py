@@ -163,8 +163,8 @@ class JointLimits:
     def sample_bounds(self, scale: float) -> tuple[np.ndarray, np.ndarray]:
         """Where random restarts are drawn: :func:`denavit.model.sampling_ranges` of these limits (±π revolute,
         ±scale prismatic where infinite)."""
-        r = sampling_ranges(np.column_stack([self.lo, self.hi]), self.revolute, scale)
-        return r[:, 0], r[:, 1]
+        lo, hi = sampling_ranges(np.column_stack([self.lo, self.hi]), self.revolute, scale).T.copy()  # contiguous
+        return lo, hi
 
     def sample(self, rng: np.random.Generator, shape: tuple[int, ...], scale: float) -> np.ndarray:
         lo, hi = self.sample_bounds(scale)

@@ -71,11 +71,10 @@ def solve_single(robot: DHRobot, q0: np.ndarray, T: np.ndarray, w: np.ndarray, w
     """The first attempt of ``solve_ik`` for one target in floats; an ``IKResult`` when it ends in a solution
     within the limits (checked by :func:`forward_kinematics`, as the batched path does), else None."""
     n = len(q0)
-    buf = ([0.0] * (16 + 6 * n), [0.0] * (16 + 6 * n), [0.0] * 6, [0.0] * 6, [0.0] * (6 * n), [0.0] * (n * n),
-           [0.0] * n, [0.0] * n)
+    buf = ([0.0] * (16 + 6 * n), [0.0] * (16 + 6 * n), [0.0] * 6, [0.0] * 6, [0.0] * (n * n), [0.0] * n, [0.0] * n)
     q = q0.tolist()
-    it, ok = single_chain(robot).attempt(T.ravel().tolist(), q, limits.lo.tolist(), limits.hi.tolist(),
-                                         limits.revolute.tolist(), w.tolist(), L, tol, max_iter, False, buf)
+    it, ok, _, _, _ = single_chain(robot).attempt(T.ravel().tolist(), q, limits.lo.tolist(), limits.hi.tolist(),
+                                                  limits.revolute.tolist(), w.tolist(), L, tol, max_iter, False, buf)
     if not ok:
         return None
     q = limits.project(np.array(q))
