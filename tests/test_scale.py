@@ -429,3 +429,28 @@ def test_refined_cells_are_the_shell_of_the_pilot_at_twice_the_edge(dim, side):
                 if any_within(occ2, np.array(c) // 2, 1, True) and any_within(occ2, np.array(c) // 2, 2, False)
                 and not (counts[c] > 0 and not any_within(counts > 0, c, 1, False))]
     assert 0 < len(expected) < side**dim and ref.cells.tolist() == expected
+
+
+def test_projected_coverage_is_the_poisson_expectation_and_sets_the_automatic_factor():
+    """projected_coverage against simulated Poisson sub-cell counts (mean share·c, Good–Turing 1 − f1/N of the
+    pooled draws); the automatic factor is the largest whose projection reaches PROJECTED_COVERAGE."""
+    from denavit.scale._refine import PROJECTED_COVERAGE, plan_refinement, projected_coverage
+
+    rng = np.random.default_rng(4)
+    c = rng.integers(1, 30, 400)
+    for share in (0.05, 0.2, 1.0):
+        draws = rng.poisson(share * np.repeat(c, 500))  # 500 sub-cells of each cell's mean
+        simulated = 1 - np.count_nonzero(draws == 1) / draws.sum()
+        assert projected_coverage(c, share) == pytest.approx(simulated, abs=0.01)
+    counts = np.zeros((64, 64), np.uint64)
+    counts[8:56, 8:56] = rng.integers(3, 9, (48, 48))  # a square, its pilot well covered
+    plan = {blocks: plan_refinement(counts, None, 1, blocks) for blocks in (2, 8, 400)}
+    for blocks, ref in plan.items():
+        later = blocks - 1  # samples after the pilot per pilot sample (a pilot of one block)
+        k = 0 if ref is None else ref.factor
+        cells = counts.reshape(-1)[plan[400].cells]
+        if k:
+            assert projected_coverage(cells, later / k**2) >= PROJECTED_COVERAGE
+        if k < 8:
+            assert projected_coverage(cells, later / (max(k, 1) * 2) ** 2) < PROJECTED_COVERAGE
+    assert plan[2] is None and plan[8].factor == 2 and plan[400].factor == 8  # fewer samples, coarser sub-cells

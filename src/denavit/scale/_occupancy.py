@@ -254,7 +254,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         yield from ((job, f, c) for f, c in _tasks(job.samples, chunk, 0, pilot))
         yield None  # barrier: every pilot result is merged into counts before the plan is made
         sink.flush()
-        ref = plan_refinement(counts, refine, pilot)
+        ref = plan_refinement(counts, refine, pilot, blocks)
         if ref is not None:
             state["job"] = dataclasses.replace(job, refine=ref)
             small = job.samples - pilot * BLOCK < 2**32  # no sub-cell count can overflow uint32
