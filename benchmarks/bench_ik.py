@@ -349,33 +349,37 @@ def per_pose(name, n, rounds=7, batch=100_000):
     return med, ratios, differ, _batch_rates(fast, eaik, _targets(robot, batch, seed=8)[1])
 
 
-def _batch_rates(fast, eaik, Tb):
-    """Poses per second of the compiled kernel's own loop over the batch Tb (one thread), of the public batched
-    ``analytic_ik`` (that loop, the hand-overs to the plain solver, the batched layout) and of EAIK's batched call
-    with one worker thread; the share of poses the kernel hands to the plain solver."""
-    kern, out = fast._analytic_solver(), {}
+def _batch_rates(fast, eaik, Tb, rounds=3):
+    """Poses per second of the compiled kernel's own loop over the batch Tb (one thread: its batch entry, blocks of
+    poses, into the plain solver's batched layout), of the public batched ``analytic_ik`` (that loop, the
+    hand-overs to the plain solver, the result) and of EAIK's batched call with one worker thread, each the best of
+    ``rounds`` interleaved rounds (CPU time); the share of poses the kernel hands to the plain solver."""
+    kern, B = fast._analytic_solver(), len(Tb)
+    Tb = np.ascontiguousarray(Tb)
+    best = {}
     if kern:
-        from denavit.codegen._ik_nb_batch import batch_entry  # the entry analytic_ik(batch) calls
-
-        K, many, B, n = kern[0], batch_entry(kern[3]), len(Tb), fast.dof
-        Tb = np.ascontiguousarray(Tb)
+        K, many, n = kern[0], kern[3], fast.dof
 
         def layout():  # the batched layout the kernel writes (as codegen._solvers._batch)
             return (np.empty((B, 8, n)), np.empty((B, 8)), np.empty((B, 8)), np.empty((B, 8), dtype=bool),
                     np.empty((B, 8), dtype=np.int8), np.empty(B, dtype=np.int64), np.empty(B, dtype=np.int8))
         many(Tb[:10], K, *(a[:10] for a in layout()))
+        fast.analytic_ik(Tb[:10])
         outs = layout()
-        t0 = time.process_time()
-        many(Tb, K, *outs)
-        dt = time.process_time() - t0
-        out = {"kernel poses/s": B / dt, "kernel µs/pose": dt / B * 1e6, "handed over": (outs[-1] == 1).mean()}
-        t0 = time.process_time()
-        fast.analytic_ik(Tb)  # the public batched call: kernel loop, hand-overs, the plain solver's layout
-        out["analytic_ik(batch) poses/s"] = len(Tb) / (time.process_time() - t0)
+        runs = {"kernel": lambda: many(Tb, K, *outs), "analytic_ik(batch)": lambda: fast.analytic_ik(Tb)}
+    else:
+        runs = {}
     if eaik:
-        t0 = time.process_time()
-        eaik.calculate_IK_batched(list(Tb), 1)
-        out["EAIK batched (1 thread) poses/s"] = len(Tb) / (time.process_time() - t0)
+        Tl = list(Tb)
+        runs["EAIK batched (1 thread)"] = lambda: eaik.calculate_IK_batched(Tl, 1)
+    for _ in range(rounds):
+        for who, f in runs.items():
+            t0 = time.process_time()
+            f()
+            best[who] = min(best.get(who, np.inf), time.process_time() - t0)
+    out = {f"{who} poses/s": B / dt for who, dt in best.items()}
+    if kern:
+        out["kernel µs/pose"], out["handed over"] = best["kernel"] / B * 1e6, (outs[-1] == 1).mean()
     return out
 
 

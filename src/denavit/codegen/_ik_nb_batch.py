@@ -17,11 +17,11 @@ import numpy as np
 from numba import njit
 
 from ._ik_nb_elbow import ik_elbow_packed
-from ._ik_nb_entry import BAD_TARGET, ENTRIES
+from ._ik_nb_entry import BAD_TARGET
 from ._ik_nb_parallel import ik_parallel_packed
 from ._ik_nb_stanford import ik_stanford_packed
 
-__all__ = ["BLOCK", "BATCH", "batch_entry"]
+__all__ = ["BLOCK", "BATCH", "ik_batch_elbow", "ik_batch_parallel", "ik_batch_stanford"]
 
 #: poses solved by one call of a kernel (its scratch: a few kB; the block's outputs: BLOCK × 1.1 kB, in L1/L2)
 BLOCK = 64
@@ -123,10 +123,3 @@ def ik_batch_stanford(T, K, sol, pe, re, valid, codes, outside, status):
 
 #: the batch entry of each closed form
 BATCH = {"elbow": ik_batch_elbow, "parallel": ik_batch_parallel, "stanford": ik_batch_stanford}
-_OF_ENTRY = {ENTRIES[kind][1]: BATCH[kind] for kind in BATCH}
-
-
-def batch_entry(many):
-    """The batch entry of the kernel whose one-pose-at-a-time batch entry (``ENTRIES[kind][1]``, kept in the
-    compiled arm's solver) is ``many``."""
-    return _OF_ENTRY.get(many, many)

@@ -188,12 +188,14 @@ class IKMethods:
 
     def _analytic_solver(self):
         """``[K, (labels, plan kind), one, many, OUT_SIZE, first call]`` for the compiled closed form of this arm's
-        IK plan (``one(T, K, o)``, ``many(T, K, o)``: the entries of :mod:`._ik_nb_entry` of its elbow, UR-class or
-        Stanford-class kernel, by plan kind and route), or False where there is none (the plain solver answers)."""
+        IK plan (``one(T, K, o)``: the one-pose entry of :mod:`._ik_nb_entry`, ``many``: the batch entry of
+        :mod:`._ik_nb_batch`, of its elbow, UR-class or Stanford-class kernel, by plan kind and route), or False
+        where there is none (the plain solver answers)."""
         plan = ik_plan(self.robot)  # UnsupportedRobotError for arms with no closed form, as the plain function
         if self.backend != NUMBA or plan.closed is None or not {"fk", "fk_jacobian0"} <= set(self.kernels):
             return False
         from ._ik_jit import fresh_cache
+        from ._ik_nb_batch import BATCH
         from ._ik_nb_entry import ENTRIES, OUT_SIZE  # module-level kernels: compiled once per machine
 
         if plan.kind == "parallel":
@@ -211,7 +213,7 @@ class IKMethods:
             if not np.array_equal(np.reshape(k["consts"], (4, 4, 4))[:3], k["chain"][:3]):
                 return False  # the kernel's labels read the frames after joints 1, 2 off its verifying FK
             K, kind = pack_constants(k, ELBOW_LAYOUT, "elbow"), "elbow"
-        one, many = ENTRIES[kind]
+        one, many = ENTRIES[kind], BATCH[kind]
         fresh_cache(one, many)  # none stale (see there)
         return [K, (tuple(plan.closed["labels"]), plan.kind), one, many, OUT_SIZE, True]
 
@@ -265,15 +267,13 @@ def _batch(robot, c, Ta: np.ndarray) -> AnalyticIKResult:
     of any pose; ``outside_limits`` counts per pose.  The kernel writes that layout itself (:mod:`._ik_nb_entry`);
     poses it hands over are solved by :func:`denavit.analytic_ik` as one sub-batch and put in their rows.  The
     kernel runs over blocks of poses (:mod:`._ik_nb_batch`: its scratch made once per block, not per pose)."""
-    from ._ik_nb_batch import batch_entry  # numba's: imported only where a compiled solver exists
-
     batch, n = Ta.shape[:-2], robot.dof
     Tf = np.ascontiguousarray(Ta.reshape(-1, 4, 4))  # (B, 4, 4)
     B = len(Tf)
     sol, pe, re = np.empty((B, 8, n)), np.empty((B, 8)), np.empty((B, 8))
     valid, codes = np.empty((B, 8), dtype=bool), np.empty((B, 8), dtype=np.int8)
     outside, status = np.empty(B, dtype=np.int64), np.empty(B, dtype=np.int8)
-    most, bad, err = batch_entry(c[3])(Tf, c[0], sol, pe, re, valid, codes, outside, status)
+    most, bad, err = c[3](Tf, c[0], sol, pe, re, valid, codes, outside, status)
     if bad >= 0:
         raise ShapeError("T has non-finite values" if err == np.inf else
                          f"T: rotation part is not orthonormal (error {err:.2g})")
