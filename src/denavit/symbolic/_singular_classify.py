@@ -119,11 +119,11 @@ def factor_solutions(f: sp.Expr, var: int, robot: DHRobot, q, params: dict) -> l
 
 
 def random_q(robot: DHRobot, rng: np.random.Generator) -> np.ndarray:
-    lim = robot.q_limits
-    lo = np.where(np.isfinite(lim[:, 0]), lim[:, 0], -math.pi)
-    hi = np.where(np.isfinite(lim[:, 1]), lim[:, 1], math.pi)
-    lo, hi = np.maximum(lo, -math.pi), np.minimum(hi, math.pi)
-    return rng.uniform(lo, hi)
+    """A random configuration within the limits (:meth:`DHRobot.sampling_ranges`: ±1 m for a prismatic joint
+    without limits, as the singularity checker's), revolute joints within one turn."""
+    ranges = robot.sampling_ranges(1.0)
+    turn = np.where([t is JointType.REVOLUTE for t in robot.joint_types], math.pi, np.inf)
+    return rng.uniform(np.maximum(ranges[:, 0], -turn), np.minimum(ranges[:, 1], turn))
 
 
 def _zero_set_samples(f, variables: list[int], sols, robot, q, params, rng, count: int = 3) -> list[np.ndarray]:

@@ -32,13 +32,8 @@ def _asset(name: str) -> str:
 
 def slider_limits(robot: DHRobot) -> np.ndarray:
     """Slider range per joint (n, 2): the joint limits; [−π, π] for unlimited revolute joints,
-    ±(arm scale) for unlimited prismatic ones."""
-    lim = robot.q_limits
-    for k, kind in enumerate(robot.joint_types):
-        if not np.all(np.isfinite(lim[k])):
-            bound = np.pi if kind is JointType.REVOLUTE else robot_scale(robot)
-            lim[k] = np.clip(lim[k], -bound, bound)
-    return lim
+    ±(arm scale) for unlimited prismatic ones (:meth:`DHRobot.sampling_ranges`)."""
+    return robot.sampling_ranges(robot_scale(robot))
 
 
 def _view_box(robot: DHRobot, lim: np.ndarray) -> tuple[list[float], float]:
