@@ -54,10 +54,8 @@ def fold(q, lo, hi, revolute, shift, clip):
 def pose_residual(Tt, P, w, e):
     """e = W (p_t − p, log(R_t Rᵀ)) for the target Tt and the pose P[:16] (4×4, row-major, flat); returns the
     norms of the position and orientation rows that w selects (unweighted: [m], [rad]) and the cost |e|².
-
-    The rotation log of M = R_t Rᵀ: θ = acos((tr M − 1)/2), log = θ/(2 sin θ) (M − Mᵀ)ᵛ; near π (cos θ < −0.9)
-    the axis from the symmetric part (its column of largest diagonal), the sign from (M − Mᵀ)ᵛ (Murray, Li &
-    Sastry 1994, Sec. 2.2)."""
+    log M = θ/(2 sin θ) (M − Mᵀ)ᵛ, θ = acos((tr M − 1)/2); near π (cos θ < −0.9) the axis from the symmetric part
+    (its column of largest diagonal), the sign from (M − Mᵀ)ᵛ (Murray, Li & Sastry 1994, Sec. 2.2)."""
     e[0] = Tt[3] - P[3]
     e[1] = Tt[7] - P[7]
     e[2] = Tt[11] - P[11]
@@ -161,28 +159,26 @@ def bind(fkj):
 
 def _attempt_of(fkj):
     def attempt(Tt, q, lo, hi, revolute, w, L, tol, max_iter, clip, buf):
-        """One LM run from q, changed in place to its end point (folded into the limits when converged).  Without
-        ``clip`` the iteration ignores the limits (revolute values wrapped); with it every step is folded and clipped
-        into them.  ``buf``: the scratch of :func:`buffers`.  Returns (iterations, converged within the limits, and
-        the position error, orientation error and cost of the end point, see :func:`pose_residual`)."""
+        """One LM run from q, changed in place to its end point (folded into the limits when converged); without
+        ``clip`` it ignores the limits (revolute values wrapped), with it every step is folded and clipped into them.
+        ``buf``: :func:`buffers`.  Returns (iterations, converged within the limits, the end point's position
+        error, orientation error and cost as :func:`pose_residual`'s)."""
         P, Pn, e, en, A, dq, qn = buf
         n = len(q)
         fold(q, lo, hi, revolute, clip, clip)
         fkj(q, P)
         pe, re, cost = pose_residual(Tt, P, w, e)
-        lam = LAMBDA0 * L * L
-        floor, stuck, half = 1e-12 * L * L, LAMBDA_MAX * L * L, 0.5 * tol
-        it = 1
+        lam, floor, stuck, half, it = LAMBDA0 * L * L, 1e-12 * L * L, LAMBDA_MAX * L * L, 0.5 * tol, 1
         while True:
             if pe <= half and re <= half:
                 for k in range(n):
                     qn[k] = q[k]
                 fold(q, lo, hi, revolute, True, False)
                 inside, moved = True, False
-                for k in range(n):
+                for k in range(n):  # moved: the folded point judged on its own pose
                     inside = inside and lo[k] - 1e-12 <= q[k] <= hi[k] + 1e-12
                     moved = moved or q[k] != qn[k]
-                if moved:  # the folded point judged on its own pose
+                if moved:
                     fkj(q, P)
                     pe, re, cost = pose_residual(Tt, P, w, e)
                 return it, inside, pe, re, cost
