@@ -92,10 +92,28 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
     sine of each joint of candidate k, given by the closed form (``given``: the very values of math.cos, math.sin
     of those floats, so the FK computes no sine) or computed here; out_rank[b, slot] the rank of each kept solution
     among the verified candidates in candidate order, out_rank[b, 8] their number (the slots of the plain solver's
-    batched layout).  Scratch: P (7, 12), the FK's partial products; vr (20,).  The outputs are indexed by b, not
-    sliced (a view per pose is an atomic reference count and its release).  Returns (kept, outside, status)."""
-    verify_tol, polish_above, dup_tol, merge_r, reach = tols[2], tols[3], tols[4], tols[5], tols[7]
-    ok, inside, used = flags[0:8], flags[8:16], flags[16:24]
+    batched layout).  Scratch: P (7, 12), the FK's partial products; vr (20,); flags (24,): verified, inside the
+    limits, placed (8 each).  The outputs are indexed by b, not sliced (a view per pose is an atomic reference
+    count and its release).  Returns (kept, outside, status)."""
+    status = _verify(T, b, cand, cerr, ncand, revolute, tols, F, frames, flags, C, cs, given, P)
+    nver = 0
+    for k in range(ncand):
+        if flags[k]:
+            vr[k] = nver
+            nver += 1
+    out_rank[b, 8] = nver
+    status = max(status, _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr))
+    status = max(status, _merge(cand, ncand, flags, revolute, tols[4], tols[5]))
+    kept, n_out = _sort_out(b, cand, cerr, ncand, flags, out_q, out_err, out_outq, perm, out_rank, vr)
+    return kept, n_out, status
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish
+def _verify(T, b, cand, cerr, ncand, revolute, tols, F, frames, flags, C, cs, given, P):
+    """Each candidate's FK (resumed from the joints it shares with the previous one) against T[b]: its position and
+    orientation residuals into cerr[k], the frames after joints 1-3 into frames[k], flags[k] whether it reproduces
+    T[b] within VERIFY_TOL.  Returns 1 if some residual is one the plain solver would polish, else 0."""
+    verify_tol, polish_above, reach = tols[2], tols[3], tols[7]
     status = 0
     for r in range(3):
         P[0, r], P[0, 3 + r], P[0, 6 + r], P[0, 9 + r] = C[0, r, 0], C[0, r, 1], C[0, r, 2], C[0, r, 3]
@@ -125,19 +143,21 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
         size = pe + reach * re
         if size < 0.05 * max(reach, 1e-3) and size > polish_above * max(reach, 1.0):
             status = 1  # would be polished by the plain solver
-        ok[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
-    nver = 0
+        flags[k] = pe <= verify_tol * max(1.0, reach) and re <= verify_tol
+    return status
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish
+def _merge(cand, ncand, flags, revolute, dup_tol, merge_r):
+    """Each verified (folded) candidate within DUPLICATE_TOL of an earlier verified one dropped (flags[k] False).
+    Returns 1 if some pair lies within the merge radius but beyond that (the plain solver merges such a pair by the
+    FK of its midpoint), else 0."""
+    status = 0
     for k in range(ncand):
-        if ok[k]:
-            vr[k] = nver
-            nver += 1
-    out_rank[b, 8] = nver
-    status = max(status, _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr))
-    for k in range(ncand):
-        if not ok[k]:
+        if not flags[k]:
             continue
         for m in range(k):
-            if not ok[m]:
+            if not flags[m]:
                 continue
             dmax = 0.0
             for j in range(6):
@@ -148,26 +168,34 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
                 if dmax >= merge_r:
                     break  # neither a duplicate nor a pair to merge (most pairs differ in q1 already)
             if dmax < dup_tol:
-                ok[k] = False
+                flags[k] = False
                 break
             if dmax < merge_r:
-                status = 1  # the plain solver merges such a pair by the FK of its midpoint
+                status = 1
+    return status
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish
+def _sort_out(b, cand, cerr, ncand, flags, out_q, out_err, out_outq, perm, out_rank, vr):
+    """The verified candidates outside the limits into out_outq[b] (in candidate order), the others sorted
+    lexicographically into out_q[b] with their residuals, perm and out_rank[b] (see ik_finish).  Returns (kept,
+    outside)."""
     kept = 0
     n_out = 0
     for k in range(ncand):
-        if ok[k] and not inside[k]:
+        if flags[k] and not flags[8 + k]:
             for j in range(6):
                 out_outq[b, n_out, j] = cand[k, j]
             n_out += 1
-            ok[k] = False
-        elif ok[k]:
+            flags[k] = False
+        elif flags[k]:
             kept += 1
     for k in range(8):
-        used[k] = False
+        flags[16 + k] = False
     for slot in range(kept):
         best = -1
         for k in range(ncand):
-            if ok[k] and not used[k]:
+            if flags[k] and not flags[16 + k]:
                 if best < 0:
                     best = k
                 else:
@@ -176,19 +204,20 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
                             if cand[k, j] < cand[best, j]:
                                 best = k
                             break
-        used[best] = True
+        flags[16 + best] = True
         perm[slot] = best
         out_rank[b, slot] = vr[best]
         for j in range(6):
             out_q[b, slot, j] = cand[best, j]
         out_err[b, slot, 0], out_err[b, slot, 1] = cerr[best, 0], cerr[best, 1]
-    return kept, n_out, status
+    return kept, n_out
 
 
 @njit(cache=True, nogil=True, inline="always")  # into ik_finish
-def _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr):
+def _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr):
     """Each verified candidate's joints folded into the limits (revolute: wrapped into (−π, π], then shifted by a
-    whole turn where that brings it inside), in place; inside[k] whether all of candidate k's are within them.
+    whole turn where that brings it inside), in place; flags[8 + k] whether all of candidate k's are within them
+    (flags[k]: verified).
     Returns 1 if some joint lies within FOLD_EDGE of a decision of the folding (the plain solver decides), else 0.
     The candidates come in families sharing their first joints (the same floats): a joint equal to the one last
     folded reuses its result (held in vr[8:14] and vr[14:20]: the last raw value and its folded value per joint;
@@ -197,7 +226,7 @@ def _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr):
     for j in range(6):
         vr[8 + j] = math.nan  # equal to nothing
     for k in range(ncand):
-        if not ok[k]:
+        if not flags[k]:
             continue
         ins = True
         for j in range(6):
@@ -220,7 +249,7 @@ def _fold(cand, ncand, ok, inside, lo_lim, hi_lim, revolute, vr):
                 vr[14 + j] = x
             cand[k, j] = x
             ins = ins and lo - 1e-12 <= x <= hi + 1e-12
-        inside[k] = ins
+        flags[8 + k] = ins
     return status
 
 
