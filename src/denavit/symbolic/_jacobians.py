@@ -20,10 +20,9 @@ import sympy as sp
 
 from ..chain import chain_of
 from ..model import DHRobot, Frame, JointType
+from ._angle_sums import collapse_angle_sums
 from ._kinematics import forward_kinematics_sym, link_transforms_sym
 from ._propagation import velocity_propagation_sym
-from sympy.simplify.fu import TR10i
-
 from ._simplify import simplify_expr, simplify_matrix
 from ._symbols import joint_symbols, matrix_from_floats
 
@@ -41,7 +40,8 @@ def reduce_trig(e: sp.Expr, q: tuple[sp.Symbol, ...]) -> sp.Expr:
     Sines and cosines of sums are expanded, each (sin q_i, cos q_i) pair becomes a polynomial variable pair
     (s_i, c_i), the polynomial is reduced by the Gröbner basis {s_i² + c_i² − 1} (lex, s before c, so the
     remainder is unique and zero exactly when the expression is identically zero), and the result is
-    collapsed back with Fu's TR10i (c1 c2 − s1 s2 → cos(q1 + q2)). Much faster than a general
+    collapsed back with Fu's TR10i (c1 c2 − s1 s2 → cos(q1 + q2); its pairs found by lookup,
+    :func:`collapse_angle_sums`, the same result). Much faster than a general
     ``simplify`` on products of kinematic matrices.
     """
     if e.is_number or not e.has(sp.sin, sp.cos):
@@ -57,7 +57,7 @@ def reduce_trig(e: sp.Expr, q: tuple[sp.Symbol, ...]) -> sp.Expr:
     basis = [s[k] ** 2 + c[k] ** 2 - 1 for k in used]
     _, r = sp.reduced(x, basis, *gens, order="lex")
     r = r.xreplace({ci: sp.cos(qi) for qi, ci in zip(q, c)}).xreplace({si: sp.sin(qi) for qi, si in zip(q, s)})
-    return sp.factor_terms(TR10i(sp.expand(r)))
+    return sp.factor_terms(collapse_angle_sums(sp.expand(r)))
 
 
 def simplify_kinematic(M: sp.MatrixBase, policy: str, q: tuple[sp.Symbol, ...]) -> sp.ImmutableMatrix:

@@ -11,7 +11,8 @@ from functools import lru_cache
 from typing import Callable
 
 import sympy as sp
-from sympy.simplify.fu import TR10i
+
+from ._angle_sums import collapse_angle_sums
 
 __all__ = ["simplify_expr", "simplify_matrix", "shorthand", "POLICIES"]
 
@@ -24,7 +25,7 @@ def _trig(e: sp.Expr) -> sp.Expr:
     e = sp.expand(e)
     if e.has(sp.Float) and len(sp.Add.make_args(e)) > 24:
         return e  # generic float geometry: pairing dozens of float terms costs minutes and gains little
-    e = TR10i(e)  # c1 c2 − s1 s2 → cos(q1 + q2), repeatedly
+    e = collapse_angle_sums(e)  # TR10i: c1 c2 − s1 s2 → cos(q1 + q2), repeatedly
     return sp.factor_terms(e)
 
 
@@ -106,7 +107,7 @@ def _shorthand(e: sp.Expr, q: tuple[sp.Symbol, ...], style: str, collapse: bool)
         if any(isinstance(t, sp.Mul) and len(t.atoms(sp.sin, sp.cos)) > 1 for t in terms) and not (
             e.has(sp.Float) and len(terms) > 24  # same bound as the "trig" policy: float geometry stays as is
         ):
-            e = TR10i(sp.expand(e))
+            e = collapse_angle_sums(sp.expand(e))
     cname, sname = ("C", "S") if style == "C" else ("c", "s")
     repl: dict[sp.Expr, sp.Expr] = {}
     for f in e.atoms(sp.cos, sp.sin):
