@@ -65,10 +65,14 @@ def _key(t: sp.Expr) -> frozenset | None:
 
 
 def _partner_keys(key: frozenset, co: dict) -> list[frozenset]:
-    """Keys of the terms that could pair with a term of key ``key``: one trig factor f → f', or two f g → f' g'."""
+    """Keys of the terms that could pair with a term of key ``key``: one trig factor f → f', or two f g → f' g'
+    (remembered in ``co`` for the call, with the co-function of each sine and cosine)."""
+    out = co.get(key)
+    if out is not None:
+        return out
     powers = dict(key)
     trig = [b for b in powers if isinstance(b, _TRIG)]
-    out = []
+    out = co[key] = []
     for swap in [(f,) for f in trig] + list(combinations(trig, 2)):
         p = dict(powers)
         for f in swap:
@@ -97,25 +101,29 @@ def _pair(a: sp.Expr, b: sp.Expr, rv: sp.Expr) -> sp.Expr:
 
 def _do(rv: sp.Expr, co: dict) -> sp.Expr:
     """TR10i's greedy pass: for each term in ``ordered`` order, the first later free term it pairs with;
-    repeated while anything paired. Candidates come from the key lookup instead of all later terms."""
+    repeated while anything paired. Candidates come from the key lookup instead of all later terms, and a sum
+    in which no term has a candidate is returned as it is (TR10i would try every pair and return it too)."""
     if not rv.is_Add:
+        return rv
+    keys = {a: _key(a) for a in rv.args}
+    index = defaultdict(list)
+    for a, k in keys.items():
+        index[k].append(a)
+    if None not in index and not any(p in index for k in index for p in _partner_keys(k, co)):
         return rv
     args = list(ordered(rv.args))
     if len(args) == 2:
         return _pair(args[0], args[1], rv)
-    keys = [_key(a) for a in args]
-    index = defaultdict(list)
-    for pos, k in enumerate(keys):
-        index[k].append(pos)
+    pos = {a: i for i, a in enumerate(args)}
     hit = False
-    for i in range(len(args)):
+    for i, a in enumerate(list(args)):
         if args[i] is None:
             continue
-        if keys[i] is None:  # not covered by the lookup: every later term, as sympy does
+        if keys[a] is None:  # not covered by the lookup: every later term, as sympy does
             cands = range(i + 1, len(args))
         else:
-            cands = sorted({j for k in _partner_keys(keys[i], co) for j in index.get(k, ()) if j > i} |
-                           set(index.get(None, ())) - set(range(i + 1)))
+            near = [b for k in _partner_keys(keys[a], co) + [None] for b in index.get(k, ())]
+            cands = sorted({pos[b] for b in near if pos[b] > i})
         for j in cands:
             if args[j] is None:
                 continue
