@@ -305,13 +305,15 @@ def _add(cells, r, acc, touched, nt):
 
 @njit(nogil=True, cache=True)
 def merge(total, part):
-    """total += the counts of part (its low 31 bits) and part keeps only its FLAG bits, touching only the
-    nonzero entries of part (one pass, no temporaries).  Sub-cell counts carry no flag: part is zeroed."""
+    """total += the counts of part (its low 31 bits, without FLAG) and part = 0, touching only the nonzero
+    entries of part (one pass, no temporaries; the caller flags the refined cells again).  Keeping part's
+    flag in the same pass (part[i] = v & FLAG, or v − count) took 0.24–0.52 s instead of 0.01–0.1 s on the
+    Puma's 2²⁴ cells (into a fresh uint64 array, as at a run's first flush), with twice the page faults."""
     for i in range(part.size):
         v = part[i]
         if v:
             total[i] += v & _COUNT
-            part[i] = v & _FLAG
+            part[i] = 0
 
 
 @njit(nogil=True, cache=True)

@@ -6,8 +6,8 @@ boundary layer is a thin shell, so only its cells are subdivided:
 
 1. a *pilot* — the first 1/PILOT_SHARE of the random blocks (whole blocks: the same for any workers or chunk
    size) — fills the grid of edge h;
-2. the cells to refine are fixed from the pilot's counts, read at edge 2h (each cell's parent, the pilot's
-   counts summed 2^d at a time, ``_volume.coarsen``): the cells whose parent is occupied or next to an occupied
+2. the cells to refine are fixed from the pilot's counts, read at edge 2h (each cell's parent, occupied when
+   one of its 2^d cells is): the cells whose parent is occupied or next to an occupied
    one, and not deep inside — its 5^d block of parents all occupied (two erosions) — except the cells interior at
    edge h (R = up(dilate(O₂) \\ erode²(O₂)) \\ I).  Cells interior in the pilot stay interior (more samples
    only occupy more cells).  Edge 2h, because the pilot leaves cells of edge h empty that more samples fill: at
@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._volume import VolumeEstimate, chao1, coarsen, interior
+from ._volume import VolumeEstimate, chao1, interior
 
 __all__ = ["PILOT_SHARE", "PROJECTED_COVERAGE", "REFINE_COVERAGE", "MAX_REFINE", "REFINE_CELLS", "Refinement",
            "plan_refinement", "projected_coverage", "refined_levels", "slot_map", "popcount", "pilot_blocks",
@@ -96,7 +96,7 @@ def plan_refinement(counts: np.ndarray, factor: int | None, pilot: int,
     if factor is None and (total == 0 or 1.0 - np.count_nonzero(counts == 1) / total < REFINE_COVERAGE):
         return None
     occ = counts > 0
-    cells = np.flatnonzero(_shell(counts) & ~interior(occ)).astype(np.int64)
+    cells = _shell_cells(occ, interior(occ))
     if cells.size == 0:
         return None
     k = MAX_REFINE if factor is None else int(factor)
@@ -137,14 +137,24 @@ def _dilate(occ: np.ndarray) -> np.ndarray:
     return grown
 
 
-def _shell(counts: np.ndarray) -> np.ndarray:
-    """Cells of edge h (shape of ``counts``) whose parent of edge 2h is in dilate(O₂) \\ erode²(O₂), O₂ the
-    parents holding a sample."""
-    occ2 = coarsen(counts) > 0
-    shell = _dilate(occ2) & ~interior(interior(occ2))
-    for ax in range(shell.ndim):  # each parent back to its 2^d cells (an odd side: the padded row dropped)
-        shell = np.repeat(shell, 2, axis=ax)
-    return shell[tuple(slice(0, n) for n in counts.shape)]
+def _shell_cells(occ: np.ndarray, inner: np.ndarray) -> np.ndarray:
+    """Sorted flat indices of the cells of edge h (occupancy ``occ``) whose parent of edge 2h is in
+    dilate(O₂) \\ erode²(O₂), O₂ the parents holding an occupied cell, and that are not in ``inner``.  The
+    children of the shell's parents are listed (an odd side: those past the grid dropped), not the grid
+    upsampled."""
+    d = occ.ndim
+    occ2 = np.pad(occ, [(0, n % 2) for n in occ.shape]) if any(n % 2 for n in occ.shape) else occ
+    for ax in range(d):  # a parent is occupied when one of its 2^d cells is (OR of pairs, axis by axis)
+        even, odd = [slice(None)] * d, [slice(None)] * d
+        even[ax], odd[ax] = slice(0, None, 2), slice(1, None, 2)
+        occ2 = occ2[tuple(even)] | occ2[tuple(odd)]
+    parents = np.argwhere(_dilate(occ2) & ~interior(interior(occ2)))  # (p, d)
+    kids = (2 * parents[:, None, :] + np.array(list(itertools.product((0, 1), repeat=d)))).reshape(-1, d)
+    kids = kids[np.all(kids < np.array(occ.shape), axis=1)]
+    flat = np.ravel_multi_index(tuple(kids.T), occ.shape).astype(np.int64)
+    flat = flat[~inner.reshape(-1)[flat]]
+    flat.sort()
+    return flat
 
 
 def refinement(cells: np.ndarray, factor: int, pilot: int) -> Refinement:

@@ -110,6 +110,8 @@ class Sink:
         if acc.tally == 0:  # nothing counted since the last flush: the accumulator is all zeros
             return
         merge(self.counts, acc.counts)
+        if self.refined is not None:
+            _flag(acc.counts, self.refined, True)  # merge zeroed the flags with the counts
         if acc.fine is not None and self.fine is not None and acc.fine is not self.fine:
             merge(self.fine, acc.fine)  # uint32 into uint32 (fewer than 2³² samples after the pilot) or uint64
         acc.tally = 0
