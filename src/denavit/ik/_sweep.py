@@ -316,6 +316,11 @@ def _densified(robot: DHRobot, held: _Held, values: np.ndarray):
         return values, q, labels, raw
     frac = np.arange(1, DENSIFY) / DENSIFY
     extra = (values[steps, None] + (values[np.array(steps) + 1, None] - values[steps, None]) * frac).ravel()
+    return _merged(robot, held, values, q, labels, extra)
+
+
+def _merged(robot: DHRobot, held: _Held, values: np.ndarray, q: np.ndarray, labels: np.ndarray, extra: np.ndarray):
+    """The samples with ``extra`` held values solved and added (sorted), and the whole set linked again."""
     q2, l2 = held.solve(extra)
     K = max(q.shape[1], q2.shape[1])
     pad = lambda a, fill: np.concatenate(
