@@ -265,6 +265,32 @@ def test_iiwa_sweep_intervals_confirmed():
         _sweep_checks(robot, T[0], q[0], free_joint_sweep(robot, T[0], joint, samples=48), rng)
 
 
+@pytest.mark.slow  # about 3 CPU-s
+def test_iiwa_sweep_finds_a_piece_narrower_than_its_step():
+    """A pose with the elbow 0.0127 rad from straight: the whole self-motion spans two q7 pieces about 0.04 wide,
+    between two of 32 evenly spaced samples (step 0.197; the 1,000-pose run of scripts/ik_free_check.py found 16
+    such iiwa7 poses at 64 samples, the generating value in no reported interval).  The cross-wise search (q5)
+    finds them; analytic_ik(free=) confirms solutions inside the piece, the generating configuration among them."""
+    robot = load_robot("iiwa7")
+    q = np.array([0.07015093314455312, 1.886897918781949, -2.111599365668808, -0.01271212090831742,
+                  -1.116614641778755, -0.32116941950986466, 2.0018212303223164])
+    T = forward_kinematics(robot, q)
+    sweep = free_joint_sweep(robot, T, "q7", samples=32)
+    assert sweep.cross == "q5"
+    even = np.linspace(*robot.q_limits[6], 32)
+    piece = [(a, b) for a, b in sweep.intervals if a - sweep.tol <= q[6] <= b + sweep.tol]
+    assert len(piece) == 1
+    a, b = piece[0]
+    assert not ((even >= a) & (even <= b)).any() and b - a < 0.5 * (even[1] - even[0])  # between two samples
+    for t in (a + 0.01 * (b - a), 0.5 * (a + b), b - 0.01 * (b - a)):
+        res = analytic_ik(robot, T, free={"q7": t})
+        assert res.count >= 1
+        _check_solutions(robot, T, res.solutions)
+    assert _gap(q[None], analytic_ik(robot, T, free={"q7": q[6]}).solutions)[0] < 1e-8
+    for br in sweep.branches:
+        _check_solutions(robot, T, br.q)
+
+
 # --- Kinova Gen3 7-DOF (offset shoulder and elbow, spherical wrist: not S-R-S) ------------------------------------
 
 @pytest.mark.parametrize("joint, n", [(2, 2), (0, 1), (5, 1)])

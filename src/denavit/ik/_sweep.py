@@ -25,6 +25,7 @@ from ..errors import ModelError, UnsupportedRobotError
 from ..model import DHRobot, JointType
 from ..numeric import forward_kinematics
 from ._analytic import analytic_ik
+from ._cross import CROSS_SAMPLES, cross_joint, missed_values, split_unconfirmed
 
 __all__ = [
     "DENSIFY",
@@ -77,7 +78,8 @@ class FreeJointSweep:
         Its limit range, the swept range.
     values : ndarray, shape (S,)
         The samples of the held joint: ``samples`` evenly spaced, plus DENSIFY − 1 more in each step where a
-        branch starts or ends.
+        branch starts or ends, plus the held values of the cross-wise search's solutions found outside every
+        branch (:mod:`denavit.ik._cross`).
     counts : ndarray of int, shape (S,)
         Solutions within the limits at each sample.
     branches : tuple of SweepBranch
@@ -87,6 +89,8 @@ class FreeJointSweep:
         Bisection tolerance of the interval ends.
     method : str
         The route of the held arm (``analytic_ik(...).method``).
+    cross : str
+        The joint swept crosswise (:mod:`denavit.ik._cross`: pieces narrower than the sample step), ``""`` if none.
     """
 
     joint: str
@@ -97,6 +101,7 @@ class FreeJointSweep:
     intervals: tuple[tuple[float, float], ...]
     tol: float
     method: str
+    cross: str = ""
 
 
 def _sweep_range(robot: DHRobot, k: int) -> tuple[float, float]:
@@ -252,8 +257,14 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     limits comes from :func:`analytic_ik` with ``free={joint: value}``.  Solutions of neighbouring samples are
     linked into branches (closest pairs first, the same branch label, at most ``LINK_RADIUS`` apart in every
     joint) and each branch's ends that fall inside the range are refined by bisection until the last confirmed
-    value is within ``tol`` of the first failing one.  A feasible piece narrower than the sample step can be
-    missed; a branch whose joints move more than LINK_RADIUS per step (next to a singularity) is split in two.
+    value is within ``tol`` of the first failing one.  A branch whose joints move more than LINK_RADIUS per step
+    (next to a singularity) is split in two.
+
+    Pieces narrower than the sample step: a second ("cross") joint is held at ``CROSS_SAMPLES`` values
+    (:func:`denavit.ik._cross.cross_joint`: iiwa and Panda q5); the held-joint value of every solution found there
+    that lies in no branch is added as a sample, and each linked step touching such a value is confirmed at its
+    middle (else the branch is cut there).  A feasible piece is found when it spans more than one sample step of
+    the held joint or one cross step of the cross joint; pieces narrow in both can still be missed.
 
     Parameters
     ----------
@@ -296,12 +307,13 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     if not (np.isfinite(tol) and tol > 0):
         raise ModelError(f"free_joint_sweep: tol must be a positive number, got {tol!r}")
     held = _Held(robot, T, k)
-    values, q, _, raw = _densified(robot, held, np.linspace(lo, hi, int(samples)))
+    values, q, labels, raw = _densified(robot, held, np.linspace(lo, hi, int(samples)))
+    values, q, _, raw, cross = _crossed(robot, held, values, q, labels, raw)
     counts = (~np.isnan(q).any(axis=-1)).sum(axis=-1)
     branches = _assemble(robot, held, values, raw, tol)
     branches.sort(key=lambda b: (b.interval, b.label))
     return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
-                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method)
+                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method, cross)
 
 
 def _densified(robot: DHRobot, held: _Held, values: np.ndarray):
@@ -330,6 +342,22 @@ def _merged(robot: DHRobot, held: _Held, values: np.ndarray, q: np.ndarray, labe
     q = np.concatenate([pad(q, np.nan), pad(q2, np.nan)])[order]
     labels = np.concatenate([pad(labels, ""), pad(l2, "")])[order]
     return values, q, labels, _branches(robot, values, q, labels)
+
+
+def _crossed(robot: DHRobot, held: _Held, values, q, labels, raw):
+    """The cross-wise search (:mod:`._cross`): solutions with the cross joint held at CROSS_SAMPLES values; their
+    held-joint values outside every branch found are added as samples and the set linked again."""
+    c = cross_joint(robot, held.k)
+    if c is None:
+        return values, q, labels, raw, ""
+    lo, hi = _sweep_range(robot, c)
+    qc, _ = _Held(robot, held.T, c).solve(np.linspace(lo, hi, CROSS_SAMPLES))
+    spans = [(values[b["idx"][0]], values[b["idx"][-1]]) for b in raw]
+    extra = missed_values(values, spans, qc[..., held.k])
+    if len(extra):
+        values, q, labels, raw = _merged(robot, held, values, q, labels, extra)
+        raw = split_unconfirmed(raw, values, np.isin(values, extra), held.solve, lambda *a: _link(robot, *a))
+    return values, q, labels, raw, f"q{c + 1}"
 
 
 def _assemble(robot: DHRobot, held: _Held, values: np.ndarray, raw: list[dict], tol: float) -> list[SweepBranch]:
