@@ -265,19 +265,29 @@ def test_iiwa_sweep_intervals_confirmed():
         _sweep_checks(robot, T[0], q[0], free_joint_sweep(robot, T[0], joint, samples=48), rng)
 
 
-@pytest.mark.slow  # about 3 CPU-s
-def test_iiwa_sweep_finds_a_piece_narrower_than_its_step():
-    """A pose with the elbow 0.0127 rad from straight: the whole self-motion spans two q7 pieces about 0.04 wide,
-    between two of 32 evenly spaced samples (step 0.197; the 1,000-pose run of scripts/ik_free_check.py found 16
-    such iiwa7 poses at 64 samples, the generating value in no reported interval).  The cross-wise search (q5)
-    finds them; analytic_ik(free=) confirms solutions inside the piece, the generating configuration among them."""
+NARROW = [  # iiwa7 poses whose generating q7 lay in no interval the sweep reported before its cross and margin searches
+    # the elbow 0.0127 rad from straight: the whole self-motion spans two q7 pieces about 0.04 wide, between two of 32
+    # samples (the 1,000-pose run of scripts/ik_free_check.py found 16 such iiwa7 poses at 64 samples)
+    ([0.07015093314455312, 1.886897918781949, -2.111599365668808, -0.01271212090831742, -1.116614641778755,
+      -0.32116941950986466, 2.0018212303223164], 32),
+    # q2 and q6 0.012 and 0.0033 rad from their limits: the limits leave a piece 0.005 wide between two of 64 samples
+    ([0.6672306455572419, -2.0825017281070695, 1.6931930925144574, -1.9307710028114171, -1.8541471749700604,
+      2.091070322499808, -2.773923471129255], 64),
+]
+
+
+@pytest.mark.slow  # about 3 CPU-s each
+@pytest.mark.parametrize("q, samples", NARROW)
+def test_iiwa_sweep_finds_a_piece_narrower_than_its_step(q, samples):
+    """The piece holding the generating q7 lies strictly between two evenly spaced samples; the sweep reports it
+    (cross-wise search over q5, limit margin of the branches without limits), and analytic_ik(free=) confirms
+    solutions inside it, the generating configuration among them."""
     robot = load_robot("iiwa7")
-    q = np.array([0.07015093314455312, 1.886897918781949, -2.111599365668808, -0.01271212090831742,
-                  -1.116614641778755, -0.32116941950986466, 2.0018212303223164])
+    q = np.array(q)
     T = forward_kinematics(robot, q)
-    sweep = free_joint_sweep(robot, T, "q7", samples=32)
+    sweep = free_joint_sweep(robot, T, "q7", samples=samples)
     assert sweep.cross == "q5"
-    even = np.linspace(*robot.q_limits[6], 32)
+    even = np.linspace(*robot.q_limits[6], samples)
     piece = [(a, b) for a, b in sweep.intervals if a - sweep.tol <= q[6] <= b + sweep.tol]
     assert len(piece) == 1
     a, b = piece[0]

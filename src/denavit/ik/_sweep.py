@@ -26,6 +26,7 @@ from ..model import DHRobot, JointType
 from ..numeric import forward_kinematics
 from ._analytic import analytic_ik
 from ._cross import CROSS_SAMPLES, cross_joint, missed_values, split_unconfirmed
+from ._margin import limit_values, without_limits
 
 __all__ = [
     "DENSIFY",
@@ -345,19 +346,22 @@ def _merged(robot: DHRobot, held: _Held, values: np.ndarray, q: np.ndarray, labe
 
 
 def _crossed(robot: DHRobot, held: _Held, values, q, labels, raw):
-    """The cross-wise search (:mod:`._cross`): solutions with the cross joint held at CROSS_SAMPLES values; their
-    held-joint values outside every branch found are added as samples and the set linked again."""
+    """Pieces between samples: held values found by the cross-wise search (:mod:`._cross`) outside every branch and,
+    for a held end joint, by the limit margin (:mod:`._margin`) are added as samples; the set is linked again and
+    every linked step touching an added value confirmed at its middle."""
     c = cross_joint(robot, held.k)
-    if c is None:
-        return values, q, labels, raw, ""
-    lo, hi = _sweep_range(robot, c)
-    qc, _ = _Held(robot, held.T, c).solve(np.linspace(lo, hi, CROSS_SAMPLES))
-    spans = [(values[b["idx"][0]], values[b["idx"][-1]]) for b in raw]
-    extra = missed_values(values, spans, qc[..., held.k])
+    extra = np.zeros(0)
+    if c is not None:
+        qc, _ = _Held(robot, held.T, c).solve(np.linspace(*_sweep_range(robot, c), CROSS_SAMPLES))
+        extra = missed_values(values, [(values[b["idx"][0]], values[b["idx"][-1]]) for b in raw], qc[..., held.k])
+    if held.end:
+        found = limit_values(robot, values, _Held(without_limits(robot), held.T, held.k).solve,
+                             lambda *a: _link(robot, *a))
+        extra = np.union1d(extra, found[~np.isin(found, values)])
     if len(extra):
         values, q, labels, raw = _merged(robot, held, values, q, labels, extra)
         raw = split_unconfirmed(raw, values, np.isin(values, extra), held.solve, lambda *a: _link(robot, *a))
-    return values, q, labels, raw, f"q{c + 1}"
+    return values, q, labels, raw, "" if c is None else f"q{c + 1}"
 
 
 def _assemble(robot: DHRobot, held: _Held, values: np.ndarray, raw: list[dict], tol: float) -> list[SweepBranch]:
