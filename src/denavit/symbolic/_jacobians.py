@@ -49,15 +49,41 @@ def reduce_trig(e: sp.Expr, q: tuple[sp.Symbol, ...]) -> sp.Expr:
     n = len(q)
     c, s = sp.symbols(f"_c1:{n + 1}"), sp.symbols(f"_s1:{n + 1}")
     x = sp.expand(sp.expand_trig(e))
-    x = x.xreplace({sp.cos(qi): ci for qi, ci in zip(q, c)}).xreplace({sp.sin(qi): si for qi, si in zip(q, s)})
-    used = [k for k in range(n) if x.has(c[k]) or x.has(s[k])]
+    x = x.xreplace({**{sp.cos(qi): ci for qi, ci in zip(q, c)}, **{sp.sin(qi): si for qi, si in zip(q, s)}})
+    free = x.free_symbols
+    used = [k for k in range(n) if c[k] in free or s[k] in free]
     if not used or any(a.has(*q) for a in x.atoms(sp.sin, sp.cos)):  # nothing to reduce, or sin(2 q1)-like atoms
         return simplify_expr(e, "trig")
-    gens = [s[k] for k in used] + [c[k] for k in used]
-    basis = [s[k] ** 2 + c[k] ** 2 - 1 for k in used]
-    _, r = sp.reduced(x, basis, *gens, order="lex")
-    r = r.xreplace({ci: sp.cos(qi) for qi, ci in zip(q, c)}).xreplace({si: sp.sin(qi) for qi, si in zip(q, s)})
+    if x.has(sp.Float):  # float coefficients: sympy's division, whose rounding the outputs were made with
+        basis = [s[k] ** 2 + c[k] ** 2 - 1 for k in used]
+        _, r = sp.reduced(x, basis, *[s[k] for k in used], *[c[k] for k in used], order="lex")
+    else:
+        r = _remainder(x, [s[k] for k in used], [c[k] for k in used])
+    r = r.xreplace({**{ci: sp.cos(qi) for qi, ci in zip(q, c)}, **{si: sp.sin(qi) for qi, si in zip(q, s)}})
     return sp.factor_terms(collapse_angle_sums(sp.expand(r)))
+
+
+def _remainder(x: sp.Expr, s: list[sp.Symbol], c: list[sp.Symbol]) -> sp.Expr:
+    """x modulo {s_i² + c_i² − 1}, lex with s before c: s_i^(2m+r) → s_i^r (1 − c_i²)^m in every term.
+
+    The leading terms s_i² are pairwise coprime, so the basis is a Gröbner basis (Cox, Little and O'Shea,
+    *Ideals, Varieties, and Algorithms*, ch. 2 §9, Prop. 4) and this remainder is the unique one that
+    ``sympy.reduced`` computes by division, at the cost of one pass over the terms."""
+    k = len(s)
+    P = sp.Poly(x, *s, *c)
+    dom = P.domain
+    out: dict = {}
+    for monom, coeff in P.as_dict(native=True).items():
+        items = [(tuple(e % 2 for e in monom[:k]) + monom[k:], coeff)]
+        for i in range(k):
+            m = monom[i] // 2
+            if m:
+                binom = [dom.convert((-1) ** j * sp.binomial(m, j)) for j in range(m + 1)]  # (1 − c_i²)^m
+                items = [(mo[:k + i] + (mo[k + i] + 2 * j,) + mo[k + i + 1:], co * b)
+                         for mo, co in items for j, b in enumerate(binom)]
+        for mo, co in items:
+            out[mo] = out.get(mo, dom.zero) + co
+    return sp.Poly.from_dict({m: v for m, v in out.items() if v}, *s, *c, domain=dom).as_expr()
 
 
 def simplify_kinematic(M: sp.MatrixBase, policy: str, q: tuple[sp.Symbol, ...]) -> sp.ImmutableMatrix:
