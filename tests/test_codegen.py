@@ -330,12 +330,15 @@ def test_compiled_numeric_ik_solves_reachable_targets_within_limits(name):
     np.testing.assert_allclose(denavit.forward_kinematics(robot, seeded.q), T[:10], atol=1e-8)
     assert np.median(seeded.iterations) <= 10  # near seeds converge in a few LM steps
     # one LM (denavit.ik.lm): from the same seeds without restarts, the compiled and the plain single-target run
-    # take the same steps (their FK and Jacobian differ by rounding only)
-    for i in range(10):
+    # take the same steps (their FK and Jacobian differ by rounding only); seeds beyond a limit are projected into
+    # the limits by both (Q near a limit plus the noise: several of the 30 are outside)
+    for i in range(30):
         q0 = Q[i] + rng.normal(0, 0.05, robot.dof)
         a, b = fast.solve_ik(T[i], q0, restarts=0), denavit.solve_ik(robot, T[i], q0, restarts=0)
-        assert a.success and b.success and a.iterations == b.iterations
-        np.testing.assert_allclose(a.q, b.q, atol=1e-9)
+        assert a.success == b.success
+        if b.success:  # a failed first attempt goes on to the plain solver's search: compared above
+            assert a.iterations == b.iterations
+            np.testing.assert_allclose(a.q, b.q, atol=1e-9)
 
 
 @needs_numba

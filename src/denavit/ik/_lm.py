@@ -216,7 +216,7 @@ def buffers(n):
 
 def _solve_of(fkj, attempt):
     def solve(T, q0, lo, hi, slo, shi, revolute, w, L, tol, max_iterations, restarts, seed, first, out_q, out_info):
-        """``attempt`` for each target T[b] (B, 4, 4) from q0[b] (iterating freely, as the plain solver's first
+        """``attempt`` for each target T[b] (B, 4, 4) from q0[b] brought into the limits (iterating freely, as the plain solver's first
         attempt), then from random q in [slo, shi] (restarts 1, 1 + CLIP_EVERY, ... iterated inside the limits, the
         others freely) until one converges within the limits; out_q[b] that solution or the best end point,
         out_info[b] = (success, position error, orientation error, iterations, restarts), the errors of out_q[b]
@@ -234,9 +234,10 @@ def _solve_of(fkj, attempt):
             done = False
             used = 0
             for used in range(restarts + 1):
-                if used == 0:
+                if used == 0:  # the seed projected into the limits, as solve_ik does (JointLimits.project)
                     for k in range(n):
                         q[k] = q0[b, k]
+                    fold(q, lo, hi, revolute, True, True)
                 else:
                     if used == 1:
                         np.random.seed((seed + 1000003 * (first + b)) & 0x7FFFFFFF)
