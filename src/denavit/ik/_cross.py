@@ -24,7 +24,7 @@ from ..model import DHRobot, JointType
 from ..numeric import forward_kinematics
 from ._analytic import analytic_ik
 
-__all__ = ["CROSS_SAMPLES", "cross_joint", "missed_values", "split_unconfirmed"]
+__all__ = ["union_intervals", "CROSS_SAMPLES", "cross_joint", "missed_values", "split_unconfirmed"]
 
 CROSS_SAMPLES = 48  #: samples of the cross joint over its range
 
@@ -106,3 +106,15 @@ def _one_near(ends, qm, lm, label, link) -> bool:
     with two different, nearby solutions)."""
     a, b = link(ends[:1], [label], qm, lm), link(ends[1:], [label], qm, lm)
     return bool(a) and bool(b) and a[0] == b[0]
+
+
+def union_intervals(intervals, gap: float) -> tuple[tuple[float, float], ...]:
+    """Sorted union; pieces less than ``gap`` apart are one (a branch split where its joints jump leaves its two
+    refined ends up to 2·tol apart with solutions in between: a gap that narrow is not resolved)."""
+    out: list[list[float]] = []
+    for a, b in sorted(intervals):
+        if out and a <= out[-1][1] + gap:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return tuple((float(a), float(b)) for a, b in out)

@@ -25,7 +25,7 @@ from ..errors import ModelError, UnsupportedRobotError
 from ..model import DHRobot, JointType
 from ..numeric import forward_kinematics
 from ._analytic import analytic_ik
-from ._cross import CROSS_SAMPLES, cross_joint, missed_values, split_unconfirmed
+from ._cross import CROSS_SAMPLES, cross_joint, missed_values, split_unconfirmed, union_intervals
 from ._margin import limit_values, without_limits
 
 __all__ = [
@@ -314,7 +314,7 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     branches = _assemble(robot, held, values, raw, tol)
     branches.sort(key=lambda b: (b.interval, b.label))
     return FreeJointSweep(joint, (lo, hi), values, counts, tuple(branches),
-                          _union((b.interval for b in branches), 2 * tol), float(tol), held.method, cross)
+                          union_intervals((b.interval for b in branches), 2 * tol), float(tol), held.method, cross)
 
 
 def _densified(robot: DHRobot, held: _Held, values: np.ndarray):
@@ -389,14 +389,3 @@ def _assemble(robot: DHRobot, held: _Held, values: np.ndarray, raw: list[dict], 
         branches.append(SweepBranch(str(b["label"]), (float(vs[0]), float(vs[-1])), vs[keep], qs[keep]))
     return branches
 
-
-def _union(intervals, gap: float) -> tuple[tuple[float, float], ...]:
-    """Sorted union; pieces less than ``gap`` apart are one (a branch split where its joints jump leaves its two
-    refined ends up to 2·tol apart with solutions in between: a gap that narrow is not resolved)."""
-    out: list[list[float]] = []
-    for a, b in sorted(intervals):
-        if out and a <= out[-1][1] + gap:
-            out[-1][1] = max(out[-1][1], b)
-        else:
-            out.append([a, b])
-    return tuple((float(a), float(b)) for a, b in out)
