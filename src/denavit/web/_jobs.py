@@ -40,6 +40,7 @@ class _Job:
         self.finished: float | None = None
         self.process: Any = None
         self.cpu_seconds: float | None = None  # the job process's own CPU time, when it finished
+        self.exitcode: int | None = None  # the process's exit code, read once by the job's reader thread
         self.slot: str | None = None  # a new job in the same slot supersedes this one (one page's one panel)
 
     def to_json(self, with_result: bool = True) -> dict[str, Any]:
@@ -123,9 +124,11 @@ class Jobs:
                     job.error, job.state = data, "failed"
         finally:
             conn.close()
-            job.process.join(timeout=5)
+            # Only this thread joins the process: a forkserver child's exit code is one message on its sentinel,
+            # so a second reader would find it gone (and record 255).
+            job.process.join(timeout=30)
+            job.exitcode = code = job.process.exitcode
             if job.state == "running":
-                code = job.process.exitcode
                 job.state = "failed"
                 job.error = (f"the job stopped: it used its {self.cpu_seconds:g} s of CPU" if code == -24  # SIGXCPU
                              else f"the job's process ended without an answer (exit code {code})")
