@@ -224,6 +224,7 @@ def test_cli_free_and_sweep(capsys, panda):
     code, out, err = _run(capsys, "ik", "panda", "--from-q", qs, "--sweep", "--samples", "32")
     assert code == 0, err
     assert "q7 swept over" in out and "feasible q7" in out and "branch(es)" in out
+    assert f"32 samples + {data['evaluated'] - 32} added: next to branch ends, from the cross-wise q5 search, from the limit margin" in out
 
 
 @pytest.mark.parametrize("argv, match", [

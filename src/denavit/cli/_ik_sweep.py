@@ -54,6 +54,12 @@ def sweep_joint(args, robot) -> str | None:
     return f"q{int(digits)}"
 
 
+def _added(res, k: int, dof: int) -> str:
+    """Where free_joint_sweep adds samples between the evenly spaced ones (ik/_sweep.py, _cross.py, _margin.py)."""
+    where = ["next to branch ends"] + ([f"from the cross-wise {res.cross} search"] if res.cross else [])
+    return ", ".join(where + (["from the limit margin"] if k in (0, dof - 1) else []))
+
+
 def cmd_sweep(args, robot, T):
     """(data, lines) of ``ik --sweep``: the branches over the held joint's range and its feasible intervals."""
     from ..ik import SAMPLES, free_joint_sweep
@@ -74,8 +80,8 @@ def cmd_sweep(args, robot, T):
             "branches": [{"label": b.label, "interval": [unit(v) for v in b.interval], "values": [unit(v) for v in b.values],
                           "solutions": qunit(b.q)} for b in res.branches]}
     span = lambda ab: f"[{fmt(ab[0])}, {fmt(ab[1])}]"
-    lines = [(f"{res.joint} swept over {span(res.limits)} ({samples} samples + {len(res.values) - samples} near branch ends, ends to {number_text(unit(res.tol), 3)}; "
-             f"held arm: {res.method})"),
+    lines = [(f"{res.joint} swept over {span(res.limits)} ({samples} samples + {len(res.values) - samples} added: {_added(res, k, robot.dof)}; "
+             f"ends to {number_text(unit(res.tol), 3)}; held arm: {res.method})"),
              f"feasible {res.joint} (a solution within every joint limit): "
              + (", ".join(span(ab) for ab in res.intervals) if res.intervals else "none"),
              f"{len(res.branches)} branch(es):"]

@@ -80,7 +80,7 @@ class FreeJointSweep:
     values : ndarray, shape (S,)
         The samples of the held joint: ``samples`` evenly spaced, plus DENSIFY − 1 more in each step where a
         branch starts or ends, plus the held values of the cross-wise search's solutions found outside every
-        branch (:mod:`denavit.ik._cross`).
+        branch (:mod:`denavit.ik._cross`) and, for a held end joint, the limit margin's (:mod:`denavit.ik._margin`).
     counts : ndarray of int, shape (S,)
         Solutions within the limits at each sample.
     branches : tuple of SweepBranch
@@ -265,7 +265,9 @@ def free_joint_sweep(robot: DHRobot, T, joint: str | None = None, *, samples: in
     (:func:`denavit.ik._cross.cross_joint`: iiwa and Panda q5); the held-joint value of every solution found there
     that lies in no branch is added as a sample, and each linked step touching such a value is confirmed at its
     middle (else the branch is cut there).  A feasible piece is found when it spans more than one sample step of
-    the held joint or one cross step of the cross joint; pieces narrow in both can still be missed.
+    the held joint or one cross step of the cross joint.  For a held end joint, pieces cut out by the limits
+    between two samples are also looked for along the branches of the arm without limits (:mod:`._margin`); other
+    pieces narrow in both joints can still be missed.
 
     Parameters
     ----------
