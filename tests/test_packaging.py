@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+import pytest
+
 import denavit
 
 
@@ -38,3 +40,36 @@ def test_catalogue_files_cite_a_source():
     for name in denavit.catalogue_names():
         text = (resources.files("denavit") / "data" / "robots" / f"{name}.yaml").read_text()
         assert text.lstrip().startswith("# Source:"), name
+
+
+def test_public_names_load_on_first_use_and_match_what_type_checkers_see():
+    """``denavit/__init__`` imports its public names on first use (PEP 562).  Its ``TYPE_CHECKING`` imports (what
+    mypy and editors read) name the same modules and names as the lazy table, and ``__all__`` is exactly those
+    plus the eager ones; a fresh ``import denavit`` loads none of the heavy subpackages, and each resolves when
+    named (as a name or as ``denavit.<submodule>``)."""
+    import ast
+    from pathlib import Path
+
+    tree = ast.parse(Path(denavit.__file__).read_text(encoding="utf-8"))
+    guarded = next(n for n in tree.body if isinstance(n, ast.If) and ast.unparse(n.test) == "TYPE_CHECKING")
+    seen = {}
+    for node in guarded.body:
+        assert isinstance(node, ast.ImportFrom) and node.level == 1
+        seen.setdefault(node.module, []).extend(a.name for a in node.names)
+    assert {m: sorted(v) for m, v in seen.items()} == {m: sorted(v) for m, v in denavit._LAZY.items()}
+    eager = {"DenavitError", "DenavitWarning", "MissingDependencyError", "ModelError", "ParseError", "ShapeError",
+             "UnsupportedRobotError", "Convention", "DHLink", "DHRobot", "Frame", "JointType", "LinkInertia"}
+    lazy = {n for names in denavit._LAZY.values() for n in names}
+    assert set(denavit.__all__) == eager | lazy | {"__version__"} and len(denavit.__all__) == len(set(denavit.__all__))
+    assert lazy <= set(dir(denavit))
+
+    code = ("import sys, denavit; heavy = ['denavit.ik', 'denavit.codegen', 'denavit.interop', 'denavit.calibration',"
+            " 'denavit.numeric', 'numba', 'scipy']; print([m for m in heavy if m in sys.modules]);"
+            " print(denavit.numeric.rnea is denavit.rnea, denavit.ik.analytic_ik is denavit.analytic_ik);"
+            " print('denavit.ik' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert out[:3] == ["[]", "True True", "True"]
+    with pytest.raises(AttributeError, match="no attribute 'not_a_name'"):
+        denavit.not_a_name  # noqa: B018
+    with pytest.raises(AttributeError):
+        denavit.__not_a_dunder__  # noqa: B018
