@@ -225,3 +225,26 @@ def test_cli_report_without_a_table_or_arm_says_what_to_give(tmp_path, capsys):
     assert "no DH table" in out and "unreadable" in out
     assert main(["check", "planar2r", str(rep)]) == 0
     assert "INCORRECT" in capsys.readouterr().out  # planar2r's x is L1 c1 + L2 c12
+
+
+def test_a_chain_ending_in_another_name_claims_its_value_for_both_and_recursions_are_definitions():
+    """Craig's force propagation as students write it (the seed reports do): ``¹f₁ = ¹R₂ ²f₂ = [⋯] = ⁰f₀`` claims
+    the vector for ¹f₁ *and* for ⁰f₀ — right for the first, wrong for the second (⁰f₀ = ⁰R₁ ¹f₁), each judged by the
+    numeric engine; the recursion ``¹n₁ = ¹R₂ n₂ + ¹P₂ × ¹f₁`` is a definition, not an unreadable value; a symbol
+    where the operator belongs (``¹P₂ α ¹f₁``) is named in the one line."""
+    vector = "\\begin{bmatrix} c_2 f_x - s_2 f_y \\\\ s_2 f_x + c_2 f_y \\\\ f_z \\end{bmatrix}"
+    text = _report(f"$${{}}^1 f_1 = {{}}^1 R_2 {{}}^2 f_2 = {vector} = {{}}^0 f_0$$",
+                   f"$${{}}^1 f_1 = {vector} = {{}}^1 \\mathbf{{f}}_1$$",
+                   "$${}^1 n_1 = {}^1 R_2 n_2 + {}^1 P_2 \\times {}^1 f_1$$",
+                   "$${}^1 n_1 = {}^1 R_2 n_2 + {}^1 P_2 \\alpha {}^1 f_1$$",
+                   "$$x = L_1 c_1 + L_2 c_{12}$$")
+    r = grade_text(text)
+    got = [(c.quantity, c.verdict) for c in r.claims]
+    assert got == [("force", "correct"), ("force", "incorrect"), ("force", "correct"), ("force", "correct"),
+                   ("moment", "not a claim"), ("moment", "unreadable"), ("position", "correct")]
+    assert [c.line for c in r.claims[:2]] == [r.claims[0].line] * 2  # both claims on the chain's line
+    assert "frame 0" in r.claims[1].understood and "frame 1" in r.claims[0].understood
+    assert "'\\alpha' where an operator" in r.claims[5].message and "\n" not in r.claims[5].message
+    # the wrong vector under the trailing name: both names judged, both wrong
+    wrong = _report(f"$${{}}^1 f_1 = {vector.replace('- s_2 f_y', '+ s_2 f_y')} = {{}}^0 f_0$$")
+    assert [(c.quantity, c.verdict) for c in grade_text(wrong).claims] == [("force", "incorrect")] * 2

@@ -19,7 +19,7 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, joint_offset, names_product, plain_name, renumber, used_where,
+from ._reading import (define_chain, formula_leftover, joint_offset, names_formula, names_product, plain_name, renumber, used_where,
                        vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
@@ -319,6 +319,9 @@ class _Walker:
         lhs, value = eq.parts[0], eq.parts[-1]
         if len(eq.parts) > 2 and _NAMED_RESULT.search(value) and "\\begin" not in value:
             value = eq.parts[-2]  # "ν = [M][q̇] = {}^0J q̇": the value is the step before the restated relation
+        also = self._trailing_name(eq, robot)
+        if also is not None:
+            value = eq.parts[-2]  # "²f₂ = ²R₃ ³f₃ = [⋯] = ¹f₁": the value is claimed for both names
         sym = read_symbol(lhs)
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
@@ -347,7 +350,8 @@ class _Walker:
             self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "
                       "matrix)", reading.spec["quantity"])
             return
-        if reading is not None and (names_product(value) or _RELATION.fullmatch(value.replace(" ", ""))):
+        if reading is not None and (names_product(value) or names_formula(value)
+                                    or _RELATION.fullmatch(value.replace(" ", ""))):
             if reading.spec["quantity"] in ("torques", "twist", "jacobian"):
                 claim = {"quantity": "relation", "value": eq.text}
                 p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "a relation between the arm's quantities",
@@ -355,7 +359,13 @@ class _Walker:
                 p.not_a_claim_if_unreadable = True
                 self.out.append(p)
                 return
-            self.note(eq, arm, "not a claim", "a definition: the product of other results", reading.spec["quantity"])
+            what = "the product of other results" if names_product(value) else "a formula in other results"
+            self.note(eq, arm, "not a claim", f"a definition: {what}", reading.spec["quantity"])
+            return
+        left = formula_leftover(value) if reading is not None else None
+        if left and re.fullmatch(r"\\[A-Za-z]{1,12}", left):
+            self.note(eq, arm, "unreadable", f"a formula in other results with '{left}' where an operator (×, ·, +) "
+                      "belongs: not judged", reading.spec["quantity"])
             return
         if reading is None:
             params = {k for k, _ in robot.parameters}
@@ -368,6 +378,16 @@ class _Walker:
                       "or an intermediate step)")
             return
         self.out.append(build_claim(self.ctx, eq, arm, reading, value))
+        if also is not None:
+            self.out.append(build_claim(self.ctx, eq, arm, also, value))
+
+    def _trailing_name(self, eq: Equation, robot: Any) -> Any:
+        """The reading of a chain's last part when it only names another result (``… = [⋯] = {}^1f_1``) after a
+        value: the value before it is claimed for that name too.  None otherwise."""
+        if len(eq.parts) < 3 or "\\begin" in eq.parts[-1] or "\\begin" not in eq.parts[-2]:
+            return None
+        sym = read_symbol(eq.parts[-1])
+        return read_name(sym, robot, eq.parts[-2]) if sym is not None else None
 
 
 def walk(doc: Document, arms: list) -> tuple[list[Pending], list[str]]:

@@ -12,7 +12,7 @@ from ._context import Context, vector_entries
 from ._lhs import read_symbol
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "names_product", "used_where", "plain_name", "joint_offset", "renumber"]
+__all__ = ["vector_reading", "define_chain", "names_product", "names_formula", "formula_leftover", "used_where", "plain_name", "joint_offset", "renumber"]
 
 
 def vector_reading(lhs: str, robot: Any) -> Reading | None:
@@ -54,6 +54,34 @@ def define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
 _NAMED = re.compile(r"(?:\{\}\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?[A-Z]\s*"
                     r"(?:_\s*\{?[\w\-+]{1,4}\}?\s*)?(?:\^\s*\{?[\w\-+]{1,4}\}?\s*)?")
 _FILLER = re.compile(r"\\(?:cdot|cdots|dots|ldots|times|left|right)|\.|[\s{}()]|\^\{?T\}?")
+
+
+#: A propagated vector named by its frame: ``{}^2 f_2``, ``n_3``, ``\\mathbf{f}_1``, ``{}^1\\omega_1``, ``{}^1 P_2`` is
+#: caught by :data:`_NAMED`.  Lower-case only with a numeric subscript (``f_x`` is an entry, ``c_1`` a cosine).
+_VECTOR_NAMED = re.compile(r"(?:\{\}\s*\^\s*\{?\s*\d\s*\}?\s*)?(?:\\mathbf\{|\\boldsymbol\{)?(?:[fnvwp]|\\omega)\}?\s*"
+                           r"_\s*\{?\s*\d{1,2}\s*\}?")
+
+
+def names_formula(value: str) -> bool:
+    """``{}^1R_2 n_2 + {}^1P_2 \\times {}^1f_1``: sums, differences, products and cross products of named results —
+    a recursion written in other quantities (Craig's force and velocity propagation), a definition, not a value.
+    At least one propagated vector is named (a product of transforms alone is :func:`names_product`'s)."""
+    return formula_leftover(value) == ""
+
+
+def formula_leftover(value: str) -> str | None:
+    """What is left of ``value`` once its named results (two or more, a propagated vector among them), operators
+    and brackets are taken out: ``""`` for a formula in other results (:func:`names_formula`), ``"\\alpha"`` for
+    ``{}^2P_3 \\alpha {}^2f_2`` (a symbol where an operator belongs); None when ``value`` is no such formula."""
+    if len(value) > 400 or "\\begin" in value or not _VECTOR_NAMED.search(value):
+        return None
+    value = re.sub(r"\^\s*\{?\s*(?:T|\\top|-1)\s*\}?", " ", value)
+    vectors = _VECTOR_NAMED.findall(value)
+    rest = _VECTOR_NAMED.sub(" ", value)
+    names = _NAMED.findall(rest)
+    if len(vectors) + len(names) < 2:
+        return None
+    return _FILLER.sub("", re.sub(r"[+\-]", "", _NAMED.sub("", rest)))
 
 
 def names_product(value: str) -> bool:
