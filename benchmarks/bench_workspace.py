@@ -2,13 +2,15 @@
 
 Run:  python benchmarks/bench_workspace.py [--robot puma560] [--samples 1e5,1e6,1e7] [--scheduler threads]
               [--workers 2] [--cluster [--repeat 5]] [--reach 0.05x100] [--kernel-ratio 1e8 [--pin 1]
-              [--rounds 2] [--refine 0]] [--markdown FILE]
+              [--rounds 2] [--refine 0] [--strata-ab]] [--markdown FILE]
 ``--kernel-ratio N`` compares, in one process, the bare compiled position kernel (``compile(robot).position`` on
 a batch of 65 536 configurations, one thread) with the whole pipeline (``occupancy`` of N samples on the threads
 scheduler: random numbers, FK, cells, counts, merge, volume), both per CPU-second (so per core, whatever else
 the machine runs) and per wall second; ``--pin CORE`` pins the process to one core first (the pipeline then
 runs on one thread: its per-core rate without the other thread's cache traffic), ``--rounds R`` interleaves
-R kernel/pipeline pairs (best of each) and ``--refine K`` sets the pipeline's boundary refinement (0: off).
+R kernel/pipeline pairs (best of each), ``--refine K`` sets the pipeline's boundary refinement (0: off) and
+``--strata-ab`` adds, in each round, the pipeline drawn without strata (``_strata.MAX_STRATA = 1``: the plain
+stream's order, as before the strata) to compare the two in one process.
 Each row is one run in this process: wall time, samples/s, peak resident memory so far (ru_maxrss, grows
 only) of this process and of the largest finished worker process, the peak PSS of the whole process tree
 during the run (sampled every 0.5 s; shared library pages split between the processes), the 1-minute load
@@ -148,7 +150,7 @@ def run_cluster(robot, n, repeat: int = 1) -> list[str]:
     return lines
 
 
-def kernel_ratio(robot, n: int, workers, rounds: int = 1, refine: int | None = None) -> list[str]:
+def kernel_ratio(robot, n: int, workers, rounds: int = 1, refine: int | None = None, ab: bool = False) -> list[str]:
     """Bare position kernel vs the pipeline, same process: throughput per CPU-second (per core, whatever else
     the machine runs) and per wall second, ``rounds`` interleaved kernel/pipeline pairs (best of each).  The
     kernel: ``compile(robot).position`` on one block of 65 536 configurations within the limits, 256 calls a
@@ -162,8 +164,10 @@ def kernel_ratio(robot, n: int, workers, rounds: int = 1, refine: int | None = N
     occupancy(robot, 8 * 65536, seed=2, scheduler="threads", workers=workers, fk=CompiledPositionFK(robot))  # warm
     rows = ["| what | samples | wall [s] | CPU [s] | samples/s (wall) | samples per CPU-second (per core) | load |",
             "|---|---:|---:|---:|---:|---:|---:|"]
-    figures = {}
-    for what in ("kernel",) + ("pipeline", "kernel") * rounds:
+    from denavit.scale import _strata
+
+    figures, strata = {}, _strata.MAX_STRATA
+    for what in ("kernel",) + (("pipeline", "unstratified", "kernel") if ab else ("pipeline", "kernel")) * rounds:
         best = None
         for _ in range(3 if what == "kernel" else 1):
             t, cpu = time.perf_counter(), time.process_time()
@@ -173,7 +177,11 @@ def kernel_ratio(robot, n: int, workers, rounds: int = 1, refine: int | None = N
                     c.position(Q)
             else:
                 m = n
-                occupancy(robot, n, seed=1, scheduler="threads", workers=workers, progress=None, refine=refine)
+                _strata.MAX_STRATA = 1 if what == "unstratified" else strata
+                try:
+                    occupancy(robot, n, seed=1, scheduler="threads", workers=workers, progress=None, refine=refine)
+                finally:
+                    _strata.MAX_STRATA = strata
             wall, cpu = time.perf_counter() - t, time.process_time() - cpu
             if best is None or cpu < best[1]:
                 best = (wall, cpu)
@@ -185,7 +193,10 @@ def kernel_ratio(robot, n: int, workers, rounds: int = 1, refine: int | None = N
     k, p = max(figures["kernel"]), max(figures["pipeline"])
     how = "refinement automatic" if refine is None else "no refinement" if refine == 0 else f"refine {refine}"
     rows.append(f"\npipeline ÷ kernel per core: {p / k:.2f} ({robot.name}, {workers or os.cpu_count()} threads, {how})")
-    print(rows[-1], flush=True)
+    if ab:
+        u = max(figures["unstratified"])
+        rows.append(f"unstratified pipeline ÷ kernel per core: {u / k:.2f}; stratified ÷ unstratified: {p / u:.2f}")
+    print("\n".join(rows[-2 if ab else -1:]), flush=True)
     return rows
 
 
@@ -213,6 +224,7 @@ def main() -> None:
     ap.add_argument("--pin", type=int, help="pin the process to this core (and run one worker thread)")
     ap.add_argument("--rounds", type=int, default=1, help="--kernel-ratio: interleaved kernel/pipeline pairs")
     ap.add_argument("--refine", type=int, help="--kernel-ratio: the pipeline's refine (default automatic; 0 off)")
+    ap.add_argument("--strata-ab", action="store_true", help="--kernel-ratio: also the pipeline without strata")
     ap.add_argument("--markdown")
     a = ap.parse_args()
     robot = denavit.load_robot(a.robot)
@@ -222,7 +234,7 @@ def main() -> None:
     lines = [f"{a.robot}, scheduler {a.scheduler}, workers {a.workers or os.cpu_count()}"
              f"{'' if a.pin is None else f', pinned to core {a.pin}'}, load average {os.getloadavg()[0]:.2f}", ""]
     if a.kernel_ratio:
-        lines += kernel_ratio(robot, int(a.kernel_ratio), a.workers, a.rounds, a.refine)
+        lines += kernel_ratio(robot, int(a.kernel_ratio), a.workers, a.rounds, a.refine, a.strata_ab)
     lines += run_samples(robot, [int(float(x)) for x in a.samples.split(",") if x], a.scheduler, a.workers)
     if a.cluster:
         more = run_cluster(robot, int(float(a.samples.split(",")[-1])), a.repeat)

@@ -7,7 +7,9 @@ does in numpy passes: draw the joint values, compute the origin, its cell and su
   through a 64-bit mixing function, which passes BigCrush) from the state K + b·2³²·γ, K from
   ``SeedSequence(seed)`` (:func:`denavit.scale._stream.block_state`): word w is mix(state + (w + 1)·γ), a pure
   function of its counter, so any worker starts any block; each word gives two 32-bit joint values (the
-  numpy route's ``_stream.draw`` bit for bit, tested against SplitMix64 stepped in Python integers).
+  numpy route's ``_stream.draw`` bit for bit, tested against SplitMix64 stepped in Python integers).  Joint 1
+  is drawn in the block's stratum (its lo and span per block, ``_strata``), so consecutive samples lie in one
+  wedge of the workspace and their counts' cache lines are reused.
 - **Position.**  The arm's traced ``position`` program (:func:`denavit.codegen.trace_kernels`) made into
   machine code by :func:`denavit.codegen.kernel_intrinsic`, the emitter of ``denavit.compile(robot).position``:
   the same instructions, so the same doubles as :class:`~denavit.scale.CompiledPositionFK`.
@@ -325,21 +327,25 @@ def flag(acc, cells, on):
 
 def _build(rows):
     """The fused task function around ``rows`` (a ``kernel_intrinsic`` batch form of the position program):
-    ``run(keys, sizes, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
-    q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks, 2), sizes
-    (blocks,) samples each), SUB_ROWS rows at a time (q, P, cells, subs: scratch of that many rows)."""
+    ``run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
+    q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks,), sizes
+    (blocks,) samples each, joint1 (blocks, 2) joint 1's lo and span in each: its stratum, ``_strata``),
+    SUB_ROWS rows at a time (q, P, cells, subs: scratch of that many rows)."""
 
     @njit(nogil=True)
-    def run(keys, sizes, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
+    def run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
+        n = q.shape[1]
         dim, k = basis.shape[0], int(grid[5])
         T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
         los, spans = np.empty(q.size), np.empty(q.size)  # the limits tiled row after row (see _draw)
         for i in range(q.shape[0]):
-            for a in range(q.shape[1]):
-                los[i * q.shape[1] + a], spans[i * q.shape[1] + a] = lo[a], span[a]
+            for a in range(n):
+                los[i * n + a], spans[i * n + a] = lo[a], span[a]
         for blk in range(keys.shape[0]):
+            for i in range(q.shape[0]):  # joint 1 in the block's stratum
+                los[i * n], spans[i * n] = joint1[blk, 0], joint1[blk, 1]
             state = keys[blk]
             j = 0
             for s in range(0, sizes[blk], q.shape[0]):

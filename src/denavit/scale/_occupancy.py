@@ -12,7 +12,9 @@ import numpy as np
 from ..errors import ModelError
 from ..model import DHRobot
 from ._refine import Refinement, check_factor, pilot_blocks, plan_refinement, refined_levels, refinement
-from ._sampler import BLOCK, CompiledPositionFK, Grid, Job, default_fk, make_job, positions_block, run_task
+from ._sampler import (BLOCK, CompiledPositionFK, Grid, Job, block_table, default_fk, make_job, positions_block,
+                       run_blocks, run_task)
+from ._strata import layout
 from ._sink import NoSink, open_sink
 from ._schedule import POOLS, Progress, resolve_auto, run
 from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
@@ -143,11 +145,10 @@ def _estimate(counts: np.ndarray, grid: Grid, ref: Refinement | None, fine) -> t
     return min(trusted, key=lambda e: (e.high - e.low, -e.resolution)), levels
 
 
-def _tasks(samples: int, chunk: int, start: int = 0, stop: int | None = None):
-    """(first block, blocks) of each task from block ``start`` to ``stop``: ``chunk`` samples each, smaller
-    towards the end (at most 1/TAIL_SHARE of what is left), so workers finish together before a barrier or
-    the end of the run.  Results do not depend on the split."""
-    blocks = -(-samples // BLOCK) if stop is None else stop
+def _tasks(blocks: int, chunk: int, start: int = 0):
+    """(first block, blocks) of each task from block ``start`` to ``blocks``: ``chunk`` // BLOCK blocks each,
+    fewer towards the end (at most 1/TAIL_SHARE of what is left), so workers finish together before a barrier
+    or the end of the run.  Results do not depend on the split."""
     most = max(1, chunk // BLOCK)
     first = start
     while first < blocks:
@@ -193,7 +194,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         Cell edge [m].  Default: the reach box / 256 (3-D) or / 2048 (planar), and coarser levels ×2, ×4 …
         from which the narrowest volume interval is reported.  Given: that edge only.
     seed : int, optional
-        Seed of the counter-based random stream; ``None`` draws one (returned in the result).
+        Seed of the counter-based random stream and of the strata's counts (:mod:`denavit.scale._strata`);
+        ``None`` draws one (returned in the result).
     scheduler : {"auto", "threads", "processes", "synchronous"}, str address or distributed.Client
         Where the tasks run; ``"auto"``: threads when the tasks run the fused kernel (the default FK from
         COMPILED_FROM samples with numba), else processes from AUTO_PROCESSES_FROM samples on, threads below;
@@ -211,7 +213,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         Progress line with ETA on stderr (``None``: when stderr is a terminal).
     refine : {None, 0, 2, 4, 8}
         Sub-cells per side of the boundary cells (see :mod:`denavit.scale._refine`): the first 1/8 of the
-        random blocks (the pilot) fix which cells of the finest grid are refined, the later blocks also count
+        samples (the pilot, a sweep of its own: :mod:`denavit.scale._strata`) fix which cells of the finest grid
+        are refined, the later samples also count
         those cells' sub-cells, and the interval is also computed at the sub-cell edges.  ``None`` (default):
         when the pilot alone fills the finest grid to coverage REFINE_COVERAGE and no ``resolution`` is given,
         with the largest factor whose sub-cells fit REFINE_CELLS; 0: never; 2, 4, 8: always (lowered to fit).
@@ -249,9 +252,9 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
 
     def tasks():
         if not pilot:
-            yield from ((job, f, c) for f, c in _tasks(job.samples, chunk))
+            yield from ((job, f, c) for f, c in _tasks(run_blocks(job), chunk))
             return
-        yield from ((job, f, c) for f, c in _tasks(job.samples, chunk, 0, pilot))
+        yield from ((job, f, c) for f, c in _tasks(job.layout.pilot_end, chunk))
         yield None  # barrier: every pilot result is merged into counts before the plan is made
         sink.flush()
         ref = plan_refinement(counts, refine, pilot, blocks)
@@ -261,7 +264,7 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
             state["fine"] = np.zeros(ref.cells.size * ref.factor**g.dim, dtype=np.uint32 if small else np.uint64)
             sink.flush(state["fine"])
             sink.flag(ref.cells)  # the fused tasks find a refined cell by bit 31 of its count
-        yield from ((state["job"], f, c) for f, c in _tasks(job.samples, chunk, pilot, blocks))
+        yield from ((state["job"], f, c) for f, c in _tasks(run_blocks(job), chunk, job.layout.pilot_end))
 
     bar = Progress(int(samples), "samples", progress)
     try:
@@ -285,12 +288,16 @@ def sample_positions(robot: DHRobot, samples: int, seed: int = 0, *, fk: Callabl
                      as_dask: bool = False, chunk: int = DEFAULT_CHUNK):
     """End-effector origins (samples, 3) of the same random stream :func:`occupancy` uses.
 
+    From 2·STRATUM_SAMPLES samples a sweep (:mod:`denavit.scale._strata`) the rows come in the order of joint 1's
+    strata: the rows as a set are i.i.d. uniform in the joint limits, but a leading part of them is not (shuffle
+    before taking a subset).
+
     With ``as_dask=True`` a lazy ``dask.array`` of the same values, one chunk per task (needs
     ``denavit[scale]``); compute it on any scheduler.
     """
     _check_sizes(samples, chunk)
     job = Job(*_job_args(robot, int(samples), int(seed), fk))
-    spans = list(_tasks(job.samples, chunk))
+    spans = list(_tasks(run_blocks(job), chunk))
     if not as_dask:
         return np.concatenate([positions_block(job, b) for f, c in spans for b in range(f, f + c)])
     try:
@@ -302,7 +309,7 @@ def sample_positions(robot: DHRobot, samples: int, seed: int = 0, *, fk: Callabl
         raise MissingDependencyError("as_dask needs dask: pip install 'denavit[scale]'") from None
     parts = []
     for f, c in spans:
-        rows = min((f + c) * BLOCK, job.samples) - f * BLOCK
+        rows = int(block_table(job, f, c)[0].sum())
         block = dask.delayed(_span_positions)(job, f, c)
         parts.append(da.from_delayed(block, shape=(rows, 3), dtype=float))
     return da.concatenate(parts)
@@ -316,4 +323,5 @@ def _job_args(robot, samples, seed, fk):
     from ._sampler import default_fk, sampling_limits
 
     return (default_fk(robot, samples) if fk is None else fk, sampling_limits(robot), seed, samples,
-            Grid(np.zeros(3), np.eye(3), 1.0, 1, 1), np.array(robot.base_matrix[:3, 3], dtype=float))
+            Grid(np.zeros(3), np.eye(3), 1.0, 1, 1), np.array(robot.base_matrix[:3, 3], dtype=float), None, False,
+            None, layout(seed, samples, BLOCK))

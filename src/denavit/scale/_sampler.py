@@ -2,7 +2,9 @@
 
 The unit of randomness is the *block* of :data:`BLOCK` samples: block ``b`` draws its joint values from the
 words of one SplitMix64 stream keyed by ``SeedSequence(seed)``, from position b·2³² on (``_stream.block_state``;
-two 32-bit joint values a word), so sample ``i`` is the same number whichever task, worker or chunk size computes it.  A *task* is any
+two 32-bit joint values a word), so sample ``i`` is the same number whichever task, worker or chunk size computes it.
+A run's blocks follow its ``_strata.Layout``: each block lies in one stratum of joint 1 of one sweep (at most
+BLOCK samples; one stratum a sweep below 2·STRATUM_SAMPLES samples: the plain stream).  A *task* is any
 run of whole blocks; tasks return sparse voxel counts (sorted cell index, count) that the driver adds into one
 grid.  Integer sums commute, so the counts, bounds and reach are bit-identical for any number of workers and
 any chunk size.  This module is the numpy route; with the compiled position kernel tasks run the fused kernel
@@ -21,10 +23,11 @@ import numpy as np
 from ..errors import DenavitError, ModelError
 from ..model import DHRobot, JointType
 from ._refine import Refinement, popcount, slot_map
+from ._strata import Layout, layout
 from ._stream import draw
 
 __all__ = ["BLOCK", "Grid", "Job", "PositionFK", "CompiledPositionFK", "default_fk", "COMPILED_FROM", "make_job",
-           "reach_bound", "sampling_limits", "positions_block", "run_task", "FINE_CELLS", "MAX_CELLS",
+           "reach_bound", "sampling_limits", "positions_block", "run_task", "block_table", "FINE_CELLS", "MAX_CELLS",
            "FLAT_TOLERANCE", "PILOT"]
 
 #: Samples per random block: the unit of randomness (fixed, independent of chunking and workers).
@@ -167,12 +170,28 @@ class Job:
     refine: Refinement | None = None  # sub-cell counts in these cells (blocks after the pilot)
     fused: bool = False  # tasks run the fused kernel (``_fused``: same numbers as fk, a CompiledPositionFK)
     sink: str | None = None  # the run's accumulators in the driver's process (``_sink``), for in-process tasks
+    layout: Layout | None = None  # the blocks' strata (``_strata``); None: the plain stream, BLOCK samples a block
+
+
+def run_blocks(job: Job) -> int:
+    """Blocks of the run (of its layout)."""
+    return -(-job.samples // BLOCK) if job.layout is None else job.layout.blocks
+
+
+def block_table(job: Job, first: int, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Samples (count,) int64 of blocks first … first+count−1 and joint 1's (lo, span) (count, 2) in each: its
+    stratum (``_strata.Layout.limits``), or its whole range without a layout."""
+    if job.layout is not None:
+        return job.layout.limits(first, count, job.limits)
+    sizes = np.array([min(BLOCK, job.samples - b * BLOCK) for b in range(first, first + count)], dtype=np.int64)
+    return sizes, np.tile([job.limits[0, 0], job.limits[0, 1] - job.limits[0, 0]], (count, 1))
 
 
 def positions_block(job: Job, block: int, rows: int | None = None) -> np.ndarray:
     """End-effector origins (m, 3) of random block ``block`` (its first ``rows`` samples)."""
-    m = min(BLOCK, job.samples - block * BLOCK) if rows is None else rows
-    return _positions(job.fk(draw(job, block, np.empty((m, len(job.limits))))))
+    sizes, bounds = block_table(job, block, 1)
+    m = int(sizes[0]) if rows is None else rows
+    return _positions(job.fk(draw(job, block, np.empty((m, len(job.limits))), bounds[0])))
 
 
 def _positions(out) -> np.ndarray:
@@ -280,13 +299,14 @@ def run_task(job: Job, first: int, count: int) -> tuple:
         from ._sink import run_fused
 
         return run_fused(job, first, count)
-    total = min((first + count) * BLOCK, job.samples) - first * BLOCK
+    sizes, bounds = block_table(job, first, count)
+    total = int(sizes.sum())
     flat = _scratch.get("flat", (total,), np.int32)
     fine = _scratch.get("fine", (total,), np.int64) if job.refine is not None else None
     lo, hi, reach, done, kept = np.full(3, np.inf), np.full(3, -np.inf), 0.0, 0, 0
     for b in range(first, first + count):
-        m = min(BLOCK, job.samples - b * BLOCK)
-        P = _positions(job.fk(draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64))))
+        m = int(sizes[b - first])
+        P = _positions(job.fk(draw(job, b, _scratch.get("q", (m, len(job.limits)), np.float64), bounds[b - first])))
         lo, hi = np.minimum(lo, P.min(axis=0)), np.maximum(hi, P.max(axis=0))  # NaN and inf reach these
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
             raise ModelError("the forward kinematics gave non-finite positions (values too large for float64)")
@@ -365,7 +385,7 @@ def make_job(robot: DHRobot, samples: int, resolution: float | None, seed: int, 
                              f"least {MIN_CELLS}): use a resolution of at most {2 * R / MIN_CELLS:.3g} m")
         side, levels = math.ceil(cells), 1
     return Job(fk, limits, seed, samples, Grid(centre, basis, h, side, levels), base_origin,
-               fused=type(fk) is CompiledPositionFK and _has_numba())
+               fused=type(fk) is CompiledPositionFK and _has_numba(), layout=layout(seed, samples, BLOCK))
 
 
 def _has_numba() -> bool:

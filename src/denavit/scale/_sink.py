@@ -215,10 +215,10 @@ def run_fused(job, first: int, count: int) -> tuple:
     """What :func:`denavit.scale._sampler.run_task` returns for blocks first … first+count−1, from the fused
     kernel; into the run's sink when ``job.sink`` names one in this process (then no cells are returned)."""
     from ._fused import SUB_ROWS, block_keys, fused_kernel
-    from ._sampler import BLOCK
+    from ._sampler import block_table
 
     g, ref, n = job.grid, job.refine, len(job.limits)
-    sizes = np.array([min(BLOCK, job.samples - b * BLOCK) for b in range(first, first + count)], dtype=np.int64)
+    sizes, joint1 = block_table(job, first, count)
     total = int(sizes.sum())
     lo = np.ascontiguousarray(job.limits[:, 0])
     span = job.limits[:, 1] - job.limits[:, 0]
@@ -228,7 +228,7 @@ def run_fused(job, first: int, count: int) -> tuple:
     slots = slot_map(ref, g.side**g.dim) if ref is not None else _SLOTS
     fine_size = 0 if ref is None else ref.cells.size * ref.factor**g.dim
     stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
-    args = (block_keys(job.entropy, first, count), sizes, lo, span, grid, np.ascontiguousarray(g.basis), axes,
+    args = (block_keys(job.entropy, first, count), sizes, joint1, lo, span, grid, np.ascontiguousarray(g.basis), axes,
             g.side, job.base_origin)
     scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (SUB_ROWS, 3), np.float64),
                _work.get("fcells", (SUB_ROWS,), np.int32), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),

@@ -39,9 +39,10 @@ def mix64(z: np.ndarray) -> np.ndarray:
     return z
 
 
-def draw(job, block: int, q: np.ndarray) -> np.ndarray:
+def draw(job, block: int, q: np.ndarray, joint1=None) -> np.ndarray:
     """Fill q (m, n) (C-contiguous) with the joint values of random block ``block`` (its first m samples) of
-    ``job`` (its ``entropy`` and ``limits`` (n, 2)).
+    ``job`` (its ``entropy`` and ``limits`` (n, 2)); ``joint1`` = (lo, span) replaces joint 1's lo and hi − lo
+    (the block's stratum, ``_strata``).
 
     Value v of the block (row-major: sample v div n, joint v mod n) is u = h·2⁻³², h the low (v even) or high
     (v odd) 32 bits of word w = v div 2, and word w is SplitMix64's mix(s + (w + 1)·γ) with s the block's
@@ -55,7 +56,10 @@ def draw(job, block: int, q: np.ndarray) -> np.ndarray:
     flat = q.reshape(-1)
     flat[0::2] = words[:(m * n + 1) // 2] & np.uint64(0xFFFFFFFF)  # exact: below 2³²
     flat[1::2] = words[:m * n // 2] >> np.uint64(32)
+    lo, span = job.limits[:, 0].copy(), job.limits[:, 1] - job.limits[:, 0]
+    if joint1 is not None:
+        lo[0], span[0] = joint1[0], joint1[1]
     q *= HALF_WORD
-    q *= job.limits[:, 1] - job.limits[:, 0]
-    q += job.limits[:, 0]  # = lo + u·(hi − lo), in place
+    q *= span
+    q += lo  # = lo + u·(hi − lo), in place
     return q
