@@ -11,8 +11,9 @@ Why: consecutive samples then lie in one wedge of the workspace, so the incremen
 the accumulator that are already in the cache (a random increment into a 16–64 MiB grid was an L2 miss per
 sample).  What it does to the statistics: nothing.  N i.i.d. uniform samples, taken as an unordered set, are
 exactly this: the numbers falling in each stratum are multinomial (N; 1/S, …), and given those numbers the
-samples in a stratum are i.i.d. uniform in it (the standard decomposition of a multinomial sample; e.g.
-Lohr, *Sampling: Design and Analysis*, §3.4 on post-stratification with random stratum sizes).  The counts per
+samples in a stratum are i.i.d. uniform in it (each sample independently picks stratum s with probability
+1/S, then a point uniform in s: the law of the numbers m_s and of the points factors as the multinomial
+N!/∏m_s! · S^−N times the uniform laws in the strata).  The counts per
 cell, the bounds and the reach depend on the set only, not its order, so every estimator (Good–Turing coverage,
 Chao1, the volume interval, the pilot's plan, whose sweep is a set of its own) sees exactly the law of i.i.d.
 sampling.  This is not proportional stratified sampling (fixed m/S per stratum), which would lower the
