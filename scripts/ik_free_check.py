@@ -9,8 +9,8 @@ free joint at even poses, the other joints in turn at odd ones; an elbow that ca
 (tests/test_ik_sweep.py's ``_dense``/``_missing``): a numeric solution missing from the analytic set is a failure.
 ``sweep``: ``free_joint_sweep`` over the default joint (64 samples) and tests/test_ik_sweep.py's ``_sweep_checks``:
 every listed solution reproduces T within the limits, the generating value lies in a feasible interval, every
-interval is confirmed by ``analytic_ik(free=)`` solutions near both ends and at two random inner points, the dense
-search finds no solution at the middle of each gap (``--gaps-every N``: at every Nth pose only), and the batch
+interval is confirmed by ``analytic_ik(free=)`` solutions near both ends and at two random inner points, and it
+finds none 1e-4 past each end (outside every interval), the dense search finds no solution at the middle of each gap (``--gaps-every N``: at every Nth pose only), and the batch
 counts agree with the intervals.
 The checks are the test module's own functions (imported), so the suite and this run judge alike.
 Prints one line per failure and a summary with CPU seconds.

@@ -150,6 +150,9 @@ def _sweep_checks(robot, T, q, sweep, rng, gaps=True):
             res = analytic_ik(robot, T, free={sweep.joint: t})
             assert res.count >= 1
             _check_solutions(robot, T, res.solutions)
+    for t in [v + d for a, b in sweep.intervals for v, d in ((a, -1e-4), (b, 1e-4))]:  # just past each end: nothing
+        if sweep.limits[0] <= t <= sweep.limits[1] and not any(a <= t <= b for a, b in sweep.intervals):
+            assert analytic_ik(robot, T, free={sweep.joint: t}).count == 0, f"a solution at {sweep.joint} = {t}"
     for (a0, b0), (a1, b1) in zip(sweep.intervals[:-1], sweep.intervals[1:]):  # gaps: the dense search agrees
         if gaps and a1 - b0 > 1e-3:
             t = 0.5 * (b0 + a1)

@@ -233,8 +233,12 @@ def _branches(robot, values, q, labels) -> list[dict]:
 
 def _refine(robot, held: _Held, ends: list[tuple[float, float, np.ndarray, str]], tol: float) -> list[tuple]:
     """Bisection of every branch end at once: (inside value, outside value, q at inside, label) → the last
-    confirmed value and its solution, within tol of where the branch stops (ends to refine, batched per step)."""
-    ends = [list(e) for e in ends]
+    confirmed value and its solution, within tol of where the branch stops (ends to refine, batched per step).
+
+    A midpoint whose solutions do not link to the last confirmed one is kept with them: next to a fold the joints
+    move as fast as 1/√(distance), and a half step can exceed LINK_RADIUS while the branch runs on (a Panda end was
+    4e-4 rad short).  A nearer midpoint confirmed, they are linked from it again (no extra solve)."""
+    ends = [[*e, []] for e in ends]  # + the failed points (previous outside value, q, labels), innermost last
     while ends and max(abs(e[1] - e[0]) for e in ends) > tol:
         live = [e for e in ends if abs(e[1] - e[0]) > tol]
         mids = np.array([0.5 * (e[0] + e[1]) for e in live])
@@ -242,10 +246,13 @@ def _refine(robot, held: _Held, ends: list[tuple[float, float, np.ndarray, str]]
         for e, qm, lm, m in zip(live, q, labels, mids):
             ok = ~np.isnan(qm).any(axis=-1)
             match = _link(robot, e[2][None], [e[3]], qm[ok], lm[ok])
-            if match:
-                e[0], e[2] = float(m), qm[ok][match[0]]
-            else:
-                e[1] = float(m)
+            if not match:
+                e[1], e[4] = float(m), e[4] + [(e[1], qm[ok], lm[ok])]
+                continue
+            e[0], e[2] = float(m), qm[ok][match[0]]
+            while e[4] and (back := _link(robot, e[2][None], [e[3]], *e[4][-1][1:])):
+                out, qf, _ = e[4].pop()
+                e[0], e[1], e[2] = e[1], out, qf[back[0]]
     return [(e[0], e[2]) for e in ends]
 
 
