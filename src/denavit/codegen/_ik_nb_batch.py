@@ -66,18 +66,14 @@ def _scatter(f, i, r, b, bad, sol, pe, re, valid, codes, outside, status):
     return int(i[r, 19])
 
 
-# One entry per kernel (T (B, 4, 4) C-contiguous; sol (B, 8, n), pe, re (B, 8), valid, codes (B, 8), outside,
-# status (B,)).  Returned: the most slots an answered pose uses, and the first refused pose with its orthonormality
-# error (-1, 0.0 if none).
-
-@njit(cache=True, nogil=True)
-def ik_batch_elbow(T, K, sol, pe, re, valid, codes, outside, status):
-    """Every pose T[b] by the elbow kernel, BLOCK at a time, into the batched layout."""
+@njit(cache=True, nogil=True, inline="always")  # into each entry (numba's IR: the entries stay cacheable)
+def _blocks(kernel, T, K, sol, pe, re, valid, codes, outside, status):
+    """Every pose T[b] by ``kernel`` (a closed form's packed kernel), BLOCK at a time, into the batched layout."""
     f, i = np.empty((BLOCK, 8, 14)), np.empty((BLOCK, 20))
     most, first, err = 0, -1, 0.0
     for s in range(0, T.shape[0], BLOCK):
         e = min(s + BLOCK, T.shape[0])
-        ik_elbow_packed(T[s:e], K, f[: e - s], i[: e - s])
+        kernel(T[s:e], K, f[: e - s], i[: e - s])
         for b in range(s, e):
             x = _target_error(T, b)
             if first < 0 and not x <= BAD_TARGET:
@@ -85,40 +81,29 @@ def ik_batch_elbow(T, K, sol, pe, re, valid, codes, outside, status):
             most = max(most, _scatter(f, i, b - s, b, not x <= BAD_TARGET, sol, pe, re, valid, codes, outside,
                                       status))
     return most, first, err
+
+
+# One entry per kernel, each the loop above around it (a kernel passed from Python would be an argument numba
+# keys its cache by, which no later process hits): T (B, 4, 4) C-contiguous; sol (B, 8, n), pe, re (B, 8), valid,
+# codes (B, 8), outside, status (B,).  Returned: the most slots an answered pose uses, and the first refused pose
+# with its orthonormality error (-1, 0.0 if none).
+
+@njit(cache=True, nogil=True)
+def ik_batch_elbow(T, K, sol, pe, re, valid, codes, outside, status):
+    """Every pose T[b] by the elbow kernel, BLOCK at a time, into the batched layout."""
+    return _blocks(ik_elbow_packed, T, K, sol, pe, re, valid, codes, outside, status)
 
 
 @njit(cache=True, nogil=True)
 def ik_batch_parallel(T, K, sol, pe, re, valid, codes, outside, status):
     """:func:`ik_batch_elbow` by the UR-class kernel."""
-    f, i = np.empty((BLOCK, 8, 14)), np.empty((BLOCK, 20))
-    most, first, err = 0, -1, 0.0
-    for s in range(0, T.shape[0], BLOCK):
-        e = min(s + BLOCK, T.shape[0])
-        ik_parallel_packed(T[s:e], K, f[: e - s], i[: e - s])
-        for b in range(s, e):
-            x = _target_error(T, b)
-            if first < 0 and not x <= BAD_TARGET:
-                first, err = b, x
-            most = max(most, _scatter(f, i, b - s, b, not x <= BAD_TARGET, sol, pe, re, valid, codes, outside,
-                                      status))
-    return most, first, err
+    return _blocks(ik_parallel_packed, T, K, sol, pe, re, valid, codes, outside, status)
 
 
 @njit(cache=True, nogil=True)
 def ik_batch_stanford(T, K, sol, pe, re, valid, codes, outside, status):
     """:func:`ik_batch_elbow` by the Stanford-class kernel."""
-    f, i = np.empty((BLOCK, 8, 14)), np.empty((BLOCK, 20))
-    most, first, err = 0, -1, 0.0
-    for s in range(0, T.shape[0], BLOCK):
-        e = min(s + BLOCK, T.shape[0])
-        ik_stanford_packed(T[s:e], K, f[: e - s], i[: e - s])
-        for b in range(s, e):
-            x = _target_error(T, b)
-            if first < 0 and not x <= BAD_TARGET:
-                first, err = b, x
-            most = max(most, _scatter(f, i, b - s, b, not x <= BAD_TARGET, sol, pe, re, valid, codes, outside,
-                                      status))
-    return most, first, err
+    return _blocks(ik_stanford_packed, T, K, sol, pe, re, valid, codes, outside, status)
 
 
 #: the batch entry of each closed form
