@@ -94,7 +94,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
             if math.isnan(q1):
                 continue
             g0, g1 = elbow_plane(c1, s1c, W[0], W[1], W[2], R1, p1)
-            q3a, q3b, x, c3a, s3a, c3b, s3b = elbow_roots(math.hypot(g0, g1), na, nb, base3, cb3, sb3, ratio_tol)
+            q3a, q3b, x, c3a, s3a, c3b, s3b = elbow_roots(math.sqrt(g0 * g0 + g1 * g1), na, nb, base3, cb3, sb3,
+                                                          ratio_tol)
             if math.isnan(x):
                 continue
             if x < 1e-6 or math.pi - x < 1e-6:
@@ -130,7 +131,8 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
                     continue
                 for s5 in range(2):
                     qb, cb, sb = (qba, cba, sba) if s5 == 0 else (qbb, cbb, sbb)
-                    qa, qc, singular, _sign, _vxy, _cb, _sb, ca, sa, cc, sc = wrist_rest(qb, cb, sb, M, R4, R5)
+                    qa, qc, singular, _sign, _vxy, _cb, _sb, ca, sa, cc, sc = wrist_rest(
+                        qb, cb, sb, M[0, 0], M[1, 0], M[2, 0], M[0, 2], M[1, 2], R4, R5)
                     if singular:
                         status = 1  # wrist singular: a continuum
                     cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3

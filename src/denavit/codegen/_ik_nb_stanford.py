@@ -134,8 +134,8 @@ def _stanford_wrist(M, C, q1, q2, q3, wc, near, cand, ncand, status, eM, cond_ma
     e5 = eM / max(wc[0] * math.sin(0.5 * (qba - qbb)), 1e-300)
     for s5 in range(2):
         qb, cb, sb = (qba, cba, sba) if s5 == 0 else (qbb, cbb, sbb)
-        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa, _cc, _sc = wrist_rest(qb, cb, sb, M, C[4, :3, :3],
-                                                                                 C[5, :3, :3])
+        qa, qc, _singular, _sign, vxy, _cb, _sb, _ca, _sa, _cc, _sc = wrist_rest(
+            qb, cb, sb, M[0, 0], M[1, 0], M[2, 0], M[0, 2], M[1, 2], C[4, :3, :3], C[5, :3, :3])
         if vxy < near:
             status = 1  # wrist singular (axes 4 and 6 aligned): a continuum, or next to one
         if eM + e5 + (eM + e5) / max(vxy, 1e-300) > cond_max:

@@ -98,7 +98,7 @@ class ElbowPosition:
         g0, g1 = elbow_plane(c1, s1, Wx[:, None], Wy[:, None], Wz[:, None], self.R1, self.p1)  # wrist centre, frame 2
         # elbow: law of cosines |g_xy|² = |v_xy|², v = p2 + R2 Rz(q3) P (Craig eq. 4.69), with (1 ∓ cos x)/2 as
         # products (Kahan's triangle angles) so that a folded or stretched elbow keeps its digits
-        q3a, q3b, _, c3a, s3a, c3b, s3b = elbow_roots(np.hypot(g0, g1), self.na, self.nb, self.base, self.cb,
+        q3a, q3b, _, c3a, s3a, c3b, s3b = elbow_roots(np.sqrt(g0 * g0 + g1 * g1), self.na, self.nb, self.base, self.cb,
                                                        self.sb, RATIO_TOL)
         q3 = np.stack([q3a, q3b], -1)  # (B, 2, 2)
         c3, s3 = np.stack([c3a, c3b], -1), np.stack([s3a, s3b], -1)  # cos q3, sin q3 (B, 2, 2)
@@ -190,5 +190,6 @@ def wrist_angles(M: np.ndarray, Ra: np.ndarray, Rb: np.ndarray):
     r, u = Ra[2, :], Rb[:, 2]
     qb, cb, sb = axis_angle_pairs(r, u, M[..., :, 2])  # (..., 2): digits kept next to the wrist singularity
     Mt = np.moveaxis(M, (-2, -1), (0, 1))[..., None]  # M[i, j] of each pose, against the two roots of qb
-    qa, qc, singular, sign = wrist_rest(qb, cb, sb, Mt, Ra, Rb)[:4]  # the one copy (numba compiles it too)
+    qa, qc, singular, sign = wrist_rest(qb, cb, sb, Mt[0, 0], Mt[1, 0], Mt[2, 0], Mt[0, 2], Mt[1, 2], Ra,
+                                        Rb)[:4]  # the one copy (numba compiles it too)
     return np.stack([qa, qb, qc], -1), singular, sign

@@ -2,14 +2,17 @@
 
 Each function here is elementwise: its arguments are floats or numpy arrays of one broadcast shape (constant
 vectors and matrices are indexed, ``R[0, 1]``, and give floats), and it uses only arithmetic, comparisons, ``&``,
-``|``, ``abs`` and the numpy ufuncs numba compiles on floats (``np.arctan2``, ``np.hypot``, ``np.sqrt``,
-``np.arcsin``, ``np.arccos``, ``np.sin``, ``np.cos``, ``np.minimum``, ``np.maximum``, ``np.mod``), plus
-:func:`select` for a choice per element.  So the plain solver calls them on whole batches (numpy, the branch
-slots stacked on trailing axes) and :mod:`denavit.codegen` jits the very same functions (``register_jitable``,
-with ``select`` as ``a if c else b``) for its one-pose loops: one copy of every formula, no source strings.
+``|``, ``abs`` and the numpy ufuncs numba compiles on floats (``np.sqrt``, ``np.sin``, ``np.cos``, ``np.minimum``, ``np.maximum``, ``np.copysign``, ``np.floor``), plus :func:`select` for a choice per element.
+Their angles come from :func:`atan2`, a branch-free rational approximation (no libm call: a compiled loop over
+poses or candidates can be vectorised; arcsin and arccos are atan2 of a sine and a cosine).  So the plain solver
+calls them on whole batches (numpy, the branch slots stacked on trailing axes) and :mod:`denavit.codegen` jits the
+very same functions (``register_jitable``, with ``select`` as ``a if c else b``) for its one-pose loops: one copy
+of every formula, no source strings.
 
 Formulas (joint-screw form of :mod:`._chain`; derivations in :mod:`._closed` and docs/ik.md):
 
+- :func:`atan2` — the angle of (x, y) within 2 ulp of libm's (Cody & Waite's reduction to |t| ≤ 0.66 and the
+  Cephes rational approximation of atan on it, Moshier 1989).
 - :func:`trig_roots` — ``a cos θ + b sin θ = c`` (Paden–Kahan subproblem 1 in scalar form); :func:`trig_pairs` —
   the cosines and sines of its roots, algebraically (only the angles themselves need atan2 and arccos).
 - :func:`half_angle` — x from ``(1 − cos x)/2`` and ``(1 + cos x)/2`` given as products (Kahan's digit-keeping
@@ -26,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["JITTABLE", "WRIST_TOL", "select", "trig_roots", "trig_pairs", "half_angle", "shoulder_roots", "elbow_plane",
-           "elbow_roots", "elbow_q2", "wrist_constants", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2",
+__all__ = ["JITTABLE", "WRIST_TOL", "select", "atan2", "trig_roots", "trig_pairs", "half_angle", "shoulder_roots",
+           "elbow_plane", "elbow_roots", "elbow_q2", "wrist_constants", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2",
            "stanford_q1"]
 
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
@@ -44,16 +47,46 @@ def _clip(x, lo, hi):
     return np.minimum(np.maximum(x, lo), hi)
 
 
+# atan t = t + t z P(z)/Q(z), z = t², |t| ≤ 0.66 (Cephes atan.c, Moshier 1989); PI_LO: π/4 − fl(π/4)
+_AP = (-8.750608600031904122785e-1, -1.615753718733365076637e1, -7.500855792314704667340e1,
+       -1.228866684490136173410e2, -6.485021904942025371773e1)
+_AQ = (2.485846490142306297962e1, 1.650270098316988542046e2, 4.328810604912902668951e2, 4.853903996359136964868e2,
+       1.945506571482613964425e2)
+_PI_LO = 3.061616997868382943065e-17
+
+
+def atan2(y, x):
+    """θ ∈ [−π, π] with (cos θ, sin θ) ∥ (x, y), as ``np.arctan2`` (signed zeros and NaN alike) within 2 ulp for
+    finite (x, y) outside the subnormals (an infinite pair gives NaN), with no branch and no libm call:
+    t = min(|x|, |y|)/max(|x|, |y|) ∈ [0, 1], above 0.66 replaced by (t − 1)/(t + 1) (then atan t + π/4; Cody &
+    Waite 1980, Ch. 17), atan by the Cephes rational t + t z P(z)/Q(z), z = t² (Moshier 1989, atan.c), then the
+    octant: π/2 − θ where |y| > |x|, π − θ where x < 0 (or −0), the sign of y."""
+    ax, ay = abs(x), abs(y)
+    hi, lo = np.maximum(ax, ay), np.minimum(ax, ay)
+    big = lo > 0.66 * hi
+    den = select(big, lo + hi, hi)
+    t = select(big, lo - hi, lo) / select(den == 0.0, 1.0, den)
+    z = t * t
+    p = (((_AP[0] * z + _AP[1]) * z + _AP[2]) * z + _AP[3]) * z + _AP[4]
+    q = ((((z + _AQ[0]) * z + _AQ[1]) * z + _AQ[2]) * z + _AQ[3]) * z + _AQ[4]
+    r = t + t * (z * p / q)
+    r = select(big, 0.7853981633974483 + (r + _PI_LO), r)
+    r = select(ay > ax, 1.5707963267948966 + (2.0 * _PI_LO - r), r)
+    r = select(np.copysign(1.0, x) < 0.0, 3.141592653589793 + (4.0 * _PI_LO - r), r)
+    return np.copysign(r, y)
+
+
 def trig_roots(a, b, c, tol):
     """(θ₊, θ₋) with ``a cos θ + b sin θ = c``: ``atan2(b, a) ± arccos(c/ρ)``, ρ = √(a² + b²); NaN where |c| > ρ
     beyond ``tol`` (a ratio within it is the tangent, double root) or where ρ ≤ 1e-12 (no dependence on θ).
     Also returns ρ and the ratio c/ρ (0 where ρ ≤ 1e-12)."""
-    rho = np.hypot(a, b)
+    rho = np.sqrt(a * a + b * b)  # lengths of an arm: no overflow to guard against (hypot is a libm call)
     some = rho > 1e-12
     ratio = select(some, c / select(some, rho, 1.0), 0.0)
     ok = some & (abs(ratio) <= 1.0 + tol)
-    base = np.arctan2(b, a)
-    delta = np.arccos(_clip(select(ok, ratio, 0.0), -1.0, 1.0))
+    base = atan2(b, a)
+    r = _clip(select(ok, ratio, 0.0), -1.0, 1.0)
+    delta = atan2(np.sqrt((1.0 - r) * (1.0 + r)), r)  # arccos r
     return select(ok, base + delta, np.nan), select(ok, base - delta, np.nan), rho, ratio
 
 
@@ -77,10 +110,11 @@ def half_angle(lo, hi, tol):
     small = lo <= hi
     y = _clip(select(small, lo, hi), 0.0, 1.0)
     r = np.sqrt(y)
-    x = 2.0 * np.arcsin(r)  # one arcsin: select evaluates both sides
+    rc = np.sqrt(1.0 - y)
+    x = 2.0 * atan2(r, rc)  # 2 arcsin √y, once: select evaluates both sides
     c = 1.0 - 2.0 * y
     return (select(ok, select(small, x, np.pi - x), np.nan), select(ok, select(small, c, -c), np.nan),
-            select(ok, 2.0 * r * np.sqrt(1.0 - y), np.nan))
+            select(ok, 2.0 * r * rc, np.nan))
 
 
 def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
@@ -94,7 +128,7 @@ def shoulder_roots(Wx, Wy, Wz, a, h, tiny, tol):
     ea, eb = a[0] * Wx + a[1] * Wy, a[0] * Wy - a[1] * Wx
     q1a, q1b, rho, ratio = trig_roots(ea, eb, c, tol)
     ca, sa, cb, sb = trig_pairs(ea, eb, rho, ratio, tol)
-    free = (np.hypot(Wx, Wy) < tiny) & (abs(c) < tiny)
+    free = (np.sqrt(Wx * Wx + Wy * Wy) < tiny) & (abs(c) < tiny)
     return (select(free, 0.0, q1a), select(free, np.nan, q1b), free, ratio, select(free, 1.0, ca),
             select(free, 0.0, sa), select(free, np.nan, cb), select(free, np.nan, sb))
 
@@ -134,7 +168,7 @@ def elbow_q2(g0, g1, c3, s3, R2, p2, P, tiny):
     h = np.sqrt(dot * dot + crs * crs)
     zero = free | (h == 0.0)  # q2 = 0 there; NaN stays NaN
     h = select(zero, 1.0, h)
-    return (select(zero, 0.0, np.arctan2(crs, dot)), free, vxy, select(zero, 1.0, dot / h),
+    return (select(zero, 0.0, atan2(crs, dot)), free, vxy, select(zero, 1.0, dot / h),
             select(zero, 0.0, crs / h))
 
 
@@ -173,12 +207,12 @@ def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
     return Ra[i, 0] * (cb * x0 - sb * x1) + Ra[i, 1] * (sb * x0 + cb * x1) + Ra[i, 2] * x2
 
 
-def wrist_rest(qb, cb, sb, M, Ra, Rb):
+def wrist_rest(qb, cb, sb, m00, m10, m20, m02, m12, Ra, Rb):
     """(qa, qc, singular, sign, vxy, cb, sb, ca, sa, cc, sc) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb
-    is known, with its cos and sin cb, sb (ca, sa, cc, sc: cos and sin of qa and qc as computed, before the
+    is known, with its cos and sin cb, sb (of M only the five entries m_ij it reads, each a float or an array) (ca, sa, cc, sc: cos and sin of qa and qc as computed, before the
     exact-alignment choice):
     qa turns v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan
-    subproblems 2 and 1).  ``M`` is indexed ``M[i, j]`` (a 3×3 matrix, or a stack with the matrix axes first).
+    subproblems 2 and 1).
 
     Each angle is one atan2 of a (sine, cosine) pair whose normalised values are its cosine and sine, so no cos or
     sin of qa or qc is computed: qa = atan2(v_xy × m_xy, v_xy · m_xy), qc = atan2(N10, N00).
@@ -191,20 +225,20 @@ def wrist_rest(qb, cb, sb, M, Ra, Rb):
     v2 = _ra_rz(Ra, cb, sb, Rb[0, 2], Rb[1, 2], Rb[2, 2], 2)
     vxy = np.sqrt(v0 * v0 + v1 * v1)  # unit vectors: no overflow to guard against (hypot is a libm call)
     exact = vxy < ALIGNED_EXACT
-    dot, crs = v0 * M[0, 2] + v1 * M[1, 2], v0 * M[1, 2] - v1 * M[0, 2]  # |v_xy| |m_xy| (cos qa, sin qa)
+    dot, crs = v0 * m02 + v1 * m12, v0 * m12 - v1 * m02  # |v_xy| |m_xy| (cos qa, sin qa)
     h = np.sqrt(dot * dot + crs * crs)
     zero = exact | (h == 0.0)  # qa = 0 there (atan2(0, 0)); NaN stays NaN
     h = select(zero, 1.0, h)
-    qa = select(zero, 0.0, np.arctan2(crs, dot))
+    qa = select(zero, 0.0, atan2(crs, dot))
     ca, sa = select(zero, 1.0, dot / h), select(zero, 0.0, crs / h)
-    y0, y1, n2 = ca * M[0, 0] + sa * M[1, 0], -sa * M[0, 0] + ca * M[1, 0], M[2, 0]  # Rz(qa)ᵀ M e_x
+    y0, y1, n2 = ca * m00 + sa * m10, -sa * m00 + ca * m10, m20  # Rz(qa)ᵀ M e_x
     N00 = (_ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 0) * y0
            + _ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 1) * y1
            + _ra_rz(Ra, cb, sb, Rb[0, 0], Rb[1, 0], Rb[2, 0], 2) * n2)
     N10 = (_ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 0) * y0
            + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 1) * y1
            + _ra_rz(Ra, cb, sb, Rb[0, 1], Rb[1, 1], Rb[2, 1], 2) * n2)
-    qc = np.arctan2(N10, N00)
+    qc = atan2(N10, N00)
     r = np.sqrt(N00 * N00 + N10 * N10)  # 1 up to rounding (a row of a rotation with N20 = 0 there)
     rn = select(r == 0.0, 1.0, r)
     sign = select(v2 >= 0.0, 1.0, -1.0)
@@ -238,9 +272,9 @@ def stanford_q1(q2, w0, w1, w2, Dx, Dy, R1):
     x, y = c2 * w0 - s2 * w1, s2 * w0 + c2 * w1  # Rz(q2) w
     ex = R1[0, 0] * x + R1[0, 1] * y + R1[0, 2] * w2
     ey = R1[1, 0] * x + R1[1, 1] * y + R1[1, 2] * w2
-    return np.arctan2(Dy, Dx) - np.arctan2(ey, ex), ex, ey
+    return atan2(Dy, Dx) - atan2(ey, ex), ex, ey
 
 
 #: The functions numba compiles (``select`` gets its scalar twin there), callers after callees.
-JITTABLE = (_clip, trig_roots, trig_pairs, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2,
+JITTABLE = (_clip, atan2, trig_roots, trig_pairs, half_angle, shoulder_roots, elbow_plane, elbow_roots, elbow_q2,
             wrist_constants, wrist_qb, _ra_rz, wrist_rest, stanford_q3, stanford_q2, stanford_q1)
