@@ -31,7 +31,7 @@ def _select(c, a, b):
 
 
 for _f in forms.JITTABLE:
-    register_jitable(_f)
+    register_jitable(inline="always")(_f)  # into each caller (numba's IR): no call passing arrays in a loop
 
 WRIST_TOL, half_angle = forms.WRIST_TOL, forms.half_angle
 elbow_plane, elbow_q2, elbow_roots = forms.elbow_plane, forms.elbow_q2, forms.elbow_roots

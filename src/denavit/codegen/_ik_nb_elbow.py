@@ -12,137 +12,67 @@ import math
 import numpy as np
 from numba import njit
 
-from ._ik_finish import DOUBLE_ROOT
-from ._ik_jit import (
-    WRIST_TOL,
-    elbow_plane,
-    elbow_q2,
-    elbow_roots,
-    shoulder_roots,
-    wrist_qb,
-    wrist_rest,
-)
+from ._ik_nb_elbow_stages import _C1, _C2, _C3, _CA, _CB, _CC, _F2, _Q1, _Q2, _Q3, _QA, _QB, _QC, _S1, _S2, _S3
+from ._ik_nb_elbow_stages import _SA, _SB, _SC, _SG, _ST, _X, CHUNK, ROWS, elbow_stages
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_elbow_packed", "ik_elbow"]
-
 
 
 @njit(cache=True, nogil=True)
 def ik_elbow_packed(T, K, f, i):
     """:func:`ik_elbow` with the constants packed in one vector K (ELBOW_LAYOUT order) and the outputs in two
     arrays (f: solutions, residuals, outside-limits solutions; i (B, 20): label codes, then k, j, status, then the
-    batched layout's slots (ik_finish's out_rank)): four
-    arguments instead of twenty-four to unbox per call."""
-    K4, K3 = K[0:192].reshape((12, 4, 4)), K[192:252].reshape((20, 3))  # two reshapes; row views are free
-    C0i, consts, chain = K4[0], K4[1:5], K4[5:12]
-    R6, R1, R2, R4, R5 = K3[0:3], K3[3:6], K3[6:9], K3[9:12], K3[12:15]
-    X_e, p1, a, p2, P = K3[15], K3[16], K3[17], K3[18], K3[19]
-    sc, trig, lo_lim, hi_lim = K[252:261], K[261:271], K[271:277], K[277:283]
-    rev, theta, tols = K[283:289], K[289:295], K[295:303]
-    ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo_lim, hi_lim, rev, theta, tols, chain,
-             f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:11], i[:, 11:20])
+    batched layout's slots (ik_finish's out_rank)): four arguments instead of twenty-four to unbox per call."""
+    consts, chain = K[16:80].reshape((4, 4, 4)), K[80:192].reshape((7, 4, 4))
+    lo_lim, hi_lim, rev, theta, tols = K[271:277], K[277:283], K[283:289], K[289:295], K[295:303]
+    ik_elbow(T, K, consts, lo_lim, hi_lim, rev, theta, tols, chain, f[:, :, :6], f[:, :, 6:8], i[:, :8],
+             f[:, :, 8:], i[:, 8:11], i[:, 11:20])
 
 
-@njit(cache=True, nogil=True, inline="always")  # into ik_elbow_packed: no 26-array call (0.2-0.3 µs a pose)
-def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo_lim, hi_lim, revolute, theta, tols,
-             chain, out_q, out_err, out_label, out_outq, out_status, out_rank):
+@njit(cache=True, nogil=True, inline="always")  # into ik_elbow_packed: no 15-array call
+def ik_elbow(T, K, consts, lo_lim, hi_lim, revolute, theta, tols, chain, out_q, out_err, out_label, out_outq,
+             out_status, out_rank):
     """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
-    of the batched layout (:func:`._ik_nb_finish.ik_finish`)."""
-    h, na, nb, base3, L, rho_w = sc[0], sc[1], sc[2], sc[3], sc[4], sc[5]
-    free_tol, ratio_tol = tols[0], tols[1]  # the others: _ik_finish's
-    tiny = free_tol * L
+    of the batched layout (:func:`._ik_nb_finish.ik_finish`).  The candidates of CHUNK poses at a time come from
+    :func:`._ik_nb_elbow_stages.elbow_stages` (every branch, one loop over the poses per stage)."""
     ct5, st5 = math.cos(theta[4]), math.sin(theta[4])  # the wrist label's sin(q5 + theta5), by the sum formula
-    wc = (trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], trig[6], trig[7])  # forms.wrist_constants
-    cb3, sb3 = trig[8], trig[9]  # cos, sin of base3
-    # scratch: two float and one flag allocation per call (not per pose), viewed without reshapes (a reshape is a
-    # helper call)
+    # scratch: a few allocations per call (not per pose), viewed without reshapes (a reshape is a helper call)
     ws = np.empty(67)
-    Xw, W, cx, cy, cz = ws[6:9], ws[9:12], ws[12:15], ws[15:18], ws[18:21]
     x1, y1c, z1, S, E, dW = ws[21:24], ws[24:27], ws[27:30], ws[30:33], ws[33:36], ws[36:39]
     perm, vr = ws[39:47], ws[47:67]  # the candidate in each sorted slot; ik_finish's scratch
-    w8 = np.empty((25, 56))  # per candidate: joints, residuals, frames after joints 1-3 (from the FK, for the
+    w8 = np.empty((22, 56))  # per candidate: joints, residuals, frames after joints 1-3 (from the FK, for the
     cand, cerr, frames, cs = w8[0:8, 0:6], w8[0:8, 6:8], w8[0:8, 8:44], w8[0:8, 44:56]  # labels), their cos, sin
-    PF, F, Y, M = w8[8:15, 0:12], w8[15:19, 0:4], w8[19:22, 0:3], w8[22:25, 0:3]  # the FK's partial products, ...
+    PF, F = w8[8:15, 0:12], w8[15:19, 0:4]  # the FK's partial products, its pose
     flags = np.zeros(24, dtype=np.bool_)
-    ok = flags[0:8]
+    St = np.empty((ROWS, min(CHUNK, T.shape[0])))  # the stages' rows (_ik_nb_elbow_stages)
     for b in range(T.shape[0]):
-        status = 0
-        # wrist centre and the target rotation without the last constant
-        for i in range(3):
-            Xw[i] = T[b, i, 0] * X_e[0] + T[b, i, 1] * X_e[1] + T[b, i, 2] * X_e[2] + T[b, i, 3]
-        for i in range(3):
-            W[i] = C0i[i, 0] * Xw[0] + C0i[i, 1] * Xw[1] + C0i[i, 2] * Xw[2] + C0i[i, 3]
-        for i in range(3):
-            for j in range(3):
-                Y[i, j] = T[b, i, 0] * R6[j, 0] + T[b, i, 1] * R6[j, 1] + T[b, i, 2] * R6[j, 2]
-        # the closed form of denavit.ik.forms (the plain solver's own functions, jitted): shoulder, elbow, wrist
-        q1a, q1b, free1, ratio, c1a, s1a, c1b, s1b = shoulder_roots(W[0], W[1], W[2], a, h, tiny, ratio_tol)
-        if free1 or (ratio == 0.0 and math.isnan(q1a)):
-            status = 1  # joint 1 free, or the shoulder equation independent of q1
-        if abs(abs(ratio) - 1.0) < DOUBLE_ROOT:
-            status = 1  # next to a double root (DOUBLE_ROOT: beyond it both roots are verified as they are)
-        if rho_w < 1e-12:
-            status = 1
+        r = b % CHUNK
+        if r == 0:  # the next chunk's candidates, every branch
+            elbow_stages(T, b, min(CHUNK, T.shape[0] - b), K, St)
+        Xw = (St[0, r], St[1, r], St[2, r])
+        # the branches of the pose in the one-pose loop's order (q1 root, q3 root, wrist root), the ones with no
+        # root skipped; the status raised where the plain solver must decide
+        status = int(St[_ST, r])
         ncand = 0
-        for k in range(8):
-            ok[k] = False
         for s1 in range(2 if status == 0 else 0):
-            q1, c1, s1c = (q1a, c1a, s1a) if s1 == 0 else (q1b, c1b, s1b)
-            if math.isnan(q1):
-                continue
-            g0, g1 = elbow_plane(c1, s1c, W[0], W[1], W[2], R1, p1)
-            q3a, q3b, x, c3a, s3a, c3b, s3b = elbow_roots(math.sqrt(g0 * g0 + g1 * g1), na, nb, base3, cb3, sb3,
-                                                          ratio_tol)
-            if math.isnan(x):
+            x = St[_X + s1, r]
+            if math.isnan(St[_Q1 + s1, r]) or math.isnan(x):
                 continue
             if x < 1e-6 or math.pi - x < 1e-6:
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
-                q3, c3, s3v = (q3a, c3a, s3a) if s3 == 0 else (q3b, c3b, s3b)
-                q2, free2, _vxy, c2, s2v = elbow_q2(g0, g1, c3, s3v, R2, p2, P, tiny)
-                if free2:
-                    status = 1
-                # R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, column by column
-                for i in range(3):
-                    cx[i], cy[i], cz[i] = consts[0, i, 0], consts[0, i, 1], consts[0, i, 2]
-                for kk in range(3):
-                    ck, sk = (c1, s1c) if kk == 0 else ((c2, s2v) if kk == 1 else (c3, s3v))
-                    for i in range(3):
-                        xi, yi = cx[i], cy[i]
-                        cx[i], cy[i] = ck * xi + sk * yi, ck * yi - sk * xi
-                    m = kk + 1  # consts[m] indexed, not sliced: a view is an atomic reference count
-                    c00, c01, c02 = consts[m, 0, 0], consts[m, 0, 1], consts[m, 0, 2]
-                    c10, c11, c12 = consts[m, 1, 0], consts[m, 1, 1], consts[m, 1, 2]
-                    c20, c21, c22 = consts[m, 2, 0], consts[m, 2, 1], consts[m, 2, 2]
-                    for i in range(3):
-                        xi, yi, zi = cx[i], cy[i], cz[i]
-                        cx[i] = xi * c00 + yi * c10 + zi * c20
-                        cy[i] = xi * c01 + yi * c11 + zi * c21
-                        cz[i] = xi * c02 + yi * c12 + zi * c22
-                for j in range(3):
-                    M[0, j] = cx[0] * Y[0, j] + cx[1] * Y[1, j] + cx[2] * Y[2, j]
-                    M[1, j] = cy[0] * Y[0, j] + cy[1] * Y[1, j] + cy[2] * Y[2, j]
-                    M[2, j] = cz[0] * Y[0, j] + cz[1] * Y[1, j] + cz[2] * Y[2, j]
-                qba, qbb, _lo, _hi, cba, sba, cbb, sbb = wrist_qb(M[0, 2], M[1, 2], M[2, 2], wc, WRIST_TOL)
-                if math.isnan(qba):
+                k2 = 2 * s1 + s3
+                if St[_F2 + k2, r] != 0.0:
+                    status = 1  # the wrist centre on axis 2: q2 free
+                if math.isnan(St[_QB + 2 * k2, r]):
                     continue
-                for s5 in range(2):
-                    qb, cb, sb = (qba, cba, sba) if s5 == 0 else (qbb, cbb, sbb)
-                    qa, qc, singular, _sign, _vxy, _cb, _sb, ca, sa, cc, sc = wrist_rest(
-                        qb, cb, sb, M[0, 0], M[1, 0], M[2, 0], M[0, 2], M[1, 2], R4, R5)
-                    if singular:
+                for k in range(2 * k2, 2 * k2 + 2):
+                    if St[_SG + k, r] != 0.0:
                         status = 1  # wrist singular: a continuum
-                    cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
-                    cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = qa, qb, qc
-                    # cos, sin of the joints for the verifying FK (of these very floats, or their closed form's
-                    # normalised (cos, sin) pairs whose atan2 they are)
-                    cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1c, c2, s2v
-                    cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, ca, sa  # qa as computed:
-                    cs[ncand, 8], cs[ncand, 9] = cb, sb  # it differs only where singular (handed over)
-                    cs[ncand, 10], cs[ncand, 11] = cc, sc
+                    _candidate(St, r, s1, k2, k, cand, cs, ncand)
                     ncand += 1
         # verified by the FK, folded into the limits, merged and sorted as the plain solver does (shared with the
         # UR and Stanford kernels); then the labels
@@ -178,3 +108,15 @@ def ik_elbow(T, X_e, C0i, R6, R1, p1, a, R2, p2, P, consts, R4, R5, sc, trig, lo
         out_status[b, 0] = kept
         out_status[b, 1] = n_out
         out_status[b, 2] = status
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_elbow: no call per candidate
+def _candidate(St, r, s1, k2, k, cand, cs, m):
+    """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows into cand[m] and the cosines and sines
+    of its joints into cs[m] (for the verifying FK: the closed form's normalised (cos, sin) pairs whose atan2 the
+    joints are; qa's as computed, which differs only where singular, handed over)."""
+    cand[m, 0], cand[m, 1], cand[m, 2] = St[_Q1 + s1, r], St[_Q2 + k2, r], St[_Q3 + k2, r]
+    cand[m, 3], cand[m, 4], cand[m, 5] = St[_QA + k, r], St[_QB + k, r], St[_QC + k, r]
+    cs[m, 0], cs[m, 1], cs[m, 2], cs[m, 3] = St[_C1 + s1, r], St[_S1 + s1, r], St[_C2 + k2, r], St[_S2 + k2, r]
+    cs[m, 4], cs[m, 5], cs[m, 6], cs[m, 7] = St[_C3 + k2, r], St[_S3 + k2, r], St[_CA + k, r], St[_SA + k, r]
+    cs[m, 8], cs[m, 9], cs[m, 10], cs[m, 11] = St[_CB + k, r], St[_SB + k, r], St[_CC + k, r], St[_SC + k, r]

@@ -2,7 +2,9 @@
 
 Each function here is elementwise: its arguments are floats or numpy arrays of one broadcast shape (constant
 vectors and matrices are indexed, ``R[0, 1]``, and give floats), and it uses only arithmetic, comparisons, ``&``,
-``|``, ``abs`` and the numpy ufuncs numba compiles on floats (``np.sqrt``, ``np.sin``, ``np.cos``, ``np.minimum``, ``np.maximum``, ``np.copysign``, ``np.floor``), plus :func:`select` for a choice per element.
+``|``, ``abs`` and the numpy ufuncs numba compiles on floats (``np.sqrt``, ``np.sin``, ``np.cos``, ``np.minimum``,
+``np.maximum``, ``np.copysign``, ``np.floor``), plus :func:`select` for a choice per element.  A square root of a
+quantity ≥ 0 by construction is taken of its ``abs`` (the same value): LLVM then knows it needs no libm call.
 Their angles come from :func:`atan2`, a branch-free rational approximation (no libm call: a compiled loop over
 poses or candidates can be vectorised; arcsin and arccos are atan2 of a sine and a cosine).  So the plain solver
 calls them on whole batches (numpy, the branch slots stacked on trailing axes) and :mod:`denavit.codegen` jits the
@@ -30,8 +32,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["JITTABLE", "WRIST_TOL", "select", "atan2", "trig_roots", "trig_pairs", "half_angle", "shoulder_roots",
-           "elbow_plane", "elbow_roots", "elbow_q2", "wrist_constants", "wrist_qb", "wrist_rest", "stanford_q3", "stanford_q2",
-           "stanford_q1"]
+           "elbow_plane", "elbow_roots", "elbow_q2", "wrist_constants", "wrist_qb", "wrist_rest", "stanford_q3",
+           "stanford_q2", "stanford_q1"]
 
 ALIGNED_EXACT = 1e-11  # below this angle [rad] the representative of the continuum is taken with qa = 0
 AXES_ALIGNED_TOL = 1e-7  # angle [rad] between the outer axes of a three-axis wrist under which it is singular
@@ -86,7 +88,7 @@ def trig_roots(a, b, c, tol):
     ok = some & (abs(ratio) <= 1.0 + tol)
     base = atan2(b, a)
     r = _clip(select(ok, ratio, 0.0), -1.0, 1.0)
-    delta = atan2(np.sqrt((1.0 - r) * (1.0 + r)), r)  # arccos r
+    delta = atan2(np.sqrt(abs((1.0 - r) * (1.0 + r))), r)  # arccos r
     return select(ok, base + delta, np.nan), select(ok, base - delta, np.nan), rho, ratio
 
 
@@ -96,7 +98,7 @@ def trig_pairs(a, b, rho, ratio, tol):
     (the ratio clipped to [−1, 1] as there); NaN where trig_roots gives NaN."""
     ok = (rho > 1e-12) & (abs(ratio) <= 1.0 + tol)
     r = _clip(select(ok, ratio, 0.0), -1.0, 1.0)
-    sd = np.sqrt((1.0 - r) * (1.0 + r))
+    sd = np.sqrt(abs((1.0 - r) * (1.0 + r)))
     n = select(ok, rho, np.nan)
     cb, sb = a / n, b / n
     return cb * r - sb * sd, sb * r + cb * sd, cb * r + sb * sd, sb * r - cb * sd
@@ -109,8 +111,8 @@ def half_angle(lo, hi, tol):
     ok = (lo >= -0.5 * tol) & (hi >= -0.5 * tol)
     small = lo <= hi
     y = _clip(select(small, lo, hi), 0.0, 1.0)
-    r = np.sqrt(y)
-    rc = np.sqrt(1.0 - y)
+    r = np.sqrt(abs(y))
+    rc = np.sqrt(abs(1.0 - y))
     x = 2.0 * atan2(r, rc)  # 2 arcsin √y, once: select evaluates both sides
     c = 1.0 - 2.0 * y
     return (select(ok, select(small, x, np.pi - x), np.nan), select(ok, select(small, c, -c), np.nan),
@@ -209,8 +211,8 @@ def _ra_rz(Ra, cb, sb, x0, x1, x2, i):
 
 def wrist_rest(qb, cb, sb, m00, m10, m20, m02, m12, Ra, Rb):
     """(qa, qc, singular, sign, vxy, cb, sb, ca, sa, cc, sc) of the wrist ``Rz(qa) Ra Rz(qb) Rb Rz(qc) = M`` once qb
-    is known, with its cos and sin cb, sb (of M only the five entries m_ij it reads, each a float or an array) (ca, sa, cc, sc: cos and sin of qa and qc as computed, before the
-    exact-alignment choice):
+    is known, with its cos and sin cb, sb (of M only the five entries m_ij it reads, each a float or an array; ca,
+    sa, cc, sc: cos and sin of qa and qc as computed, before the exact-alignment choice):
     qa turns v = Ra Rz(qb) Rb e_z onto M e_z, qc from the x-row of ``(Rz(qa) Ra Rz(qb) Rb)ᵀ M`` (Paden–Kahan
     subproblems 2 and 1).
 
