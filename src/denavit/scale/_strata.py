@@ -29,6 +29,7 @@ a longer one (its stratum counts depend on N).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -79,8 +80,10 @@ class Layout:
     counts: tuple
     block: int
 
+    @cached_property
     def _table(self):
-        """Per (sweep, stratum): samples, blocks, stratum index, strata of its sweep, and the blocks' cumsum."""
+        """Per (sweep, stratum): samples, blocks, stratum index, strata of its sweep, and the blocks' cumsum (kept:
+        a few kB, read by every task)."""
         n = np.concatenate(self.counts)
         nb = -(-n // self.block)
         s = np.concatenate([np.arange(c.size) for c in self.counts])
@@ -99,7 +102,7 @@ class Layout:
 
     def sizes(self, first: int, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Samples (count,) int64, stratum and strata (count,) of blocks first … first+count−1."""
-        n, nb, s, S, cum = self._table()
+        n, nb, s, S, cum = self._table
         b = np.arange(first, first + count)
         k = np.searchsorted(cum, b, side="right")
         j = b - (cum[k] - nb[k])

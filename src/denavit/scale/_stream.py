@@ -8,6 +8,8 @@ The numpy route draws here; the fused kernel (``_fused``) computes the same word
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 __all__ = ["HALF_WORD", "GAMMA", "MIX1", "MIX2", "BLOCK_STRIDE", "block_state", "mix64", "draw"]
@@ -24,9 +26,15 @@ def block_state(entropy: int, blocks) -> np.ndarray:
     """Starting states (uint64, shaped as ``blocks``) of the random blocks ``blocks`` of seed ``entropy``:
     K + b·2³²·γ (mod 2⁶⁴), K the first 64-bit word of ``SeedSequence(entropy)``.  Block b's words are those of
     one SplitMix64 stream from position b·2³² on, so blocks never overlap (b < 2³², a block < 2³² words)."""
-    key = np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0]
+    key = _key(entropy)
     with np.errstate(over="ignore"):
         return key + np.asarray(blocks, dtype=np.uint64) * np.uint64(BLOCK_STRIDE * GAMMA % 2**64)
+
+
+@functools.lru_cache(maxsize=64)
+def _key(entropy: int) -> np.uint64:
+    """K: the first 64-bit word of ``SeedSequence(entropy)`` (kept: every task asks for it)."""
+    return np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0]
 
 
 def mix64(z: np.ndarray) -> np.ndarray:
