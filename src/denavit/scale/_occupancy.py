@@ -208,7 +208,8 @@ def occupancy(robot: DHRobot, samples: int = 1_000_000, resolution: float | None
         Local pool size (default: the CPU count).
     chunk : int, optional
         Samples per task (rounded down to whole blocks of 65 536); default SINK_CHUNK for fused tasks on
-        threads or in this process, DEFAULT_CHUNK on other local pools, CLUSTER_CHUNK on a cluster.  Results do not depend on it.
+        threads or in this process, DEFAULT_CHUNK on other local pools, CLUSTER_CHUNK on a cluster.  Results
+        do not depend on it.
     fk : callable, optional
         Joint values (m, n) → end-effector origins (m, 3) or poses (m, 4, 4); default
         :func:`default_fk`: the compiled position kernel (``denavit.compile``) for runs of at least
