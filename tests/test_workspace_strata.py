@@ -137,6 +137,7 @@ def test_stratified_sampling_has_the_statistics_of_iid_sampling(strata):
     assert ours[:, 1].mean() > 1000  # a sparse regime: f1 matters
 
 
+@pytest.mark.slow
 def test_stratified_run_holds_the_area(strata):
     robot = denavit.load_robot("planar2r")
     ws = occupancy(robot, 2**20, seed=4, scheduler="synchronous")  # 16 and 256 strata
@@ -147,6 +148,7 @@ def test_stratified_run_holds_the_area(strata):
     assert ws.refinement is not None and e.resolution < 0.05 and e.low <= np.pi * 2.0**2 <= e.high
 
 
+@pytest.mark.slow
 def test_stratified_counts_are_the_histogram_of_the_sampled_positions(strata):
     robot = denavit.load_robot("puma560")
     n = 3 * BLOCK + 123
@@ -166,6 +168,7 @@ def _same(a, b):
         assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
 
 
+@pytest.mark.slow
 def test_stratified_runs_are_identical_for_routes_workers_and_chunks(strata):
     pytest.importorskip("numba")
 
