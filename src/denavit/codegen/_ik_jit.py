@@ -1,9 +1,12 @@
 """The shared closed forms of :mod:`denavit.ik` (``denavit.ik.forms``) made callable from numba-compiled code.
 
 Every function of ``forms.JITTABLE`` is registered with ``numba.extending.register_jitable`` (numba compiles the
-very function the plain solver runs on numpy batches, inlined into each compiled caller), and ``forms.select``
-gets its scalar meaning ``a if c else b`` (``np.where`` would make a 0-d array of each choice).  Importing this
-module is what registers them: the compiled closed forms import their names from here.
+very function the plain solver runs on numpy batches, inlined into each compiled caller by numba's IR), and
+``forms.select`` gets its scalar meaning ``a if c else b`` (``np.where`` would make a 0-d array of each choice) as
+LLVM's ``select`` instruction: the lambda ``a if c else b`` stayed a call in large loop bodies, and a call stops
+LLVM's loop vectoriser ("call instruction cannot be vectorized"; with the instruction a loop over poses of all of
+``wrist_rest`` vectorises).  Importing this module is what registers them: the compiled closed forms import their
+names from here.
 
 numba keys the cached machine code of a function by its own file's modification time and size only, while the
 kernels of ``codegen/_ik_nb_*.py`` inline :mod:`denavit.ik.forms` and each other: :func:`fresh_cache` keeps a
@@ -16,7 +19,8 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from numba.extending import overload, register_jitable
+from numba.core import types
+from numba.extending import intrinsic, overload, register_jitable
 
 from ..ik import forms
 
@@ -25,8 +29,23 @@ __all__ = ["fresh_cache", "WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", 
            "trig_pairs", "wrist_constants"]
 
 
-@overload(forms.select, jit_options={"nogil": True})
+@intrinsic
+def _select_ir(typingctx, c, a, b):
+    """LLVM's ``select`` of two scalars (no branch: a loop of them stays vectorisable)."""
+    ty = typingctx.unify_types(a, b)
+    if not isinstance(c, types.Boolean) or not isinstance(ty, types.Number):
+        return None
+
+    def codegen(context, builder, sig, args):
+        x, y = (context.cast(builder, v, t, ty) for v, t in zip(args[1:], sig.args[1:]))
+        return builder.select(args[0], x, y)
+    return ty(c, a, b), codegen
+
+
+@overload(forms.select, jit_options={"nogil": True}, inline="always")
 def _select(c, a, b):
+    if isinstance(c, types.Boolean) and isinstance(a, types.Number) and isinstance(b, types.Number):
+        return lambda c, a, b: _select_ir(c, a, b)
     return lambda c, a, b: a if c else b
 
 
