@@ -12,8 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ._ik_nb_elbow_stages import _C1, _C2, _C3, _CA, _CB, _CC, _F2, _Q1, _Q2, _Q3, _QA, _QB, _QC, _S1, _S2, _S3
-from ._ik_nb_elbow_stages import _SA, _SB, _SC, _SG, _ST, _X, CHUNK, ROWS, elbow_stages
+from ._ik_nb_elbow_stages import RC1, RC2, RC3, RCA, RCB, RCC, RF2, RQ1, RQ2, RQ3, RQA, RQB, RQC, RS1, RS2, RS3
+from ._ik_nb_elbow_stages import RSA, RSB, RSC, RSG, RST, RX, CHUNK, ROWS, elbow_stages
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_elbow_packed", "ik_elbow"]
@@ -55,22 +55,22 @@ def ik_elbow(T, K, consts, lo_lim, hi_lim, revolute, theta, tols, chain, out_q, 
         Xw = (St[0, r], St[1, r], St[2, r])
         # the branches of the pose in the one-pose loop's order (q1 root, q3 root, wrist root), the ones with no
         # root skipped; the status raised where the plain solver must decide
-        status = int(St[_ST, r])
+        status = int(St[RST, r])
         ncand = 0
         for s1 in range(2 if status == 0 else 0):
-            x = St[_X + s1, r]
-            if math.isnan(St[_Q1 + s1, r]) or math.isnan(x):
+            x = St[RX + s1, r]
+            if math.isnan(St[RQ1 + s1, r]) or math.isnan(x):
                 continue
             if x < 1e-6 or math.pi - x < 1e-6:
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
                 k2 = 2 * s1 + s3
-                if St[_F2 + k2, r] != 0.0:
+                if St[RF2 + k2, r] != 0.0:
                     status = 1  # the wrist centre on axis 2: q2 free
-                if math.isnan(St[_QB + 2 * k2, r]):
+                if math.isnan(St[RQB + 2 * k2, r]):
                     continue
                 for k in range(2 * k2, 2 * k2 + 2):
-                    if St[_SG + k, r] != 0.0:
+                    if St[RSG + k, r] != 0.0:
                         status = 1  # wrist singular: a continuum
                     _candidate(St, r, s1, k2, k, cand, cs, ncand)
                     ncand += 1
@@ -115,8 +115,8 @@ def _candidate(St, r, s1, k2, k, cand, cs, m):
     """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows into cand[m] and the cosines and sines
     of its joints into cs[m] (for the verifying FK: the closed form's normalised (cos, sin) pairs whose atan2 the
     joints are; qa's as computed, which differs only where singular, handed over)."""
-    cand[m, 0], cand[m, 1], cand[m, 2] = St[_Q1 + s1, r], St[_Q2 + k2, r], St[_Q3 + k2, r]
-    cand[m, 3], cand[m, 4], cand[m, 5] = St[_QA + k, r], St[_QB + k, r], St[_QC + k, r]
-    cs[m, 0], cs[m, 1], cs[m, 2], cs[m, 3] = St[_C1 + s1, r], St[_S1 + s1, r], St[_C2 + k2, r], St[_S2 + k2, r]
-    cs[m, 4], cs[m, 5], cs[m, 6], cs[m, 7] = St[_C3 + k2, r], St[_S3 + k2, r], St[_CA + k, r], St[_SA + k, r]
-    cs[m, 8], cs[m, 9], cs[m, 10], cs[m, 11] = St[_CB + k, r], St[_SB + k, r], St[_CC + k, r], St[_SC + k, r]
+    cand[m, 0], cand[m, 1], cand[m, 2] = St[RQ1 + s1, r], St[RQ2 + k2, r], St[RQ3 + k2, r]
+    cand[m, 3], cand[m, 4], cand[m, 5] = St[RQA + k, r], St[RQB + k, r], St[RQC + k, r]
+    cs[m, 0], cs[m, 1], cs[m, 2], cs[m, 3] = St[RC1 + s1, r], St[RS1 + s1, r], St[RC2 + k2, r], St[RS2 + k2, r]
+    cs[m, 4], cs[m, 5], cs[m, 6], cs[m, 7] = St[RC3 + k2, r], St[RS3 + k2, r], St[RCA + k, r], St[RSA + k, r]
+    cs[m, 8], cs[m, 9], cs[m, 10], cs[m, 11] = St[RCB + k, r], St[RSB + k, r], St[RCC + k, r], St[RSC + k, r]

@@ -20,16 +20,20 @@ from numba import njit
 from ._ik_finish import DOUBLE_ROOT
 from ._ik_jit import WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roots, wrist_qb, wrist_rest
 
-__all__ = ["CHUNK", "ROWS", "elbow_stages"]
+#: the scratch layout (rows of S) is shared with the walk over the branches (_ik_nb_elbow)
+__all__ = [
+    "CHUNK", "ROWS", "elbow_stages", "RC1", "RC2", "RC3", "RCA", "RCB", "RCC", "RF2", "RQ1", "RQ2", "RQ3",
+    "RQA", "RQB", "RQC", "RS1", "RS2", "RS3", "RSA", "RSB", "RSC", "RSG", "RST", "RX",
+]
 
 #: poses per chunk of the stages (its scratch: ROWS × CHUNK floats, 24 kB, in L1)
 CHUNK = 16
 # rows of S: per pose, then per branch (s1: 2, k2 = 2 s1 + s3: 4, k = 2 k2 + s5: 8)
-_XW, _W, _Y0, _Y2, _ST = 0, 3, 6, 9, 12  # wrist centre (world, frame of C0), columns 0 and 2 of T_R R6ᵀ, status
-_Q1, _C1, _S1, _G, _X = 13, 15, 17, 19, 23  # per s1: q1 and its cos, sin; (g0, g1) at _G + 2 s1; the elbow's x
-_Q3, _C3, _S3, _Q2, _C2, _S2, _F2 = 25, 29, 33, 37, 41, 45, 49  # per k2
-_M = 53  # per k2: m00, m10, m20, m02, m12, m22 of M = R_0_3ᵀ T_R R6ᵀ at _M + 6 k2
-_QB, _CB, _SB, _QA, _QC, _SG, _CA, _SA, _CC, _SC = 77, 85, 93, 101, 109, 117, 125, 133, 141, 149  # per k
+RXW, RW, RY0, RY2, RST = 0, 3, 6, 9, 12  # wrist centre (world, frame of C0), columns 0 and 2 of T_R R6ᵀ, status
+RQ1, RC1, RS1, RG, RX = 13, 15, 17, 19, 23  # per s1: q1 and its cos, sin; (g0, g1) at RG + 2 s1; the elbow's x
+RQ3, RC3, RS3, RQ2, RC2, RS2, RF2 = 25, 29, 33, 37, 41, 45, 49  # per k2
+RM = 53  # per k2: m00, m10, m20, m02, m12, m22 of M = R_0_3ᵀ T_R R6ᵀ at RM + 6 k2
+RQB, RCB, RSB, RQA, RQC, RSG, RCA, RSA, RCC, RSC = 77, 85, 93, 101, 109, 117, 125, 133, 141, 149  # per k
 ROWS = 157
 
 
@@ -65,28 +69,28 @@ def _shoulder(T, s, n, X_e, C0i, R6, a, h, tiny, ratio_tol, rho_w, S):
         w0 = C0i[0, 0] * x0 + C0i[0, 1] * x1 + C0i[0, 2] * x2 + C0i[0, 3]
         w1 = C0i[1, 0] * x0 + C0i[1, 1] * x1 + C0i[1, 2] * x2 + C0i[1, 3]
         w2 = C0i[2, 0] * x0 + C0i[2, 1] * x1 + C0i[2, 2] * x2 + C0i[2, 3]
-        S[_XW, b], S[_XW + 1, b], S[_XW + 2, b], S[_W, b], S[_W + 1, b], S[_W + 2, b] = x0, x1, x2, w0, w1, w2
+        S[RXW, b], S[RXW + 1, b], S[RXW + 2, b], S[RW, b], S[RW + 1, b], S[RW + 2, b] = x0, x1, x2, w0, w1, w2
         for i in range(3):
-            S[_Y0 + i, b] = T[t, i, 0] * R6[0, 0] + T[t, i, 1] * R6[0, 1] + T[t, i, 2] * R6[0, 2]
-            S[_Y2 + i, b] = T[t, i, 0] * R6[2, 0] + T[t, i, 1] * R6[2, 1] + T[t, i, 2] * R6[2, 2]
+            S[RY0 + i, b] = T[t, i, 0] * R6[0, 0] + T[t, i, 1] * R6[0, 1] + T[t, i, 2] * R6[0, 2]
+            S[RY2 + i, b] = T[t, i, 0] * R6[2, 0] + T[t, i, 1] * R6[2, 1] + T[t, i, 2] * R6[2, 2]
         q1a, q1b, free1, ratio, c1a, s1a, c1b, s1b = shoulder_roots(w0, w1, w2, a, h, tiny, ratio_tol)
         bad = free1 | ((ratio == 0.0) & math.isnan(q1a)) | (abs(abs(ratio) - 1.0) < DOUBLE_ROOT) | (rho_w < 1e-12)
-        S[_ST, b] = 1.0 if bad else 0.0
-        S[_Q1, b], S[_Q1 + 1, b], S[_C1, b], S[_C1 + 1, b] = q1a, q1b, c1a, c1b
-        S[_S1, b], S[_S1 + 1, b] = s1a, s1b
+        S[RST, b] = 1.0 if bad else 0.0
+        S[RQ1, b], S[RQ1 + 1, b], S[RC1, b], S[RC1 + 1, b] = q1a, q1b, c1a, c1b
+        S[RS1, b], S[RS1 + 1, b] = s1a, s1b
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _elbow(n, s1, R1, p1, na, nb, base3, cb3, sb3, ratio_tol, S):
     """The elbow's two roots q3 for the shoulder root s1 of each pose (elbow_plane, elbow_roots)."""
     for b in range(n):
-        g0, g1 = elbow_plane(S[_C1 + s1, b], S[_S1 + s1, b], S[_W, b], S[_W + 1, b], S[_W + 2, b], R1, p1)
+        g0, g1 = elbow_plane(S[RC1 + s1, b], S[RS1 + s1, b], S[RW, b], S[RW + 1, b], S[RW + 2, b], R1, p1)
         q3a, q3b, x, c3a, s3a, c3b, s3b = elbow_roots(np.sqrt(g0 * g0 + g1 * g1), na, nb, base3, cb3, sb3,
                                                       ratio_tol)
-        S[_G + 2 * s1, b], S[_G + 2 * s1 + 1, b], S[_X + s1, b] = g0, g1, x
+        S[RG + 2 * s1, b], S[RG + 2 * s1 + 1, b], S[RX + s1, b] = g0, g1, x
         k = 2 * s1
-        S[_Q3 + k, b], S[_C3 + k, b], S[_S3 + k, b] = q3a, c3a, s3a
-        S[_Q3 + k + 1, b], S[_C3 + k + 1, b], S[_S3 + k + 1, b] = q3b, c3b, s3b
+        S[RQ3 + k, b], S[RC3 + k, b], S[RS3 + k, b] = q3a, c3a, s3a
+        S[RQ3 + k + 1, b], S[RC3 + k + 1, b], S[RS3 + k + 1, b] = q3b, c3b, s3b
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -110,32 +114,32 @@ def _arm(n, k2, R2, p2, P, tiny, consts, wc, S):
     R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3) and the wrist's two roots qb (wrist_qb)."""
     s1 = k2 >> 1
     for b in range(n):
-        c1, sn1, c3, sn3 = S[_C1 + s1, b], S[_S1 + s1, b], S[_C3 + k2, b], S[_S3 + k2, b]
-        q2, free2, _vxy, c2, sn2 = elbow_q2(S[_G + 2 * s1, b], S[_G + 2 * s1 + 1, b], c3, sn3, R2, p2, P, tiny)
-        S[_Q2 + k2, b], S[_C2 + k2, b], S[_S2 + k2, b], S[_F2 + k2, b] = q2, c2, sn2, 1.0 if free2 else 0.0
+        c1, sn1, c3, sn3 = S[RC1 + s1, b], S[RS1 + s1, b], S[RC3 + k2, b], S[RS3 + k2, b]
+        q2, free2, _vxy, c2, sn2 = elbow_q2(S[RG + 2 * s1, b], S[RG + 2 * s1 + 1, b], c3, sn3, R2, p2, P, tiny)
+        S[RQ2 + k2, b], S[RC2 + k2, b], S[RS2 + k2, b], S[RF2 + k2, b] = q2, c2, sn2, 1.0 if free2 else 0.0
         F = (consts[0, 0, 0], consts[0, 1, 0], consts[0, 2, 0], consts[0, 0, 1], consts[0, 1, 1], consts[0, 2, 1],
              consts[0, 0, 2], consts[0, 1, 2], consts[0, 2, 2])  # the columns of C0
         F = _turn(consts, 2, c2, sn2, _turn(consts, 1, c1, sn1, F))
         x0, x1, x2, y0, y1, y2, z0, z1, z2 = _turn(consts, 3, c3, sn3, F)
-        m = _M + 6 * k2
+        m = RM + 6 * k2
         for j in range(2):
-            r = _Y0 if j == 0 else _Y2
+            r = RY0 if j == 0 else RY2
             S[m + 3 * j, b] = x0 * S[r, b] + x1 * S[r + 1, b] + x2 * S[r + 2, b]
             S[m + 3 * j + 1, b] = y0 * S[r, b] + y1 * S[r + 1, b] + y2 * S[r + 2, b]
             S[m + 3 * j + 2, b] = z0 * S[r, b] + z1 * S[r + 1, b] + z2 * S[r + 2, b]
         qba, qbb, _lo, _hi, cba, sba, cbb, sbb = wrist_qb(S[m + 3, b], S[m + 4, b], S[m + 5, b], wc, WRIST_TOL)
         k = 2 * k2
-        S[_QB + k, b], S[_CB + k, b], S[_SB + k, b] = qba, cba, sba
-        S[_QB + k + 1, b], S[_CB + k + 1, b], S[_SB + k + 1, b] = qbb, cbb, sbb
+        S[RQB + k, b], S[RCB + k, b], S[RSB + k, b] = qba, cba, sba
+        S[RQB + k + 1, b], S[RCB + k + 1, b], S[RSB + k + 1, b] = qbb, cbb, sbb
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _wrist(n, k, R4, R5, S):
     """For the candidate k = 2 k2 + s5 of each pose: qa, qc (wrist_rest), their cos and sin, the singular flag."""
-    m = _M + 6 * (k >> 1)
+    m = RM + 6 * (k >> 1)
     for b in range(n):
         qa, qc, singular, _sign, _vxy, _cb, _sb, ca, sa, cc, sc = wrist_rest(
-            S[_QB + k, b], S[_CB + k, b], S[_SB + k, b], S[m, b], S[m + 1, b], S[m + 2, b], S[m + 3, b],
+            S[RQB + k, b], S[RCB + k, b], S[RSB + k, b], S[m, b], S[m + 1, b], S[m + 2, b], S[m + 3, b],
             S[m + 4, b], R4, R5)
-        S[_QA + k, b], S[_QC + k, b], S[_SG + k, b] = qa, qc, 1.0 if singular else 0.0
-        S[_CA + k, b], S[_SA + k, b], S[_CC + k, b], S[_SC + k, b] = ca, sa, cc, sc
+        S[RQA + k, b], S[RQC + k, b], S[RSG + k, b] = qa, qc, 1.0 if singular else 0.0
+        S[RCA + k, b], S[RSA + k, b], S[RCC + k, b], S[RSC + k, b] = ca, sa, cc, sc
