@@ -14,6 +14,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _occupancy_same import NumpyRoute, same_occupancy, stanford_routes
 from _random_robots import random_robot
 
 import denavit
@@ -25,10 +26,6 @@ pytest.importorskip("numba")
 from denavit.scale import _fused, _sink
 from denavit.scale._refine import plan_refinement
 from denavit.scale._sampler import make_job, run_task
-
-
-class NumpyRoute(CompiledPositionFK):
-    """The same compiled kernel, but not the exact class: tasks take the numpy route."""
 
 
 def _limited(robot):
@@ -50,15 +47,6 @@ def _same_task(a, b):
         assert np.array_equal(ia, ib) and np.array_equal(ca, cb)
     assert np.array_equal(a[2], b[2]) and np.array_equal(a[3], b[3])  # bounds, bit for bit
     assert a[4] == b[4] and a[5] == b[5]  # reach, samples
-
-
-def _same(a, b):
-    assert np.array_equal(a.counts, b.counts)
-    assert np.array_equal(a.bounds_min, b.bounds_min) and np.array_equal(a.bounds_max, b.bounds_max)
-    assert a.reach == b.reach and a.estimate == b.estimate
-    assert (a.fine is None) == (b.fine is None)
-    if a.fine is not None:
-        assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
 
 
 def _splitmix64(state: int, count: int) -> list[int]:
@@ -173,17 +161,10 @@ def test_coordinate_plane_cells_are_the_numpy_routes():
 
 
 def test_identical_for_chunks_workers_accumulators_and_routes(monkeypatch):
-    robot = denavit.load_robot("stanford")
-    n = 5 * BLOCK + 999
-    args = {"resolution": 0.1, "seed": 42, "refine": 4}
-    ref = occupancy(robot, n, scheduler="synchronous", chunk=BLOCK, fk=NumpyRoute(robot), **args)
-    assert ref.refinement is not None and ref.fine.sum() > 0
-    fk = CompiledPositionFK(robot)
-    _same(ref, occupancy(robot, n, scheduler="synchronous", chunk=2 * BLOCK, fk=fk, **args))
-    _same(ref, occupancy(robot, n, scheduler="threads", workers=2, chunk=BLOCK, fk=fk, **args))
+    robot, n, args, ref, fk = stanford_routes()
     monkeypatch.setattr(_sink, "_MOST", BLOCK + 1)  # an accumulator flushed before nearly every task
     monkeypatch.setattr(_sink, "ACC_BUDGET", 1)  # one accumulator for three threads
-    _same(ref, occupancy(robot, n, scheduler="threads", workers=3, chunk=BLOCK, fk=fk, **args))
+    same_occupancy(ref, occupancy(robot, n, scheduler="threads", workers=3, chunk=BLOCK, fk=fk, **args))
 
 
 @pytest.mark.slow
@@ -191,7 +172,7 @@ def test_identical_on_a_process_pool_with_the_fused_kernel():
     robot = denavit.load_robot("puma560")
     n = 4 * BLOCK + 5
     ref = occupancy(robot, n, 0.05, seed=8, scheduler="synchronous", fk=NumpyRoute(robot), refine=2)
-    _same(ref, occupancy(robot, n, 0.05, seed=8, scheduler="processes", workers=2, chunk=BLOCK,
+    same_occupancy(ref, occupancy(robot, n, 0.05, seed=8, scheduler="processes", workers=2, chunk=BLOCK,
                          fk=CompiledPositionFK(robot), refine=2))
 
 

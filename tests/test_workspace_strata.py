@@ -14,8 +14,10 @@ import dataclasses
 import numpy as np
 import pytest
 
+from _occupancy_same import same_occupancy, stanford_routes
+
 import denavit
-from denavit.scale import BLOCK, CompiledPositionFK, occupancy, sample_positions
+from denavit.scale import BLOCK, occupancy, sample_positions
 from denavit.scale import _strata
 from denavit.scale._refine import pilot_blocks
 from denavit.scale._sampler import block_table, make_job, run_blocks
@@ -160,29 +162,10 @@ def test_stratified_counts_are_the_histogram_of_the_sampled_positions(strata):
     np.testing.assert_array_equal(ws.bounds_min, p.min(axis=0))
 
 
-def _same(a, b):
-    assert np.array_equal(a.counts, b.counts) and a.estimate == b.estimate and a.reach == b.reach
-    assert np.array_equal(a.bounds_min, b.bounds_min) and np.array_equal(a.bounds_max, b.bounds_max)
-    assert (a.fine is None) == (b.fine is None)
-    if a.fine is not None:
-        assert np.array_equal(a.fine, b.fine) and np.array_equal(a.refinement.cells, b.refinement.cells)
-
-
 @pytest.mark.slow
 def test_stratified_runs_are_identical_for_routes_workers_and_chunks(strata):
     pytest.importorskip("numba")
-
-    class NumpyRoute(CompiledPositionFK):
-        """The same compiled kernel, but not the exact class: tasks take the numpy route."""
-
-    robot = denavit.load_robot("stanford")
-    n = 5 * BLOCK + 999
-    args = {"resolution": 0.1, "seed": 42, "refine": 4}
-    ref = occupancy(robot, n, scheduler="synchronous", chunk=BLOCK, fk=NumpyRoute(robot), **args)
-    assert ref.refinement is not None and ref.fine.sum() > 0
-    fk = CompiledPositionFK(robot)
-    _same(ref, occupancy(robot, n, scheduler="synchronous", chunk=2 * BLOCK, fk=fk, **args))
-    _same(ref, occupancy(robot, n, scheduler="threads", workers=2, chunk=BLOCK, fk=fk, **args))
-    _same(ref, occupancy(robot, n, scheduler="processes", workers=2, chunk=3 * BLOCK, fk=fk, **args))
+    robot, n, args, ref, fk = stanford_routes()
+    same_occupancy(ref, occupancy(robot, n, scheduler="processes", workers=2, chunk=3 * BLOCK, fk=fk, **args))
     plain = occupancy(robot, n, scheduler="synchronous", fk=fk, **args | {"refine": 0})
     assert np.array_equal(plain.counts, ref.counts)  # the layout does not depend on refine
