@@ -19,8 +19,8 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, formula_leftover, joint_offset, names_formula, names_product, plain_name, renumber, used_where,
-                       vector_reading)
+from ._reading import (define_chain, formula_leftover, joint_offset, names_product, plain_name, renumber,
+                       used_where, vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
 from ._values import wrench_symbols
@@ -350,8 +350,9 @@ class _Walker:
             self.note(eq, arm, "not a claim", "a definition (a transform written as named motions, not as a "
                       "matrix)", reading.spec["quantity"])
             return
-        if reading is not None and (names_product(value) or names_formula(value)
-                                    or _RELATION.fullmatch(value.replace(" ", ""))):
+        product = reading is not None and names_product(value)
+        left = formula_leftover(value) if reading is not None else None  # "" for a formula in other results
+        if reading is not None and (product or left == "" or _RELATION.fullmatch(value.replace(" ", ""))):
             if reading.spec["quantity"] in ("torques", "twist", "jacobian"):
                 claim = {"quantity": "relation", "value": eq.text}
                 p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "a relation between the arm's quantities",
@@ -359,10 +360,9 @@ class _Walker:
                 p.not_a_claim_if_unreadable = True
                 self.out.append(p)
                 return
-            what = "the product of other results" if names_product(value) else "a formula in other results"
+            what = "the product of other results" if product else "a formula in other results"
             self.note(eq, arm, "not a claim", f"a definition: {what}", reading.spec["quantity"])
             return
-        left = formula_leftover(value) if reading is not None else None
         if left and re.fullmatch(r"\\[A-Za-z]{1,12}", left):
             self.note(eq, arm, "unreadable", f"a formula in other results with '{left}' where an operator (×, ·, +) "
                       "belongs: not judged", reading.spec["quantity"])

@@ -12,7 +12,8 @@ from ._context import Context, vector_entries
 from ._lhs import read_symbol
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "names_product", "names_formula", "formula_leftover", "used_where", "plain_name", "joint_offset", "renumber"]
+__all__ = ["vector_reading", "define_chain", "names_product", "formula_leftover", "used_where", "plain_name",
+           "joint_offset", "renumber"]
 
 
 def vector_reading(lhs: str, robot: Any) -> Reading | None:
@@ -62,17 +63,11 @@ _VECTOR_NAMED = re.compile(r"(?:\{\}\s*\^\s*\{?\s*\d\s*\}?\s*)?(?:\\mathbf\{|\\b
                            r"_\s*\{?\s*\d{1,2}\s*\}?")
 
 
-def names_formula(value: str) -> bool:
-    """``{}^1R_2 n_2 + {}^1P_2 \\times {}^1f_1``: sums, differences, products and cross products of named results —
-    a recursion written in other quantities (Craig's force and velocity propagation), a definition, not a value.
-    At least one propagated vector is named (a product of transforms alone is :func:`names_product`'s)."""
-    return formula_leftover(value) == ""
-
-
 def formula_leftover(value: str) -> str | None:
     """What is left of ``value`` once its named results (two or more, a propagated vector among them), operators
-    and brackets are taken out: ``""`` for a formula in other results (:func:`names_formula`), ``"\\alpha"`` for
-    ``{}^2P_3 \\alpha {}^2f_2`` (a symbol where an operator belongs); None when ``value`` is no such formula."""
+    and brackets are taken out: ``""`` for a formula in other results (``{}^1R_2 n_2 + {}^1P_2 \\times {}^1f_1``,
+    Craig's propagation: a definition, not a value), ``"\\alpha"`` for ``{}^2P_3 \\alpha {}^2f_2`` (a symbol where
+    an operator belongs); None when ``value`` is no such formula."""
     if len(value) > 400 or "\\begin" in value or not _VECTOR_NAMED.search(value):
         return None
     value = re.sub(r"\^\s*\{?\s*(?:T|\\top|-1)\s*\}?", " ", value)
