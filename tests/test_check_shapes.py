@@ -279,3 +279,27 @@ def test_transposed_jacobians_and_unit_headers():
     (w,) = _v([{"quantity": "position", "entry": 1, "value": x,
                 "q": r"(\theta_1, \theta_2, \theta_3)[deg] = (" + f"{math.degrees(0.5)!r}, 45, -90)"}])
     assert w.verdict == "correct", w.message
+
+
+@pytest.mark.parametrize("lc2, th2, wrong", [
+    ("Lc_2", r"\theta_2", False), ("L c_2", r"\theta 2", False), ("L c_{2}", r"\theta_{2}", False),
+    ("L c_2", r"\theta 2", True),
+])
+def test_names_split_by_a_text_conversion_are_joined(lc2, th2, wrong):
+    """``L c_2`` is Lc₂ when L alone names nothing; the potential energy of the planar 3R arm from the textbook
+    (gravity along −y: P = g Σ mᵢ y_cᵢ), so a wrong mass in it is still caught."""
+    m3 = "m_2" if wrong else "m_3"
+    text = (rf"P = Lc_1 g m_1 \sin(\theta_1) + g m_2 (L_1 \sin(\theta_1) + {lc2} \sin({th2} + \theta_1))"
+            rf" + g {m3} (L_1 \sin\theta_1 + L_2 \sin({th2} + \theta_1) + Lc_3 \sin({th2} + \theta_3 + \theta_1))")
+    (v,) = _v([{"quantity": "potential_energy", "q": "0.3, -0.4, 0.9", "value": text.split("=", 1)[1]}])
+    assert v.verdict == ("incorrect" if wrong else "correct"), v.message
+
+
+@pytest.mark.parametrize("dot", [r"\dot{\theta}_1", r"\dot{\theta}1", r"\dot{\theta 1}", r"\dot{\theta} 1"])
+def test_a_lost_subscript_of_a_joint_rate_is_read(dot):
+    """v_c1 = Lc₁ θ̇₁ (−sin θ₁, cos θ₁, 0) (the textbook's planar arm), with the rate's subscript written as
+    conversions leave it."""
+    value = rf"\begin{{bmatrix}} -Lc_1 \sin(\theta_1) {dot} \\ Lc_1 \cos(\theta_1) {dot} \\ 0 \end{{bmatrix}}"
+    (v,) = _v([{"quantity": "com_velocity", "index": 1, "q": "0.3, -0.4, 0.9", "qd": "0.7, 0.1, -0.2",
+                "value": value}])
+    assert v.verdict == "correct", v.message

@@ -308,6 +308,9 @@ class _Parser:
         try:
             return self.resolve(ident)
         except ParseError:
+            joined = self.joined_name(word, ident)
+            if joined is not None:
+                return joined
             if len(word) == 1:
                 raise
         # "Lc" might be L·c: split letters, the last one keeps the subscript
@@ -317,6 +320,23 @@ class _Parser:
         for n in nodes[1:]:
             out = ("bin", "*", out, n)
         return out
+
+    def joined_name(self, word: str, ident: Ident) -> tuple | None:
+        """``L c_2`` read as ``Lc_2`` when ``L`` alone is unknown and the two words make a known name (a space a
+        PDF-to-text conversion put inside the name); None, with nothing consumed, when they do not."""
+        nxt = self.peek()
+        if ident.sub or ident.dots or nxt is None or nxt[0] != "word" or not nxt[1].isalpha():
+            return None
+        start = self.i
+        self.take()
+        try:
+            node = self.resolve(self.read_sub(word + nxt[1]))
+        except ParseError:
+            node = None
+        if node is None or node[0] != "name":
+            self.i = start
+            return None
+        return node
 
     def resolve_ident(self, ident: Ident, allow_sub: bool) -> tuple:
         return self.resolve(ident)

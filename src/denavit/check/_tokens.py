@@ -63,8 +63,15 @@ class Ident:
 Resolver = Callable[[Ident], tuple]
 
 
-_JOINT_SPACE = re.compile(r"(\\(?:var)?theta|\\dot\{?\\theta\}?|\\ddot\{?\\theta\}?)\s+(\d)(?![\d.])")
+_JOINT_SPACE = re.compile(r"(\\(?:var)?theta|\\dot\{?\\theta\}?|\\ddot\{?\\theta\}?)\s+(\d)(?![\d.])"
+                          r"|(\\d?dot\{\\theta)(?:\}\s*(\d)(?![\d.])|\s*(\d)\})")  # \dot{\theta}2, \dot{\theta 2}
 _OF_TIME = re.compile(r"(?<=[A-Za-z0-9}])\s*\(\s*t\s*\)")
+
+
+def _joint_subscript(m: re.Match) -> str:
+    if m.group(1):
+        return f"{m.group(1)}_{{{m.group(2)}}}"
+    return f"{m.group(3)}}}_{{{m.group(4) or m.group(5)}}}"
 
 
 def normalize(text: str) -> str:
@@ -73,7 +80,7 @@ def normalize(text: str) -> str:
     text = re.sub(r"([θαβφψωτϑσ])(\d+)", lambda m: _UNICODE[m.group(1)].strip() + "_{" + m.group(2) + "}", text)
     for k, v in _UNICODE.items():
         text = text.replace(k, v)
-    text = _JOINT_SPACE.sub(lambda m: f"{m.group(1)}_{{{m.group(2)}}}", text)  # \\theta 2 → \\theta_{2}
+    text = _JOINT_SPACE.sub(_joint_subscript, text)  # \\theta 2 → \\theta_{2}
     return _OF_TIME.sub("", text)  # \\theta_1(t) → \\theta_1
 
 
