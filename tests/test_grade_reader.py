@@ -248,3 +248,19 @@ def test_a_chain_ending_in_another_name_claims_its_value_for_both_and_recursions
     # the wrong vector under the trailing name: both names judged, both wrong
     wrong = _report(f"$${{}}^1 f_1 = {vector.replace('- s_2 f_y', '+ s_2 f_y')} = {{}}^0 f_0$$")
     assert [(c.quantity, c.verdict) for c in grade_text(wrong).claims] == [("force", "incorrect")] * 2
+
+
+def test_a_section_without_a_table_is_offered_the_catalogue_arms_whose_parameters_it_writes():
+    """The advice names a catalogue arm with the section's joint count and its symbols; followed, the section's
+    textbook centre-of-mass position (p_c2 = (L1 c1 + Lc2 c12, L1 s1 + Lc2 s12, 0)) is judged correct."""
+    pc2 = ("$$p_{c2} = \\begin{bmatrix} L_1 \\cos\\theta_1 + Lc_2 \\cos(\\theta_1 + \\theta_2) \\\\ "
+           "L_1 \\sin\\theta_1 + L c_2 \\sin(\\theta_1 + \\theta_2) \\\\ 0 \\end{bmatrix}$$")
+    text = (_report("$$x = L_1 c_1 + L_2 c_{12}$$") + "\n# 2. Dynamics of a 3DOF arm\n\n"
+            "$$K = \\frac{1}{2} m_1 Lc_1^2 \\dot\\theta_1^2 + \\frac{1}{2} I_1 \\dot\\theta_1^2$$\n\n" + pc2 + "\n")
+    notes = grade_text(text).notes
+    advice = [n for n in notes if "--arm 2=p" in n]
+    assert len(advice) == 1 and advice[0].index("--arm 2=planar3r-lagrange") < advice[0].find("--arm 2=planar3r ")
+    judged = grade_text(text, arms={"2": load_robot("planar3r-lagrange")}).claims
+    assert [c.verdict for c in judged if c.quantity == "com_position"] == ["correct"]
+    other = _report("$$x = L_1 c_1$$") + "\n# 2. A 3DOF arm\n\n$$x = h_1 + w_2 + u_3$$\n"
+    assert not [n for n in grade_text(other).notes if "--arm 2=p" in n]  # no catalogue arm writes h1, w2, u3

@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass
 
 from ..errors import DenavitError, ParseError
-from ..io import robot_from_dict
+from ..io import catalogue_names, load_robot, robot_from_dict
 from ..model import DHRobot
 from ..tables import find_tables, import_table
 from ._document import Document, Heading
@@ -39,6 +39,7 @@ class Arm:
     robot: DHRobot | None
     info: ArmInfo
     problem: str = ""
+    advice: str = ""
 
 
 def _dof_named(title: str) -> int | None:
@@ -137,12 +138,35 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
                 and not has_table:
             spans.append((Section(h, h.line, end), Arm(None, ArmInfo("", h.title, h.line, end, "none", "", 0),
                           f"the section at line {h.line} is about a {named}-joint arm and has no DH table of its own "
-                          f"(give one: --arm {h.key or 'SECTION'}=ROBOT)")))
+                          f"(give one: --arm {h.key or 'SECTION'}=ROBOT)",
+                          _catalogue_advice(doc.lines[h.line - 1:end], named, h.key or "SECTION", h.line))))
     spans.sort(key=lambda s: s[0].end_line - s[0].line)  # the most specific section decides
     for k, (start, arm) in enumerate(base):
         stop = base[k + 1][0] - 1 if k + 1 < len(base) else n
         spans.append((Section(None, start, stop), arm))
     return spans
+
+
+_SYMBOL = re.compile(r"\b([A-Za-z]{1,3})\s?_?\{?(\d)\}?")
+
+
+def _catalogue_advice(lines, dof: int, key: str, line: int) -> str:
+    """The catalogue arms with ``dof`` joints whose parameters are the symbols a section writes (L_1, Lc_2, m_3,
+    I_1 …), best first: a suggestion for ``--arm``, never applied (the user says which arm the section is about).
+    """
+    written = {a + b for a, b in _SYMBOL.findall("\n".join(lines))}
+    scored = []
+    for name in catalogue_names():
+        robot = load_robot(name)
+        shared = sorted({k for k, _ in robot.parameters} & written)
+        if robot.dof == dof and len(shared) >= 2:
+            scored.append((-len(shared), name, shared))
+    if not scored:
+        return ""
+    best = sorted(scored)[:2]
+    said = "; ".join(f"--arm {key}={name} (its parameters {', '.join(shared)} are symbols the section writes)"
+                     for _, name, shared in best)
+    return f"arms of the catalogue with {dof} joints that may fit the section at line {line}: {said}"
 
 
 def compare_tables(doc: Document, robot: DHRobot, source: str) -> list[GradedClaim]:

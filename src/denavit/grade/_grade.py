@@ -139,6 +139,8 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
             seen[arm.info.name] = arm.info
         if arm is not None and arm.problem and arm.problem not in notes:
             notes.append(arm.problem)
+            if arm.advice:
+                notes.append(arm.advice)
     if not seen:
         notes.append("no DH table found in the report: give the arm (denavit check ROBOT REPORT)")
     arms_in_order = tuple(sorted(seen.values(), key=lambda a: a.line))  # as the report runs (spans are ordered
