@@ -264,3 +264,13 @@ def test_a_section_without_a_table_is_offered_the_catalogue_arms_whose_parameter
     assert [c.verdict for c in judged if c.quantity == "com_position"] == ["correct"]
     other = _report("$$x = L_1 c_1$$") + "\n# 2. A 3DOF arm\n\n$$x = h_1 + w_2 + u_3$$\n"
     assert not [n for n in grade_text(other).notes if "--arm 2=p" in n]  # no catalogue arm writes h1, w2, u3
+
+
+def test_a_wrong_planar_pair_is_judged_entry_by_entry_not_by_shape():
+    """(x, y) of the planar 2R tip (Spong 3.2: y = L1 s1 + L2 s12) with y wrong: the entry is named, not the shape."""
+    good = "$$p_E = \\begin{bmatrix} L_1 c_1 + L_2 c_{12} \\\\ L_1 s_1 + L_2 s_{12} \\end{bmatrix}$$"
+    bad = "$$p_E = \\begin{bmatrix} L_1 c_1 + L_2 c_{12} \\\\ L_1 c_1 + L_2 s_{12} \\end{bmatrix}$$"
+    ok, wrong = grade_text(_report(good, bad)).claims
+    assert ok.verdict == "correct" and "(x, y)" in ok.message
+    assert wrong.verdict == "incorrect" and "(x, y)" in wrong.message and "shape" not in wrong.message
+    assert "1 entry differs (2)" in wrong.message
