@@ -274,3 +274,13 @@ def test_a_wrong_planar_pair_is_judged_entry_by_entry_not_by_shape():
     assert ok.verdict == "correct" and "(x, y)" in ok.message
     assert wrong.verdict == "incorrect" and "(x, y)" in wrong.message and "shape" not in wrong.message
     assert "1 entry differs (2)" in wrong.message
+
+
+@pytest.mark.parametrize("tail", ["S v_s", "{}^0v_s", "\\vec{u}"])
+def test_names_after_a_matrix_name_it_and_the_matrix_is_judged(tail):
+    """``⁴v₄ = [⋯] = S v_s`` (report 004): the matrix is the claim, right (Spong 3.2's tip) or wrong."""
+    good = f"$$p_E = \\begin{{bmatrix}} L_1 c_1 + L_2 c_{{12}} \\\\ L_1 s_1 + L_2 s_{{12}} \\end{{bmatrix}} = {tail}$$"
+    bad = good.replace("L_1 s_1", "L_1 c_1")
+    ok, wrong = grade_text(_report(good, bad)).claims
+    assert (ok.verdict, wrong.verdict) == ("correct", "incorrect"), (ok.message, wrong.message)
+    assert "the matrix before" in ok.understood

@@ -34,6 +34,13 @@ _SINGULAR = re.compile(r"singular|vanish|loses? rank|rank[- ]deficien|degenerat"
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
+_ONLY_NAMES = re.compile(r"(?:[A-Za-z{}\s]|\\(?:dot|mathbf|boldsymbol|vec)\b){1,40}")
+_SCRIPT = re.compile(r"[_^](?:\{[^{}]{0,8}\}|\w)")
+
+
+def _only_names(text: str) -> bool:
+    """``S v_s``, ``{}^0v_s``, ``\\mathbf{p}``: names (with sub- and superscripts), no number, no operator."""
+    return bool(_ONLY_NAMES.fullmatch(_SCRIPT.sub("", text.strip()))) and bool(re.search("[A-Za-z]", text))
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
@@ -322,6 +329,8 @@ class _Walker:
         also = self._trailing_name(eq, robot)
         if also is not None:
             value = eq.parts[-2]  # "²f₂ = ²R₃ ³f₃ = [⋯] = ¹f₁": the value is claimed for both names
+        elif len(eq.parts) > 2 and "\\begin" in eq.parts[-2] and _only_names(value):
+            value = eq.parts[-2]  # "⁴v₄ = [⋯] = S v_s": names after the matrix, not a value: the matrix is judged
         sym = read_symbol(lhs)
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
@@ -378,6 +387,8 @@ class _Walker:
                       "or an intermediate step)")
             return
         self.out.append(build_claim(self.ctx, eq, arm, reading, value))
+        if value is not eq.parts[-1] and also is None and "\\begin" in value and "\\begin" not in eq.parts[-1]:
+            self.out[-1].understood += f" (the matrix before '= {eq.parts[-1].strip()[:40]}')"
         if also is not None:
             self.out.append(build_claim(self.ctx, eq, arm, also, value))
 
