@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._volume import VolumeEstimate, chao1, interior
+from ._volume import VolumeEstimate, chao1, interior, level_stats
 
 __all__ = ["PILOT_SHARE", "PROJECTED_COVERAGE", "REFINE_COVERAGE", "MAX_REFINE", "REFINE_CELLS", "Refinement",
            "plan_refinement", "projected_coverage", "refined_levels", "slot_map", "popcount", "pilot_blocks",
@@ -92,11 +92,11 @@ def plan_refinement(counts: np.ndarray, factor: int | None, pilot: int,
     of the grid reaches REFINE_COVERAGE; the factor is then the largest that fits REFINE_CELLS and whose
     sub-cells' coverage, projected from the pilot (:func:`projected_coverage`; ``blocks``: the run's, default
     PILOT_SHARE·pilot), reaches PROJECTED_COVERAGE)."""
-    total = float(counts.sum())
-    if factor is None and (total == 0 or 1.0 - np.count_nonzero(counts == 1) / total < REFINE_COVERAGE):
+    _, _, f1, _, total, inner = level_stats(counts, mask=True)
+    if factor is None and (total == 0 or 1.0 - f1 / float(total) < REFINE_COVERAGE):
         return None
     occ = counts > 0
-    cells = _shell_cells(occ, interior(occ))
+    cells = _shell_cells(occ, inner)
     if cells.size == 0:
         return None
     k = MAX_REFINE if factor is None else int(factor)
@@ -234,16 +234,13 @@ def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarr
     """The refined estimates at edges h/k, h/(k/2), … h/2 (finest first) from the counts of edge h (whole run)
     and the sub-cell counts ``fine`` (r, k^d) of the refined cells."""
     d, k, r = counts.ndim, ref.factor, ref.cells.size
-    occ = counts > 0
-    inner = interior(occ)
-    flat_occ, flat_in = occ.reshape(-1), inner.reshape(-1)
-    n_in = np.count_nonzero(flat_in)
-    boundary = flat_occ[ref.cells] & ~flat_in[ref.cells]  # refined cells in B
+    n_occ, n_in, f1h, f2h, total, inner = level_stats(counts, mask=True)
+    flat_in = inner.reshape(-1)
+    boundary = (counts.reshape(-1)[ref.cells] > 0) & ~flat_in[ref.cells]  # refined cells in B
     rows = np.flatnonzero(boundary)
-    n_unrefined = np.count_nonzero(flat_occ) - n_in - rows.size  # cells of B without sub-cell counts
-    f1h, f2h = np.count_nonzero(counts == 1), np.count_nonzero(counts == 2)
+    n_unrefined = n_occ - n_in - rows.size  # cells of B without sub-cell counts
     m_h, sd_h = chao1(f1h, f2h)
-    cover_h = 1.0 - f1h / max(float(counts.sum()), 1.0)
+    cover_h = 1.0 - f1h / max(float(total), 1.0)
     # the row of each neighbour (offset o) of each refined cell of B: its slot, r (no data) or r + 1 (interior)
     index = np.array(np.unravel_index(ref.cells[rows], counts.shape))  # (d, nb)
     neighbour_slots = []

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["VolumeEstimate", "estimate_volume", "coarsen", "interior", "chao1", "MIN_COVERAGE"]
+__all__ = ["VolumeEstimate", "estimate_volume", "coarsen", "interior", "chao1", "level_stats", "MIN_COVERAGE"]
 
 #: Least Good–Turing coverage 1 − f1/N at which a level's interval is used (else only as a last resort).
 MIN_COVERAGE = 0.99
@@ -81,6 +81,17 @@ class VolumeEstimate:
 
 def coarsen(counts: np.ndarray) -> np.ndarray:
     """Sum 2×2(×2) blocks of cells (an odd last row is dropped into a padded zero row); uint64."""
+    c3 = _jit_view(counts)
+    if c3 is not None:
+        from ._tally import coarsen3
+
+        out = np.zeros(tuple((s + 1) // 2 for s in c3.shape[counts.ndim == 2:]), dtype=np.uint64)
+        coarsen3(c3, out.reshape(c3.shape[:3 - counts.ndim] + out.shape))
+        return out
+    return _coarsen_numpy(counts)
+
+
+def _coarsen_numpy(counts: np.ndarray) -> np.ndarray:
     pad = [(0, s % 2) for s in counts.shape]
     c = np.pad(counts, pad) if any(p for _, p in pad) else counts
     c = c.astype(np.uint64, copy=False)
@@ -89,6 +100,38 @@ def coarsen(counts: np.ndarray) -> np.ndarray:
         even[ax], odd[ax] = slice(0, None, 2), slice(1, None, 2)
         c = c[tuple(even)] + c[tuple(odd)]
     return c
+
+
+def _jit_view(counts: np.ndarray) -> np.ndarray | None:
+    """``counts`` as (I, J, K) for ``_tally`` (a planar grid as (1, J, K)) when numba is installed and the counts
+    are a C-contiguous 2-D or 3-D grid of unsigned integers at least 3 cells a side; else None (the numpy
+    route)."""
+    import importlib.util
+
+    ok = (counts.ndim in (2, 3) and counts.dtype.kind == "u" and counts.flags.c_contiguous and min(counts.shape) >= 3
+          and importlib.util.find_spec("numba") is not None)
+    return (counts.reshape((1,) * (3 - counts.ndim) + counts.shape)) if ok else None
+
+
+def level_stats(counts: np.ndarray, mask: bool = False) -> tuple:
+    """(|O|, |I|, f1, f2, N, inner) of one level: occupied cells, interior cells (:func:`interior`), cells hit
+    once and twice, samples, and — when ``mask`` — the interior mask (shape of counts, bool; else None).  One
+    jitted pass (``_tally``) when numba is installed, else numpy: the same integers."""
+    c3 = _jit_view(counts)
+    if c3 is None:
+        return _level_stats_numpy(counts, mask)
+    from ._tally import stats3
+
+    inner = np.empty(counts.shape, dtype=bool) if mask else np.empty((0, 0, 0), dtype=bool)
+    n_occ, n_in, f1, f2, total = stats3(c3, counts.ndim, inner.reshape(c3.shape) if mask else inner)
+    return int(n_occ), int(n_in), int(f1), int(f2), int(total), inner if mask else None
+
+
+def _level_stats_numpy(counts: np.ndarray, mask: bool = False) -> tuple:
+    occ = counts > 0
+    inner = interior(occ)
+    return (int(np.count_nonzero(occ)), int(np.count_nonzero(inner)), int(np.count_nonzero(counts == 1)),
+            int(np.count_nonzero(counts == 2)), counts.sum(), inner if mask else None)
 
 
 def interior(occupied: np.ndarray) -> np.ndarray:
@@ -115,14 +158,11 @@ def chao1(f1: int, f2: int) -> tuple[float, float]:
 
 
 def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
-    occ = counts > 0
-    n_occ = np.count_nonzero(occ)
-    n_in = np.count_nonzero(interior(occ))
-    f1 = np.count_nonzero(counts == 1)
-    m, sd = chao1(f1, np.count_nonzero(counts == 2))
+    n_occ, n_in, f1, f2, total, _ = level_stats(counts)
+    m, sd = chao1(f1, f2)
     cell = h ** counts.ndim
     low, high = n_in * cell, (n_occ + m + 2 * sd) * cell
-    coverage = 1.0 - f1 / max(float(counts.sum()), 1.0)
+    coverage = 1.0 - f1 / max(float(total), 1.0)
     return VolumeEstimate(0.5 * (low + high), low, high, h, n_occ, n_in, m, counts.ndim, coverage)
 
 

@@ -1,0 +1,57 @@
+"""The jitted one-pass level statistics (``scale._tally``) against the numpy route and the brute-force erosion."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from denavit.scale._volume import _coarsen_numpy, _level_stats_numpy, coarsen, level_stats
+
+pytest.importorskip("numba")
+
+SHAPES = [(7, 7, 7), (9, 8, 11), (3, 3, 3), (5, 6), (8, 7), (3, 3), (4, 12, 5)]
+
+
+def _counts(seed: int, shape: tuple, dtype) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    hit = rng.random(shape) < rng.uniform(0.4, 1.0)  # holes and faces of every kind
+    return (rng.integers(1, 4, shape) * hit).astype(dtype)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(SHAPES), st.sampled_from([np.uint64, np.uint32]))
+def test_level_stats_jitted_equal_numpy_route(seed, shape, dtype):
+    c = _counts(seed, shape, dtype)
+    got, want = level_stats(c, mask=True), _level_stats_numpy(c, mask=True)
+    assert got[:5] == tuple(int(v) for v in want[:5])
+    assert got[5].shape == c.shape and np.array_equal(got[5], want[5])
+    assert level_stats(c)[:5] == got[:5] and level_stats(c)[5] is None
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(SHAPES))
+def test_level_stats_interior_is_the_moore_erosion(seed, shape):
+    """Brute force: a cell is interior when the 3^d block around it (outside the grid: empty) is occupied."""
+    c = _counts(seed, shape, np.uint64)
+    inner = level_stats(c, mask=True)[5]
+    padded = np.pad(c > 0, 1)
+    for idx in np.ndindex(c.shape):
+        assert inner[idx] == padded[tuple(slice(i, i + 3) for i in idx)].all()
+    assert level_stats(c)[1] == int(inner.sum())
+    assert level_stats(c)[2:5] == (int((c == 1).sum()), int((c == 2).sum()), int(c.sum()))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(SHAPES), st.sampled_from([np.uint64, np.uint32]))
+def test_coarsen_jitted_equal_numpy_route(seed, shape, dtype):
+    c = _counts(seed, shape, dtype)
+    got = coarsen(c)
+    assert got.dtype == np.uint64 and np.array_equal(got, _coarsen_numpy(c))
+    assert int(got.sum()) == int(c.sum())
+
+
+def test_float_and_strided_counts_take_the_numpy_route():
+    c = _counts(3, (6, 6, 6), np.uint64)
+    assert level_stats(c.astype(float))[:4] == level_stats(c)[:4]
+    assert np.array_equal(coarsen(c[:, ::-1]), _coarsen_numpy(c[:, ::-1]))
