@@ -176,77 +176,96 @@ def _draw(q, r, j, state, lo, span):
 
 
 @njit(nogil=True, cache=True)
-def _coordinates(P, r, grid, basis, axes, T):
-    """T[a, i] = (u_a − lo)/h, u = (p_i − centre) in the grid's basis (u_a = (d0·b_a0 + d1·b_a1) + d2·b_a2), for
-    i < r: straight loops with no branches (vectorised).  When every basis row is a coordinate axis (``axes[a]``
-    its index; else ``axes`` is empty) u_a is d_axes[a]: the same double (the other products are zeros; −0 + 0
-    only changes the sign of a zero, and zero − lo is −lo)."""
-    cx, cy, cz, glo, inv = grid[0], grid[1], grid[2], grid[3], grid[4]
-    if axes.size:
-        for a in range(axes.size):
-            k = axes[a]
-            c = grid[k]
-            for i in range(r):
-                T[a, i] = (P[i, k] - c - glo) * inv
-        return
-    for a in range(basis.shape[0]):
-        b0, b1, b2 = basis[a, 0], basis[a, 1], basis[a, 2]
+def _cells(P, r, grid, basis, axes, side, origin, cells, stats, T):
+    """Cells (cells[:r]) and coordinates T[a, i] = (u_a − lo)/h (u = (p_i − centre) in the grid's basis) of the
+    origins P[:, :r] (3, r), and their bounds and squared reach into stats (min xyz, max xyz, max |p − origin|²;
+    sqrt is monotone: the root is taken at the end); returns the status.  The arithmetic of
+    ``_sampler._cells`` in its order (no fused multiply-adds), so the same cells; the loops are straight and
+    vectorise (their reductions are integer counts), and the exact min/max pass (``_extremes``) runs only on the
+    steps where some origin lies beyond the bounds so far (rarer as the run goes on: the bounds are the same)."""
+    if basis.shape[0] == 3:
+        bad, out = _cells3(P, r, grid, side, origin, cells, stats, T)
+    else:
+        bad, out = _cells2(P, r, grid, basis, axes, side, origin, cells, stats, T)
+    if bad:  # outside [0, side) on some axis, NaN, or (planar) a non-finite coordinate off the plane
         for i in range(r):
-            T[a, i] = ((P[i, 0] - cx) * b0 + (P[i, 1] - cy) * b1 + (P[i, 2] - cz) * b2 - glo) * inv
+            if not (np.isfinite(P[0, i]) and np.isfinite(P[1, i]) and np.isfinite(P[2, i])):
+                return NON_FINITE
+        return OUTSIDE
+    if out:
+        _extremes(P, r, origin, stats)
+    return OK
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _beyond(x, y, z, q, stats):
+    """Whether (x, y, z), |·−origin|² = q, lies beyond the bounds so far (as an integer: OR-reduced)."""
+    return ((x < stats[0]) | (y < stats[1]) | (z < stats[2]) | (x > stats[3]) | (y > stats[4]) | (z > stats[5])
+            | (q > stats[6]))
+
+
+@njit(nogil=True, cache=True)
+def _cells3(P, r, grid, side, origin, cells, stats, T):
+    """:func:`_cells` of a 3-D grid (its basis the world axes, ``make_job``; ``run_fused`` checks):
+    (samples outside, samples beyond the bounds)."""
+    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    c0, c1, c2, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
+    X, Y, Z = P[0], P[1], P[2]
+    bad = out = 0
+    for i in range(r):
+        x, y, z = X[i], Y[i], Z[i]
+        dx, dy, dz = x - ox, y - oy, z - oz
+        q = dx * dx + dy * dy + dz * dz
+        t0, t1, t2 = (x - c0 - glo) * inv, (y - c1 - glo) * inv, (z - c2 - glo) * inv
+        T[0, i], T[1, i], T[2, i] = t0, t1, t2
+        bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (t2 >= 0.0) & (t2 < s))
+        out |= _beyond(x, y, z, q, stats)
+        cells[i] = (np.int32(t0) * si + np.int32(t1)) * si + np.int32(t2)
+    return bad, out
+
+
+@njit(nogil=True, cache=True)
+def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, T):
+    """:func:`_cells` of a planar grid.  When every basis row is a coordinate axis (``axes[a]`` its index; else
+    ``axes`` is empty) u_a is d_axes[a]: the same double as ((d0·b_a0 + d1·b_a1) + d2·b_a2) (the other products
+    are zeros; −0 + 0 only changes the sign of a zero, and zero − lo is −lo).  A non-finite coordinate off the
+    plane shows in |p − origin|²."""
+    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    cx, cy, cz, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
+    b00, b01, b02, b10, b11, b12 = basis[0, 0], basis[0, 1], basis[0, 2], basis[1, 0], basis[1, 1], basis[1, 2]
+    plain = axes.size > 0
+    k0, k1 = (axes[0], axes[1]) if plain else (0, 1)
+    bad = out = 0
+    for i in range(r):
+        x, y, z = P[0, i], P[1, i], P[2, i]
+        dx, dy, dz = x - ox, y - oy, z - oz
+        q = dx * dx + dy * dy + dz * dz
+        if plain:
+            t0, t1 = (P[k0, i] - grid[k0] - glo) * inv, (P[k1, i] - grid[k1] - glo) * inv
+        else:
+            ex, ey, ez = x - cx, y - cy, z - cz
+            t0 = (ex * b00 + ey * b01 + ez * b02 - glo) * inv
+            t1 = (ex * b10 + ey * b11 + ez * b12 - glo) * inv
+        T[0, i], T[1, i] = t0, t1
+        bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (q < np.inf))
+        out |= _beyond(x, y, z, q, stats)
+        cells[i] = np.int32(t0) * si + np.int32(t1)
+    return bad, out
 
 
 @njit(nogil=True, cache=True, fastmath={"nnan", "ninf", "nsz"})
-def _bounds(P, r, origin, R2, stats):
-    """R2[i] = |p_i − origin|² ((dx² + dy²) + dz²) for i < r, and stats[:7] = min xyz, max xyz, max R2 over them
-    and what stats held: one pass over P (a pass each cost 1.5 ns more per planar2r sample).  Exact for finite
-    values: the flags allow no contraction or reassociation (no fused multiply-add, the sums in this order), and
-    min and max do not round; they let the reductions vectorise.  A non-finite sample fails the run anyway
-    (``_flat`` tests T and R2)."""
+def _extremes(P, r, origin, stats):
+    """stats[:7] = min xyz, max xyz, max |p − origin|² ((dx² + dy²) + dz²) over P[:, :r] and what stats held.
+    Exact for finite values (the only ones here: ``_cells`` fails a step with others first): the flags allow no
+    contraction or reassociation, and min and max do not round."""
     ox, oy, oz = origin[0], origin[1], origin[2]
     x0, y0, z0, x1, y1, z1, reach = stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6]
     for i in range(r):
-        x, y, z = P[i, 0], P[i, 1], P[i, 2]
+        x, y, z = P[0, i], P[1, i], P[2, i]
         dx, dy, dz = x - ox, y - oy, z - oz
-        q = dx * dx + dy * dy + dz * dz
-        R2[i] = q
         x0, y0, z0, x1, y1, z1 = min(x0, x), min(y0, y), min(z0, z), max(x1, x), max(y1, y), max(z1, z)
-        reach = max(reach, q)
+        reach = max(reach, dx * dx + dy * dy + dz * dz)
     stats[0], stats[1], stats[2], stats[3], stats[4], stats[5], stats[6] = x0, y0, z0, x1, y1, z1, reach
-
-
-@njit(nogil=True, cache=True)
-def _flat(T, R2, r, dim, side, cells):
-    """cells[i] = row-major flat index of the cells (int32: < MAX_CELLS = 2²⁴) of coordinates T[:, i]; returns
-    how many samples fall outside [0, side) on some axis (NaN does too) or have a non-finite R2[i] (a planar
-    grid's coordinates leave one axis out: a non-finite value there shows in R2).  Inside, truncation is floor."""
-    s = float(side)
-    bad = 0
-    if dim == 3:
-        for i in range(r):
-            t0, t1, t2 = T[0, i], T[1, i], T[2, i]
-            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (t2 >= 0.0) & (t2 < s))
-            cells[i] = (np.int32(t0) * np.int32(side) + np.int32(t1)) * np.int32(side) + np.int32(t2)
-    else:
-        for i in range(r):
-            t0, t1 = T[0, i], T[1, i]
-            bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (R2[i] < np.inf))
-            cells[i] = np.int32(t0) * np.int32(side) + np.int32(t1)
-    return bad
-
-
-@njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, axes, side, origin, cells, stats, T, R2):
-    """Bounds and squared reach (into stats: min xyz, max xyz, max |p − origin|²; sqrt is monotone, so the root
-    is taken at the end) and cells (cells[:r]) of the origins P[:r]; returns the status.  The arithmetic of
-    ``_sampler._cells``, in its order."""
-    _bounds(P, r, origin, R2, stats)
-    _coordinates(P, r, grid, basis, axes, T)
-    if _flat(T, R2, r, basis.shape[0], side, cells):
-        for i in range(r):
-            if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
-                return NON_FINITE
-        return OUTSIDE
-    return OK
 
 
 @njit(nogil=True, cache=True)
@@ -335,7 +354,7 @@ def _build(rows):
     ``run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
     q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks,), sizes
     (blocks,) samples each, joint1 (blocks, 2) joint 1's lo and span in each: its stratum, ``_strata``),
-    SUB_ROWS rows at a time (q, P, cells, subs: scratch of that many rows)."""
+    SUB_ROWS rows at a time (q (rows, n), P (3, rows), cells, subs: scratch of that many rows)."""
 
     @njit(nogil=True)
     def run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
@@ -343,7 +362,7 @@ def _build(rows):
         nt = nft = 0
         n = q.shape[1]
         dim, k = basis.shape[0], int(grid[5])
-        T, R2 = np.empty((3, q.shape[0])), np.empty(q.shape[0])
+        T = np.empty((3, q.shape[0]))
         los, spans = np.empty(q.size), np.empty(q.size)  # the limits tiled row after row (see _draw)
         for i in range(q.shape[0]):
             for a in range(n):
@@ -355,11 +374,11 @@ def _build(rows):
             j = 0
             for s in range(0, sizes[blk], q.shape[0]):
                 r = min(q.shape[0], sizes[blk] - s)
-                qs, Ps = q[:r], P[:r]
+                qs = q[:r]
                 j = _draw(qs, r, j, state, los, spans)
                 for b in range(0, r, 4):
-                    rows(qs, Ps, b)
-                status = _cells(Ps, r, grid, basis, axes, side, origin, cells, stats, T, R2)
+                    rows(qs, P.T, b)  # the origins into P (3, rows): the cells' loops read it contiguously
+                status = _cells(P, r, grid, basis, axes, side, origin, cells, stats, T)
                 if status:
                     return nt, nft, status
                 nt, ns = _count(cells, r, acc, touched, nt, slots, subs, T[:dim], k)

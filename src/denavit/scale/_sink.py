@@ -230,7 +230,9 @@ def run_fused(job, first: int, count: int) -> tuple:
     stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
     args = (block_keys(job.entropy, first, count), sizes, joint1, lo, span, grid, np.ascontiguousarray(g.basis), axes,
             g.side, job.base_origin)
-    scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (SUB_ROWS, 3), np.float64),
+    if g.dim == 3 and not np.array_equal(g.basis, np.eye(3)):
+        raise DenavitError("the fused kernel counts a 3-D grid along the world axes only (internal error)")
+    scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (3, SUB_ROWS), np.float64),
                _work.get("fcells", (SUB_ROWS,), np.int32), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
                stats)
     kernel = fused_kernel(job.fk.robot)
