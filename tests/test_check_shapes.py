@@ -303,3 +303,22 @@ def test_a_lost_subscript_of_a_joint_rate_is_read(dot):
     (v,) = _v([{"quantity": "com_velocity", "index": 1, "q": "0.3, -0.4, 0.9", "qd": "0.7, 0.1, -0.2",
                 "value": value}])
     assert v.verdict == "correct", v.message
+
+
+@pytest.mark.parametrize("drop", [0, 1, 5])
+def test_a_vector_with_one_entry_left_out_says_which(drop):
+    """A column of the planar 3R arm's J0 (textbook: column 1 = (−y, x, 0, 0, 0, 1)) with one entry dropped: the
+    verdict stays incorrect (shape) and names the entry; a wrong entry besides the gap names none."""
+    q = (0.3, -0.4, 0.9)
+    x = math.cos(q[0]) + 0.8 * math.cos(q[0] + q[1]) + 0.6 * math.cos(sum(q))
+    y = math.sin(q[0]) + 0.8 * math.sin(q[0] + q[1]) + 0.6 * math.sin(sum(q))
+    col = [repr(-y), repr(x), "0", "0", "0", "1"]
+    short = col[:drop] + col[drop + 1:]
+    (v,) = _v([{"quantity": "jacobian", "column": 1, "q": _q(q), "value": "[" + ", ".join(short) + "]"}])
+    assert v.verdict == "incorrect" and "shape" in v.message
+    zeros = [str(i + 1) for i, c in enumerate(col) if c == "0"]
+    said = f"entry {drop + 1} left out" if col[drop] != "0" else f"the equal entries {', '.join(zeros)} left out"
+    assert said in v.message, v.message
+    wrong = [repr(-y + 0.5)] + short[1:] if drop else [short[0], repr(x + 0.5)] + short[2:]
+    (w,) = _v([{"quantity": "jacobian", "column": 1, "q": _q(q), "value": "[" + ", ".join(wrong) + "]"}])
+    assert w.verdict == "incorrect" and "left out" not in w.message

@@ -106,8 +106,8 @@ def check_claim(robot: DHRobot, raw: dict[str, Any], label: str, rng: np.random.
         try:
             readings = shape_readings(qty, spec, truth.shape[1:], cells)
         except ShapeMismatch as exc:
-            return Verdict(cid, qty.name, "incorrect", f"incorrect: shape: {exc}", expected=truth[0].tolist(),
-                           method="the shape of the value compared with the quantity's")
+            return Verdict(cid, qty.name, "incorrect", f"incorrect: shape: {exc}{_left_out(cells, points, spec, truth)}",
+                           expected=truth[0].tolist(), method="the shape of the value compared with the quantity's")
     except ShapeMismatch as exc:
         return Verdict(cid, qname, "incorrect", f"incorrect: shape: {exc}",
                        method="the shape of the value compared with the quantity's")
@@ -141,6 +141,29 @@ def _says_transpose(text: str) -> bool:
     """``J^T = …`` / ``J_\\theta^{T} = …``: the left side names a transposed matrix."""
     head = text[:len(text) - len(after_last_equals(text))]
     return bool(_TRANSPOSED.search(head))
+
+
+def _left_out(cells, points, spec, truth) -> str:
+    """For a vector written with one entry fewer than the quantity has: which entry, left out, makes the rest right
+    (a column of J with ω's zero lost); "" when none does or the shapes differ otherwise."""
+    flat = [c for row in cells for c in row]
+    n = truth.shape[1] if truth.ndim == 2 else 0
+    if n < 2 or len(flat) != n - 1 or min(len(cells), len(cells[0])) != 1:
+        return ""
+    try:
+        claimed = np.array([evaluate_cells([[c] for c in flat], p, spec.get("_where", ())).ravel() for p in points])
+    except ParseError:
+        return ""
+    tol = np.array([10.0 ** -decimals(c) if decimals(c) >= 2 else 0.0 for c in flat])
+    gaps = []
+    for k in range(n):
+        rest = np.delete(truth, k, axis=1)
+        if (np.abs(claimed - rest) <= EXACT_RTOL * np.maximum(1.0, np.abs(rest)) + tol).all():
+            gaps.append(str(k + 1))
+    if not gaps:
+        return ""
+    which = f"entry {gaps[0]}" if len(gaps) == 1 else f"one of the equal entries {', '.join(gaps)}"
+    return f"; it is the right vector with {which} left out (its other {n - 1} entries are correct)"
 
 
 def _compare(robot, cid, qty, spec, cells, points, truth, rng, detail) -> Verdict:
