@@ -284,3 +284,17 @@ def test_names_after_a_matrix_name_it_and_the_matrix_is_judged(tail):
     ok, wrong = grade_text(_report(good, bad)).claims
     assert (ok.verdict, wrong.verdict) == ("correct", "incorrect"), (ok.message, wrong.message)
     assert "the matrix before" in ok.understood
+
+
+def test_lengths_the_report_states_equal_are_equal_from_there_on():
+    """``L_1 = L_2 = L`` (the table leaves both without a value): x = L (c₁ + c₁₂) is the textbook tip of the
+    planar 2R arm with equal links, judged correct after the statement; before it, and for an arm whose table gives
+    the two lengths different values, the same formula is wrong."""
+    early = grade_text(_report("$$x = L_1 (c_1 + c_{12})$$", "$$L_1 = L_2 = L$$", "$$x = L (c_1 + c_{12})$$",
+                               "$$y = L_1 s_1 + L_2 s_{12}$$", "$$y = L_1 s_1 + L_1 s_{12}$$"))
+    judged = [c.verdict for c in early.claims if c.quantity == "position"]
+    assert judged == ["incorrect", "correct", "correct", "correct"]
+    assert any("L1 = L2" in n for n in early.notes)
+    valued = _report("$$L_1 = L_2 = L$$", "$$x = L (c_1 + c_{12})$$").replace("| $L_1$ |", "| $L_1 = 0.5$ |") \
+        .replace("| $L_2$ |", "| $L_2 = 0.3$ |")
+    assert [c.verdict for c in grade_text(valued).claims if c.quantity == "position"] == ["incorrect"]

@@ -19,7 +19,7 @@ from ..tables import find_tables, import_table
 from ._document import Document, Heading
 from ._types import ArmInfo, GradedClaim
 
-__all__ = ["Arm", "Section", "arms_of", "compare_tables", "GENERIC_LENGTHS"]
+__all__ = ["Arm", "Section", "arms_of", "compare_tables", "with_equal_lengths", "GENERIC_LENGTHS"]
 
 #: Values given to lengths a table names without a value (distinct, not round, so no two coincide).
 GENERIC_LENGTHS = (0.537, 0.419, 0.3271, 0.6143, 0.2789, 0.4657, 0.3917, 0.7129, 0.2473, 0.5861)
@@ -40,6 +40,8 @@ class Arm:
     info: ArmInfo
     problem: str = ""
     advice: str = ""
+    data: dict | None = None  # the table as read (a robot file's dict), to rebuild the arm with lengths equated
+    free: tuple[str, ...] = ()  # its lengths without a value (generic numbers stand in for them)
 
 
 def _dof_named(title: str) -> int | None:
@@ -79,7 +81,25 @@ def _table_arm(doc: Document, first: int, last: int, source: str, title: str, en
         notes += (f"{', '.join(free)} kept as symbols (no value in the table; numbers need them)",)
     info = ArmInfo(robot.name, title, first, end_line, f"table at lines {first}-{last}", robot.convention.value,
                    robot.dof, notes)
-    return Arm(robot, info)
+    return Arm(robot, info, data=imp.data, free=tuple(free))
+
+
+def with_equal_lengths(arm: Arm, names: list[str], where: str) -> Arm | None:
+    """The arm with the table's value-less lengths ``names`` made one (``d_4 = a_2 = k``: the report's arm has
+    d₄ = a₂): every entry naming one of them names the last instead, and the others are no parameters any more.
+    None when fewer than two of ``names`` are such lengths (a length the table gives a value keeps it)."""
+    same = [n for n in dict.fromkeys(names) if n in arm.free]
+    if len(same) < 2 or arm.data is None:
+        return None
+    keep, gone = same[-1], same[:-1]
+    word = re.compile(r"\b(" + "|".join(map(re.escape, gone)) + r")\b")
+    joints = [{k: word.sub(keep, v) if isinstance(v, str) else v for k, v in j.items()} for j in arm.data["joints"]]
+    params = {k: v for k, v in arm.data["parameters"].items() if k not in gone}
+    data = {**arm.data, "joints": joints, "parameters": params}
+    free = tuple(n for n in arm.free if n not in gone)
+    values = {n: GENERIC_LENGTHS[k % len(GENERIC_LENGTHS)] for k, n in enumerate(free)}
+    robot = robot_from_dict({**data, "parameters": {**params, **values}}, where=where)
+    return Arm(robot, arm.info, arm.problem, arm.advice, data, free)
 
 
 def _extent(h: Heading, heads: list[Heading], n: int) -> int:

@@ -12,7 +12,7 @@ import itertools
 import re
 from typing import Any
 
-from ._arms import Arm
+from ._arms import Arm, with_equal_lengths
 from ._prose import plain_prose, prose_case, prose_conditions, prose_definitions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
                        rates_or_wrench, vector_entries)
@@ -57,6 +57,7 @@ class _Walker:
         self.sing: list[tuple[Equation, str]] = []
         self.sing_arm: Arm | None = None
         self.offsets: dict = {}
+        self.equated: dict[int, Arm] = {}  # id of a section's arm → the arm with the lengths the report equates
         self.notes: list[str] = []
         from ..tables import find_tables
         self.tables = [(a, b) for a, b, why in find_tables(list(doc.lines)) if why is None]
@@ -86,8 +87,26 @@ class _Walker:
     def arm_at(self, line: int) -> Arm | None:
         for sec, arm in self.arms:
             if sec.line <= line <= sec.end_line:
-                return arm
+                return self.equated.get(id(arm), arm)
         return None
+
+    def equate(self, eq: Equation, arm: Arm) -> None:
+        """``d_4 = a_2 = k``: lengths the table leaves without a value stated equal; from here on the section's
+        arm has them equal (judging with distinct generic values would call a right formula wrong)."""
+        written = {re.sub(r"[^A-Za-z0-9]", "", plain_name(p)): p.strip() for p in eq.parts[:-1]}
+        new = with_equal_lengths(arm, list(written), f"the equation at line {eq.line}")
+        if new is None:
+            return
+        gone = [n for n in arm.free if n in written and n not in new.free]
+        keep = next(n for n in reversed(list(written)) if n in new.free)
+        for sec, a in self.arms:
+            if sec.line <= eq.line <= sec.end_line:
+                self.equated[id(a)] = new
+                break
+        for n in gone:
+            self.ctx.define(written[n], written[keep])
+        self.notes.append(f"line {eq.line}: {', '.join(gone)} = {keep} as the report states: the table's arm is "
+                          "read with them equal from there on")
 
     def run(self) -> list[Pending]:
         items = list(self.doc.items)
@@ -335,6 +354,8 @@ class _Walker:
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
             lhs, value, sym = value, lhs, last  # "\arctan(P_y, P_x) = q_1"
+        if len(eq.parts) >= 3:
+            self.equate(eq, arm)
         if len(eq.parts) >= 2 and define_chain(self.ctx, eq.parts, robot):
             self.note(eq, arm, "not a claim", "a name the derivation introduces")
             return
