@@ -16,10 +16,10 @@ from ._arms import Arm, with_equal_lengths
 from ._prose import plain_prose, prose_case, prose_conditions, prose_definitions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
                        rates_or_wrench, vector_entries)
-from ._document import Document, Heading, Math, Prose, plain_names
+from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, formula_leftover, joint_offset, names_product, plain_name, renumber,
+from ._reading import (define_chain, only_names, formula_leftover, joint_offset, names_product, plain_name, renumber,
                        used_where, vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
@@ -34,13 +34,6 @@ _SINGULAR = re.compile(r"singular|vanish|loses? rank|rank[- ]deficien|degenerat"
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
-_ONLY_NAMES = re.compile(r"(?:[A-Za-z{}\s]|\\(?:dot|mathbf|boldsymbol|vec)\b){1,40}")
-_SCRIPT = re.compile(r"[_^](?:\{[^{}]{0,8}\}|\w)")
-
-
-def _only_names(text: str) -> bool:
-    """``S v_s``, ``{}^0v_s``, ``\\mathbf{p}``: names (with sub- and superscripts), no number, no operator."""
-    return bool(_ONLY_NAMES.fullmatch(_SCRIPT.sub("", text.strip()))) and bool(re.search("[A-Za-z]", text))
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
@@ -127,7 +120,7 @@ class _Walker:
             elif isinstance(it, Prose):
                 self.prose(it)
             elif isinstance(it, Math) and not self.in_table(it.line):
-                it, k = self._joined(items, k)
+                it, k = joined_display(items, k)
                 self.math(it)
             k += 1
         self.flush()
@@ -170,27 +163,6 @@ class _Walker:
                 eq = Equation(it.line, it.line, cond, (cond,), "=")
                 self.sing.append((eq, cond))
                 self.sing_arm = arm
-
-    def _joined(self, items: list, k: int) -> tuple[Math, int]:
-        """An equation split over consecutive display blocks (brackets left open) as one block."""
-        it = items[k]
-        while it.display and k + 1 < len(items):
-            nxt = items[k + 1]
-            if not isinstance(nxt, Math) or not nxt.display or nxt.line - it.end_line > 3:
-                break
-            head = re.sub(r"^(?:\s|&|\\q?quad(?![A-Za-z])|\\[,;:!])+", "", nxt.latex)
-            open_first = it.latex.count("(") > it.latex.count(")")
-            closes_next = nxt.latex.count(")") > nxt.latex.count("(") or head[:1] in "+-*" or \
-                head.startswith("\\cdot")
-            if head.startswith("=") and "=" in it.latex:
-                it = Math(it.line, nxt.end_line, it.latex.split("=", 1)[0] + " " + head, True)
-                k += 1
-                continue
-            if "=" in nxt.latex or not (open_first or closes_next):
-                break
-            it = Math(it.line, nxt.end_line, it.latex + "\n" + nxt.latex, True)
-            k += 1
-        return it, k
 
     def math(self, m: Math) -> None:
         arm = self.arm_at(m.line)
@@ -348,7 +320,7 @@ class _Walker:
         also = self._trailing_name(eq, robot)
         if also is not None:
             value = eq.parts[-2]  # "²f₂ = ²R₃ ³f₃ = [⋯] = ¹f₁": the value is claimed for both names
-        elif len(eq.parts) > 2 and "\\begin" in eq.parts[-2] and _only_names(value):
+        elif len(eq.parts) > 2 and "\\begin" in eq.parts[-2] and only_names(value):
             value = eq.parts[-2]  # "⁴v₄ = [⋯] = S v_s": names after the matrix, not a value: the matrix is judged
         sym = read_symbol(lhs)
         last = read_symbol(value)

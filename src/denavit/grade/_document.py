@@ -12,7 +12,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "MAX_BLOCK_LINES", "MAX_ITEMS"]
+__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "joined_display", "MAX_BLOCK_LINES",
+           "MAX_ITEMS"]
 
 #: Longest display block (lines); a block left open longer than this is closed there.
 MAX_BLOCK_LINES = 400
@@ -239,3 +240,25 @@ def read_document(text: str, fmt: str = "md") -> Document:
     if len(s.items) >= MAX_ITEMS:
         s.notes.append(f"only the first {MAX_ITEMS} pieces of the report were read")
     return Document(tuple(lines), tuple(s.items), tuple(s.notes))
+
+
+def joined_display(items: list, k: int) -> tuple[Math, int]:
+    """An equation split over consecutive display blocks (brackets left open) as one block."""
+    it = items[k]
+    while it.display and k + 1 < len(items):
+        nxt = items[k + 1]
+        if not isinstance(nxt, Math) or not nxt.display or nxt.line - it.end_line > 3:
+            break
+        head = re.sub(r"^(?:\s|&|\\q?quad(?![A-Za-z])|\\[,;:!])+", "", nxt.latex)
+        open_first = it.latex.count("(") > it.latex.count(")")
+        closes_next = nxt.latex.count(")") > nxt.latex.count("(") or head[:1] in "+-*" or \
+            head.startswith("\\cdot")
+        if head.startswith("=") and "=" in it.latex:
+            it = Math(it.line, nxt.end_line, it.latex.split("=", 1)[0] + " " + head, True)
+            k += 1
+            continue
+        if "=" in nxt.latex or not (open_first or closes_next):
+            break
+        it = Math(it.line, nxt.end_line, it.latex + "\n" + nxt.latex, True)
+        k += 1
+    return it, k

@@ -12,7 +12,7 @@ from ._context import Context, vector_entries
 from ._lhs import read_symbol
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "names_product", "formula_leftover", "used_where", "plain_name",
+__all__ = ["vector_reading", "define_chain", "only_names", "names_product", "formula_leftover", "used_where", "plain_name",
            "joint_offset", "renumber"]
 
 
@@ -128,3 +128,12 @@ def renumber(latex: str, offset: int, n_rows: int) -> str:
         return m.group(1) + digits
 
     return _LEFT_SUP.sub(shift, _SUBSCRIPT.sub(shift, latex))
+
+
+_ONLY_NAMES = re.compile(r"(?:[A-Za-z{}\s]|\\(?:dot|mathbf|boldsymbol|vec)\b){1,40}")
+_SCRIPT = re.compile(r"[_^](?:\{[^{}]{0,8}\}|\w)")
+
+
+def only_names(text: str) -> bool:
+    """``S v_s``, ``{}^0v_s``, ``\\mathbf{p}``: names (with sub- and superscripts), no number, no operator."""
+    return bool(_ONLY_NAMES.fullmatch(_SCRIPT.sub("", text.strip()))) and bool(re.search("[A-Za-z]", text))
