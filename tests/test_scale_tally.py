@@ -55,3 +55,22 @@ def test_float_and_strided_counts_take_the_numpy_route():
     c = _counts(3, (6, 6, 6), np.uint64)
     assert level_stats(c.astype(float))[:4] == level_stats(c)[:4]
     assert np.array_equal(coarsen(c[:, ::-1]), _coarsen_numpy(c[:, ::-1]))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(9, 9, 9), (6, 6, 6), (12, 12), (7, 7)]))
+def test_neighbour_rows_jitted_equal_numpy_route(seed, shape):
+    """The row of each neighbour of the refined boundary cells: slot, no data (r) or interior (r + 1)."""
+    from denavit.scale._refine import _neighbour_rows_numpy, neighbour_rows, refinement
+
+    rng = np.random.default_rng(seed)
+    c = _counts(seed, shape, np.uint64)
+    flat_in = level_stats(c, mask=True)[5].reshape(-1)
+    cells = np.flatnonzero(rng.random(c.size) < rng.uniform(0.05, 0.9))
+    if cells.size == 0:
+        return
+    ref = refinement(cells, 2, 1)
+    rows = np.flatnonzero(rng.random(cells.size) < 0.7)
+    got = neighbour_rows(shape, ref, rows, flat_in)
+    assert got.shape == (3 ** len(shape), rows.size)
+    assert np.array_equal(got, _neighbour_rows_numpy(shape, ref, rows, flat_in))

@@ -230,6 +230,38 @@ def _sub_interior(Fo: np.ndarray, rows: np.ndarray, neighbour_slots: list, d: in
     return count
 
 
+def neighbour_rows(shape: tuple, ref: Refinement, rows: np.ndarray, flat_in: np.ndarray) -> np.ndarray:
+    """The row of each neighbour (offset o, in ``itertools.product((-1, 0, 1), repeat=d)`` order) of each refined
+    cell ``ref.cells[rows]``: its slot, r (no data, or off the grid) or r + 1 (interior), (3^d, len(rows))
+    int64; jitted (``_tally``) when numba is installed."""
+    import importlib.util
+
+    r, d = ref.cells.size, len(shape)
+    if importlib.util.find_spec("numba") is not None:
+        from ._tally import neighbour_slots3
+
+        out = np.empty((3**d, rows.size), dtype=np.int64)
+        shape3 = np.array((1,) * (3 - d) + tuple(shape), dtype=np.int64)
+        neighbour_slots3(ref.cells[rows], shape3, d, slot_map(ref, int(np.prod(shape))), flat_in, r, out)
+        return out
+    return _neighbour_rows_numpy(shape, ref, rows, flat_in)
+
+
+def _neighbour_rows_numpy(shape: tuple, ref: Refinement, rows: np.ndarray, flat_in: np.ndarray) -> np.ndarray:
+    r = ref.cells.size
+    index = np.array(np.unravel_index(ref.cells[rows], shape))  # (d, nb)
+    out = []
+    for o in itertools.product((-1, 0, 1), repeat=len(shape)):
+        nb = index + np.array(o)[:, None]
+        inside = np.all((nb >= 0) & (nb < np.array(shape)[:, None]), axis=0)
+        flat = np.ravel_multi_index(np.where(inside, nb, 0), shape)
+        pos = np.minimum(np.searchsorted(ref.cells, flat), r - 1)
+        slot = np.where(ref.cells[pos] == flat, pos, r)
+        slot = np.where(flat_in[flat], r + 1, slot)
+        out.append(np.where(inside, slot, r))
+    return np.array(out, dtype=np.int64).reshape(3 ** len(shape), rows.size)
+
+
 def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarray) -> list:
     """The refined estimates at edges h/k, h/(k/2), … h/2 (finest first) from the counts of edge h (whole run)
     and the sub-cell counts ``fine`` (r, k^d) of the refined cells."""
@@ -241,17 +273,7 @@ def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarr
     n_unrefined = n_occ - n_in - rows.size  # cells of B without sub-cell counts
     m_h, sd_h = chao1(f1h, f2h)
     cover_h = 1.0 - f1h / max(float(total), 1.0)
-    # the row of each neighbour (offset o) of each refined cell of B: its slot, r (no data) or r + 1 (interior)
-    index = np.array(np.unravel_index(ref.cells[rows], counts.shape))  # (d, nb)
-    neighbour_slots = []
-    for o in itertools.product((-1, 0, 1), repeat=d):
-        nb = index + np.array(o)[:, None]
-        inside = np.all((nb >= 0) & (nb < counts.shape[0]), axis=0)
-        flat = np.ravel_multi_index(np.where(inside, nb, 0), counts.shape)
-        pos = np.minimum(np.searchsorted(ref.cells, flat), r - 1)
-        slot = np.where(ref.cells[pos] == flat, pos, r)
-        slot = np.where(flat_in[flat], r + 1, slot)
-        neighbour_slots.append(np.where(inside, slot, r))
+    neighbour_slots = neighbour_rows(counts.shape, ref, rows, flat_in)
     F = fine.reshape((r,) + (k,) * d)
     out, j = [], k
     while j >= 2:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["coarsen3", "stats3"]
+__all__ = ["coarsen3", "neighbour_slots3", "stats3"]
 
 
 @njit(cache=True, nogil=True)
@@ -94,3 +94,40 @@ def coarsen3(c, out):
                 o[k] += np.uint64(c[i, j, 2 * k]) + np.uint64(c[i, j, 2 * k + 1])
             if K & 1:
                 o[K >> 1] += np.uint64(c[i, j, K - 1])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _bits(x):
+    """Set bits of a uint64 (the SWAR sum, which LLVM turns into one ``popcnt``)."""
+    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+    return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+
+
+@njit(cache=True, nogil=True)
+def neighbour_slots3(cells, shape, d, slots, flat_in, r, out):
+    """out[o, b] = the row holding the neighbour at offset o (the 3^d offsets in ``itertools.product((-1, 0, 1),
+    repeat=d)`` order over the last d axes of ``shape`` (I, J, K)) of the refined cell ``cells[b]`` (flat): r + 1
+    when it is interior (``flat_in``), its slot when it is refined (``slots``: ``_refine.slot_map``'s bitmap and
+    counts), else r (no data; also off the grid)."""
+    I, J, K = shape[0], shape[1], shape[2]
+    for b in range(cells.size):
+        c = cells[b]
+        i, j, k = c // (J * K), (c // K) % J, c % K
+        for o in range(3**d):
+            di = o // 9 - 1 if d == 3 else 0
+            dj, dk = (o // 3) % 3 - 1, o % 3 - 1
+            a, e, f = i + di, j + dj, k + dk
+            if a < 0 or a >= I or e < 0 or e >= J or f < 0 or f >= K:
+                out[o, b] = r
+                continue
+            g = (a * J + e) * K + f
+            if flat_in[g]:
+                out[o, b] = r + 1
+                continue
+            word, bit = slots[g >> 6, 0], np.uint64(g & 63)
+            if (word >> bit) & np.uint64(1):
+                out[o, b] = np.int64(slots[g >> 6, 1] + _bits(word & ((np.uint64(1) << bit) - np.uint64(1))))
+            else:
+                out[o, b] = r
