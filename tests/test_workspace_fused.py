@@ -73,7 +73,8 @@ def test_splitmix64_reference_vector_and_block_starts():
 
 def test_random_values_are_the_halves_of_splitmix64_words_across_calls():
     """Rows drawn in pieces (starting mid-way through a word) are lo + (h·2⁻³²)·span, h the 32-bit halves
-    (low first) of the block's SplitMix64 words stepped in Python integers, and the numpy route's rows too."""
+    (low first) of the block's SplitMix64 words stepped in Python integers, and the numpy route's rows too; the
+    words holding no joint the position program reads are skipped, and only those."""
     from denavit.scale._stream import draw as _draw
 
     for seed, block, n in ((3, 0, 5), (2**40 + 7, 12, 2), (0, 3, 6), (9, 1, 1)):
@@ -83,12 +84,19 @@ def test_random_values_are_the_halves_of_splitmix64_words_across_calls():
         lo, hi = np.linspace(-1, 1, n), np.linspace(0.5, 3, n) + 1.0
         span = hi - lo  # as the numpy route computes it
         ref = h * 2.0**-32 * span + lo
-        q = np.empty((41, n))
-        tiled = np.tile(lo, 41), np.tile(span, 41)
-        j = _fused._draw(q[:3], 3, 0, state, *tiled)
-        assert j == 3 * n
-        assert _fused._draw(q[3:], 38, j, state, *tiled) == 41 * n
-        assert np.array_equal(q, ref)
+        for cut in (3, 4):  # an odd n: half a period, then a start mid-way through a word (3); whole periods (4)
+            q = np.empty((n, 41))  # sample i's joint a in q[a, i]
+            j = _fused._draw(q, cut, 0, state, lo, span, np.ones(n, bool))
+            assert j == cut * n
+            assert _fused._draw(q[:, cut:], 41 - cut, j, state, lo, span, np.ones(n, bool)) == 41 * n
+            assert np.array_equal(q.T, ref)
+        for used in np.eye(n, dtype=bool):  # one joint read: its word drawn, the others' entries left alone
+            q = np.full((n, 40), 7.0)
+            assert _fused._draw(q, 40, 0, state, lo, span, used) == 40 * n
+            assert np.array_equal(q[used], ref[:40, used].T)
+            pairs = np.arange(n * 40).reshape(40, n).T // 2  # the word of each value
+            drawn = np.isin(pairs, pairs[used])
+            assert np.array_equal(q[drawn], ref[:40].T[drawn]) and np.all(q[~drawn] == 7.0)
         job = SimpleNamespace(entropy=seed, limits=np.stack([lo, hi], axis=1))
         assert np.array_equal(_draw(job, block, np.empty((41, n))), ref)
         assert 0 <= h.min() and h.max() < 2**32 and len(np.unique(h)) > 40 * n  # 32 random bits each

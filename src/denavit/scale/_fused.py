@@ -7,9 +7,10 @@ does in numpy passes: draw the joint values, compute the origin, its cell and su
   through a 64-bit mixing function, which passes BigCrush) from the state K + b·2³²·γ, K from
   ``SeedSequence(seed)`` (:func:`denavit.scale._stream.block_state`): word w is mix(state + (w + 1)·γ), a pure
   function of its counter, so any worker starts any block; each word gives two 32-bit joint values (the
-  numpy route's ``_stream.draw`` bit for bit, tested against SplitMix64 stepped in Python integers).  Joint 1
-  is drawn in the block's stratum (its lo and span per block, ``_strata``), so consecutive samples lie in one
-  wedge of the workspace and their counts' cache lines are reused.
+  numpy route's ``_stream.draw`` bit for bit, tested against SplitMix64 stepped in Python integers; the words
+  of joints the position program never reads are skipped).  Joint 1 is drawn in the block's stratum (its lo
+  and span per block, ``_strata``), so consecutive samples lie in one wedge of the workspace and their counts'
+  cache lines are reused.
 - **Position.**  The arm's traced ``position`` program (:func:`denavit.codegen.trace_kernels`) made into
   machine code by :func:`denavit.codegen.kernel_intrinsic`, the emitter of ``denavit.compile(robot).position``:
   the same instructions, so the same doubles as :class:`~denavit.scale.CompiledPositionFK`.
@@ -88,15 +89,18 @@ def fused_kernel(robot):
             from ..codegen import kernel_intrinsic, trace_kernels
 
             steps, outputs = _program(trace_kernels(robot, ["position"])["position"])
-            hit = _build(kernel_intrinsic(1, steps, outputs)[1])
+            read = {x[2] for op, a, b in steps for x in (a, b) if x is not None and x[0] == "i"}
+            read |= {ref[2] for _, ref in outputs if ref[0] == "i"}
+            hit = _build(kernel_intrinsic(1, steps, outputs)[1], tuple(k in read for k in range(robot.dof)))
             if len(_kernels) >= _KEEP:
                 _kernels.pop(next(iter(_kernels)))
             _kernels[robot] = hit
         return hit
 
 
-def _bits_intrinsic():
-    """The intrinsic uint64 → float64 of the same 64 bits (an LLVM ``bitcast``: no conversion)."""
+def _bit_intrinsics():
+    """Two intrinsics: uint64 → float64 of the same 64 bits (an LLVM ``bitcast``: no conversion), and the set
+    bits of a uint64 (LLVM ``ctpop``: one ``popcnt`` instruction where the CPU has it)."""
     from llvmlite import ir
     from numba import types
     from numba.extending import intrinsic
@@ -108,15 +112,6 @@ def _bits_intrinsic():
 
         return types.float64(types.uint64), codegen
 
-    return as_double
-
-
-def _ctpop_intrinsic():
-    """The intrinsic: set bits of a uint64 (LLVM ``ctpop``: one ``popcnt`` instruction where the CPU has it)."""
-    from llvmlite import ir
-    from numba import types
-    from numba.extending import intrinsic
-
     @intrinsic
     def ctpop(typingctx, x):
         def codegen(context, builder, sig, args):
@@ -124,11 +119,11 @@ def _ctpop_intrinsic():
 
         return types.uint64(types.uint64), codegen
 
-    return ctpop
+    return as_double, ctpop
 
 
-_as_double, _popcount = _bits_intrinsic(), _ctpop_intrinsic()
-_Z, _S32, _ONE, _LOW6, _LOW32 = np.uint64(0), np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
+_as_double, _popcount = _bit_intrinsics()
+_S32, _ONE, _LOW6, _LOW32 = np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
 _GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
 _S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
 _FLAG, _COUNT, _UONE, _S31U = np.uint32(1 << 31), np.uint32(2**31 - 1), np.uint32(1), np.uint32(31)
@@ -151,28 +146,40 @@ def _unit(h):
 
 
 @njit(nogil=True, cache=True)
-def _draw(q, r, j, state, lo, span):
-    """Rows 0 … r−1 of q (C-contiguous, n columns) from values j, j+1 … (j a multiple of n) of the block whose
-    starting state is ``state``; returns the next value's index.  Value v is the low (v even) or high (v odd)
-    32-bit half h of word w = v div 2, word w is SplitMix64's mix(state + (w + 1)·γ) (``_stream.draw``); the
-    joint value is lo + (h·2⁻³²)·span, in that order, with ``lo``, ``span`` the limits tiled row after row (at
-    least r·n entries: value i of the rows takes entry i, so the loop is straight and vectorises)."""
-    flat = q.reshape(-1)
-    m = r * q.shape[1]
-    if j & 1:  # a start in the middle of a word (not reached by run: blocks start at 0, steps are even)
-        for v in range(m):
-            w = np.uint64((j + v) >> 1)
-            h = (_mix(state + (w + _ONE) * _GAMMA) >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
-            flat[v] = _unit(h) * span[v] + lo[v]
-    else:
-        base = state + np.uint64((j >> 1) + 1) * _GAMMA
-        for p in range(m // 2):  # both halves of each word
-            w = _mix(base + np.uint64(p) * _GAMMA)
-            flat[2 * p] = _unit(w & _LOW32) * span[2 * p] + lo[2 * p]
-            flat[2 * p + 1] = _unit(w >> _S32) * span[2 * p + 1] + lo[2 * p + 1]
-        if m & 1:
-            flat[m - 1] = _unit(_mix(base + np.uint64(m // 2) * _GAMMA) & _LOW32) * span[m - 1] + lo[m - 1]
-    return j + m
+def _draw(q, r, j, state, lo, span, used):
+    """Columns 0 … r−1 of q (n, rows) — sample i's joint a in q[a, i] — from values j, j+1 … (j a multiple of
+    n) of the block whose starting state is ``state``; returns the next value's index.  Value v (sample v div n,
+    joint v mod n) is the low (v even) or high (v odd) 32-bit half h of word w = v div 2, word w is SplitMix64's
+    mix(state + (w + 1)·γ) (``_stream.draw``); the joint value is lo + (h·2⁻³²)·span, in that order.  Words of
+    joints that ``used`` marks unread (by the position program) are not computed: their entries of q are left as
+    they were.  For each word of a period (a sample, or two of an odd n) a straight loop over the periods,
+    which vectorises; a start in the middle of a word or half a period (the last step of a block of an odd
+    length, for an odd n) takes the values one by one."""
+    n = q.shape[0]
+    per = 1 if n % 2 == 0 else 2  # samples of a whole number of words
+    words = per * n // 2
+    if j & 1 or r % per:
+        for v in range(r * n):
+            h = (_mix(state + (np.uint64((j + v) >> 1) + _ONE) * _GAMMA) >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
+            q[v % n, v // n] = _unit(h) * span[v % n] + lo[v % n]
+        return j + r * n
+    base = state + np.uint64((j >> 1) + 1) * _GAMMA
+    for k in range(words):
+        a0, a1, s0, s1 = (2 * k) % n, (2 * k + 1) % n, (2 * k) // n, (2 * k + 1) // n
+        if not (used[a0] or used[a1]):
+            continue
+        X, Y, l0, w0, l1, w1 = q[a0], q[a1], lo[a0], span[a0], lo[a1], span[a1]
+        if per == 1:
+            for t in range(r):
+                z = _mix(base + np.uint64(t * words + k) * _GAMMA)
+                X[t] = _unit(z & _LOW32) * w0 + l0
+                Y[t] = _unit(z >> _S32) * w1 + l1
+        else:
+            for t in range(r // 2):
+                z = _mix(base + np.uint64(t * words + k) * _GAMMA)
+                X[2 * t + s0] = _unit(z & _LOW32) * w0 + l0
+                Y[2 * t + s1] = _unit(z >> _S32) * w1 + l1
+    return j + r * n
 
 
 @njit(nogil=True, cache=True)
@@ -349,33 +356,32 @@ def flag(acc, cells, on):
         acc[c] = (acc[c] | _FLAG) if on else (acc[c] & _COUNT)
 
 
-def _build(rows):
-    """The fused task function around ``rows`` (a ``kernel_intrinsic`` batch form of the position program):
-    ``run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
-    q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task (keys (blocks,), sizes
-    (blocks,) samples each, joint1 (blocks, 2) joint 1's lo and span in each: its stratum, ``_strata``),
-    SUB_ROWS rows at a time (q (rows, n), P (3, rows), cells, subs: scratch of that many rows)."""
+def _build(rows, used):
+    """The fused task function around ``rows`` (a ``kernel_intrinsic`` batch form of the position program, which
+    reads the joints ``used`` marks): ``run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc,
+    touched, slots, fine, ftouched, q, P, cells, subs, stats) -> (nt, nft, status)`` over every block of a task
+    (keys (blocks,), sizes (blocks,) samples each, joint1 (blocks, 2) joint 1's lo and span in each: its
+    stratum, ``_strata``), SUB_ROWS rows at a time (q (n, rows), P (3, rows), cells, subs: scratch of that many
+    rows)."""
 
     @njit(nogil=True)
     def run(keys, sizes, joint1, lo, span, grid, basis, axes, side, origin, acc, touched, slots, fine, ftouched,
             q, P, cells, subs, stats):
         nt = nft = 0
-        n = q.shape[1]
+        n, most = q.shape
         dim, k = basis.shape[0], int(grid[5])
-        T = np.empty((3, q.shape[0]))
-        los, spans = np.empty(q.size), np.empty(q.size)  # the limits tiled row after row (see _draw)
-        for i in range(q.shape[0]):
-            for a in range(n):
-                los[i * n + a], spans[i * n + a] = lo[a], span[a]
+        T = np.empty((3, most))
+        lo_b, span_b, use = lo.copy(), span.copy(), np.empty(n, np.bool_)
+        for a in range(n):
+            use[a] = used[a]
         for blk in range(keys.shape[0]):
-            for i in range(q.shape[0]):  # joint 1 in the block's stratum
-                los[i * n], spans[i * n] = joint1[blk, 0], joint1[blk, 1]
+            lo_b[0], span_b[0] = joint1[blk, 0], joint1[blk, 1]  # joint 1 in the block's stratum
             state = keys[blk]
             j = 0
-            for s in range(0, sizes[blk], q.shape[0]):
-                r = min(q.shape[0], sizes[blk] - s)
-                qs = q[:r]
-                j = _draw(qs, r, j, state, los, spans)
+            for s in range(0, sizes[blk], most):
+                r = min(most, sizes[blk] - s)
+                j = _draw(q, r, j, state, lo_b, span_b, use)
+                qs = q[:, :r].T  # (r, n)
                 for b in range(0, r, 4):
                     rows(qs, P.T, b)  # the origins into P (3, rows): the cells' loops read it contiguously
                 status = _cells(P, r, grid, basis, axes, side, origin, cells, stats, T)

@@ -232,7 +232,7 @@ def run_fused(job, first: int, count: int) -> tuple:
             g.side, job.base_origin)
     if g.dim == 3 and not np.array_equal(g.basis, np.eye(3)):
         raise DenavitError("the fused kernel counts a 3-D grid along the world axes only (internal error)")
-    scratch = (_work.get("fq", (SUB_ROWS, n), np.float64), _work.get("fP", (3, SUB_ROWS), np.float64),
+    scratch = (_work.get("fq", (n, SUB_ROWS), np.float64), _work.get("fP", (3, SUB_ROWS), np.float64),
                _work.get("fcells", (SUB_ROWS,), np.int32), _work.get("fsubs", (SUB_ROWS if ref else 0,), np.int64),
                stats)
     kernel = fused_kernel(job.fk.robot)
