@@ -298,3 +298,25 @@ def test_lengths_the_report_states_equal_are_equal_from_there_on():
     valued = _report("$$L_1 = L_2 = L$$", "$$x = L (c_1 + c_{12})$$").replace("| $L_1$ |", "| $L_1 = 0.5$ |") \
         .replace("| $L_2$ |", "| $L_2 = 0.3$ |")
     assert [c.verdict for c in grade_text(valued).claims if c.quantity == "position"] == ["incorrect"]
+
+
+@pytest.mark.parametrize("arrow", ["", "\\{x_1, y_1, z_1\\} \\rightarrow ", "\\{x_1, y_1, z_1\\} \\Rightarrow "])
+def test_a_matlab_position_column_and_the_subject_carried_over_an_arrow(arrow):
+    """``T_1^0(1:3,4)``: frame 1's origin, (L1 c1, L1 s1, 0) for the planar 2R arm (Spong 3.2); after an arrow the
+    matrix is the value of the name before it, and a vector of bare names after it only names it."""
+    tail = " = \\begin{bmatrix} P_x \\\\ P_y \\\\ P_z \\end{bmatrix}"
+    good = f"$$T_1^0(1:3,4) = {arrow}\\begin{{bmatrix}} L_1 c_1 \\\\ L_1 s_1 \\\\ 0 \\end{{bmatrix}}{tail}$$"
+    bad = good.replace("L_1 s_1", "L_1 c_1")
+    judged = [c for c in grade_text(_report(good, bad)).claims if c.quantity == "origin" and c.verdict != "not a claim"]
+    assert [c.verdict for c in judged] == ["correct", "incorrect"], [c.message for c in judged]
+    assert all("column 4 of T_0_1" in c.understood for c in judged)
+
+
+def test_a_determinant_after_an_arrow_keeps_its_own_reading():
+    """``\\det J = 0 ⇒ |J| = 0 ⇒ θ₂ = 0``: the bars are a determinant, not the value of the name before the arrow
+    (planar 2R, Spong 3.2: det J = L1 L2 s2)."""
+    j = ("\\begin{vmatrix} -L_1 s_1 - L_2 s_{12} & -L_2 s_{12} \\\\ L_1 c_1 + L_2 c_{12} & L_2 c_{12} \\end{vmatrix}")
+    for bars in (j, j.replace("-L_2 s_{12}", "a")):  # a stray 'a' (report 004) leaves the det J claim judged
+        claims = grade_text(_report(f"$$\\det(J) = 0 \\Rightarrow {bars} = 0 \\Rightarrow \\theta_2 = 0$$")).claims
+        assert "unreadable" not in [c.verdict for c in claims if c.quantity == "det_jacobian"]
+        assert "correct" in [c.verdict for c in claims]

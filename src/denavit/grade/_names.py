@@ -11,7 +11,7 @@ reading that is only a guess carries ``sure=False``: an "incorrect" under it bec
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from ..model import IDENTITY, DHRobot, JointType
@@ -91,6 +91,26 @@ def _transform(sym: Symbol, robot: DHRobot) -> Reading | None:
     if fa is None or fb is None:
         return None
     return _pose(fa, fb, ordered, kind, robot)
+
+
+_POSITION_COLUMN = re.compile(r"\(?(?:1:3|:3|1:end-1),4\)?")
+
+
+def _position_column(sym: Symbol, robot: DHRobot) -> Reading | None:
+    """``T_4^0(1:3,4)`` (MATLAB's rows 1–3 of column 4): the position of frame 4's origin in the base frame."""
+    if not _POSITION_COLUMN.fullmatch(sym.args.replace(" ", "")):
+        return None
+    pose = _transform(replace(sym, args=""), robot)
+    if pose is None or not pose.sure:
+        return None
+    if pose.spec["quantity"] == "end_effector":
+        return Reading({"quantity": "position"}, "the end-effector position (rows 1–3 of column 4 of the pose)")
+    link_1 = pose.spec == {"quantity": "link_transform", "index": 1}  # A_1 = T_0_1
+    if link_1 or pose.spec["quantity"] == "transform" and pose.spec["from"] == 0:
+        k = 1 if link_1 else pose.spec["to"]
+        return Reading({"quantity": "origin", "index": k}, f"the origin of DH frame {k} (rows 1–3 of column 4 of "
+                       f"T_0_{k})", needs=("q",))
+    return None
 
 
 def _pose(fa: int | str, fb: int | str, ordered: bool, kind: str, robot: DHRobot) -> Reading | None:
@@ -274,6 +294,8 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
     if b in ("T", "A", "R", "H") and not sym.dots and not sym.det:
         if b == "T" and dynamic and not (sym.sub or sym.sup or sym.pre_sup):
             return _energy(sym)
+        if sym.args and b != "R":
+            return _position_column(sym, robot)
         return _transform(sym, robot)
     if b == "J" or (sym.det and b == "J"):
         return _jacobian(sym, robot)

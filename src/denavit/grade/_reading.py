@@ -134,6 +134,15 @@ _ONLY_NAMES = re.compile(r"(?:[A-Za-z{}\s]|\\(?:dot|mathbf|boldsymbol|vec)\b){1,
 _SCRIPT = re.compile(r"[_^](?:\{[^{}]{0,8}\}|\w)")
 
 
+_ONE_NAME = re.compile(r"\s*(?:\{\})?[A-Za-z]{1,3}\s*")
+_MATRIX = re.compile(r"\s*\\begin\{([pbvBV]?matrix)\}(.{0,400})\\end\{\1\}\s*", re.S)
+
+
 def only_names(text: str) -> bool:
-    """``S v_s``, ``{}^0v_s``, ``\\mathbf{p}``: names (with sub- and superscripts), no number, no operator."""
+    """``S v_s``, ``{}^0v_s``, ``\\mathbf{p}``: names (with sub- and superscripts), no number, no operator; or a
+    matrix of single names (``[P_x; P_y; P_z]``)."""
+    m = _MATRIX.fullmatch(text)
+    if m:
+        cells = re.split(r"\\\\|&", m.group(2))
+        return all(_ONE_NAME.fullmatch(_SCRIPT.sub("", c)) for c in cells)  # P_x, not L_1 c_1 (a formula)
     return bool(_ONLY_NAMES.fullmatch(_SCRIPT.sub("", text.strip()))) and bool(re.search("[A-Za-z]", text))

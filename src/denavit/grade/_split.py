@@ -111,7 +111,12 @@ def _pieces(row: str) -> list[str]:
     row = _TEXT.sub(lambda m: " \\Rightarrow " if m.group(1).strip().lower() in ("or", "and", "or when", "and when")
                     else " ", row)
     out: list[str] = []
+    subject = ""
     for piece in top_level_split(row, _ARROWS):
+        if subject and re.match(r"\s*\\begin\{[pbB]?matrix\}", piece) and "=" in piece:
+            piece = subject + " = " + piece  # "T(1:3,4) = {x_c, …} → [⋯] = [P_x …]": the matrix is T(1:3,4)'s value
+        first = top_level_split(piece, ("=",))[0]
+        subject = first.strip() if "=" in piece and "\\begin" not in first else ""
         sub = top_level_split(piece, ("\\qquad", "\\quad"))
         merged = _merge(sub, " ")
         for m in merged:
