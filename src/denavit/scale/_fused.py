@@ -33,7 +33,7 @@ from numba import njit
 
 from ._stream import GAMMA, MIX1, MIX2
 
-__all__ = ["FLAG", "NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "flag", "fused_kernel", "merge"]
+__all__ = ["FLAG", "NON_FINITE", "OK", "OUTSIDE", "SUB_ROWS", "block_keys", "fused_kernel"]
 
 #: Rows drawn, positioned and counted per step (their joint values and origins stay in the L2 cache).  Each of
 #: the step's loops has a fixed cost (alias checks, vector prologue and remainder, view reference counts): 2048
@@ -126,7 +126,7 @@ _as_double, _popcount = _bit_intrinsics()
 _S32, _ONE, _LOW6, _LOW32 = np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
 _GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
 _S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
-_FLAG, _COUNT, _UONE, _S31U = np.uint32(1 << 31), np.uint32(2**31 - 1), np.uint32(1), np.uint32(31)
+_COUNT, _UONE, _S31U = np.uint32(2**31 - 1), np.uint32(1), np.uint32(31)
 _EXP52 = np.uint64(0x4330000000000000)  # the bits of 2⁵²: 2⁵² + h for h < 2³² by an OR
 _HALF = 2.0**-32
 
@@ -334,26 +334,6 @@ def _add(cells, r, acc, touched, nt):
         for i in range(r):
             acc[cells[i]] += 1
     return nt
-
-
-@njit(nogil=True, cache=True)
-def merge(total, part):
-    """total += the counts of part (its low 31 bits, without FLAG) and part = 0, touching only the nonzero
-    entries of part (one pass, no temporaries; the caller flags the refined cells again).  Keeping part's
-    flag in the same pass (part[i] = v & FLAG, or v − count) took 0.24–0.52 s instead of 0.01–0.1 s on the
-    Puma's 2²⁴ cells (into a fresh uint64 array, as at a run's first flush), with twice the page faults."""
-    for i in range(part.size):
-        v = part[i]
-        if v:
-            total[i] += v & _COUNT
-            part[i] = 0
-
-
-@njit(nogil=True, cache=True)
-def flag(acc, cells, on):
-    """Set (``on``) or clear bit 31 (FLAG) of acc at ``cells``: the refined cells of a run."""
-    for c in cells:
-        acc[c] = (acc[c] | _FLAG) if on else (acc[c] & _COUNT)
 
 
 def _build(rows, used):

@@ -44,7 +44,7 @@ _NONE = np.empty(0, np.uint32)  # no counts (read-only use: nothing is ever writ
 
 
 def _flag(acc: np.ndarray, cells: np.ndarray, on: bool) -> None:
-    from ._fused import flag
+    from ._tally import flag
 
     flag(acc, cells, on)
 
@@ -105,7 +105,7 @@ class Sink:
             self.cond.notify()
 
     def _flush_one(self, acc: _Accumulator) -> None:
-        from ._fused import merge
+        from ._tally import merge
 
         if acc.tally == 0:  # nothing counted since the last flush: the accumulator is all zeros
             return

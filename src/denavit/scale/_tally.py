@@ -1,4 +1,5 @@
-"""The statistics of one level of counts in one pass, and the 2×2(×2) sums of the next level, jitted.
+"""Jitted passes over count grids: the statistics of one level in one pass, the 2×2(×2) sums of the next level,
+the neighbours of refined cells, and the accumulators' merge and flags (``_sink``).
 
 ``_volume`` needs, at each level, the occupied cells |O|, the interior cells |I| (every one of the 3^d − 1
 neighbours occupied: the Moore erosion of O), f1 and f2 (cells hit once and twice) and the samples N; its numpy
@@ -16,7 +17,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["coarsen3", "neighbour_slots3", "stats3"]
+__all__ = ["coarsen3", "flag", "merge", "neighbour_slots3", "stats3"]
+
+_FLAG, _COUNT = np.uint32(1 << 31), np.uint32(2**31 - 1)  # bit 31 of a uint32 accumulator, the count bits
 
 
 @njit(cache=True, nogil=True)
@@ -131,3 +134,23 @@ def neighbour_slots3(cells, shape, d, slots, flat_in, r, out):
                 out[o, b] = np.int64(slots[g >> 6, 1] + _bits(word & ((np.uint64(1) << bit) - np.uint64(1))))
             else:
                 out[o, b] = r
+
+
+@njit(nogil=True, cache=True)
+def merge(total, part):
+    """total += the counts of part (its low 31 bits, without FLAG) and part = 0, touching only the nonzero
+    entries of part (one pass, no temporaries; the caller flags the refined cells again).  Keeping part's
+    flag in the same pass (part[i] = v & FLAG, or v − count) took 0.24–0.52 s instead of 0.01–0.1 s on the
+    Puma's 2²⁴ cells (into a fresh uint64 array, as at a run's first flush), with twice the page faults."""
+    for i in range(part.size):
+        v = part[i]
+        if v:
+            total[i] += v & _COUNT
+            part[i] = 0
+
+
+@njit(nogil=True, cache=True)
+def flag(acc, cells, on):
+    """Set (``on``) or clear bit 31 (FLAG) of acc at ``cells``: the refined cells of a run."""
+    for c in cells:
+        acc[c] = (acc[c] | _FLAG) if on else (acc[c] & _COUNT)
