@@ -74,3 +74,17 @@ def test_neighbour_rows_jitted_equal_numpy_route(seed, shape):
     got = neighbour_rows(shape, ref, rows, flat_in)
     assert got.shape == (3 ** len(shape), rows.size)
     assert np.array_equal(got, _neighbour_rows_numpy(shape, ref, rows, flat_in))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 200), st.sampled_from([np.uint64, np.uint32]))
+def test_merge_adds_the_counts_without_flags_and_zeroes_the_part(seed, size, dtype):
+    from denavit.scale._tally import merge
+
+    rng = np.random.default_rng(seed)
+    part = (rng.integers(0, 2**31, size) * (rng.random(size) < rng.uniform(0, 0.3))).astype(np.uint32)
+    part |= np.where(rng.random(size) < 0.2, np.uint32(2**31), np.uint32(0))  # flagged cells, counted or not
+    total = rng.integers(0, 2**20, size).astype(dtype)
+    want = total + (part & np.uint32(2**31 - 1)).astype(dtype)
+    merge(total, part)
+    assert np.array_equal(total, want) and not part.any()

@@ -138,15 +138,23 @@ def neighbour_slots3(cells, shape, d, slots, flat_in, r, out):
 
 @njit(nogil=True, cache=True)
 def merge(total, part):
-    """total += the counts of part (its low 31 bits, without FLAG) and part = 0, touching only the nonzero
-    entries of part (one pass, no temporaries; the caller flags the refined cells again).  Keeping part's
-    flag in the same pass (part[i] = v & FLAG, or v − count) took 0.24–0.52 s instead of 0.01–0.1 s on the
-    Puma's 2²⁴ cells (into a fresh uint64 array, as at a run's first flush), with twice the page faults."""
-    for i in range(part.size):
-        v = part[i]
-        if v:
-            total[i] += v & _COUNT
-            part[i] = 0
+    """total += the counts of part (low 31 bits: no FLAG), part = 0 (the caller flags the refined cells again),
+    touching only the runs of 16 entries holding a nonzero one (an OR of 16 loads: vectorised; most runs of a
+    workspace's grid are empty): 0.02 s for the Puma's 2²⁴ cells into a fresh uint64 array, 0.07 s entry by
+    entry, 0.24–0.52 s writing every entry (twice the page faults)."""
+    n = part.size
+    m = n - n % 16
+    for c in range(0, m, 16):
+        seen = np.uint32(0)
+        for i in range(c, c + 16):
+            seen |= part[i]
+        if seen:
+            for i in range(c, c + 16):
+                total[i] += part[i] & _COUNT
+                part[i] = 0
+    for i in range(m, n):
+        total[i] += part[i] & _COUNT
+        part[i] = 0
 
 
 @njit(nogil=True, cache=True)
