@@ -17,7 +17,7 @@ from ._sampler import (BLOCK, CompiledPositionFK, Grid, Job, block_table, defaul
 from ._strata import layout
 from ._sink import NoSink, open_sink
 from ._schedule import POOLS, Progress, resolve_auto, run
-from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume
+from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume, level_stats
 
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK", "SINK_CHUNK",
            "CLUSTER_CHUNK", "MAX_CHUNK", "TAIL_SHARE", "new_seed"]
@@ -141,10 +141,11 @@ def load_occupancy(path) -> Occupancy:
 
 def _estimate(counts: np.ndarray, grid: Grid, ref: Refinement | None, fine) -> tuple[VolumeEstimate, list]:
     """The narrowest trusted interval over the grid's levels and, with a refinement, its finer levels."""
-    best, levels = estimate_volume(counts, grid.resolution, grid.levels)
+    stats = level_stats(counts, mask=ref is not None)  # the finest level's, once
+    best, levels = estimate_volume(counts, grid.resolution, grid.levels, stats=stats)
     if ref is None:
         return best, levels
-    levels = refined_levels(counts, grid.resolution, ref, fine) + levels
+    levels = refined_levels(counts, grid.resolution, ref, fine, stats=stats) + levels
     trusted = [e for e in levels if e.coverage >= MIN_COVERAGE] or [best]
     return min(trusted, key=lambda e: (e.high - e.low, -e.resolution)), levels
 

@@ -262,11 +262,13 @@ def _neighbour_rows_numpy(shape: tuple, ref: Refinement, rows: np.ndarray, flat_
     return np.array(out, dtype=np.int64).reshape(3 ** len(shape), rows.size)
 
 
-def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarray) -> list:
+def refined_levels(counts: np.ndarray, h: float, ref: Refinement, fine: np.ndarray, *,
+                   stats: tuple | None = None) -> list:
     """The refined estimates at edges h/k, h/(k/2), … h/2 (finest first) from the counts of edge h (whole run)
-    and the sub-cell counts ``fine`` (r, k^d) of the refined cells."""
+    and the sub-cell counts ``fine`` (r, k^d) of the refined cells (``stats``: ``level_stats(counts, mask=True)``
+    when the caller has it already)."""
     d, k, r = counts.ndim, ref.factor, ref.cells.size
-    n_occ, n_in, f1h, f2h, total, inner = level_stats(counts, mask=True)
+    n_occ, n_in, f1h, f2h, total, inner = level_stats(counts, mask=True) if stats is None else stats
     flat_in = inner.reshape(-1)
     boundary = (counts.reshape(-1)[ref.cells] > 0) & ~flat_in[ref.cells]  # refined cells in B
     rows = np.flatnonzero(boundary)

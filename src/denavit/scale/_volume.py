@@ -157,8 +157,8 @@ def chao1(f1: int, f2: int) -> tuple[float, float]:
     return m, float(np.sqrt(max(var, 0.0)))
 
 
-def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
-    n_occ, n_in, f1, f2, total, _ = level_stats(counts)
+def _at_level(counts: np.ndarray, h: float, stats: tuple | None = None) -> VolumeEstimate:
+    n_occ, n_in, f1, f2, total, _ = level_stats(counts) if stats is None else stats
     m, sd = chao1(f1, f2)
     cell = h ** counts.ndim
     low, high = n_in * cell, (n_occ + m + 2 * sd) * cell
@@ -166,13 +166,15 @@ def _at_level(counts: np.ndarray, h: float) -> VolumeEstimate:
     return VolumeEstimate(0.5 * (low + high), low, high, h, n_occ, n_in, m, counts.ndim, coverage)
 
 
-def estimate_volume(counts: np.ndarray, resolution: float, levels: int) -> tuple[VolumeEstimate, list]:
-    """The narrowest-interval estimate over ``levels`` cell edges (resolution·2^j) and all of them."""
+def estimate_volume(counts: np.ndarray, resolution: float, levels: int, *,
+                    stats: tuple | None = None) -> tuple[VolumeEstimate, list]:
+    """The narrowest-interval estimate over ``levels`` cell edges (resolution·2^j) and all of them (``stats``:
+    :func:`level_stats` of ``counts`` when the caller has it already)."""
     found, c, h = [], counts, resolution
     for j in range(levels):
         if j:
             c, h = coarsen(c), 2 * h
-        found.append(_at_level(c, h))
+        found.append(_at_level(c, h, None if j else stats))
     trusted = [e for e in found if e.coverage >= MIN_COVERAGE] or found[-1:]
     best = min(trusted, key=lambda e: (e.high - e.low, -e.resolution))
     return best, found
