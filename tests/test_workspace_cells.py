@@ -1,4 +1,4 @@
-"""The fused kernel's cell step (``scale._fused._cells``) against numpy: cells, coordinates, bounds, reach and
+"""The fused kernel's cell step (``scale._fused._cells``) against numpy: cells, sub-cells, bounds, reach and
 the status of origins outside the grid or not finite."""
 
 from __future__ import annotations
@@ -11,13 +11,13 @@ pytest.importorskip("numba")
 
 from denavit.scale._fused import NON_FINITE, OK, OUTSIDE, _cells  # noqa: E402
 
-SIDE, H = 64, 0.05
+SIDE, H, K = 64, 0.05, 4
 CENTRE, ORIGIN = np.array([0.1, -0.2, 0.3]), np.array([0.05, 0.0, -0.1])
 LO = -0.5 * SIDE * H
 
 
 def _grid():
-    return np.array([*CENTRE, LO, 1.0 / H, 0.0])
+    return np.array([*CENTRE, LO, 1.0 / H, K])
 
 
 def _basis(kind: str) -> tuple[np.ndarray, np.ndarray]:
@@ -30,18 +30,18 @@ def _basis(kind: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _run(P: np.ndarray, kind: str, steps: int = 1):
-    """Cells, T and stats of P (3, m), in ``steps`` equal steps as the kernel takes them."""
+    """Cells, sub-cells and stats of P (3, m), in ``steps`` equal steps as the kernel takes them."""
     basis, axes = _basis(kind)
     m = P.shape[1]
-    cells, T = np.empty(m, np.int32), np.empty((3, m))
+    cells, sub = np.empty(m, np.int32), np.empty(m, np.int32)
     stats = np.array([np.inf] * 3 + [-np.inf] * 3 + [0.0])
     statuses = []
     for part in np.array_split(np.arange(m), steps):
         Pp = np.ascontiguousarray(P[:, part])
-        c, t = np.empty(part.size, np.int32), np.empty((3, part.size))
+        c, t = np.empty(part.size, np.int32), np.empty(part.size, np.int32)
         statuses.append(_cells(Pp, part.size, _grid(), basis, axes, SIDE, ORIGIN, c, stats, t))
-        cells[part], T[:, part] = c, t
-    return cells, T[:basis.shape[0]], stats, statuses
+        cells[part], sub[part] = c, t
+    return cells, sub, stats, statuses
 
 
 @settings(max_examples=40, deadline=None)
@@ -51,12 +51,13 @@ def test_cells_bounds_and_reach_are_numpys(seed, kind, steps):
     basis, _ = _basis(kind)
     u = rng.uniform(LO * 0.99, -LO * 0.99, (basis.shape[0], 300))  # inside the grid, in its basis
     P = (CENTRE[:, None] + basis.T @ u)  # (3, m): on the plane for a planar grid
-    cells, T, stats, statuses = _run(P, kind, steps)
+    cells, sub, stats, statuses = _run(P, kind, steps)
     assert statuses == [OK] * steps
-    want_T = (((P - CENTRE[:, None]).T @ basis.T).T - LO) / H
-    np.testing.assert_allclose(T, want_T, atol=1e-9)
-    want = np.ravel_multi_index(tuple(np.floor(want_T).astype(int)), (SIDE,) * basis.shape[0])
+    T = (((P - CENTRE[:, None]).T @ basis.T).T - LO) / H  # (dim, m) coordinates in cell edges
+    want = np.ravel_multi_index(tuple(np.floor(T).astype(int)), (SIDE,) * basis.shape[0])
     assert np.array_equal(cells, want)
+    fine = np.floor(T * K).astype(int)  # the sub-cell grid K times finer: its index within the cell, row-major
+    assert np.array_equal(sub, np.ravel_multi_index(tuple(fine - K * np.floor(T).astype(int)), (K,) * len(T)))
     assert np.array_equal(stats[:3], P.min(axis=1)) and np.array_equal(stats[3:6], P.max(axis=1))
     d = P - ORIGIN[:, None]
     assert stats[6] == (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).max()

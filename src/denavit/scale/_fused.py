@@ -160,7 +160,8 @@ def _draw(q, r, j, state, lo, span, used):
     words = per * n // 2
     if j & 1 or r % per:
         for v in range(r * n):
-            h = (_mix(state + (np.uint64((j + v) >> 1) + _ONE) * _GAMMA) >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
+            w = _mix(state + (np.uint64((j + v) >> 1) + _ONE) * _GAMMA)
+            h = (w >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
             q[v % n, v // n] = _unit(h) * span[v % n] + lo[v % n]
         return j + r * n
     base = state + np.uint64((j >> 1) + 1) * _GAMMA
@@ -183,17 +184,19 @@ def _draw(q, r, j, state, lo, span, used):
 
 
 @njit(nogil=True, cache=True)
-def _cells(P, r, grid, basis, axes, side, origin, cells, stats, T):
-    """Cells (cells[:r]) and coordinates T[a, i] = (u_a − lo)/h (u = (p_i − centre) in the grid's basis) of the
-    origins P[:, :r] (3, r), and their bounds and squared reach into stats (min xyz, max xyz, max |p − origin|²;
-    sqrt is monotone: the root is taken at the end); returns the status.  The arithmetic of
-    ``_sampler._cells`` in its order (no fused multiply-adds), so the same cells; the loops are straight and
-    vectorise (their reductions are integer counts), and the exact min/max pass (``_extremes``) runs only on the
-    steps where some origin lies beyond the bounds so far (rarer as the run goes on: the bounds are the same)."""
+def _cells(P, r, grid, basis, axes, side, origin, cells, stats, sub):
+    """Cells (cells[:r]) and sub-cells (sub[:r], row-major among the k^d of a cell, k = grid[5]: floor(T·k) −
+    k·floor(T) on each axis) of the coordinates T_a = (u_a − lo)/h (u = (p_i − centre) in the grid's basis) of
+    the origins P[:, :r] (3, r), and their bounds and squared reach into stats (min xyz, max xyz,
+    max |p − origin|²; sqrt is monotone: the root is taken at the end); returns the status.  The arithmetic of
+    ``_sampler._cells`` / ``_sub_cells`` in its order (no fused multiply-adds), so the same cells; the loops
+    are straight and vectorise (their reductions are integer counts), and the exact min/max pass
+    (``_extremes``) runs only on the steps where some origin lies beyond the bounds so far (rarer as the run
+    goes on: the bounds are the same)."""
     if basis.shape[0] == 3:
-        bad, out = _cells3(P, r, grid, side, origin, cells, stats, T)
+        bad, out = _cells3(P, r, grid, side, origin, cells, stats, sub)
     else:
-        bad, out = _cells2(P, r, grid, basis, axes, side, origin, cells, stats, T)
+        bad, out = _cells2(P, r, grid, basis, axes, side, origin, cells, stats, sub)
     if bad:  # outside [0, side) on some axis, NaN, or (planar) a non-finite coordinate off the plane
         for i in range(r):
             if not (np.isfinite(P[0, i]) and np.isfinite(P[1, i]) and np.isfinite(P[2, i])):
@@ -212,10 +215,10 @@ def _beyond(x, y, z, q, stats):
 
 
 @njit(nogil=True, cache=True)
-def _cells3(P, r, grid, side, origin, cells, stats, T):
+def _cells3(P, r, grid, side, origin, cells, stats, sub):
     """:func:`_cells` of a 3-D grid (its basis the world axes, ``make_job``; ``run_fused`` checks):
     (samples outside, samples beyond the bounds)."""
-    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    s, glo, inv, si, kf, ki = float(side), grid[3], grid[4], np.int32(side), grid[5], np.int32(grid[5])
     c0, c1, c2, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
     X, Y, Z = P[0], P[1], P[2]
     bad = out = 0
@@ -224,7 +227,8 @@ def _cells3(P, r, grid, side, origin, cells, stats, T):
         dx, dy, dz = x - ox, y - oy, z - oz
         q = dx * dx + dy * dy + dz * dz
         t0, t1, t2 = (x - c0 - glo) * inv, (y - c1 - glo) * inv, (z - c2 - glo) * inv
-        T[0, i], T[1, i], T[2, i] = t0, t1, t2
+        sub[i] = ((np.int32(t0 * kf) - ki * np.int32(t0)) * ki + np.int32(t1 * kf) - ki * np.int32(t1)) * ki + (
+            np.int32(t2 * kf) - ki * np.int32(t2))
         bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (t2 >= 0.0) & (t2 < s))
         out |= _beyond(x, y, z, q, stats)
         cells[i] = (np.int32(t0) * si + np.int32(t1)) * si + np.int32(t2)
@@ -232,12 +236,12 @@ def _cells3(P, r, grid, side, origin, cells, stats, T):
 
 
 @njit(nogil=True, cache=True)
-def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, T):
+def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, sub):
     """:func:`_cells` of a planar grid.  When every basis row is a coordinate axis (``axes[a]`` its index; else
     ``axes`` is empty) u_a is d_axes[a]: the same double as ((d0·b_a0 + d1·b_a1) + d2·b_a2) (the other products
     are zeros; −0 + 0 only changes the sign of a zero, and zero − lo is −lo).  A non-finite coordinate off the
     plane shows in |p − origin|²."""
-    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    s, glo, inv, si, kf, ki = float(side), grid[3], grid[4], np.int32(side), grid[5], np.int32(grid[5])
     cx, cy, cz, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
     b00, b01, b02, b10, b11, b12 = basis[0, 0], basis[0, 1], basis[0, 2], basis[1, 0], basis[1, 1], basis[1, 2]
     plain = axes.size > 0
@@ -253,7 +257,7 @@ def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, T):
             ex, ey, ez = x - cx, y - cy, z - cz
             t0 = (ex * b00 + ey * b01 + ez * b02 - glo) * inv
             t1 = (ex * b10 + ey * b11 + ez * b12 - glo) * inv
-        T[0, i], T[1, i] = t0, t1
+        sub[i] = (np.int32(t0 * kf) - ki * np.int32(t0)) * ki + np.int32(t1 * kf) - ki * np.int32(t1)
         bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (q < np.inf))
         out |= _beyond(x, y, z, q, stats)
         cells[i] = np.int32(t0) * si + np.int32(t1)
@@ -276,10 +280,10 @@ def _extremes(P, r, origin, stats):
 
 
 @njit(nogil=True, cache=True)
-def _count(cells, r, acc, touched, nt, slots, subs, T, k):
+def _count(cells, r, acc, touched, nt, slots, subs, sub, kd):
     """acc[cells[i]] += 1 for i < r (the count in the low 31 bits; bit 31 is FLAG, set on the refined cells of a
     refined run); the first hit of each cell appended to touched when it has room; returns (nt, ns) with the
-    sub-cells of the samples in refined cells in subs[:ns], in order (``_sampler._sub_cells``' arithmetic).
+    sub-cells of the samples in refined cells in subs[:ns], in order: slot·k^d + sub[i] (kd = k^d).
 
     The refined flag comes with the count's own load, so a sample outside the refined cells costs no look-up
     (the bitmap of ``slots`` is read only for the flagged ones).  Its increments are independent, so the cache
@@ -307,15 +311,11 @@ def _count(cells, r, acc, touched, nt, slots, subs, T, k):
             f = subs[i]
             subs[ns] = i
             ns += f
-    for t in range(ns):  # their sub-cells; T ≥ 0 here: floor(T·k) − k·floor(T) by truncation
+    for t in range(ns):  # their sub-cells: the slot of the cell (bitmap and counts) and the sub-cell in it
         i = subs[t]
         flat = cells[i]
         word, before = slots[flat >> 6, 0], slots[flat >> 6, 1]
-        idx = np.int64(before + _popcount(word & ((_ONE << (np.uint64(flat) & _LOW6)) - _ONE)))
-        for a in range(T.shape[0]):
-            x = T[a, i]
-            idx = idx * k + (np.int64(x * k) - k * np.int64(x))
-        subs[t] = idx
+        subs[t] = np.int64(before + _popcount(word & ((_ONE << (np.uint64(flat) & _LOW6)) - _ONE))) * kd + sub[i]
     return nt, ns
 
 
@@ -349,8 +349,8 @@ def _build(rows, used):
             q, P, cells, subs, stats):
         nt = nft = 0
         n, most = q.shape
-        dim, k = basis.shape[0], int(grid[5])
-        T = np.empty((3, most))
+        kd = int(grid[5]) ** basis.shape[0]
+        sub = np.empty(most, np.int32)
         lo_b, span_b, use = lo.copy(), span.copy(), np.empty(n, np.bool_)
         for a in range(n):
             use[a] = used[a]
@@ -364,10 +364,10 @@ def _build(rows, used):
                 qs = q[:, :r].T  # (r, n)
                 for b in range(0, r, 4):
                     rows(qs, P.T, b)  # the origins into P (3, rows): the cells' loops read it contiguously
-                status = _cells(P, r, grid, basis, axes, side, origin, cells, stats, T)
+                status = _cells(P, r, grid, basis, axes, side, origin, cells, stats, sub)
                 if status:
                     return nt, nft, status
-                nt, ns = _count(cells, r, acc, touched, nt, slots, subs, T[:dim], k)
+                nt, ns = _count(cells, r, acc, touched, nt, slots, subs, sub, kd)
                 nft = _add(subs, ns, fine, ftouched, nft)
         return nt, nft, 0
 
