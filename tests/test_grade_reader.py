@@ -320,3 +320,8 @@ def test_a_determinant_after_an_arrow_keeps_its_own_reading():
         claims = grade_text(_report(f"$$\\det(J) = 0 \\Rightarrow {bars} = 0 \\Rightarrow \\theta_2 = 0$$")).claims
         assert "unreadable" not in [c.verdict for c in claims if c.quantity == "det_jacobian"]
         assert "correct" in [c.verdict for c in claims]
+
+
+def test_unbalanced_brackets_are_named_in_the_unreadable_line():
+    (c,) = grade_text(_report("$$x = (L_1 c_1 + L_2 c_{12}))$$")).claims
+    assert c.verdict == "unreadable" and "1 more ')' than '('" in c.message

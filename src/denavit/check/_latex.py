@@ -389,7 +389,9 @@ def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
     p = _Parser(text, resolve)
     node = p.expr()
     if p.peek() is not None:
-        raise ParseError(f"unexpected {p.peek()[1]!r} after a complete expression in {text[:60]!r}")
+        extra = text.count(")") - text.count("(")
+        why = f" (the brackets do not balance: {extra} more ')' than '(')" if p.peek()[1] == ")" and extra > 0 else ""
+        raise ParseError(f"unexpected {p.peek()[1]!r} after a complete expression in {text[:60]!r}{why}")
     if tree_depth(node) > MAX_TREE_DEPTH:
         raise ParseError(f"expression too long: more than {MAX_TREE_DEPTH} operations in a chain "
                          "(split it, or group terms in parentheses)")
