@@ -164,22 +164,25 @@ def _draw(q, r, j, state, lo, span, used):
             h = (w >> (_S32 * np.uint64((j + v) & 1))) & _LOW32
             q[v % n, v // n] = _unit(h) * span[v % n] + lo[v % n]
         return j + r * n
-    base = state + np.uint64((j >> 1) + 1) * _GAMMA
+    base, step = state + np.uint64((j >> 1) + 1) * _GAMMA, np.uint64(words) * _GAMMA
     for k in range(words):
         a0, a1, s0, s1 = (2 * k) % n, (2 * k + 1) % n, (2 * k) // n, (2 * k + 1) // n
         if not (used[a0] or used[a1]):
             continue
         X, Y, l0, w0, l1, w1 = q[a0], q[a1], lo[a0], span[a0], lo[a1], span[a1]
+        z = base + np.uint64(k) * _GAMMA  # the state of word t·words + k, by additions (an induction: 1.6×)
         if per == 1:
             for t in range(r):
-                z = _mix(base + np.uint64(t * words + k) * _GAMMA)
-                X[t] = _unit(z & _LOW32) * w0 + l0
-                Y[t] = _unit(z >> _S32) * w1 + l1
+                w = _mix(z)
+                z += step
+                X[t] = _unit(w & _LOW32) * w0 + l0
+                Y[t] = _unit(w >> _S32) * w1 + l1
         else:
             for t in range(r // 2):
-                z = _mix(base + np.uint64(t * words + k) * _GAMMA)
-                X[2 * t + s0] = _unit(z & _LOW32) * w0 + l0
-                Y[2 * t + s1] = _unit(z >> _S32) * w1 + l1
+                w = _mix(z)
+                z += step
+                X[2 * t + s0] = _unit(w & _LOW32) * w0 + l0
+                Y[2 * t + s1] = _unit(w >> _S32) * w1 + l1
     return j + r * n
 
 
