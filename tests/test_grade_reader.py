@@ -325,3 +325,33 @@ def test_a_determinant_after_an_arrow_keeps_its_own_reading():
 def test_unbalanced_brackets_are_named_in_the_unreadable_line():
     (c,) = grade_text(_report("$$x = (L_1 c_1 + L_2 c_{12}))$$")).claims
     assert c.verdict == "unreadable" and "1 more ')' than '('" in c.message
+
+
+RRP = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | 0 | $-90^\\circ$ | $d_1$ | $\\theta_1$ |
+| 2 | 0 | $90^\\circ$ | $d_2$ | $\\theta_2$ |
+| 3 | 0 | 0 | $d_3$ | 0 |
+"""
+
+
+def test_the_determinant_of_a_spatial_three_joint_arm_is_of_its_position_rows():
+    """A spherical RRP arm: det J_v = −d₃² sin θ₂ (derived here with sympy from the DH product, not by denavit);
+    the sign slipped is named, and 'singular when θ₂ = 0 or d₃ = 0' is judged with the position rows (θ₂ = π
+    missing), not with the 6-row J whose angular rows keep θ₂ = 0 regular."""
+    import sympy as sp
+    t1, t2, d1, d2, d3 = sp.symbols("t1 t2 d1 d2 d3")
+
+    def dh(th, d, al):
+        return sp.Matrix([[sp.cos(th), -sp.sin(th) * sp.cos(al), sp.sin(th) * sp.sin(al), 0],
+                          [sp.sin(th), sp.cos(th) * sp.cos(al), -sp.cos(th) * sp.sin(al), 0],
+                          [0, sp.sin(al), sp.cos(al), d], [0, 0, 0, 1]])
+    p = (dh(t1, d1, -sp.pi / 2) * dh(t2, d2, sp.pi / 2) * dh(0, d3, 0))[:3, 3]
+    assert sp.simplify(p.jacobian([t1, t2, d3]).det() + d3 ** 2 * sp.sin(t2)) == 0
+    text = ("# RRP arm\n\n" + RRP + "\n$$\\det J_v = -d_3^2 s_2$$\n\n$$\\det J_v = d_3^2 s_2$$\n\n"
+            "The arm is singular when $\\theta_2 = 0$ or $d_3 = 0$.\n")
+    dets = [c for c in grade_text(text).claims if c.quantity == "det_jacobian"]
+    assert [c.verdict for c in dets] == ["correct", "incorrect"]
+    assert "opposite sign" in str(dets[1].details.get("hints"))
+    (sing,) = [c for c in grade_text(text).claims if c.quantity == "singularities"]
+    assert sing.verdict == "incorrect" and "vx,vy,vz" in sing.message and "3.14159" in sing.message

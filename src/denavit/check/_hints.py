@@ -54,6 +54,8 @@ def _entrywise(claimed, truth, bad, tol) -> list[str]:
     shape = truth.shape[1:]
     bad_ix = [tuple(ix) for ix in zip(*np.nonzero(bad))] if bad.ndim else []
     signs = [ix for ix in bad_ix if _close(claimed[(slice(None),) + ix], -truth[(slice(None),) + ix], tol[ix])]
+    if not shape and _close(claimed, -truth, tol) and not _close(claimed, truth, tol):
+        hints.append("sign slip: the value has the opposite sign")
     if signs:
         hints.append("sign slip: entr" + ("y " if len(signs) == 1 else "ies ") + ", ".join(map(_entry_name, signs))
                      + " ha" + ("s" if len(signs) == 1 else "ve") + " the opposite sign")

@@ -19,7 +19,7 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, only_names, formula_leftover, joint_offset, names_product, plain_name, renumber,
+from ._reading import (define_chain, det_rows, only_names, formula_leftover, joint_offset, names_product, plain_name, renumber,
                        used_where, vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
@@ -288,7 +288,7 @@ class _Walker:
         claim: dict[str, Any] = {"quantity": "det_jacobian", "value": value}
         if sym is not None and sym.pre_sup.strip().isdigit():
             claim["frame"] = int(sym.pre_sup.strip())
-        rows = "planar" if arm.robot.dof <= 3 else None
+        rows = det_rows(sym, arm.robot)
         p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
                     quantity="det_jacobian")
         names = ("vx", "vy", "vz", "wx", "wy", "wz")

@@ -80,15 +80,16 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
             return "incorrect", (v.message + ": it does not solve for the joint (a formula for it must use the "
                                  "target's entries r_ij, p_x … and joints found before it)"), "", details
         return "unreadable", v.message, "", details
-    fitting = None  # the first other form of the result whose shape the written value has
+    closest = None  # the other form of the result that fits best: the written shape, the fewest entries wrong
     for alt, words in p.equivalent:
         w = _judge(robot, alt, seed)
         if w.verdict == "correct":
             return "correct", f"correct ({words})", "", w.to_json()
-        if fitting is None and w.verdict == "incorrect" and "shape:" not in w.message:
-            fitting = w, words
-    if fitting is not None and "shape:" in v.message:
-        v = dataclasses.replace(fitting[0], message=f"read as {fitting[1]}: {fitting[0].message}")
+        if w.verdict == "incorrect" and "shape:" not in w.message and (
+                closest is None or len(w.entries) < len(closest[0].entries)):
+            closest = w, words
+    if closest is not None and ("shape:" in v.message or len(closest[0].entries) < len(v.entries)):
+        v = dataclasses.replace(closest[0], message=f"read as {closest[1]}: {closest[0].message}")
         details = v.to_json()
     for alt, words in p.alternatives:
         w = _judge(robot, alt, seed)

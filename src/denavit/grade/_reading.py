@@ -12,7 +12,7 @@ from ._context import Context, vector_entries
 from ._lhs import read_symbol
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "only_names", "names_product", "formula_leftover", "used_where", "plain_name",
+__all__ = ["vector_reading", "define_chain", "det_rows", "only_names", "names_product", "formula_leftover", "used_where", "plain_name",
            "joint_offset", "renumber"]
 
 
@@ -146,3 +146,27 @@ def only_names(text: str) -> bool:
         cells = re.split(r"\\\\|&", m.group(2))
         return all(_ONE_NAME.fullmatch(_SCRIPT.sub("", c)) for c in cells)  # P_x, not L_1 c_1 (a formula)
     return bool(_ONLY_NAMES.fullmatch(_SCRIPT.sub("", text.strip()))) and bool(re.search("[A-Za-z]", text))
+
+
+def det_rows(sym: Any, robot: Any) -> str | None:
+    """The rows of J a determinant is taken of: those its name says (``J_v``, ``J_\\omega``), else for an arm of up
+    to 3 joints (vx, vy, ωz) when it moves in a plane, (vx, vy, vz) when it does not; None (all) beyond."""
+    sub = (sym.sub if sym is not None else "").strip("{} \\")
+    if sub == "v":
+        return "vx,vy,vz"
+    if sub in ("omega", "w"):
+        return "wx,wy,wz"
+    if robot.dof > 3:
+        return None
+    return "planar" if _moves_in_xy(robot) else "vx,vy,vz"
+
+
+def _moves_in_xy(robot: Any) -> bool:
+    """Every joint moves the tip in the base's xy plane only (J's vz, ωx, ωy rows zero at random q)."""
+    import numpy as np
+
+    from .. import numeric as N
+
+    rng = np.random.default_rng(0)
+    J = N.geometric_jacobian(robot, rng.uniform(-1.0, 1.0, (3, robot.dof)))
+    return bool(np.abs(J[:, 2:5, :]).max() < 1e-9 * max(1.0, np.abs(J).max()))
