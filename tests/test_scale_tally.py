@@ -88,3 +88,25 @@ def test_merge_adds_the_counts_without_flags_and_zeroes_the_part(seed, size, dty
     want = total + (part & np.uint32(2**31 - 1)).astype(dtype)
     merge(total, part)
     assert np.array_equal(total, want) and not part.any()
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(9, 9, 9), (8, 8, 8), (7, 10, 6), (12, 12), (13, 11)]))
+def test_shell_children_jitted_equal_numpy_route(seed, shape):
+    """The cells to refine: children (off ``inner``) of the shell's parents, listed in one pass or by numpy."""
+    from denavit.scale._refine import _children_numpy, _shell_cells
+    from denavit.scale._tally import children3
+
+    rng = np.random.default_rng(seed)
+    inner = rng.random(shape) < 0.3
+    shell = rng.random(tuple((s + 1) // 2 for s in shape)) < rng.uniform(0.1, 0.9)
+    lift = (1,) * (3 - len(shape))
+    out = np.empty(inner.size, np.int64)
+    n = children3(shell.reshape(lift + shell.shape), inner.reshape(lift + inner.shape), out)
+    want = _children_numpy(shell, inner)
+    assert np.array_equal(out[:n], want)
+    up = shell[tuple(np.indices(shape) // 2)]  # the grid upsampled: the definition, by a third route
+    assert np.array_equal(want, np.flatnonzero(up & ~inner))
+    c = _counts(seed, shape, np.uint64)
+    inner_c = level_stats(c, mask=True)[5]
+    assert np.all(np.diff(_shell_cells(c, inner_c)) > 0)

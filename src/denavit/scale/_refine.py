@@ -33,13 +33,14 @@ scale of the sub-cells; its width is about the boundary area × 3h/j.
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import itertools
 import threading
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._volume import VolumeEstimate, chao1, interior, level_stats
+from ._volume import VolumeEstimate, chao1, coarsen, interior, level_stats
 
 __all__ = ["PILOT_SHARE", "PROJECTED_COVERAGE", "REFINE_COVERAGE", "MAX_REFINE", "REFINE_CELLS", "Refinement",
            "plan_refinement", "projected_coverage", "refined_levels", "slot_map", "popcount", "pilot_blocks",
@@ -95,17 +96,16 @@ def plan_refinement(counts: np.ndarray, factor: int | None, pilot: int,
     _, _, f1, _, total, inner = level_stats(counts, mask=True)
     if factor is None and (total == 0 or 1.0 - f1 / float(total) < REFINE_COVERAGE):
         return None
-    occ = counts > 0
-    cells = _shell_cells(occ, inner)
+    cells = _shell_cells(counts, inner)
     if cells.size == 0:
         return None
     k = MAX_REFINE if factor is None else int(factor)
-    while k >= 2 and cells.size * k**occ.ndim > REFINE_CELLS:
+    while k >= 2 and cells.size * k**counts.ndim > REFINE_CELLS:
         k //= 2
     if factor is None:
         later = ((PILOT_SHARE * pilot if blocks is None else blocks) - pilot) / max(pilot, 1)
         pilot_counts = counts.reshape(-1)[cells]
-        while k >= 2 and projected_coverage(pilot_counts, later / k**occ.ndim) < PROJECTED_COVERAGE:
+        while k >= 2 and projected_coverage(pilot_counts, later / k**counts.ndim) < PROJECTED_COVERAGE:
             k //= 2
     if k < 2:
         return None
@@ -137,21 +137,30 @@ def _dilate(occ: np.ndarray) -> np.ndarray:
     return grown
 
 
-def _shell_cells(occ: np.ndarray, inner: np.ndarray) -> np.ndarray:
-    """Sorted flat indices of the cells of edge h (occupancy ``occ``) whose parent of edge 2h is in
-    dilate(O₂) \\ erode²(O₂), O₂ the parents holding an occupied cell, and that are not in ``inner``.  The
-    children of the shell's parents are listed (an odd side: those past the grid dropped), not the grid
-    upsampled."""
-    d = occ.ndim
-    occ2 = np.pad(occ, [(0, n % 2) for n in occ.shape]) if any(n % 2 for n in occ.shape) else occ
-    for ax in range(d):  # a parent is occupied when one of its 2^d cells is (OR of pairs, axis by axis)
-        even, odd = [slice(None)] * d, [slice(None)] * d
-        even[ax], odd[ax] = slice(0, None, 2), slice(1, None, 2)
-        occ2 = occ2[tuple(even)] | occ2[tuple(odd)]
-    parents = np.argwhere(_dilate(occ2) & ~interior(interior(occ2)))  # (p, d)
+def _shell_cells(counts: np.ndarray, inner: np.ndarray) -> np.ndarray:
+    """Sorted flat indices of the cells of edge h (counts ``counts``) whose parent of edge 2h is in
+    dilate(O₂) \\ erode²(O₂), O₂ the parents holding an occupied cell (the 2×2(×2) sums, an odd side padded),
+    and that are not in ``inner``.  The cells are listed in one jitted pass (``_tally.children3``) or, without
+    numba, as the children of the shell's parents (those past the grid dropped); the grid is not upsampled."""
+    occ2 = coarsen(counts) > 0
+    shell = _dilate(occ2) & ~interior(interior(occ2))
+    if importlib.util.find_spec("numba") is None:
+        return _children_numpy(shell, inner)
+    from ._tally import children3
+
+    d = counts.ndim
+    out = np.empty(np.count_nonzero(shell) * 2**d, dtype=np.int64)
+    lift = (1,) * (3 - d)
+    n = children3(shell.reshape(lift + shell.shape), inner.reshape(lift + inner.shape), out)
+    return out[:n].copy()
+
+
+def _children_numpy(shell: np.ndarray, inner: np.ndarray) -> np.ndarray:
+    d = inner.ndim
+    parents = np.argwhere(shell)  # (p, d)
     kids = (2 * parents[:, None, :] + np.array(list(itertools.product((0, 1), repeat=d)))).reshape(-1, d)
-    kids = kids[np.all(kids < np.array(occ.shape), axis=1)]
-    flat = np.ravel_multi_index(tuple(kids.T), occ.shape).astype(np.int64)
+    kids = kids[np.all(kids < np.array(inner.shape), axis=1)]
+    flat = np.ravel_multi_index(tuple(kids.T), inner.shape).astype(np.int64)
     flat = flat[~inner.reshape(-1)[flat]]
     flat.sort()
     return flat
@@ -234,8 +243,6 @@ def neighbour_rows(shape: tuple, ref: Refinement, rows: np.ndarray, flat_in: np.
     """The row of each neighbour (offset o, in ``itertools.product((-1, 0, 1), repeat=d)`` order) of each refined
     cell ``ref.cells[rows]``: its slot, r (no data, or off the grid) or r + 1 (interior), (3^d, len(rows))
     int64; jitted (``_tally``) when numba is installed."""
-    import importlib.util
-
     r, d = ref.cells.size, len(shape)
     if importlib.util.find_spec("numba") is not None:
         from ._tally import neighbour_slots3

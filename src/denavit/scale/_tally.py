@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["coarsen3", "flag", "merge", "neighbour_slots3", "stats3"]
+__all__ = ["children3", "coarsen3", "flag", "merge", "neighbour_slots3", "stats3"]
 
 _FLAG, _COUNT = np.uint32(1 << 31), np.uint32(2**31 - 1)  # bit 31 of a uint32 accumulator, the count bits
 
@@ -162,3 +162,20 @@ def flag(acc, cells, on):
     """Set (``on``) or clear bit 31 (FLAG) of acc at ``cells``: the refined cells of a run."""
     for c in cells:
         acc[c] = (acc[c] | _FLAG) if on else (acc[c] & _COUNT)
+
+
+@njit(cache=True, nogil=True)
+def children3(shell, inner, out):
+    """The flat indices, ascending, of the cells of ``inner``'s grid (I, J, K) whose parent (i, j, k) // 2 is in
+    ``shell`` (⌈I/2⌉, ⌈J/2⌉, ⌈K/2⌉) and which are not in ``inner``, into out; returns how many (a planar grid as
+    (1, J, K), its parents' as (1, ⌈J/2⌉, ⌈K/2⌉))."""
+    I, J, K = inner.shape
+    n = 0
+    for i in range(I):
+        for j in range(J):
+            row = shell[i >> 1, j >> 1]
+            for k in range(K):
+                if row[k >> 1] and not inner[i, j, k]:
+                    out[n] = (i * J + j) * K + k
+                    n += 1
+    return n
