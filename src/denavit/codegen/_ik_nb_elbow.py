@@ -47,30 +47,30 @@ def ik_elbow(T, K, consts, lo_lim, hi_lim, revolute, theta, tols, chain, out_q, 
     cand, cerr, frames, cs = w8[0:8, 0:6], w8[0:8, 6:8], w8[0:8, 8:44], w8[0:8, 44:56]  # labels), their cos, sin
     PF, F = w8[8:15, 0:12], w8[15:19, 0:4]  # the FK's partial products, its pose
     flags = np.zeros(24, dtype=np.bool_)
-    St = np.empty((ROWS, min(CHUNK, T.shape[0])))  # the stages' rows (_ik_nb_elbow_stages)
+    St = np.empty(ROWS * CHUNK)  # the stages' rows (_ik_nb_elbow_stages), CHUNK floats each
     for b in range(T.shape[0]):
         r = b % CHUNK
         if r == 0:  # the next chunk's candidates, every branch
             elbow_stages(T, b, min(CHUNK, T.shape[0] - b), K, St)
-        Xw = (St[0, r], St[1, r], St[2, r])
+        Xw = (St[r], St[CHUNK + r], St[2 * CHUNK + r])
         # the branches of the pose in the one-pose loop's order (q1 root, q3 root, wrist root), the ones with no
         # root skipped; the status raised where the plain solver must decide
-        status = int(St[RST, r])
+        status = int(St[RST * CHUNK + r])
         ncand = 0
         for s1 in range(2 if status == 0 else 0):
-            x = St[RX + s1, r]
-            if math.isnan(St[RQ1 + s1, r]) or math.isnan(x):
+            x = St[(RX + s1) * CHUNK + r]
+            if math.isnan(St[(RQ1 + s1) * CHUNK + r]) or math.isnan(x):
                 continue
             if x < 1e-6 or math.pi - x < 1e-6:
                 status = 1  # folded or stretched elbow: a double root
             for s3 in range(2):
                 k2 = 2 * s1 + s3
-                if St[RF2 + k2, r] != 0.0:
+                if St[(RF2 + k2) * CHUNK + r] != 0.0:
                     status = 1  # the wrist centre on axis 2: q2 free
-                if math.isnan(St[RQB + 2 * k2, r]):
+                if math.isnan(St[(RQB + 2 * k2) * CHUNK + r]):
                     continue
                 for k in range(2 * k2, 2 * k2 + 2):
-                    if St[RSG + k, r] != 0.0:
+                    if St[(RSG + k) * CHUNK + r] != 0.0:
                         status = 1  # wrist singular: a continuum
                     _candidate(St, r, s1, k2, k, cand, cs, ncand)
                     ncand += 1
@@ -112,11 +112,15 @@ def ik_elbow(T, K, consts, lo_lim, hi_lim, revolute, theta, tols, chain, out_q, 
 
 @njit(cache=True, nogil=True, inline="always")  # into ik_elbow: no call per candidate
 def _candidate(St, r, s1, k2, k, cand, cs, m):
-    """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows into cand[m] and the cosines and sines
-    of its joints into cs[m] (for the verifying FK: the closed form's normalised (cos, sin) pairs whose atan2 the
-    joints are; qa's as computed, which differs only where singular, handed over)."""
-    cand[m, 0], cand[m, 1], cand[m, 2] = St[RQ1 + s1, r], St[RQ2 + k2, r], St[RQ3 + k2, r]
-    cand[m, 3], cand[m, 4], cand[m, 5] = St[RQA + k, r], St[RQB + k, r], St[RQC + k, r]
-    cs[m, 0], cs[m, 1], cs[m, 2], cs[m, 3] = St[RC1 + s1, r], St[RS1 + s1, r], St[RC2 + k2, r], St[RS2 + k2, r]
-    cs[m, 4], cs[m, 5], cs[m, 6], cs[m, 7] = St[RC3 + k2, r], St[RS3 + k2, r], St[RCA + k, r], St[RSA + k, r]
-    cs[m, 8], cs[m, 9], cs[m, 10], cs[m, 11] = St[RCB + k, r], St[RSB + k, r], St[RCC + k, r], St[RSC + k, r]
+    """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows St into cand[m] and the cosines and
+    sines of its joints into cs[m] (for the verifying FK: the closed form's normalised (cos, sin) pairs whose atan2
+    the joints are; qa's as computed, which differs only where singular, handed over)."""
+    a, c, d = s1 * CHUNK + r, k2 * CHUNK + r, k * CHUNK + r  # the pose's column in the rows of s1, k2, k
+    cand[m, 0], cand[m, 1], cand[m, 2] = St[RQ1 * CHUNK + a], St[RQ2 * CHUNK + c], St[RQ3 * CHUNK + c]
+    cand[m, 3], cand[m, 4], cand[m, 5] = St[RQA * CHUNK + d], St[RQB * CHUNK + d], St[RQC * CHUNK + d]
+    cs[m, 0], cs[m, 1], cs[m, 2], cs[m, 3] = St[RC1 * CHUNK + a], St[RS1 * CHUNK + a], St[RC2 * CHUNK + c], \
+        St[RS2 * CHUNK + c]
+    cs[m, 4], cs[m, 5], cs[m, 6], cs[m, 7] = St[RC3 * CHUNK + c], St[RS3 * CHUNK + c], St[RCA * CHUNK + d], \
+        St[RSA * CHUNK + d]
+    cs[m, 8], cs[m, 9], cs[m, 10], cs[m, 11] = St[RCB * CHUNK + d], St[RSB * CHUNK + d], St[RCC * CHUNK + d], \
+        St[RSC * CHUNK + d]
