@@ -24,7 +24,7 @@ from numba.extending import intrinsic, overload, register_jitable
 
 from ..ik import forms
 
-__all__ = ["fresh_cache", "WRIST_TOL", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
+__all__ = ["fresh_cache", "WRIST_TOL", "atan2", "select", "half_angle", "elbow_plane", "elbow_q2", "elbow_roots", "shoulder_roots", "wrist_qb",
            "wrist_rest", "stanford_q1", "stanford_q2", "stanford_q3", "trig_roots",
            "trig_pairs", "wrist_constants"]
 
@@ -52,7 +52,7 @@ def _select(c, a, b):
 for _f in forms.JITTABLE:
     register_jitable(inline="always")(_f)  # into each caller (numba's IR): no call passing arrays in a loop
 
-WRIST_TOL, half_angle = forms.WRIST_TOL, forms.half_angle
+WRIST_TOL, half_angle, atan2, select = forms.WRIST_TOL, forms.half_angle, forms.atan2, forms.select
 elbow_plane, elbow_q2, elbow_roots = forms.elbow_plane, forms.elbow_q2, forms.elbow_roots
 shoulder_roots, wrist_qb, wrist_rest = forms.shoulder_roots, forms.wrist_qb, forms.wrist_rest
 wrist_constants = forms.wrist_constants

@@ -29,10 +29,11 @@ from ._ik_jit import WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roo
 #: the scratch layout (rows of S) is shared with the walk over the branches (_ik_nb_elbow)
 __all__ = [
     "CHUNK", "ROWS", "elbow_stages", "RC1", "RC2", "RC3", "RCA", "RCB", "RCC", "RF2", "RQ1", "RQ2", "RQ3",
-    "RQA", "RQB", "RQC", "RS1", "RS2", "RS3", "RSA", "RSB", "RSC", "RSG", "RST", "RX",
+    "RQA", "RQB", "RQC", "RS1", "RS2", "RS3", "RSA", "RSB", "RSC", "RSG", "RST", "RX", "RXW", "RT", "RF3", "RL2",
+    "RPE", "RRE", "RVF", "RPO", "RLB", "RW2",
 ]
 
-#: poses per chunk of the stages (its scratch: ROWS × CHUNK floats, 20 kB, in L1)
+#: poses per chunk of the stages (their scratch: ROWS × CHUNK floats, 33 kB, in L1)
 CHUNK = 16
 # rows of S: per pose, then per branch (s1: 2, k2 = 2 s1 + s3: 4, k = 2 k2 + s5: 8)
 RXW, RW, RY0, RY2, RST = 0, 3, 6, 9, 12  # wrist centre (world, frame of C0), columns 0 and 2 of T_R R6ᵀ, status
@@ -40,7 +41,12 @@ RQ1, RC1, RS1, RG, RX = 13, 15, 17, 19, 23  # per s1: q1 and its cos, sin; (g0, 
 RQ3, RC3, RS3, RQ2, RC2, RS2, RF2 = 25, 29, 33, 37, 41, 45, 49  # per k2
 RM = 53  # per k2: m00, m10, m20, m02, m12, m22 of M = R_0_3ᵀ T_R R6ᵀ at RM + 6 k2
 RQB, RCB, RSB, RQA, RQC, RSG, RCA, RSA, RCC, RSC = 77, 85, 93, 101, 109, 117, 125, 133, 141, 149  # per k
-ROWS = 157
+# rows of the checks (_ik_nb_elbow_checks): the target's top 3×4 (row-major), per k2 the frame after joint 3 (x0, x1,
+# x2, y0, …, p2 at RF3 + 12 k2) and the label's shoulder and elbow bits; per k the residuals, the verified and
+# polish flags and the label code
+RT, RF3, RL2, RPE, RRE, RVF, RPO, RLB = 157, 169, 217, 221, 229, 237, 245, 253
+RW2 = 261  # per k2: 1.0 where the wrist's two roots qb (nearly) coincide (wrist_qb's lo or hi next to 0)
+ROWS = 265
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -131,7 +137,9 @@ def _turn(C, m, c, s, F):
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _arm(n, k2, R2, p2, P, tiny, consts, wc, S):
     """For the arm branch k2 = 2 s1 + s3 of each pose: q2 (elbow_q2), M = R_0_3ᵀ T_R R6ᵀ (its columns 0 and 2,
-    R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3) and the wrist's two roots qb (wrist_qb)."""
+    R_0_3 = C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3), the wrist's two roots qb (wrist_qb) and whether they (nearly)
+    coincide: the wrist's axes coplanar, a singularity of any three-axis wrist (for the Puma's, axes 4 and 6 are
+    then aligned too; for a wrist of other twists the two roots merge while qa and qc stay determined)."""
     s1, k = k2 >> 1, 2 * k2
     o1, o2, om, ob = s1 * CHUNK, k2 * CHUNK, (RM + 6 * k2) * CHUNK, k * CHUNK
     C0 = (consts[0, 0, 0], consts[0, 1, 0], consts[0, 2, 0], consts[0, 0, 1], consts[0, 1, 1], consts[0, 2, 1],
@@ -152,7 +160,9 @@ def _arm(n, k2, R2, p2, P, tiny, consts, wc, S):
         u0, u1, u2 = S[RY2 * CHUNK + b], S[(RY2 + 1) * CHUNK + b], S[(RY2 + 2) * CHUNK + b]
         m02, m12, m22 = x0 * u0 + x1 * u1 + x2 * u2, y0 * u0 + y1 * u1 + y2 * u2, z0 * u0 + z1 * u1 + z2 * u2
         S[om + 3 * CHUNK + b], S[om + 4 * CHUNK + b], S[om + 5 * CHUNK + b] = m02, m12, m22
-        qba, qbb, _lo, _hi, cba, sba, cbb, sbb = wrist_qb(m02, m12, m22, wc, WRIST_TOL)
+        qba, qbb, lo, hi, cba, sba, cbb, sbb = wrist_qb(m02, m12, m22, wc, WRIST_TOL)
+        least = min(lo, hi)
+        S[RW2 * CHUNK + o2 + b] = 1.0 if (least < 1e-12) & (least > -2.0 * WRIST_TOL) else 0.0
         S[RQB * CHUNK + ob + b], S[RCB * CHUNK + ob + b], S[RSB * CHUNK + ob + b] = qba, cba, sba
         S[(RQB + 1) * CHUNK + ob + b], S[(RCB + 1) * CHUNK + ob + b], S[(RSB + 1) * CHUNK + ob + b] = qbb, cbb, sbb
 

@@ -18,7 +18,7 @@ from numba import njit
 
 from ._ik_finish import FOLD_EDGE
 
-__all__ = ["chain_fk", "ik_check", "ik_finish"]
+__all__ = ["chain_fk", "ik_check", "ik_finish", "ik_sorted"]
 
 _INV_2PI = 0.5 / math.pi
 
@@ -96,13 +96,23 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
     limits, placed (8 each).  The outputs are indexed by b, not sliced (a view per pose is an atomic reference
     count and its release).  Returns (kept, outside, status)."""
     status = _verify(T, b, cand, cerr, ncand, revolute, tols, F, frames, flags, C, cs, given, P)
+    kept, n_out, st = ik_sorted(b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, flags, out_q, out_err,
+                                out_outq, perm, out_rank, vr)
+    return kept, n_out, max(status, st)
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_finish and the elbow kernel (verified in its stages)
+def ik_sorted(b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, flags, out_q, out_err, out_outq, perm, out_rank,
+              vr):
+    """:func:`ik_finish` after the verification (flags[k]: candidate k verified; cerr[k]: its residuals): the
+    verified ones ranked, folded, merged and sorted into pose b's outputs.  Returns (kept, outside, status)."""
     nver = 0
     for k in range(ncand):
         if flags[k]:
             vr[k] = nver
             nver += 1
     out_rank[b, 8] = nver
-    status = max(status, _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr))
+    status = _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr)
     status = max(status, _merge(cand, ncand, flags, revolute, tols[4], tols[5]))
     kept, n_out = _sort_out(b, cand, cerr, ncand, flags, out_q, out_err, out_outq, perm, out_rank, vr)
     return kept, n_out, status
