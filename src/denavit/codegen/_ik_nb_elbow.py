@@ -1,8 +1,9 @@
 """The elbow + spherical-wrist closed form compiled by numba, once per machine (``cache=True``): the formulas of
 :mod:`denavit.ik.forms` (the plain solver's own, jitted through :mod:`._ik_jit`) for the eight candidates of each
 pose, verified and labelled (shoulder, elbow, wrist: the tests of docs/ik.md) in stages over chunks of poses, then
-folded, merged and sorted by :func:`._ik_nb_finish.ik_sorted`.  The constants (``ELBOW_LAYOUT`` of :mod:`._ik_elbow`) are arguments, so one
-compiled kernel serves every arm of the class.  Imported only where numba is.
+folded, merged and sorted by :func:`._ik_nb_finish.ik_sorted`.  The constants (``ELBOW_LAYOUT`` of
+:mod:`._ik_elbow`) are arguments, so one compiled kernel serves every arm of the class.  Imported only where numba
+is.
 """
 
 from __future__ import annotations
