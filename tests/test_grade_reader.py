@@ -355,3 +355,16 @@ def test_the_determinant_of_a_spatial_three_joint_arm_is_of_its_position_rows():
     assert "opposite sign" in str(dets[1].details.get("hints"))
     (sing,) = [c for c in grade_text(text).claims if c.quantity == "singularities"]
     assert sing.verdict == "incorrect" and "vx,vy,vz" in sing.message and "3.14159" in sing.message
+
+
+@pytest.mark.parametrize("given", ["At $\\theta_1 = 30^\\circ$, $\\theta_2 = 60^\\circ$ and a tip force $F = (0, -10)$ N.",
+                                   "Case: $\\theta_1 = 30^\\circ$, $\\theta_2 = 60^\\circ$.\n\n"
+                                   "$$F = \\begin{bmatrix} 0 \\\\ -10 \\end{bmatrix}$$"])
+def test_a_force_of_two_entries_is_a_force_in_the_plane(given):
+    """τ = Jᵀ F for the planar 2R arm (a1 = 1, a2 = 0.5) at (30°, 60°) with F = (0, −10): J's first row
+    (−y, −a2 s12) = (−1, −0.5), its second (x, a2 c12) = (√3/2, 0), so τ = (−5√3, 0) (by hand)."""
+    table = TABLE.replace("| $L_1$ |", "| $a_1 = 1$ |").replace("| $L_2$ |", "| $a_2 = 0.5$ |")
+    good = "$$\\tau = J^T F = \\begin{bmatrix} -8.66 \\\\ 0 \\end{bmatrix}$$"
+    text = "# Planar arm\n\n" + table + "\n" + given + "\n\n" + good + "\n\n" + good.replace("-8.66", "8.66") + "\n"
+    judged = [c.verdict for c in grade_text(text).claims if c.quantity == "torques"]
+    assert judged == ["correct", "incorrect"]

@@ -92,10 +92,8 @@ class _Walker:
             return
         gone = [n for n in arm.free if n in written and n not in new.free]
         keep = next(n for n in reversed(list(written)) if n in new.free)
-        for sec, a in self.arms:
-            if sec.line <= eq.line <= sec.end_line:
-                self.equated[id(a)] = new
-                break
+        governing = next(a for sec, a in self.arms if sec.line <= eq.line <= sec.end_line)
+        self.equated[id(governing)] = new
         for n in gone:
             self.ctx.define(written[n], written[keep])
         self.notes.append(f"line {eq.line}: {', '.join(gone)} = {keep} as the report states: the table's arm is "
@@ -232,9 +230,10 @@ class _Walker:
             self.ctx.qd = "[" + ", ".join(vec) + "]"
             self.note(eq, arm, "not a claim", "the joint rates of this case", "given: q̇")
             return True
-        if vec and is_wrench_name(lhs) and len(vec) in (3, 6):
-            self.ctx.wrench = "[" + ", ".join(vec) + "]"
-            self.note(eq, arm, "not a claim", "the wrench at the end effector", "given: wrench")
+        if vec and is_wrench_name(lhs) and len(vec) in (2, 3, 6):
+            self.ctx.wrench = "[" + ", ".join(vec + ["0"] * (len(vec) == 2)) + "]"  # (f_x, f_y): in the plane
+            self.note(eq, arm, "not a claim", "the wrench at the end effector" + " (f_x, f_y; f_z = 0)" * (len(vec) == 2),
+                      "given: wrench")
             return True
         for part in eq.parts[1:]:
             rw = rates_or_wrench(part)

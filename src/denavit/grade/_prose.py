@@ -62,14 +62,15 @@ _WRENCH = re.compile(r"\bF\s?=\s?\(([-+\d.,\s]{1,200})\)")
 
 
 def prose_wrench(plain: str) -> str | None:
-    """``F = (0, 10, -5) N`` in words: the wrench's numbers (3 or 6), as the checker reads them."""
+    """``F = (0, 10, -5) N`` in words: the wrench's numbers (3 or 6; 2 are a force in the plane, f_z = 0), as the
+    checker reads them."""
     m = _WRENCH.search(plain)
     if m is None:
         return None
     items = [x.strip() for x in m.group(1).split(",") if x.strip()]
-    if len(items) not in (3, 6) or not all(re.fullmatch(r"[-+]?\d+(?:\.\d+)?", x) for x in items):
+    if len(items) not in (2, 3, 6) or not all(re.fullmatch(r"[-+]?\d+(?:\.\d+)?", x) for x in items):
         return None
-    return "[" + ", ".join(items) + "]"
+    return "[" + ", ".join(items + ["0"] * (len(items) == 2)) + "]"  # (f_x, f_y): a planar force
 
 
 _DEFINITION = re.compile(r"\b([a-zA-Z]_[a-z0-9]{1,2})\s?=\s?([A-Za-z0-9_^*/+\- ().]{3,120}?)(?=,\s|;|\.\s|\.$|$|\sand\s|\sis\s)")
