@@ -368,3 +368,11 @@ def test_a_force_of_two_entries_is_a_force_in_the_plane(given):
     text = "# Planar arm\n\n" + table + "\n" + given + "\n\n" + good + "\n\n" + good.replace("-8.66", "8.66") + "\n"
     judged = [c.verdict for c in grade_text(text).claims if c.quantity == "torques"]
     assert judged == ["correct", "incorrect"]
+
+
+def test_torque_numbers_without_a_stated_wrench_are_a_question_not_wrong():
+    """Numbers for τ with no F given before them cannot be judged (τ = Jᵀ F is linear in F): ambiguous."""
+    text = ("# Planar arm\n\n" + TABLE + "\nCase: $\\theta_1 = 30^\\circ$, $\\theta_2 = 60^\\circ$.\n\n"
+            "$$\\tau = J^T F = \\begin{bmatrix} -8.66 \\\\ 0 \\end{bmatrix}$$\n")
+    (c,) = [c for c in grade_text(text).claims if c.quantity == "torques"]
+    assert c.verdict == "ambiguous" and "no wrench" in c.message

@@ -35,6 +35,7 @@ class Pending:
     message: str = ""
     quantity: str = ""
     numeric_without_case: bool = False
+    numeric_without_wrench: bool = False  # numbers for τ, ⁱfᵢ, ⁱnᵢ with no wrench stated: judged at random ones
     not_a_claim_if_unreadable: bool = False
 
 
@@ -107,6 +108,7 @@ def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric
             claim["wrench"] = ctx.wrench
         else:
             claim["wrench"] = "[" + ", ".join(WRENCH_NAMES) + "]"
+            p.numeric_without_wrench = numeric
     if claim["quantity"] == "torques":
         first, second = ("tool", "base") if ctx.propagation else ("base", "tool")
         if ctx.wrench_frame:
