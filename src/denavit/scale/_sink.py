@@ -201,14 +201,15 @@ _work = _Work()
 
 
 def task_memory(job, count: int) -> int:
-    """Bytes a fused task allocates beyond the accumulators: keys, sizes, scratch rows and — away from the
-    driver — the first-hit buffers (4 + 8 bytes per sample with sub-cells).  Independent of ``job.samples``."""
+    """Bytes a fused task allocates beyond the accumulators: keys, sizes, scratch rows (joint values and
+    origins, doubles; cells, sub-cells and the refined rows, 4 + 4 + 8 bytes) and — away from the driver — the
+    first-hit buffers (4 + 8 bytes per sample with sub-cells).  Independent of ``job.samples``."""
     from ._fused import SUB_ROWS
     from ._sampler import BLOCK
 
     n = len(job.limits)
     touched = 0 if job.sink else (4 + (8 if job.refine is not None else 0)) * count * BLOCK
-    return 24 * count + SUB_ROWS * 8 * (n + 3) + touched
+    return 24 * count + SUB_ROWS * (8 * (n + 3) + 16) + touched
 
 
 def run_fused(job, first: int, count: int) -> tuple:
