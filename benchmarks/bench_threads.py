@@ -14,6 +14,11 @@ coriolis (and the derivative kernels where the compiled object has them):
   kernel  ``denavit._threads.run_batch`` of the batch kernel into one output reused across calls: the kernel's
           own throughput, without the page faults of a fresh output
 IK (LM): ``fast.solve_ik(T, threads=t)`` on ``--ik-targets`` targets (FK of random q inside the limits, no seeds).
+``--first-touch``: instead, where a fresh output's first touch goes (FK and J0 batch kernels of each robot):
+  fresh   ``np.empty`` and the kernel in the threads (the public call's way: each thread first-touches its block)
+  touch in threads / touch in caller   the output zero-filled first, by each thread for its block or by the
+          calling thread, then the kernel (pre-faulting)
+  reused  one output across calls (no first touch)
 Plain (``denavit.forward_kinematics`` …, numpy): ``f(robot, q, …, threads=t)`` on ``--plain-batch`` rows.
 Times are the best of ``--repeat`` rounds, the thread counts taking turns within each round.  ``CPU t/1`` is the
 process CPU time (all threads) of the t-thread call over the 1-thread call's: near 1.0, splitting adds no work, so
@@ -149,6 +154,48 @@ def _table(title, rows, threads, batch):
         print(f"| {label} | {times} | {n / call[0] / 1e6:.2f} | {rc} | {rp} | {ro} | {ru} | {rk} |")
 
 
+def _filled(shape) -> np.ndarray:
+    o = np.empty(shape)
+    o.fill(0.0)  # every page touched here, in the calling thread
+    return o
+
+
+def _first_touch(robot, threads, rows: int, repeat: int) -> None:
+    """Best wall time and CPU t/1 of the FK and J0 batch kernels into a fresh, pre-faulted or reused output."""
+    from denavit._threads import split_rows
+
+    fast = denavit.compile(robot)
+    fast.warm()
+    q = _inputs(robot.dof, rows)[0]
+    for name in ("fk", "jacobian0"):
+        k, shape = getattr(fast._m, f"{name}_n"), (rows,) + fast._shapes[name]
+        kept = np.zeros(shape)
+
+        def touch_in(t, k=k, shape=shape):
+            o = np.empty(shape)
+
+            def work(s, e):
+                o[s:e].fill(0.0)
+                k(q[s:e], o[s:e])
+            split_rows(rows, work, t)
+
+        variants = {"fresh": lambda t, k=k, shape=shape: run_batch(k, (q,), (np.empty(shape),), t),
+                    "touch in threads": touch_in,
+                    "touch in caller": lambda t, k=k, shape=shape: run_batch(k, (q,), (_filled(shape),), t),
+                    "reused": lambda t, k=k, kept=kept: run_batch(k, (q,), (kept,), t)}
+        names = [(v, t) for v in variants for t in threads]
+        wall, cpu = _times([lambda v=v, t=t: variants[v](t) for v, t in names], repeat)
+        best = dict(zip(names, zip(wall, cpu)))
+        print(f"\n{robot.name} {LABEL.get(name, name)}, {rows:,} rows, output {np.prod(shape) * 8 / 2**20:.0f} MiB\n")
+        print("| output | " + " | ".join(f"{t} thr [ms]" for t in threads) + " | " +
+              " | ".join(f"1/{t} | CPU {t}/1" for t in threads[1:]) + " |")
+        print("|---" * (1 + len(threads) + 2 * (len(threads) - 1)) + "|")
+        for v in variants:
+            w = [best[(v, t)] for t in threads]
+            print(f"| {v} | " + " | ".join(f"{1e3 * x[0]:.1f}" for x in w) + " | " +
+                  " | ".join(f"{w[0][0] / x[0]:.2f} | {x[1] / w[0][1]:.2f}" for x in w[1:]) + " |")
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--batch", type=float, default=1e6)
@@ -159,6 +206,7 @@ def main(argv=None) -> None:
     p.add_argument("--no-plain", action="store_true")
     p.add_argument("--no-compiled", action="store_true")
     p.add_argument("--ik-targets", type=int, default=2000, help="numeric IK batch (0: none)")
+    p.add_argument("--first-touch", action="store_true", help="fresh, pre-faulted and reused outputs only")
     a = p.parse_args(argv)
     threads = [int(t) for t in a.threads.split(",")]
     print(f"{platform.processor() or platform.machine()}, {available_cores()} cores available, numpy {np.__version__}, "
@@ -166,6 +214,9 @@ def main(argv=None) -> None:
     start, wall = _busy(), time.perf_counter()
     for name in a.robots.split(","):
         robot = denavit.load_robot(name)
+        if a.first_touch:
+            _first_touch(robot, threads, int(a.batch), a.repeat)
+            continue
         if not a.no_compiled:
             backend, rows = _compiled_rows(robot, threads, int(a.batch), a.repeat, a.ik_targets)
             _table(f"{name}: compiled ({backend})", rows, threads, int(a.batch))
