@@ -9,14 +9,17 @@ get distinct generic values (never 1, so that no two lengths coincide by acciden
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from dataclasses import dataclass
+from typing import Any
 
 from ..errors import DenavitError, ParseError
 from ..io import catalogue_names, load_robot, robot_from_dict
 from ..model import DHRobot
 from ..tables import find_tables, import_table
-from ._document import Document, Heading
+from ._document import Document, Heading, Math
+from ._masses import check_buildable, massed_arm_data, moves_in_xy, names_written
 from ._types import ArmInfo, GradedClaim
 
 __all__ = ["Arm", "Section", "arms_of", "compare_tables", "with_equal_lengths", "GENERIC_LENGTHS"]
@@ -42,6 +45,7 @@ class Arm:
     advice: str = ""
     data: dict | None = None  # the table as read (a robot file's dict), to rebuild the arm with lengths equated
     free: tuple[str, ...] = ()  # its lengths without a value (generic numbers stand in for them)
+    gravity_assumed: bool = False  # masses read from the report's symbols: gravity along −y is our assumption
 
 
 def _dof_named(title: str) -> int | None:
@@ -84,6 +88,31 @@ def _table_arm(doc: Document, first: int, last: int, source: str, title: str, en
     return Arm(robot, info, data=imp.data, free=tuple(free))
 
 
+def _with_masses(arm: Arm, maths: list[str]) -> Arm:
+    """The table's arm with the lumped masses its part of the report writes (see :mod:`._masses`), or as it is."""
+    if arm.robot is None or arm.data is None or arm.robot.has_dynamics:
+        return arm
+    names = names_written(maths)
+    if not any(re.fullmatch(r"m\d", k) for k in names):
+        return arm
+    found = massed_arm_data(arm.data, arm.robot, names, moves_in_xy(arm.robot))
+    robot = check_buildable(found[0], arm.info.source) if found else None
+    if robot is None:
+        return arm
+    info = dataclasses.replace(arm.info, notes=arm.info.notes + (found[1],))
+    return Arm(robot, info, arm.problem, arm.advice, found[0], arm.free, gravity_assumed=True)
+
+
+def _renamed(value: Any, word: re.Pattern, keep: str) -> Any:
+    if isinstance(value, str):
+        return word.sub(keep, value)
+    if isinstance(value, dict):
+        return {k: _renamed(v, word, keep) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_renamed(v, word, keep) for v in value]
+    return value
+
+
 def with_equal_lengths(arm: Arm, names: list[str], where: str) -> Arm | None:
     """The arm with the table's value-less lengths ``names`` made one (``d_4 = a_2 = k``: the report's arm has
     d₄ = a₂): every entry naming one of them names the last instead, and the others are no parameters any more.
@@ -93,13 +122,13 @@ def with_equal_lengths(arm: Arm, names: list[str], where: str) -> Arm | None:
         return None
     keep, gone = same[-1], same[:-1]
     word = re.compile(r"\b(" + "|".join(map(re.escape, gone)) + r")\b")
-    joints = [{k: word.sub(keep, v) if isinstance(v, str) else v for k, v in j.items()} for j in arm.data["joints"]]
+    joints = _renamed(arm.data["joints"], word, keep)
     params = {k: v for k, v in arm.data["parameters"].items() if k not in gone}
     data = {**arm.data, "joints": joints, "parameters": params}
     free = tuple(n for n in arm.free if n not in gone)
     values = {n: GENERIC_LENGTHS[k % len(GENERIC_LENGTHS)] for k, n in enumerate(free)}
     robot = robot_from_dict({**data, "parameters": {**params, **values}}, where=where)
-    return Arm(robot, arm.info, arm.problem, arm.advice, data, free)
+    return Arm(robot, arm.info, arm.problem, arm.advice, data, free, arm.gravity_assumed)
 
 
 def _extent(h: Heading, heads: list[Heading], n: int) -> int:
@@ -163,7 +192,8 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
     spans.sort(key=lambda s: s[0].end_line - s[0].line)  # the most specific section decides
     for k, (start, arm) in enumerate(base):
         stop = base[k + 1][0] - 1 if k + 1 < len(base) else n
-        spans.append((Section(None, start, stop), arm))
+        maths = [it.latex for it in doc.items if isinstance(it, Math) and start <= it.line <= stop]
+        spans.append((Section(None, start, stop), _with_masses(arm, maths)))
     return spans
 
 

@@ -91,6 +91,10 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
     if closest is not None and ("shape:" in v.message or len(closest[0].entries) < len(v.entries)):
         v = dataclasses.replace(closest[0], message=f"read as {closest[1]}: {closest[0].message}")
         details = v.to_json()
+    other = _other_gravity(p, seed) if p.arm.gravity_assumed else None
+    if other is not None:
+        return "ambiguous", (f"correct with gravity along {other}; the report does not say which way gravity "
+                             f"points and −y (a vertical plane, y up) was taken: {v.message}"), "", details
     for alt, words in p.alternatives:
         w = _judge(robot, alt, seed)
         if w.verdict == "correct":
@@ -105,6 +109,19 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
         return "ambiguous", ("numbers, but no configuration (Case …: q = (…)) stated before them; at random "
                              f"configurations: {v.message}"), "", details
     return "incorrect", v.message, str(v.extra.get("expected_latex") or ""), details
+
+
+_GRAVITY_WAYS = (("−x", (-9.81, 0.0, 0.0)), ("+x", (9.81, 0.0, 0.0)), ("+y", (0.0, 9.81, 0.0)),
+                 ("−z (a horizontal plane: no gravity torques)", (0.0, 0.0, -9.81)))
+
+
+def _other_gravity(p: Pending, seed: int) -> str | None:
+    """The direction of gravity, other than the −y taken, under which the claim is right (None: none is)."""
+    robot = p.arm.robot
+    for words, g in _GRAVITY_WAYS:
+        if _judge(robot.replace(gravity=g), p.claim, seed).verdict == "correct":
+            return words
+    return None
 
 
 def _graded(p: Pending, seed: int) -> GradedClaim:

@@ -251,13 +251,15 @@ def _propagated(sym: Symbol, robot: DHRobot) -> Reading | None:
                    needs=("q", "qd") if q in ("omega", "velocity") else ("q", "wrench"))
 
 
-def _dynamics(sym: Symbol, robot: DHRobot) -> Reading | None:
+def _dynamics(sym: Symbol, robot: DHRobot, gravity_rhs: bool = False) -> Reading | None:
+    """M, g, c, C with an entry; ``g_2`` alone only when its value has g and a mass in it (else a cosine-like
+    shorthand or the gravity's magnitude)."""
     names = {"M": ("mass_matrix", "the mass matrix M(q)"), "G": ("gravity", "the gravity torques g(q)"),
              "g": ("gravity", "the gravity torques g(q)"), "c": ("coriolis", "the Coriolis/centrifugal torques c(q, q̇)"),
              "C": ("coriolis_matrix", "the Coriolis matrix C(q, q̇)"), "h": ("coriolis", "c(q, q̇)")}
     if sym.base not in names or sym.pre_sup or sym.dots:
         return None
-    if sym.base in ("g", "c", "C", "h", "G") and not sym.args:
+    if sym.base in ("g", "c", "C", "h", "G") and not sym.args and not (sym.base in ("g", "G") and gravity_rhs):
         return None
     qty, words = names[sym.base]
     spec: dict[str, Any] = {"quantity": qty}
@@ -331,7 +333,7 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
     if b in _TWIST and not sym.sub and not sym.pre_sup:
         return Reading({"quantity": "twist"}, "the end-effector twist (v, ω) = J q̇", needs=("q", "qd"))
     if b in ("M", "G", "g", "c", "C", "h"):
-        return _dynamics(sym, robot)
+        return _dynamics(sym, robot, gravity_rhs=bool(re.search(r"\bg\b", rhs)) and "m_" in rhs)
     if b in ("K", "P", "U", "V", "L", "mathcal{L}") and (dynamic or b in ("K",)):
         return _energy(sym)
     return None

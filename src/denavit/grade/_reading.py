@@ -10,6 +10,7 @@ from typing import Any
 
 from ._context import Context, vector_entries
 from ._lhs import read_symbol
+from ._masses import moves_in_xy
 from ._names import Reading, read_name
 
 __all__ = ["vector_reading", "define_chain", "det_rows", "only_names", "names_product", "formula_leftover", "used_where", "plain_name",
@@ -43,12 +44,12 @@ def define_chain(ctx: Context, parts: tuple[str, ...], robot: Any) -> bool:
     if bare is None or len(parts) < 3 and not parts[-1].strip().startswith("\\{"):
         return False
     name = bare.group(1)
-    if name.replace("_", "").replace("{", "").replace("}", "") in params or read_symbol(name) is None:
+    if name.replace("_", "").replace("{", "").replace("}", "") in params or read_symbol(last) is None:
         return False
-    sym = read_symbol(name)
+    sym = read_symbol(last)  # "\\ell" as written (read_symbol("ell") is no symbol)
     if sym is None or sym.base in ("theta", "q", "Q", "x", "y", "z", "p", "P", "J", "T", "R", "A"):
         return False
-    ctx.define(name, parts[-2])
+    ctx.define(last if last.startswith("\\") else name, parts[-2])
     return True
 
 
@@ -158,15 +159,4 @@ def det_rows(sym: Any, robot: Any) -> str | None:
         return "wx,wy,wz"
     if robot.dof > 3:
         return None
-    return "planar" if _moves_in_xy(robot) else "vx,vy,vz"
-
-
-def _moves_in_xy(robot: Any) -> bool:
-    """Every joint moves the tip in the base's xy plane only (J's vz, ωx, ωy rows zero at random q)."""
-    import numpy as np
-
-    from .. import numeric as N
-
-    rng = np.random.default_rng(0)
-    J = N.geometric_jacobian(robot, rng.uniform(-1.0, 1.0, (3, robot.dof)))
-    return bool(np.abs(J[:, 2:5, :]).max() < 1e-9 * max(1.0, np.abs(J).max()))
+    return "planar" if moves_in_xy(robot) else "vx,vy,vz"

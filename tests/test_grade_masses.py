@@ -1,0 +1,91 @@
+"""A report's own planar arm given the masses its dynamics section writes (grade._masses).
+
+The truths are the textbook's, typed from the book: Spong, Hutchinson & Vidyasagar, *Robot Modeling and Control*,
+Sec. 7.4 (the two-link planar arm, gravity along −y): d11 = m1 lc1² + m2 (l1² + lc2² + 2 l1 lc2 c2) + I1 + I2,
+d12 = m2 (lc2² + l1 lc2 c2) + I2, d22 = m2 lc2² + I2, φ1 = (m1 lc1 + m2 l1) g c1 + m2 lc2 g c12,
+φ2 = m2 lc2 g c12.  A second route: the same entries from sympy's Lagrange equations written here.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from denavit.grade import grade_text
+
+STANDARD = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | $\\ell_1$ | 0 | 0 | $q_1$ |
+| 2 | $\\ell_2$ | 0 | 0 | $q_2$ |
+"""
+MODIFIED = """| i | $a_{i-1}$ | $\\alpha_{i-1}$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | 0 | 0 | 0 | $q_1$ |
+| 2 | $\\ell_1$ | 0 | 0 | $q_2$ |
+"""
+SPONG = {
+    "M_{11}": "m_1 \\ell_{c1}^2 + m_2(\\ell_1^2 + \\ell_{c2}^2 + 2 \\ell_1 \\ell_{c2} \\cos q_2) + I_1 + I_2",
+    "M_{12}": "m_2(\\ell_{c2}^2 + \\ell_1 \\ell_{c2} \\cos q_2) + I_2",
+    "M_{22}": "m_2 \\ell_{c2}^2 + I_2",
+    "g_1": "(m_1 \\ell_{c1} + m_2 \\ell_1) g \\cos q_1 + m_2 \\ell_{c2} g \\cos(q_1 + q_2)",
+    "g_2": "m_2 \\ell_{c2} g \\cos(q_1 + q_2)",
+}
+
+
+def _judged(table: str, equations: list[str]) -> list[str]:
+    text = "# Two-link arm\n\n" + table + "\n" + "\n\n".join(f"$${e}$$" for e in equations) + "\n"
+    return [c.verdict for c in grade_text(text).claims]
+
+
+@pytest.mark.parametrize("table", [STANDARD, MODIFIED])
+def test_the_textbook_equations_of_the_two_link_arm_are_correct_and_a_slip_is_not(table):
+    right = [f"{k} = {v}" for k, v in SPONG.items()]
+    assert _judged(table, right) == ["correct"] * len(right)
+    slips = [right[0].replace("2 \\ell_1", "\\ell_1"), right[2].replace("+ I_2", "+ 2 I_2"),
+             right[4].replace("\\ell_{c2} g", "\\ell_{c1} g")]
+    assert _judged(table, slips) == ["incorrect"] * 3
+
+
+def test_the_entries_agree_with_lagrange_derived_here():
+    """M and g from L = K − P of the lumped model (sympy, independent of denavit), written as the claims."""
+    import sympy as sp
+
+    q1, q2, l1, lc1, lc2, m1, m2, i1, i2, g = sp.symbols("q1 q2 ell1 ellc1 ellc2 m1 m2 I1 I2 g")
+    qd = sp.symbols("qd1 qd2")
+    p1 = sp.Matrix([lc1 * sp.cos(q1), lc1 * sp.sin(q1)])
+    p2 = sp.Matrix([l1 * sp.cos(q1) + lc2 * sp.cos(q1 + q2), l1 * sp.sin(q1) + lc2 * sp.sin(q1 + q2)])
+    v1, v2 = (p.jacobian([q1, q2]) * sp.Matrix(qd) for p in (p1, p2))
+    K = (m1 * v1.dot(v1) + m2 * v2.dot(v2) + i1 * qd[0] ** 2 + i2 * (qd[0] + qd[1]) ** 2) / 2
+    P = g * (m1 * p1[1] + m2 * p2[1])
+    M = sp.hessian(K, qd)
+    G = [sp.diff(P, q) for q in (q1, q2)]
+    names = {"ellc1": "\\ell_{c1}", "ellc2": "\\ell_{c2}", "ell1": "\\ell_1", "m1": "m_1", "m2": "m_2",
+             "I1": "I_1", "I2": "I_2", "q1": "q_1", "q2": "q_2"}
+
+    def latex(e):
+        return sp.latex(sp.expand(e), symbol_names={sp.Symbol(k): v for k, v in names.items()})
+    claims = [f"M_{{11}} = {latex(M[0, 0])}", f"M_{{12}} = {latex(M[0, 1])}", f"M_{{22}} = {latex(M[1, 1])}",
+              f"g_1 = {latex(G[0])}", f"g_2 = {latex(G[1])}"]
+    assert _judged(STANDARD, claims) == ["correct"] * 5
+
+
+def test_gravity_another_way_is_a_question_and_links_not_named_get_names():
+    """Only link 2 named (m_2, ℓ_c2): link 1's symbols are made; g₂ with sin is right for gravity along −x."""
+    assert _judged(STANDARD, ["g_2 = -m_2 \\ell_{c2} g \\sin(q_1 + q_2)"]) == ["ambiguous"]
+    assert _judged(STANDARD, ["M_{22} = m_2 \\ell_{c2}^2 + I_2", "g_2 = m_2 \\ell_{c2} g \\sin(q_1 + q_2) + 1"]) \
+        == ["correct", "incorrect"]
+
+
+def test_lengths_stated_equal_carry_into_the_masses():
+    eqs = ["\\ell_1 = \\ell_2 = \\ell", "M_{12} = m_2(\\ell_{c2}^2 + \\ell \\ell_{c2} \\cos q_2) + I_2"]
+    assert _judged(STANDARD, eqs)[-1] == "correct"
+
+
+def test_no_masses_for_a_spatial_arm_or_without_a_centre_of_mass():
+    rrp = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | 0 | $-90^\\circ$ | $d_1$ | $\\theta_1$ |
+| 2 | 0 | $90^\\circ$ | $d_2$ | $\\theta_2$ |
+| 3 | 0 | 0 | $d_3$ | 0 |
+"""
+    assert _judged(rrp, ["M_{33} = m_3"]) == ["unreadable"]
+    assert _judged(STANDARD, ["M_{22} = m_2 \\ell_2^2"]) == ["unreadable"]  # no ℓ_c: where the mass sits is unsaid
