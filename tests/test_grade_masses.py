@@ -89,3 +89,9 @@ def test_no_masses_for_a_spatial_arm_or_without_a_centre_of_mass():
 """
     assert _judged(rrp, ["M_{33} = m_3"]) == ["unreadable"]
     assert _judged(STANDARD, ["M_{22} = m_2 \\ell_2^2"]) == ["unreadable"]  # no ℓ_c: where the mass sits is unsaid
+
+
+def test_spongs_own_names_d_ij_and_phi_k():
+    eqs = [f"d_{{11}} = {SPONG['M_{11}']}", f"d_{{12}} = {SPONG['M_{12}']}", f"\\phi_2 = {SPONG['g_2']}",
+           f"\\phi_1 = {SPONG['g_2']}"]
+    assert _judged(STANDARD, eqs) == ["correct", "correct", "correct", "incorrect"]

@@ -332,8 +332,12 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         return rate
     if b in _TWIST and not sym.sub and not sym.pre_sup:
         return Reading({"quantity": "twist"}, "the end-effector twist (v, ω) = J q̇", needs=("q", "qd"))
+    gravity_rhs = bool(re.search(r"\bg\b", rhs)) and "m_" in rhs
+    if b in ("d", "D", "phi") and (b != "phi" or gravity_rhs) and "m_" in rhs and not sym.pre_sup:
+        b = {"d": "M", "D": "M", "phi": "g"}[b]  # Spong's d_ij (the inertia matrix) and φ_k (gravity), by its value
+        sym = replace(sym, base=b)
     if b in ("M", "G", "g", "c", "C", "h"):
-        return _dynamics(sym, robot, gravity_rhs=bool(re.search(r"\bg\b", rhs)) and "m_" in rhs)
+        return _dynamics(sym, robot, gravity_rhs=gravity_rhs)
     if b in ("K", "P", "U", "V", "L", "mathcal{L}") and (dynamic or b in ("K",)):
         return _energy(sym)
     return None
