@@ -19,8 +19,8 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, det_rows, only_names, formula_leftover, joint_offset, names_product, plain_name, renumber,
-                       used_where, vector_reading)
+from ._reading import (define_chain, det_rows, formula_leftover, joint_offset, names_product, only_names, plain_name,
+                       renumber, trailing_name, used_where, vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
 from ._values import wrench_symbols
@@ -316,7 +316,7 @@ class _Walker:
         lhs, value = eq.parts[0], eq.parts[-1]
         if len(eq.parts) > 2 and _NAMED_RESULT.search(value) and "\\begin" not in value:
             value = eq.parts[-2]  # "ν = [M][q̇] = {}^0J q̇": the value is the step before the restated relation
-        also = self._trailing_name(eq, robot)
+        also = trailing_name(eq.parts, robot)
         if also is not None:
             value = eq.parts[-2]  # "²f₂ = ²R₃ ³f₃ = [⋯] = ¹f₁": the value is claimed for both names
         elif len(eq.parts) > 2 and "\\begin" in eq.parts[-2] and only_names(value):
@@ -383,14 +383,6 @@ class _Walker:
             self.out[-1].understood += f" (the matrix before '= {eq.parts[-1].strip()[:40]}')"
         if also is not None:
             self.out.append(build_claim(self.ctx, eq, arm, also, value))
-
-    def _trailing_name(self, eq: Equation, robot: Any) -> Any:
-        """The reading of a chain's last part when it only names another result (``… = [⋯] = {}^1f_1``) after a
-        value: the value before it is claimed for that name too.  None otherwise."""
-        if len(eq.parts) < 3 or "\\begin" in eq.parts[-1] or "\\begin" not in eq.parts[-2]:
-            return None
-        sym = read_symbol(eq.parts[-1])
-        return read_name(sym, robot, eq.parts[-2]) if sym is not None else None
 
 
 def walk(doc: Document, arms: list) -> tuple[list[Pending], list[str]]:

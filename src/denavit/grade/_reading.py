@@ -13,7 +13,7 @@ from ._lhs import read_symbol
 from ._masses import moves_in_xy
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "det_rows", "only_names", "names_product", "formula_leftover", "used_where", "plain_name",
+__all__ = ["vector_reading", "define_chain", "det_rows", "only_names", "trailing_name", "names_product", "formula_leftover", "used_where", "plain_name",
            "joint_offset", "renumber"]
 
 
@@ -160,3 +160,12 @@ def det_rows(sym: Any, robot: Any) -> str | None:
     if robot.dof > 3:
         return None
     return "planar" if moves_in_xy(robot) else "vx,vy,vz"
+
+
+def trailing_name(parts: tuple[str, ...], robot: Any) -> Reading | None:
+    """The reading of a chain's last part when it only names another result (``… = [⋯] = {}^1f_1``) after a
+    value: the value before it is claimed for that name too.  None otherwise."""
+    if len(parts) < 3 or "\\begin" in parts[-1] or "\\begin" not in parts[-2]:
+        return None
+    sym = read_symbol(parts[-1])
+    return read_name(sym, robot, parts[-2]) if sym is not None else None
