@@ -211,6 +211,18 @@ def _cells(P, r, grid, basis, axes, side, origin, cells, stats, sub):
 
 
 @njit(nogil=True, cache=True, inline="always")
+def _fine(k):
+    """(k, k − 1, log2 k) for the sub-cells per side k = 2, 4, 8 (1, 0, 0 for none: no sub-cells).  With T ≥ 0
+    and k a power of two, T·k is exact and u = floor(T·k) holds the cell floor(T) = u >> log2 k and the
+    sub-cell floor(T·k) − k·floor(T) = u & (k − 1): one truncation per axis for both."""
+    kf = max(k, 1.0)
+    lk = 0
+    while (1 << lk) < kf:
+        lk += 1
+    return kf, np.int32((1 << lk) - 1), np.int32(lk)
+
+
+@njit(nogil=True, cache=True, inline="always")
 def _beyond(x, y, z, q, stats):
     """Whether (x, y, z), |·−origin|² = q, lies beyond the bounds so far (as an integer: OR-reduced)."""
     return ((x < stats[0]) | (y < stats[1]) | (z < stats[2]) | (x > stats[3]) | (y > stats[4]) | (z > stats[5])
@@ -221,7 +233,8 @@ def _beyond(x, y, z, q, stats):
 def _cells3(P, r, grid, side, origin, cells, stats, sub):
     """:func:`_cells` of a 3-D grid (its basis the world axes, ``make_job``; ``run_fused`` checks):
     (samples outside, samples beyond the bounds)."""
-    s, glo, inv, si, kf, ki = float(side), grid[3], grid[4], np.int32(side), grid[5], np.int32(grid[5])
+    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    kf, km, lk = _fine(grid[5])
     c0, c1, c2, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
     X, Y, Z = P[0], P[1], P[2]
     bad = out = 0
@@ -230,11 +243,11 @@ def _cells3(P, r, grid, side, origin, cells, stats, sub):
         dx, dy, dz = x - ox, y - oy, z - oz
         q = dx * dx + dy * dy + dz * dz
         t0, t1, t2 = (x - c0 - glo) * inv, (y - c1 - glo) * inv, (z - c2 - glo) * inv
-        sub[i] = ((np.int32(t0 * kf) - ki * np.int32(t0)) * ki + np.int32(t1 * kf) - ki * np.int32(t1)) * ki + (
-            np.int32(t2 * kf) - ki * np.int32(t2))
         bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (t2 >= 0.0) & (t2 < s))
         out |= _beyond(x, y, z, q, stats)
-        cells[i] = (np.int32(t0) * si + np.int32(t1)) * si + np.int32(t2)
+        u0, u1, u2 = np.int32(t0 * kf), np.int32(t1 * kf), np.int32(t2 * kf)  # floor(T·k), the cell's bits above
+        cells[i] = ((u0 >> lk) * si + (u1 >> lk)) * si + (u2 >> lk)
+        sub[i] = ((((u0 & km) << lk) + (u1 & km)) << lk) + (u2 & km)
     return bad, out
 
 
@@ -244,7 +257,8 @@ def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, sub):
     ``axes`` is empty) u_a is d_axes[a]: the same double as ((d0·b_a0 + d1·b_a1) + d2·b_a2) (the other products
     are zeros; −0 + 0 only changes the sign of a zero, and zero − lo is −lo).  A non-finite coordinate off the
     plane shows in |p − origin|²."""
-    s, glo, inv, si, kf, ki = float(side), grid[3], grid[4], np.int32(side), grid[5], np.int32(grid[5])
+    s, glo, inv, si = float(side), grid[3], grid[4], np.int32(side)
+    kf, km, lk = _fine(grid[5])
     cx, cy, cz, ox, oy, oz = grid[0], grid[1], grid[2], origin[0], origin[1], origin[2]
     b00, b01, b02, b10, b11, b12 = basis[0, 0], basis[0, 1], basis[0, 2], basis[1, 0], basis[1, 1], basis[1, 2]
     plain = axes.size > 0
@@ -260,10 +274,11 @@ def _cells2(P, r, grid, basis, axes, side, origin, cells, stats, sub):
             ex, ey, ez = x - cx, y - cy, z - cz
             t0 = (ex * b00 + ey * b01 + ez * b02 - glo) * inv
             t1 = (ex * b10 + ey * b11 + ez * b12 - glo) * inv
-        sub[i] = (np.int32(t0 * kf) - ki * np.int32(t0)) * ki + np.int32(t1 * kf) - ki * np.int32(t1)
         bad += not ((t0 >= 0.0) & (t0 < s) & (t1 >= 0.0) & (t1 < s) & (q < np.inf))
         out |= _beyond(x, y, z, q, stats)
-        cells[i] = np.int32(t0) * si + np.int32(t1)
+        u0, u1 = np.int32(t0 * kf), np.int32(t1 * kf)
+        cells[i] = (u0 >> lk) * si + (u1 >> lk)
+        sub[i] = ((u0 & km) << lk) + (u1 & km)
     return bad, out
 
 
