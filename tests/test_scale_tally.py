@@ -110,3 +110,28 @@ def test_shell_children_jitted_equal_numpy_route(seed, shape):
     c = _counts(seed, shape, np.uint64)
     inner_c = level_stats(c, mask=True)[5]
     assert np.all(np.diff(_shell_cells(c, inner_c)) > 0)
+
+
+def test_a_run_without_numba_gives_the_same_estimate():
+    """The whole occupancy run in a process where numba cannot be imported (every pass on its numpy route: the
+    sampler, the level statistics, the plan, the refined levels) against this process's (jitted passes)."""
+    import json
+    import subprocess
+    import sys
+
+    import denavit
+    from denavit.scale import PositionFK, occupancy
+
+    code = ("import sys, json; sys.modules['numba'] = None\n"
+            "import denavit; from denavit.scale import occupancy\n"
+            "for name in ('planar2r', 'puma560'):\n"
+            "    ws = occupancy(denavit.load_robot(name), 300_000, seed=5, scheduler='synchronous', refine=2)\n"
+            "    print(json.dumps([ws.counts.sum().item(), ws.refinement.cells.tolist(), int(ws.fine.sum()),\n"
+            "                      [e.summary() for e in ws.levels]]))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.splitlines()
+    for name, line in zip(("planar2r", "puma560"), out):
+        robot = denavit.load_robot(name)
+        ws = occupancy(robot, 300_000, seed=5, scheduler="synchronous", refine=2, fk=PositionFK(robot))
+        total, cells, fine, levels = json.loads(line)
+        assert total == int(ws.counts.sum()) and cells == ws.refinement.cells.tolist() and fine == int(ws.fine.sum())
+        assert levels == [e.summary() for e in ws.levels]
