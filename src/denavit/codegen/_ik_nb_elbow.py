@@ -1,7 +1,7 @@
 """The elbow + spherical-wrist closed form compiled by numba, once per machine (``cache=True``): the formulas of
 :mod:`denavit.ik.forms` (the plain solver's own, jitted through :mod:`._ik_jit`) for the eight candidates of each
-pose, verified and labelled (shoulder, elbow, wrist: the tests of docs/ik.md) in stages over chunks of poses, then
-folded, merged and sorted by :func:`._ik_nb_finish.ik_sorted`.  The constants (``ELBOW_LAYOUT`` of
+pose, verified, labelled (shoulder, elbow, wrist: the tests of docs/ik.md) and folded into the limits in stages over
+chunks of poses, then merged and sorted by :func:`._ik_nb_finish.ik_placed`.  The constants (``ELBOW_LAYOUT`` of
 :mod:`._ik_elbow`) are arguments, so one compiled kernel serves every arm of the class.  Imported only where numba
 is.
 """
@@ -13,11 +13,11 @@ import math
 import numpy as np
 from numba import njit
 
-from ._ik_nb_elbow_checks import elbow_checks
-from ._ik_nb_elbow_stages import CHUNK, RF2, RLB, ROWS, RPE, RPO, RQ1, RQ2, RQ3, RQA, RQB, RQC, RRE, RSG, RST, RVF
-from ._ik_nb_elbow_stages import RW2, RX
+from ._ik_nb_elbow_checks import elbow_checks, elbow_folds
+from ._ik_nb_elbow_stages import CHUNK, RF2, RFL, RLB, ROWS, RPE, RPO, RQ1, RQ2, RQ3, RQA, RQB, RQC, RRE, RSG
+from ._ik_nb_elbow_stages import RST, RVF, RW2, RX
 from ._ik_nb_elbow_stages import elbow_stages
-from ._ik_nb_finish import ik_sorted
+from ._ik_nb_finish import ik_placed
 
 __all__ = ["ik_elbow_packed", "ik_elbow"]
 
@@ -27,20 +27,20 @@ def ik_elbow_packed(T, K, f, i):
     """:func:`ik_elbow` with the constants packed in one vector K (ELBOW_LAYOUT order) and the outputs in two
     arrays (f: solutions, residuals, outside-limits solutions; i (B, 20): label codes, then k, j, status, then the
     batched layout's slots (ik_finish's out_rank)): four arguments instead of twenty-four to unbox per call."""
-    lo_lim, hi_lim, rev, tols = K[271:277], K[277:283], K[283:289], K[295:303]
-    ik_elbow(T, K, lo_lim, hi_lim, rev, tols, f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:11],
+    ik_elbow(T, K, K[283:289], K[295:303], f[:, :, :6], f[:, :, 6:8], i[:, :8], f[:, :, 8:], i[:, 8:11],
              i[:, 11:20])
 
 
-@njit(cache=True, nogil=True, inline="always")  # into ik_elbow_packed: no 12-array call
-def ik_elbow(T, K, lo_lim, hi_lim, revolute, tols, out_q, out_err, out_label, out_outq, out_status, out_rank):
+@njit(cache=True, nogil=True, inline="always")  # into ik_elbow_packed: no 10-array call
+def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_status, out_rank):
     """All solutions of each pose T[b]: out_q[b, :k] (folded, sorted), out_err[b, :k] = (position, orientation)
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
     of the batched layout (:func:`._ik_nb_finish.ik_finish`).  Every branch of CHUNK poses at a time comes from the
     stages (:func:`._ik_nb_elbow_stages.elbow_stages`: the candidates; :func:`._ik_nb_elbow_checks.elbow_checks`:
-    their verifying FK, residuals and labels), then each pose's branches are walked in the one-pose order and
-    folded, merged and sorted as the plain solver does (:func:`._ik_nb_finish.ik_sorted`)."""
+    their verifying FK, residuals and labels; :func:`._ik_nb_elbow_checks.elbow_folds`: the fold into the limits),
+    then each pose's branches are walked in the one-pose order, merged and sorted as the plain solver does
+    (:func:`._ik_nb_finish.ik_placed`)."""
     # scratch: a few allocations per call (not per pose), viewed without reshapes (a reshape is a helper call)
     ws = np.empty(36)
     perm, vr, codes = ws[0:8], ws[8:28], ws[28:36]  # the candidate in each sorted slot; ik_sorted's; label codes
@@ -54,6 +54,7 @@ def ik_elbow(T, K, lo_lim, hi_lim, revolute, tols, out_q, out_err, out_label, ou
             n = min(CHUNK, T.shape[0] - b)
             elbow_stages(T, b, n, K, St)
             elbow_checks(T, b, n, K, St)
+            elbow_folds(n, K, St)
         # the branches of the pose in the one-pose loop's order (q1 root, q3 root, wrist root), the ones with no
         # root skipped; the status raised where the plain solver must decide
         status = int(St[RST * CHUNK + r])
@@ -73,12 +74,13 @@ def ik_elbow(T, K, lo_lim, hi_lim, revolute, tols, out_q, out_err, out_label, ou
                 for k in range(2 * k2, 2 * k2 + 2):
                     if St[(RSG + k) * CHUNK + r] != 0.0 or St[(RPO + k) * CHUNK + r] != 0.0:
                         status = 1  # wrist singular (a continuum), or a residual the plain solver would polish
-                    _candidate(St, r, s1, k2, k, cand, cerr, flags, codes, ncand)
+                    if _candidate(St, r, s1, k2, k, cand, cerr, flags, codes, ncand):
+                        status = 1  # verified, and a joint next to an edge of the fold: the plain solver decides
                     ncand += 1
-        # folded into the limits, merged and sorted as the plain solver does (shared with the UR and Stanford
-        # kernels); then the labels
-        kept, n_out, st = ik_sorted(b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, flags, out_q, out_err,
-                                    out_outq, perm, out_rank, vr)
+        # (folded into the limits in the stages) merged and sorted as the plain solver does (shared with the UR and
+        # Stanford kernels); then the labels
+        kept, n_out, st = ik_placed(b, cand, cerr, ncand, revolute, tols, flags, out_q, out_err, out_outq, perm,
+                                    out_rank, vr)
         for slot in range(kept):
             out_label[b, slot] = codes[int(perm[slot])]
         out_status[b, 0] = kept
@@ -89,9 +91,14 @@ def ik_elbow(T, K, lo_lim, hi_lim, revolute, tols, out_q, out_err, out_label, ou
 @njit(cache=True, nogil=True, inline="always")  # into ik_elbow: no call per candidate
 def _candidate(St, r, s1, k2, k, cand, cerr, flags, codes, m):
     """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows St into candidate m: its joints
-    cand[m], residuals cerr[m], whether they verify the pose flags[m] and its label code codes[m]."""
+    cand[m] (folded), residuals cerr[m], whether they verify the pose flags[m], whether its joints lie within the
+    limits flags[8 + m] and its label code codes[m].  Returns whether it is verified with a joint next to an edge
+    of the fold."""
     a, c, d = s1 * CHUNK + r, k2 * CHUNK + r, k * CHUNK + r  # the pose's column in the rows of s1, k2, k
     cand[m, 0], cand[m, 1], cand[m, 2] = St[RQ1 * CHUNK + a], St[RQ2 * CHUNK + c], St[RQ3 * CHUNK + c]
     cand[m, 3], cand[m, 4], cand[m, 5] = St[RQA * CHUNK + d], St[RQB * CHUNK + d], St[RQC * CHUNK + d]
     cerr[m, 0], cerr[m, 1], flags[m] = St[RPE * CHUNK + d], St[RRE * CHUNK + d], St[RVF * CHUNK + d] != 0.0
     codes[m] = St[RLB * CHUNK + d]
+    fold = St[RFL * CHUNK + d]
+    flags[8 + m] = fold == 1.0 or fold == 3.0
+    return flags[m] and fold >= 2.0

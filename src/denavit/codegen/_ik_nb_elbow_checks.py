@@ -16,11 +16,16 @@ import math
 
 from numba import njit
 
-from ._ik_jit import atan2, select
-from ._ik_nb_elbow_stages import CHUNK, RC1, RC2, RC3, RCA, RCB, RCC, RF3, RLB, RPE, RPO, RRE, RS1, RS2, RS3
-from ._ik_nb_elbow_stages import RL2, RSA, RSB, RSC, RT, RVF, RXW
+import numpy as np
 
-__all__ = ["elbow_checks"]
+from ._ik_finish import FOLD_EDGE
+from ._ik_jit import atan2, select
+from ._ik_nb_elbow_stages import CHUNK, RC1, RC2, RC3, RCA, RCB, RCC, RF3, RFL, RFL1, RFL2, RLB, RPE, RPO, RQ1, RQ2
+from ._ik_nb_elbow_stages import RQ3, RQA, RQB, RQC, RRE, RS1, RS2, RS3, RL2, RSA, RSB, RSC, RT, RVF, RXW
+
+__all__ = ["elbow_checks", "elbow_folds"]
+
+_INV_2PI = 0.5 / math.pi
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -130,3 +135,81 @@ def _check(n, k, C, c, S):
         S[RVF * CHUNK + ok + b] = select((pe <= pe_tol) & (re <= re_tol), 1.0, 0.0)
         S[RPO * CHUNK + ok + b] = select((size < polish_below) & (size > polish_above), 1.0, 0.0)
         S[RLB * CHUNK + ok + b] = S[(RL2 + (k >> 1)) * CHUNK + b] + select(sb * ct5 + cb * st5 < 0.0, 4.0, 0.0)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def elbow_folds(n, K, S):
+    """Every branch's joints of the chunk's first n poses folded into the limits in place (the rows RQ1 … RQC;
+    :func:`._ik_nb_finish.ik_sorted`'s fold of a revolute joint, the same operations), and per branch whether all
+    of its joints lie within them and whether one lies within FOLD_EDGE of a decision of the folding (rows RFL).
+    The elbow class is 6R (joints 1-3 revolute with axes 2 ∥ 3, a spherical wrist)."""
+    lo, hi = K[271:277], K[277:283]
+    _fold1(n, 0, lo[0], hi[0], S)
+    _fold1(n, 1, lo[0], hi[0], S)
+    _fold2(n, 0, lo[1], hi[1], lo[2], hi[2], S)
+    _fold2(n, 1, lo[1], hi[1], lo[2], hi[2], S)
+    _fold2(n, 2, lo[1], hi[1], lo[2], hi[2], S)
+    _fold2(n, 3, lo[1], hi[1], lo[2], hi[2], S)
+    lims = (lo[3], hi[3], lo[4], hi[4], lo[5], hi[5])
+    _fold3(n, 0, lims, S)
+    _fold3(n, 1, lims, S)
+    _fold3(n, 2, lims, S)
+    _fold3(n, 3, lims, S)
+    _fold3(n, 4, lims, S)
+    _fold3(n, 5, lims, S)
+    _fold3(n, 6, lims, S)
+    _fold3(n, 7, lims, S)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _fold(x, lo, hi):
+    """(x folded, inside, near an edge) for a revolute joint x with limits lo, hi: wrapped into (−π, π] (as
+    _ik_nb_finish._wrap), then shifted by a whole turn where that brings it inside (as _ik_nb_finish._fold, with
+    selects for its branches); near an edge: within FOLD_EDGE of ±π or of a limit, itself or a whole turn off."""
+    y = math.pi - x
+    x = math.pi - (y - 2.0 * math.pi * np.floor(y * _INV_2PI))
+    edge = (math.pi - abs(x) < FOLD_EDGE) | (abs(x + -2.0 * math.pi - lo) < FOLD_EDGE) \
+        | (abs(x + -2.0 * math.pi - hi) < FOLD_EDGE) | (abs(x + 0.0 - lo) < FOLD_EDGE) \
+        | (abs(x + 0.0 - hi) < FOLD_EDGE) | (abs(x + 2.0 * math.pi - lo) < FOLD_EDGE) \
+        | (abs(x + 2.0 * math.pi - hi) < FOLD_EDGE)
+    up = x + 2.0 * math.pi
+    x = select(((x < lo - 1e-12) | (x > hi + 1e-12)) & (lo <= up) & (up <= hi), up, x)
+    down = x - 2.0 * math.pi
+    x = select(((x < lo - 1e-12) | (x > hi + 1e-12)) & (lo <= down) & (down <= hi), down, x)
+    return x, (lo - 1e-12 <= x) & (x <= hi + 1e-12), edge
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _fold1(n, s1, lo, hi, S):
+    """q1 of the shoulder root s1 folded; row RFL1 + s1: 1.0 inside, plus 2.0 near an edge."""
+    for b in range(n):
+        x, inside, edge = _fold(S[(RQ1 + s1) * CHUNK + b], lo, hi)
+        S[(RQ1 + s1) * CHUNK + b] = x
+        S[(RFL1 + s1) * CHUNK + b] = select(inside, 1.0, 0.0) + select(edge, 2.0, 0.0)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _fold2(n, k2, lo2, hi2, lo3, hi3, S):
+    """q2, q3 of the arm branch k2 folded; row RFL2 + k2: q1 to q3 all inside (1.0), plus 2.0 if one is near an
+    edge."""
+    for b in range(n):
+        x2, in2, e2 = _fold(S[(RQ2 + k2) * CHUNK + b], lo2, hi2)
+        x3, in3, e3 = _fold(S[(RQ3 + k2) * CHUNK + b], lo3, hi3)
+        f1 = S[(RFL1 + (k2 >> 1)) * CHUNK + b]
+        S[(RQ2 + k2) * CHUNK + b], S[(RQ3 + k2) * CHUNK + b] = x2, x3
+        S[(RFL2 + k2) * CHUNK + b] = select(in2 & in3 & ((f1 == 1.0) | (f1 == 3.0)), 1.0, 0.0) \
+            + select(e2 | e3 | (f1 >= 2.0), 2.0, 0.0)
+
+
+@njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _fold3(n, k, lims, S):
+    """qa, qb, qc of the branch k folded; row RFL + k: all six joints inside (1.0), plus 2.0 if one is near an
+    edge."""
+    for b in range(n):
+        xa, ina, ea = _fold(S[(RQA + k) * CHUNK + b], lims[0], lims[1])
+        xb, inb, eb = _fold(S[(RQB + k) * CHUNK + b], lims[2], lims[3])
+        xc, inc, ec = _fold(S[(RQC + k) * CHUNK + b], lims[4], lims[5])
+        f2 = S[(RFL2 + (k >> 1)) * CHUNK + b]
+        S[(RQA + k) * CHUNK + b], S[(RQB + k) * CHUNK + b], S[(RQC + k) * CHUNK + b] = xa, xb, xc
+        S[(RFL + k) * CHUNK + b] = select(ina & inb & inc & ((f2 == 1.0) | (f2 == 3.0)), 1.0, 0.0) \
+            + select(ea | eb | ec | (f2 >= 2.0), 2.0, 0.0)

@@ -30,10 +30,10 @@ from ._ik_jit import WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roo
 __all__ = [
     "CHUNK", "ROWS", "elbow_stages", "RC1", "RC2", "RC3", "RCA", "RCB", "RCC", "RF2", "RQ1", "RQ2", "RQ3",
     "RQA", "RQB", "RQC", "RS1", "RS2", "RS3", "RSA", "RSB", "RSC", "RSG", "RST", "RX", "RXW", "RT", "RF3", "RL2",
-    "RPE", "RRE", "RVF", "RPO", "RLB", "RW2",
+    "RPE", "RRE", "RVF", "RPO", "RLB", "RW2", "RFL",
 ]
 
-#: poses per chunk of the stages (their scratch: ROWS × CHUNK floats, 33 kB, in L1)
+#: poses per chunk of the stages (their scratch: ROWS × CHUNK floats, 36 kB, in L1)
 CHUNK = 16
 # rows of S: per pose, then per branch (s1: 2, k2 = 2 s1 + s3: 4, k = 2 k2 + s5: 8)
 RXW, RW, RY0, RY2, RST = 0, 3, 6, 9, 12  # wrist centre (world, frame of C0), columns 0 and 2 of T_R R6ᵀ, status
@@ -46,7 +46,10 @@ RQB, RCB, RSB, RQA, RQC, RSG, RCA, RSA, RCC, RSC = 77, 85, 93, 101, 109, 117, 12
 # polish flags and the label code
 RT, RF3, RL2, RPE, RRE, RVF, RPO, RLB = 157, 169, 217, 221, 229, 237, 245, 253
 RW2 = 261  # per k2: 1.0 where the wrist's two roots qb (nearly) coincide (wrist_qb's lo or hi next to 0)
-ROWS = 265
+# rows of the fold into the limits (_ik_nb_elbow_checks; the joints' rows RQ* then hold the folded values): 1.0 where
+# all of a branch's joints so far lie within their limits, plus 2.0 where one of them lies next to an edge of the fold
+RFL1, RFL2, RFL = 265, 267, 271  # per s1, per k2, per k
+ROWS = 279
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

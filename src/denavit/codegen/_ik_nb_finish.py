@@ -18,7 +18,7 @@ from numba import njit
 
 from ._ik_finish import FOLD_EDGE
 
-__all__ = ["chain_fk", "ik_check", "ik_finish", "ik_sorted"]
+__all__ = ["chain_fk", "ik_check", "ik_finish", "ik_placed", "ik_sorted"]
 
 _INV_2PI = 0.5 / math.pi
 
@@ -105,15 +105,24 @@ def ik_finish(T, b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, F, frames
 def ik_sorted(b, cand, cerr, ncand, lo_lim, hi_lim, revolute, tols, flags, out_q, out_err, out_outq, perm, out_rank,
               vr):
     """:func:`ik_finish` after the verification (flags[k]: candidate k verified; cerr[k]: its residuals): the
-    verified ones ranked, folded, merged and sorted into pose b's outputs.  Returns (kept, outside, status)."""
+    verified ones folded, ranked, merged and sorted into pose b's outputs.  Returns (kept, outside, status)."""
+    status = _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr)
+    kept, n_out, st = ik_placed(b, cand, cerr, ncand, revolute, tols, flags, out_q, out_err, out_outq, perm,
+                                out_rank, vr)
+    return kept, n_out, max(status, st)
+
+
+@njit(cache=True, nogil=True, inline="always")  # into ik_sorted and the elbow kernel (folded in its stages)
+def ik_placed(b, cand, cerr, ncand, revolute, tols, flags, out_q, out_err, out_outq, perm, out_rank, vr):
+    """:func:`ik_sorted` after the fold (flags[8 + k]: candidate k's folded joints all within the limits): the
+    verified ones ranked, merged and sorted into pose b's outputs.  Returns (kept, outside, status)."""
     nver = 0
     for k in range(ncand):
         if flags[k]:
             vr[k] = nver
             nver += 1
     out_rank[b, 8] = nver
-    status = _fold(cand, ncand, flags, lo_lim, hi_lim, revolute, vr)
-    status = max(status, _merge(cand, ncand, flags, revolute, tols[4], tols[5]))
+    status = _merge(cand, ncand, flags, revolute, tols[4], tols[5])
     kept, n_out = _sort_out(b, cand, cerr, ncand, flags, out_q, out_err, out_outq, perm, out_rank, vr)
     return kept, n_out, status
 
