@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from ._ik_finish import DOUBLE_ROOT
-from ._ik_jit import elbow_q2, trig_pairs, trig_roots, wrist_qb
+from ._ik_jit import atan2, elbow_q2, trig_pairs, trig_roots, wrist_qb
 from ._ik_nb_finish import ik_finish
 
 __all__ = ["ik_parallel_packed", "frame1", "next_frame"]
@@ -111,10 +111,10 @@ def _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, 
             y1 = sigma * (t0 * C[5, 0, 1] + t1 * C[5, 1, 1] + t2 * C[5, 2, 1])
             if math.sqrt(y0 * y0 + y1 * y1) < sc[9]:
                 status = 1  # axis 6 parallel to axes 2-4: q6 and q2 + q3 + q4 coupled (a continuum)
-            q6 = math.atan2(y1, y0) - math.atan2(ell1, ell0)
+            q6 = atan2(y1, y0) - atan2(ell1, ell0)
             e6 = (1.0 + e1 + e5) / max(math.sqrt(y0 * y0 + y1 * y1), 1e-300)
             eP = 1.0 + e1 + e5 + e6  # of the point P, per reach
-            c6, s6v = math.cos(q6), math.sin(q6)
+            c6, s6v = _angle_between(y0, y1, ell0, ell1)
             _tail(C, c5, s5v, c6, s6v, tl)  # C4 Rz(q5) C5 Rz(q6) C6: rotation columns, origin
             # X = F1^-1 T tail^-1: its origin P and first column xr
             for r in range(3):
@@ -159,14 +159,26 @@ def _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, 
                 f0, f1 = c3 * e0 + s3v * e1, -s3v * e0 + c3 * e1
                 N00 = C[3, 0, 0] * f0 + C[3, 1, 0] * f1 + C[3, 2, 0] * e2
                 N10 = C[3, 0, 1] * f0 + C[3, 1, 1] * f1 + C[3, 2, 1] * e2
-                q4 = math.atan2(N10, N00)
+                q4 = atan2(N10, N00)
+                c4, s4 = _angle_between(N00, N10, 1.0, 0.0)
                 cs[ncand, 0], cs[ncand, 1], cs[ncand, 2], cs[ncand, 3] = c1, s1v, c2, s2v
-                cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, math.cos(q4), math.sin(q4)
+                cs[ncand, 4], cs[ncand, 5], cs[ncand, 6], cs[ncand, 7] = c3, s3v, c4, s4
                 cs[ncand, 8], cs[ncand, 9], cs[ncand, 10], cs[ncand, 11] = c5, s5v, c6, s6v
                 cand[ncand, 0], cand[ncand, 1], cand[ncand, 2] = q1, q2, q3
                 cand[ncand, 3], cand[ncand, 4], cand[ncand, 5] = q4, q5, q6
                 ncand += 1
     return ncand, status
+
+
+@njit(cache=True, nogil=True, inline="always")  # no libm call
+def _angle_between(x0, x1, u0, u1):
+    """(cos θ, sin θ) of θ = atan2(x1, x0) − atan2(u1, u0), the angle from u to x (the normalised dot and cross
+    products; within a few ulps of cos and sin of the difference of the two atan2), (1, 0) where x or u is 0."""
+    d, c = x0 * u0 + x1 * u1, u0 * x1 - u1 * x0
+    h = math.sqrt(d * d + c * c)
+    if h == 0.0:
+        return 1.0, 0.0
+    return d / h, c / h
 
 
 @njit(cache=True, nogil=True, inline="always")  # no call passing arrays
