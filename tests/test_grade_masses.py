@@ -95,3 +95,16 @@ def test_spongs_own_names_d_ij_and_phi_k():
     eqs = [f"d_{{11}} = {SPONG['M_{11}']}", f"d_{{12}} = {SPONG['M_{12}']}", f"\\phi_2 = {SPONG['g_2']}",
            f"\\phi_1 = {SPONG['g_2']}"]
     assert _judged(STANDARD, eqs) == ["correct", "correct", "correct", "incorrect"]
+
+
+def test_the_equations_of_motion_in_the_reports_own_names():
+    """Spong (7.4): τ₁ = d11 q̈1 + d12 q̈2 + 2h q̇1 q̇2 + h q̇2² + φ1, τ₂ = d21 q̈1 + d22 q̈2 − h q̇1² + φ2 with
+    h = −m2 ℓ1 ℓc2 sin q2; d21 is d12 (M symmetric).  A wrong d12 carries into τ₁ and τ₂."""
+    defs = [f"d_{{11}} = {SPONG['M_{11}']}", f"d_{{12}} = {SPONG['M_{12}']}", f"d_{{22}} = {SPONG['M_{22}']}",
+            "h = -m_2 \\ell_1 \\ell_{c2} \\sin q_2", f"\\phi_1 = {SPONG['g_1']}", f"\\phi_2 = {SPONG['g_2']}"]
+    eom = ["\\tau_1 = d_{11} \\ddot q_1 + d_{12} \\ddot q_2 + 2 h \\dot q_1 \\dot q_2 + h \\dot q_2^2 + \\phi_1",
+           "\\tau_2 = d_{21} \\ddot q_1 + d_{22} \\ddot q_2 - h \\dot q_1^2 + \\phi_2"]
+    assert _judged(STANDARD, defs + eom) == ["correct"] * 3 + ["not a claim"] + ["correct"] * 4  # h: a definition
+    wrong = [defs[0], defs[1].replace("+ I_2", "+ I_1")] + defs[2:] + eom
+    judged = _judged(STANDARD, wrong)
+    assert judged[-2:] == ["incorrect", "incorrect"] and judged.count("incorrect") == 3

@@ -34,6 +34,10 @@ _SINGULAR = re.compile(r"singular|vanish|loses? rank|rank[- ]deficien|degenerat"
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
+#: Results whose names a derivation goes on to use (d_{11}, φ_1, K, P in τ = … and L = K − P); never the pose's
+#: entries (p_x, p_z in an inverse-kinematics formula are the target's).
+_TERMS = ("mass_matrix", "gravity", "coriolis", "coriolis_matrix", "kinetic_energy", "potential_energy")
+_SCALAR_NAME = re.compile(r"\\?[A-Za-z]{1,5}(?:_\{?\w{1,3}\}?)?")
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
@@ -379,6 +383,11 @@ class _Walker:
                       "or an intermediate step)")
             return
         self.out.append(build_claim(self.ctx, eq, arm, reading, value))
+        if "\\begin" not in value and _SCALAR_NAME.fullmatch(lhs.strip()) and reading.spec["quantity"] in _TERMS:
+            self.ctx.define(lhs.strip(), value)  # "d_{11} = …": a later τ₁ = d_{11} q̈₁ + … uses the report's value
+            pair = re.fullmatch(r"(.+_\{?)(\d)(,?)(\d)(\}?)", lhs.strip())
+            if pair and reading.spec["quantity"] == "mass_matrix":  # M is symmetric: d_{21} is d_{12}
+                self.ctx.define(pair.expand(r"\g<1>\g<4>\g<3>\g<2>\g<5>"), value)
         if value is not eq.parts[-1] and also is None and "\\begin" in value and "\\begin" not in eq.parts[-1]:
             self.out[-1].understood += f" (the matrix before '= {eq.parts[-1].strip()[:40]}')"
         if also is not None:
