@@ -124,11 +124,9 @@ def _bit_intrinsics():
 
 _as_double, _popcount = _bit_intrinsics()
 _S32, _ONE, _LOW6, _LOW32 = np.uint64(32), np.uint64(1), np.uint64(63), np.uint64(0xFFFFFFFF)
-_GAMMA, _MIX1, _MIX2 = np.uint64(GAMMA), np.uint64(MIX1), np.uint64(MIX2)
-_S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
+_GAMMA, _MIX1, _MIX2, _S30, _S27, _S31 = (np.uint64(x) for x in (GAMMA, MIX1, MIX2, 30, 27, 31))
 _COUNT, _UONE, _S31U = np.uint32(2**31 - 1), np.uint32(1), np.uint32(31)
-_EXP52 = np.uint64(0x4330000000000000)  # the bits of 2⁵²: 2⁵² + h for h < 2³² by an OR
-_HALF = 2.0**-32
+_EXP52, _HALF = np.uint64(0x4330000000000000), 2.0**-32  # the bits of 2⁵²: 2⁵² + h for h < 2³² by an OR
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -215,8 +213,7 @@ def _fine(k):
     """(k, k − 1, log2 k) for the sub-cells per side k = 2, 4, 8 (1, 0, 0 for none: no sub-cells).  With T ≥ 0
     and k a power of two, T·k is exact and u = floor(T·k) holds the cell floor(T) = u >> log2 k and the
     sub-cell floor(T·k) − k·floor(T) = u & (k − 1): one truncation per axis for both."""
-    kf = max(k, 1.0)
-    lk = 0
+    kf, lk = max(k, 1.0), 0
     while (1 << lk) < kf:
         lk += 1
     return kf, np.int32((1 << lk) - 1), np.int32(lk)
@@ -298,14 +295,15 @@ def _extremes(P, r, origin, stats):
 
 
 @njit(nogil=True, cache=True)
-def _count(cells, r, acc, touched, nt, slots, subs, sub, kd):
+def _count(cells, r, acc, touched, nt, slots, subs, sub, kd, rare):
     """acc[cells[i]] += 1 for i < r (the count in the low 31 bits; bit 31 is FLAG, set on the refined cells of a
     refined run); the first hit of each cell appended to touched when it has room; returns (nt, ns) with the
     sub-cells of the samples in refined cells in subs[:ns], in order: slot·k^d + sub[i] (kd = k^d).
 
     The refined flag comes with the count's own load, so a sample outside the refined cells costs no look-up
     (the bitmap of ``slots`` is read only for the flagged ones).  Its increments are independent, so the cache
-    misses of a large grid overlap."""
+    misses of a large grid overlap.  ``rare`` (the last step's guess): the flagged rows listed by a branch in
+    that loop (planar2r's 2 %: 0.5 ns less a sample), else by a branch-free second loop (the Puma's 20 %: 0.65)."""
     ns = 0
     if slots.shape[0] == 0:  # no refined cells, no flags
         return _add(cells, r, acc, touched, nt), 0
@@ -319,6 +317,14 @@ def _count(cells, r, acc, touched, nt, slots, subs, sub, kd):
             acc[c] = v + _UONE
             subs[ns] = i
             ns += np.int64(v >> _S31U)
+    elif rare:
+        for i in range(r):
+            c = cells[i]
+            v = acc[c]
+            acc[c] = v + _UONE
+            if v >> _S31U:
+                subs[ns] = i
+                ns += 1
     else:
         for i in range(r):  # the flag of each sample's cell into subs[i] (no loop-carried dependence)
             c = cells[i]
@@ -367,7 +373,7 @@ def _build(rows, used):
             q, P, cells, subs, stats):
         nt = nft = 0
         n, most = q.shape
-        kd = int(grid[5]) ** basis.shape[0]
+        kd, rare = int(grid[5]) ** basis.shape[0], True
         sub = np.empty(most, np.int32)
         lo_b, span_b, use = lo.copy(), span.copy(), np.empty(n, np.bool_)
         for a in range(n):
@@ -385,7 +391,8 @@ def _build(rows, used):
                 status = _cells(P, r, grid, basis, axes, side, origin, cells, stats, sub)
                 if status:
                     return nt, nft, status
-                nt, ns = _count(cells, r, acc, touched, nt, slots, subs, sub, kd)
+                nt, ns = _count(cells, r, acc, touched, nt, slots, subs, sub, kd, rare)
+                rare = 16 * ns < r  # fewer than 1 in 16 flagged: the branch is cheaper
                 nft = _add(subs, ns, fine, ftouched, nft)
         return nt, nft, 0
 
