@@ -19,8 +19,8 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, det_rows, formula_leftover, joint_offset, names_product, only_names, plain_name,
-                       renumber, trailing_name, used_where, vector_reading)
+from ._reading import (define_chain, define_term, det_rows, formula_leftover, joint_offset, names_product, only_names,
+                       plain_name, renumber, trailing_name, used_where, vector_reading)
 from ._pending import Pending, build_claim
 from ._split import Equation, split_block
 from ._values import wrench_symbols
@@ -34,10 +34,6 @@ _SINGULAR = re.compile(r"singular|vanish|loses? rank|rank[- ]deficien|degenerat"
 _MATRIX_QUANTITIES = ("dh_matrix", "link_transform", "transform", "end_effector")
 _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(?:F|\\mathbf\{F\}|\\dot\{?q\}?|"
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
-#: Results whose names a derivation goes on to use (d_{11}, φ_1, K, P in τ = … and L = K − P); never the pose's
-#: entries (p_x, p_z in an inverse-kinematics formula are the target's).
-_TERMS = ("mass_matrix", "gravity", "coriolis", "coriolis_matrix", "kinetic_energy", "potential_energy")
-_SCALAR_NAME = re.compile(r"\\?[A-Za-z]{1,5}(?:_\{?\w{1,3}\}?)?")
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
 _SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
@@ -55,6 +51,7 @@ class _Walker:
         self.sing_arm: Arm | None = None
         self.offsets: dict = {}
         self.equated: dict[int, Arm] = {}  # id of a section's arm → the arm with the lengths the report equates
+        self.ctx_arm: Arm | None = None  # the arm of the last equation read
         self.notes: list[str] = []
         from ..tables import find_tables
         self.tables = [(a, b) for a, b, why in find_tables(list(doc.lines)) if why is None]
@@ -115,8 +112,9 @@ class _Walker:
             if isinstance(it, Heading):
                 self.flush()
                 self.ctx.singular = bool(_SINGULAR.search(it.title))
-                if it.level <= top:
-                    self.ctx = Context(singular=self.ctx.singular)
+                if it.level <= top:  # a new part: its givens are its own; names defined stay while the arm does
+                    same = self.ctx_arm is not None and self.arm_at(it.line) is self.ctx_arm
+                    self.ctx = Context(singular=self.ctx.singular, where=dict(self.ctx.where) if same else {})
                 elif _CASE.search(it.title):
                     self.ctx.q = None
             elif isinstance(it, Prose):
@@ -167,7 +165,7 @@ class _Walker:
                 self.sing_arm = arm
 
     def math(self, m: Math) -> None:
-        arm = self.arm_at(m.line)
+        arm = self.ctx_arm = self.arm_at(m.line)
         offset = self.offset_of(m.line, arm)
         latex = renumber(m.latex, offset, arm.robot.n_rows) if offset else m.latex
         eqs = split_block(latex, m.line, m.end_line)
@@ -236,8 +234,8 @@ class _Walker:
             return True
         if vec and is_wrench_name(lhs) and len(vec) in (2, 3, 6):
             self.ctx.wrench = "[" + ", ".join(vec + ["0"] * (len(vec) == 2)) + "]"  # (f_x, f_y): in the plane
-            self.note(eq, arm, "not a claim", "the wrench at the end effector" + " (f_x, f_y; f_z = 0)" * (len(vec) == 2),
-                      "given: wrench")
+            planar = " (f_x, f_y; f_z = 0)" * (len(vec) == 2)
+            self.note(eq, arm, "not a claim", "the wrench at the end effector" + planar, "given: wrench")
             return True
         for part in eq.parts[1:]:
             rw = rates_or_wrench(part)
@@ -383,11 +381,7 @@ class _Walker:
                       "or an intermediate step)")
             return
         self.out.append(build_claim(self.ctx, eq, arm, reading, value))
-        if "\\begin" not in value and _SCALAR_NAME.fullmatch(lhs.strip()) and reading.spec["quantity"] in _TERMS:
-            self.ctx.define(lhs.strip(), value)  # "d_{11} = …": a later τ₁ = d_{11} q̈₁ + … uses the report's value
-            pair = re.fullmatch(r"(.+_\{?)(\d)(,?)(\d)(\}?)", lhs.strip())
-            if pair and reading.spec["quantity"] == "mass_matrix":  # M is symmetric: d_{21} is d_{12}
-                self.ctx.define(pair.expand(r"\g<1>\g<4>\g<3>\g<2>\g<5>"), value)
+        define_term(self.ctx, lhs, value, reading.spec["quantity"])
         if value is not eq.parts[-1] and also is None and "\\begin" in value and "\\begin" not in eq.parts[-1]:
             self.out[-1].understood += f" (the matrix before '= {eq.parts[-1].strip()[:40]}')"
         if also is not None:

@@ -13,7 +13,7 @@ from ._lhs import read_symbol
 from ._masses import moves_in_xy
 from ._names import Reading, read_name
 
-__all__ = ["vector_reading", "define_chain", "det_rows", "only_names", "trailing_name", "names_product", "formula_leftover", "used_where", "plain_name",
+__all__ = ["vector_reading", "define_chain", "define_term", "det_rows", "only_names", "trailing_name", "names_product", "formula_leftover", "used_where", "plain_name",
            "joint_offset", "renumber"]
 
 
@@ -169,3 +169,21 @@ def trailing_name(parts: tuple[str, ...], robot: Any) -> Reading | None:
         return None
     sym = read_symbol(parts[-1])
     return read_name(sym, robot, parts[-2]) if sym is not None else None
+
+
+#: Results whose names a derivation goes on to use (d_{11}, φ_1, K, P in τ = … and L = K − P); never the pose's
+#: entries (p_x, p_z in an inverse-kinematics formula are the target's).
+_TERMS = ("mass_matrix", "gravity", "coriolis", "coriolis_matrix", "kinetic_energy", "potential_energy")
+_SCALAR_NAME = re.compile(r"\\?[A-Za-z]{1,5}(?:_\{?\w{1,3}\}?)?")
+
+
+def define_term(ctx: Context, lhs: str, value: str, quantity: str) -> None:
+    """``d_{11} = …`` judged: a later ``τ₁ = d_{11} q̈₁ + …`` uses the report's value (so a wrong d₁₁ carries into
+    τ₁, as it does on paper); M is symmetric, so ``d_{21}`` is defined by ``d_{12}`` too."""
+    name = lhs.strip()
+    if "\\begin" in value or not _SCALAR_NAME.fullmatch(name) or quantity not in _TERMS:
+        return
+    ctx.define(name, value)
+    pair = re.fullmatch(r"(.+_\{?)(\d)(,?)(\d)(\}?)", name)
+    if pair and quantity == "mass_matrix":
+        ctx.define(pair.expand(r"\g<1>\g<4>\g<3>\g<2>\g<5>"), value)

@@ -299,3 +299,45 @@ def f16():
         R("incorrect", "(13) theta2: sign of the second atan2", test=lambda: ik_ok(armn, 2, ik2(+1), signs=branch)
           or not ik_ok(armn, 2, ik2(-1), signs=branch)),
     ]
+
+
+# --- 17: two-link planar arm, Spong's d_ij/φ_k, masses from the report's symbols (no robot given) ---------------
+
+@fixture("17_two_link_dynamics.tex")
+def f17():
+    from _truth_dh import planar_lagrange
+    l1, l2 = sp.symbols("l1 l2", positive=True)
+    lc = sp.symbols("lc1 lc2", positive=True)
+    m1, m2 = m = sp.symbols("m1 m2", positive=True)
+    i1, i2 = II = sp.symbols("I1 I2", positive=True)
+    g = sp.Symbol("g", positive=True)
+    _, _, K, V, Mq, G = planar_lagrange(2, (l1, l2), lc, m, II, g)
+    qd = sp.symbols("qd1 qd2", real=True)
+    qdd = sp.symbols("qdd1 qdd2", real=True)
+    q = (t1, t2)
+
+    def tau(i):  # Lagrange: d/dt ∂K/∂q̇ − ∂K/∂q + ∂V/∂q, the time derivative by the chain rule
+        p = sp.diff(K, qd[i])
+        ddt = sum(sp.diff(p, q[j]) * qd[j] + sp.diff(p, qd[j]) * qdd[j] for j in range(2))
+        return sp.expand(ddt - sp.diff(K, q[i]) + sp.diff(V, q[i]))
+    lc1, lc2 = lc
+    c2_, s2_, c1_, c12 = c(t2), s(t2), c(t1), c(t1 + t2)
+    d11 = m1 * lc1 ** 2 + m2 * (l1 ** 2 + lc2 ** 2 + 2 * l1 * lc2 * c2_) + i1 + i2
+    d12 = m2 * (lc2 ** 2 + l1 * lc2 * c2_) + i2
+    d22 = m2 * lc2 ** 2 + i2
+    phi1 = (m1 * lc1 + m2 * l1) * g * c1_ + m2 * lc2 * g * c12
+    h = -m2 * l1 * lc2 * s2_
+    return [
+        R("correct", "K", m1 * lc1 ** 2 * qd[0] ** 2 / 2 + m2 * (l1 ** 2 * qd[0] ** 2 + lc2 ** 2 * (qd[0] + qd[1]) ** 2
+                                                                 + 2 * l1 * lc2 * c2_ * qd[0] * (qd[0] + qd[1])) / 2
+          + i1 * qd[0] ** 2 / 2 + i2 * (qd[0] + qd[1]) ** 2 / 2, K),
+        R("correct", "P", m1 * g * lc1 * s(t1) + m2 * g * (l1 * s(t1) + lc2 * s(t1 + t2)), V),
+        R("correct", "d11", d11, Mq[0, 0]),
+        R("incorrect", "d12: 2 l1 lc2 c2 for l1 lc2 c2", m2 * (lc2 ** 2 + 2 * l1 * lc2 * c2_) + i2, Mq[0, 1]),
+        R("correct", "d22", d22, Mq[1, 1]),
+        R("correct", "phi1", phi1, G[0]),
+        R("incorrect", "phi2: l2 for lc2", m2 * l2 * g * c12, G[1]),
+        R("correct", "tau1 (with the report's phi1)", d11 * qdd[0] + d12 * qdd[1] + 2 * h * qd[0] * qd[1]
+          + h * qd[1] ** 2 + phi1, tau(0)),
+        R("correct", "tau2", d12 * qdd[0] + d22 * qdd[1] - h * qd[0] ** 2 + m2 * lc2 * g * c12, tau(1)),
+    ]
