@@ -8,7 +8,6 @@ configurations stated over several lines ("θ₃ = 0° … θ₃ = 180° … and
 
 from __future__ import annotations
 
-import itertools
 import re
 from typing import Any
 
@@ -19,9 +18,9 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._names import joint_of, read_name
-from ._reading import (define_chain, define_term, det_rows, formula_leftover, joint_offset, names_product, only_names,
+from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
                        plain_name, renumber, trailing_name, used_where, vector_reading)
-from ._pending import Pending, build_claim
+from ._pending import Pending, build_claim, det_pending
 from ._split import Equation, split_block
 from ._values import wrench_symbols
 
@@ -286,18 +285,7 @@ class _Walker:
         return False
 
     def _det(self, eq: Equation, arm: Arm, value: str, sym: Any) -> None:
-        claim: dict[str, Any] = {"quantity": "det_jacobian", "value": value}
-        if sym is not None and sym.pre_sup.strip().isdigit():
-            claim["frame"] = int(sym.pre_sup.strip())
-        rows = det_rows(sym, arm.robot)
-        p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
-                    quantity="det_jacobian")
-        names = ("vx", "vy", "vz", "wx", "wy", "wz")
-        subsets = [",".join(c) for c in itertools.combinations(names, arm.robot.dof)] if arm.robot.dof <= 6 else []
-        p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in subsets]
-        if rows:
-            claim["rows"] = rows
-        self.out.append(p)
+        self.out.append(det_pending(eq, arm, value, sym))
 
     def flush(self) -> None:
         """The singular conditions collected so far, as one claim."""

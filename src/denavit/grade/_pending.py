@@ -5,17 +5,19 @@ Moved from ``_claims.py`` (code unchanged: the walker's ``claim``/``_wrench`` me
 
 from __future__ import annotations
 
+import itertools
+
 from dataclasses import dataclass, field
 from typing import Any
 
 from ._arms import Arm
 from ._context import Context, has_joint_names, vector_entries
 from ._names import Reading
-from ._reading import used_where
+from ._reading import det_rows, used_where
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
-__all__ = ["Pending", "build_claim"]
+__all__ = ["Pending", "build_claim", "det_pending"]
 
 
 @dataclass
@@ -115,3 +117,19 @@ def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric
             first, second = ctx.wrench_frame, ("tool" if ctx.wrench_frame == "base" else "base")
         claim["frame"] = first
         p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+
+
+def det_pending(eq: Equation, arm: Arm, value: str, sym: Any) -> Pending:
+    """A det J claim: its rows from the name or the arm (det_rows), every square block of rows another form."""
+    claim: dict[str, Any] = {"quantity": "det_jacobian", "value": value}
+    if sym is not None and sym.pre_sup.strip().isdigit():
+        claim["frame"] = int(sym.pre_sup.strip())
+    rows = det_rows(sym, arm.robot)
+    p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
+                quantity="det_jacobian")
+    names = ("vx", "vy", "vz", "wx", "wy", "wz")
+    subsets = [",".join(c) for c in itertools.combinations(names, arm.robot.dof)] if arm.robot.dof <= 6 else []
+    p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in subsets]
+    if rows:
+        claim["rows"] = rows
+    return p
