@@ -50,7 +50,7 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
         if len(row) != robot.dof:
             raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
         q = np.array([_expr.evaluate(c) for c in row])
-        unit = np.array([10.0 ** -d if (d := decimals(c)) >= 2 else 0.0 for c in row])
+        unit = np.array([10.0 ** -d if (d := decimals(c)) >= 2 or deg else 0.0 for c in row])  # 98.6°, 109°: rounded
         if deg:
             q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
         out.append((q, unit))
@@ -107,14 +107,21 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
             keep = [i for i in range(robot.dof) if i not in free_joints(free)]
             if not any(r and np.all(joint_distance(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
                        for r, (q, unit) in zip(reach, claimed)):
-                missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in s) + "]")
+                shown = np.where(revolute_mask(robot), np.degrees(s), s) if deg else s
+                missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in shown) + "]" + (" (degrees)" * deg))
     method = ("FK of each claimed solution on the rows the arm controls (to the decimals written, through J); "
               + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
     extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
     if not entries and not missing:
         return Verdict(cid, "ik_solutions", "correct", f"correct: all {len(claimed)} solution(s) reach the target"
                        + (" and none is missing" if res is not None else ""), method=method, extra=extra)
+    if not entries and raw.get("complete") is False:  # "θ = (…) (elbow down)": one branch claimed, not all
+        return Verdict(cid, "ik_solutions", "correct", f"correct: the {len(claimed)} solution(s) given reach the "
+                       f"target (the others: {'; '.join(missing[:8])})", method=method, extra=extra)
     parts = [f"solution {e['entry'][0]} does not reach the target (error {e['claimed']:.3g})" for e in entries]
-    parts += [f"missing {m}" for m in missing]
+    if raw.get("complete") is False:
+        parts += [f"the solutions: {'; '.join(missing[:8])}"] if missing else []
+    else:
+        parts += [f"missing {m}" for m in missing]
     return Verdict(cid, "ik_solutions", "incorrect", "incorrect: " + "; ".join(parts[:8]), tuple(entries),
                    {"q": entries[0]["q"]} if entries else None, (), extra["solutions"], method, extra)

@@ -22,6 +22,7 @@ from ._reading import (define_chain, define_term, formula_leftover, joint_offset
                        plain_name, renumber, trailing_name, used_where, vector_reading)
 from ._pending import Pending, build_claim, det_pending
 from ._split import Equation, split_block
+from ._target import is_target_part, prose_target, solution_claim
 from ._values import wrench_symbols
 
 __all__ = ["Pending", "walk"]
@@ -141,6 +142,8 @@ class _Walker:
                 q = prose_case(plain, robot)
                 if q is not None:
                     self.ctx.q = self.ctx.cases[number] = q
+        if robot is not None and (target := prose_target(it.text, robot.dof)) is not None:
+            self.ctx.target, self.ctx.target_line = target, it.line
         for name, value in prose_definitions(plain_names(plain)):
             self.ctx.define(name, value)
         w = prose_wrench(plain)
@@ -218,6 +221,9 @@ class _Walker:
         """A case's q, rates, a wrench: remembered, and the equation is "not a claim"."""
         robot = arm.robot if arm is not None else None
         lhs, last = eq.parts[0], eq.parts[-1]
+        if is_target_part(self.ctx, eq.line, lhs):
+            self.note(eq, arm, "not a claim", "the target of the inverse kinematics", "given: target")
+            return True
         q = case_of(eq.parts, eq.text, robot) if robot is not None else None
         if q is not None:
             self.ctx.q, self.ctx.partial = q, {}
@@ -250,6 +256,9 @@ class _Walker:
                 self.ctx.partial[jv[0]] = f"q_{jv[0]} = {jv[1]}"
                 if len(self.ctx.partial) == robot.dof:
                     self.ctx.q = ", ".join(self.ctx.partial[k] for k in sorted(self.ctx.partial))
+                    if self.ctx.target is not None:  # joint values after a target: a solution claimed
+                        self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, solution_claim(
+                            self.ctx, self.ctx.partial), "joint values that reach the target", quantity="ik_solutions"))
                 self.note(eq, arm, "not a claim", f"a given joint value (θ{jv[0]})", "given: q")
                 return True
         return False

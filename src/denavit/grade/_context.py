@@ -46,6 +46,8 @@ class Context:
     cases: dict[str, str] = field(default_factory=dict)
     case_number: str = ""
     wrench_texts: list[str] = field(default_factory=list)
+    target: str | None = None  # an IK target stated in words (a 4×4 as text), and the line that stated it
+    target_line: int = 0
 
     def define(self, name: str, value: str) -> None:
         self.where.pop(name, None)

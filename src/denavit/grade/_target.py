@@ -1,0 +1,52 @@
+"""The target of a report's inverse kinematics, stated in words, and the joint values that answer it.
+
+"The tool must reach $x = 1.2$, $y = 0.9$ with orientation $\\phi = 60^\\circ$" sets a target; joint values
+given after it ("$\\theta_1 = -19.4^\\circ$, $\\theta_2 = 108.9^\\circ$, …") are a claimed solution, judged by
+the checker's ``ik_solutions`` (FK of the values reaches the target, to the decimals written; the other solutions
+are named, not required).  The target is the pose whose position is (x, y, z) and whose rotation is a turn φ
+about the base's z axis: a planar arm's heading, as the textbooks state it.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+from ._context import Context
+
+__all__ = ["prose_target", "is_target_part", "solution_claim"]
+
+_WORDS = re.compile(r"\b(?:reach(?:es|ed)?|target|desired|goal|move[sd]? to|placed? at|must be at)\b", re.I)
+_NUMBER = r"(-?\s?\d+(?:\.\d+)?)\s*(\^\s*\{?\\circ\}?|°)?"
+_COORD = re.compile(r"\$\s*(x|y|z|p_\{?[xyz]\}?|\\phi|\\varphi|\\psi)\s*=\s*" + _NUMBER + r"\s*\$")
+
+
+def prose_target(text: str, dof: int) -> str | None:
+    """The target pose (a 4×4 matrix as text for the checker) a paragraph states, or None: it needs words of a
+    target and at least as many numbers (x, y, z, φ) as the arm has joints."""
+    if not _WORDS.search(text):
+        return None
+    found: dict[str, float] = {}
+    for m in _COORD.finditer(text):
+        key = re.sub(r"[^a-z]", "", m.group(1).replace("p_", "")) or m.group(1)
+        key = "phi" if key in ("phi", "varphi", "psi") else key[-1]
+        value = float(m.group(2).replace(" ", ""))
+        found[key] = math.radians(value) if m.group(3) or key == "phi" and abs(value) > 2 * math.pi else value
+    if len(found) < dof or not {"x", "y"} <= set(found):
+        return None
+    c, s = math.cos(found.get("phi", 0.0)), math.sin(found.get("phi", 0.0))
+    rows = [[c, -s, 0.0, found["x"]], [s, c, 0.0, found["y"]], [0.0, 0.0, 1.0, found.get("z", 0.0)], [0, 0, 0, 1]]
+    return "[" + "; ".join(", ".join(repr(float(v)) for v in r) for r in rows) + "]"
+
+
+def is_target_part(ctx: Context, line: int, lhs: str) -> bool:
+    """``x = 1.2`` on the line that stated the target: a given, not the end effector's x claimed."""
+    return ctx.target is not None and ctx.target_line == line and _COORD.fullmatch(f"$ {lhs} = 0 $") is not None
+
+
+def solution_claim(ctx: Context, partial: dict[int, str]) -> dict[str, Any]:
+    """The ``ik_solutions`` claim of joint values given after a target: one solution, the others not required."""
+    deg = any(re.search(r"\\circ|°", v) for v in partial.values())
+    values = [re.sub(r"\^\s*\{?\\circ\}?|°", "", partial[k].split("=", 1)[1]).strip() for k in sorted(partial)]
+    return {"quantity": "ik_solutions", "T": ctx.target, "value": [values], "complete": False, "deg": deg}

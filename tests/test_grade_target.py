@@ -1,0 +1,81 @@
+"""An IK target stated in words and the joint values a report gives for it (grade._target → ik_solutions).
+
+The truth is the planar 3R arm's closed form written here (Spong et al. Sec. 3.3 / Craig Sec. 4.x: the wrist point
+x_w = x − L3 cos φ, y_w = y − L3 sin φ, cos θ2 = (x_w² + y_w² − L1² − L2²)/(2 L1 L2), θ1 = atan2(y_w, x_w) −
+atan2(L2 s2, L1 + L2 c2), θ3 = φ − θ1 − θ2), never denavit's solver.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from denavit.check import check_claims
+from denavit.grade import grade_text
+from denavit.io import load_robot
+
+L1, L2, L3 = 1.0, 0.8, 0.5
+X, Y, PHI = 1.2, 0.9, 60.0
+TABLE = f"""| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | $L_1 = {L1}$ | 0 | 0 | $\\theta_1$ |
+| 2 | $L_2 = {L2}$ | 0 | 0 | $\\theta_2$ |
+| 3 | $L_3 = {L3}$ | 0 | 0 | $\\theta_3$ |
+"""
+
+
+def _solutions() -> list[tuple[float, float, float]]:
+    phi = math.radians(PHI)
+    xw, yw = X - L3 * math.cos(phi), Y - L3 * math.sin(phi)
+    c2 = (xw ** 2 + yw ** 2 - L1 ** 2 - L2 ** 2) / (2 * L1 * L2)
+    out = []
+    for sign in (1, -1):
+        t2 = math.atan2(sign * math.sqrt(1 - c2 * c2), c2)
+        t1 = math.atan2(yw, xw) - math.atan2(L2 * math.sin(t2), L1 + L2 * math.cos(t2))
+        out.append(tuple(math.degrees(v) for v in (t1, t2, phi - t1 - t2)))
+    return out
+
+
+def _report(values: str, words: str = "The tool must reach") -> str:
+    return (f"# Inverse kinematics\n\n{TABLE}\n{words} $x = {X}$, $y = {Y}$ with orientation $\\phi = {PHI:g}^\\circ$.\n\n"
+            f"Numerically: {values} (elbow down).\n")
+
+
+def _values(q, fmt="{:.2f}") -> str:
+    return ", ".join(f"$\\theta_{k} = {fmt.format(v)}^\\circ$" for k, v in enumerate(q, start=1))
+
+
+@pytest.mark.parametrize("which, fmt", [(0, "{:.2f}"), (1, "{:.2f}"), (0, "{:.1f}"), (1, "{:.0f}")])
+def test_joint_values_that_reach_the_target_are_correct_and_the_other_solution_is_named(which, fmt):
+    sols = _solutions()
+    claims = grade_text(_report(_values(sols[which], fmt))).claims
+    (c,) = [c for c in claims if c.quantity == "ik_solutions"]
+    assert c.verdict == "correct", c.message
+    other = sols[1 - which]
+    assert f"{other[1]:.6g}" in c.message  # the other branch's θ2, in degrees as the report wrote them
+    assert not [c for c in claims if c.quantity == "position"]  # x = 1.2 … are the target, not claims
+
+
+def test_joint_values_that_miss_are_incorrect_with_the_solutions():
+    sols = _solutions()
+    wrong = (sols[0][0] + 3.0, sols[0][1], sols[0][2])
+    (c,) = [c for c in grade_text(_report(_values(wrong))).claims if c.quantity == "ik_solutions"]
+    assert c.verdict == "incorrect" and "does not reach" in c.message
+    assert all(f"{s[1]:.6g}" in c.message for s in sols)
+
+
+def test_without_words_of_a_target_the_numbers_are_no_target():
+    claims = grade_text(_report(_values(_solutions()[0]), words="We note")).claims
+    assert not [c for c in claims if c.quantity == "ik_solutions"]
+
+
+def test_a_partial_list_of_solutions_is_correct_only_when_said_so():
+    """The checker's own claim: one of the two solutions, with complete: false (correct) and without (missing)."""
+    robot = load_robot("planar3r")
+    q = (0.3, 1.1, -0.4)
+    one = [{"quantity": "ik_solutions", "q": ", ".join(map(str, q)), "value": [list(q)], "complete": False},
+           {"quantity": "ik_solutions", "q": ", ".join(map(str, q)), "value": [list(q)]}]
+    first, second = check_claims(robot, one).verdicts
+    assert first.verdict == "correct" and "the others" in first.message
+    assert second.verdict == "incorrect" and "missing" in second.message
