@@ -79,3 +79,13 @@ def test_a_partial_list_of_solutions_is_correct_only_when_said_so():
     first, second = check_claims(robot, one).verdicts
     assert first.verdict == "correct" and "the others" in first.message
     assert second.verdict == "incorrect" and "missing" in second.message
+
+
+def test_the_heading_formula_of_a_planar_arm_is_judged_and_phi_elsewhere_is_not():
+    """θ3 = φ − θ1 − θ2 (the planar arm's heading, the closed form above) is an IK formula; on a spatial arm φ
+    names no target entry the reader may assume (an Euler angle?), so the equation stays no claim."""
+    text = f"# IK\n\n{TABLE}\n$$\\theta_3 = \\phi - \\theta_1 - \\theta_2$$\n\n$$\\theta_3 = \\phi + \\theta_1 - \\theta_2$$\n"
+    assert [c.verdict for c in grade_text(text).claims] == ["correct", "incorrect"]
+    rrp = TABLE.replace("| 0 | 0 | $\\theta_2$ |", "| $90^\\circ$ | 0 | $\\theta_2$ |")
+    text = f"# IK\n\n{rrp}\n$$\\theta_3 = \\phi - \\theta_1 - \\theta_2$$\n"
+    assert [c.verdict for c in grade_text(text).claims] == ["not a claim"]

@@ -17,6 +17,7 @@ from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_na
                        rates_or_wrench, vector_entries)
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
+from ._masses import moves_in_xy
 from ._names import joint_of, read_name
 from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
                        plain_name, renumber, trailing_name, used_where, vector_reading)
@@ -330,7 +331,8 @@ class _Walker:
             self.note(eq, arm, "not a claim", "a name the derivation introduces")
             return
         if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
-            if _IK_FUNCS.search(value) and len(eq.parts) == 2:
+            heading = re.search(r"\\(?:var)?phi\b", value) and moves_in_xy(robot)  # θ₃ = φ − θ₁ − θ₂ (planar)
+            if (_IK_FUNCS.search(value) or heading) and len(eq.parts) == 2:
                 claim = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
                 used = used_where(self.ctx.where, value)
                 if used:

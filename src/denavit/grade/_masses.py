@@ -12,6 +12,7 @@ Without an ``I_i`` a link's inertia about its centre is zero (a point mass).
 
 from __future__ import annotations
 
+import functools
 import re
 from typing import Any
 
@@ -103,6 +104,7 @@ def check_buildable(data: dict, where: str) -> Any:
         return None
 
 
+@functools.lru_cache(maxsize=64)
 def moves_in_xy(robot: Any) -> bool:
     """Every joint moves the tip in the base's xy plane only (J's vz, ωx, ωy rows zero at random q)."""
     import numpy as np
