@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._constants import TWIST_ROWS
 from ..errors import ShapeError
 
 __all__ = ["singular_values", "manipulability", "condition_number", "smallest_singular_value",
@@ -20,8 +21,6 @@ __all__ = ["singular_values", "manipulability", "condition_number", "smallest_si
 
 #: A singular value below RANK_RTOL · σ_max counts as zero.
 RANK_RTOL = 1e-9
-#: Names of the rows of a twist / Jacobian, in order.
-TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 
 def _as_matrix(J) -> np.ndarray:

@@ -9,6 +9,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .._constants import MAX_SAMPLES
 from ..errors import ModelError
 from ..model import DHRobot
 from ._refine import Refinement, check_factor, pilot_blocks, plan_refinement, refined_levels, refinement
@@ -22,8 +23,6 @@ from ._volume import MIN_COVERAGE, VolumeEstimate, estimate_volume, level_stats
 __all__ = ["Occupancy", "occupancy", "sample_positions", "load_occupancy", "MAX_SAMPLES", "DEFAULT_CHUNK", "SINK_CHUNK",
            "CLUSTER_CHUNK", "MAX_CHUNK", "TAIL_SHARE", "new_seed"]
 
-#: Most samples in one run (10¹⁰ ≈ 1 h here with the default FK; bounded time).
-MAX_SAMPLES = 10**10
 #: Default samples per task (4 random blocks; about 60 MB of scratch per worker with the default FK).
 DEFAULT_CHUNK = 4 * BLOCK
 #: Default samples per task on a dask.distributed cluster (fewer, larger tasks: less scheduling per sample).

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .._constants import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS
 from ..errors import ModelError, UnsupportedRobotError
 from ..model import DHRobot
 from ._sampler import MAX_CELLS, MIN_CELLS, Grid, reach_bound, sampling_limits
@@ -28,9 +29,6 @@ from ._schedule import Progress, run, session
 __all__ = ["ReachabilityMap", "reachability", "orientation_set", "DEFAULT_ORIENTATIONS", "MAX_ORIENTATIONS",
            "MAX_POSES", "MAX_NUMERIC_POSES", "VOXELS_PER_TASK"]
 
-#: Orientations per voxel by default, and at most.
-DEFAULT_ORIENTATIONS = 100
-MAX_ORIENTATIONS = 10_000
 #: Most (voxel, orientation) poses in one map with closed-form IK, and with numeric IK.
 MAX_POSES = 5 * 10**7
 MAX_NUMERIC_POSES = 20_000

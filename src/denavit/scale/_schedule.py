@@ -16,21 +16,18 @@ import sys
 import time
 from typing import Any, Callable, Iterable, Iterator
 
+from .._constants import LOCAL_SCHEDULERS, MAX_WORKERS
 from ._cluster import check_address, cluster_failure, connect, local_cluster
 
 __all__ = ["LOCAL_SCHEDULERS", "POOLS", "AUTO_PROCESSES_FROM", "resolve_auto", "IN_FLIGHT", "MAX_WORKERS",
            "check_scheduler", "session", "run", "Progress"]
 
-#: Schedulers that need no address: in this process, a thread or process pool, a LocalCluster started here.
-LOCAL_SCHEDULERS = ("auto", "synchronous", "threads", "processes", "dask")
 #: The local schedulers that run without Dask.
 POOLS = ("auto", "synchronous", "threads", "processes")
 #: "auto" runs on processes from this many samples on (FK threads contend for the GIL), on threads below.
 AUTO_PROCESSES_FROM = 10_000_000
 #: Tasks submitted ahead per worker (bounds the results held at once).
 IN_FLIGHT = 2
-#: Most local workers.
-MAX_WORKERS = 256
 
 
 def check_scheduler(scheduler: Any) -> None:
