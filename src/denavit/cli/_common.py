@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 
-from ..display import terminal_text
 from ..errors import ParseError
 
 __all__ = ["OneLineParser", "add_common", "finite_float", "nonneg_int", "one_line", "positive_float", "add_q", "emit", "load", "joint_values",
@@ -89,6 +88,9 @@ MAX_MESSAGE = 300
 
 def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
     """An error message as one line of at most about ``limit`` characters (long user text is cut in the middle)."""
+    # imported here, not at the top: building the parser (and --help) needs no display code
+    from ..display import terminal_text
+
     text = " ".join(terminal_text(str(message)).split())  # user text in a message is shown, not obeyed
     if len(text) > limit:
         text = text[: limit * 2 // 3] + " ... " + text[-(limit // 3):]
@@ -348,6 +350,8 @@ _LINE_BREAK_ESCAPES = {ord(c): c.encode("unicode_escape").decode("ascii") for c 
 
 
 def emit(args: argparse.Namespace, data: Any, text: str) -> None:
+    from ..display import terminal_text
+
     if getattr(args, "json", False):
         json.dump(to_json(data), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")

@@ -10,8 +10,8 @@ import re
 
 import numpy as np
 
+from .._constants import TWIST_ROWS as ROWS
 from ..errors import ParseError
-from ..numeric import TWIST_ROWS as ROWS
 from ._common import (add_common, add_q, check_values, joint_values, load, matrix_text, numbers_text, require_finite,
                       require_symbolic_size)
 from ._kin_derivatives import (add_kin_derivative_args, analytic_numeric, check_analytic_symbolic, cmd_kin_derivatives,

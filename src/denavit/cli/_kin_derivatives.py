@@ -14,8 +14,8 @@ import argparse
 
 import numpy as np
 
+from .._constants import TWIST_ROWS as ROWS
 from ..errors import ParseError
-from ..numeric import TWIST_ROWS as ROWS
 from ._common import joint_values, matrix_text, numbers_text, require_finite, require_symbolic_size
 from ._shared import q_out, q_text, sym_formatter
 

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParseError
-from ..io import parse_values, resolve_pose, split_values
 from ._common import add_common, joint_values, load, nonneg_int, stage_printer
 from ._output import add_no_clobber, check_output, output_file, output_files
 
@@ -137,6 +136,7 @@ def cmd_report(args: argparse.Namespace):
 
 def _cases(args: argparse.Namespace, robot) -> list[dict[str, Any]]:
     """The numeric cases of -q/--qd/--wrench (each validated: count, syntax, limits), as text values."""
+    from ..io import parse_values, resolve_pose, split_values
     from ..report import MAX_CASES
 
     qs = args.q or [None]

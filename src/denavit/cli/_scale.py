@@ -53,7 +53,7 @@ def scheduler_name(text: str) -> str:
 
 
 def _add_run_options(p: argparse.ArgumentParser) -> None:
-    from ..scale import LOCAL_SCHEDULERS, MAX_WORKERS
+    from .._constants import LOCAL_SCHEDULERS, MAX_WORKERS
 
     p.add_argument("--scheduler", type=scheduler_name, default="auto", metavar="WHERE",
                    help=f"{', '.join(LOCAL_SCHEDULERS)} (default auto: processes for 1e7 samples or more, threads "
@@ -95,7 +95,7 @@ def where_to_run(args: argparse.Namespace):
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from ..scale import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, MAX_SAMPLES
+    from .._constants import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS, MAX_SAMPLES
 
     p = sub.add_parser("workspace", help="reachable workspace by streamed sampling: bounds, volume with an interval")
     add_common(p, angles=False)

@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
+from .._constants import TWIST_ROWS as ROWS
 from ..errors import ParseError
-from ..numeric import TWIST_ROWS as ROWS
 from ._common import (MAX_SYMBOLIC_ANALYSIS_JOINTS, add_common, add_q, joint_values, load, matrix_text, number_text,
                       numbers_text, require_finite, require_symbolic_size, stage_printer)
 from ._shared import add_frame, add_sym_format, q_out, q_text, sym_formatter
