@@ -1,7 +1,9 @@
 """Packaging: public names resolve, the core import stays light, every catalogue robot loads."""
 
+import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -73,3 +75,59 @@ def test_public_names_load_on_first_use_and_match_what_type_checkers_see():
         denavit.not_a_name  # noqa: B018
     with pytest.raises(AttributeError):
         denavit.__not_a_dunder__  # noqa: B018
+
+
+#: What the command line's parser, ``--help`` and the commands that only read a robot must not load.
+CLI_HEAVY = ("denavit.scale", "denavit.numeric", "numba", "sympy", "matplotlib")
+
+
+def _modules_loaded_by(argv: list[str], probe: str = "denavit.scale") -> dict:
+    """In a fresh interpreter: build the parser, run ``main(argv)``; the heavy modules then loaded, the exit code,
+    the output, and whether the same check sees ``probe`` once it is imported (so an empty list means something)."""
+    code = ("import contextlib, io, json, sys; import denavit.cli as cli; cli.build_parser(); out = io.StringIO()\n"
+            f"with contextlib.redirect_stdout(out): rc = cli.main({argv!r})\n"
+            f"heavy = {CLI_HEAVY!r}; loaded = [m for m in heavy if m in sys.modules]; import {probe}\n"
+            "print(json.dumps({'rc': rc, 'loaded': loaded, 'probe': [m for m in heavy if m in sys.modules],"
+            " 'out': out.getvalue()}))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["workspace", "--help"], ["reachability", "--help"],
+                                  ["jacobian", "--help"], ["robots"], ["show", "puma560"]])
+def test_cli_parser_help_and_show_load_neither_scale_nor_numeric(argv):
+    """Building the parser and ``denavit --help`` (and each subcommand's), ``robots`` and ``show`` import neither
+    :mod:`denavit.scale` nor :mod:`denavit.numeric`, numba, sympy or matplotlib: the defaults and limits the help
+    texts show come from ``denavit._constants``; the commands import what they use when they run."""
+    got = _modules_loaded_by(argv)
+    assert got["rc"] == 0 and got["out"]
+    assert got["loaded"] == []
+    assert "denavit.scale" in got["probe"]  # the check sees a loaded module
+    if argv[0] == "workspace":  # the limits shown are the library's
+        from denavit.scale import MAX_SAMPLES
+
+        assert f"{MAX_SAMPLES:.0e}" in " ".join(got["out"].split())
+    if argv[0] == "reachability":
+        from denavit.scale import DEFAULT_ORIENTATIONS, MAX_ORIENTATIONS
+
+        assert f"(default {DEFAULT_ORIENTATIONS}; at most {MAX_ORIENTATIONS})" in " ".join(got["out"].split())
+
+
+def test_console_help_imports_neither_scale_nor_numeric():
+    """``python -m denavit --help`` as a user runs it (``__main__``, then exit): the modules loaded at exit."""
+    code = ("import atexit, sys; heavy = %r\n"
+            "atexit.register(lambda: print([m for m in heavy if m in sys.modules], 'denavit.cli._scale' in sys.modules,"
+            " file=sys.stderr))\n"
+            "import runpy; sys.argv = ['denavit', '--help']; runpy.run_module('denavit', run_name='__main__')" % (CLI_HEAVY,))
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0 and done.stdout.startswith("usage: denavit")
+    assert done.stderr.strip() == "[] True"  # nothing heavy, though every subcommand's module was loaded
+
+
+def test_cli_check_report_does_not_load_the_scale_package():
+    """``denavit check REPORT`` judges with the engines it needs (sympy, numeric) but not :mod:`denavit.scale`."""
+    report = Path(__file__).parent.parent / "examples" / "reports" / "planar2r-homework.md"
+    got = _modules_loaded_by(["check", str(report)], probe="denavit.scale")
+    assert got["rc"] == 0 and got["out"]
+    assert "denavit.scale" not in got["loaded"] and "matplotlib" not in got["loaded"]
+    assert "denavit.scale" in got["probe"]
