@@ -1,0 +1,111 @@
+"""Where a pose of the compiled analytic IK's batch loop goes (issue 30): the kernel's steps cut one at a time.
+
+Run:  python benchmarks/bench_ik_profile.py [--robot puma560] [--n 100000]
+
+Each variant is a numba loop over the same n poses (FK of random joint values within the limits, seeded) running
+the kernel's steps up to one point, timed by CPU time on one core (best of five interleaved rounds); the
+differences between consecutive rows are the steps' costs.  Elbow kernel (puma560, offset-6r): "stages" (the
+candidates of every branch, ``_ik_nb_elbow_stages``), "+ checks" (verifying FK, residuals, labels:
+``_ik_nb_elbow_checks.elbow_checks``), "kernel" (its fold, the walk over the branches, merge and sort too:
+``ik_elbow_packed`` over blocks of 64 poses), "batch entry" (the target check and the scatter into the plain
+solver's batched layout).  UR-class kernel (ur5): "candidates", "kernel", "batch entry".  Report the load
+(``uptime``) with the figures: the machine is shared.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+from numba import njit
+
+import denavit
+from denavit import forward_kinematics, load_robot
+from denavit.codegen._ik_nb_elbow import ik_elbow_packed
+from denavit.codegen._ik_nb_elbow_checks import elbow_checks
+from denavit.codegen._ik_nb_elbow_stages import CHUNK, ROWS, RQA, elbow_stages
+from denavit.codegen._ik_nb_parallel import _parallel_candidates, ik_parallel_packed
+
+
+@njit(nogil=True)
+def _stages(T, K, checks):
+    St, acc = np.empty(ROWS * CHUNK), 0.0
+    for b in range(0, T.shape[0], CHUNK):
+        n = min(CHUNK, T.shape[0] - b)
+        elbow_stages(T, b, n, K, St)
+        if checks:
+            elbow_checks(T, b, n, K, St)
+        acc += St[RQA * CHUNK]
+    return acc
+
+
+@njit(nogil=True)
+def _ur_candidates(T, K):
+    Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
+    a, sc, tols, trig = K[131:134], K[134:145], K[169:177], K[178:186]
+    ws, w = np.empty(76), np.empty((27, 36))
+    V, TC, cols, tl = ws[31:34], ws[34:43].reshape((3, 3)), ws[43:55].reshape((4, 3)), ws[55:67].reshape((4, 3))
+    xr, wv, g = ws[67:70], ws[70:73], ws[73:76]
+    R2, p2, p3 = C[2, :3, :3], C[2, :3, 3], C[3, :3, 3]
+    cand, cs, acc = w[0:8, 0:6], w[0:8, 8:20], 0.0
+    for b in range(T.shape[0]):
+        ncand, _ = _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, cols, tl, xr, wv, g,
+                                        R2, p2, p3)
+        acc += ncand + cand[0, 0]
+    return acc
+
+
+@njit(nogil=True)
+def _kernel(packed, T, K):
+    f, i = np.empty((64, 8, 14)), np.empty((64, 20))
+    for s in range(0, T.shape[0], 64):
+        e = min(s + 64, T.shape[0])
+        packed(T[s:e], K, f[: e - s], i[: e - s])
+    return f[0, 0, 0]
+
+
+def profile(name, n):
+    robot = load_robot(name)
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    kern = fast._analytic_solver()
+    K, many = kern[0], kern[3]
+    rng = np.random.default_rng(8)
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    T = np.ascontiguousarray(forward_kinematics(robot, rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))))
+    outs = (np.empty((n, 8, 6)), np.empty((n, 8)), np.empty((n, 8)), np.empty((n, 8), dtype=bool),
+            np.empty((n, 8), dtype=np.int8), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int8))
+    if kern[1][1] == "parallel":
+        runs = {"candidates": lambda: _ur_candidates(T, K), "kernel": lambda: _kernel(ik_parallel_packed, T, K)}
+    else:
+        runs = {"stages": lambda: _stages(T, K, False), "+ checks": lambda: _stages(T, K, True),
+                "kernel": lambda: _kernel(ik_elbow_packed, T, K)}
+    runs["batch entry"] = lambda: many(T, K, *outs)
+    for f in runs.values():
+        f()
+    best = {}
+    for _ in range(5):
+        for who, f in runs.items():
+            t0 = time.process_time()
+            f()
+            best[who] = min(best.get(who, np.inf), time.process_time() - t0)
+    return {who: dt / n * 1e9 for who, dt in best.items()}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--robot", action="append", help="catalogue arm (repeatable; default puma560, ur5, offset-6r)")
+    ap.add_argument("--n", type=int, default=100_000, help="poses (default 100000)")
+    args = ap.parse_args(argv)
+    try:
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    except (AttributeError, OSError):
+        pass
+    for name in args.robot or ["puma560", "ur5", "offset-6r"]:
+        print(name, " | ".join(f"{who} {ns:.0f} ns/pose" for who, ns in profile(name, args.n).items()),
+              "| load", os.getloadavg()[0])
+
+
+if __name__ == "__main__":
+    main()
