@@ -89,3 +89,27 @@ def test_the_heading_formula_of_a_planar_arm_is_judged_and_phi_elsewhere_is_not(
     rrp = TABLE.replace("| 0 | 0 | $\\theta_2$ |", "| $90^\\circ$ | 0 | $\\theta_2$ |")
     text = f"# IK\n\n{rrp}\n$$\\theta_3 = \\phi - \\theta_1 - \\theta_2$$\n"
     assert [c.verdict for c in grade_text(text).claims] == ["not a claim"]
+
+
+def test_manipulability_written_out_is_judged_with_the_rows_its_j_names():
+    """w = √det(J_v J_vᵀ) of the elbow RRR arm = |det J_v| = a2 a3 |s3| |a2 c2 + a3 c23| (Spong et al. Sec. 4.10,
+    det J_v = a2 a3 s3 (a2 c2 + a3 c23) up to sign); without the second bars the sign changes with q: wrong, hinted."""
+    table = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
+|---|---|---|---|---|
+| 1 | 0 | $90^\\circ$ | $d_1$ | $\\theta_1$ |
+| 2 | $a_2$ | 0 | 0 | $\\theta_2$ |
+| 3 | $a_3$ | 0 | 0 | $\\theta_3$ |
+"""
+    good = "$$w = \\sqrt{\\det(J_v J_v^T)} = a_2 a_3 |s_3| |a_2 c_2 + a_3 c_{23}|$$"
+    bad = "$$w = \\sqrt{\\det(J_v J_v^T)} = a_2 a_3 |s_3| (a_2 c_2 + a_3 c_{23})$$"
+    ok, wrong = grade_text(f"# Elbow\n\n{table}\n{good}\n\n{bad}\n").claims
+    assert (ok.verdict, wrong.verdict) == ("correct", "incorrect") and ok.quantity == "manipulability"
+    assert "absolute value" in str(wrong.details.get("hints"))
+
+
+def test_the_checkers_manipulability_of_the_planar_two_link_arm():
+    """w = L1 L2 |sin θ2| for the (x, y) rows of the planar 2R arm (Yoshikawa's textbook example)."""
+    robot = load_robot("planar2r")
+    claims = [{"quantity": "manipulability", "rows": "vx,vy", "value": "L_1 L_2 |\\sin\\theta_2|"},
+              {"quantity": "manipulability", "rows": "vx,vy", "value": "L_1 L_2 \\sin\\theta_2"}]
+    assert [v.verdict for v in check_claims(robot, claims).verdicts] == ["correct", "incorrect"]

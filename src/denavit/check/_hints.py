@@ -56,6 +56,8 @@ def _entrywise(claimed, truth, bad, tol) -> list[str]:
     signs = [ix for ix in bad_ix if _close(claimed[(slice(None),) + ix], -truth[(slice(None),) + ix], tol[ix])]
     if not shape and _close(claimed, -truth, tol) and not _close(claimed, truth, tol):
         hints.append("sign slip: the value has the opposite sign")
+    elif not shape and _close(np.abs(claimed), np.abs(truth), tol) and not _close(claimed, truth, tol):
+        hints.append("right up to its sign, which changes with q: an absolute value is missing (or one too many)")
     if signs:
         hints.append("sign slip: entr" + ("y " if len(signs) == 1 else "ies ") + ", ".join(map(_entry_name, signs))
                      + " ha" + ("s" if len(signs) == 1 else "ve") + " the opposite sign")

@@ -85,6 +85,8 @@ class _Parser:
         if t is None:
             return False
         kind, s = t
+        if s == "|":  # a_2 |s_3|: an absolute value starts a factor, unless this bar closes the one we are in
+            return not getattr(self, "in_bars", 0)
         return kind in ("num", "word") or (kind == "cmd" and s not in ("\\cdot", "\\times")) or s in ("(", "[", "{", "\\{")
 
     def term(self) -> tuple:
@@ -163,7 +165,11 @@ class _Parser:
             self.take(_OPEN[s])
             return inner
         if s == "|":
-            inner = self.expr()
+            self.in_bars = getattr(self, "in_bars", 0) + 1
+            try:
+                inner = self.expr()
+            finally:
+                self.in_bars -= 1
             self.take("|")
             return ("call", "abs", (inner,))
         if kind == "cmd":

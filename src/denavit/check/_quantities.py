@@ -212,6 +212,12 @@ def _det(p: Point, spec: dict[str, Any]) -> np.ndarray:
     return np.asarray(np.linalg.det(J))
 
 
+def _manipulability(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    """Yoshikawa's w = √det(J Jᵀ) of the rows named (all six by default); |det J| for a square block."""
+    J = jacobian_in(p, spec)[_rows(spec)]
+    return np.asarray(np.sqrt(max(float(np.linalg.det(J @ J.T)), 0.0)))
+
+
 def _dynamics(name: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
     def truth(p: Point, spec: dict[str, Any]) -> np.ndarray:
         fn = getattr(N, name, None)
@@ -262,6 +268,8 @@ QUANTITIES: dict[str, Quantity] = {
         Quantity("lagrangian", _energy("lagrangian"), ("qd",), about="L = K − V"),
         Quantity("equations_of_motion", _equations_of_motion, ("qd", "qdd"), about="τ = M(q) q̈ + C(q, q̇) q̇ + g(q) "
                  "(+ the robot's friction): the Lagrange or Newton–Euler equations of motion"),
+        Quantity("manipulability", _manipulability, about="Yoshikawa's w = √det(J Jᵀ) of the rows named ('rows'; all "
+                 "six by default): |det J| for a square block"),
         Quantity("det_jacobian", _det, about="det J (square: 6 joints, or 'rows' naming as many rows as joints); "
                  "a list of factors is read as their product"),
     )

@@ -21,7 +21,7 @@ from ._masses import moves_in_xy
 from ._names import joint_of, read_name
 from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
                        plain_name, renumber, trailing_name, used_where, vector_reading)
-from ._pending import Pending, build_claim, det_pending
+from ._pending import MANIPULABILITY, Pending, build_claim, det_pending, manipulability_pending
 from ._split import Equation, split_block
 from ._target import is_target_part, prose_target, solution_claim
 from ._values import wrench_symbols
@@ -342,6 +342,10 @@ class _Walker:
             else:
                 self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
                           "the joint in terms of the target")
+            return
+        manip = next((m for part in eq.parts[:-1] if (m := MANIPULABILITY.search(part))), None)
+        if manip is not None and len(eq.parts) > 2:
+            self.out.append(manipulability_pending(eq, arm, value, manip.group(1)))
             return
         reading = read_name(sym, robot, value) if sym is not None else vector_reading(lhs, robot)
         if reading is not None and reading.spec.get("quantity") == "det_jacobian":

@@ -6,6 +6,7 @@ Moved from ``_claims.py`` (code unchanged: the walker's ``claim``/``_wrench`` me
 from __future__ import annotations
 
 import itertools
+import re
 
 from dataclasses import dataclass, field
 from typing import Any
@@ -17,7 +18,7 @@ from ._reading import det_rows, used_where
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
-__all__ = ["Pending", "build_claim", "det_pending"]
+__all__ = ["Pending", "build_claim", "det_pending", "manipulability_pending", "MANIPULABILITY"]
 
 
 @dataclass
@@ -132,4 +133,25 @@ def det_pending(eq: Equation, arm: Arm, value: str, sym: Any) -> Pending:
     p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in subsets]
     if rows:
         claim["rows"] = rows
+    return p
+
+
+#: Yoshikawa's measure written out: ``\\sqrt{\\det(J_v J_v^T)}`` (the J named decides the rows).
+MANIPULABILITY = re.compile(r"\\sqrt\s*\{?\s*\\det\s*\\?(?:left)?\(?\s*(J(?:_\{?\\?\w+\}?)?)")
+
+
+def manipulability_pending(eq: Equation, arm: Arm, value: str, written: str) -> Pending:
+    """``w = \\sqrt{\\det(J_v J_v^T)} = …``: the measure of the rows the J's name says (or the arm's default, as
+    for det J); the usual other blocks of rows (position, planar, angular, all) other forms."""
+    from ._lhs import read_symbol
+
+    claim: dict[str, Any] = {"quantity": "manipulability", "value": value}
+    rows = det_rows(read_symbol(written), arm.robot)
+    if rows:
+        claim["rows"] = rows
+    p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "the manipulability w = √det(J Jᵀ)",
+                quantity="manipulability")
+    blocks = ("vx,vy,vz", "vx,vy,wz", "vx,vy", "wx,wy,wz", "vx,vy,vz,wx,wy,wz")
+    p.equivalent = [({**claim, "rows": r}, f"w of the rows {r}") for r in blocks
+                    if r != rows and r.count(",") + 1 >= arm.robot.dof]
     return p
