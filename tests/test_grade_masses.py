@@ -108,3 +108,9 @@ def test_the_equations_of_motion_in_the_reports_own_names():
     wrong = [defs[0], defs[1].replace("+ I_2", "+ I_1")] + defs[2:] + eom
     judged = _judged(STANDARD, wrong)
     assert judged[-2:] == ["incorrect", "incorrect"] and judged.count("incorrect") == 3
+
+
+def test_the_correct_value_writes_the_centre_of_mass_distance_as_the_report_does():
+    text = "# Two-link arm\n\n" + STANDARD + "\n$$M_{22} = m_2 \\ell_{c2}^2 + 2 I_2$$\n"
+    (c,) = grade_text(text).claims
+    assert c.verdict == "incorrect" and "\\ell_{c2}" in c.fix and "ellc" not in c.fix

@@ -5,6 +5,8 @@ Moved unchanged from ``_engine.py``.
 
 from __future__ import annotations
 
+import re
+
 from functools import lru_cache
 from typing import Any
 
@@ -63,7 +65,7 @@ def _expected_statics(robot: DHRobot, name: str, spec: dict[str, Any]) -> str | 
     M = sp.ImmutableMatrix(M.applyfunc(sp.expand))
     if len(str(M)) > 20_000:
         return None
-    return sp.latex(S.shorthand_matrix(M, S.joint_symbols(robot.dof).q), mat_str="bmatrix", mat_delim="")
+    return _latex(S.shorthand_matrix(M, S.joint_symbols(robot.dof).q))
 
 
 @lru_cache(maxsize=8)
@@ -111,7 +113,7 @@ def _expected_formula(robot: DHRobot, name: str, index: int | None, frm: int | N
     if len(str(M)) > 20_000:
         return None
     M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
-    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+    return _latex(M)
 
 
 #: Most joints for which an incorrect J claim is given the correct formula (symbolic geometric Jacobian).
@@ -137,7 +139,7 @@ def _expected_jacobian(robot: DHRobot, frame: str, rows: tuple[int, ...] | None 
     M = S.shorthand_matrix(sp.ImmutableMatrix(M), S.joint_symbols(robot.dof).q)
     if rows:
         M = M.extract(list(rows), list(range(M.shape[1])))
-    return sp.latex(M, mat_str="bmatrix", mat_delim="")
+    return _latex(M)
 
 
 def _inverse(T):
@@ -145,3 +147,18 @@ def _inverse(T):
 
     R, p = T[:3, :3], T[:3, 3]
     return sp.ImmutableMatrix(sp.BlockMatrix([[R.T, -R.T * p], [sp.zeros(1, 3), sp.ones(1, 1)]]).as_explicit())
+
+
+_COM_NAME = re.compile(r"(ell|[A-Za-z])c(\d{1,2})")
+
+
+def _latex(M) -> str:
+    """A result in LaTeX, a centre-of-mass distance as a report writes it: ``ellc1`` → ℓ_{c1}, ``Lc2`` → L_{c2}."""
+    import sympy as sp
+
+    names = {}
+    for sym in M.free_symbols:
+        m = _COM_NAME.fullmatch(sym.name)
+        if m:
+            names[sym] = ("\\ell" if m.group(1) == "ell" else m.group(1)) + f"_{{c{m.group(2)}}}"
+    return sp.latex(M, mat_str="bmatrix", mat_delim="", symbol_names=names)
