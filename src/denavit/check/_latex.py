@@ -21,9 +21,10 @@ import re
 
 from .. import _expr
 from ..errors import ParseError
+from ._text import strip_equation_number, strip_rhs
 from ._tokens import FUNCS, GREEK, MAX_DEPTH, MAX_TREE_DEPTH, WRAP_CMDS, Ident, Resolver, tokenize
 
-__all__ = ["parse_math", "strip_equation_number", "tree_depth"]
+__all__ = ["parse_math", "tree_depth"]
 
 _OPEN = {"(": ")", "[": "]", "{": "}", "\\{": "\\}"}
 
@@ -361,35 +362,13 @@ def _is_minus_one(node: tuple) -> bool:
         return False
 
 
-def _strip_rhs(text: str) -> str:
-    """``T = [...]`` → ``[...]``: keep what follows the last top-level ``=``."""
-    level = 0
-    cut = -1
-    for k, ch in enumerate(text):
-        if ch in "({[":
-            level += 1
-        elif ch in ")}]":
-            level -= 1
-        elif ch == "=" and level == 0:
-            cut = k
-    return text[cut + 1:] if cut >= 0 else text
-
-
-_EQ_NUMBER = re.compile(r"(?:\\q?quad\s*\(\s*\d{1,6}[a-z]?\s*\)|\\tag\*?\{[^{}]{0,40}\})\s*$")
-
-
-def strip_equation_number(text: str) -> str:
-    """``… \\quad (11)`` or ``… \\tag{11}`` at the end: the report's equation number, not a factor 11."""
-    return _EQ_NUMBER.sub("", text.strip().strip("$").strip())
-
-
 def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
     """One scalar expression (LaTeX or plain) → an :mod:`denavit._expr` tree."""
     if not isinstance(text, str):
         text = str(text)
     text = strip_equation_number(text).strip()
     if rhs:
-        text = _strip_rhs(text)
+        text = strip_rhs(text)
     if not text.strip():
         raise ParseError("empty expression")
     p = _Parser(text, resolve)

@@ -8,7 +8,8 @@ from __future__ import annotations
 import re
 
 from ..errors import ParseError
-from ._latex import parse_math, strip_equation_number
+from ._latex import parse_math
+from ._text import strip_equation_number
 from ._tokens import MAX_CHARS, Resolver, normalize
 
 __all__ = ["RaggedMatrix", "split_matrix", "after_last_equals", "split_list", "encloses", "parse_matrix"]

@@ -11,7 +11,7 @@ import re
 
 from ..errors import ParseError
 
-__all__ = ["split_top", "split_relation", "expand_pm", "MAX_SIGN_COMBOS"]
+__all__ = ["split_top", "split_relation", "expand_pm", "strip_rhs", "strip_equation_number", "MAX_SIGN_COMBOS"]
 
 MAX_SIGN_COMBOS = 64
 _OPENERS, _CLOSERS = "({[", ")}]"
@@ -80,3 +80,25 @@ def expand_pm(texts: list[str]) -> list[list[str]]:
             out[i] = t  # replaced from the right, so earlier positions stay valid
         versions.append(out)
     return versions
+
+
+def strip_rhs(text: str) -> str:
+    """``T = [...]`` → ``[...]``: keep what follows the last top-level ``=``."""
+    level = 0
+    cut = -1
+    for k, ch in enumerate(text):
+        if ch in "({[":
+            level += 1
+        elif ch in ")}]":
+            level -= 1
+        elif ch == "=" and level == 0:
+            cut = k
+    return text[cut + 1:] if cut >= 0 else text
+
+
+_EQ_NUMBER = re.compile(r"(?:\\q?quad\s*\(\s*\d{1,6}[a-z]?\s*\)|\\tag\*?\{[^{}]{0,40}\})\s*$")
+
+
+def strip_equation_number(text: str) -> str:
+    """``… \\quad (11)`` or ``… \\tag{11}`` at the end: the report's equation number, not a factor 11."""
+    return _EQ_NUMBER.sub("", text.strip().strip("$").strip())
