@@ -4,7 +4,6 @@ entries one after another, each labelled with its (row, column) and wrapped to t
 
 from __future__ import annotations
 
-import os
 import shutil
 import textwrap
 
