@@ -36,7 +36,7 @@ def _stages(T, K, checks):
         n = min(CHUNK, T.shape[0] - b)
         elbow_stages(T, b, n, K, St)
         if checks:
-            elbow_checks(T, b, n, K, St)
+            elbow_checks(n, K, St)
         acc += St[RQA * CHUNK]
     return acc
 

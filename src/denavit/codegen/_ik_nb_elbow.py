@@ -53,7 +53,7 @@ def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_stat
         if r == 0:  # the next chunk's candidates and checks, every branch
             n = min(CHUNK, T.shape[0] - b)
             elbow_stages(T, b, n, K, St)
-            elbow_checks(T, b, n, K, St)
+            elbow_checks(n, K, St)
             elbow_folds(n, K, St)
         # the branches of the pose in the one-pose loop's order (q1 root, q3 root, wrist root), the ones with no
         # root skipped; the status raised where the plain solver must decide

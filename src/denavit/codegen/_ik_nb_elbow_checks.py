@@ -29,16 +29,12 @@ _INV_2PI = 0.5 / math.pi
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def elbow_checks(T, s, n, K, S):
-    """Residuals, verification and polish flags and label codes of every branch of poses T[s:s + n] (n ≤ CHUNK)
-    into S (rows RT, RF3, RL2, RPE, RRE, RVF, RPO, RLB; the candidates' rows from elbow_stages already there)."""
+def elbow_checks(n, K, S):
+    """Residuals, verification and polish flags and label codes of every branch of the chunk's first n poses into S
+    (rows RF3, RL2, RPE, RRE, RVF, RPO, RLB; the targets' and the candidates' rows from elbow_stages already
+    there)."""
     C = K[80:192].reshape((7, 4, 4))  # the chain's constants C0 … C6 (C0 also the kernel's consts[0])
     theta, tols = K[289:295], K[295:303]
-    for b in range(n):  # the targets into rows (a loop reading T stays scalar: its run-time strides)
-        t = s + b
-        for i in range(3):
-            S[(RT + 4 * i) * CHUNK + b], S[(RT + 4 * i + 1) * CHUNK + b] = T[t, i, 0], T[t, i, 1]
-            S[(RT + 4 * i + 2) * CHUNK + b], S[(RT + 4 * i + 3) * CHUNK + b] = T[t, i, 2], T[t, i, 3]
     _frame3(n, 0, C, S)
     _frame3(n, 1, C, S)
     _frame3(n, 2, C, S)

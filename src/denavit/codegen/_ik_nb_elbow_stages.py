@@ -41,9 +41,9 @@ RQ1, RC1, RS1, RG, RX = 13, 15, 17, 19, 23  # per s1: q1 and its cos, sin; (g0, 
 RQ3, RC3, RS3, RQ2, RC2, RS2, RF2 = 25, 29, 33, 37, 41, 45, 49  # per k2
 RM = 53  # per k2: m00, m10, m20, m02, m12, m22 of M = R_0_3ᵀ T_R R6ᵀ at RM + 6 k2
 RQB, RCB, RSB, RQA, RQC, RSG, RCA, RSA, RCC, RSC = 77, 85, 93, 101, 109, 117, 125, 133, 141, 149  # per k
-# rows of the checks (_ik_nb_elbow_checks): the target's top 3×4 (row-major), per k2 the frame after joint 3 (x0, x1,
-# x2, y0, …, p2 at RF3 + 12 k2) and the label's shoulder and elbow bits; per k the residuals, the verified and
-# polish flags and the label code
+# the target's top 3×4 (row-major, copied first: the stages then read no other array); rows of the checks
+# (_ik_nb_elbow_checks): per k2 the frame after joint 3 (x0, x1, x2, y0, …, p2 at RF3 + 12 k2) and the label's
+# shoulder and elbow bits; per k the residuals, the verified and polish flags and the label code
 RT, RF3, RL2, RPE, RRE, RVF, RPO, RLB = 157, 169, 217, 221, 229, 237, 245, 253
 RW2 = 261  # per k2: 1.0 where the wrist's two roots qb (nearly) coincide (wrist_qb's lo or hi next to 0)
 # rows of the fold into the limits (_ik_nb_elbow_checks; the joints' rows RQ* then hold the folded values): 1.0 where
@@ -62,7 +62,12 @@ def elbow_stages(T, s, n, K, S):
     X_e, p1, a, p2, P = K3[15], K3[16], K3[17], K3[18], K3[19]
     sc, trig, tols = K[252:261], K[261:271], K[295:303]
     tiny = tols[0] * sc[4]
-    _shoulder(T, s, n, X_e, C0i, R6, a, sc[0], tiny, tols[1], sc[5], S)
+    for b in range(n):  # the targets into rows (a loop reading T stays scalar: its run-time strides)
+        t = s + b
+        for i in range(3):
+            S[(RT + 4 * i) * CHUNK + b], S[(RT + 4 * i + 1) * CHUNK + b] = T[t, i, 0], T[t, i, 1]
+            S[(RT + 4 * i + 2) * CHUNK + b], S[(RT + 4 * i + 3) * CHUNK + b] = T[t, i, 2], T[t, i, 3]
+    _shoulder(n, X_e, C0i, R6, a, sc[0], tiny, tols[1], sc[5], S)
     _elbow(n, 0, R1, p1, sc[1], sc[2], sc[3], trig[8], trig[9], tols[1], S)
     _elbow(n, 1, R1, p1, sc[1], sc[2], sc[3], trig[8], trig[9], tols[1], S)
     wc = (trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], trig[6], trig[7])  # forms.wrist_constants
@@ -81,25 +86,31 @@ def elbow_stages(T, s, n, K, S):
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _shoulder(T, s, n, X_e, C0i, R6, a, h, tiny, ratio_tol, rho_w, S):
-    """Wrist centre, T_R R6ᵀ and the shoulder's roots of each pose; status 1.0 where the plain solver decides (joint
-    1 free, the shoulder equation independent of q1, next to a double root, a wrist with no z-row dependence)."""
+def _shoulder(n, X_e, C0i, R6, a, h, tiny, ratio_tol, rho_w, S):
+    """Wrist centre, T_R R6ᵀ and the shoulder's roots of each pose (its target from the rows RT); status 1.0 where
+    the plain solver decides (joint 1 free, the shoulder equation independent of q1, next to a double root, a wrist
+    with no z-row dependence)."""
     for b in range(n):
-        t = s + b
-        x0 = T[t, 0, 0] * X_e[0] + T[t, 0, 1] * X_e[1] + T[t, 0, 2] * X_e[2] + T[t, 0, 3]
-        x1 = T[t, 1, 0] * X_e[0] + T[t, 1, 1] * X_e[1] + T[t, 1, 2] * X_e[2] + T[t, 1, 3]
-        x2 = T[t, 2, 0] * X_e[0] + T[t, 2, 1] * X_e[1] + T[t, 2, 2] * X_e[2] + T[t, 2, 3]
+        t00, t01, t02, t03 = S[RT * CHUNK + b], S[(RT + 1) * CHUNK + b], S[(RT + 2) * CHUNK + b], \
+            S[(RT + 3) * CHUNK + b]
+        t10, t11, t12, t13 = S[(RT + 4) * CHUNK + b], S[(RT + 5) * CHUNK + b], S[(RT + 6) * CHUNK + b], \
+            S[(RT + 7) * CHUNK + b]
+        t20, t21, t22, t23 = S[(RT + 8) * CHUNK + b], S[(RT + 9) * CHUNK + b], S[(RT + 10) * CHUNK + b], \
+            S[(RT + 11) * CHUNK + b]
+        x0 = t00 * X_e[0] + t01 * X_e[1] + t02 * X_e[2] + t03
+        x1 = t10 * X_e[0] + t11 * X_e[1] + t12 * X_e[2] + t13
+        x2 = t20 * X_e[0] + t21 * X_e[1] + t22 * X_e[2] + t23
         w0 = C0i[0, 0] * x0 + C0i[0, 1] * x1 + C0i[0, 2] * x2 + C0i[0, 3]
         w1 = C0i[1, 0] * x0 + C0i[1, 1] * x1 + C0i[1, 2] * x2 + C0i[1, 3]
         w2 = C0i[2, 0] * x0 + C0i[2, 1] * x1 + C0i[2, 2] * x2 + C0i[2, 3]
         S[RXW * CHUNK + b], S[(RXW + 1) * CHUNK + b], S[(RXW + 2) * CHUNK + b] = x0, x1, x2
         S[RW * CHUNK + b], S[(RW + 1) * CHUNK + b], S[(RW + 2) * CHUNK + b] = w0, w1, w2
-        S[RY0 * CHUNK + b] = T[t, 0, 0] * R6[0, 0] + T[t, 0, 1] * R6[0, 1] + T[t, 0, 2] * R6[0, 2]
-        S[(RY0 + 1) * CHUNK + b] = T[t, 1, 0] * R6[0, 0] + T[t, 1, 1] * R6[0, 1] + T[t, 1, 2] * R6[0, 2]
-        S[(RY0 + 2) * CHUNK + b] = T[t, 2, 0] * R6[0, 0] + T[t, 2, 1] * R6[0, 1] + T[t, 2, 2] * R6[0, 2]
-        S[RY2 * CHUNK + b] = T[t, 0, 0] * R6[2, 0] + T[t, 0, 1] * R6[2, 1] + T[t, 0, 2] * R6[2, 2]
-        S[(RY2 + 1) * CHUNK + b] = T[t, 1, 0] * R6[2, 0] + T[t, 1, 1] * R6[2, 1] + T[t, 1, 2] * R6[2, 2]
-        S[(RY2 + 2) * CHUNK + b] = T[t, 2, 0] * R6[2, 0] + T[t, 2, 1] * R6[2, 1] + T[t, 2, 2] * R6[2, 2]
+        S[RY0 * CHUNK + b] = t00 * R6[0, 0] + t01 * R6[0, 1] + t02 * R6[0, 2]
+        S[(RY0 + 1) * CHUNK + b] = t10 * R6[0, 0] + t11 * R6[0, 1] + t12 * R6[0, 2]
+        S[(RY0 + 2) * CHUNK + b] = t20 * R6[0, 0] + t21 * R6[0, 1] + t22 * R6[0, 2]
+        S[RY2 * CHUNK + b] = t00 * R6[2, 0] + t01 * R6[2, 1] + t02 * R6[2, 2]
+        S[(RY2 + 1) * CHUNK + b] = t10 * R6[2, 0] + t11 * R6[2, 1] + t12 * R6[2, 2]
+        S[(RY2 + 2) * CHUNK + b] = t20 * R6[2, 0] + t21 * R6[2, 1] + t22 * R6[2, 2]
         q1a, q1b, free1, ratio, c1a, s1a, c1b, s1b = shoulder_roots(w0, w1, w2, a, h, tiny, ratio_tol)
         bad = free1 | ((ratio == 0.0) & math.isnan(q1a)) | (abs(abs(ratio) - 1.0) < DOUBLE_ROOT) | (rho_w < 1e-12)
         S[RST * CHUNK + b] = 1.0 if bad else 0.0
