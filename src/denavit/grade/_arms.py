@@ -60,14 +60,18 @@ def _dof_named(title: str) -> int | None:
 _NO_VALUE = re.compile(r"parameter (\w{1,40}) has no value")
 
 
+def _generic_values(names) -> dict[str, float]:
+    """Distinct generic lengths for ``names``, in order."""
+    n = len(GENERIC_LENGTHS)
+    return {name: GENERIC_LENGTHS[k % n] * (1 + k // n) for k, name in enumerate(names)}
+
+
 def _generic(robot: DHRobot, data: dict, notes: tuple[str, ...], where: str) -> tuple[DHRobot, list[str]]:
     """The table's robot with every parameter that had no value set to a distinct generic length."""
     missing = [m.group(1) for n in notes for m in [_NO_VALUE.search(n)] if m]
     if not missing:
         return robot, []
-    params = dict(data["parameters"])
-    for k, name in enumerate(missing):
-        params[name] = GENERIC_LENGTHS[k % len(GENERIC_LENGTHS)] * (1 + k // len(GENERIC_LENGTHS))
+    params = {**data["parameters"], **_generic_values(missing)}
     return robot_from_dict({**data, "parameters": params}, where=where), missing
 
 
@@ -126,7 +130,7 @@ def with_equal_lengths(arm: Arm, names: list[str], where: str) -> Arm | None:
     params = {k: v for k, v in arm.data["parameters"].items() if k not in gone}
     data = {**arm.data, "joints": joints, "parameters": params}
     free = tuple(n for n in arm.free if n not in gone)
-    values = {n: GENERIC_LENGTHS[k % len(GENERIC_LENGTHS)] for k, n in enumerate(free)}
+    values = _generic_values(free)
     robot = robot_from_dict({**data, "parameters": {**params, **values}}, where=where)
     return Arm(robot, arm.info, arm.problem, arm.advice, data, free, arm.gravity_assumed)
 
