@@ -113,3 +113,13 @@ def test_the_checkers_manipulability_of_the_planar_two_link_arm():
     claims = [{"quantity": "manipulability", "rows": "vx,vy", "value": "L_1 L_2 |\\sin\\theta_2|"},
               {"quantity": "manipulability", "rows": "vx,vy", "value": "L_1 L_2 \\sin\\theta_2"}]
     assert [v.verdict for v in check_claims(robot, claims).verdicts] == ["correct", "incorrect"]
+
+
+def test_a_case_or_a_heading_after_the_target_ends_it():
+    """Joint values of a later case (forward kinematics at a configuration) are no IK answer."""
+    sols = _solutions()
+    after = [f"Case 2: {_values(sols[0])}.", f"## Forward kinematics\n\n{_values(sols[0])}"]
+    for tail in after:
+        text = _report(_values(sols[0])) + "\n" + tail + "\n"
+        judged = [c for c in grade_text(text).claims if c.quantity == "ik_solutions"]
+        assert len(judged) == 1 and judged[0].verdict == "correct"

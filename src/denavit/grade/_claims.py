@@ -112,7 +112,7 @@ class _Walker:
             it = items[k]
             if isinstance(it, Heading):
                 self.flush()
-                self.ctx.singular = bool(_SINGULAR.search(it.title))
+                self.ctx.singular, self.ctx.target = bool(_SINGULAR.search(it.title)), None
                 if it.level <= top:  # a new part: its givens are its own; names defined stay while the arm does
                     same = self.ctx_arm is not None and self.arm_at(it.line) is self.ctx_arm
                     self.ctx = Context(singular=self.ctx.singular, where=dict(self.ctx.where) if same else {})
@@ -137,7 +137,7 @@ class _Walker:
         case = _CASE.search(it.text)
         if case:
             number = re.sub(r"\D", "", case.group(0))
-            self.ctx.q, self.ctx.partial = self.ctx.cases.get(number), {}
+            self.ctx.q, self.ctx.partial, self.ctx.target = self.ctx.cases.get(number), {}, None
             self.ctx.case_number = number
             if robot is not None:
                 q = prose_case(plain, robot)
