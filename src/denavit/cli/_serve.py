@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import errno
-import socket
 import sys
-import threading
+from typing import TYPE_CHECKING
 
 from ..errors import ParseError
 from ._common import bounded_int, load
+
+if TYPE_CHECKING:
+    import socket
 
 #: Port used when --port is not given.
 DEFAULT_PORT = 8765
@@ -35,6 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _bind(host: str, port: int) -> socket.socket:
     """A listening socket, or one line saying why not (a port in use, an unknown address)."""
+    # imported here, not at the top: only serve opens a socket (socket is 8 ms of every command's start-up)
+    import errno
+    import socket
+
     try:
         infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
     except (socket.gaierror, UnicodeError) as exc:
@@ -75,6 +80,7 @@ def cmd_serve(args: argparse.Namespace):
     app = create_app(robot, allowed_hosts=hosts)
     print(f"denavit workbench at {url}  (Ctrl-C stops it)", flush=True)
     if args.open:
+        import threading
         import webbrowser
 
         threading.Timer(0.5, webbrowser.open, args=(url,)).start()
