@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .. import _expr
+from .._constants import TWIST_ROWS
 from ..codegen import numeric_function
 from ..errors import ParseError
 from ..model import DHRobot, Frame
@@ -36,7 +37,6 @@ from ._zero_sets import Arm, roots_along, scale_of, zero_set_points
 __all__ = ["check_singularities", "SINGULAR_RTOL", "MAX_ANALYSIS_CPU_SECONDS"]
 
 SINGULAR_RTOL = 1e-7
-TWIST_ROWS = ("vx", "vy", "vz", "wx", "wy", "wz")
 #: CPU seconds the library's symbolic singularity analysis may take for one set of rows of one arm (it runs in a
 #: child process with this CPU limit, :func:`._bounded.cpu_bounded`; the Panda's 6 rows take ~4 s, but some row
 #: subsets of 6- and 7-joint arms do not finish in minutes).  Past it, a claim is judged on its own conditions only (never "correct").

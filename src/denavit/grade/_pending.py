@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import itertools
 import re
-
 from dataclasses import dataclass, field
 from typing import Any
 
+from .._constants import TWIST_ROWS
 from ._arms import Arm
 from ._context import Context, has_joint_names, vector_entries
 from ._names import Reading
@@ -128,8 +128,7 @@ def det_pending(eq: Equation, arm: Arm, value: str, sym: Any) -> Pending:
     rows = det_rows(sym, arm.robot)
     p = Pending(eq.line, eq.end_line, eq.text, arm, claim, "det J, the Jacobian's determinant",
                 quantity="det_jacobian")
-    names = ("vx", "vy", "vz", "wx", "wy", "wz")
-    subsets = [",".join(c) for c in itertools.combinations(names, arm.robot.dof)] if arm.robot.dof <= 6 else []
+    subsets = [",".join(c) for c in itertools.combinations(TWIST_ROWS, arm.robot.dof)] if arm.robot.dof <= 6 else []
     p.equivalent = [({**claim, "rows": r}, f"det J of the rows {r}") for r in subsets]
     if rows:
         claim["rows"] = rows

@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from .._constants import TWIST_ROWS
 from ._context import Context, vector_entries
 from ._lhs import read_symbol
 from ._masses import moves_in_xy
@@ -29,7 +30,7 @@ def vector_reading(lhs: str, robot: Any) -> Reading | None:
         k = r.spec.get("entry") if r is not None and r.spec.get("quantity") == "twist" else None
         if not isinstance(k, int):
             return None
-        rows.append(("vx", "vy", "vz", "wx", "wy", "wz")[k - 1])
+        rows.append(TWIST_ROWS[k - 1])
     if len(set(rows)) != len(rows):
         return None
     return Reading({"quantity": "twist", "rows": ",".join(rows)}, f"the end-effector velocity rows {', '.join(rows)}",

@@ -16,6 +16,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import numeric as N
+from .._constants import TWIST_ROWS
 from ._context import Context
 from ._derivation import Equation, Figure, Numbers, Section, Table, Text
 from ._sections import latex
@@ -74,11 +75,10 @@ def section_singularities(ctx: Context) -> Section:
             steps.append(Text(f"The symbolic analysis ({sym[0]}) failed: {type(exc).__name__}: {exc}."))
         else:
             steps += _singular_result_steps(result)
-            names = ("vx", "vy", "vz", "wx", "wy", "wz")
-            rows = [names.index(r) for r in getattr(result, "rows", names) if r in names] or rows
+            rows = [TWIST_ROWS.index(r) for r in getattr(result, "rows", TWIST_ROWS) if r in TWIST_ROWS] or rows
     J = N.geometric_jacobian(robot, ctx.q)[rows, :]  # the task rows analysed (an arm of < 6 joints: its own)
     sv = np.linalg.svd(J, compute_uv=False)
-    which = "" if len(rows) == 6 else " (rows " + ", ".join(("vx", "vy", "vz", "wx", "wy", "wz")[i] for i in rows) + ")"
+    which = "" if len(rows) == 6 else " (rows " + ", ".join(TWIST_ROWS[i] for i in rows) + ")"
     steps.append(Numbers("\\sigma(J_0(q))", sv, note="singular values at the numeric case" + which))
     manip = capability("denavit.numeric", "manipulability")
     if manip is not None:
