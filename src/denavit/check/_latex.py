@@ -21,7 +21,7 @@ import re
 
 from .. import _expr
 from ..errors import ParseError
-from ._text import strip_equation_number, strip_rhs
+from ._text import after_last_equals, strip_equation_number
 from ._tokens import FUNCS, GREEK, MAX_DEPTH, MAX_TREE_DEPTH, WRAP_CMDS, Ident, Resolver, tokenize
 
 __all__ = ["parse_math", "tree_depth"]
@@ -368,7 +368,7 @@ def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
         text = str(text)
     text = strip_equation_number(text).strip()
     if rhs:
-        text = strip_rhs(text)
+        text = after_last_equals(text)
     if not text.strip():
         raise ParseError("empty expression")
     p = _Parser(text, resolve)

@@ -9,7 +9,7 @@ import re
 
 from ..errors import ParseError
 from ._latex import parse_math
-from ._text import strip_equation_number
+from ._text import after_last_equals, strip_equation_number
 from ._tokens import MAX_CHARS, Resolver, normalize
 
 __all__ = ["RaggedMatrix", "split_matrix", "after_last_equals", "split_list", "encloses", "parse_matrix"]
@@ -40,29 +40,6 @@ def split_matrix(text: str) -> list[list[str]] | None:
     body = text[m.end():end]
     rows = [r for r in re.split(r"\\\\(?:\[[^\]]*\])?", body) if r.strip() and not r.strip().startswith("\\hline")]
     return [[c.strip() for c in r.split("&")] for r in rows]
-
-
-_ENV = re.compile(r"\\(begin|end)\{(?:[bBpvV]?matrix|array|smallmatrix)\*?\}")  # not split/aligned: an = there counts
-
-
-def after_last_equals(text: str) -> str:
-    """What follows the last ``=`` outside brackets and matrix environments (``J = [\\begin…] = \\begin…``)."""
-    level, cut, k = 0, -1, 0
-    while k < len(text):
-        m = _ENV.match(text, k)
-        if m:
-            level += 1 if m.group(1) == "begin" else -1
-            k = m.end()
-            continue
-        ch = text[k]
-        if ch in "({[":
-            level += 1
-        elif ch in ")}]":
-            level -= 1
-        elif ch == "=" and level == 0:
-            cut = k
-        k += 1
-    return text[cut + 1:] if cut >= 0 else text
 
 
 def split_list(text: str) -> list[list[str]] | None:

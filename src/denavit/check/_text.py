@@ -11,7 +11,7 @@ import re
 
 from ..errors import ParseError
 
-__all__ = ["split_top", "split_relation", "expand_pm", "strip_rhs", "strip_equation_number", "MAX_SIGN_COMBOS"]
+__all__ = ["split_top", "split_relation", "expand_pm", "after_last_equals", "strip_equation_number", "MAX_SIGN_COMBOS"]
 
 MAX_SIGN_COMBOS = 64
 _OPENERS, _CLOSERS = "({[", ")}]"
@@ -82,17 +82,26 @@ def expand_pm(texts: list[str]) -> list[list[str]]:
     return versions
 
 
-def strip_rhs(text: str) -> str:
-    """``T = [...]`` → ``[...]``: keep what follows the last top-level ``=``."""
-    level = 0
-    cut = -1
-    for k, ch in enumerate(text):
+_ENV = re.compile(r"\\(begin|end)\{(?:[bBpvV]?matrix|array|smallmatrix)\*?\}")  # not split/aligned: an = there counts
+
+
+def after_last_equals(text: str) -> str:
+    """What follows the last ``=`` outside brackets and matrix environments (``J = [\\begin…] = \\begin…``)."""
+    level, cut, k = 0, -1, 0
+    while k < len(text):
+        m = _ENV.match(text, k)
+        if m:
+            level += 1 if m.group(1) == "begin" else -1
+            k = m.end()
+            continue
+        ch = text[k]
         if ch in "({[":
             level += 1
         elif ch in ")}]":
             level -= 1
         elif ch == "=" and level == 0:
             cut = k
+        k += 1
     return text[cut + 1:] if cut >= 0 else text
 
 
