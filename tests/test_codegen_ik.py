@@ -338,9 +338,9 @@ def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
                handed_over=0.6)
 
 
-def _random_stanford_class(seed: int) -> DHRobot:
-    """A random R R P arm with axes 1, 2 meeting and a spherical wrist (either convention): random offsets, twists
-    (half of the wrists with equal outer twists, so that axes 4 and 6 can align), limits, base and tool."""
+def random_wrist_draws(seed: int):
+    """The first draws of a random arm with a spherical wrist: (rng, convention, twist(), length(), t4, t5) —
+    half of the wrists with equal outer twists, so that axes 4 and 6 can align."""
     rng = np.random.default_rng(seed)
     conv = Convention.MODIFIED if rng.random() < 0.5 else Convention.STANDARD
 
@@ -352,6 +352,29 @@ def _random_stanford_class(seed: int) -> DHRobot:
 
     t4 = twist()
     t5 = -t4 if rng.random() < 0.5 else twist()
+    return rng, conv, twist, length, t4, t5
+
+
+def random_revolute(rng, a: float, alpha: float, d: float) -> DHLink:
+    """A revolute row with a random joint offset and random limits (a full turn and more, or the whole circle)."""
+    lo = float(rng.choice([-2 * np.pi, rng.uniform(-np.pi, 0.0)]))
+    return DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)),
+                  q_limits=(lo, lo + float(rng.uniform(np.pi, 4 * np.pi))))
+
+
+def random_base_tool(rng) -> tuple[np.ndarray, np.ndarray]:
+    """Identity base and tool, or (seven times in ten) random ones."""
+    base, tool = np.eye(4), np.eye(4)
+    if rng.random() < 0.7:
+        base = transform_from_xyz_rpy(rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3))
+        tool = transform_from_xyz_rpy(rng.uniform(-0.3, 0.3, 3), rng.uniform(-np.pi, np.pi, 3))
+    return base, tool
+
+
+def _random_stanford_class(seed: int) -> DHRobot:
+    """A random R R P arm with axes 1, 2 meeting and a spherical wrist (either convention): random offsets, twists
+    (half of the wrists with equal outer twists, so that axes 4 and 6 can align), limits, base and tool."""
+    rng, conv, twist, length, t4, t5 = random_wrist_draws(seed)
     if conv is Convention.STANDARD:  # (a, alpha, d) of z_{i-1} -> z_i; axes 1, 2 = z0, z1; wrist z3, z4, z5 at o4
         rows = [(0.0, twist(), length()), (length(), twist(), length()), (length(), twist(), 0.0),
                 (0.0, t4, length()), (0.0, t5, 0.0), (length(), twist(), length())]
@@ -365,13 +388,8 @@ def _random_stanford_class(seed: int) -> DHRobot:
             links.append(DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)), joint="prismatic",
                                 q_limits=(lo, lo + float(rng.uniform(0.3, 1.5)))))
             continue
-        lo = float(rng.choice([-2 * np.pi, rng.uniform(-np.pi, 0.0)]))
-        links.append(DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)),
-                            q_limits=(lo, lo + float(rng.uniform(np.pi, 4 * np.pi)))))
-    base, tool = np.eye(4), np.eye(4)
-    if rng.random() < 0.7:
-        base = transform_from_xyz_rpy(rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3))
-        tool = transform_from_xyz_rpy(rng.uniform(-0.3, 0.3, 3), rng.uniform(-np.pi, np.pi, 3))
+        links.append(random_revolute(rng, a, alpha, d))
+    base, tool = random_base_tool(rng)
     return DHRobot(name="random-stanford", links=tuple(links), convention=conv, base=base, tool=tool)
 
 

@@ -17,12 +17,12 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 import denavit
-from denavit import Convention, DHLink, DHRobot
-from denavit.numeric import transform_from_xyz_rpy
+from denavit import Convention, DHRobot
 
 pytest.importorskip("numba")
 
-from test_codegen_ik import N_POSES, _axes, _check_arm, _meet, _same_batch, _shoulder, _wrist_coplanar  # noqa: E402
+from test_codegen_ik import (N_POSES, _axes, _check_arm, _meet, _same_batch, _shoulder,  # noqa: E402
+                             _wrist_coplanar, random_base_tool, random_revolute, random_wrist_draws)
 from test_codegen_ik import _kernel_cache  # noqa: E402, F401  (the module's kernel folder, a fixture)
 
 from denavit.ik import ik_plan  # noqa: E402
@@ -32,32 +32,15 @@ def _random_elbow_class(seed: int) -> DHRobot:
     """A random 6R arm with axes 2 ∥ 3 and a spherical wrist (either convention): random lengths, offsets along the
     axes, twists of the other axes (half of the wrists with equal outer twists, so that axes 4 and 6 can align),
     joint offsets, limits, base and tool."""
-    rng = np.random.default_rng(seed)
-    conv = Convention.MODIFIED if rng.random() < 0.5 else Convention.STANDARD
-
-    def twist():
-        return float(rng.choice([-1.0, 1.0]) * rng.uniform(0.3, np.pi - 0.3))
-
-    def length():
-        return float(rng.choice([0.0, rng.uniform(-0.6, 0.6)]))
-
-    t4 = twist()
-    t5 = -t4 if rng.random() < 0.5 else twist()
+    rng, conv, twist, length, t4, t5 = random_wrist_draws(seed)
     if conv is Convention.STANDARD:  # (a, alpha, d) of z_{i-1} -> z_i; axes 2, 3 = z1, z2; wrist z3, z4, z5 at o4
         rows = [(length(), twist(), length()), (rng.uniform(0.2, 0.8), 0.0, length()), (length(), twist(), length()),
                 (0.0, t4, length()), (0.0, t5, 0.0), (length(), twist(), length())]
     else:  # (a_{i-1}, alpha_{i-1}, d_i); axes 2, 3 = z2, z3; wrist z4, z5, z6 at o4 = o5
         rows = [(length(), twist(), length()), (length(), twist(), length()), (rng.uniform(0.2, 0.8), 0.0, length()),
                 (length(), twist(), length()), (0.0, t4, 0.0), (0.0, t5, length())]
-    links = []
-    for a, alpha, d in rows:
-        lo = float(rng.choice([-2 * np.pi, rng.uniform(-np.pi, 0.0)]))
-        links.append(DHLink(a=a, alpha=alpha, d=d, theta=float(rng.uniform(-np.pi, np.pi)),
-                            q_limits=(lo, lo + float(rng.uniform(np.pi, 4 * np.pi)))))
-    base, tool = np.eye(4), np.eye(4)
-    if rng.random() < 0.7:
-        base = transform_from_xyz_rpy(rng.uniform(-1, 1, 3), rng.uniform(-np.pi, np.pi, 3))
-        tool = transform_from_xyz_rpy(rng.uniform(-0.3, 0.3, 3), rng.uniform(-np.pi, np.pi, 3))
+    links = [random_revolute(rng, a, alpha, d) for a, alpha, d in rows]
+    base, tool = random_base_tool(rng)
     return DHRobot(name="random-elbow", links=tuple(links), convention=conv, base=base, tool=tool)
 
 
