@@ -376,3 +376,34 @@ def test_torque_numbers_without_a_stated_wrench_are_a_question_not_wrong():
             "$$\\tau = J^T F = \\begin{bmatrix} -8.66 \\\\ 0 \\end{bmatrix}$$\n")
     (c,) = [c for c in grade_text(text).claims if c.quantity == "torques"]
     assert c.verdict == "ambiguous" and "no wrench" in c.message
+
+
+def _planar2r_tip_sympy():
+    """T_2^0 of the planar 2R arm as SymPy writes it (``\\left[\\begin{matrix} … \\end{matrix}\\right]``): the
+    product of Spong's A_i, Rot_z(θ_i) Trans_x(L_i), multiplied out here."""
+    import sympy as sp
+
+    t1, t2, l1, l2 = sp.symbols("theta_1 theta_2 L_1 L_2")
+
+    def a(t, length):
+        return sp.Matrix([[sp.cos(t), -sp.sin(t), 0, length * sp.cos(t)], [sp.sin(t), sp.cos(t), 0, length * sp.sin(t)],
+                          [0, 0, 1, 0], [0, 0, 0, 1]])
+    return sp.Matrix(sp.simplify(a(t1, l1) * a(t2, l2))), sp
+
+
+@pytest.mark.parametrize("form", ["matrix", "array"])
+def test_sympy_and_array_matrices_are_read_as_bmatrix(form):
+    """Jupyter/SymPy reports write ``\\left[\\begin{matrix} … \\end{matrix}\\right]``, hand-written LaTeX
+    ``\\left[\\begin{array}{cccc} … \\end{array}\\right]``: both are the matrix, judged (a slip still caught)."""
+    T, sp = _planar2r_tip_sympy()
+    slipped = sp.Matrix(T)
+    slipped[0, 3] = -slipped[0, 3]
+    texts = []
+    for M in (T, slipped):
+        tex = sp.latex(M)
+        if form == "array":
+            tex = tex.replace("\\begin{matrix}", "\\begin{array}{cccc}").replace("\\end{matrix}", "\\end{array}")
+        assert tex.startswith("\\left[\\begin{")
+        texts.append(f"$$T_2^0 = {tex}$$")
+    got = [v for _, q, v in _verdicts(_report(*texts), fmt="md") if q == "end_effector"]
+    assert got == ["correct", "incorrect"]

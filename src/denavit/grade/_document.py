@@ -12,8 +12,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "joined_display", "MAX_BLOCK_LINES",
-           "MAX_ITEMS"]
+__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "delimited_matrices",
+           "joined_display", "MAX_BLOCK_LINES", "MAX_ITEMS"]
 
 #: Longest display block (lines); a block left open longer than this is closed there.
 MAX_BLOCK_LINES = 400
@@ -94,6 +94,26 @@ _POINT = re.compile(r"\b([xyzp])([cw])\b")
 def plain_names(text: str) -> str:
     """Plain-text names written without underscores: ``xc`` → ``x_c`` (the wrist centre's coordinates)."""
     return _POINT.sub(r"\1_\2", text)
+
+
+_DELIMITED = {"[": "bmatrix", "(": "pmatrix", "|": "vmatrix"}
+_DELIMITED_MATRIX = re.compile(  # \left[\begin{matrix} … \end{matrix}\right] holding no other matrix
+    r"\\left\s*(\[|\(|\|)\s*\\begin\{(matrix|array)\}(?:\{[lcr|\s]{0,60}\})?"
+    r"((?:(?!\\begin\{(?:matrix|array)\}|\\end\{(?:matrix|array)\}).){0,20000}?)"
+    r"\\end\{\2\}\s*\\right\s*[\])|]", re.DOTALL)
+
+
+def delimited_matrices(text: str) -> str:
+    """``\\left[\\begin{matrix} … \\end{matrix}\\right]`` (SymPy's ``latex()``, Jupyter) and ``\\left[\\begin{array}{ccc}
+    … \\end{array}\\right]`` written as the ``bmatrix`` they mean (``(`` → ``pmatrix``, ``|`` → ``vmatrix``), innermost
+    first."""
+    for _ in range(64):  # nested matrices: one level a pass (bounded)
+        new = _DELIMITED_MATRIX.sub(lambda m: (f"\\begin{{{_DELIMITED[m.group(1)]}}}{m.group(3)}"
+                                               f"\\end{{{_DELIMITED[m.group(1)]}}}"), text)
+        if new == text:
+            return text
+        text = new
+    return text
 
 
 def _plain_equation(line: str) -> bool:
@@ -195,7 +215,7 @@ class _Scanner:
                 end = e + len(closer)
                 body = line[start:e] if not opener.startswith("\\begin") else line[p:end]
                 display = opener != "$"
-                self.items.append(Math(n + 1, n + 1, body, display))
+                self.items.append(Math(n + 1, n + 1, delimited_matrices(body), display))
                 if not display:
                     prose.append("$" + body + "$")
                 k = end
@@ -220,7 +240,7 @@ class _Scanner:
             e = self.lines[m].find(closer)
             if e >= 0:
                 parts.append(self.lines[m][:e + len(closer)] if env else self.lines[m][:e])
-                self.items.append(Math(n + 1, m + 1, "\n".join(parts), True))
+                self.items.append(Math(n + 1, m + 1, delimited_matrices("\n".join(parts)), True))
                 rest = self.lines[m][e + len(closer):]
                 if rest.strip():
                     self.items.append(Prose(m + 1, rest.strip()))
