@@ -1,9 +1,9 @@
 """The arm(s) of a report: its own DH tables (read as ``import-table`` reads them), or arms given by the user.
 
 Each table governs the report from its own section on, until the next table.  A section whose heading names a
-different number of joints ("Equation of Motion for 3DOF Manipulator" after a 6-joint table) gets no arm unless
-one is given for it (``--arm 6=planar3r-lagrange``): judging it against the wrong arm would call right results
-wrong.  Lengths a table names without a value (``a_2``, ``d_4``) stay symbols for formulas; for numeric work they
+different number of joints ("Equation of Motion for 3DOF Manipulator" after a 6-joint table) gets no arm here
+(judging it against the wrong arm would call right results wrong): one is given for it (``--arm
+6=planar3r-lagrange``) or recognised from its own results (:func:`._infer.infer_sections`).  Lengths a table names without a value (``a_2``, ``d_4``) stay symbols for formulas; for numeric work they
 get distinct generic values (never 1, so that no two lengths coincide by accident).
 """
 
@@ -46,6 +46,7 @@ class Arm:
     data: dict | None = None  # the table as read (a robot file's dict), to rebuild the arm with lengths equated
     free: tuple[str, ...] = ()  # its lengths without a value (generic numbers stand in for them)
     gravity_assumed: bool = False  # masses read from the report's symbols: gravity along −y is our assumption
+    wants_dof: int = 0  # no arm: the section's heading names an arm of this many joints (one may be recognised)
 
 
 def _dof_named(title: str) -> int | None:
@@ -152,12 +153,14 @@ def _check_given(heads: list[Heading], given: dict[str, DHRobot]) -> None:
                              "heading's number)")
 
 
-def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, DHRobot]) -> list[tuple[Section, Arm | None]]:
+def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, DHRobot],
+            recognised: frozenset[str] = frozenset()) -> list[tuple[Section, Arm | None]]:
     """Spans of the report and the arm that governs each (None: no arm); the first span holding a line decides.
 
     Each table governs from the heading just before it (the first table from the top of the report) to the span of
-    the next table; a section given with ``--arm`` takes that arm; a section whose heading names another number
-    of joints and holds no table of its own gets none.
+    the next table; a section given with ``--arm`` takes that arm (``recognised``: the keys whose arm was not
+    given but recognised from the section's results); a section whose heading names another number of joints
+    and holds no table of its own gets none.
     """
     n = len(doc.lines)
     heads = [h for h in doc.items if isinstance(h, Heading)]
@@ -180,9 +183,10 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
         end = _extent(h, heads, n)
         if h.key in given:
             g = given[h.key]
-            spans.append((Section(h, h.line, end), Arm(g, ArmInfo(g.name, h.title, h.line, end,
-                                                                    f"--arm {h.key}={g.name}", g.convention.value,
-                                                                    g.dof))))
+            how = (f"catalogue arm its results fit (--arm {h.key}=ROBOT overrides)" if h.key in recognised
+                   else f"--arm {h.key}={g.name}")
+            spans.append((Section(h, h.line, end), Arm(g, ArmInfo(g.name, h.title, h.line, end, how,
+                                                                    g.convention.value, g.dof))))
             continue
         current = next((arm for start, arm in reversed(base) if start <= h.line), None)
         named = _dof_named(h.title)
@@ -192,7 +196,8 @@ def arms_of(doc: Document, source: str, robot: DHRobot | None, given: dict[str, 
             spans.append((Section(h, h.line, end), Arm(None, ArmInfo("", h.title, h.line, end, "none", "", 0),
                           f"the section at line {h.line} is about a {named}-joint arm and has no DH table of its own "
                           f"(give one: --arm {h.key or 'SECTION'}=ROBOT)",
-                          _catalogue_advice(doc.lines[h.line - 1:end], named, h.key or "SECTION", h.line))))
+                          _catalogue_advice(doc.lines[h.line - 1:end], named, h.key or "SECTION", h.line),
+                          wants_dof=named)))
     spans.sort(key=lambda s: s[0].end_line - s[0].line)  # the most specific section decides
     for k, (start, arm) in enumerate(base):
         stop = base[k + 1][0] - 1 if k + 1 < len(base) else n

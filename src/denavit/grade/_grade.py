@@ -19,7 +19,7 @@ from ..errors import DenavitError, ParseError
 from ..model import DHRobot
 from ..tables import find_tables
 from ._arms import arms_of, compare_tables
-from ._infer import infer_arms
+from ._infer import infer_arms, infer_sections
 from ._claims import Pending, walk
 from ._document import read_document
 from ._types import ArmInfo, GradedClaim, GradedReport
@@ -141,11 +141,20 @@ def grade_text(text: str, fmt: str = "md", *, robot: DHRobot | None = None,
     """Grade the report ``text`` (see :func:`grade_report`)."""
     doc = read_document(text, fmt)
     given = dict(arms or {})
+    inferred: dict[str, DHRobot] = {}
     inferred_notes: list[str] = []
     if robot is None and not find_tables(list(doc.lines)):
         inferred, inferred_notes = infer_arms(doc, source, seed, tuple(given))
         given = {**inferred, **given}
-    governed = arms_of(doc, source, robot, given)
+    governed = arms_of(doc, source, robot, given, frozenset(inferred))
+    wanted = [(s.heading.key, s.line, s.end_line, a.wants_dof) for s, a in governed
+              if a is not None and a.robot is None and a.wants_dof and s.heading is not None and s.heading.key]
+    if wanted:  # sections about another arm, without a table of their own: an arm their results fit
+        more, more_notes = infer_sections(doc, source, wanted, seed)
+        if more:
+            inferred, inferred_notes = {**inferred, **more}, inferred_notes + more_notes
+            given = {**more, **given}
+            governed = arms_of(doc, source, robot, given, frozenset(inferred))
     pending, read_notes = walk(doc, governed)
     notes = list(doc.notes) + inferred_notes + read_notes
     if len(pending) > MAX_JUDGED:
