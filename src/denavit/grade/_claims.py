@@ -20,8 +20,10 @@ from ._lhs import read_symbol
 from ._masses import moves_in_xy
 from ._names import joint_of, read_name
 from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
-                       plain_name, renumber, trailing_name, used_where, vector_reading)
-from ._pending import MANIPULABILITY, Pending, build_claim, det_pending, manipulability_pending
+                       plain_name, renumber, trailing_name, vector_reading)
+from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_formula_pending,
+                       manipulability_pending)
+from ._points import names_wrist_centre
 from ._split import Equation, split_block
 from ._target import is_target_part, prose_target, solution_claim
 from ._values import wrench_symbols
@@ -115,7 +117,8 @@ class _Walker:
                 self.ctx.singular, self.ctx.target = bool(_SINGULAR.search(it.title)), None
                 if it.level <= top:  # a new part: its givens are its own; names defined stay while the arm does
                     same = self.ctx_arm is not None and self.arm_at(it.line) is self.ctx_arm
-                    self.ctx = Context(singular=self.ctx.singular, where=dict(self.ctx.where) if same else {})
+                    self.ctx = Context(singular=self.ctx.singular, where=dict(self.ctx.where) if same else {},
+                                       p_wrist=self.ctx.p_wrist and same)
                 elif _CASE.search(it.title):
                     self.ctx.q = None
             elif isinstance(it, Prose):
@@ -333,12 +336,7 @@ class _Walker:
         if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
             heading = re.search(r"\\(?:var)?phi\b", value) and moves_in_xy(robot)  # θ₃ = φ − θ₁ − θ₂ (planar)
             if (_IK_FUNCS.search(value) or heading) and len(eq.parts) == 2:
-                claim = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
-                used = used_where(self.ctx.where, value)
-                if used:
-                    claim["where"] = used
-                self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, claim,
-                                        f"{lhs}: an inverse-kinematics formula", quantity="ik_formula"))
+                self.out.append(ik_formula_pending(self.ctx, eq, arm, lhs, value))
             else:
                 self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
                           "the joint in terms of the target")
@@ -385,6 +383,7 @@ class _Walker:
             return
         self.out.append(build_claim(self.ctx, eq, arm, reading, value))
         define_term(self.ctx, lhs, value, reading.spec["quantity"])
+        self.ctx.p_wrist = self.ctx.p_wrist or names_wrist_centre(eq.parts, reading.spec, robot)
         if value is not eq.parts[-1] and also is None and "\\begin" in value and "\\begin" not in eq.parts[-1]:
             self.out[-1].understood += f" (the matrix before '= {eq.parts[-1].strip()[:40]}')"
         if also is not None:

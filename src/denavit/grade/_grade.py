@@ -23,6 +23,7 @@ from ._infer import infer_arms, infer_sections
 from ._claims import Pending, walk
 from ._document import read_document
 from ._types import ArmInfo, GradedClaim, GradedReport
+from ._values import missing_plus
 
 __all__ = ["grade_report", "grade_text", "REPORT_SUFFIXES", "MAX_JUDGED"]
 
@@ -108,7 +109,20 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
     if p.numeric_without_case and not _constant(robot, p.claim):
         return "ambiguous", ("numbers, but no configuration (Case …: q = (…)) stated before them; at random "
                              f"configurations: {v.message}"), "", details
-    return "incorrect", v.message, str(v.extra.get("expected_latex") or ""), details
+    slip = _missing_plus(p, seed)
+    message = v.message + (f"; with a '+' {slip} it is correct (a '+' left out?)" if slip else "")
+    return "incorrect", message, str(v.extra.get("expected_latex") or ""), details
+
+
+def _missing_plus(p: Pending, seed: int) -> str | None:
+    """Where a '+' put between two squares makes an incorrect claim right (:func:`._values.missing_plus`)."""
+    value = p.claim.get("value")
+    if not isinstance(value, str):
+        return None
+    for variant, where in missing_plus(value):
+        if _judge(p.arm.robot, {**p.claim, "value": variant}, seed).verdict == "correct":
+            return where
+    return None
 
 
 _GRAVITY_WAYS = (("−x", (-9.81, 0.0, 0.0)), ("+x", (9.81, 0.0, 0.0)), ("+y", (0.0, 9.81, 0.0)),

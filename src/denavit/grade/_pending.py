@@ -18,7 +18,7 @@ from ._reading import det_rows, used_where
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
-__all__ = ["Pending", "build_claim", "det_pending", "manipulability_pending", "MANIPULABILITY"]
+__all__ = ["Pending", "build_claim", "det_pending", "ik_formula_pending", "manipulability_pending", "MANIPULABILITY"]
 
 
 @dataclass
@@ -118,6 +118,19 @@ def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric
             first, second = ctx.wrench_frame, ("tool" if ctx.wrench_frame == "base" else "base")
         claim["frame"] = first
         p.alternatives.append(({**claim, "frame": second}, f"τ for the wrench in {second} axes"))
+
+
+def ik_formula_pending(ctx: Context, eq: Equation, arm: Arm, lhs: str, value: str) -> Pending:
+    """``q_1 = atan2(p_y, p_x)``: an inverse-kinematics formula, with the names the derivation defined that it uses
+    and the wrist centre as P when the report named it so (:func:`._points.names_wrist_centre`)."""
+    claim: dict[str, Any] = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
+    used = used_where(ctx.where, value)
+    if used:
+        claim["where"] = used
+    if ctx.p_wrist:
+        claim["point"] = "wrist"
+    return Pending(eq.line, eq.end_line, eq.text, arm, claim, f"{lhs}: an inverse-kinematics formula",
+                   quantity="ik_formula")
 
 
 def det_pending(eq: Equation, arm: Arm, value: str, sym: Any) -> Pending:

@@ -13,7 +13,8 @@ import re
 from ._context import is_numeric, vector_entries
 from ._split import top_level_split
 
-__all__ = ["matrices", "scale_matrix", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES"]
+__all__ = ["matrices", "scale_matrix", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES",
+           "missing_plus"]
 
 _MAT = re.compile(r"\\begin\{([bBpv]?matrix)\}")
 #: The wrench's symbols, in the order (f, n), as the checker names them.
@@ -94,3 +95,32 @@ def scale_matrix(value: str) -> str | None:
     factor = factor.strip()
     rows = [" & ".join(f"({factor})({c})" for c in r) for r in _cells(mats[0])]
     return "\\begin{bmatrix} " + " \\\\ ".join(rows) + " \\end{bmatrix}"
+
+
+#: A square written right before a bracket: ``P_y^2 (P_z - d_1)^2``, where a sum of squares lost its '+'.
+_SQUARE_THEN_BRACKET = re.compile(r"\^\s*\{?\s*2\s*\}?(?=\s*(?:\\left\s*)?[(\[])")
+
+
+def missing_plus(text: str, most: int = 4) -> list[tuple[str, str]]:
+    """``text`` with a '+' put between a square and a bracketed square after it, one place at a time (at most
+    ``most``), each with where it was put: the slip of a sum of squares, ``P_x^2 + P_y^2 (P_z - d_1)^2``
+    for ``P_x^2 + P_y^2 + (P_z - d_1)^2``.  Only where the bracket is itself squared."""
+    out = []
+    for m in _SQUARE_THEN_BRACKET.finditer(text):
+        rest = re.sub(r"^\s*(?:\\left\s*)?", "", text[m.end():])
+        depth, k = 0, 0
+        for k, ch in enumerate(rest):
+            depth += ch in "([{"
+            depth -= ch in ")]}"
+            if depth == 0:
+                break
+        if depth != 0 or not re.match(r"\s*(?:\\right\s*[)\]]\s*)?\^\s*\{?\s*2", rest[k + 1:]):
+            continue
+        head = text[:m.end()].rstrip()
+        left = re.search(r"[A-Za-z0-9_{}\\]{0,24}\^\s*\{?\s*2\s*\}?$", head)
+        tail = text[m.end():].lstrip()
+        right = tail[:len(tail) - len(rest) + k + 1]
+        out.append((head + " + " + tail, f"between {left.group(0) if left else head[-12:]} and {right}^2"))
+        if len(out) >= most:
+            break
+    return out
