@@ -22,7 +22,7 @@ from ._names import joint_of, read_name
 from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
                        plain_name, renumber, trailing_name, vector_reading)
 from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_formula_pending,
-                       manipulability_pending)
+                       manipulability_pending, singular_pending)
 from ._points import names_wrist_centre
 from ._split import Equation, split_block
 from ._target import is_target_part, prose_target, solution_claim
@@ -302,16 +302,8 @@ class _Walker:
 
     def flush(self) -> None:
         """The singular conditions collected so far, as one claim."""
-        if not self.sing:
-            return
-        eqs = [e for e, _ in self.sing]
-        claim = {"quantity": "singularities", "value": [c for _, c in self.sing]}
-        first = Equation(eqs[0].line, max(e.end_line for e in eqs), "; ".join(c for _, c in self.sing), (), "=")
-        p = Pending(first.line, first.end_line, first.text, self.sing_arm, claim,
-                    "the singular configurations", quantity="singularities")
-        p.equivalent = [({**claim, "rows": r}, f"the singular configurations of the rows {r}")
-                        for r in ("vx,vy,vz", "vx,vy,wz", "vx,vy", "wx,wy,wz")]
-        self.out.append(p)
+        if self.sing:
+            self.out.append(singular_pending(self.sing, self.sing_arm))
         self.sing, self.sing_arm = [], None
 
     def result(self, eq: Equation, arm: Arm) -> None:

@@ -18,7 +18,8 @@ from ._reading import det_rows, used_where
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
-__all__ = ["Pending", "build_claim", "det_pending", "ik_formula_pending", "manipulability_pending", "MANIPULABILITY"]
+__all__ = ["Pending", "build_claim", "det_pending", "ik_formula_pending", "manipulability_pending", "singular_pending",
+           "MANIPULABILITY"]
 
 
 @dataclass
@@ -166,4 +167,17 @@ def manipulability_pending(eq: Equation, arm: Arm, value: str, written: str) -> 
     blocks = ("vx,vy,vz", "vx,vy,wz", "vx,vy", "wx,wy,wz", "vx,vy,vz,wx,wy,wz")
     p.equivalent = [({**claim, "rows": r}, f"w of the rows {r}") for r in blocks
                     if r != rows and r.count(",") + 1 >= arm.robot.dof]
+    return p
+
+
+def singular_pending(sing: list[tuple[Equation, str]], arm: Arm | None) -> Pending:
+    """The singular conditions collected in a row (each equation and its condition), as one claim (moved from the
+    walker's ``flush``, code unchanged)."""
+    eqs = [e for e, _ in sing]
+    claim = {"quantity": "singularities", "value": [c for _, c in sing]}
+    first = Equation(eqs[0].line, max(e.end_line for e in eqs), "; ".join(c for _, c in sing), (), "=")
+    p = Pending(first.line, first.end_line, first.text, arm, claim,
+                "the singular configurations", quantity="singularities")
+    p.equivalent = [({**claim, "rows": r}, f"the singular configurations of the rows {r}")
+                    for r in ("vx,vy,vz", "vx,vy,wz", "vx,vy", "wx,wy,wz")]
     return p
