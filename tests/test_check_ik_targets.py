@@ -51,18 +51,44 @@ def test_a_genuine_target_is_still_judged():
 
 def test_a_target_written_with_few_decimals_is_checked_for_completeness(tmp_path):
     """A pose rounded to 3 decimals is still a pose: an empty (or partial) solution list is judged against every
-    closed-form solution of the pose it rounds, not called correct because analytic_ik refused the rounded matrix."""
+    closed-form solution of the pose it rounds, not called correct because analytic_ik refused the rounded matrix;
+    the one solution within the limits of another pose, written to 3 decimals, is all of them (correct: its
+    rounding and the target's are allowed for, each solution standing for the nearest one only)."""
     import numpy as np
 
     import denavit
     from denavit.check import check_claims
 
     robot = denavit.load_robot("puma560")
-    T = np.round(denavit.forward_kinematics(robot, np.array([0.3, -0.4, 0.2, 0.5, 0.6, -0.7])), 3)
-    target = [[float(x) for x in row] for row in T]
-    empty = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": []}]).verdicts[0]
-    assert empty.verdict == "incorrect" and "missing" in empty.message
-    sols = denavit.analytic_ik(robot, denavit.forward_kinematics(robot, np.array([0.3, -0.4, 0.2, 0.5, 0.6, -0.7])))
-    one = [[round(float(x), 3) for x in sols.solutions[0]]]
-    partial = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": one}]).verdicts[0]
-    assert partial.verdict == "incorrect" and "missing" in partial.message
+    for q, count in (([0.1, 1.0, -0.6, 0.3, 0.8, 0.2], 6), ([0.3, -0.4, 0.2, 0.5, 0.6, -0.7], 1)):
+        exact = denavit.forward_kinematics(robot, np.array(q))
+        target = [[float(x) for x in row] for row in np.round(exact, 3)]
+        sols = np.asarray(denavit.analytic_ik(robot, exact).solutions).reshape(-1, 6)
+        assert len(sols) == count and all(np.allclose(denavit.forward_kinematics(robot, s), exact) for s in sols)
+        empty = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": []}]).verdicts[0]
+        assert empty.verdict == "incorrect" and "missing" in empty.message
+        one = [[round(float(x), 3) for x in sols[0]]]
+        partial = check_claims(robot, [{"quantity": "ik_solutions", "T": target, "value": one}]).verdicts[0]
+        if count > 1:
+            assert partial.verdict == "incorrect" and partial.message.count("missing") == count - 1, partial.message
+        else:
+            assert partial.verdict == "correct", partial.message
+
+
+def test_a_right_solution_of_a_target_written_rounded_is_correct():
+    """A target written with 3 decimals (a textbook's or a student's): the exact joint values of the pose it rounds
+    reach it to its decimals (correct), a joint 0.0123 rad off does not (incorrect); the full solution list of the
+    exact pose, each verified by FK here, is complete for the rounded target."""
+    robot = dn.load_robot("puma560")
+    q = np.array([0.1, 1.0, -0.6, 0.3, 0.8, 0.2])
+    exact = dn.forward_kinematics(robot, q)
+    target = np.round(exact, 3).tolist()
+    one = {"quantity": "ik_solutions", "T": target, "complete": False}
+    assert check_claims(robot, [{**one, "value": [q.tolist()]}]).verdicts[0].verdict == "correct"
+    off = q + np.array([0.0123, 0, 0, 0, 0, 0])  # written with 4 decimals: reaches to about 1e-4 rad
+    assert check_claims(robot, [{**one, "value": [off.tolist()]}]).verdicts[0].verdict == "incorrect"
+    sols = np.asarray(dn.analytic_ik(robot, exact).solutions).reshape(-1, 6)
+    assert len(sols) >= 2 and all(np.allclose(dn.forward_kinematics(robot, s), exact, atol=1e-9) for s in sols)
+    full = {"quantity": "ik_solutions", "T": target, "value": [[round(float(x), 4) for x in s] for s in sols]}
+    v = check_claims(robot, [full]).verdicts[0]
+    assert v.verdict == "correct", v.message

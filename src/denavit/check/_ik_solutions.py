@@ -69,15 +69,48 @@ def _nearest_pose(T: np.ndarray) -> np.ndarray:
     return out
 
 
+def _target_slack(cells) -> np.ndarray:
+    """How far FK of a right answer may be from a target written rounded, per row of the pose error (position,
+    then rotation vector): an entry with d ≥ 2 decimals is off by at most half of 10⁻ᵈ; the rotation vector of a
+    rotation block off by u per entry is off by at most 3u/2 per component (taken as 2u), its position by u."""
+    from ._values import decimals
+
+    unit = np.array([[10.0 ** -d if (d := decimals(c)) >= 2 else 0.0 for c in r] for r in cells])
+    return np.concatenate([unit[:3, 3], np.full(3, 2.0 * unit[:3, :3].max())])
+
+
+def _covered(robot: DHRobot, sols: np.ndarray, frees, claimed, reach: list[bool], rows,
+             slack: np.ndarray) -> list[bool]:
+    """Which closed-form solutions the claimed q that reach the target stand for: those within a q's rounding.  For
+    a target written rounded the q may also have moved by the joint motion the rounding allows (|J⁺| times the
+    target's slack, doubled), and then a q stands only for its nearest solution, so that it never stands for two."""
+    keeps = [[i for i in range(robot.dof) if i not in free_joints(f)] for f in frees]
+    if not slack.any():
+        return [any(r and np.all(joint_distance(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
+                    for r, (q, unit) in zip(reach, claimed)) for s, keep in zip(sols, keeps)]
+    moved = [np.abs(np.linalg.pinv(N.geometric_jacobian(robot, s)[rows])) @ slack[rows] for s in sols]
+    covered = [False] * len(sols)
+    for r, (q, unit) in zip(reach, claimed):
+        if not r or not len(sols):
+            continue
+        gaps = [joint_distance(robot, q, s) for s in sols]
+        k = int(np.argmin([np.max(g[keep], initial=0.0) for g, keep in zip(gaps, keeps)]))
+        covered[k] = covered[k] or bool(np.all((gaps[k] - unit - 2.0 * moved[k])[keeps[k]] <= MATCH_TOL))
+    return covered
+
+
 def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.random.Generator, deg: bool):
     """Each claimed q reaches the target; every closed-form solution within the limits is listed."""
     from ._engine import Verdict
     from ._values import claim_cells, joint_values, no_names
 
+    slack = np.zeros(6)  # how far the target as written may be from the pose it rounds (p rows, then ω rows)
     if "q" in raw:
         T = N.forward_kinematics(robot, joint_values(raw["q"], robot, "q", deg))
     elif "T" in raw:
-        T = np.array([[_expr.evaluate(c) for c in r] for r in claim_cells(raw["T"], no_names)])
+        cells = claim_cells(raw["T"], no_names)
+        T = np.array([[_expr.evaluate(c) for c in r] for r in cells])
+        slack = _target_slack(cells) if T.shape == (4, 4) else slack
     else:
         raise ParseError("an ik_solutions claim needs the target: 'q' (its pose is the target) or 'T' (4×4)")
     if T.shape != (4, 4):
@@ -95,7 +128,7 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
     entries, reach = [], []
     for k, (q, unit) in enumerate(claimed, start=1):
         e = pose_error(robot, q, T)[rows]
-        allowed = 1e-9 + 2.0 * np.abs(N.geometric_jacobian(robot, q)[rows]) @ unit
+        allowed = 1e-9 + 2.0 * np.abs(N.geometric_jacobian(robot, q)[rows]) @ unit + slack[rows]
         ok = bool(np.all(np.abs(e) <= allowed))
         reach.append(ok)
         if not ok:
@@ -103,13 +136,13 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
                             "note": "FK(q) does not reach the target"})
     missing = []
     if res is not None:
-        for s, label, free in zip(np.asarray(res.solutions).reshape(-1, robot.dof), res.branches, res.free):
-            keep = [i for i in range(robot.dof) if i not in free_joints(free)]
-            if not any(r and np.all(joint_distance(robot, q, s)[keep] <= unit[keep] + MATCH_TOL)
-                       for r, (q, unit) in zip(reach, claimed)):
+        sols = np.asarray(res.solutions).reshape(-1, robot.dof)
+        for s, label, hit in zip(sols, res.branches, _covered(robot, sols, res.free, claimed, reach, rows, slack)):
+            if not hit:
                 shown = np.where(revolute_mask(robot), np.degrees(s), s) if deg else s
                 missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in shown) + "]" + (" (degrees)" * deg))
-    method = ("FK of each claimed solution on the rows the arm controls (to the decimals written, through J); "
+    method = ("FK of each claimed solution on the rows the arm controls (to the decimals written of q and of the "
+              "target, through J); "
               + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
     extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
     if not entries and not missing:
