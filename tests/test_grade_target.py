@@ -123,3 +123,50 @@ def test_a_case_or_a_heading_after_the_target_ends_it():
         text = _report(_values(sols[0])) + "\n" + tail + "\n"
         judged = [c for c in grade_text(text).claims if c.quantity == "ik_solutions"]
         assert len(judged) == 1 and judged[0].verdict == "correct"
+
+
+# A 6R arm with a spherical wrist (standard DH), its target a 4×4 written with 4 decimals: the pose is an independent
+# DH product here (numpy), never denavit's forward kinematics.
+WRIST_ROWS = [(0.4, 0.0, -90.0), (0.0, 0.5, 0.0), (0.0, 0.0, -90.0), (0.45, 0.0, 90.0), (0.0, 0.0, -90.0),
+              (0.1, 0.0, 0.0)]
+WRIST_TABLE = "| i | $\\theta_i$ | $d_i$ | $a_i$ | $\\alpha_i$ |\n|---|---|---|---|---|\n" + "".join(
+    f"| {k} | $q_{k}$ | {d:g} | {a:g} | {al:g}° |\n" for k, (d, a, al) in enumerate(WRIST_ROWS, start=1))
+Q_TRUE = (0.3, -0.5, 0.4, 0.7, -0.6, 1.1)
+
+
+def _pose(q):
+    import numpy as np
+
+    T = np.eye(4)
+    for th, (d, a, al) in zip(q, WRIST_ROWS):
+        ct, st, ca, sa = np.cos(th), np.sin(th), np.cos(np.radians(al)), np.sin(np.radians(al))
+        T = T @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d],
+                          [0, 0, 0, 1]])
+    return T
+
+
+def _pose_report(words: str, q) -> str:
+    rows = " \\\\ ".join(" & ".join(f"{v:.4f}" for v in r) for r in _pose(Q_TRUE)[:3]) + " \\\\ 0 & 0 & 0 & 1"
+    return (f"# IK\n\n{WRIST_TABLE}\n{words}\n\n$$T_6^0 = \\begin{{bmatrix}} {rows} \\end{{bmatrix}}$$\n\n"
+            f"One solution is\n\n$$q = ({', '.join(f'{v:.4f}' for v in q)})$$\n")
+
+
+def test_a_target_pose_written_as_a_matrix_and_the_joint_values_that_reach_it():
+    """"The desired pose is T_6^0 = [4×4 of numbers]": the target; the q given after it is judged by FK against the
+    target to both their decimals (the other solutions named, none required)."""
+    report = grade_text(_pose_report("Find the joints for the desired pose of the tool:", Q_TRUE))
+    (c,) = [c for c in report.claims if c.quantity == "ik_solutions"]
+    assert c.verdict == "correct", c.message
+    assert [c.verdict for c in report.claims if c.quantity == "given: target"] == ["not a claim"]
+    wrong = list(Q_TRUE)
+    wrong[1] += 0.05
+    (c,) = [c for c in grade_text(_pose_report("The desired pose:", wrong)).claims if c.quantity == "ik_solutions"]
+    assert c.verdict == "incorrect" and "does not reach" in c.message
+
+
+def test_a_numeric_pose_without_words_of_a_target_is_no_target():
+    """Without words of a target the matrix is a numeric end-effector result (no case given: ambiguous) and the q
+    after it a case, not an answer."""
+    report = grade_text(_pose_report("The pose of the tool is", Q_TRUE))
+    assert not [c for c in report.claims if c.quantity == "ik_solutions"]
+    assert [c.verdict for c in report.claims if c.quantity == "end_effector"] == ["ambiguous"]

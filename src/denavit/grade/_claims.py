@@ -25,7 +25,7 @@ from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_for
                        manipulability_pending, singular_pending)
 from ._points import names_wrist_centre
 from ._split import Equation, split_block
-from ._target import is_target_part, prose_target, solution_claim
+from ._target import case_solution, is_target_part, matrix_target, prose_target, solution_claim, target_words
 from ._values import wrench_symbols
 
 __all__ = ["Pending", "walk"]
@@ -148,6 +148,7 @@ class _Walker:
                     self.ctx.q = self.ctx.cases[number] = q
         if robot is not None and (target := prose_target(it.text, robot.dof)) is not None:
             self.ctx.target, self.ctx.target_line = target, it.line
+        self.ctx.target_words_line = it.line if target_words(it.text) else self.ctx.target_words_line
         for name, value in prose_definitions(plain_names(plain)):
             self.ctx.define(name, value)
         w = prose_wrench(plain)
@@ -228,9 +229,16 @@ class _Walker:
         if is_target_part(self.ctx, eq.line, lhs):
             self.note(eq, arm, "not a claim", "the target of the inverse kinematics", "given: target")
             return True
+        if robot is not None and (target := matrix_target(self.ctx, eq.parts, eq.line)) is not None:
+            self.ctx.target, self.ctx.target_line = target, eq.line
+            self.note(eq, arm, "not a claim", "the target of the inverse kinematics (a pose)", "given: target")
+            return True
         q = case_of(eq.parts, eq.text, robot) if robot is not None else None
         if q is not None:
             self.ctx.q, self.ctx.partial = q, {}
+            if (claim := case_solution(self.ctx, eq.parts[1])) is not None:  # a whole q after a target
+                self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, claim, "joint values that reach the "
+                                        "target", quantity="ik_solutions"))
             if self.ctx.case_number:
                 self.ctx.cases[self.ctx.case_number] = q
             self.note(eq, arm, "not a claim", "the configuration of this case (used for the numeric results "

@@ -48,6 +48,7 @@ class Context:
     wrench_texts: list[str] = field(default_factory=list)
     target: str | None = None  # an IK target stated in words (a 4×4 as text), and the line that stated it
     target_line: int = 0
+    target_words_line: int = 0  # the last line with words of a target ("the desired pose"): a T after it is one
     p_wrist: bool = False  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
 
     def define(self, name: str, value: str) -> None:

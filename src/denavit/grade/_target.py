@@ -13,11 +13,17 @@ import math
 import re
 from typing import Any
 
-from ._context import Context
+from ._context import Context, is_numeric, vector_entries
+from ._lhs import read_symbol
+from ._values import cells, matrices
 
-__all__ = ["prose_target", "is_target_part", "solution_claim"]
+__all__ = ["prose_target", "is_target_part", "solution_claim", "target_words", "matrix_target", "case_solution"]
 
 _WORDS = re.compile(r"\b(?:reach(?:es|ed)?|target|desired|goal|move[sd]? to|placed? at|must be at)\b", re.I)
+_POSE_WORDS = re.compile(r"\b(?:given|following|this)\s+(?:end[- ]effector\s+|tool\s+)?(?:pose|transform(?:ation)?)\b",
+                         re.I)
+#: Lines a target matrix may follow the words that announce it.
+TARGET_REACH = 6
 _NUMBER = r"(-?\s?\d+(?:\.\d+)?)\s*(\^\s*\{?\\circ\}?|°)?"
 _COORD = re.compile(r"\$\s*(x|y|z|p_\{?[xyz]\}?|\\phi|\\varphi|\\psi)\s*=\s*" + _NUMBER + r"\s*\$")
 
@@ -38,6 +44,37 @@ def prose_target(text: str, dof: int) -> str | None:
     c, s = math.cos(found.get("phi", 0.0)), math.sin(found.get("phi", 0.0))
     rows = [[c, -s, 0.0, found["x"]], [s, c, 0.0, found["y"]], [0.0, 0.0, 1.0, found.get("z", 0.0)], [0, 0, 0, 1]]
     return "[" + "; ".join(", ".join(repr(float(v)) for v in r) for r in rows) + "]"
+
+
+def target_words(text: str) -> bool:
+    """Words that announce a target: "the desired pose", "must reach", "the given end-effector pose"."""
+    return bool(_WORDS.search(text) or _POSE_WORDS.search(text))
+
+
+def matrix_target(ctx: Context, parts: tuple[str, ...], line: int) -> str | None:
+    """``T = [4×4 of numbers]`` within :data:`TARGET_REACH` lines after words of a target: the target (the matrix
+    as written, for the checker), else None.  A pose's name on the left (``T``, ``T_6^0``, ``{}^0T_6``,
+    ``T_{d}``), numbers only (fractions, √, π), the bottom row 0 0 0 1."""
+    if not ctx.target_words_line or not 0 <= line - ctx.target_words_line <= TARGET_REACH or len(parts) != 2:
+        return None
+    sym = read_symbol(parts[0])
+    mats = matrices(parts[1])
+    if sym is None or sym.base not in ("T", "H") or sym.dots or mats is None or len(mats) != 1:
+        return None
+    rows = cells(mats[0])
+    if len(rows) != 4 or any(len(r) != 4 for r in rows) or not all(is_numeric(c) for r in rows for c in r):
+        return None
+    if [c.replace(" ", "") for c in rows[3]] not in (["0", "0", "0", "1"], ["0", "0", "0", "1.0"]):
+        return None
+    return mats[0]
+
+
+def case_solution(ctx: Context, value: str) -> dict[str, Any] | None:
+    """A whole q (``q = (…)``) after a target: the ``ik_solutions`` claim of that one solution, else None."""
+    entries = vector_entries(value)
+    if ctx.target is None or not entries:
+        return None
+    return solution_claim(ctx, {k: f"q_{k} = {e}" for k, e in enumerate(entries, start=1)})
 
 
 def is_target_part(ctx: Context, line: int, lhs: str) -> bool:

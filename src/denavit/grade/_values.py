@@ -14,7 +14,7 @@ from ._context import is_numeric, vector_entries
 from ._split import top_level_split
 
 __all__ = ["matrices", "scale_matrix", "expand_product", "numeric_value", "wrench_symbols", "WRENCH_NAMES",
-           "missing_plus"]
+           "missing_plus", "cells"]
 
 _MAT = re.compile(r"\\begin\{([bBpv]?matrix)\}")
 #: The wrench's symbols, in the order (f, n), as the checker names them.
@@ -43,7 +43,8 @@ def matrices(text: str) -> list[str] | None:
     return out
 
 
-def _cells(matrix: str) -> list[list[str]]:
+def cells(matrix: str) -> list[list[str]]:
+    """The entries of one matrix environment, row by row, as written."""
     m = _MAT.match(matrix)
     body = matrix[m.end():matrix.rfind("\\end{")]
     rows = [r for r in top_level_split(body, ("\\\\",)) if r.strip()]
@@ -55,7 +56,7 @@ def expand_product(value: str) -> str | None:
     mats = matrices(value)
     if mats is None or len(mats) != 2:
         return None
-    a = _cells(mats[0])
+    a = cells(mats[0])
     v = vector_entries(mats[1])
     if not a or v is None or len(a) > 8 or any(len(r) != len(v) for r in a) or len(v) > 8:
         return None
@@ -93,7 +94,7 @@ def scale_matrix(value: str) -> str | None:
     if mats is None or len(mats) != 1:
         return None
     factor = factor.strip()
-    rows = [" & ".join(f"({factor})({c})" for c in r) for r in _cells(mats[0])]
+    rows = [" & ".join(f"({factor})({c})" for c in r) for r in cells(mats[0])]
     return "\\begin{bmatrix} " + " \\\\ ".join(rows) + " \\end{bmatrix}"
 
 
