@@ -327,6 +327,14 @@ def test_unbalanced_brackets_are_named_in_the_unreadable_line():
     assert c.verdict == "unreadable" and "1 more ')' than '('" in c.message
 
 
+@pytest.mark.parametrize("value", ["\\frac{L_1 (c_1 + L_2 c_{12}}{2}", "(L_1 c_1 + L_2 c_{12}",
+                                   "\\frac{\\left( L_1 \\left( c_1 \\right)^2}{2}"])
+def test_a_bracket_left_open_is_named_in_the_unreadable_line(value):
+    """Seed 000's K: ``\\frac{m_3 \\left( \\left( … \\right)^2}{2}`` (one '(' never closed)."""
+    (c,) = grade_text(_report(f"$$x = {value}$$")).claims
+    assert c.verdict == "unreadable" and "is not closed (the brackets do not balance)" in c.message, c.message
+
+
 RRP = """| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |
 |---|---|---|---|---|
 | 1 | 0 | $-90^\\circ$ | $d_1$ | $\\theta_1$ |

@@ -29,6 +29,9 @@ __all__ = ["parse_math", "tree_depth"]
 _OPEN = {"(": ")", "[": "]", "{": "}", "\\{": "\\}"}
 
 
+_OPENS = {")": "(", "]": "[", "\\right)": "\\left(", "\\right]": "\\left["}
+
+
 class _Parser:
     def __init__(self, text: str, resolve: Resolver) -> None:
         self.text = text
@@ -44,10 +47,12 @@ class _Parser:
 
     def take(self, text: str | None = None) -> tuple[str, str]:
         tok = self.peek()
+        unclosed = f": a {_OPENS[text]!r} opened before it is not closed (the brackets do not balance)" \
+            if text in _OPENS else ""
         if tok is None:
-            raise ParseError(f"unexpected end of expression{f' (expected {text!r})' if text else ''}")
+            raise ParseError(f"unexpected end of expression{f' (expected {text!r})' if text else ''}{unclosed}")
         if text is not None and tok[1] != text:
-            raise ParseError(f"expected {text!r} but found {tok[1]!r}")
+            raise ParseError(f"expected {text!r} but found {tok[1]!r}{unclosed}")
         self.i += 1
         return tok
 
