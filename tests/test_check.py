@@ -442,3 +442,38 @@ def test_check_coriolis_claims_from_the_symbolic_engine(name):
     v = _check(robot, claims)
     assert [x.verdict for x in v] == ["correct"] * 5 + ["incorrect"], [x.message for x in v]
     assert "factorization" in v[3].message and [e["entry"] for e in v[5].entries] == [[2]]
+
+
+def test_christoffel_symbols_of_the_planar_elbow_are_spongs():
+    """Spong, Hutchinson, Vidyasagar (2006) Sec. 7.4, the planar elbow with ℓ_c2 = L2 and I2 = 0 (the catalogue's
+    point masses at the link ends): c_121 = c_211 = c_221 = h, c_112 = −h, the rest 0, h = −m2 L1 L2 sin q2."""
+    robot = dn.load_robot("planar2r")
+    h = "-m_2 L_1 L_2 \\sin q_2"
+    truth = {(1, 2, 1): h, (2, 1, 1): h, (2, 2, 1): h, (1, 1, 2): f"-({h})", (1, 1, 1): "0", (1, 2, 2): "0",
+             (2, 1, 2): "0", (2, 2, 2): "0"}
+    claims = [{"quantity": "christoffel", "entry": list(k), "value": v} for k, v in truth.items()]
+    assert [v.verdict for v in check_claims(robot, claims).verdicts] == ["correct"] * 8
+    wrong = [{"quantity": "christoffel", "entry": [2, 2, 1], "value": "0"}]
+    assert check_claims(robot, wrong).verdicts[0].verdict == "incorrect"
+
+
+def test_christoffel_symbols_equal_finite_differences_of_m():
+    """c_ijk = ½(∂M_kj/∂q_i + ∂M_ki/∂q_j − ∂M_ij/∂q_k) with ∂M by central differences of the CRBA's M (a second
+    route), on the Puma 560 and the Panda at random q; and C q̇ = Σ c_ijk q̇_i q̇_j is the RNEA's velocity term."""
+    from denavit.check import QUANTITIES
+    from denavit.check._quantities import Point
+
+    rng = np.random.default_rng(3)
+    for name in ("puma560", "panda"):
+        robot = dn.load_robot(name)
+        n = robot.dof
+        q, qd = rng.uniform(-1.5, 1.5, n), rng.uniform(-1, 1, n)
+        G = QUANTITIES["christoffel"].truth(Point(robot, q), {})
+        eps = 1e-6
+        dM = np.stack([(dn.mass_matrix(robot, q + eps * e) - dn.mass_matrix(robot, q - eps * e)) / (2 * eps)
+                       for e in np.eye(n)])  # [i, j, k] = ∂M_jk/∂q_i
+        fd = np.array([[[0.5 * (dM[i, k, j] + dM[j, k, i] - dM[k, i, j]) for k in range(n)] for j in range(n)]
+                       for i in range(n)])
+        assert np.allclose(G, fd, atol=1e-6)
+        c = np.einsum("ijk,i,j->k", G, qd, qd)
+        assert np.allclose(c, dn.coriolis_vector(robot, q, qd), atol=1e-9)

@@ -231,6 +231,15 @@ def _dynamics(name: str) -> Callable[[Point, dict[str, Any]], np.ndarray]:
     return truth
 
 
+def _christoffel(p: Point, spec: dict[str, Any]) -> np.ndarray:
+    """Spong's Christoffel symbols c_ijk = ½(∂M_kj/∂q_i + ∂M_ki/∂q_j − ∂M_ij/∂q_k), shape (n, n, n), [i, j, k]
+    (Spong, Hutchinson, Vidyasagar 2006, eq. 7.51: C_kj = Σ_i c_ijk q̇_i), from ∂M/∂q of the CRBA."""
+    if not p.robot.has_dynamics:
+        raise ParseError("the robot has no inertial data, so dynamics claims cannot be checked")
+    dM = N.mass_matrix_derivatives(p.robot, p.q)  # [i, j, k] = ∂M_jk/∂q_i
+    return 0.5 * (np.einsum("ikj->ijk", dM) + np.einsum("jki->ijk", dM) - np.einsum("kij->ijk", dM))
+
+
 QUANTITIES: dict[str, Quantity] = {
     q.name: q
     for q in (
@@ -252,6 +261,8 @@ QUANTITIES: dict[str, Quantity] = {
                  about="velocity torques c(q, q̇) = C(q, q̇) q̇ (Coriolis and centrifugal)"),
         Quantity("coriolis_matrix", _dynamics("coriolis_matrix"), ("qd",),
                  about="C(q, q̇) from the Christoffel symbols of M (a whole C with C q̇ = c is accepted too)"),
+        Quantity("christoffel", _christoffel, about="Spong's Christoffel symbol c_ijk = ½(∂M_kj/∂q_i + ∂M_ki/∂q_j − "
+                 "∂M_ij/∂q_k), 'entry': [i, j, k] (C_kj = Σ_i c_ijk q̇_i)"),
         Quantity("omega", _omega, ("qd",), about="ⁱωᵢ: angular velocity of frame 'index' in its own axes "
                  "(velocity propagation; index 0 … N, or e)"),
         Quantity("velocity", _velocity, ("qd",), about="ⁱvᵢ: velocity of the origin of frame 'index' in its own axes"),
@@ -279,7 +290,7 @@ _ALIASES = {"eom": "equations_of_motion", "dynamics": "equations_of_motion", "z"
             "V": "potential_energy", "U": "potential_energy", "L": "lagrangian", "det": "det_jacobian",
             "detJ": "det_jacobian", "A": "link_transform", "T": "transform", "fk": "end_effector", "pose": "end_effector",
             "J": "jacobian", "J0": "jacobian", "Je": "jacobian", "tau": "torques", "M": "mass_matrix", "g": "gravity",
-            "c": "coriolis", "C": "coriolis_matrix"}
+            "c": "coriolis", "C": "coriolis_matrix", "Gamma": "christoffel"}
 
 
 def quantity(name: Any) -> tuple[Quantity, dict[str, Any]]:
