@@ -114,3 +114,43 @@ def test_the_correct_value_writes_the_centre_of_mass_distance_as_the_report_does
     text = "# Two-link arm\n\n" + STANDARD + "\n$$M_{22} = m_2 \\ell_{c2}^2 + 2 I_2$$\n"
     (c,) = grade_text(text).claims
     assert c.verdict == "incorrect" and "\\ell_{c2}" in c.fix and "ellc" not in c.fix
+
+
+def _christoffel_truth():
+    """Spong's c_ijk = ½(∂d_kj/∂q_i + ∂d_ki/∂q_j − ∂d_ij/∂q_k) of the textbook M above, differentiated by sympy here
+    (Sec. 7.4: c121 = c211 = c221 = h, c112 = −h, the rest 0, h = −m2 l1 lc2 sin q2)."""
+    import sympy as sp
+
+    q1, q2, l1, lc1, lc2, m1, m2, i1, i2 = sp.symbols("q_1 q_2 ell_1 ell_c1 ell_c2 m_1 m_2 I_1 I_2")
+    M = sp.Matrix([[m1 * lc1 ** 2 + m2 * (l1 ** 2 + lc2 ** 2 + 2 * l1 * lc2 * sp.cos(q2)) + i1 + i2,
+                    m2 * (lc2 ** 2 + l1 * lc2 * sp.cos(q2)) + i2],
+                   [m2 * (lc2 ** 2 + l1 * lc2 * sp.cos(q2)) + i2, m2 * lc2 ** 2 + i2]])
+    q = (q1, q2)
+    out = {}
+    for i in range(2):
+        for j in range(2):
+            for k in range(2):
+                c = sp.simplify((sp.diff(M[k, j], q[i]) + sp.diff(M[k, i], q[j]) - sp.diff(M[i, j], q[k])) / 2)
+                out[(i + 1, j + 1, k + 1)] = sp.latex(c)
+    return out
+
+
+def test_spongs_christoffel_symbols_are_judged_and_a_slip_is_caught():
+    truth = _christoffel_truth()
+    assert truth[(1, 2, 1)] != "0" and truth[(1, 1, 1)] == "0"  # the derivation is not trivially empty
+    right = [f"c_{{{i}{j}{k}}} = {v}" for (i, j, k), v in truth.items()]
+    right.append(f"\\Gamma^1_{{22}} = {truth[(2, 2, 1)]}")
+    intro = "M_{22} = m_2 \\ell_{c2}^2 + I_2"  # names the masses, so the arm is read with them
+    assert _judged(STANDARD, [intro] + right) == ["correct"] * (len(right) + 1)
+    slips = [f"c_{{221}} = -({truth[(2, 2, 1)]})", "c_{222} = m_2 \\ell_1 \\ell_{c2} \\sin q_2"]
+    assert _judged(STANDARD, [intro] + slips) == ["correct", "incorrect", "incorrect"]
+
+
+def test_the_other_index_order_is_a_question_and_a_cosine_shorthand_is_no_christoffel_symbol():
+    """``c_{112}`` written with the row index first (Murray–Li–Sastry's Γ_ijk: the value of Spong's c_121) is
+    ambiguous, not incorrect; ``c_{122} = \\cos(q_1 + 2 q_2)`` and ``c_{122} = c_{12} c_2 - s_{12} s_2`` are cosines."""
+    truth = _christoffel_truth()
+    intro = "M_{22} = m_2 \\ell_{c2}^2 + I_2"
+    got = _judged(STANDARD, [intro, f"c_{{112}} = {truth[(1, 2, 1)]}", "c_{122} = \\cos(q_1 + 2 q_2)",
+                             "c_{122} = c_{12} c_2 - s_{12} s_2"])
+    assert got[:2] == ["correct", "ambiguous"] and "incorrect" not in got[2:], got

@@ -278,6 +278,24 @@ def _dynamics(sym: Symbol, robot: DHRobot, gravity_rhs: bool = False) -> Reading
     return Reading(spec, words, needs=("q",))
 
 
+def _christoffel(sym: Symbol, robot: DHRobot, rhs: str) -> Reading | None:
+    """``c_{121}`` (Spong's c_ijk, the row index of C last) or ``\\Gamma^1_{21}``: a Christoffel symbol of M; the
+    other order, the row index first (``\\Gamma_{ijk}`` of Murray, Li, Sastry), is the second reading.  Sure only
+    when the value has a mass or a derivative in it, or is 0 (``c_{123} = c_{12} c_3 - s_{12} s_3`` is a cosine)."""
+    sub, sup = re.sub(r"[{}\s,]", "", sym.sub), re.sub(r"[{}\s,]", "", sym.sup)
+    if sym.pre_sup or sym.dots or sym.args or sym.pre_sub:
+        return None
+    idx = sub + sup if sym.base == "Gamma" and len(sup) == 1 and len(sub) == 2 else sub if not sup else ""
+    if len(idx) != 3 or not idx.isdigit() or not all(1 <= int(d) <= robot.dof for d in idx):
+        return None
+    i, j, k = map(int, idx)
+    other = ({"quantity": "christoffel", "entry": [j, k, i]}, f"the Christoffel symbol with the row index first "
+             f"(Spong's c_{j}{k}{i})")
+    sure = bool(re.search(r"m_|\\partial", rhs)) or rhs.strip() == "0"
+    return Reading({"quantity": "christoffel", "entry": [i, j, k]}, f"Spong's Christoffel symbol c_{i}{j}{k} of M",
+                   (other,) if len({i, j, k}) > 1 else (), sure=sure, needs=("q",))
+
+
 def _energy(sym: Symbol) -> Reading | None:
     names = {"K": ("kinetic_energy", "the kinetic energy K"), "T": ("kinetic_energy", "the kinetic energy"),
              "P": ("potential_energy", "the potential energy"), "U": ("potential_energy", "the potential energy"),
@@ -336,6 +354,10 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
     if b in ("d", "D", "phi") and (b != "phi" or gravity_rhs) and "m_" in rhs and not sym.pre_sup:
         b = {"d": "M", "D": "M", "phi": "g"}[b]  # Spong's d_ij (the inertia matrix) and φ_k (gravity), by its value
         sym = replace(sym, base=b)
+    if b in ("c", "Gamma") and robot.has_dynamics and not re.match(r"\s*\\?cos", rhs):
+        christoffel = _christoffel(sym, robot, rhs)
+        if christoffel is not None:
+            return christoffel
     if b in ("M", "G", "g", "c", "C", "h"):
         return _dynamics(sym, robot, gravity_rhs=gravity_rhs)
     if b in ("K", "P", "U", "V", "L", "mathcal{L}") and (dynamic or b in ("K",)):
