@@ -11,31 +11,46 @@ import re
 
 from ..errors import ParseError
 
-__all__ = ["split_top", "split_relation", "expand_pm", "after_last_equals", "strip_equation_number", "MAX_SIGN_COMBOS"]
+__all__ = ["bracket_depths", "split_top", "split_relation", "expand_pm", "after_last_equals", "strip_equation_number", "MAX_SIGN_COMBOS"]
 
 MAX_SIGN_COMBOS = 64
 _OPENERS, _CLOSERS = "({[", ")}]"
 
 
-def split_top(text: str, seps: tuple[str, ...]) -> list[str]:
-    """Split ``text`` at any of ``seps`` that stand outside brackets and braces."""
-    out, cur, level, k = [], "", 0, 0
+def bracket_depths(text: str, env: re.Pattern | None = None, clamp: bool = False, start: int = 0):
+    """Yield ``(index, depth)`` for every character of ``text`` from ``start``: the depth after it in brackets,
+    braces and (``env``: a pattern of ``\\begin{…}``/``\\end{…}`` with the word in group 1) environments, whose
+    own characters count at least 1 deep.  ``clamp``: a closer too many leaves the depth at 0 (else it goes below).
+    The one bracket walker of the checker and the report reader."""
+    depth, k = 0, start
     while k < len(text):
+        m = env.match(text, k) if env is not None and text[k] == "\\" else None
+        if m:
+            depth += 1 if m.group(1) == "begin" else -1
+            for j in range(k, m.end()):
+                yield j, max(depth, 1)
+            k = m.end()
+            continue
         ch = text[k]
         if ch in _OPENERS:
-            level += 1
+            depth += 1
         elif ch in _CLOSERS:
-            level -= 1
-        if level == 0:
-            sep = next((s for s in seps if text.startswith(s, k)), None)
-            if sep is not None:
-                out.append(cur)
-                cur = ""
-                k += len(sep)
-                continue
-        cur += ch
+            depth = max(depth - 1, 0) if clamp else depth - 1
+        yield k, depth
         k += 1
-    out.append(cur)
+
+
+def split_top(text: str, seps: tuple[str, ...]) -> list[str]:
+    """Split ``text`` at any of ``seps`` that stand outside brackets and braces."""
+    out, start, skip_to = [], 0, 0
+    for k, depth in bracket_depths(text):
+        if k < skip_to or depth:
+            continue
+        sep = next((s for s in seps if text.startswith(s, k)), None)
+        if sep is not None:
+            out.append(text[start:k])
+            start = skip_to = k + len(sep)
+    out.append(text[start:])
     return out
 
 
@@ -87,21 +102,7 @@ _ENV = re.compile(r"\\(begin|end)\{(?:[bBpvV]?matrix|array|smallmatrix)\*?\}")  
 
 def after_last_equals(text: str) -> str:
     """What follows the last ``=`` outside brackets and matrix environments (``J = [\\begin…] = \\begin…``)."""
-    level, cut, k = 0, -1, 0
-    while k < len(text):
-        m = _ENV.match(text, k)
-        if m:
-            level += 1 if m.group(1) == "begin" else -1
-            k = m.end()
-            continue
-        ch = text[k]
-        if ch in "({[":
-            level += 1
-        elif ch in ")}]":
-            level -= 1
-        elif ch == "=" and level == 0:
-            cut = k
-        k += 1
+    cut = max((k for k, depth in bracket_depths(text, _ENV) if depth == 0 and text[k] == "="), default=-1)
     return text[cut + 1:] if cut >= 0 else text
 
 

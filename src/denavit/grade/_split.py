@@ -11,6 +11,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from ..check import bracket_depths
+
 __all__ = ["Equation", "split_block", "top_level_split", "clean"]
 
 _WRAP_ENV = re.compile(r"\\(begin|end)\{(aligned|align|split|gather|gathered|equation|multline|eqnarray|flalign|"
@@ -35,22 +37,7 @@ class Equation:
 
 def _levels(text: str):
     """Yield (index, depth) for every character, depth counting braces, brackets and matrix environments."""
-    depth, k = 0, 0
-    while k < len(text):
-        m = _MATRIX_ENV.match(text, k) if text[k] == "\\" else None
-        if m:
-            depth += 1 if m.group(1) == "begin" else -1
-            for j in range(k, m.end()):
-                yield j, max(depth, 1)
-            k = m.end()
-            continue
-        ch = text[k]
-        if ch in "{[(":
-            depth += 1
-        elif ch in "}])":
-            depth = max(depth - 1, 0)
-        yield k, depth
-        k += 1
+    return bracket_depths(text, _MATRIX_ENV, clamp=True)
 
 
 def top_level_split(text: str, seps: tuple[str, ...]) -> list[str]:
