@@ -28,13 +28,16 @@ def _index(sub: str) -> int | None:
 
 
 def _joint_sum(digits: str, n: int) -> tuple | None:
-    """``"123"`` → q1 + q2 + q3 (single digits when n < 10; ``"1,2"`` style separators allowed)."""
-    parts = [p for p in re.split(r"[,\s]+", digits) if p] if "," in digits else list(digits)
-    if not parts or not all((k := _index(p)) is not None and 1 <= k <= n for p in parts):
+    """``"123"`` → q1 + q2 + q3 (single digits when n < 10; ``"1,2"`` style separators allowed); ``"12-4"`` →
+    q1 + q2 − q4 (the SCARA's c_{12-4}; a sign stands before one digit)."""
+    terms = [("+", p) for p in re.split(r"[,\s]+", digits) if p] if "," in digits else [("+", d) for d in digits]
+    if re.fullmatch(r"\d+(?:[-+]\d)+", digits) and n < 10:
+        terms = [(sign or "+", d) for sign, d in re.findall(r"([-+]?)(\d)", digits)]
+    if not terms or not all((k := _index(p)) is not None and 1 <= k <= n for _, p in terms):
         return None
-    node: tuple = ("name", f"q{parts[0]}")
-    for p in parts[1:]:
-        node = ("bin", "+", node, ("name", f"q{p}"))
+    node: tuple = ("name", f"q{terms[0][1]}")
+    for sign, p in terms[1:]:
+        node = ("bin", sign, node, ("name", f"q{p}"))
     return node
 
 
@@ -64,7 +67,7 @@ def robot_resolver(robot: DHRobot, extra: Iterable[str] = ()):
         if base == "d" and k is not None and k in prismatic:
             return ("name", f"{prefix}{k}")
         if base in _SHORT and ident.dots == 0:
-            if ident.sub_tree is not None and sub and not sub.isdigit():
+            if ident.sub_tree is not None and sub and not re.fullmatch(r"[\d+-]+", sub):
                 return ("call", _SHORT[base], (ident.sub_tree,))
             node = _joint_sum(sub, n)
             if node is not None:
