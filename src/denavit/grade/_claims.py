@@ -24,8 +24,10 @@ from ._reading import (define_chain, define_term, formula_leftover, joint_offset
 from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_formula_pending,
                        manipulability_pending, singular_pending)
 from ._points import names_wrist_centre
+from ._shorthand import define_name, rename_recent
 from ._split import Equation, split_block
-from ._target import case_solution, is_target_part, matrix_target, prose_target, solution_claim, target_words
+from ._target import (case_solution, is_target_part, matrix_target, prose_target, slide_formula, solution_claim,
+                      target_words)
 from ._values import wrench_symbols
 
 __all__ = ["Pending", "walk"]
@@ -39,7 +41,6 @@ _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
-_SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
 _PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
@@ -335,7 +336,7 @@ class _Walker:
             return
         if (sym is not None and joint_of(sym, robot) is not None) or _TRIG_LHS.match(lhs.replace(" ", "")):
             heading = re.search(r"\\(?:var)?phi\b", value) and moves_in_xy(robot)  # θ₃ = φ − θ₁ − θ₂ (planar)
-            if (_IK_FUNCS.search(value) or heading) and len(eq.parts) == 2:
+            if (_IK_FUNCS.search(value) or heading or slide_formula(sym, robot, value)) and len(eq.parts) == 2:
                 self.out.append(ik_formula_pending(self.ctx, eq, arm, lhs, value))
             else:
                 self.note(eq, arm, "not a claim", f"not judged: {lhs} = … is an intermediate step, not a formula for "
@@ -372,12 +373,8 @@ class _Walker:
                       "belongs: not judged", reading.spec["quantity"])
             return
         if reading is None:
-            params = {k for k, _ in robot.parameters}
-            name = plain_name(lhs)
-            if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
-                    and len(eq.parts) == 2 and name.replace("_", "").replace("{", "").replace("}", "") not in params \
-                    and "\\begin" not in value and not _SHORTHAND.fullmatch(name):
-                self.ctx.define(name, value)
+            if define_name(self.ctx, sym, lhs, value, eq.parts, {k for k, _ in robot.parameters}):
+                rename_recent(self.out, self.ctx, eq.line)  # "… where c_{124} = \cos(θ1 + θ2 − θ4)"
             self.note(eq, arm, "not a claim", f"not judged: {lhs[:60]} names no result denavit checks (a definition "
                       "or an intermediate step)")
             return

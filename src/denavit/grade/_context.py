@@ -49,6 +49,7 @@ class Context:
     target: str | None = None  # an IK target stated in words (a 4×4 as text), and the line that stated it
     target_line: int = 0
     target_words_line: int = 0  # the last line with words of a target ("the desired pose"): a T after it is one
+    renames: dict[str, str] = field(default_factory=dict)  # shorthand digits → signed form ("124" → "12-4")
     p_wrist: bool = False  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
 
     def define(self, name: str, value: str) -> None:

@@ -15,6 +15,7 @@ from ._arms import Arm
 from ._context import Context, has_joint_names, vector_entries
 from ._names import Reading
 from ._reading import det_rows, used_where
+from ._shorthand import renamed
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
@@ -46,6 +47,7 @@ class Pending:
 def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
     """The claim an equation makes under ``reading`` (with the case, rates, wrench and names ``ctx`` carries), and
     the other readings of its left-hand side."""
+    value = renamed(value, ctx.renames) if ctx.renames else value
     if "\\begin" in value and matrices(value) is None:
         value = scale_matrix(value) or value
     if "\\begin" in value:

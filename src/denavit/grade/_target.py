@@ -15,9 +15,12 @@ from typing import Any
 
 from ._context import Context, is_numeric, vector_entries
 from ._lhs import read_symbol
+from ._names import joint_of
+from ._shorthand import TARGET_NAMES
 from ._values import cells, matrices
 
-__all__ = ["prose_target", "is_target_part", "solution_claim", "target_words", "matrix_target", "case_solution"]
+__all__ = ["prose_target", "is_target_part", "solution_claim", "target_words", "matrix_target", "case_solution",
+           "slide_formula"]
 
 _WORDS = re.compile(r"\b(?:reach(?:es|ed)?|target|desired|goal|move[sd]? to|placed? at|must be at)\b", re.I)
 _POSE_WORDS = re.compile(r"\b(?:given|following|this)\s+(?:end[- ]effector\s+|tool\s+)?(?:pose|transform(?:ation)?)\b",
@@ -87,3 +90,9 @@ def solution_claim(ctx: Context, partial: dict[int, str]) -> dict[str, Any]:
     deg = any(re.search(r"\\circ|°", v) for v in partial.values())
     values = [re.sub(r"\^\s*\{?\\circ\}?|°", "", partial[k].split("=", 1)[1]).strip() for k in sorted(partial)]
     return {"quantity": "ik_solutions", "T": ctx.target, "value": [values], "complete": False, "deg": deg}
+
+
+def slide_formula(sym: Any, robot: Any, value: str) -> bool:
+    """``d_3 = d_1 - d_4 - z``: a prismatic joint's IK formula (the target's names, no inverse function needed)."""
+    k = joint_of(sym, robot) if sym is not None else None
+    return k is not None and robot.joint_types[k - 1].value == "prismatic" and TARGET_NAMES.search(value) is not None
