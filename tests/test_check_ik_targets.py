@@ -92,3 +92,38 @@ def test_a_right_solution_of_a_target_written_rounded_is_correct():
     full = {"quantity": "ik_solutions", "T": target, "value": [[round(float(x), 4) for x in s] for s in sols]}
     v = check_claims(robot, [full]).verdicts[0]
     assert v.verdict == "correct", v.message
+
+
+def _polar_rp():
+    """The polar RP arm (Spong's): a revolute joint about z0, α1 = 90°, a prismatic joint along z1; no fixed length."""
+    return dn.robot_from_dict({"name": "polar-rp", "convention": "standard", "joints": [
+        {"alpha": "pi/2", "theta": "q"}, {"d": "q"}]})
+
+
+def test_ik_formulas_of_an_arm_without_a_closed_form_are_checked_numerically():
+    """No closed form for the 2-joint RP arm: its solutions come from Gauss–Newton on the tip's position. The tip is
+    (d2 sin θ1, −d2 cos θ1, 0) (its DH product, multiplied out by hand), so d2 = √(x² + y²) and θ1 = atan2(x, −y) are
+    right (one branch each; d2 < 0, θ1 + π is the other), atan2(y, x) and x² + y² are not."""
+    robot = _polar_rp()
+    q = np.array([0.4, 0.7])
+    assert np.allclose(dn.forward_kinematics(robot, q)[:3, 3], [0.7 * np.sin(0.4), -0.7 * np.cos(0.4), 0])
+    claims = [{"quantity": "ik_formula", "value": v} for v in (
+        "d_2 = \\sqrt{x^2 + y^2}", "\\theta_1 = \\operatorname{atan2}(x, -y)",
+        "\\theta_1 = \\operatorname{atan2}(y, x)", "d_2 = x^2 + y^2")]
+    got = check_claims(robot, claims).verdicts
+    assert [v.verdict for v in got] == ["correct", "correct", "incorrect", "incorrect"], [v.message for v in got]
+    assert "Gauss-Newton on the tip's position" in got[0].method and "one branch" in got[0].message
+
+
+def test_ik_solutions_of_an_arm_without_a_closed_form_are_complete_against_a_numeric_search():
+    """The polar RP arm at the tip (0.3, −0.4, 0): (θ1, d2) = (atan2(0.3, 0.4), 0.5) and (that − π, −0.5), from the
+    tip formula above; one alone is correct when said to be one (the other named), both are complete."""
+    robot = _polar_rp()
+    t1 = float(np.arctan2(0.3, 0.4))
+    T = dn.forward_kinematics(robot, np.array([t1, 0.5]))
+    assert np.allclose(T[:3, 3], [0.3, -0.4, 0.0])
+    one = {"quantity": "ik_solutions", "T": T.tolist(), "value": [[t1, 0.5]]}
+    both = {**one, "value": [[t1, 0.5], [t1 - np.pi, -0.5]]}
+    got = check_claims(robot, [{**one, "complete": False}, one, both]).verdicts
+    assert [v.verdict for v in got] == ["correct", "incorrect", "correct"], [v.message for v in got]
+    assert "-0.5" in got[0].message and "missing" in got[1].message

@@ -30,8 +30,8 @@ from .. import numeric as N
 from ..errors import ParseError
 from ..ik import analytic_ik, characteristic_length, ik_structure
 from ..model import DHRobot, JointType
-from ._ik_targets import (MATCH_TOL, POSE_COLUMNS, controlled_rows, free_joints, joint_distance, reaches,
-                          revolute_mask, target_env)
+from ._ik_targets import (MATCH_TOL, NUMERIC_STARTS, POSE_COLUMNS, controlled_rows, free_joints, joint_distance,
+                          numeric_solutions, reaches, revolute_mask, target_env)
 from ._latex import parse_math
 from ._resolve import robot_resolver
 from ._text import MAX_SIGN_COMBOS, expand_pm, split_relation
@@ -139,16 +139,20 @@ def _formula_values(names, versions, used_signs, env: dict) -> np.ndarray:
     return np.array(out)
 
 
-def _targets(robot: DHRobot, rng: np.random.Generator, count: int):
-    """(q_gen, T, analytic result) for random reachable, well-conditioned targets."""
-    ranges = robot.sampling_ranges(characteristic_length(robot))  # ±L for a prismatic joint without limits
+def _targets(robot: DHRobot, rng: np.random.Generator, count: int, numeric: bool = False):
+    """(q_gen, T, analytic result) for random reachable, well-conditioned targets (``numeric``: the solutions by
+    Gauss–Newton from many starts, for an arm of at most 3 joints without a closed form)."""
+    length = characteristic_length(robot)
+    length = 1.0 if length <= 1e-3 else length  # no fixed length at all (a polar RP arm): prismatic joints over ±1 m
+    ranges = robot.sampling_ranges(length)  # ±L for a prismatic joint without limits
     turn = np.where([t is JointType.REVOLUTE for t in robot.joint_types], np.pi, np.inf)  # one turn (it repeats)
     lo, hi = np.maximum(ranges[:, 0], -turn), np.minimum(ranges[:, 1], turn)
     out = []
     for _ in range(count * 4):
         q = rng.uniform(lo, hi)
         T = N.forward_kinematics(robot, q)
-        res = analytic_ik(robot, T)
+        res = numeric_solutions(robot, T, q, rng.uniform(lo, hi, (NUMERIC_STARTS, robot.dof))) if numeric \
+            else analytic_ik(robot, T)
         J = N.geometric_jacobian(robot, q)[controlled_rows(res)]
         s = np.linalg.svd(J, compute_uv=False)
         if s[-1] > 1e-3 * s[0]:
@@ -260,14 +264,17 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
     pose = str(raw.get("pose", "dh"))
     if pose not in ("dh", "world"):
         raise ParseError(f"'pose' must be dh (T_0_N, default) or world (end-effector pose), got {pose!r}")
+    numeric = False
     try:
         ik_structure(robot)
     except Exception as exc:
-        raise ParseError(f"IK formulas cannot be checked for this arm: {exc}") from None
+        if robot.dof > 3:
+            raise ParseError(f"IK formulas cannot be checked for this arm: {exc}") from None
+        numeric = True  # a small arm without a closed form (the polar RP arm): its solutions found numerically
     tol = MATCH_TOL + (10.0 * 10.0 ** -d if (d := _decimals_of([v for _, v in versions])) >= 2 else 0.0)
     params = dict(robot.parameters)
     bad, hints, cover, checked = [], [], [], 0
-    for t, (qg, T, res) in enumerate(_targets(robot, rng, N_TARGETS)):
+    for t, (qg, T, res) in enumerate(_targets(robot, rng, N_TARGETS, numeric)):
         if len(bad) >= 3:
             break
         S, free = _solution_set(robot, res)
@@ -311,8 +318,10 @@ def _check_ik_formula(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ran
         cover.append((len({round(float(S[k][j]), 6) for k in hit}), len(distinct)))
     if checked == 0:
         raise ParseError(f"q{j + 1} is not determined by the pose at the targets tried (a continuum of solutions)")
-    method = (f"evaluated at {checked} random reachable target(s) (pose: {pose}); values compared with the closed-form "
-              "solution set (analytic_ik), gaps re-checked by Gauss-Newton with the joint held")
+    method = (f"evaluated at {checked} random reachable target(s) (pose: {pose}); values compared with the "
+              + (f"solution set found by Gauss-Newton on the tip's position from {NUMERIC_STARTS} starts (no closed "
+                 "form for this arm)" if numeric else "closed-form solution set (analytic_ik)")
+              + ", gaps re-checked by Gauss-Newton with the joint held")
     extra = {"joint": j + 1, "coverage": cover}
     if not bad:
         a, b = min(cover)

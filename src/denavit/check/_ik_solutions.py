@@ -11,10 +11,10 @@ import numpy as np
 from .. import _expr
 from .. import numeric as N
 from ..errors import ParseError
-from ..ik import analytic_ik
+from ..ik import analytic_ik, characteristic_length
 from ..model import DHRobot
-from ._ik_targets import (MATCH_TOL, controlled_rows, free_joints, joint_distance, pose_error, revolute_mask,
-                          rigid_target)
+from ._ik_targets import (MATCH_TOL, NUMERIC_STARTS, controlled_rows, free_joints, joint_distance,
+                          numeric_solutions, pose_error, revolute_mask, rigid_target)
 from ._latex import parse_math
 from ._matrices import parse_matrix
 
@@ -50,7 +50,8 @@ def _claimed_solutions(robot: DHRobot, raw: Any, deg: bool) -> list[tuple[np.nda
         if len(row) != robot.dof:
             raise ParseError(f"solution {k}: expected {robot.dof} joint values, got {len(row)}")
         q = np.array([_expr.evaluate(c) for c in row])
-        unit = np.array([10.0 ** -d if (d := decimals(c)) >= 2 or deg else 0.0 for c in row])  # 98.6°, 109°: rounded
+        unit = np.array([10.0 ** -d if (d := decimals(c)) >= 2 or deg and r else 0.0  # 98.6°, 109°: rounded
+                         for c, r in zip(row, rev)])
         if deg:
             q, unit = np.where(rev, np.radians(q), q), np.where(rev, np.radians(unit), unit)
         out.append((q, unit))
@@ -117,10 +118,16 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
         raise ParseError(f"'T' must be 4×4, got {T.shape}")
     rigid_target(T)  # a matrix that is no pose (bottom row 5 5 5 5) makes the claim unreadable, not judged
     claimed = [] if raw["value"] == [] else _claimed_solutions(robot, raw["value"], deg)
+    numeric = False
     try:
         res = analytic_ik(robot, _nearest_pose(T))
     except Exception:  # no closed form: each solution is still checked by FK
         res = None
+    if res is None and robot.dof <= 3 and claimed:  # a small arm places its tip: its solutions found numerically
+        ranges = robot.sampling_ranges(max(characteristic_length(robot), 1.0))
+        res = numeric_solutions(robot, T, claimed[0][0], rng.uniform(ranges[:, 0], ranges[:, 1],
+                                                                      (NUMERIC_STARTS, robot.dof)))
+        numeric = True
     if res is None and not claimed:
         raise ParseError("an empty list of solutions cannot be checked: this arm has no closed form to show that "
                          "the target is out of reach")
@@ -143,7 +150,9 @@ def check_ik_solutions(robot: DHRobot, raw: dict[str, Any], cid: str, rng: np.ra
                 missing.append(f"{label}: q = [" + ", ".join(f"{x:.6g}" for x in shown) + "]" + (" (degrees)" * deg))
     method = ("FK of each claimed solution on the rows the arm controls (to the decimals written of q and of the "
               "target, through J); "
-              + ("completeness against analytic_ik" if res is not None else "completeness not checked (no closed form)"))
+              + ("completeness against the tip positions' solutions found by Gauss-Newton from "
+                 f"{NUMERIC_STARTS} starts (no closed form)" if numeric else "completeness against analytic_ik"
+                 if res is not None else "completeness not checked (no closed form)"))
     extra = {"missing": missing, "solutions": None if res is None else np.asarray(res.solutions).tolist()}
     if not entries and not missing:
         return Verdict(cid, "ik_solutions", "correct", f"correct: all {len(claimed)} solution(s) reach the target"

@@ -4,6 +4,7 @@ and joint-wise distances (angles modulo 2π) — shared by the ik_formula and ik
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,7 +14,8 @@ from ..errors import ParseError
 from ..model import DHRobot, JointType
 
 __all__ = ["MATCH_TOL", "POSE_COLUMNS", "RIGID_TOL", "revolute_mask", "joint_distance", "target_env",
-           "controlled_rows", "pose_error", "reaches", "free_joints", "rigid_target"]
+           "controlled_rows", "pose_error", "reaches", "free_joints", "rigid_target", "NumericSolutions",
+           "numeric_solutions", "NUMERIC_STARTS"]
 
 MATCH_TOL = 1e-6
 POSE_COLUMNS = {"n": 0, "o": 1, "a": 2}
@@ -98,3 +100,37 @@ def free_joints(text: str) -> set[int]:
     import re
 
     return {int(m) - 1 for m in re.findall(r"q(\d+)", text or "")}
+
+
+#: Starts of the Gauss–Newton search for the solutions of an arm without a closed form.
+NUMERIC_STARTS = 48
+
+
+@dataclass(frozen=True)
+class NumericSolutions:
+    """The IK solutions of a target for an arm of at most 3 joints without a closed form (the 2-joint polar RP arm),
+    found by Gauss–Newton on its tip's position from many starts: complete as far as the starts reach.  The fields
+    an analytic_ik result has that the IK checks read."""
+
+    solutions: np.ndarray
+    outside_limits: np.ndarray
+    free: tuple[str, ...]
+    branches: tuple[str, ...]
+    controlled: str = "position"
+
+
+def numeric_solutions(robot: DHRobot, T: np.ndarray, known: np.ndarray, starts: np.ndarray) -> NumericSolutions:
+    """The distinct configurations (revolute angles in (−π, π]) that put the tip at T's position, from ``known``
+    (one that does) and each of ``starts``."""
+    rev = revolute_mask(robot)
+    found: list[np.ndarray] = []
+    for q0 in [np.asarray(known, dtype=float), *starts]:
+        q = reaches(robot, q0, T, [], [0, 1, 2])
+        if q is None:
+            continue
+        q = np.where(rev, (q + np.pi) % (2 * np.pi) - np.pi, q)
+        if not any(np.all(joint_distance(robot, q, f) < 1e-7) for f in found):
+            found.append(q)
+    sols = np.array(found).reshape(-1, robot.dof)
+    return NumericSolutions(sols, np.zeros((0, robot.dof)), ("",) * len(sols),
+                            tuple(f"solution {k} (numeric)" for k in range(1, len(sols) + 1)))
