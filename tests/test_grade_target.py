@@ -66,7 +66,8 @@ def test_joint_values_that_miss_are_incorrect_with_the_solutions():
 
 
 def test_without_words_of_a_target_the_numbers_are_no_target():
-    claims = grade_text(_report(_values(_solutions()[0]), words="We note")).claims
+    text = _report(_values(_solutions()[0]), words="We note").replace("# Inverse kinematics", "# Exercise 3")
+    claims = grade_text(text).claims  # (under a heading about inverse kinematics the numbers would be its target)
     assert not [c for c in claims if c.quantity == "ik_solutions"]
 
 
@@ -170,3 +171,19 @@ def test_a_numeric_pose_without_words_of_a_target_is_no_target():
     report = grade_text(_pose_report("The pose of the tool is", Q_TRUE))
     assert not [c for c in report.claims if c.quantity == "ik_solutions"]
     assert [c.verdict for c in report.claims if c.quantity == "end_effector"] == ["ambiguous"]
+
+
+def test_coordinates_stated_under_an_inverse_kinematics_heading_are_the_target():
+    """"With x = 0.3 m and y = −0.4 m, d_2 = 0.5 m and θ_1 = 36.87°" under "Inverse kinematics", for the polar RP arm
+    (tip (d2 sin θ1, −d2 cos θ1), so atan2(0.3, 0.4) = 36.87°): the coordinates are the target, the joint values a
+    solution (judged against the tip's position; this arm has no closed form); elsewhere they are no target."""
+    table = ("| Link | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |\n|---|---|---|---|---|\n"
+             "| 1 | 0 | $90^\\circ$ | 0 | $\\theta_1$ |\n| 2 | 0 | 0 | $d_2$ | 0 |\n")
+    assert abs(math.degrees(math.atan2(0.3, 0.4)) - 36.87) < 0.005
+
+    def report(heading: str, angle: str) -> str:
+        return (f"# RP arm\n\n## 1. DH table\n\n{table}\n## 2. {heading}\n\nWith $x = 0.3$ m and $y = -0.4$ m, "
+                f"$d_2 = 0.5$ m and $\\theta_1 = {angle}^\\circ$.\n")
+    verdicts = [[c.verdict for c in grade_text(report(h, a)).claims if c.quantity == "ik_solutions"]
+                for h, a in (("Inverse kinematics", "36.87"), ("Inverse kinematics", "30"), ("A case", "36.87"))]
+    assert verdicts == [["correct"], ["incorrect"], []]

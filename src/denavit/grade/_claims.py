@@ -26,7 +26,7 @@ from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_for
 from ._points import names_wrist_centre
 from ._shorthand import define_name, rename_recent
 from ._split import Equation, split_block
-from ._target import (case_solution, is_target_part, matrix_target, prose_target, slide_formula, solution_claim,
+from ._target import (IK_HEADING, case_solution, is_target_part, matrix_target, prose_target, slide_formula, solution_claim,
                       target_words)
 from ._values import wrench_symbols
 
@@ -122,6 +122,7 @@ class _Walker:
                                        p_wrist=self.ctx.p_wrist and same)
                 elif _CASE.search(it.title):
                     self.ctx.q = None
+                self.ctx.ik_section = bool(IK_HEADING.search(it.title))
             elif isinstance(it, Prose):
                 self.prose(it)
             elif isinstance(it, Math) and not self.in_table(it.line):
@@ -147,7 +148,7 @@ class _Walker:
                 q = prose_case(plain, robot)
                 if q is not None:
                     self.ctx.q = self.ctx.cases[number] = q
-        if robot is not None and (target := prose_target(it.text, robot.dof)) is not None:
+        if robot is not None and (target := prose_target(it.text, robot.dof, self.ctx.ik_section)) is not None:
             self.ctx.target, self.ctx.target_line = target, it.line
         self.ctx.target_words_line = it.line if target_words(it.text) else self.ctx.target_words_line
         for name, value in prose_definitions(plain_names(plain)):

@@ -50,7 +50,8 @@ class Context:
     target_line: int = 0
     target_words_line: int = 0  # the last line with words of a target ("the desired pose"): a T after it is one
     renames: dict[str, str] = field(default_factory=dict)  # shorthand digits → signed form ("124" → "12-4")
-    p_wrist: bool = False  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
+    p_wrist: bool = False
+    ik_section: bool = False  # under a heading about inverse kinematics: coordinates stated are a target  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
 
     def define(self, name: str, value: str) -> None:
         self.where.pop(name, None)

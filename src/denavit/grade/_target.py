@@ -19,22 +19,25 @@ from ._names import joint_of
 from ._shorthand import TARGET_NAMES
 from ._values import cells, matrices
 
-__all__ = ["prose_target", "is_target_part", "solution_claim", "target_words", "matrix_target", "case_solution",
+__all__ = ["IK_HEADING", "prose_target", "is_target_part", "solution_claim", "target_words", "matrix_target", "case_solution",
            "slide_formula"]
 
 _WORDS = re.compile(r"\b(?:reach(?:es|ed)?|target|desired|goal|move[sd]? to|placed? at|must be at)\b", re.I)
 _POSE_WORDS = re.compile(r"\b(?:given|following|this)\s+(?:end[- ]effector\s+|tool\s+)?(?:pose|transform(?:ation)?)\b",
                          re.I)
+#: A heading about inverse kinematics: coordinates its prose states are the target, without words of a target.
+IK_HEADING = re.compile(r"inverse\s+kinematics|\bIK\b|inverse\s+position", re.I)
 #: Lines a target matrix may follow the words that announce it.
 TARGET_REACH = 6
 _NUMBER = r"(-?\s?\d+(?:\.\d+)?)\s*(\^\s*\{?\\circ\}?|°)?"
 _COORD = re.compile(r"\$\s*(x|y|z|p_\{?[xyz]\}?|\\phi|\\varphi|\\psi)\s*=\s*" + _NUMBER + r"\s*\$")
 
 
-def prose_target(text: str, dof: int) -> str | None:
+def prose_target(text: str, dof: int, ik_section: bool = False) -> str | None:
     """The target pose (a 4×4 matrix as text for the checker) a paragraph states, or None: it needs words of a
-    target and at least as many numbers (x, y, z, φ) as the arm has joints."""
-    if not _WORDS.search(text):
+    target (or a heading about inverse kinematics: ``ik_section``) and at least as many numbers (x, y, z, φ) as the
+    arm has joints."""
+    if not (_WORDS.search(text) or ik_section):
         return None
     found: dict[str, float] = {}
     for m in _COORD.finditer(text):
