@@ -415,3 +415,25 @@ def test_sympy_and_array_matrices_are_read_as_bmatrix(form):
         texts.append(f"$$T_2^0 = {tex}$$")
     got = [v for _, q, v in _verdicts(_report(*texts), fmt="md") if q == "end_effector"]
     assert got == ["correct", "incorrect"]
+
+
+def test_a_wrench_named_with_capitals_is_the_wrench():
+    """``F = [F_x, F_y]^T`` then ``τ = J^T F = [⋯ F_x ⋯]``: the capital names are the wrench's (were "in terms of
+    other results"). τ = J_vᵀ F of the planar 2R arm by hand: (−L1 s1 − L2 s12) F_x + (L1 c1 + L2 c12) F_y,
+    −L2 s12 F_x + L2 c12 F_y."""
+    tau = ("\\begin{bmatrix} (-L_1 s_1 - L_2 s_{12}) F_x + (L_1 c_1 + L_2 c_{12}) F_y \\\\ "
+           "-L_2 s_{12} F_x + L_2 c_{12} F_y \\end{bmatrix}")
+    right = _report("For a force $F = [F_x, F_y]^T$ at the tip:", f"$$\\tau = J^T F = {tau}$$")
+    wrong = right.replace("-L_2 s_{12} F_x", "L_2 s_{12} F_x")
+    assert [v for _, q, v in _verdicts(right) if q == "torques"] == ["correct"]
+    assert [v for _, q, v in _verdicts(wrong) if q == "torques"] == ["incorrect"]
+
+
+@pytest.mark.parametrize("lhs", ["\\det J", "\\det \\begin{bmatrix} -L_1 s_1 - L_2 s_{12} & -L_2 s_{12} \\\\ "
+                                 "L_1 c_1 + L_2 c_{12} & L_2 c_{12} \\end{bmatrix}"])
+def test_det_of_the_planar_two_link_arm_and_of_its_rows_written_out(lhs):
+    """det of the (x, y) rows of the planar 2R Jacobian = L1 L2 sin θ2 (Spong Sec. 4.10, by hand: the 2×2 above);
+    a slip is incorrect (the default rows of a 2-joint planar arm are (vx, vy), a square block)."""
+    right, wrong = (_report(f"$${lhs} = {v}$$") for v in ("L_1 L_2 s_2", "L_1 L_2 c_2"))
+    assert [v for _, q, v in _verdicts(right) if q == "det_jacobian"] == ["correct"]
+    assert [v for _, q, v in _verdicts(wrong) if q == "det_jacobian"] == ["incorrect"]

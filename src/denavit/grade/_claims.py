@@ -41,6 +41,7 @@ _RELATION = re.compile(r"(?:J(?:_\{?\\?\w+\}?)?(?:\^\{?T\}?)?|\\mathbf\{J\}\^T)(
                        r"\\dot\{?\\theta\}?|\\begin\{bmatrix\}f_E\\\\n_E\\end\{bmatrix\})")
 _NAMED_RESULT = re.compile(r"(?:\{\}\s*\^\s*\{?\w{1,3}\}?\s*)?(?:\\mathbf\{)?J\}?(?:_|\^|\s|\\dot|$)")
 _MORE_VALUES = re.compile(r"\$\s*([^$=]{1,60}?)\s*=\s*[^$=]{1,60}\$\s*(?:,|or|and)\s*\$\s*([^$=]{1,60}?)\s*\$")
+_DET_OF_MATRIX = re.compile(r"\s*\\det\s*(?:\\left\s*)?[(\[|]?\s*\\begin\{[bpv]?matrix\}")
 _CASE = re.compile(r"\bcase\s*\d", re.I)
 _WRENCH_NAMES = re.compile(r"\b[fFnN]_\{?[xyz123456]")
 _PROPAGATION = re.compile(r"\{\}\s*\^\s*\{?\s*\d\s*\}?\s*\\?(?:mathbf\{)?[fn]\}?\s*_")
@@ -347,6 +348,8 @@ class _Walker:
         if manip is not None and len(eq.parts) > 2:
             self.out.append(manipulability_pending(eq, arm, value, manip.group(1)))
             return
+        if _DET_OF_MATRIX.match(lhs) and "\\begin" not in value:  # det [the rows of J written out] = −d_2
+            return self._det(eq, arm, value, None)
         reading = read_name(sym, robot, value) if sym is not None else vector_reading(lhs, robot)
         if reading is not None and reading.spec.get("quantity") == "det_jacobian":
             self._det(eq, arm, value, sym)

@@ -62,6 +62,8 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
             if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
                 reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
     qty = str(reading.spec.get("quantity"))
+    if "wrench" in reading.needs:  # F = [F_x, F_y]: the wrench's capital names are the checker's f_x, f_y
+        value = _CAPITAL_WRENCH.sub(lambda m: f"{m.group(1).lower()}_{{{m.group(2)}}}", value)
     vec = vector_entries(value)
     spec = dict(reading.spec)
     if qty in ("torques", "equations_of_motion") and "entry" in spec and vec and len(vec) == arm.robot.dof:
@@ -101,6 +103,9 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
             if key in claim and key not in alt:
                 alt[key] = claim[key]
     return p
+
+_CAPITAL_WRENCH = re.compile(r"(?<![A-Za-z\\])([FN])\s*_\s*\{?\s*([xyz])\s*\}?")
+
 
 def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric: bool) -> None:
     """The wrench a τ, ⁱfᵢ or ⁱnᵢ claim is about: the stated numbers, or the symbols the section names."""

@@ -152,7 +152,8 @@ def only_names(text: str) -> bool:
 
 def det_rows(sym: Any, robot: Any) -> str | None:
     """The rows of J a determinant is taken of: those its name says (``J_v``, ``J_\\omega``), else for an arm of up
-    to 3 joints (vx, vy, ωz) when it moves in a plane, (vx, vy, vz) when it does not; None (all) beyond."""
+    to 3 joints (vx, vy) or (vx, vy, ωz) when it moves in a plane, (vx, vy, vz) when it does not; None (all)
+    beyond."""
     sub = (sym.sub if sym is not None else "").strip("{} \\")
     if sub == "v":
         return "vx,vy,vz"
@@ -160,7 +161,9 @@ def det_rows(sym: Any, robot: Any) -> str | None:
         return "wx,wy,wz"
     if robot.dof > 3:
         return None
-    return "planar" if moves_in_xy(robot) else "vx,vy,vz"
+    if moves_in_xy(robot):
+        return "vx,vy" if robot.dof == 2 else "planar"  # (vx, vy, ωz) for three joints
+    return "vx,vy,vz"
 
 
 def trailing_name(parts: tuple[str, ...], robot: Any) -> Reading | None:
