@@ -187,3 +187,16 @@ def test_coordinates_stated_under_an_inverse_kinematics_heading_are_the_target()
     verdicts = [[c.verdict for c in grade_text(report(h, a)).claims if c.quantity == "ik_solutions"]
                 for h, a in (("Inverse kinematics", "36.87"), ("Inverse kinematics", "30"), ("A case", "36.87"))]
     assert verdicts == [["correct"], ["incorrect"], []]
+
+
+def test_the_heading_stated_as_a_result_stays_the_targets_in_ik_and_a_cosine_step_is_its_value():
+    """``\\phi = \\theta_1 + \\theta_2 + \\theta_3`` (forward kinematics) must not make φ a name for the joints in
+    the IK after it (θ₃ = φ − θ₁ − θ₂ was "uses q3 itself"); ``\\cos\\theta_2 = …`` is an IK step and the
+    ``\\theta_2 = atan2(±√(1 − \\cos^2\\theta_2), \\cos\\theta_2)`` after it uses that value (the closed form above)."""
+    steps = ["\\phi = \\theta_1 + \\theta_2 + \\theta_3", "x_w = x - L_3 \\cos\\phi", "y_w = y - L_3 \\sin\\phi",
+             "\\cos\\theta_2 = \\frac{x_w^2 + y_w^2 - L_1^2 - L_2^2}{2 L_1 L_2}",
+             "\\theta_2 = \\operatorname{atan2}(\\pm\\sqrt{1 - \\cos^2\\theta_2}, \\cos\\theta_2)",
+             "\\theta_3 = \\phi - \\theta_1 - \\theta_2"]
+    text = f"# IK\n\n{TABLE}\n" + "\n\n".join(f"$${s}$$" for s in steps) + "\n"
+    got = [c.verdict for c in grade_text(text).claims if c.quantity == "ik_formula"]
+    assert got == ["correct"] * 3, got

@@ -18,6 +18,7 @@ from ..model import DHRobot
 from ._engine import Verdict, check_claim
 from ._ik_claims import wrist_offset
 from ._text import bracket_depths
+from ._tokens import normalize
 from ._latex import parse_math
 from ._matrices import parse_matrix, split_matrix
 from ._quantities import QUANTITIES
@@ -26,7 +27,7 @@ from ._resolve import robot_resolver
 __all__ = ["CheckResult", "Verdict", "check_claims", "check_file", "verdicts_text", "parse_math", "parse_matrix",
            "split_matrix", "robot_resolver", "QUANTITIES", "MAX_CLAIMS", "MAX_SIGN_CHOICES", "MAX_SINGULAR_SETS", "MAX_DETAILED",
            "MAX_FILE_BYTES", "read_input_text", "wrist_offset",
-           "bracket_depths"]
+           "bracket_depths", "normalize"]
 
 #: Most claims in one file (a whole course report is a few hundred; 500 are judged in well under a minute).
 MAX_CLAIMS = 500

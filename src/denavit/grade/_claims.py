@@ -120,7 +120,7 @@ class _Walker:
                 if it.level <= top:  # a new part: its givens are its own; names defined stay while the arm does
                     same = self.ctx_arm is not None and self.arm_at(it.line) is self.ctx_arm
                     self.ctx = Context(singular=self.ctx.singular, where=dict(self.ctx.where) if same else {},
-                                       p_wrist=self.ctx.p_wrist and same)
+                                       p_wrist=self.ctx.p_wrist and same, cases=dict(self.ctx.cases) if same else {})
                 elif _CASE.search(it.title):
                     self.ctx.q = None
                 self.ctx.ik_section = bool(IK_HEADING.search(it.title))

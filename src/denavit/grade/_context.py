@@ -49,7 +49,8 @@ class Context:
     target: str | None = None  # an IK target stated in words (a 4×4 as text), and the line that stated it
     target_line: int = 0
     target_words_line: int = 0  # the last line with words of a target ("the desired pose"): a T after it is one
-    renames: dict[str, str] = field(default_factory=dict)  # shorthand digits → signed form ("124" → "12-4")
+    renames: dict[str, str] = field(default_factory=dict)
+    trig_steps: dict[tuple[str, int], str] = field(default_factory=dict)  # ("cos", 2) → the formula "cos θ2 = …" gave  # shorthand digits → signed form ("124" → "12-4")
     p_wrist: bool = False
     ik_section: bool = False  # under a heading about inverse kinematics: coordinates stated are a target  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "delimited_matrices",
+__all__ = ["Math", "Heading", "Prose", "Document", "read_document", "plain_names", "plain_math", "delimited_matrices",
            "joined_display", "MAX_BLOCK_LINES", "MAX_ITEMS"]
 
 #: Longest display block (lines); a block left open longer than this is closed there.
@@ -25,6 +25,7 @@ _OPEN_ENV = re.compile(r"\\begin\{(" + "|".join(_ENVS) + r")(\*?)\}")
 _MD_HEADING = re.compile(r"^\s{0,3}(#{1,6})\s+(.*?)\s*#*\s*$")
 _TEX_HEADING = re.compile(r"^\s*\\(section|subsection|subsubsection|paragraph)\*?\{(.{0,300})\}")
 _EXERCISE = re.compile(r"^\s*(\d{1,3})\)\s+\S")
+_TXT_HEADING = re.compile(r"^\s*(\d{1,2})\.\s+([A-Z][^=$.:;]{1,80})$")  # plain text: "4. Inverse kinematics"
 _KEY = re.compile(r"^\W{0,4}(\d{1,3})(?:[.)]|\s|$)")
 
 
@@ -74,6 +75,9 @@ def _heading(line: str, n: int, fmt: str) -> Heading | None:
     m = _EXERCISE.match(line)
     if m and "$" not in line[:m.end()]:
         return Heading(n, line.strip()[:120], 1, m.group(1))
+    m = _TXT_HEADING.match(line) if fmt == "txt" else None
+    if m and len(m.group(2).split()) <= 6:
+        return Heading(n, line.strip(), 1, m.group(1))
     return None
 
 
@@ -84,7 +88,9 @@ def _key(title: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", title.lower()).strip("-")[:40]
 
 
-_PLAIN_EQ = re.compile(r"^\s*[A-Za-z\\][\w{}^\\,()]{0,40}\s*=\s*\S")
+_PLAIN_EQ = re.compile(r"^\s*(?:(?:det|cos|sin|tan)\s+)?(?:[^\W\d_]|\\)[\w{}^\\,()'²³]{0,40}\s*=\s*\S")
+#: Lines a plain-text matrix left open (``J = [ a, b ;``) may continue over.
+PLAIN_MATRIX_LINES = 12
 _WORDS = re.compile(r"[A-Za-z]{3,}\s+[A-Za-z]{2,}\s+[A-Za-z]{2,}")
 
 
@@ -116,6 +122,14 @@ def delimited_matrices(text: str) -> str:
     return text
 
 
+def plain_math(text: str) -> str:
+    """A plain-text equation in the LaTeX the readers take: ``θ2`` → ``\\theta_{2}``, ``τ1``, ``φ``, ``cos²`` →
+    ``cos^2``, and a leading ``det J`` / ``cos θ2`` as ``\\det J`` / ``\\cos \\theta_{2}``."""
+    from ..check import normalize
+
+    return re.sub(r"^\s*(det|cos|sin|tan)\s+", r"\\\1 ", normalize(text))
+
+
 def _plain_equation(line: str) -> bool:
     """A plain-text report's line that is an equation (``theta1 = atan2(yc, xc) - …``), not a sentence."""
     if "$" in line or "\\[" in line or len(line) > 2000 or not _PLAIN_EQ.match(line):
@@ -123,6 +137,10 @@ def _plain_equation(line: str) -> bool:
     rhs = line.split("=", 1)[1]
     funcs = re.sub(r"\b(?:atan2|arctan|arccos|arcsin|sqrt|sin|cos|tan|pi)\b", " ", rhs)
     return not _WORDS.search(funcs) and bool(re.search(r"[\d()_^*/+-]", rhs))
+
+
+def _open_brackets(text: str) -> int:
+    return sum(text.count(c) for c in "([{") - sum(text.count(c) for c in ")]}")
 
 
 def _strip_comments(line: str, in_comment: bool) -> tuple[str, bool]:
@@ -199,8 +217,12 @@ class _Scanner:
 
     def _pieces(self, line: str, n: int) -> int:
         if self.fmt == "txt" and _plain_equation(line):
-            self.items.append(Math(n + 1, n + 1, plain_names(line.strip()), True))
-            return n + 1
+            text, end = line.strip(), n
+            while _open_brackets(text) > 0 and end + 1 < len(self.lines) and end - n < PLAIN_MATRIX_LINES:
+                end += 1  # a matrix written over several lines: J = [ a, b ; ⏎ c, d ]
+                text += " " + self.lines[end].strip()
+            self.items.append(Math(n + 1, end + 1, plain_math(plain_names(text)), True))
+            return end + 1
         k, prose = 0, []
         while True:
             found = _next_open(line, k)

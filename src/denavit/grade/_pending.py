@@ -15,7 +15,8 @@ from ._arms import Arm
 from ._context import Context, has_joint_names, vector_entries
 from ._names import Reading
 from ._reading import det_rows, used_where
-from ._shorthand import renamed
+from ._lhs import read_symbol
+from ._shorthand import renamed, trig_named, trig_of_joint
 from ._split import Equation
 from ._values import WRENCH_NAMES, expand_product, matrices, numeric_value, scale_matrix, wrench_symbols
 
@@ -62,8 +63,9 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
             if reading.spec["quantity"] == "end_effector":  # "T = [J^T] [f]": an OCR'd τ
                 reading = Reading({"quantity": "torques"}, "τ (written T)", sure=False, needs=("q", "wrench"))
     qty = str(reading.spec.get("quantity"))
-    if "wrench" in reading.needs:  # F = [F_x, F_y]: the wrench's capital names are the checker's f_x, f_y
-        value = _CAPITAL_WRENCH.sub(lambda m: f"{m.group(1).lower()}_{{{m.group(2)}}}", value)
+    if "wrench" in reading.needs:  # F = [F_x, F_y, M_z]: the wrench's names as the checker's f_x, f_y, n_z
+        value = _CAPITAL_WRENCH.sub(lambda m: f"{'n' if m.group(1) in 'Mm' else m.group(1).lower()}_{{{m.group(2)}}}",
+                                    value)  # a moment m_z / M_z is the checker's n_z
     vec = vector_entries(value)
     spec = dict(reading.spec)
     if qty in ("torques", "equations_of_motion") and "entry" in spec and vec and len(vec) == arm.robot.dof:
@@ -104,7 +106,7 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
                 alt[key] = claim[key]
     return p
 
-_CAPITAL_WRENCH = re.compile(r"(?<![A-Za-z\\])([FN])\s*_\s*\{?\s*([xyz])\s*\}?")
+_CAPITAL_WRENCH = re.compile(r"(?<![A-Za-z\\])([FfNnMm])\s*_?\s*\{?\s*([xyz])\s*\}?(?![A-Za-z])")
 
 
 def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric: bool) -> None:
@@ -131,6 +133,15 @@ def _wrench(ctx: Context, p: Pending, claim: dict[str, Any], value: str, numeric
 def ik_formula_pending(ctx: Context, eq: Equation, arm: Arm, lhs: str, value: str) -> Pending:
     """``q_1 = atan2(p_y, p_x)``: an inverse-kinematics formula, with the names the derivation defined that it uses
     and the wrist centre as P when the report named it so (:func:`._points.names_wrist_centre`)."""
+    step = trig_of_joint(lhs)
+    if step is not None:  # "cos θ2 = …": the formulas for θ2 after it may use cos θ2 as that value
+        ctx.trig_steps[step] = value
+    joint = read_symbol(lhs)
+    k = int(joint.sub.strip("{} ")) if joint is not None and joint.sub.strip("{} ").isdigit() else None
+    for (fn, j), given in (ctx.trig_steps.items() if step is None else ()):
+        if j == k and trig_named(value, fn, j) != value:
+            value = trig_named(value, fn, j)
+            ctx.define(f"{fn[0]}_{{{j}}}", given)
     claim: dict[str, Any] = {"quantity": "ik_formula", "value": f"{lhs} = {value}"}
     used = used_where(ctx.where, value)
     if used:

@@ -10,11 +10,12 @@ from typing import Any
 
 from ._context import Context, has_joint_names
 
-__all__ = ["define_name", "rename_recent", "renamed", "SHORTHAND", "TARGET_NAMES"]
+__all__ = ["define_name", "rename_recent", "renamed", "SHORTHAND", "TARGET_NAMES", "trig_of_joint", "trig_named"]
 
 SHORTHAND = re.compile(r"[cCsS]_?\{?\d{1,6}\}?")
 #: Names of the target's entries in an IK formula (x, y, z, p_x, r_13, n_x …).
 TARGET_NAMES = re.compile(r"(?<![A-Za-z\\])(?:[xyz](?![A-Za-z_])|[pP]_\{?[xyz]\}?|r_\{?\d\d\}?|[noa]_\{?[xyz]\}?)")
+_TARGET_NAME = re.compile(r"\\(?:var)?phi|\\psi|[xyz]|[pP]_\{?[xyz]\}?|r_\{?\d\d\}?")
 _TRIG = re.compile(r"^\s*\\?(cos|sin)\s*(?:\\left)?\s*\((.{1,120})\)\s*(?:\\right\))?\s*$")
 _TERM = re.compile(r"([-+]?)\s*(?:\\(?:var)?theta|q)\s*_\s*\{?\s*(\d)\s*\}?")
 #: How many lines a definition may follow the claim it explains ("… where c₁₂₄ = …").
@@ -53,6 +54,8 @@ def define_name(ctx: Context, sym: Any, lhs: str, value: str, parts: tuple[str, 
         ctx.renames[signed[0]] = signed[1]
         return True
     name = re.sub(r"\s+", "", lhs)
+    if _TARGET_NAME.fullmatch(name):  # φ = θ1 + θ2 + θ3, x = …: results; in IK formulas these are the target's
+        return False
     intermediate = not has_joint_names(value) and TARGET_NAMES.search(value) is not None  # c_2 = (x² + y² …)/…
     if sym is not None and re.fullmatch(r"[A-Za-z]{1,3}", sym.base) and not sym.pre_sup and not sym.dots \
             and len(parts) == 2 and re.sub(r"[_{}]", "", name) not in params and "\\begin" not in value \
@@ -75,3 +78,29 @@ def rename_recent(out: list, ctx: Context, line: int) -> None:
                            else a, w) for a, w in p.alternatives]
         p.equivalent = [({**a, "value": renamed(a["value"], ctx.renames)} if isinstance(a.get("value"), str)
                          else a, w) for a, w in p.equivalent]
+
+
+_JOINT = r"(?:\\(?:var)?theta|q)\s*_\s*(?:\{\s*(D)\s*\}|(D))"  # θ_2 or θ_{2}: a brace only in pairs
+
+
+def _joint_arg(digit: str) -> str:
+    """θ_j, q_j, (θ_j), \\left(θ_j\\right): a joint as a trig function's argument (a bracket only when it closes)."""
+    one = _JOINT.replace("(D)", digit)
+    return r"(?:(?:\\left\s*)?\(\s*" + one + r"\s*(?:\\right\s*)?\)|" + one + ")"
+
+
+_TRIG_OF_JOINT = re.compile(r"^\s*\\?(cos|sin)\s*" + _joint_arg(r"(\d)") + r"\s*$")
+
+
+def trig_of_joint(lhs: str) -> tuple[str, int] | None:
+    """``\\cos\\theta_2``, ``cos(q_2)``, ``\\sin \\theta_{3}`` → ("cos", 2): the left side of an IK step that
+    gives a joint's cosine or sine; None otherwise."""
+    m = _TRIG_OF_JOINT.match(lhs)
+    return (m.group(1), int(next(g for g in m.groups()[1:] if g))) if m else None
+
+
+def trig_named(value: str, fn: str, joint: int) -> str:
+    """``value`` with the joint's cosine (sine) written as the name ``c_j`` (``s_j``), its square too:
+    ``atan2(±sqrt(1 - cos^2\\theta_2), \\cos\\theta_2)`` → ``atan2(±sqrt(1 - c_{2}^2), c_{2})``."""
+    pattern = r"(?<![A-Za-z])\\?" + fn + r"\s*(\^\s*\{?\s*2\s*\}?)?\s*" + _joint_arg(str(joint))
+    return re.sub(pattern, lambda m: f"{fn[0]}_{{{joint}}}" + ("^2" if m.group(1) else ""), value)
