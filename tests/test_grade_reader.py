@@ -437,3 +437,27 @@ def test_det_of_the_planar_two_link_arm_and_of_its_rows_written_out(lhs):
     right, wrong = (_report(f"$${lhs} = {v}$$") for v in ("L_1 L_2 s_2", "L_1 L_2 c_2"))
     assert [v for _, q, v in _verdicts(right) if q == "det_jacobian"] == ["correct"]
     assert [v for _, q, v in _verdicts(wrong) if q == "det_jacobian"] == ["incorrect"]
+
+
+def test_a_notebook_export_names_its_outputs_by_the_cell_before_them():
+    """nbconvert's Markdown: a code cell ending in a bare name (``T02``, ``display(Jv)``) and its output as
+    ``$\\displaystyle \\left[\\begin{matrix} … \\end{matrix}\\right]$`` with no left-hand side: judged as ``T02 = …``,
+    ``J_v = …`` (the planar 2R's T and J_v multiplied out by SymPy here); a cell ending in another call names nothing."""
+    import sympy as sp
+
+    t1, t2, l1, l2 = sp.symbols("theta_1 theta_2 L_1 L_2")
+
+    def a(t, length):
+        return sp.Matrix([[sp.cos(t), -sp.sin(t), 0, length * sp.cos(t)], [sp.sin(t), sp.cos(t), 0, length * sp.sin(t)],
+                          [0, 0, 1, 0], [0, 0, 0, 1]])
+    T = sp.simplify(a(t1, l1) * a(t2, l2))
+    Jv = T[:3, 3].jacobian([t1, t2])
+    slipped = sp.Matrix(Jv)
+    slipped[0, 1] = -slipped[0, 1]
+
+    def cell(code: str, out) -> str:
+        return f"```python\n{code}\n```\n\n\n\n$\\displaystyle {sp.latex(out)}$\n"
+    text = _report(cell("T02 = sp.simplify(A1 * A2)\nT02", T), cell("Jv = p.jacobian([t1, t2])\ndisplay(Jv)", Jv),
+                   cell("Jw", slipped).replace("Jw", "Jv"), cell("sp.simplify(Jv[:2, :].det())", l1 * l2 * sp.sin(t2)))
+    got = [(q, v) for _, q, v in _verdicts(text) if v != "not a claim"]
+    assert got == [("end_effector", "correct"), ("jacobian", "correct"), ("jacobian", "incorrect")], got

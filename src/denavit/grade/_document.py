@@ -26,6 +26,24 @@ _MD_HEADING = re.compile(r"^\s{0,3}(#{1,6})\s+(.*?)\s*#*\s*$")
 _TEX_HEADING = re.compile(r"^\s*\\(section|subsection|subsubsection|paragraph)\*?\{(.{0,300})\}")
 _EXERCISE = re.compile(r"^\s*(\d{1,3})\)\s+\S")
 _TXT_HEADING = re.compile(r"^\s*(\d{1,2})\.\s+([A-Z][^=$.:;]{1,80})$")  # plain text: "4. Inverse kinematics"
+#: A code cell's last line that shows a value: ``T``, ``J_v``, ``display(T06)``, ``sp.simplify(T)``.
+_SHOWN = re.compile(r"(?:display|(?:sp\.|sympy\.)?simplify|(?:sp\.|sympy\.)?Matrix)\(\s*([A-Za-z]\w{0,15})\s*\)"
+                    r"|([A-Za-z]\w{0,15})")
+#: Lines after a code cell its output may start on (nbconvert leaves blank lines between).
+NOTEBOOK_OUTPUT_LINES = 8
+
+
+def notebook_name(name: str) -> str:
+    """A Python name as the report readers take it: ``T0_2``, ``T_02`` → ``T02``; ``Jv``/``J_v`` → ``J_v``,
+    ``Jw`` → ``J_\\omega``; others as they are."""
+    if re.fullmatch(r"[A-Za-z]_?\d_?\d", name):
+        return name.replace("_", "")
+    m = re.fullmatch(r"J_?(v|w|omega)", name)
+    if m:
+        return "J_v" if m.group(1) == "v" else "J_\\omega"
+    return name
+
+
 _KEY = re.compile(r"^\W{0,4}(\d{1,3})(?:[.)]|\s|$)")
 
 
@@ -185,11 +203,16 @@ class _Scanner:
 
     def run(self) -> None:
         in_comment, fence, n = False, None, 0
+        self.shown: tuple[str, int] | None = None  # a notebook cell's last line names what its output shows
         while n < len(self.lines) and len(self.items) < MAX_ITEMS:
             raw = self.lines[n]
             stripped = raw.strip()
             if fence is not None:
-                fence = None if stripped.startswith(fence) else fence
+                if stripped.startswith(fence):
+                    fence = None
+                elif stripped:
+                    m = _SHOWN.fullmatch(stripped)
+                    self.shown = (notebook_name(m.group(1) or m.group(2)), n + 1) if m else None
                 n += 1
                 continue
             if self.fmt != "tex" and (stripped.startswith("```") or stripped.startswith("~~~")):
@@ -237,6 +260,7 @@ class _Scanner:
                 end = e + len(closer)
                 body = line[start:e] if not opener.startswith("\\begin") else line[p:end]
                 display = opener != "$"
+                body = self._named_output(body, n)
                 self.items.append(Math(n + 1, n + 1, delimited_matrices(body), display))
                 if not display:
                     prose.append("$" + body + "$")
@@ -250,6 +274,14 @@ class _Scanner:
         if text:
             self.items.append(Prose(n + 1, text))
         return n + 1
+
+    def _named_output(self, body: str, n: int) -> str:
+        """A notebook's output right after a code cell ending in a bare name (``T``, ``display(J)``), written
+        without a left-hand side: ``NAME = output`` (once)."""
+        shown, self.shown = self.shown, None
+        if shown is None or n + 1 - shown[1] > NOTEBOOK_OUTPUT_LINES or "=" in body.replace("\\leq", ""):
+            return body
+        return shown[0] + " = " + re.sub(r"^\s*\\displaystyle\s*", "", body)
 
     def _block(self, line: str, n: int, p: int, opener: str, closer: str, before: str) -> int:
         """A display block opened on line ``n`` at ``p`` and closed on a later line."""
