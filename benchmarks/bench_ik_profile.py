@@ -6,7 +6,7 @@ Each variant is a numba loop over the same n poses (FK of random joint values wi
 the kernel's steps up to one point, timed by CPU time on one core (best of five interleaved rounds); the
 differences between consecutive rows are the steps' costs.  Elbow kernel (puma560, offset-6r): "stages" (the
 candidates of every branch, ``_ik_nb_elbow_stages``), "+ checks" (verifying FK, residuals, labels:
-``_ik_nb_elbow_checks.elbow_checks``), "kernel" (its fold, the walk over the branches, merge and sort too:
+``_ik_nb_checks.elbow_checks``), "kernel" (its fold, the walk over the branches, merge and sort too:
 ``ik_elbow_packed`` over blocks of 64 poses), "batch entry" (the target check and the scatter into the plain
 solver's batched layout).  UR-class kernel (ur5): "candidates", "kernel", "batch entry".  Report the load
 (``uptime``) with the figures: the machine is shared.
@@ -24,7 +24,7 @@ from numba import njit
 import denavit
 from denavit import forward_kinematics, load_robot
 from denavit.codegen._ik_nb_elbow import ik_elbow_packed
-from denavit.codegen._ik_nb_elbow_checks import elbow_checks
+from denavit.codegen._ik_nb_checks import elbow_checks
 from denavit.codegen._ik_nb_elbow_stages import CHUNK, ROWS, RQA, elbow_stages
 from denavit.codegen._ik_nb_parallel import _parallel_candidates, ik_parallel_packed
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._ik_nb_elbow_checks import elbow_checks, elbow_folds
+from ._ik_nb_checks import elbow_checks, elbow_folds
 from ._ik_nb_elbow_stages import CHUNK, RF2, RFL, RLB, ROWS, RPE, RPO, RQ1, RQ2, RQ3, RQA, RQB, RQC, RRE, RSG
 from ._ik_nb_elbow_stages import RST, RVF, RW2, RX
 from ._ik_nb_elbow_stages import elbow_stages
@@ -37,8 +37,8 @@ def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_stat
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
     of the batched layout (:func:`._ik_nb_finish.ik_finish`).  Every branch of CHUNK poses at a time comes from the
-    stages (:func:`._ik_nb_elbow_stages.elbow_stages`: the candidates; :func:`._ik_nb_elbow_checks.elbow_checks`:
-    their verifying FK, residuals and labels; :func:`._ik_nb_elbow_checks.elbow_folds`: the fold into the limits),
+    stages (:func:`._ik_nb_elbow_stages.elbow_stages`: the candidates; :func:`._ik_nb_checks.elbow_checks`:
+    their verifying FK, residuals and labels; :func:`._ik_nb_checks.elbow_folds`: the fold into the limits),
     then each pose's branches are walked in the one-pose order, merged and sorted as the plain solver does
     (:func:`._ik_nb_finish.ik_placed`)."""
     # scratch: a few allocations per call (not per pose), viewed without reshapes (a reshape is a helper call)

@@ -42,11 +42,11 @@ RQ3, RC3, RS3, RQ2, RC2, RS2, RF2 = 25, 29, 33, 37, 41, 45, 49  # per k2
 RM = 53  # per k2: m00, m10, m20, m02, m12, m22 of M = R_0_3ᵀ T_R R6ᵀ at RM + 6 k2
 RQB, RCB, RSB, RQA, RQC, RSG, RCA, RSA, RCC, RSC = 77, 85, 93, 101, 109, 117, 125, 133, 141, 149  # per k
 # the target's top 3×4 (row-major, copied first: the stages then read no other array); rows of the checks
-# (_ik_nb_elbow_checks): per k2 the frame after joint 3 (x0, x1, x2, y0, …, p2 at RF3 + 12 k2) and the label's
+# (_ik_nb_checks): per k2 the frame after joint 3 (x0, x1, x2, y0, …, p2 at RF3 + 12 k2) and the label's
 # shoulder and elbow bits; per k the residuals, the verified and polish flags and the label code
 RT, RF3, RL2, RPE, RRE, RVF, RPO, RLB = 157, 169, 217, 221, 229, 237, 245, 253
 RW2 = 261  # per k2: 1.0 where the wrist's two roots qb (nearly) coincide (wrist_qb's lo or hi next to 0)
-# rows of the fold into the limits (_ik_nb_elbow_checks; the joints' rows RQ* then hold the folded values): 1.0 where
+# rows of the fold into the limits (_ik_nb_checks; the joints' rows RQ* then hold the folded values): 1.0 where
 # all of a branch's joints so far lie within their limits, plus 2.0 where one of them lies next to an edge of the fold
 RFL1, RFL2, RFL = 265, 267, 271  # per s1, per k2, per k
 ROWS = 279
