@@ -6,9 +6,10 @@ Each variant is a numba loop over the same n poses (FK of random joint values wi
 the kernel's steps up to one point, timed by CPU time on one core (best of five interleaved rounds); the
 differences between consecutive rows are the steps' costs.  Elbow kernel (puma560, offset-6r): "stages" (the
 candidates of every branch, ``_ik_nb_elbow_stages``), "+ checks" (verifying FK, residuals, labels:
-``_ik_nb_checks.elbow_checks``), "kernel" (its fold, the walk over the branches, merge and sort too:
+``_ik_nb_elbow.elbow_checks``), "kernel" (its fold, the walk over the branches, merge and sort too:
 ``ik_elbow_packed`` over blocks of 64 poses), "batch entry" (the target check and the scatter into the plain
-solver's batched layout).  UR-class kernel (ur5): "candidates", "kernel", "batch entry".  Report the load
+solver's batched layout).  UR-class kernel (ur5): the same rows (``_ik_nb_parallel_stages``,
+``_ik_nb_parallel.parallel_checks``, ``ik_parallel_packed``).  Report the load
 (``uptime``) with the figures: the machine is shared.
 """
 
@@ -23,10 +24,12 @@ from numba import njit
 
 import denavit
 from denavit import forward_kinematics, load_robot
-from denavit.codegen._ik_nb_elbow import ik_elbow_packed
-from denavit.codegen._ik_nb_checks import elbow_checks
+from denavit.codegen._ik_nb_elbow import elbow_checks, ik_elbow_packed
 from denavit.codegen._ik_nb_elbow_stages import CHUNK, ROWS, RQA, elbow_stages
-from denavit.codegen._ik_nb_parallel import _parallel_candidates, ik_parallel_packed
+from denavit.codegen._ik_nb_parallel import ik_parallel_packed, parallel_checks
+from denavit.codegen._ik_nb_parallel_stages import ROWS as UR_ROWS
+from denavit.codegen._ik_nb_parallel_stages import RQ2 as UR_RQ2
+from denavit.codegen._ik_nb_parallel_stages import parallel_stages
 
 
 @njit(nogil=True)
@@ -42,18 +45,14 @@ def _stages(T, K, checks):
 
 
 @njit(nogil=True)
-def _ur_candidates(T, K):
-    Q_e, C0i, C = K[0:3], K[3:19].reshape((4, 4)), K[19:131].reshape((7, 4, 4))
-    a, sc, tols, trig = K[131:134], K[134:145], K[169:177], K[178:186]
-    ws, w = np.empty(76), np.empty((27, 36))
-    V, TC, cols, tl = ws[31:34], ws[34:43].reshape((3, 3)), ws[43:55].reshape((4, 3)), ws[55:67].reshape((4, 3))
-    xr, wv, g = ws[67:70], ws[70:73], ws[73:76]
-    R2, p2, p3 = C[2, :3, :3], C[2, :3, 3], C[3, :3, 3]
-    cand, cs, acc = w[0:8, 0:6], w[0:8, 8:20], 0.0
-    for b in range(T.shape[0]):
-        ncand, _ = _parallel_candidates(T, b, Q_e, C0i, C, a, sc, trig, tols, cand, cs, V, TC, cols, tl, xr, wv, g,
-                                        R2, p2, p3)
-        acc += ncand + cand[0, 0]
+def _ur_stages(T, K, checks):
+    St, acc = np.empty(UR_ROWS * CHUNK), 0.0
+    for b in range(0, T.shape[0], CHUNK):
+        n = min(CHUNK, T.shape[0] - b)
+        parallel_stages(T, b, n, K, St)
+        if checks:
+            parallel_checks(n, K, St)
+        acc += St[UR_RQ2 * CHUNK]
     return acc
 
 
@@ -77,7 +76,8 @@ def profile(name, n):
     outs = (np.empty((n, 8, 6)), np.empty((n, 8)), np.empty((n, 8)), np.empty((n, 8), dtype=bool),
             np.empty((n, 8), dtype=np.int8), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int8))
     if kern[1][1] == "parallel":
-        runs = {"candidates": lambda: _ur_candidates(T, K), "kernel": lambda: _kernel(ik_parallel_packed, T, K)}
+        runs = {"stages": lambda: _ur_stages(T, K, False), "+ checks": lambda: _ur_stages(T, K, True),
+                "kernel": lambda: _kernel(ik_parallel_packed, T, K)}
     else:
         runs = {"stages": lambda: _stages(T, K, False), "+ checks": lambda: _stages(T, K, True),
                 "kernel": lambda: _kernel(ik_elbow_packed, T, K)}

@@ -338,6 +338,37 @@ def test_random_ur_class_arms_compiled_equals_plain(seed, _kernel_cache):
                handed_over=0.6)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(3) if REDUCED else range(10))
+def test_random_ur_class_batches_equal_plain(seed, _kernel_cache):
+    """Random UR-class arms, batches through the staged kernel (its candidates, checks and folds run over chunks of
+    poses, every branch at once; codegen/_ik_nb_parallel_stages.py): 45 poses (two chunks and part of a third),
+    random ones mixed with singular and rounded ones and one out of reach, in the plain solver's batched layout
+    (the same slots, labels, continuum texts and outside-limits counts); every filled row reproduces its target by
+    the plain FK."""
+    robot = _random_ur_class(1000 + seed)
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    assert fast._analytic_solver()[1][1] == "parallel"  # the UR-class kernel answers
+    rng = np.random.default_rng(seed)
+    lim = np.clip(robot.q_limits, -2 * np.pi, 2 * np.pi)
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (45, robot.dof))
+    singular, _ = _singular_set(robot, rng, 3, UR_SINGULAR, wrist=True)
+    pick = rng.choice(45, 15, replace=False)
+    Q[pick] = singular[rng.choice(len(singular), 15)]
+    T = denavit.forward_kinematics(robot, Q)
+    T[17, :3, 3] = 50.0 * (1.0 + sum(abs(l.a) + abs(l.d) for l in robot.links))  # beyond every reachable point
+    a, b = fast.analytic_ik(T), denavit.analytic_ik(robot, T)
+    _same_batch(robot, a, b)
+    L = max(1.0, sum(abs(l.a) + abs(l.d) for l in robot.links))
+    for k in range(len(T)):
+        S = a.solutions[k][a.valid[k]]
+        assert k != 17 or len(S) == 0
+        if len(S):
+            F = denavit.forward_kinematics(robot, S)
+            assert np.all(np.abs(F[:, :3, 3] - T[k, :3, 3]).max(axis=-1) < 1e-9 * L)
+            assert np.all(np.abs(F[:, :3, :3] - T[k, :3, :3]).max(axis=(-1, -2)) < 1e-9)
+
+
 def random_wrist_draws(seed: int):
     """The first draws of a random arm with a spherical wrist: (rng, convention, twist(), length(), t4, t5) —
     half of the wrists with equal outer twists, so that axes 4 and 6 can align."""

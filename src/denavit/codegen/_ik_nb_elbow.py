@@ -13,13 +13,12 @@ import math
 import numpy as np
 from numba import njit
 
-from ._ik_nb_checks import elbow_checks, elbow_folds
-from ._ik_nb_elbow_stages import CHUNK, RF2, RFL, RLB, ROWS, RPE, RPO, RQ1, RQ2, RQ3, RQA, RQB, RQC, RRE, RSG
-from ._ik_nb_elbow_stages import RST, RVF, RW2, RX
+from ._ik_nb_checks import CHUNK, stage_checks, stage_folds, take_branch
+from ._ik_nb_elbow_stages import FOLD_GROUPS, LAYOUT, RF2, RPO, RQ1, RQB, ROWS, RSG, RST, RW2, RX
 from ._ik_nb_elbow_stages import elbow_stages
 from ._ik_nb_finish import ik_placed
 
-__all__ = ["ik_elbow_packed", "ik_elbow"]
+__all__ = ["ik_elbow_packed", "ik_elbow", "elbow_checks", "elbow_folds"]
 
 
 @njit(cache=True, nogil=True)
@@ -37,8 +36,8 @@ def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_stat
     residuals, out_label[b, :k] bit codes (1 shoulder left, 2 elbow down, 4 wrist flip), out_outq[b, :j] the
     solutions outside the limits, out_status[b] = (k, j, 1 if the plain solver must decide), out_rank[b] the slots
     of the batched layout (:func:`._ik_nb_finish.ik_finish`).  Every branch of CHUNK poses at a time comes from the
-    stages (:func:`._ik_nb_elbow_stages.elbow_stages`: the candidates; :func:`._ik_nb_checks.elbow_checks`:
-    their verifying FK, residuals and labels; :func:`._ik_nb_checks.elbow_folds`: the fold into the limits),
+    stages (:func:`._ik_nb_elbow_stages.elbow_stages`: the candidates; :func:`elbow_checks`:
+    their verifying FK, residuals and labels; :func:`elbow_folds`: the fold into the limits),
     then each pose's branches are walked in the one-pose order, merged and sorted as the plain solver does
     (:func:`._ik_nb_finish.ik_placed`)."""
     # scratch: a few allocations per call (not per pose), viewed without reshapes (a reshape is a helper call)
@@ -74,7 +73,7 @@ def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_stat
                 for k in range(2 * k2, 2 * k2 + 2):
                     if St[(RSG + k) * CHUNK + r] != 0.0 or St[(RPO + k) * CHUNK + r] != 0.0:
                         status = 1  # wrist singular (a continuum), or a residual the plain solver would polish
-                    if _candidate(St, r, s1, k2, k, cand, cerr, flags, codes, ncand):
+                    if take_branch(St, r, k, LAYOUT, cand, cerr, flags, codes, ncand):
                         status = 1  # verified, and a joint next to an edge of the fold: the plain solver decides
                     ncand += 1
         # (folded into the limits in the stages) merged and sorted as the plain solver does (shared with the UR and
@@ -88,17 +87,15 @@ def ik_elbow(T, K, revolute, tols, out_q, out_err, out_label, out_outq, out_stat
         out_status[b, 2] = max(status, st)
 
 
-@njit(cache=True, nogil=True, inline="always")  # into ik_elbow: no call per candidate
-def _candidate(St, r, s1, k2, k, cand, cerr, flags, codes, m):
-    """Branch k (arm branch k2, shoulder root s1) of pose r of the stages' rows St into candidate m: its joints
-    cand[m] (folded), residuals cerr[m], whether they verify the pose flags[m], whether its joints lie within the
-    limits flags[8 + m] and its label code codes[m].  Returns whether it is verified with a joint next to an edge
-    of the fold."""
-    a, c, d = s1 * CHUNK + r, k2 * CHUNK + r, k * CHUNK + r  # the pose's column in the rows of s1, k2, k
-    cand[m, 0], cand[m, 1], cand[m, 2] = St[RQ1 * CHUNK + a], St[RQ2 * CHUNK + c], St[RQ3 * CHUNK + c]
-    cand[m, 3], cand[m, 4], cand[m, 5] = St[RQA * CHUNK + d], St[RQB * CHUNK + d], St[RQC * CHUNK + d]
-    cerr[m, 0], cerr[m, 1], flags[m] = St[RPE * CHUNK + d], St[RRE * CHUNK + d], St[RVF * CHUNK + d] != 0.0
-    codes[m] = St[RLB * CHUNK + d]
-    fold = St[RFL * CHUNK + d]
-    flags[8 + m] = fold == 1.0 or fold == 3.0
-    return flags[m] and fold >= 2.0
+@njit(cache=True, nogil=True, error_model="numpy")
+def elbow_checks(n, K, S):
+    """The verifying FK, residuals, verification and polish flags and label codes of every branch of the chunk's
+    first n poses into S (:func:`._ik_nb_checks.stage_checks` on the elbow kernel's rows)."""
+    stage_checks(n, K[80:192].reshape((7, 4, 4)), K[289:295], K[295:303], S, LAYOUT)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def elbow_folds(n, K, S):
+    """Every branch's joints of the chunk's first n poses folded into the limits in place, with the fold's flags
+    (:func:`._ik_nb_checks.stage_folds` on the elbow kernel's rows)."""
+    stage_folds(n, K[271:277], K[277:283], S, LAYOUT, FOLD_GROUPS)

@@ -24,17 +24,15 @@ import numpy as np
 from numba import njit
 
 from ._ik_finish import DOUBLE_ROOT
+from ._ik_nb_checks import CHUNK, copy_targets
 from ._ik_jit import WRIST_TOL, elbow_plane, elbow_q2, elbow_roots, shoulder_roots, wrist_qb, wrist_rest
 
 #: the scratch layout (rows of S) is shared with the walk over the branches (_ik_nb_elbow)
 __all__ = [
     "CHUNK", "ROWS", "elbow_stages", "RC1", "RC2", "RC3", "RCA", "RCB", "RCC", "RF2", "RQ1", "RQ2", "RQ3",
     "RQA", "RQB", "RQC", "RS1", "RS2", "RS3", "RSA", "RSB", "RSC", "RSG", "RST", "RX", "RXW", "RT", "RF3", "RL2",
-    "RPE", "RRE", "RVF", "RPO", "RLB", "RW2", "RFL",
+    "RPE", "RRE", "RVF", "RPO", "RLB", "RW2", "RFL", "LAYOUT", "FOLD_GROUPS",
 ]
-
-#: poses per chunk of the stages (their scratch: ROWS × CHUNK floats, 36 kB, in L1)
-CHUNK = 16
 # rows of S: per pose, then per branch (s1: 2, k2 = 2 s1 + s3: 4, k = 2 k2 + s5: 8)
 RXW, RW, RY0, RY2, RST = 0, 3, 6, 9, 12  # wrist centre (world, frame of C0), columns 0 and 2 of T_R R6ᵀ, status
 RQ1, RC1, RS1, RG, RX = 13, 15, 17, 19, 23  # per s1: q1 and its cos, sin; (g0, g1) at RG + 2 s1; the elbow's x
@@ -50,6 +48,11 @@ RW2 = 261  # per k2: 1.0 where the wrist's two roots qb (nearly) coincide (wrist
 # all of a branch's joints so far lie within their limits, plus 2.0 where one of them lies next to an edge of the fold
 RFL1, RFL2, RFL = 265, 267, 271  # per s1, per k2, per k
 ROWS = 279
+#: the rows as the check and fold stages read them (_ik_nb_checks: joint 1 per s1, joints 2, 3 per k2, the wrist's
+#: per k; the elbow label's far point is the wrist centre) and the fold's levels (joints 2, 3; then 4, 5, 6)
+LAYOUT = (RT, RXW, RF3, RL2, RPE, RRE, RVF, RPO, RLB, RFL1, RFL2, RFL, 0, RQ1, RC1, RS1, 2, RQ2, RC2, RS2, 1, RQ3, RC3,
+          RS3, 1, RQA, RCA, RSA, 0, RQB, RCB, RSB, 0, RQC, RCC, RSC, 0)
+FOLD_GROUPS = (1, 2, 3, 4, 5)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -62,11 +65,7 @@ def elbow_stages(T, s, n, K, S):
     X_e, p1, a, p2, P = K3[15], K3[16], K3[17], K3[18], K3[19]
     sc, trig, tols = K[252:261], K[261:271], K[295:303]
     tiny = tols[0] * sc[4]
-    for b in range(n):  # the targets into rows (a loop reading T stays scalar: its run-time strides)
-        t = s + b
-        for i in range(3):
-            S[(RT + 4 * i) * CHUNK + b], S[(RT + 4 * i + 1) * CHUNK + b] = T[t, i, 0], T[t, i, 1]
-            S[(RT + 4 * i + 2) * CHUNK + b], S[(RT + 4 * i + 3) * CHUNK + b] = T[t, i, 2], T[t, i, 3]
+    copy_targets(T, s, n, S, RT)
     _shoulder(n, X_e, C0i, R6, a, sc[0], tiny, tols[1], sc[5], S)
     _elbow(n, 0, R1, p1, sc[1], sc[2], sc[3], trig[8], trig[9], tols[1], S)
     _elbow(n, 1, R1, p1, sc[1], sc[2], sc[3], trig[8], trig[9], tols[1], S)

@@ -12,8 +12,9 @@ Every case the plain solver treats specially is handed back to it (``status`` 1)
 nearly parallel to axes 2–4 (the wrist-singular continuum; NEAR_SINGULAR), a target beyond the bound where the
 plain solver substitutes a reachable stand-in (``far``), a candidate that would need polishing, two solutions
 closer than the merge radius.  The compiled path answers only where its answer is the plain solver's.  The kernel
-is :mod:`._ik_nb_parallel` (compiled once per machine; the formulas are :mod:`denavit.ik.forms`', the verification
-the FK of the arm's chain); this module holds its constants.
+is :mod:`._ik_nb_parallel` (compiled once per machine; the formulas are :mod:`denavit.ik.forms`', run as stages
+over chunks of poses, every branch at once, :mod:`._ik_nb_parallel_stages`; the verification the FK of the arm's
+chain, :mod:`._ik_nb_checks`); this module holds its constants.
 """
 
 from __future__ import annotations
