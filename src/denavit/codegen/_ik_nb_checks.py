@@ -12,14 +12,13 @@ four poses to an AVX2 register; the frames after joint 3 shared by several branc
 Where a kernel keeps its rows is its ``layout`` (a tuple of ints, a global constant of the kernel's module: inlined,
 its entries are constants, so each loop's rows lie at constant offsets): (RT, RX, RF3, RL2, RPE, RRE, RVF, RPO, RLB,
 RFL1, RFL2, RFL, W3), then per joint j (RQ, RC, RS, SH) at 13 + 4 j: the joint's rows of values, cosines and sines,
-branch k's at row ``R + (k >> SH)`` (the branches k = 0 … 7 share a joint's value in groups of 2^SH; joint 1's SH
-is 2, joint 3's 1 or 0).  RT: the target's top 3×4; RX: the point of the shoulder label (the wrist centre, or the
-UR arm's Q); RF3, RL2: where pairs of branches share joint 3, the frames after it (12 rows per pair) and the
-shoulder and elbow bits of the label per pair; RPE, RRE, RVF, RPO, RLB: per branch the residuals, the verified
-and polish flags, the label code; RFL1, RFL2, RFL: the fold's flags per group of joint 1, per pair, per branch;
-W3: 1 where the elbow label's far point W is the origin of frame 3 (the UR arm's), 0 where it is RX (the wrist
-centre).  The fold runs in three levels of joints (``groups``: the two joints shared by pairs of branches, then
-the three of each branch).
+branch k's at row ``R + (k >> SH)`` (the branches k = 0 … 7 share a joint's value in groups of 2^SH).  RT: the
+target's top 3×4; RX: the point of the shoulder label (the wrist centre, or the UR arm's Q); RF3: the frames after
+joint 3 (12 rows per group of joint 3); RL2: the shoulder and elbow bits of the label per group of joint 3; RPE,
+RRE, RVF, RPO, RLB: per branch the residuals, the verified and polish flags, the label code; RFL1, RFL2, RFL: the
+fold's flags per group of joint 1, per group of the middle level, per branch; W3: 1 where the elbow label's far
+point W is the origin of frame 3 (the UR arm's), 0 where it is RX (the wrist centre).  The fold runs in three
+levels of joints (``groups``: the two joints shared in pairs of branches, then the three of each branch).
 Compiled once per machine (``cache=True``), ``error_model="numpy"``.  Imported only where numba is.
 """
 
@@ -54,34 +53,30 @@ def copy_targets(T, s, n, S, rt):
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def stage_checks(n, C, theta, tols, S, L):
     """Residuals, verification and polish flags and label codes of every branch of the chunk's first n poses into S
-    (rows RPE, RRE, RVF, RPO, RLB of the layout L, and RF3, RL2 where branches share joint 3; the targets' and the
-    candidates' rows already there); C (7, 4, 4) the chain's constants, theta the joints' offsets, tols
-    ik_finish's."""
+    (rows RF3, RL2, RPE, RRE, RVF, RPO, RLB of the layout L; the targets' and the candidates' rows already there); C
+    (7, 4, 4) the chain's constants, theta the joints' offsets, tols ik_finish's."""
+    groups = 8 >> L[13 + 4 * 2 + 3]  # of joint 3 (a constant: each call a loop at constant offsets)
+    _frame3(n, 0, C, S, L)
+    _frame3(n, 1, C, S, L)
+    if groups > 2:
+        _frame3(n, 2, C, S, L)
+        _frame3(n, 3, C, S, L)
+    if groups > 4:
+        _frame3(n, 4, C, S, L)
+        _frame3(n, 5, C, S, L)
+        _frame3(n, 6, C, S, L)
+        _frame3(n, 7, C, S, L)
     reach = tols[7]
     c = (math.cos(theta[4]), math.sin(theta[4]), tols[2] * max(1.0, reach), tols[2], reach, 0.05 * max(reach, 1e-3),
          tols[3] * max(reach, 1.0))  # cos, sin of theta5; the verify and polish bounds (ik_finish's)
-    if L[13 + 4 * 2 + 3] == 0:  # each branch its own joint 3 (a constant: each call a loop at constant offsets)
-        _branch(n, 0, C, c, S, L)
-        _branch(n, 1, C, c, S, L)
-        _branch(n, 2, C, c, S, L)
-        _branch(n, 3, C, c, S, L)
-        _branch(n, 4, C, c, S, L)
-        _branch(n, 5, C, c, S, L)
-        _branch(n, 6, C, c, S, L)
-        _branch(n, 7, C, c, S, L)
-    else:  # joint 3 shared by pairs of branches: the frames after it once per pair
-        _frame3(n, 0, C, S, L)
-        _frame3(n, 1, C, S, L)
-        _frame3(n, 2, C, S, L)
-        _frame3(n, 3, C, S, L)
-        _check(n, 0, C, c, S, L)
-        _check(n, 1, C, c, S, L)
-        _check(n, 2, C, c, S, L)
-        _check(n, 3, C, c, S, L)
-        _check(n, 4, C, c, S, L)
-        _check(n, 5, C, c, S, L)
-        _check(n, 6, C, c, S, L)
-        _check(n, 7, C, c, S, L)
+    _check(n, 0, C, c, S, L)
+    _check(n, 1, C, c, S, L)
+    _check(n, 2, C, c, S, L)
+    _check(n, 3, C, c, S, L)
+    _check(n, 4, C, c, S, L)
+    _check(n, 5, C, c, S, L)
+    _check(n, 6, C, c, S, L)
+    _check(n, 7, C, c, S, L)
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -112,95 +107,71 @@ def chain_step(F, c, s, C, m):
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _frame3(n, f, C, S, L):
-    """For the pair f of branches sharing joint 3 (k = 2 f, 2 f + 1) of each pose: the frame after joint 3 (C0
-    Rz(q1) C1 Rz(q2) C2 Rz(q3) C3) into the rows RF3 + 12 f, and the shoulder and elbow bits of the label (_bits)
-    into row RL2 + f (the wrist's are added by _check)."""
-    of = (L[2] + 12 * f) * CHUNK
+    """For the group f of joint 3 (its branches k = f << SH3 …) of each pose: the frame after joint 3 (C0 Rz(q1) C1
+    Rz(q2) C2 Rz(q3) C3) into the rows RF3 + 12 f, and the shoulder and elbow bits of the label into row RL2 + f
+    (the wrist's are added by _check): 1 shoulder left (x1 · (X − O1) < 0, X the point of row RX, O1 C0's origin),
+    2 elbow down (the origin E of frame 2 on the far side of the line from the origin S of frame 1 to W, seen along
+    axis 1, normal z1 × (W − S); W = X, or the origin of frame 3 where W3)."""
+    k = f << L[13 + 4 * 2 + 3]
+    r1, r2, r3 = _rows(L, 0, k), _rows(L, 1, k), _rows(L, 2, k)
+    rx, of, w3 = L[1] * CHUNK, (L[2] + 12 * f) * CHUNK, L[12]
+    F0 = (C[0, 0, 0], C[0, 1, 0], C[0, 2, 0], C[0, 0, 1], C[0, 1, 1], C[0, 2, 1], C[0, 0, 2], C[0, 1, 2], C[0, 2, 2],
+          C[0, 0, 3], C[0, 1, 3], C[0, 2, 3])
     for b in range(n):
-        F3, bits = _arm(S, b, C, L, 2 * f)
+        F1 = chain_step(F0, S[r1[1] * CHUNK + b], S[r1[2] * CHUNK + b], C, 1)
+        F2 = chain_step(F1, S[r2[1] * CHUNK + b], S[r2[2] * CHUNK + b], C, 2)
+        F3 = chain_step(F2, S[r3[1] * CHUNK + b], S[r3[2] * CHUNK + b], C, 3)
         S[of + b], S[of + CHUNK + b], S[of + 2 * CHUNK + b], S[of + 3 * CHUNK + b] = F3[0], F3[1], F3[2], F3[3]
         S[of + 4 * CHUNK + b], S[of + 5 * CHUNK + b], S[of + 6 * CHUNK + b] = F3[4], F3[5], F3[6]
         S[of + 7 * CHUNK + b], S[of + 8 * CHUNK + b], S[of + 9 * CHUNK + b] = F3[7], F3[8], F3[9]
         S[of + 10 * CHUNK + b], S[of + 11 * CHUNK + b] = F3[10], F3[11]
-        S[(L[3] + f) * CHUNK + b] = bits
+        X0, X1, X2 = S[rx + b], S[rx + CHUNK + b], S[rx + 2 * CHUNK + b]
+        s_right = F1[0] * (X0 - F0[9]) + F1[1] * (X1 - F0[10]) + F1[2] * (X2 - F0[11])
+        if w3:
+            d0, d1, d2 = F3[9] - F1[9], F3[10] - F1[10], F3[11] - F1[11]
+        else:
+            d0, d1, d2 = X0 - F1[9], X1 - F1[10], X2 - F1[11]
+        n0, n1, n2 = F1[7] * d2 - F1[8] * d1, F1[8] * d0 - F1[6] * d2, F1[6] * d1 - F1[7] * d0
+        towards = select(F0[6] * n0 + F0[7] * n1 + F0[8] * n2 >= 0.0, 1.0, -1.0)
+        side = (F2[9] - F1[9]) * n0 + (F2[10] - F1[10]) * n1 + (F2[11] - F1[11]) * n2
+        S[(L[3] + f) * CHUNK + b] = select(s_right < 0.0, 1.0, 0.0) + select(side * towards < 0.0, 2.0, 0.0)
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _check(n, k, C, c, S, L):
-    """For the branch k of each pose: :func:`_tip` from the frame after joint 3 and the label bits of its pair
-    (rows RF3, RL2, left by _frame3)."""
-    f = k >> 1
-    f3 = (L[2] + 12 * f) * CHUNK
+    """For the branch k of each pose: the FK from the frame after joint 3 on (joints 4, 5, 6), its residuals
+    against the target (rows RPE, RRE: ik_finish's), 1.0 in row RVF where they verify it, in row RPO where the
+    plain solver would polish it, and the label code in row RLB (the wrist bit 4 where sin(q5 + theta5) < 0)."""
+    ct5, st5, pe_tol, re_tol, reach, polish_below, polish_above = c
+    f = k >> L[13 + 4 * 2 + 3]
+    r4, r5, r6 = _rows(L, 3, k), _rows(L, 4, k), _rows(L, 5, k)
+    ok, f3, rt = k * CHUNK, (L[2] + 12 * f) * CHUNK, L[0] * CHUNK
     for b in range(n):
         F = (S[f3 + b], S[f3 + CHUNK + b], S[f3 + 2 * CHUNK + b], S[f3 + 3 * CHUNK + b], S[f3 + 4 * CHUNK + b],
              S[f3 + 5 * CHUNK + b], S[f3 + 6 * CHUNK + b], S[f3 + 7 * CHUNK + b], S[f3 + 8 * CHUNK + b],
              S[f3 + 9 * CHUNK + b], S[f3 + 10 * CHUNK + b], S[f3 + 11 * CHUNK + b])
-        _tip(S, b, k, F, S[(L[3] + f) * CHUNK + b], C, c, L)
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _branch(n, k, C, c, S, L):
-    """For the branch k of each pose (its own joint 3): the frame after joint 3 and the label bits (_arm), then
-    :func:`_tip`, in one loop (nothing kept in rows between them)."""
-    for b in range(n):
-        F3, bits = _arm(S, b, C, L, k)
-        _tip(S, b, k, F3, bits, C, c, L)
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _arm(S, b, C, L, k):
-    """(F3, bits) of pose b's branch k: the frame after joint 3 (C0 Rz(q1) C1 Rz(q2) C2 Rz(q3) C3, the tuple of
-    chain_step) and the shoulder and elbow bits of its label: 1 shoulder left (x1 · (X − O1) < 0, X the point of
-    row RX, O1 C0's origin), 2 elbow down (the origin E of frame 2 on the far side of the line from the origin S of
-    frame 1 to W, seen along axis 1, normal z1 × (W − S); W = X, or the origin of frame 3 where W3)."""
-    r1, r2, r3 = _rows(L, 0, k), _rows(L, 1, k), _rows(L, 2, k)
-    rx = L[1] * CHUNK
-    F0 = (C[0, 0, 0], C[0, 1, 0], C[0, 2, 0], C[0, 0, 1], C[0, 1, 1], C[0, 2, 1], C[0, 0, 2], C[0, 1, 2], C[0, 2, 2],
-          C[0, 0, 3], C[0, 1, 3], C[0, 2, 3])
-    F1 = chain_step(F0, S[r1[1] * CHUNK + b], S[r1[2] * CHUNK + b], C, 1)
-    F2 = chain_step(F1, S[r2[1] * CHUNK + b], S[r2[2] * CHUNK + b], C, 2)
-    F3 = chain_step(F2, S[r3[1] * CHUNK + b], S[r3[2] * CHUNK + b], C, 3)
-    X0, X1, X2 = S[rx + b], S[rx + CHUNK + b], S[rx + 2 * CHUNK + b]
-    s_right = F1[0] * (X0 - F0[9]) + F1[1] * (X1 - F0[10]) + F1[2] * (X2 - F0[11])
-    if L[12]:
-        d0, d1, d2 = F3[9] - F1[9], F3[10] - F1[10], F3[11] - F1[11]
-    else:
-        d0, d1, d2 = X0 - F1[9], X1 - F1[10], X2 - F1[11]
-    n0, n1, n2 = F1[7] * d2 - F1[8] * d1, F1[8] * d0 - F1[6] * d2, F1[6] * d1 - F1[7] * d0
-    towards = select(F0[6] * n0 + F0[7] * n1 + F0[8] * n2 >= 0.0, 1.0, -1.0)
-    side = (F2[9] - F1[9]) * n0 + (F2[10] - F1[10]) * n1 + (F2[11] - F1[11]) * n2
-    return F3, select(s_right < 0.0, 1.0, 0.0) + select(side * towards < 0.0, 2.0, 0.0)
-
-
-@njit(cache=True, nogil=True, error_model="numpy", inline="always")
-def _tip(S, b, k, F, bits, C, c, L):
-    """For pose b's branch k: the FK from the frame after joint 3 on (F; joints 4, 5, 6), its residuals against the
-    target (rows RPE, RRE: ik_finish's), 1.0 in row RVF where they verify it, in row RPO where the plain solver
-    would polish it, and the label code (bits, plus the wrist bit 4 where sin(q5 + theta5) < 0) in row RLB."""
-    ct5, st5, pe_tol, re_tol, reach, polish_below, polish_above = c
-    r4, r5, r6 = _rows(L, 3, k), _rows(L, 4, k), _rows(L, 5, k)
-    ok, rt = k * CHUNK, L[0] * CHUNK
-    cb, sb = S[r5[1] * CHUNK + b], S[r5[2] * CHUNK + b]
-    F = chain_step(F, S[r4[1] * CHUNK + b], S[r4[2] * CHUNK + b], C, 4)
-    F = chain_step(F, cb, sb, C, 5)
-    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = chain_step(F, S[r6[1] * CHUNK + b], S[r6[2] * CHUNK + b], C, 6)
-    t = (S[rt + b], S[rt + CHUNK + b], S[rt + 2 * CHUNK + b], S[rt + 3 * CHUNK + b], S[rt + 4 * CHUNK + b],
-         S[rt + 5 * CHUNK + b], S[rt + 6 * CHUNK + b], S[rt + 7 * CHUNK + b], S[rt + 8 * CHUNK + b],
-         S[rt + 9 * CHUNK + b], S[rt + 10 * CHUNK + b], S[rt + 11 * CHUNK + b])
-    pe = math.sqrt((p0 - t[3]) ** 2 + (p1 - t[7]) ** 2 + (p2 - t[11]) ** 2)
-    # the angle of R_t Rᵀ, summed in ik_finish's order
-    tr = 0.0 + t[0] * x0 + t[1] * y0 + t[2] * z0 + t[4] * x1 + t[5] * y1 + t[6] * z1 + t[8] * x2 + t[9] * y2 \
-        + t[10] * z2
-    v0 = ((0.0 + (t[8] * x1 - t[4] * x2)) + (t[9] * y1 - t[5] * y2)) + (t[10] * z1 - t[6] * z2)
-    v1 = ((0.0 + (t[0] * x2 - t[8] * x0)) + (t[1] * y2 - t[9] * y0)) + (t[2] * z2 - t[10] * z0)
-    v2 = ((0.0 + (t[4] * x0 - t[0] * x1)) + (t[5] * y0 - t[1] * y1)) + (t[6] * z0 - t[2] * z1)
-    sn, co = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
-    re = select(sn < 1e-6 * co, sn / co, atan2(sn, co))  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
-    size = pe + reach * re
-    S[L[4] * CHUNK + ok + b], S[L[5] * CHUNK + ok + b] = pe, re
-    S[L[6] * CHUNK + ok + b] = select((pe <= pe_tol) & (re <= re_tol), 1.0, 0.0)
-    S[L[7] * CHUNK + ok + b] = select((size < polish_below) & (size > polish_above), 1.0, 0.0)
-    S[L[8] * CHUNK + ok + b] = bits + select(sb * ct5 + cb * st5 < 0.0, 4.0, 0.0)
+        cb, sb = S[r5[1] * CHUNK + b], S[r5[2] * CHUNK + b]
+        F = chain_step(F, S[r4[1] * CHUNK + b], S[r4[2] * CHUNK + b], C, 4)
+        F = chain_step(F, cb, sb, C, 5)
+        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = chain_step(F, S[r6[1] * CHUNK + b], S[r6[2] * CHUNK + b],
+                                                                    C, 6)
+        t = (S[rt + b], S[rt + CHUNK + b], S[rt + 2 * CHUNK + b], S[rt + 3 * CHUNK + b], S[rt + 4 * CHUNK + b],
+             S[rt + 5 * CHUNK + b], S[rt + 6 * CHUNK + b], S[rt + 7 * CHUNK + b], S[rt + 8 * CHUNK + b],
+             S[rt + 9 * CHUNK + b], S[rt + 10 * CHUNK + b], S[rt + 11 * CHUNK + b])
+        pe = math.sqrt((p0 - t[3]) ** 2 + (p1 - t[7]) ** 2 + (p2 - t[11]) ** 2)
+        # the angle of R_t Rᵀ, summed in ik_finish's order
+        tr = 0.0 + t[0] * x0 + t[1] * y0 + t[2] * z0 + t[4] * x1 + t[5] * y1 + t[6] * z1 + t[8] * x2 + t[9] * y2 \
+            + t[10] * z2
+        v0 = ((0.0 + (t[8] * x1 - t[4] * x2)) + (t[9] * y1 - t[5] * y2)) + (t[10] * z1 - t[6] * z2)
+        v1 = ((0.0 + (t[0] * x2 - t[8] * x0)) + (t[1] * y2 - t[9] * y0)) + (t[2] * z2 - t[10] * z0)
+        v2 = ((0.0 + (t[4] * x0 - t[0] * x1)) + (t[5] * y0 - t[1] * y1)) + (t[6] * z0 - t[2] * z1)
+        sn, co = 0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (tr - 1.0)
+        re = select(sn < 1e-6 * co, sn / co, atan2(sn, co))  # atan(t) = t (1 - t²/3 ...): t below 1e-6, t
+        size = pe + reach * re
+        S[L[4] * CHUNK + ok + b], S[L[5] * CHUNK + ok + b] = pe, re
+        S[L[6] * CHUNK + ok + b] = select((pe <= pe_tol) & (re <= re_tol), 1.0, 0.0)
+        S[L[7] * CHUNK + ok + b] = select((size < polish_below) & (size > polish_above), 1.0, 0.0)
+        S[L[8] * CHUNK + ok + b] = S[(L[3] + f) * CHUNK + b] + select(sb * ct5 + cb * st5 < 0.0, 4.0, 0.0)
 
 
 @njit(cache=True, nogil=True, error_model="numpy", inline="always")

@@ -50,14 +50,13 @@ RF6, RR3, RD3, REP, RE3 = 108, 112, 116, 120, 124  # per j: flags (axis 6 ∥ 2-
 # dependence; q3 next to a double root), the errors of P and of q3
 RQ2, RC2, RS2, RQ3, RC3, RS3, RQ4, RC4, RS4, RFK = 128, 136, 144, 152, 160, 168, 176, 184, 192, 200  # per k; RFK:
 # flag (the elbow's point next to axis 2, or the error estimate beyond COND_MAX)
-# rows of the checks and folds (_ik_nb_checks; each branch has its own joint 3, so no frame after it is kept in rows:
-# RF3 and RL2 none): residuals, flags, label codes, the fold's flags
-RPE, RRE, RVF, RPO, RLB, RFL1, RFL2, RFL = 208, 216, 224, 232, 240, 248, 250, 254
-RAE = 262  # per s1: atan2 of ell (q6 = atan2(y) − this)
-ROWS = 264
+# rows of the checks and folds (_ik_nb_checks): frame after joint 3 (12 per k), label bits, residuals, flags
+RF3, RL2, RPE, RRE, RVF, RPO, RLB, RFL1, RFL2, RFL = 208, 304, 312, 320, 328, 336, 344, 352, 354, 358
+RAE = 366  # per s1: atan2 of ell (q6 = atan2(y) − this)
+ROWS = 368
 #: the rows as the check and fold stages read them: joint 1 per s1, joints 2-4 per branch, joints 5, 6 per j; the
 #: elbow label's far point is the origin of frame 3; the fold's levels: joints 5, 6, then 2, 3, 4
-LAYOUT = (RT, RX, -1, -1, RPE, RRE, RVF, RPO, RLB, RFL1, RFL2, RFL, 1, RQ1, RC1, RS1, 2, RQ2, RC2, RS2, 0, RQ3, RC3,
+LAYOUT = (RT, RX, RF3, RL2, RPE, RRE, RVF, RPO, RLB, RFL1, RFL2, RFL, 1, RQ1, RC1, RS1, 2, RQ2, RC2, RS2, 0, RQ3, RC3,
           RS3, 0, RQ4, RC4, RS4, 0, RQ5, RC5, RS5, 1, RQ6, RC6, RS6, 1)
 FOLD_GROUPS = (4, 5, 1, 2, 3)
 
