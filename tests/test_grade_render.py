@@ -432,3 +432,18 @@ def test_a_report_graded_by_the_cli_opens_in_chromium_with_every_mark(browser, t
     n_wrong = sum(c["verdict"] == "incorrect" for c in claims)
     assert page.evaluate("document.querySelectorAll('article.report .correction .katex').length") >= n_wrong
     page.close()
+
+
+def test_latex_sections_and_the_dh_tabular_are_a_heading_and_a_table_and_the_preamble_is_left_out():
+    """A paragraph ``\\section{DH parameters} Text \\begin{tabular}…\\end{tabular}`` is a heading, a paragraph and a
+    table of escaped cells (a cell's markup stays text); ``\\documentclass``/``\\begin{document}`` are not shown."""
+    text = ("\\documentclass{article}\n\\begin{document}\n\\section{DH parameters}\nThe table:\n"
+            "\\begin{tabular}{|c|c|}\n\\hline\n$a_i$ & $\\alpha_i$ \\\\\n\\hline\n"
+            "<script>alert(1)</script> & 0 \\\\\n\\end{tabular}\n\\end{document}\n")
+    html = render_checked_html(GradedReport("r.tex", text, "tex", (ARM,), ()))
+    tags = [t for t, _ in _tags(html)]
+    assert "h2" in tags and tags.count("table") >= 1 and tags.count("td") >= 4
+    body = html[html.index('<article'):html.index('</article>')]
+    assert "documentclass" not in body and "begin{document}" not in body and "hline" not in body
+    assert '<p data-line="4">The table:</p>' in body  # the line its text is on
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html and tags.count("script") == 2

@@ -2,8 +2,8 @@ r"""The body of the checked page for a LaTeX report: a simple, safe rendering, n
 
 Display mathematics (``\[…\]``, ``$$…$$``, ``equation``/``align``/… environments) is typeset by KaTeX with the
 marks beside it; everything else is shown as paragraphs of escaped text between blank lines, with ``$…$`` and
-``\(…\)`` typeset inline and a paragraph that is one ``\section{…}`` shown as a heading.  Other commands stay
-as written.
+``\(…\)`` typeset inline, ``\section{…}`` shown as a heading and a ``tabular`` (the DH table) as a table, the
+preamble (``\documentclass``, ``\usepackage``, ``\begin{document}``) left out.  Other commands stay as written.
 """
 
 from __future__ import annotations
@@ -34,14 +34,41 @@ def _paragraph(text: str, first: int) -> str:
     return "".join(out)
 
 
+_PIECES = re.compile(r"(\\(?:section|subsection|subsubsection)\*?\{[^{}]*\}"
+                     r"|\\begin\{tabular\}\{[^{}]{0,80}\}.*?\\end\{tabular\})", re.DOTALL)
+_PREAMBLE = re.compile(r"\\(?:documentclass|usepackage)(?:\[[^\]]*\])?\{[^{}]*\}|\\(?:begin|end)\{document\}|\\maketitle")
+
+
+def _table(text: str, first: int) -> str:
+    """A ``tabular`` as an HTML table: rows at ``\\\\``, cells at ``&``, rules dropped, cells as paragraphs."""
+    body = re.sub(r"^\\begin\{tabular\}\{[^{}]*\}|\\end\{tabular\}$", "", text.strip())
+    rows = [r for r in (re.sub(r"\\(?:hline|toprule|midrule|bottomrule)", "", r).strip() for r in body.split("\\\\"))
+            if r]
+    cells = "".join("<tr>" + "".join(f"<td>{_paragraph(c.strip(), first)}</td>" for c in r.split("&")) + "</tr>"
+                    for r in rows)
+    return f'<table class="tex-table" data-line="{first}">{cells}</table>'
+
+
 def _text_block(b: Block, claims: list[Numbered]) -> str:
-    m = _HEADING.match(b.body)
+    """A paragraph of the report: its headings (``\\section{…}``) and tables (``tabular``) as HTML, the rest as text
+    with inline formulas; the preamble's commands left out."""
     marks = marks_html(claims) if claims else ""
-    if m:
-        tag = {"section": "h2", "subsection": "h3"}.get(m.group(1), "h4")
-        return f'<{tag} data-line="{b.start + 1}">{esc(m.group(2))}{marks}</{tag}>\n' + corrections_html(claims)
-    return (f'<p data-line="{b.start + 1}">{_paragraph(b.body, b.start + 1)}{marks}</p>\n'
-            + corrections_html(claims))
+    out, line = [], b.start + 1
+    for k, piece in enumerate(_PIECES.split(_PREAMBLE.sub("", b.body))):
+        m = _HEADING.match(piece) if k % 2 else None
+        if m:
+            tag = {"section": "h2", "subsection": "h3"}.get(m.group(1), "h4")
+            out.append(f'<{tag} data-line="{line}">{esc(m.group(2))}</{tag}>')
+        elif k % 2:
+            out.append(_table(piece, line))
+        elif piece.strip():
+            at = line + piece[:len(piece) - len(piece.lstrip())].count("\n")  # the line its text starts on
+            out.append(f'<p data-line="{at}">{_paragraph(piece.strip(), at)}</p>')
+        line += piece.count("\n")
+    if not out or (marks and out[-1].startswith("<table")):
+        out.append(f'<p data-line="{b.start + 1}"></p>')
+    out[-1] = out[-1][:out[-1].rindex("</")] + marks + out[-1][out[-1].rindex("</"):]
+    return "\n".join(out) + "\n" + corrections_html(claims)
 
 
 def tex_body(report: GradedReport, blocks: list[Block]) -> tuple[str, list[Numbered]]:
