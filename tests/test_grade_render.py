@@ -447,3 +447,14 @@ def test_latex_sections_and_the_dh_tabular_are_a_heading_and_a_table_and_the_pre
     assert "documentclass" not in body and "begin{document}" not in body and "hline" not in body
     assert '<p data-line="4">The table:</p>' in body  # the line its text is on
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html and tags.count("script") == 2
+
+
+def test_a_plain_text_report_keeps_its_lines():
+    """One equation a line in a .txt report stays one a line on the page (a paragraph's line breaks are kept;
+    Markdown and LaTeX reports reflow as their formats do)."""
+    text = "x = L1 cos θ1 + L2 cos(θ1 + θ2)\ny = L1 sin θ1 + L2 sin(θ1 + θ2)\n"
+    page = render_checked_html(GradedReport("r.txt", text, "txt", (ARM,), ()))
+    body = page[page.index("<article"):page.index("</article>")]
+    assert body.count("<br") == 1
+    same = render_checked_html(GradedReport("r.md", text, "md", (ARM,), ()))
+    assert same[same.index("<article"):same.index("</article>")].count("<br") == 0

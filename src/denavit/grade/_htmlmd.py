@@ -128,8 +128,8 @@ def _image(self, tokens, idx, options, env) -> str:
     return f'<span class="image-omitted">[picture: {esc(alt)} — {esc(t.attrGet("src") or "")}]</span>'
 
 
-def _parser():
-    md = markdown_parser()
+def _parser(breaks: bool = False):
+    md = markdown_parser(breaks)
     for name in (*MATH_BLOCKS, *_CODE):
         md.add_render_rule(name, _block)
     for name in _INLINE_MATH:
@@ -145,7 +145,7 @@ def markdown_body(report: GradedReport) -> tuple[str, list[Numbered]]:
     """(the report rendered as HTML with its marks and corrections, the claims that had no place)."""
     from markdown_it.token import Token
 
-    md = _parser()
+    md = _parser(breaks=report.format == "txt")  # plain text: its lines kept
     tokens = md.parse(report.text)
     unplaced = _place_claims(tokens, report, Token)
     return md.renderer.render(tokens, md.options, {}), unplaced

@@ -190,17 +190,19 @@ def _bounded(rule, scan_end):
     return bounded
 
 
-def markdown_parser():
+def markdown_parser(breaks: bool = False):
     """A markdown-it parser for student reports: CommonMark + tables + TeX mathematics, raw HTML disabled.
 
     A display block may start right under a line of text (``…is\n$$``, as students write), as a fence may.
+    ``breaks``: every line break kept (a plain-text report: one equation a line).
     """
     from markdown_it import MarkdownIt
     from mdit_py_plugins.amsmath import amsmath_block, amsmath_plugin
     from mdit_py_plugins.dollarmath import dollarmath_plugin
     from mdit_py_plugins.dollarmath.index import math_block_dollar
 
-    md = MarkdownIt("commonmark", {"html": False, "linkify": False, "typographer": False}).enable("table")
+    md = MarkdownIt("commonmark", {"html": False, "linkify": False, "typographer": False, "breaks": breaks})
+    md.enable("table")
     md.use(dollarmath_plugin, allow_labels=True, allow_space=True, allow_digits=True, double_inline=True)
     md.use(amsmath_plugin)
     interrupts = {"alt": ["paragraph", "reference", "blockquote", "list"]}
