@@ -86,7 +86,8 @@ def test_a_plain_text_report_is_read_and_judged():
     got = _verdicts(REPORT)
     assert all(v == "correct" for _, _, v in got), got
     kinds = [q for _, q, _ in got]
-    assert kinds.count("ik_formula") == 4 and {"jacobian", "det_jacobian", "singularities", "torques"} <= set(kinds)
+    assert kinds.count("ik_formula") == 4 and {"jacobian", "det_jacobian", "singularities", "torques",
+                                                "heading"} <= set(kinds)
     assert [line for line, q, _ in got if q == "jacobian"] == [18]  # the three lines of J are one matrix
 
 
@@ -95,6 +96,7 @@ def test_a_plain_text_report_is_read_and_judged():
     ("θ1 = atan2(yw, xw) - atan2(L2", "θ1 = atan2(yw, xw) + atan2(L2", "ik_formula"),
     ("+ (L1 c1 + L2 c12 + L3 c123) fy + mz", "+ (L1 c1 + L2 c12 + L3 c123) fy - mz", "torques"),
     ("1, 1, 1 ]", "1, 1, 0 ]", "jacobian"),
+    ("φ = θ1 + θ2 + θ3", "φ = θ1 + θ2 - θ3", "heading"),
 ])
 def test_a_slip_in_a_plain_text_report_is_incorrect(right, slip, quantity):
     assert right in REPORT

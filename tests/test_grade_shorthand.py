@@ -87,3 +87,11 @@ def test_a_signed_shorthand_written_or_defined_after_the_matrix(written, where, 
 def test_renamed_touches_only_the_shorthand_named():
     assert renamed("c_{124} + s_124 + c_{1245} + C_{124}", {"124": "12-4"}) == \
         "c_{12-4} + s_{12-4} + c_{1245} + C_{12-4}"
+
+
+def test_the_heading_of_a_scara_is_judged_with_its_tool_z_down():
+    """φ = θ1 + θ2 − θ4 is the SCARA's heading (R = [c s 0; s −c 0; 0 0 −1] with c = cos(θ1 + θ2 − θ4), checked
+    above); θ1 + θ2 + θ4 is not."""
+    got = [_verdicts(_report(f"\\phi = {v}")) for v in ("\\theta_1 + \\theta_2 - \\theta_4",
+                                                         "\\theta_1 + \\theta_2 + \\theta_4")]
+    assert got == [[("heading", "correct")], [("heading", "incorrect")]], got

@@ -21,7 +21,7 @@ from ..errors import ParseError
 from ..io import robot_from_dict
 from ..model import JointType
 
-__all__ = ["massed_arm_data", "names_written", "check_buildable", "moves_in_xy", "MASS_NOTE"]
+__all__ = ["massed_arm_data", "names_written", "check_buildable", "moves_in_xy", "turns_about_z", "MASS_NOTE"]
 
 #: Said of an arm read this way (in the arm's notes).
 MASS_NOTE = ("masses {m}, centres of mass at {c} along the links, inertias {i} from the report's symbols (the "
@@ -105,6 +105,17 @@ def check_buildable(data: dict, where: str) -> Any:
 
 
 @functools.lru_cache(maxsize=64)
+def turns_about_z(robot: Any) -> bool:
+    """Every joint turns the tip about the base's z axis only, or slides it (J's ωx, ωy rows zero at random q: a
+    planar arm, a SCARA): its heading φ is defined."""
+    import numpy as np
+
+    from .. import numeric as N
+
+    J = N.geometric_jacobian(robot, np.random.default_rng(0).uniform(-1.0, 1.0, (3, robot.dof)))
+    return bool(np.abs(J[:, 3:5, :]).max() < 1e-9 * max(1.0, np.abs(J).max()))
+
+
 def moves_in_xy(robot: Any) -> bool:
     """Every joint moves the tip in the base's xy plane only (J's vz, ωx, ωy rows zero at random q)."""
     import numpy as np

@@ -16,6 +16,7 @@ from typing import Any
 
 from ..model import IDENTITY, DHRobot, JointType
 from ._lhs import Symbol, frame_token
+from ._masses import turns_about_z
 
 __all__ = ["Reading", "read_name", "JOINT_LETTERS"]
 
@@ -362,6 +363,10 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         return _dynamics(sym, robot, gravity_rhs=gravity_rhs)
     if b in ("K", "P", "U", "V", "L", "mathcal{L}") and (dynamic or b in ("K",)):
         return _energy(sym)
+    if b in ("phi", "varphi", "psi") and not (sym.sub or sym.sup or sym.pre_sup or sym.dots) \
+            and re.search(r"theta|\bq_|θ", rhs) and turns_about_z(robot):
+        plain = robot.base == IDENTITY and robot.tool == IDENTITY  # else φ may be the last link's, not the tool's
+        return Reading({"quantity": "heading"}, "the heading φ of the end effector (its turn about z)", sure=plain)
     return None
 
 

@@ -49,6 +49,8 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
     """The claim an equation makes under ``reading`` (with the case, rates, wrench and names ``ctx`` carries), and
     the other readings of its left-hand side."""
     value = renamed(value, ctx.renames) if ctx.renames else value
+    if reading.spec.get("quantity") == "heading":
+        return _heading(ctx, eq, arm, reading, value)
     if "\\begin" in value and matrices(value) is None:
         value = scale_matrix(value) or value
     if "\\begin" in value:
@@ -105,6 +107,21 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
             if key in claim and key not in alt:
                 alt[key] = claim[key]
     return p
+
+def _heading(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: str) -> Pending:
+    """``φ = θ1 + θ2 + θ3`` on an arm moving in the xy plane: the end effector's rotation is a turn φ about z (tool
+    z up), or φ with the tool's z down (a SCARA: [c s 0; s −c 0; 0 0 −1]); a guess (never incorrect) when the arm
+    has a base or tool transform."""
+    c, s = f"\\cos({value})", f"\\sin({value})"
+    up = f"\\begin{{bmatrix}} {c} & -{s} & 0 \\\\ {s} & {c} & 0 \\\\ 0 & 0 & 1 \\end{{bmatrix}}"
+    down = f"\\begin{{bmatrix}} {c} & {s} & 0 \\\\ {s} & -{c} & 0 \\\\ 0 & 0 & -1 \\end{{bmatrix}}"
+    claim: dict[str, Any] = {"quantity": "rotation", "value": up}
+    if not has_joint_names(value) and ctx.q:
+        claim["q"] = ctx.q
+    p = Pending(eq.line, eq.end_line, eq.text, arm, claim, reading.understood, sure=reading.sure, quantity="heading")
+    p.equivalent = [({**claim, "value": down}, "the heading with the tool's z axis down")]
+    return p
+
 
 _CAPITAL_WRENCH = re.compile(r"(?<![A-Za-z\\])([FfNnMm])\s*_?\s*\{?\s*([xyz])\s*\}?(?![A-Za-z])")
 
