@@ -461,3 +461,20 @@ def test_a_notebook_export_names_its_outputs_by_the_cell_before_them():
                    cell("Jw", slipped).replace("Jw", "Jv"), cell("sp.simplify(Jv[:2, :].det())", l1 * l2 * sp.sin(t2)))
     got = [(q, v) for _, q, v in _verdicts(text) if v != "not a claim"]
     assert got == [("end_effector", "correct"), ("jacobian", "correct"), ("jacobian", "incorrect")], got
+
+
+@pytest.mark.parametrize("given", ["$L_1 = L_2 = 1$ m", "$L_1 = 1$ m and $L_2 = 1$ m", "$L_1 = L_2 = 1\\,\\text{m}$"])
+def test_lengths_given_a_value_are_used_for_the_numbers_after_them(given):
+    """The table leaves L1, L2 as symbols; "L_1 = L_2 = 1 m" then T at θ = (30°, 45°): the tip (c30 + c75,
+    s30 + s75) = (1.125, 1.466) by hand is right (was judged with generic lengths: incorrect), (1.2, 1.466) is not."""
+    import math
+
+    assert abs(math.cos(math.radians(30)) + math.cos(math.radians(75)) - 1.125) < 5e-4
+    assert abs(math.sin(math.radians(30)) + math.sin(math.radians(75)) - 1.466) < 5e-4
+
+    def t(x):
+        return (f"$$T_2^0 = \\begin{{bmatrix}} 0.259 & -0.966 & 0 & {x} \\\\ 0.966 & 0.259 & 0 & 1.466 \\\\ "
+                "0 & 0 & 1 & 0 \\\\ 0 & 0 & 0 & 1 \\end{bmatrix}$$")
+    for x, verdict in (("1.125", "correct"), ("1.2", "incorrect")):
+        text = _report(f"For $\\theta = (30^\\circ, 45^\\circ)$ and {given}:", t(x))
+        assert [v for _, q, v in _verdicts(text) if q == "end_effector"] == [verdict]

@@ -22,7 +22,8 @@ from ._document import Document, Heading, Math
 from ._masses import check_buildable, massed_arm_data, moves_in_xy, names_written
 from ._types import ArmInfo, GradedClaim
 
-__all__ = ["Arm", "Section", "arms_of", "compare_tables", "with_equal_lengths", "GENERIC_LENGTHS"]
+__all__ = ["Arm", "Section", "arms_of", "compare_tables", "with_equal_lengths", "with_given_lengths", "length_value",
+           "stated_lengths", "GENERIC_LENGTHS"]
 
 #: Values given to lengths a table names without a value (distinct, not round, so no two coincide).
 GENERIC_LENGTHS = (0.537, 0.419, 0.3271, 0.6143, 0.2789, 0.4657, 0.3917, 0.7129, 0.2473, 0.5861)
@@ -134,6 +135,49 @@ def with_equal_lengths(arm: Arm, names: list[str], where: str) -> Arm | None:
     values = _generic_values(free)
     robot = robot_from_dict({**data, "parameters": {**params, **values}}, where=where)
     return Arm(robot, arm.info, arm.problem, arm.advice, data, free, arm.gravity_assumed)
+
+
+_LENGTH = re.compile(r"^\s*(-?\d{1,6}(?:\.\d{1,9})?)\s*(?:\\[,;:! ]\s*)*(?:\\(?:text|mathrm|rm)\s*\{\s*(m|cm|mm)\s*\}"
+                     r"|(m|cm|mm)\b)?\s*[.,;]?\s*$")
+
+
+def length_value(text: str) -> float | None:
+    """``1``, ``0.8 m``, ``250\\,\\text{mm}`` → the number as written (1, 0.8, 250: the report's results are in
+    its own unit, so no conversion); None for anything else (a formula, a name)."""
+    m = _LENGTH.match(text)
+    return float(m.group(1)) if m else None
+
+
+def with_given_lengths(arm: Arm, names: list[str], value: float, where: str) -> Arm | None:
+    """The arm with the table's value-less lengths ``names`` given ``value`` (``L_1 = L_2 = 1`` m: the report's
+    numbers at a case use them); None when none of ``names`` is such a length."""
+    given = [n for n in dict.fromkeys(names) if n in arm.free]
+    if not given or arm.data is None:
+        return None
+    free = tuple(n for n in arm.free if n not in given)
+    params = {**arm.data["parameters"], **{n: value for n in given}}
+    data = {**arm.data, "parameters": params}
+    robot = robot_from_dict({**data, "parameters": {**params, **_generic_values(free)}}, where=where)
+    return Arm(robot, arm.info, arm.problem, arm.advice, data, free, arm.gravity_assumed)
+
+
+def stated_lengths(arm: Arm, parts: tuple[str, ...], line: int) -> tuple[Arm, str, list[tuple[str, str]]] | None:
+    """``d_4 = a_2 = k`` (the table's value-less lengths stated equal) or ``L_1 = L_2 = 1`` m (given a value): (the
+    arm so, a note, the names now written as another) — judging with distinct generic values would call a right
+    formula, or a right number at a case, wrong; None when the equation states nothing of the kind."""
+    written = {re.sub(r"[^A-Za-z0-9]", "", re.sub(r"\s+", "", p)): p.strip() for p in parts[:-1]}
+    value, where = length_value(parts[-1]), f"the equation at line {line}"
+    new = with_given_lengths(arm, list(written), value, where) if value is not None else \
+        with_equal_lengths(arm, list(written), where)
+    if new is None:
+        return None
+    gone = [n for n in arm.free if n in written and n not in new.free]
+    if value is not None:
+        return new, (f"line {line}: {' = '.join(gone)} = {value:g} as the report states: the table's arm is read "
+                     "with that value from there on (in the report's unit)"), []
+    keep = next(n for n in reversed(list(written)) if n in new.free)
+    return new, (f"line {line}: {', '.join(gone)} = {keep} as the report states: the table's arm is read with them "
+                 "equal from there on"), [(written[n], written[keep]) for n in gone]
 
 
 def _extent(h: Heading, heads: list[Heading], n: int) -> int:

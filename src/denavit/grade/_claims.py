@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from ._arms import Arm, with_equal_lengths
+from ._arms import Arm, length_value, stated_lengths
 from ._prose import plain_prose, prose_case, prose_conditions, prose_definitions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
                        rates_or_wrench, vector_entries)
@@ -20,7 +20,7 @@ from ._lhs import read_symbol
 from ._masses import moves_in_xy
 from ._names import joint_of, read_name
 from ._reading import (define_chain, define_term, formula_leftover, joint_offset, names_product, only_names,
-                       plain_name, renumber, trailing_name, vector_reading)
+                       renumber, trailing_name, vector_reading)
 from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_formula_pending,
                        manipulability_pending, singular_pending)
 from ._points import names_wrist_centre
@@ -90,20 +90,14 @@ class _Walker:
         return None
 
     def equate(self, eq: Equation, arm: Arm) -> None:
-        """``d_4 = a_2 = k``: lengths the table leaves without a value stated equal; from here on the section's
-        arm has them equal (judging with distinct generic values would call a right formula wrong)."""
-        written = {re.sub(r"[^A-Za-z0-9]", "", plain_name(p)): p.strip() for p in eq.parts[:-1]}
-        new = with_equal_lengths(arm, list(written), f"the equation at line {eq.line}")
-        if new is None:
-            return
-        gone = [n for n in arm.free if n in written and n not in new.free]
-        keep = next(n for n in reversed(list(written)) if n in new.free)
-        governing = next(a for sec, a in self.arms if sec.line <= eq.line <= sec.end_line)
-        self.equated[id(governing)] = new
-        for n in gone:
-            self.ctx.define(written[n], written[keep])
-        self.notes.append(f"line {eq.line}: {', '.join(gone)} = {keep} as the report states: the table's arm is "
-                          "read with them equal from there on")
+        """Lengths stated equal (``d_4 = a_2 = k``) or given a value (``L_1 = L_2 = 1`` m): the section's arm so
+        from here on (:func:`._arms.stated_lengths`)."""
+        found = stated_lengths(arm, eq.parts, eq.line)
+        if found is not None:
+            self.equated[id(next(a for sec, a in self.arms if sec.line <= eq.line <= sec.end_line))] = found[0]
+            for name, value in found[2]:
+                self.ctx.define(name, value)
+            self.notes.append(found[1])
 
     def run(self) -> list[Pending]:
         items = list(self.doc.items)
@@ -331,7 +325,7 @@ class _Walker:
         last = read_symbol(value)
         if len(eq.parts) == 2 and last is not None and joint_of(last, robot) is not None and _IK_FUNCS.search(lhs):
             lhs, value, sym = value, lhs, last  # "\arctan(P_y, P_x) = q_1"
-        if len(eq.parts) >= 3:
+        if len(eq.parts) >= 3 or (len(eq.parts) == 2 and length_value(eq.parts[1]) is not None):
             self.equate(eq, arm)
         if len(eq.parts) >= 2 and define_chain(self.ctx, eq.parts, robot):
             self.note(eq, arm, "not a claim", "a name the derivation introduces")
