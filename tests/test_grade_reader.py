@@ -478,3 +478,19 @@ def test_lengths_given_a_value_are_used_for_the_numbers_after_them(given):
     for x, verdict in (("1.125", "correct"), ("1.2", "incorrect")):
         text = _report(f"For $\\theta = (30^\\circ, 45^\\circ)$ and {given}:", t(x))
         assert [v for _, q, v in _verdicts(text) if q == "end_effector"] == [verdict]
+
+
+def test_joint_rates_given_one_by_one_are_the_rates_of_the_velocities_after_them():
+    """θ1 = 30°, θ2 = 60° (L1 = 1, L2 = 0.5), θ̇1 = 0.1, θ̇2 = 0.2: ẋ = −(L1 s1 + L2 s12) θ̇1 − L2 s12 θ̇2 = −0.2 and
+    ẏ = (L1 c1 + L2 c12) θ̇1 + L2 c12 θ̇2 = 0.0866 by hand (s12 = 1, c12 = 0); −0.3 is wrong; without the rates
+    the numbers are a question, not wrong."""
+    import math
+
+    assert abs(-(math.sin(math.radians(30)) + 0.5) * 0.1 - 0.5 * 0.2 - (-0.2)) < 1e-12
+    assert abs(math.cos(math.radians(30)) * 0.1 - 0.0866) < 5e-5
+    head = "The links are $L_1 = 1$ and $L_2 = 0.5$. Take $\\theta_1 = 30^\\circ$ and $\\theta_2 = 60^\\circ$."
+    rates = "With $\\dot\\theta_1 = 0.1$ and $\\dot\\theta_2 = 0.2$ the tip moves at"
+    for given, x, verdict in ((rates, "-0.2", "correct"), (rates, "-0.3", "incorrect"), ("The tip moves at", "-0.2",
+                                                                                         "ambiguous")):
+        text = _report(head, given, f"$$\\dot x = {x}, \\quad \\dot y = 0.0866$$")
+        assert [v for _, q, v in _verdicts(text) if q == "twist"][:1] == [verdict], (given, x)

@@ -14,7 +14,7 @@ from typing import Any
 from ._arms import Arm, length_value, stated_lengths
 from ._prose import plain_prose, prose_case, prose_conditions, prose_definitions, prose_wrench
 from ._context import (Context, case_of, has_joint_names, is_numeric, is_rate_name, is_wrench_name, joint_value,
-                       rates_or_wrench, vector_entries)
+                       rate_value, rates_or_wrench, vector_entries)
 from ._document import Document, Heading, Math, Prose, joined_display, plain_names
 from ._lhs import read_symbol
 from ._masses import moves_in_xy
@@ -26,8 +26,8 @@ from ._pending import (MANIPULABILITY, Pending, build_claim, det_pending, ik_for
 from ._points import names_wrist_centre
 from ._shorthand import define_name, rename_recent
 from ._split import Equation, split_block
-from ._target import (IK_HEADING, case_solution, is_target_part, matrix_target, prose_target, slide_formula, solution_claim,
-                      target_words)
+from ._target import (IK_HEADING, case_solution, is_target_part, matrix_target, prose_target, slide_formula,
+                      solution_claim, target_words)
 from ._values import wrench_symbols
 
 __all__ = ["Pending", "walk"]
@@ -269,6 +269,13 @@ class _Walker:
                         self.out.append(Pending(eq.line, eq.end_line, eq.text, arm, solution_claim(
                             self.ctx, self.ctx.partial), "joint values that reach the target", quantity="ik_solutions"))
                 self.note(eq, arm, "not a claim", f"a given joint value (θ{jv[0]})", "given: q")
+                return True
+            rv = rate_value(sym, last, robot) if sym is not None and len(eq.parts) == 2 else None
+            if rv is not None:  # θ̇1 = 0.1, θ̇2 = 0.2: the rates, once all are given
+                self.ctx.partial_rates[rv[0]] = rv[1]
+                if len(self.ctx.partial_rates) == robot.dof:
+                    self.ctx.qd = "[" + ", ".join(v for _, v in sorted(self.ctx.partial_rates.items())) + "]"
+                self.note(eq, arm, "not a claim", f"a given joint rate (θ̇{rv[0]})", "given: q̇")
                 return True
         return False
 

@@ -10,14 +10,14 @@ checker reads the values themselves (its q reader accepts all of these forms).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ..model import DHRobot
 from ._lhs import Symbol
 from ._names import JOINT_LETTERS
 from ._split import top_level_split
 
-__all__ = ["Context", "case_of", "vector_entries", "is_numeric", "has_joint_names", "rates_or_wrench",
+__all__ = ["Context", "case_of", "rate_value", "vector_entries", "is_numeric", "has_joint_names", "rates_or_wrench",
            "MAX_WHERE", "is_wrench_name", "is_rate_name"]
 
 #: Most names a derivation introduces that are passed to one claim (the checker's own bound).
@@ -38,6 +38,7 @@ class Context:
     qd: str | None = None
     wrench: str | None = None
     partial: dict[int, str] = field(default_factory=dict)
+    partial_rates: dict[int, str] = field(default_factory=dict)  # joint rates given one by one
     where: dict[str, str] = field(default_factory=dict)
     singular: bool = False
     propagation: bool = False
@@ -50,7 +51,7 @@ class Context:
     target_line: int = 0
     target_words_line: int = 0  # the last line with words of a target ("the desired pose"): a T after it is one
     renames: dict[str, str] = field(default_factory=dict)
-    trig_steps: dict[tuple[str, int], str] = field(default_factory=dict)  # ("cos", 2) → the formula "cos θ2 = …" gave  # shorthand digits → signed form ("124" → "12-4")
+    trig_steps: dict[tuple[str, int], str] = field(default_factory=dict)  # ("cos", 2) → what "cos θ2 = …" gave  # shorthand digits → signed form ("124" → "12-4")
     p_wrist: bool = False
     ik_section: bool = False  # under a heading about inverse kinematics: coordinates stated are a target  # the report named the wrist centre's coordinates P_x, P_y, P_z (see ._points)
 
@@ -125,6 +126,13 @@ def joint_value(sym: Symbol, rhs: str, robot: DHRobot) -> tuple[int, str] | None
                             or f"d{k}" in {n for n, _ in robot.parameters}):
         return None
     return int(k), rhs
+
+
+def rate_value(sym: Symbol, rhs: str, robot: DHRobot) -> tuple[int, str] | None:
+    """``\\dot\\theta_2 = 0.2``: (joint, value text) of a joint rate given as one number."""
+    if sym.dots != 1 or sym.pre_sup or sym.sup:
+        return None
+    return joint_value(replace(sym, dots=0), rhs, robot)
 
 
 def is_rate_name(lhs: str) -> bool:

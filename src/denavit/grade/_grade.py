@@ -103,6 +103,9 @@ def _decide(p: Pending, seed: int) -> tuple[str, str, str, dict[str, Any]]:
                                  f"({v.message})"), "", details
     if not p.sure:
         return "ambiguous", f"read as {p.understood} (a guess from the name), it is not: {v.message}", "", details
+    if p.numeric_without_rates:
+        return "ambiguous", ("numbers, but no joint rates (q̇ = (…)) stated before them; at random rates: "
+                             f"{v.message}"), "", details
     if p.numeric_without_wrench:
         return "ambiguous", ("numbers, but no wrench (F = (…)) stated before them; at random wrenches: "
                              f"{v.message}"), "", details

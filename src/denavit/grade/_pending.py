@@ -42,6 +42,7 @@ class Pending:
     quantity: str = ""
     numeric_without_case: bool = False
     numeric_without_wrench: bool = False  # numbers for τ, ⁱfᵢ, ⁱnᵢ with no wrench stated: judged at random ones
+    numeric_without_rates: bool = False  # numbers for a velocity with no joint rates stated: judged at random ones
     not_a_claim_if_unreadable: bool = False
 
 
@@ -85,6 +86,8 @@ def build_claim(ctx: Context, eq: Equation, arm: Arm, reading: Reading, value: s
         p.numeric_without_case = True
     if "qd" in reading.needs and numeric and ctx.qd:
         claim["qd"] = ctx.qd
+    elif "qd" in reading.needs and numeric:
+        p.numeric_without_rates = True
     if "wrench" in reading.needs:
         _wrench(ctx, p, claim, value, numeric)
     if qty == "jacobian" and "frame" not in claim and ctx.jacobian_frame is not None:
