@@ -369,6 +369,30 @@ def test_random_ur_class_batches_equal_plain(seed, _kernel_cache):
             assert np.all(np.abs(F[:, :3, :3] - T[k, :3, :3]).max(axis=(-1, -2)) < 1e-9)
 
 
+@pytest.mark.parametrize("name", ["ur5", "puma560"])  # the UR-class and the elbow kernel
+def test_compiled_solutions_come_in_the_plain_order(name, _kernel_cache):
+    """One pose at a time, the compiled kernel's solutions (sorted in machine code) come in the plain solver's
+    order, row by row, with its labels: random poses and rounded ones (joints on round values, where solutions
+    share joint values and the order is decided by a later joint)."""
+    robot = denavit.load_robot(name)
+    fast = denavit.compile(robot, kernels=["fk", "fk_jacobian0"])
+    rng = np.random.default_rng(12)
+    lim = np.clip(robot.q_limits, -np.pi, np.pi)
+    Q = rng.uniform(lim[:, 0], lim[:, 1], (60, robot.dof))
+    Q[::3] = np.round(Q[::3], 1)
+    Q[1::6, 0] = 0.0
+    found = 0
+    for q in Q:
+        T = denavit.forward_kinematics(robot, q)
+        a, b = fast.analytic_ik(T), denavit.analytic_ik(robot, T)
+        A, B = np.asarray(a.solutions), np.asarray(b.solutions)
+        assert A.shape == B.shape
+        assert np.all(np.abs(A - B).max(axis=-1, initial=0.0) < _tolerance(robot, A))
+        assert list(a.branches) == list(b.branches)
+        found += len(A)
+    assert found >= 2 * len(Q)  # mostly several solutions a pose (a rounded q may leave the limits)
+
+
 def random_wrist_draws(seed: int):
     """The first draws of a random arm with a spherical wrist: (rng, convention, twist(), length(), t4, t5) —
     half of the wrists with equal outer twists, so that axes 4 and 6 can align."""

@@ -207,8 +207,10 @@ def take_branch(St, r, k, L, cand, cerr, flags, codes, m):
     """Branch k of pose r of the stages' rows St (layout L) into candidate m: its joints cand[m] (folded),
     residuals cerr[m], whether they verify the pose flags[m], whether its joints lie within the limits flags[8 + m]
     and its label code codes[m].  Returns whether it is verified with a joint next to an edge of the fold."""
-    for j in range(6):
-        cand[m, j] = St[(L[13 + 4 * j] + (k >> L[16 + 4 * j])) * CHUNK + r]
+    # (the layout's entries by literal indices: constants, where a variable index is a switch over the tuple)
+    cand[m, 0], cand[m, 1] = St[(L[13] + (k >> L[16])) * CHUNK + r], St[(L[17] + (k >> L[20])) * CHUNK + r]
+    cand[m, 2], cand[m, 3] = St[(L[21] + (k >> L[24])) * CHUNK + r], St[(L[25] + (k >> L[28])) * CHUNK + r]
+    cand[m, 4], cand[m, 5] = St[(L[29] + (k >> L[32])) * CHUNK + r], St[(L[33] + (k >> L[36])) * CHUNK + r]
     d = k * CHUNK + r
     cerr[m, 0], cerr[m, 1], flags[m] = St[L[4] * CHUNK + d], St[L[5] * CHUNK + d], St[L[6] * CHUNK + d] != 0.0
     codes[m] = St[L[8] * CHUNK + d]
