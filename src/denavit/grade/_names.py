@@ -11,12 +11,14 @@ reading that is only a guess carries ``sure=False``: an "incorrect" under it bec
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any
 
 from ..model import IDENTITY, DHRobot, JointType
 from ._lhs import Symbol, frame_token
 from ._masses import turns_about_z
+from ._names_dyn import christoffel_reading, dynamics_reading, energy_reading
+from ._reading_type import Reading, digit
 
 __all__ = ["Reading", "read_name", "JOINT_LETTERS"]
 
@@ -24,22 +26,6 @@ JOINT_LETTERS = ("theta", "vartheta", "q", "Q", "heta")
 _LINEAR = ("v", "L", "P", "p", "linear", "lin", "V")
 _ANGULAR = ("\\omega", "omega", "w", "\\Omega", "R", "A", "o", "\\omega}", "ang", "W")
 _TWIST = ("vartheta", "nu", "xi", "mathcal{V}", "mathcal V", "V_e", "xi_e", "nu_e")
-
-
-@dataclass(frozen=True)
-class Reading:
-    """How a left-hand side was read: the claim keys, in words, other readings, and whether it is only a guess."""
-
-    spec: dict[str, Any]
-    understood: str
-    alternatives: tuple[tuple[dict[str, Any], str], ...] = ()
-    sure: bool = True
-    needs: tuple[str, ...] = field(default=())  # "q" "qd" "wrench": context the claim takes when the value is numeric
-
-
-def _digit(t: str) -> int | None:
-    t = re.sub(r"[{}\s]", "", t)
-    return int(t) if t.isdigit() and len(t) <= 3 else None
 
 
 def _joint_of_axis(k: int, robot: DHRobot) -> int:
@@ -65,7 +51,7 @@ def _transform(sym: Symbol, robot: DHRobot) -> Reading | None:
     if sym.base in ("A", "T") and re.fullmatch(r"\{?[ikn]\}?", sym.sub.strip()) and not sym.sup and not sym.pre_sup:
         return Reading({"quantity": "dh_matrix"}, "the general DH link matrix")
     if sym.base == "A" and sym.sub and not sym.sup and not sym.pre_sup:
-        k = _digit(sym.sub)
+        k = digit(sym.sub)
         if k is not None and 1 <= k <= n:
             return Reading({"quantity": "link_transform", "index": k}, f"A_{k}: the link transform of DH row {k}")
         return None
@@ -74,7 +60,7 @@ def _transform(sym: Symbol, robot: DHRobot) -> Reading | None:
     elif sym.sub and sym.sup:
         a, b, ordered = sym.sub, sym.sup, False
     elif sym.sub:
-        k = _digit(sym.sub)
+        k = digit(sym.sub)
         if k is None or not 1 <= k <= n or sym.base == "R":
             return None
         return Reading({"quantity": "transform", "from": 0, "to": k}, f"T_{k} read as T_0_{k}, the pose of frame {k} in "
@@ -173,7 +159,7 @@ def _jacobian(sym: Symbol, robot: DHRobot) -> Reading | None:
         spec["rows"] = "angular"
         words.append("angular rows (J_ω)")
     else:
-        k = _digit(sub)
+        k = digit(sub)
         two = re.fullmatch(r"(\d),?(\d)", sub)
         if k is not None and 1 <= k <= robot.dof and not sym.det:
             spec["column"] = k
@@ -215,7 +201,7 @@ def _position(sym: Symbol, robot: DHRobot) -> Reading | None:
         if sym.dots:
             return Reading({"quantity": "twist", "rows": "linear"}, "the end-effector linear velocity", needs=("q", "qd"))
         return Reading({"quantity": "position"}, "the end-effector position", sure=sub != "", needs=("q",))
-    k = _digit(re.sub(r"(?i)org$", "", sub))
+    k = digit(re.sub(r"(?i)org$", "", sub))
     if k is not None and not sym.dots and 0 <= k <= robot.n_rows:
         return Reading({"quantity": "origin", "index": k}, f"the origin of DH frame {k} (base axes)", needs=("q",))
     return None
@@ -252,76 +238,20 @@ def _propagated(sym: Symbol, robot: DHRobot) -> Reading | None:
                    needs=("q", "qd") if q in ("omega", "velocity") else ("q", "wrench"))
 
 
-def _dynamics(sym: Symbol, robot: DHRobot, gravity_rhs: bool = False) -> Reading | None:
-    """M, g, c, C with an entry; ``g_2`` alone only when its value has g and a mass in it (else a cosine-like
-    shorthand or the gravity's magnitude)."""
-    names = {"M": ("mass_matrix", "the mass matrix M(q)"), "G": ("gravity", "the gravity torques g(q)"),
-             "g": ("gravity", "the gravity torques g(q)"), "c": ("coriolis", "the Coriolis/centrifugal torques c(q, q̇)"),
-             "C": ("coriolis_matrix", "the Coriolis matrix C(q, q̇)"), "h": ("coriolis", "c(q, q̇)")}
-    if sym.base not in names or sym.pre_sup or sym.dots:
-        return None
-    if sym.base in ("g", "c", "C", "h", "G") and not sym.args and not (sym.base in ("g", "G") and gravity_rhs):
-        return None
-    qty, words = names[sym.base]
-    spec: dict[str, Any] = {"quantity": qty}
-    sub = re.sub(r"[{}\s]", "", sym.sub)
-    if sub:
-        two = re.fullmatch(r"(\d),?(\d)", sub)
-        k = _digit(sub)
-        if two and qty in ("mass_matrix", "coriolis_matrix"):
-            spec["entry"] = [int(two.group(1)), int(two.group(2))]
-            words += f", entry ({two.group(1)}, {two.group(2)})"
-        elif k is not None and qty in ("gravity", "coriolis") and 1 <= k <= robot.dof:
-            spec["entry"] = k
-            words += f", entry {k}"
-        else:
-            return None
-    return Reading(spec, words, needs=("q",))
-
-
-def _christoffel(sym: Symbol, robot: DHRobot, rhs: str) -> Reading | None:
-    """``c_{121}`` (Spong's c_ijk, the row index of C last) or ``\\Gamma^1_{21}``: a Christoffel symbol of M; the
-    other order, the row index first (``\\Gamma_{ijk}`` of Murray, Li, Sastry), is the second reading.  Sure only
-    when the value has a mass or a derivative in it, or is 0 (``c_{123} = c_{12} c_3 - s_{12} s_3`` is a cosine)."""
-    sub, sup = re.sub(r"[{}\s,]", "", sym.sub), re.sub(r"[{}\s,]", "", sym.sup)
-    if sym.pre_sup or sym.dots or sym.args or sym.pre_sub:
-        return None
-    idx = sub + sup if sym.base == "Gamma" and len(sup) == 1 and len(sub) == 2 else sub if not sup else ""
-    if len(idx) != 3 or not idx.isdigit() or not all(1 <= int(d) <= robot.dof for d in idx):
-        return None
-    i, j, k = map(int, idx)
-    other = ({"quantity": "christoffel", "entry": [j, k, i]}, f"the Christoffel symbol with the row index first "
-             f"(Spong's c_{j}{k}{i})")
-    sure = bool(re.search(r"m_|\\partial", rhs)) or rhs.strip() == "0"
-    return Reading({"quantity": "christoffel", "entry": [i, j, k]}, f"Spong's Christoffel symbol c_{i}{j}{k} of M",
-                   (other,) if len({i, j, k}) > 1 else (), sure=sure, needs=("q",))
-
-
-def _energy(sym: Symbol) -> Reading | None:
-    names = {"K": ("kinetic_energy", "the kinetic energy K"), "T": ("kinetic_energy", "the kinetic energy"),
-             "P": ("potential_energy", "the potential energy"), "U": ("potential_energy", "the potential energy"),
-             "V": ("potential_energy", "the potential energy"), "L": ("lagrangian", "the Lagrangian L = K − P"),
-             "mathcal{L}": ("lagrangian", "the Lagrangian")}
-    if sym.base not in names or sym.sub or sym.sup or sym.pre_sup or sym.dots:
-        return None
-    qty, words = names[sym.base]
-    return Reading({"quantity": qty}, words, needs=("q",))
-
-
 def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
     """The reading of a left-hand side for ``robot`` (``rhs`` decides between look-alikes such as ``L``)."""
     b = sym.base
     dynamic = bool(re.search(r"\\dot|\\ddot|m_|I_|\bg\b", rhs))
     if b in ("T", "A", "R", "H") and not sym.dots and not sym.det:
         if b == "T" and dynamic and not (sym.sub or sym.sup or sym.pre_sup):
-            return _energy(sym)
+            return energy_reading(sym)
         if sym.args and b != "R":
             return _position_column(sym, robot)
         return _transform(sym, robot)
     if b == "J" or (sym.det and b == "J"):
         return _jacobian(sym, robot)
     if b in ("P", "V", "U") and dynamic and not (sym.sub or sym.pre_sup or sym.dots):
-        return _energy(sym)
+        return energy_reading(sym)
     if b in ("p", "P", "o", "O") and not sym.det:
         return _position(sym, robot)
     if b in ("x", "y", "z"):
@@ -336,7 +266,7 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
                            " velocity", needs=("q", "qd"))
         return _propagated(sym, robot)
     if b == "tau":
-        k = _digit(sym.sub) if sym.sub else None
+        k = digit(sym.sub) if sym.sub else None
         if sym.sub and (k is None or not 1 <= k <= robot.dof):
             return None
         qty = "equations_of_motion" if "\\ddot" in rhs else "torques"
@@ -356,13 +286,13 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         b = {"d": "M", "D": "M", "phi": "g"}[b]  # Spong's d_ij (the inertia matrix) and φ_k (gravity), by its value
         sym = replace(sym, base=b)
     if b in ("c", "Gamma") and robot.has_dynamics and not re.match(r"\s*\\?cos", rhs):
-        christoffel = _christoffel(sym, robot, rhs)
+        christoffel = christoffel_reading(sym, robot, rhs)
         if christoffel is not None:
             return christoffel
     if b in ("M", "G", "g", "c", "C", "h"):
-        return _dynamics(sym, robot, gravity_rhs=gravity_rhs)
+        return dynamics_reading(sym, robot, gravity_rhs=gravity_rhs)
     if b in ("K", "P", "U", "V", "L", "mathcal{L}") and (dynamic or b in ("K",)):
-        return _energy(sym)
+        return energy_reading(sym)
     if b in ("phi", "varphi", "psi") and not (sym.sub or sym.sup or sym.pre_sup or sym.dots) \
             and re.search(r"theta|\bq_|θ", rhs) and turns_about_z(robot):
         plain = robot.base == IDENTITY and robot.tool == IDENTITY  # else φ may be the last link's, not the tool's
@@ -374,7 +304,7 @@ def joint_of(sym: Symbol, robot: DHRobot) -> int | None:
     """The joint a left-hand side such as ``\\theta_2``, ``q_3``, ``d_3`` (a prismatic joint) names, if any."""
     if sym.dots or sym.pre_sup or sym.sup or sym.args or sym.det:
         return None
-    k = _digit(sym.sub) if sym.sub else None
+    k = digit(sym.sub) if sym.sub else None
     if k is None or not 1 <= k <= robot.dof:
         return None
     if sym.base in JOINT_LETTERS:
