@@ -494,3 +494,23 @@ def test_joint_rates_given_one_by_one_are_the_rates_of_the_velocities_after_them
                                                                                          "ambiguous")):
         text = _report(head, given, f"$$\\dot x = {x}, \\quad \\dot y = 0.0866$$")
         assert [v for _, q, v in _verdicts(text) if q == "twist"][:1] == [verdict], (given, x)
+
+
+@pytest.mark.parametrize("name", ["z_1", "\\hat{z}_1", "e_{z_1}", "{}^{0}z_{1}"])
+def test_joint_axes_written_as_z_i_are_judged(name):
+    """Spong's articulated RRR (standard DH, α1 = 90°): z_1 (frame 1's z, the axis of joint 2) = (s1, −c1, 0) — the
+    third column of A_1 = Rot_z(θ1) Rot_x(90°), multiplied out here; (c1, s1, 0) is not; z_0 = (0, 0, 1)."""
+    import numpy as np
+
+    t = 0.7
+    A1 = np.array([[np.cos(t), 0, np.sin(t)], [np.sin(t), 0, -np.cos(t)], [0, 1, 0]])
+    assert np.allclose(A1[:, 2], [np.sin(t), -np.cos(t), 0])
+    table = ("| i | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |\n|---|---|---|---|---|\n"
+             "| 1 | 0 | $90^\\circ$ | $d_1$ | $\\theta_1$ |\n| 2 | $a_2$ | 0 | 0 | $\\theta_2$ |\n"
+             "| 3 | $a_3$ | 0 | 0 | $\\theta_3$ |\n")
+    eqs = ["z_0 = \\begin{bmatrix} 0 \\\\ 0 \\\\ 1 \\end{bmatrix}",
+           f"{name} = \\begin{{bmatrix}} s_1 \\\\ -c_1 \\\\ 0 \\end{{bmatrix}}",
+           f"{name} = \\begin{{bmatrix}} c_1 \\\\ s_1 \\\\ 0 \\end{{bmatrix}}"]
+    text = "# RRR\n\n" + table + "\n" + "\n\n".join(f"$${e}$$" for e in eqs) + "\n"
+    got = [(c.quantity, c.verdict) for c in grade_text(text).claims]
+    assert got == [("joint_axis", "correct"), ("joint_axis", "correct"), ("joint_axis", "incorrect")], got

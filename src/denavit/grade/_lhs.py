@@ -15,7 +15,7 @@ __all__ = ["Symbol", "read_symbol", "frame_token", "MAX_LHS"]
 #: Longest left-hand side taken apart (characters); a longer one is no name.
 MAX_LHS = 160
 
-_STYLE = re.compile(r"\\(?:mathbf|boldsymbol|bm|mathrm|mathit|mathsf|mathcal|vec|mathbb|operatorname|text|textbf)"
+_STYLE = re.compile(r"\\(?:mathbf|boldsymbol|bm|hat|mathrm|mathit|mathsf|mathcal|vec|mathbb|operatorname|text|textbf)"
                     r"\s*(?=\{)")
 _SPACES = re.compile(r"\\(?:left|right|,|;|!|:|quad|qquad|big|Big|bigl|bigr)(?![A-Za-z])|\s+")
 

@@ -207,6 +207,24 @@ def _position(sym: Symbol, robot: DHRobot) -> Reading | None:
     return None
 
 
+def _axis(sym: Symbol, robot: DHRobot, rhs: str) -> Reading | None:
+    """``z_1 = [⋯]``, ``\\hat{z}_1``, ``e_{z_1}``, ``{}^0\\hat{Z}_2``: the z axis of DH frame k in base axes, a vector
+    — the axis of joint k + 1 (standard DH: z_{i−1} carries joint i) or of joint k (modified DH: z_i)."""
+    base, sub = sym.base, sym.sub.strip("{} ")
+    if base == "e" and re.fullmatch(r"z_?\{?\d\}?", sub):
+        base, sub = "z", sub.lstrip("z_{").rstrip("}")
+    if base not in ("z", "Z", "hatz", "hatZ") or sym.dots or sym.args or sym.sup or sym.pre_sup not in ("", "0"):
+        return None
+    k = digit(sub) if sub else None
+    if k is None or not ("\\begin" in rhs or rhs.lstrip()[:1] in "[(") or "=" in rhs:
+        return None
+    joint = k + 1 if robot.convention.value == "standard" else k
+    if not 1 <= joint <= robot.dof:
+        return None
+    return Reading({"quantity": "joint_axis", "index": joint}, f"z_{k}: the axis of joint {joint} (base axes)",
+                   needs=("q",))
+
+
 def _coordinate(sym: Symbol, robot: DHRobot) -> Reading | None:
     """``x``, ``y``, ``z`` and their rates: the end effector's coordinates (a guess: x may name something else)."""
     k = {"x": 1, "y": 2, "z": 3}[sym.base]
@@ -254,6 +272,9 @@ def read_name(sym: Symbol, robot: DHRobot, rhs: str = "") -> Reading | None:
         return energy_reading(sym)
     if b in ("p", "P", "o", "O") and not sym.det:
         return _position(sym, robot)
+    axis = _axis(sym, robot, rhs)
+    if axis is not None:
+        return axis
     if b in ("x", "y", "z"):
         return _coordinate(sym, robot)
     rate = _rate_row(sym, robot)

@@ -284,6 +284,8 @@ def f16():
         R("correct", "(4) p_x", c1 * w, T03[0, 3]),
         R("correct", "(5) p_y", s1 * w, T03[1, 3]),
         R("incorrect", "(6) p_z: s3 for s23", d1 + a2 * s2 + a3 * s3, T03[2, 3]),
+        R("correct", "z_0 (the axis of joint 1: J_omega's first column)", sp.Matrix([0, 0, 1]), J[3:, 0]),
+        R("correct", "z_1 (the axis of joint 2)", sp.Matrix([s1, -c1, 0]), J[3:, 1]),
         R("correct", "(7) J_v", M([-s1 * w, -c1 * (a2 * s2 + a3 * s23), -a3 * c1 * s23],
                                   [c1 * w, -s1 * (a2 * s2 + a3 * s23), -a3 * s1 * s23], [0, a2 * c2 + a3 * c23, a3 * c23]),
           J[:3, :]),
