@@ -25,7 +25,8 @@ from typing import Any, Callable, Mapping
 
 from .errors import ParseError
 
-__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "is_literal", "fold", "lookup", "MAX_LENGTH", "MAX_DEPTH"]
+__all__ = ["Node", "parse", "evaluate", "to_sympy", "to_text", "names_in", "is_literal", "fold", "lookup", "tree_depth", "MAX_LENGTH",
+           "MAX_DEPTH"]
 
 MAX_LENGTH = 500
 MAX_DEPTH = 30
@@ -215,6 +216,22 @@ def names_in(node: Node) -> set[str]:
         elif kind == "call":
             stack += n[2]
     return out
+
+
+def tree_depth(node: Node) -> int:
+    """The depth of an expression tree, computed without recursion (so any tree can be measured)."""
+    deepest, stack = 0, [(node, 1)]
+    while stack:
+        nd, d = stack.pop()
+        deepest = max(deepest, d)
+        kind = nd[0]
+        if kind == "neg":
+            stack.append((nd[1], d + 1))
+        elif kind == "bin":
+            stack += [(nd[2], d + 1), (nd[3], d + 1)]
+        elif kind == "call":
+            stack += [(a, d + 1) for a in nd[2]]
+    return deepest
 
 
 def fold(node: Node, number: Callable[[str], Any], name: Callable[[str], Any],

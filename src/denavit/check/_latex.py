@@ -24,7 +24,7 @@ from ..errors import ParseError
 from ._text import after_last_equals, strip_equation_number
 from ._tokens import FUNCS, GREEK, MAX_DEPTH, MAX_TREE_DEPTH, WRAP_CMDS, Ident, Resolver, tokenize
 
-__all__ = ["parse_math", "tree_depth"]
+__all__ = ["parse_math"]
 
 _OPEN = {"(": ")", "[": "]", "{": "}", "\\{": "\\}"}
 
@@ -382,23 +382,8 @@ def parse_math(text: str, resolve: Resolver, *, rhs: bool = True) -> tuple:
         extra = text.count(")") - text.count("(")
         why = f" (the brackets do not balance: {extra} more ')' than '(')" if p.peek()[1] == ")" and extra > 0 else ""
         raise ParseError(f"unexpected {p.peek()[1]!r} after a complete expression in {text[:60]!r}{why}")
-    if tree_depth(node) > MAX_TREE_DEPTH:
+    if _expr.tree_depth(node) > MAX_TREE_DEPTH:
         raise ParseError(f"expression too long: more than {MAX_TREE_DEPTH} operations in a chain "
                          "(split it, or group terms in parentheses)")
     return node
 
-
-def tree_depth(node: tuple) -> int:
-    """The depth of an expression tree, computed without recursion (so any tree can be measured)."""
-    deepest, stack = 0, [(node, 1)]
-    while stack:
-        nd, d = stack.pop()
-        deepest = max(deepest, d)
-        kind = nd[0]
-        if kind == "neg":
-            stack.append((nd[1], d + 1))
-        elif kind == "bin":
-            stack += [(nd[2], d + 1), (nd[3], d + 1)]
-        elif kind == "call":
-            stack += [(a, d + 1) for a in nd[2]]
-    return deepest
