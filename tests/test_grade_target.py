@@ -200,3 +200,29 @@ def test_the_heading_stated_as_a_result_stays_the_targets_in_ik_and_a_cosine_ste
     text = f"# IK\n\n{TABLE}\n" + "\n\n".join(f"$${s}$$" for s in steps) + "\n"
     got = [c.verdict for c in grade_text(text).claims if c.quantity == "ik_formula"]
     assert got == ["correct"] * 3, got
+
+
+def test_a_squared_name_defined_is_its_root_in_the_ik_after_it():
+    """Spong's elbow arm (Sec. 5.3): ``r^2 = x^2 + y^2``, ``s = z - d_1``, D = (r² + s² − a2² − a3²)/(2 a2 a3),
+    θ3 = atan2(±√(1 − D²), D), θ2 = atan2(s, r) − atan2(a3 s3, a2 + a3 c3) — r is √(x² + y²) (was "unknown
+    symbol r"); the formulas checked first with the arm's FK written by hand at random configurations."""
+    import numpy as np
+
+    a2, a3, d1 = 0.6, 0.45, 0.3
+    for q in np.random.default_rng(5).uniform([-3, 0.1, 0.2], [3, 0.8, 1.2], (20, 3)):  # a2 c2 + a3 c23 > 0
+        w = a2 * np.cos(q[1]) + a3 * np.cos(q[1] + q[2])
+        x, y, z = np.cos(q[0]) * w, np.sin(q[0]) * w, d1 + a2 * np.sin(q[1]) + a3 * np.sin(q[1] + q[2])
+        r, s = np.hypot(x, y), z - d1
+        D = (r * r + s * s - a2 ** 2 - a3 ** 2) / (2 * a2 * a3)
+        assert np.isclose(np.arctan2(np.sqrt(1 - D * D), D), q[2])
+        assert np.isclose(np.arctan2(s, r) - np.arctan2(a3 * np.sin(q[2]), a2 + a3 * np.cos(q[2])), q[1])
+    table = ("| Link | $a_i$ | $\\alpha_i$ | $d_i$ | $\\theta_i$ |\n|---|---|---|---|---|\n"
+             "| 1 | 0 | $90^\\circ$ | $d_1$ | $\\theta_1$ |\n| 2 | $a_2$ | 0 | 0 | $\\theta_2$ |\n"
+             "| 3 | $a_3$ | 0 | 0 | $\\theta_3$ |\n")
+    steps = ["r^2 = x^2 + y^2", "s = z - d_1", "D = \\frac{r^2 + s^2 - a_2^2 - a_3^2}{2 a_2 a_3}",
+             "\\theta_3 = \\operatorname{atan2}\\left(\\pm\\sqrt{1 - D^2}, D\\right)",
+             "\\theta_2 = \\operatorname{atan2}(s, r) - \\operatorname{atan2}(a_3 s_3, a_2 + a_3 c_3)",
+             "\\theta_2 = \\operatorname{atan2}(s, r) + \\operatorname{atan2}(a_3 s_3, a_2 + a_3 c_3)"]
+    text = "# Elbow\n\n" + table + "\n" + "\n\n".join(f"$${e}$$" for e in steps) + "\n"
+    got = [c.verdict for c in grade_text(text).claims if c.quantity == "ik_formula"]
+    assert got == ["correct", "correct", "incorrect"], got

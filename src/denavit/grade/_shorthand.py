@@ -54,6 +54,10 @@ def define_name(ctx: Context, sym: Any, lhs: str, value: str, parts: tuple[str, 
         ctx.renames[signed[0]] = signed[1]
         return True
     name = re.sub(r"\s+", "", lhs)
+    square = re.fullmatch(r"([A-Za-z](?:_\{?\w{1,3}\}?)?)\^\{?2\}?", name)
+    if square and not has_joint_names(value) and not _TARGET_NAME.fullmatch(square.group(1)):
+        ctx.define(square.group(1), f"\\sqrt{{{value}}}")  # r^2 = x^2 + y^2: r is the distance, its root
+        return False
     if _TARGET_NAME.fullmatch(name):  # φ = θ1 + θ2 + θ3, x = …: results; in IK formulas these are the target's
         return False
     intermediate = not has_joint_names(value) and TARGET_NAMES.search(value) is not None  # c_2 = (x² + y² …)/…
