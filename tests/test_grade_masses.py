@@ -154,3 +154,18 @@ def test_the_other_index_order_is_a_question_and_a_cosine_shorthand_is_no_christ
     got = _judged(STANDARD, [intro, f"c_{{112}} = {truth[(1, 2, 1)]}", "c_{122} = \\cos(q_1 + 2 q_2)",
                              "c_{122} = c_{12} c_2 - s_{12} s_2"])
     assert got[:2] == ["correct", "ambiguous"] and "incorrect" not in got[2:], got
+
+
+def test_numbers_given_to_the_masses_are_used_at_a_case():
+    """ℓ1 = ℓ2 = 1, ℓc1 = ℓc2 = 0.5, m1 = m2 = 2, I1 = I2 = 0.2 at q = (0, 90°): by the textbook entries above,
+    d11 = 2·0.25 + 2·(1 + 0.25 + 0) + 0.4 = 3.4, d12 = 2·0.25 + 0.2 = 0.7, d22 = 0.7; a wrong d12 = 0.9 is
+    caught in exactly its two entries (with stand-in values every entry differed)."""
+    def report(d12: str) -> str:
+        return ("# Two-link arm\n\n" + STANDARD + "\n$$M_{22} = m_2 \\ell_{c2}^2 + I_2$$\n\n"
+                "Numbers: $\\ell_1 = \\ell_2 = 1$, $\\ell_{c1} = \\ell_{c2} = 0.5$, $m_1 = m_2 = 2$, $I_1 = I_2 = 0.2$. "
+                "At $q = (0, 90^\\circ)$:\n\n"
+                f"$$M = \\begin{{bmatrix}} 3.4 & {d12} \\\\ {d12} & 0.7 \\end{{bmatrix}}$$\n")
+    right = [c for c in grade_text(report("0.7")).claims if c.quantity == "mass_matrix"]
+    wrong = [c for c in grade_text(report("0.9")).claims if c.quantity == "mass_matrix"]
+    assert [c.verdict for c in right] == ["correct", "correct"]
+    assert [c.verdict for c in wrong] == ["correct", "incorrect"] and "(1, 2), (2, 1)" in wrong[1].message

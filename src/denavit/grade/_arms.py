@@ -106,7 +106,9 @@ def _with_masses(arm: Arm, maths: list[str]) -> Arm:
     if robot is None:
         return arm
     info = dataclasses.replace(arm.info, notes=arm.info.notes + (found[1],))
-    return Arm(robot, info, arm.problem, arm.advice, found[0], arm.free, gravity_assumed=True)
+    added = tuple(k for k in found[0]["parameters"] if k not in arm.data["parameters"] and k not in arm.free)
+    # the masses' names have stand-in values too: a report that gives them numbers (m_1 = 2) has them so after
+    return Arm(robot, info, arm.problem, arm.advice, found[0], arm.free + added, gravity_assumed=True)
 
 
 def _renamed(value: Any, word: re.Pattern, keep: str) -> Any:
