@@ -68,20 +68,24 @@ def define_name(ctx: Context, sym: Any, lhs: str, value: str, parts: tuple[str, 
     return False
 
 
+def _renamed_claim(claim: dict[str, Any], renames: dict[str, str]) -> dict[str, Any]:
+    value = claim.get("value")
+    return {**claim, "value": renamed(value, renames)} if isinstance(value, str) else claim
+
+
 def rename_recent(out: list, ctx: Context, line: int) -> None:
     """The claims of the last :data:`RECENT_LINES` lines before ``line`` with the signed shorthands applied."""
     for p in reversed(out):
-        if p.claim is None or p.line < line - RECENT_LINES:
-            if p.line < line - RECENT_LINES:
-                break
+        if p.line < line - RECENT_LINES:
+            break
+        if p.claim is None:
             continue
-        if isinstance(p.claim.get("value"), str) and renamed(p.claim["value"], ctx.renames) != p.claim["value"]:
-            p.claim["value"] = renamed(p.claim["value"], ctx.renames)
+        new = _renamed_claim(p.claim, ctx.renames)
+        if new.get("value") != p.claim.get("value"):
+            p.claim["value"] = new["value"]  # in place: the claim dict is the Pending's own
             p.understood += f" (the shorthand as line {line} defines it)"
-        p.alternatives = [({**a, "value": renamed(a["value"], ctx.renames)} if isinstance(a.get("value"), str)
-                           else a, w) for a, w in p.alternatives]
-        p.equivalent = [({**a, "value": renamed(a["value"], ctx.renames)} if isinstance(a.get("value"), str)
-                         else a, w) for a, w in p.equivalent]
+        p.alternatives = [(_renamed_claim(a, ctx.renames), w) for a, w in p.alternatives]
+        p.equivalent = [(_renamed_claim(a, ctx.renames), w) for a, w in p.equivalent]
 
 
 _JOINT = r"(?:\\(?:var)?theta|q)\s*_\s*(?:\{\s*(D)\s*\}|(D))"  # θ_2 or θ_{2}: a brace only in pairs
