@@ -33,26 +33,16 @@ from denavit.codegen._ik_nb_parallel_stages import parallel_stages
 
 
 @njit(nogil=True)
-def _stages(T, K, checks):
-    St, acc = np.empty(ROWS * CHUNK), 0.0
+def _stages(stages, check, rows, probe, T, K, checks):
+    """The stage loop of a kernel (``stages``, then ``check`` when ``checks``) over T in chunks; ``probe``: a row read
+    so the work is not optimised away."""
+    St, acc = np.empty(rows * CHUNK), 0.0
     for b in range(0, T.shape[0], CHUNK):
         n = min(CHUNK, T.shape[0] - b)
-        elbow_stages(T, b, n, K, St)
+        stages(T, b, n, K, St)
         if checks:
-            elbow_checks(n, K, St)
-        acc += St[RQA * CHUNK]
-    return acc
-
-
-@njit(nogil=True)
-def _ur_stages(T, K, checks):
-    St, acc = np.empty(UR_ROWS * CHUNK), 0.0
-    for b in range(0, T.shape[0], CHUNK):
-        n = min(CHUNK, T.shape[0] - b)
-        parallel_stages(T, b, n, K, St)
-        if checks:
-            parallel_checks(n, K, St)
-        acc += St[UR_RQ2 * CHUNK]
+            check(n, K, St)
+        acc += St[probe * CHUNK]
     return acc
 
 
@@ -75,11 +65,12 @@ def profile(name, n):
     T = np.ascontiguousarray(forward_kinematics(robot, rng.uniform(lim[:, 0], lim[:, 1], (n, robot.dof))))
     outs = (np.empty((n, 8, 6)), np.empty((n, 8)), np.empty((n, 8)), np.empty((n, 8), dtype=bool),
             np.empty((n, 8), dtype=np.int8), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int8))
+    elbow, ur = (elbow_stages, elbow_checks, ROWS, RQA), (parallel_stages, parallel_checks, UR_ROWS, UR_RQ2)
     if kern[1][1] == "parallel":
-        runs = {"stages": lambda: _ur_stages(T, K, False), "+ checks": lambda: _ur_stages(T, K, True),
+        runs = {"stages": lambda: _stages(*ur, T, K, False), "+ checks": lambda: _stages(*ur, T, K, True),
                 "kernel": lambda: _kernel(ik_parallel_packed, T, K)}
     else:
-        runs = {"stages": lambda: _stages(T, K, False), "+ checks": lambda: _stages(T, K, True),
+        runs = {"stages": lambda: _stages(*elbow, T, K, False), "+ checks": lambda: _stages(*elbow, T, K, True),
                 "kernel": lambda: _kernel(ik_elbow_packed, T, K)}
     runs["batch entry"] = lambda: many(T, K, *outs)
     for f in runs.values():
